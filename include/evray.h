@@ -1,0 +1,114 @@
+/* evray: an event-camera (DVS) simulator driven by a ray tracer.
+ *
+ * The public C interface. A scene (evr_scene) is loaded from a file or generated; a simulation
+ * (evr_sim) renders it over time, every pixel sampling at its own times, and turns the sampled
+ * log intensity into a time-sorted stream of ON/OFF events written to the run folder.
+ *
+ * Conventions: every function that can fail returns an evr_status and fills an evr_error with
+ * one line saying why; no function prints or exits; every handle made by a *_new/_load has a
+ * matching *_release. */
+#ifndef EVRAY_H
+#define EVRAY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    EVR_OK = 0,
+    EVR_ERR_ARG,          /* a parameter value that makes no sense */
+    EVR_ERR_IO,           /* a file could not be read or written */
+    EVR_ERR_FORMAT,       /* a file was read but is not a usable scene or event file */
+    EVR_ERR_NOMEM,        /* out of memory */
+    EVR_ERR_BACKEND,      /* the ray tracer or device failed */
+    EVR_ERR_INTERRUPTED   /* stopped on request; outputs hold every finished segment */
+} evr_status;
+
+typedef struct { char msg[512]; } evr_error;
+
+/* One DVS event. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in microseconds. */
+typedef struct {
+    int64_t t;
+    uint16_t x, y;
+    int8_t p;
+} evr_event;
+
+/* ---- scenes ---- */
+typedef struct evr_scene evr_scene;
+
+/* Loads any format Assimp reads (glTF 2.0 .gltf/.glb first of all). */
+evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err);
+/* Loads from memory; hint is the file extension ("glb", "gltf", "obj", ...). */
+evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out, evr_error *err);
+/* Names of the built-in scenes, NULL-terminated. */
+const char *const *evr_demo_names(void);
+/* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
+evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err);
+/* Builds a built-in scene and loads it (through the same importer as any file). */
+evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err);
+void evr_scene_release(evr_scene *s);
+
+/* A human-readable description (cameras, lights, animations and time ranges, meshes, triangles);
+ * free the returned string with free(). */
+char *evr_scene_describe(const evr_scene *s);
+
+/* ---- simulation ---- */
+typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
+
+typedef struct {
+    /* image and time */
+    int width, height;            /* pixels */
+    double duration;              /* seconds; <= 0: the scene's animation length */
+    double start;                 /* seconds into the animation */
+    double fps;                   /* segments per second; <= 0: the scene's frame rate, else 30 */
+    int samples_per_frame;        /* samples per pixel per segment */
+    const char *camera;           /* camera name, NULL for the first */
+    /* pixel model */
+    float pos_thres, neg_thres;   /* contrast thresholds in log intensity */
+    float refractory;             /* seconds */
+    float log_floor;              /* intensity below which log response turns linear */
+    /* shading */
+    float ambient;                /* ambient fraction of the base colour */
+    uint64_t seed;
+    int threads;                  /* 0: all cores */
+    /* output */
+    const char *out_dir;
+    int formats;                  /* evr_format bits */
+    double preview_window;        /* seconds per preview frame; <= 0: no previews */
+    int force;                    /* overwrite an existing run folder */
+} evr_config;
+
+void evr_config_defaults(evr_config *c);
+/* Checks every value; fills err with the first problem. */
+evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_error *err);
+
+typedef struct {
+    uint64_t events_on, events_off, unique_timestamps;
+    uint64_t samples, rays;
+    double sim_time;              /* seconds simulated */
+    double wall_time;             /* seconds */
+    double samples_per_second, rays_per_second, realtime_factor;
+    int segments_done, segments_total;
+    int interrupted;
+} evr_stats;
+
+typedef struct evr_sim evr_sim;
+
+/* Called after every segment; return non-zero to stop after it. */
+typedef int (*evr_progress_fn)(void *user, const evr_stats *st);
+
+evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err);
+/* Runs to the end (or until progress asks to stop) and finalizes every output file. */
+evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err);
+const evr_stats *evr_sim_stats(const evr_sim *sim);
+void evr_sim_release(evr_sim *sim);
+
+const char *evr_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,35 @@
+/* One interface for every event output format. The simulation hands each segment's events,
+ * sorted by time, to every open writer; finish() completes the file (header counts, indices)
+ * and renames it from its temporary name; abort() removes the temporary file. */
+#ifndef EVR_IO_EVENT_WRITER_H
+#define EVR_IO_EVENT_WRITER_H
+
+#include <stddef.h>
+#include "evray.h"
+
+typedef struct evr_event_writer evr_event_writer;
+
+struct evr_event_writer {
+    /* Appends n events (sorted by t, and t not below any earlier call's). */
+    evr_status (*write)(evr_event_writer *w, const evr_event *ev, size_t n, evr_error *err);
+    /* Makes what has been written durable, so an interrupted run keeps it (called per segment). */
+    evr_status (*flush)(evr_event_writer *w, evr_error *err);
+    /* Completes the file; duration_us is the simulated time span (for indices such as ms_to_idx).
+     * Frees the writer whatever the result. */
+    evr_status (*finish)(evr_event_writer *w, int64_t duration_us, evr_error *err);
+    /* Removes the partial file and frees the writer. */
+    void (*abort)(evr_event_writer *w);
+};
+
+/* Metadata every writer may store: image size and the full configuration as JSON text. */
+typedef struct {
+    int width, height;
+    const char *config_json;
+} evr_writer_meta;
+
+/* path is the final name; writers write to path + ".tmp" until finish(). */
+evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
+evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
+evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
+
+#endif
