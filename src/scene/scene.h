@@ -18,6 +18,7 @@ typedef struct {
     float *uvs;         /* 2 per vertex, or NULL */
     uint32_t *indices;  /* 3 per triangle */
     int material;       /* index into scene materials */
+    evr_v3 bounds_min, bounds_max;  /* object-space bounds of the positions */
 } evr_mesh;
 
 typedef struct {
@@ -52,6 +53,8 @@ typedef struct {
     evr_m34 rest_matrix;          /* rest pose as a matrix (nodes given by a matrix keep it exactly) */
     int animated;                 /* any curve present */
     evr_curve t_curve, r_curve, s_curve;  /* num_keys == 0 when absent */
+    int has_bounds;               /* 1 when the node places meshes */
+    evr_v3 bounds_min, bounds_max;/* union of the object-space bounds of the meshes it places */
 } evr_node;
 
 typedef struct {
@@ -84,6 +87,8 @@ typedef struct {
 
 struct evr_scene {
     char source[512];
+    char format[32];              /* the Assimp importer that read it, e.g. "glTF2 Importer" */
+    int num_animations;           /* animation clips in the file; all play together from time 0 */
     int num_meshes, num_materials, num_textures, num_nodes, num_instances, num_lights, num_cameras;
     evr_mesh *meshes;
     evr_material *materials;
@@ -108,6 +113,9 @@ evr_m34 evr_node_world_at(const evr_scene *s, int node, double t);
  * Returns the number of keys written (1 for a node that does not move in the segment). */
 int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, float tol,
                          evr_motion_key *keys, int max_keys);
+
+/* Index of the camera whose name is `name`, or -1; NULL or "" gives 0 (the first camera). */
+int evr_scene_find_camera(const evr_scene *s, const char *name);
 
 /* Frees everything a scene owns. */
 void evr_scene_free_contents(evr_scene *s);

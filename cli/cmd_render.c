@@ -1,0 +1,182 @@
+#include "commands.h"
+#include "evray.h"
+#include "options.h"
+
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static volatile sig_atomic_t interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+typedef struct {
+    int show;
+    double duration;
+    double started;
+} progress_state;
+
+static double wall(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int on_progress(void *user, const evr_stats *st)
+{
+    progress_state *p = (progress_state *)user;
+    if (p->duration <= 0 && st->segments_done > 0)   /* the animation's length: known from the first segment */
+        p->duration = st->sim_time * st->segments_total / st->segments_done;
+    if (p->show) {
+        double frac = st->segments_total ? (double)st->segments_done / st->segments_total : 1.0;
+        double el = wall() - p->started;
+        double eta = frac > 0 ? el * (1.0 - frac) / frac : 0.0;
+        char bar[31];
+        int filled = (int)(frac * 30.0), i;
+        for (i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '-';
+        bar[30] = 0;
+        fprintf(stderr, "\r[%s] %6.3f/%.3f s  %llu events  %.1f Msamples/s  ETA %.0f s   ", bar,
+                st->sim_time, p->duration, (unsigned long long)(st->events_on + st->events_off),
+                st->samples_per_second / 1e6, eta);
+        fflush(stderr);
+    }
+    return interrupted ? 1 : 0;
+}
+
+static void help(void)
+{
+    puts("usage: evray render SCENE [options]\n"
+         "       evray [options]            (the built-in eye demo)\n"
+         "\n"
+         "Renders SCENE over time with every pixel sampling at its own times and writes the\n"
+         "time-sorted DVS events, previews and run.json into the run folder.\n"
+         "\n"
+         "output:\n"
+         "  -o, --out DIR              run folder (default ./evray-out)\n"
+         "  --force                    overwrite a non-empty run folder\n"
+         "  --format LIST              h5, txt, npy or all, comma-separated (default h5)\n"
+         "  --preview-window S         seconds per preview frame (default 0.05)\n"
+         "  --no-preview               no preview images\n"
+         "  -q, --quiet                no progress bar or summary\n"
+         "image and time:\n"
+         "  --res WxH                  resolution (default 346x260)\n"
+         "  --camera NAME              camera of the scene (default: the first)\n"
+         "  --duration S               seconds to simulate (default: the animation's length)\n"
+         "  --start S                  start time in the animation (default 0)\n"
+         "  --fps F                    segments per second (default: the scene's frame rate, else 30)\n"
+         "  --samples-per-frame N      samples per pixel per segment (default 10)\n"
+         "  --threads N                worker threads (default: all cores)\n"
+         "sensor:\n"
+         "  --pos-thres C, --neg-thres C   ON/OFF contrast thresholds in log intensity (default 0.2)\n"
+         "  --thres C                  both thresholds\n"
+         "  --refractory S             refractory period in seconds (default 0)\n"
+         "  --log-floor I              intensity below which the response is linear (default 0.02)\n"
+         "  --seed N                   seed of the per-pixel sample phases (default 1)\n"
+         "shading:\n"
+         "  --ambient A                ambient light as a fraction of the base colour (default 0.02)");
+}
+
+int cmd_render(int argc, char **argv, const char *default_demo)
+{
+    evr_config cfg;
+    const char *scene_path = NULL, *v;
+    int quiet = 0, i;
+    evr_config_defaults(&cfg);
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+#define VAL(name) if (!(v = opt_value(argc, argv, &i, name))) return 2
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); return 0; }
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
+        else if (!strcmp(a, "--force")) cfg.force = 1;
+        else if (!strcmp(a, "--no-preview")) cfg.preview_window = 0.0;
+        else if (!strcmp(a, "-o")) { VAL("-o"); cfg.out_dir = v; }
+        else if (opt_is(a, "--out")) { VAL("--out"); cfg.out_dir = v; }
+        else if (opt_is(a, "--format")) { VAL("--format"); if (!opt_formats(v, &cfg.formats)) return 2; }
+        else if (opt_is(a, "--preview-window")) { VAL("--preview-window"); if (!opt_double(a, v, &cfg.preview_window)) return 2; }
+        else if (opt_is(a, "--res")) { VAL("--res"); if (!opt_size("--res", v, &cfg.width, &cfg.height)) return 2; }
+        else if (opt_is(a, "--camera")) { VAL("--camera"); cfg.camera = v; }
+        else if (opt_is(a, "--duration")) { VAL("--duration"); if (!opt_double("--duration", v, &cfg.duration)) return 2;
+            if (cfg.duration <= 0) { cli_error("--duration must be a positive number of seconds (got %s)", v); return 2; } }
+        else if (opt_is(a, "--start")) { VAL("--start"); if (!opt_double("--start", v, &cfg.start)) return 2; }
+        else if (opt_is(a, "--fps")) { VAL("--fps"); if (!opt_double("--fps", v, &cfg.fps)) return 2;
+            if (cfg.fps <= 0) { cli_error("--fps must be a positive number (got %s)", v); return 2; } }
+        else if (opt_is(a, "--samples-per-frame")) { VAL("--samples-per-frame"); if (!opt_int("--samples-per-frame", v, &cfg.samples_per_frame)) return 2; }
+        else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return 2; }
+        else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return 2; }
+        else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return 2; }
+        else if (opt_is(a, "--thres")) { VAL("--thres"); if (!opt_float("--thres", v, &cfg.pos_thres)) return 2; cfg.neg_thres = cfg.pos_thres; }
+        else if (opt_is(a, "--refractory")) { VAL("--refractory"); if (!opt_float("--refractory", v, &cfg.refractory)) return 2; }
+        else if (opt_is(a, "--log-floor")) { VAL("--log-floor"); if (!opt_float("--log-floor", v, &cfg.log_floor)) return 2; }
+        else if (opt_is(a, "--ambient")) { VAL("--ambient"); if (!opt_float("--ambient", v, &cfg.ambient)) return 2; }
+        else if (opt_is(a, "--seed")) { VAL("--seed"); if (!opt_u64("--seed", v, &cfg.seed)) return 2; }
+        else if (a[0] == '-' && a[1]) { cli_error("unknown option '%s' (see evray render --help)", a); return 2; }
+        else if (!scene_path && !default_demo) scene_path = a;
+        else { cli_error("unexpected argument '%s'", a); return 2; }
+#undef VAL
+    }
+    if (!scene_path && !default_demo) {
+        cli_error("render needs a scene file (evray render SCENE [options]; evray demo for the built-in scene)");
+        return 2;
+    }
+
+    evr_error err = {{0}};
+    evr_scene *scene = NULL;
+    evr_status st = scene_path ? evr_scene_load(scene_path, &scene, &err) : evr_demo_load(default_demo, &scene, &err);
+    if (st != EVR_OK) {
+        cli_error("%s", err.msg);
+        return 1;
+    }
+    evr_sim *sim = NULL;
+    if ((st = evr_sim_new(scene, &cfg, &sim, &err)) != EVR_OK) {
+        cli_error("%s", err.msg);
+        evr_scene_release(scene);
+        return st == EVR_ERR_ARG ? 2 : 1;
+    }
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    progress_state ps;
+    ps.show = !quiet && isatty(2);
+    ps.started = wall();
+    ps.duration = 0;
+    const evr_stats *stats = evr_sim_stats(sim);
+    ps.duration = cfg.duration;
+    st = evr_sim_run(sim, on_progress, &ps, &err);
+    if (ps.show) fputc('\n', stderr);
+    int rc = 0;
+    if (st != EVR_OK && st != EVR_ERR_INTERRUPTED) {
+        cli_error("%s", err.msg);
+        rc = 1;
+    } else {
+        if (!quiet) {
+            unsigned long long ev = (unsigned long long)(stats->events_on + stats->events_off);
+            printf("%s: %llu events (%llu ON, %llu OFF), %llu unique timestamps, %.3f s simulated\n",
+                   cfg.out_dir, ev, (unsigned long long)stats->events_on, (unsigned long long)stats->events_off,
+                   (unsigned long long)stats->unique_timestamps, stats->sim_time);
+            printf("%llu samples, %llu rays in %.2f s: %.2f M samples/s, %.2f M rays/s, real-time factor %.4f\n",
+                   (unsigned long long)stats->samples, (unsigned long long)stats->rays, stats->wall_time,
+                   stats->samples_per_second / 1e6, stats->rays_per_second / 1e6, stats->realtime_factor);
+            if (ev == 0)
+                printf("no events: nothing in view changed brightness by a threshold over the simulated time "
+                       "(a static scene gives none; noise is off)\n");
+        }
+        if (st == EVR_ERR_INTERRUPTED) {
+            fprintf(stderr, "evray: interrupted: %s holds every event of the first %.3f s\n", cfg.out_dir, stats->sim_time);
+            rc = 130;
+        }
+    }
+    evr_sim_release(sim);
+    evr_scene_release(scene);
+    return rc;
+}

@@ -1,0 +1,42 @@
+/* evray: the command-line program. */
+#include "commands.h"
+#include "evray.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static void usage(FILE *f)
+{
+    fputs("usage: evray [COMMAND] [OPTIONS]\n"
+          "\n"
+          "Simulates an event camera (DVS) looking at an animated 3D scene, with a ray tracer.\n"
+          "With no command, renders the built-in eye demo into ./evray-out/.\n"
+          "\n"
+          "commands:\n"
+          "  render SCENE [options]   render a scene file (glTF 2.0 .glb/.gltf or any format Assimp reads)\n"
+          "  info SCENE               describe a scene: cameras, lights, animations, meshes, triangles\n"
+          "  demo [--scene NAME] ...  render a built-in scene, or export it with --export FILE.glb\n"
+          "\n"
+          "  evray COMMAND --help     options of a command\n"
+          "  evray --version          version of evray and its libraries\n", f);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) return cmd_render(argc, argv, "eye");
+    const char *c = argv[1];
+    if (!strcmp(c, "--help") || !strcmp(c, "-h") || !strcmp(c, "help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(c, "--version") || !strcmp(c, "-V")) {
+        printf("evray %s\n", evr_version());
+        return 0;
+    }
+    if (!strcmp(c, "render")) return cmd_render(argc - 1, argv + 1, NULL);
+    if (!strcmp(c, "info")) return cmd_info(argc - 1, argv + 1);
+    if (!strcmp(c, "demo")) return cmd_demo(argc - 1, argv + 1);
+    if (c[0] == '-') return cmd_render(argc, argv, "eye");   /* options for the default job */
+    fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
+    return 2;
+}

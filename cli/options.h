@@ -1,0 +1,23 @@
+/* Command-line parsing helpers: strict numbers, WxH sizes, one-line usage errors. */
+#ifndef EVR_CLI_OPTIONS_H
+#define EVR_CLI_OPTIONS_H
+
+#include "evray.h"
+
+/* Each returns 0 and prints "evray: error: ..." when the text is not a valid value. */
+int opt_double(const char *opt, const char *text, double *out);
+int opt_float(const char *opt, const char *text, float *out);
+int opt_int(const char *opt, const char *text, int *out);
+int opt_u64(const char *opt, const char *text, uint64_t *out);
+int opt_size(const char *opt, const char *text, int *w, int *h);
+int opt_formats(const char *text, int *formats);
+
+/* Splits "--name=value" or "--name value"; returns the value or NULL (after an error message)
+ * when it is missing. *i is advanced past a separate value. */
+const char *opt_value(int argc, char **argv, int *i, const char *name);
+/* 1 when argv[i] is --name or --name=... */
+int opt_is(const char *arg, const char *name);
+
+void cli_error(const char *fmt, ...);
+
+#endif

@@ -1,0 +1,106 @@
+/* Simulation parameters: defaults, checks, and the JSON form stored with every output. */
+#include "evray.h"
+#include "config_json.h"
+#include "io/json.h"
+#include "scene/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+void evr_config_defaults(evr_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->width = 346;               /* DAVIS346 */
+    c->height = 260;
+    c->duration = 0.0;
+    c->start = 0.0;
+    c->fps = 0.0;
+    c->samples_per_frame = 10;
+    c->camera = NULL;
+    c->pos_thres = 0.2f;
+    c->neg_thres = 0.2f;
+    c->refractory = 0.0f;
+    c->log_floor = 0.02f;
+    c->ambient = 0.02f;
+    c->seed = 1;
+    c->threads = 0;
+    c->out_dir = "evray-out";
+    c->formats = EVR_FORMAT_H5;
+    c->preview_window = 0.05;
+    c->force = 0;
+}
+
+#define BAD(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
+
+evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_error *err)
+{
+    if (c->width < 1 || c->height < 1 || c->width > 65535 || c->height > 65535)
+        BAD("resolution %dx%d is out of range (1 to 65535 pixels a side)", c->width, c->height);
+    if ((double)c->width * (double)c->height > 1e9) BAD("resolution %dx%d is too large", c->width, c->height);
+    if (c->samples_per_frame < 1 || c->samples_per_frame > 1000000)
+        BAD("samples per frame must be between 1 and 1000000 (got %d)", c->samples_per_frame);
+    if (!(c->pos_thres > 0.0f) || !isfinite(c->pos_thres)) BAD("ON threshold must be a positive number (got %g)", (double)c->pos_thres);
+    if (!(c->neg_thres > 0.0f) || !isfinite(c->neg_thres)) BAD("OFF threshold must be a positive number (got %g)", (double)c->neg_thres);
+    if (!(c->refractory >= 0.0f) || !isfinite(c->refractory)) BAD("refractory period must be >= 0 seconds (got %g)", (double)c->refractory);
+    if (!(c->log_floor > 0.0f) || !isfinite(c->log_floor)) BAD("log floor must be a positive intensity (got %g)", (double)c->log_floor);
+    if (!(c->ambient >= 0.0f) || !isfinite(c->ambient)) BAD("ambient must be >= 0 (got %g)", (double)c->ambient);
+    if (!isfinite(c->fps) || c->fps < 0.0 || c->fps > 1e6) BAD("fps must be a positive number of segments per second (got %g)", c->fps);
+    if (!isfinite(c->duration) || c->duration < 0.0) BAD("duration must be a positive number of seconds (got %g)", c->duration);
+    if (!isfinite(c->start) || c->start < 0.0) BAD("start time must be >= 0 seconds (got %g)", c->start);
+    if (c->preview_window < 0.0 || !isfinite(c->preview_window)) BAD("preview window must be >= 0 seconds (got %g)", c->preview_window);
+    if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
+    if (!c->out_dir || !c->out_dir[0]) BAD("no output folder given");
+    if (!c->formats || (c->formats & ~(EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY))) BAD("no valid output format selected");
+    if (s) {
+        if (c->camera && evr_scene_find_camera(s, c->camera) < 0) {
+            char names[256] = "";
+            size_t len = 0;
+            int i;
+            for (i = 0; i < s->num_cameras && len < 180; i++) {
+                if (s->cameras[i].automatic) continue;
+                len += (size_t)snprintf(names + len, sizeof names - len, "%s%.60s", len ? ", " : "", s->cameras[i].name);
+            }
+            BAD("no camera named '%s' in the scene (cameras: %s)", c->camera, names[0] ? names : "none");
+        }
+        double end = s->anim_end;
+        if (end > 0.0) {
+            if (c->start >= end) BAD("start time %g s is at or beyond the end of the animation (%g s)", c->start, end);
+            if (c->duration > 0.0 && c->start + c->duration > end + 1e-6)
+                BAD("duration %g s from %g s goes beyond the end of the animation (%g s)", c->duration, c->start, end);
+        }
+    }
+    return EVR_OK;
+}
+
+char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene, const char *camera, int pretty)
+{
+    evr_json j;
+    evr_json_init(&j, pretty);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "scene"); evr_json_string(&j, scene);
+    evr_json_key(&j, "camera"); evr_json_string(&j, camera);
+    evr_json_key(&j, "width"); evr_json_integer(&j, c->width);
+    evr_json_key(&j, "height"); evr_json_integer(&j, c->height);
+    evr_json_key(&j, "start"); evr_json_number(&j, c->start);
+    evr_json_key(&j, "duration"); evr_json_number(&j, duration);
+    evr_json_key(&j, "fps"); evr_json_number(&j, fps);
+    evr_json_key(&j, "samples_per_frame"); evr_json_integer(&j, c->samples_per_frame);
+    evr_json_key(&j, "sampling"); evr_json_string(&j, "uniform, per-pixel phase");
+    evr_json_key(&j, "pos_thres"); evr_json_float(&j, c->pos_thres);
+    evr_json_key(&j, "neg_thres"); evr_json_float(&j, c->neg_thres);
+    evr_json_key(&j, "refractory"); evr_json_float(&j, c->refractory);
+    evr_json_key(&j, "log_floor"); evr_json_float(&j, c->log_floor);
+    evr_json_key(&j, "ambient"); evr_json_float(&j, c->ambient);
+    evr_json_key(&j, "seed"); evr_json_unsigned(&j, c->seed);
+    evr_json_key(&j, "backend"); evr_json_string(&j, "cpu");
+    evr_json_key(&j, "gi"); evr_json_string(&j, "none");
+    evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);
+    evr_json_key(&j, "formats"); evr_json_begin_array(&j);
+    if (c->formats & EVR_FORMAT_H5) evr_json_string(&j, "h5");
+    if (c->formats & EVR_FORMAT_TXT) evr_json_string(&j, "txt");
+    if (c->formats & EVR_FORMAT_NPY) evr_json_string(&j, "npy");
+    evr_json_end_array(&j);
+    evr_json_end_object(&j);
+    return evr_json_take(&j);
+}

@@ -1,0 +1,142 @@
+/* Surface description at a hit, lights, and the radiance the sensor sees. Monochrome sensor:
+ * the result is the Rec. 709 luminance of linear RGB, never clamped. */
+#ifndef EVR_CORE_SHADING_H
+#define EVR_CORE_SHADING_H
+
+#include "core/render_scene.h"
+
+#define EVR_PI 3.14159265358979f
+
+EVR_HD static inline float evr_srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+EVR_HD static inline float evr_linear_to_srgb(float c)
+{
+    return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
+}
+EVR_HD static inline float evr_luminance(float r, float g, float b)
+{
+    return 0.2126f * r + 0.7152f * g + 0.0722f * b;
+}
+
+/* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
+EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v, float out[4])
+{
+    float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    float ax = x - fx, ay = y - fy;
+    int x0 = (int)fx % t->width, y0 = (int)fy % t->height;
+    if (x0 < 0) x0 += t->width;
+    if (y0 < 0) y0 += t->height;
+    int x1 = (x0 + 1) % t->width, y1 = (y0 + 1) % t->height;
+    const float *p00 = t->rgba + 4 * ((long)y0 * t->width + x0), *p10 = t->rgba + 4 * ((long)y0 * t->width + x1);
+    const float *p01 = t->rgba + 4 * ((long)y1 * t->width + x0), *p11 = t->rgba + 4 * ((long)y1 * t->width + x1);
+    int c;
+    for (c = 0; c < 4; c++)
+        out[c] = (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
+}
+
+typedef struct {
+    evr_v3 p;          /* world position */
+    evr_v3 n;          /* world shading normal, facing the incoming ray */
+    float albedo[3];
+    float emissive[3];
+} evr_surface;
+
+/* Fills the surface at barycentrics (u, v) of triangle prim of instance inst, whose transform at
+ * the ray's time is xf; ray_dir is the incoming direction, t_hit the distance along it. */
+EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim, float u, float v,
+                                         const evr_m34 *xf, evr_ray ray, float t_hit, evr_surface *s)
+{
+    const evr_mesh_view *m = &rs->meshes[rs->instances[inst].mesh];
+    const evr_material_view *mat = &rs->materials[m->material];
+    uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1], i2 = m->indices[3 * prim + 2];
+    float w = 1.0f - u - v;
+    evr_v3 n0 = evr_v3_make(m->normals[3 * i0], m->normals[3 * i0 + 1], m->normals[3 * i0 + 2]);
+    evr_v3 n1 = evr_v3_make(m->normals[3 * i1], m->normals[3 * i1 + 1], m->normals[3 * i1 + 2]);
+    evr_v3 n2 = evr_v3_make(m->normals[3 * i2], m->normals[3 * i2 + 1], m->normals[3 * i2 + 2]);
+    evr_v3 n = evr_v3_add(evr_v3_add(evr_v3_scale(n0, w), evr_v3_scale(n1, u)), evr_v3_scale(n2, v));
+    n = evr_m34_normal(xf, n);
+    if (evr_v3_dot(n, ray.dir) > 0.0f) n = evr_v3_scale(n, -1.0f);   /* two-sided */
+    s->n = n;
+    s->p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
+    s->albedo[0] = mat->base_color[0];
+    s->albedo[1] = mat->base_color[1];
+    s->albedo[2] = mat->base_color[2];
+    if (mat->base_texture >= 0 && m->uvs) {
+        float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
+        float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
+        float tex[4];
+        evr_texture_bilinear(&rs->textures[mat->base_texture], tu, tv, tex);
+        s->albedo[0] *= tex[0];
+        s->albedo[1] *= tex[1];
+        s->albedo[2] *= tex[2];
+    }
+    s->emissive[0] = mat->emissive[0];
+    s->emissive[1] = mat->emissive[1];
+    s->emissive[2] = mat->emissive[2];
+}
+
+/* Light arriving at p from light l at normalized segment time f: direction towards the light,
+ * distance to it (for the shadow ray; huge for directional) and irradiance on a surface facing
+ * it. Returns 0 when no light arrives (outside a spot cone, zero power). */
+EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const evr_light_view *l, float f,
+                                            evr_v3 p, evr_v3 *wi, float *dist, float e_rgb[3])
+{
+    evr_v3 lp = l->pos, ld = l->dir;
+    float scale = 1.0f;
+    if (l->track >= 0) {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, l->track), f);
+        lp = evr_m34_point(&xf, lp);
+        ld = evr_v3_norm(evr_m34_vector(&xf, ld));
+    }
+    if (l->type == 2) {   /* directional */
+        *wi = evr_v3_scale(ld, -1.0f);
+        *dist = 1e30f;
+    } else {
+        evr_v3 d = evr_v3_sub(lp, p);
+        float d2 = evr_v3_dot(d, d);
+        if (d2 <= 0.0f) return 0;
+        *dist = sqrtf(d2);
+        *wi = evr_v3_scale(d, 1.0f / *dist);
+        scale = 1.0f / d2;
+        if (l->type == 1) {   /* spot: glTF's recommended smooth falloff */
+            float cd = -evr_v3_dot(*wi, ld);
+            float a = (cd - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f);
+            a = fminf(fmaxf(a, 0.0f), 1.0f);
+            scale *= a * a;
+        }
+    }
+    e_rgb[0] = l->color[0] * scale;
+    e_rgb[1] = l->color[1] * scale;
+    e_rgb[2] = l->color[2] * scale;
+    return scale > 0.0f && (e_rgb[0] > 0.0f || e_rgb[1] > 0.0f || e_rgb[2] > 0.0f);
+}
+
+/* Adds an unshadowed light's Lambertian contribution (irradiance times cosine) to acc. */
+EVR_HD static inline void evr_accumulate_lambert(const evr_surface *s, evr_v3 wi, const float e_rgb[3], float acc[3])
+{
+    float c = evr_v3_dot(s->n, wi);
+    if (c <= 0.0f) return;
+    acc[0] += e_rgb[0] * c;
+    acc[1] += e_rgb[1] * c;
+    acc[2] += e_rgb[2] * c;
+}
+
+/* Sensor intensity: luminance of albedo * (ambient + E/pi) + emissive. */
+EVR_HD static inline float evr_surface_intensity(const evr_surface *s, const float acc[3], float ambient)
+{
+    float r = s->albedo[0] * (ambient + acc[0] / EVR_PI) + s->emissive[0];
+    float g = s->albedo[1] * (ambient + acc[1] / EVR_PI) + s->emissive[1];
+    float b = s->albedo[2] * (ambient + acc[2] / EVR_PI) + s->emissive[2];
+    return evr_luminance(r, g, b);
+}
+
+/* Shadow ray start: the hit point pushed off the surface along the normal. */
+EVR_HD static inline evr_v3 evr_offset_point(const evr_surface *s, float eps)
+{
+    return evr_v3_add(s->p, evr_v3_scale(s->n, eps));
+}
+
+#endif

@@ -1,0 +1,355 @@
+/* CPU backend: Embree finds the triangles; motion-blurred instances carry each node's segment
+ * keys as quaternion-decomposition time steps; tiles of pixels are spread over threads. */
+#include "backend.h"
+#include "core/rng.h"
+#include "core/shading.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define TILE 16
+
+typedef struct {
+    evr_backend base;
+    const evr_scene *scene;
+    evr_render_host host;          /* copy of the views; keys are set per segment */
+    evr_run_setup setup;
+    RTCDevice device;
+    RTCScene *mesh_scenes;
+    RTCScene top;
+    evr_pixel_state *pixels;
+    float *phase;                  /* per-pixel sample-time offset in [0, 1) */
+    int tiles_x, tiles_y;
+    evr_event_vec *tile_events;
+    char embree_error[256];
+    /* per-segment work */
+    const evr_segment *seg;
+    atomic_int next_tile;
+    atomic_ullong samples, rays;
+    atomic_int failed;
+} cpu_backend;
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    cpu_backend *b = (cpu_backend *)user;
+    if (!b->embree_error[0]) snprintf(b->embree_error, sizeof b->embree_error, "Embree error %d: %s", (int)code, str ? str : "");
+}
+
+static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
+{
+    rtcInitQuaternionDecomposition(q);
+    q->scale_x = k->scale[0];
+    q->scale_y = k->scale[1];
+    q->scale_z = k->scale[2];
+    q->skew_xy = k->skew[0];
+    q->skew_xz = k->skew[1];
+    q->skew_yz = k->skew[2];
+    q->quaternion_r = k->rot.w;
+    q->quaternion_i = k->rot.x;
+    q->quaternion_j = k->rot.y;
+    q->quaternion_k = k->rot.z;
+    q->translation_x = k->trans.x;
+    q->translation_y = k->trans.y;
+    q->translation_z = k->trans.z;
+}
+
+static int occluded(RTCScene top, evr_v3 org, evr_v3 dir, float tfar, float time)
+{
+    struct RTCIntersectContext ctx;
+    struct RTCRay r;
+    rtcInitIntersectContext(&ctx);
+    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
+    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
+    r.tnear = 0.0f;
+    r.tfar = tfar;
+    r.time = time;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(top, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+/* Intensity seen by one sample at normalized segment time f; counts the rays it traces. */
+static float sample_intensity(const evr_render_scene *rs, RTCScene top, const evr_m34 *pose, int x, int y,
+                              float f, unsigned long long *rays)
+{
+    evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
+    struct RTCIntersectContext ctx;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&ctx);
+    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = INFINITY;
+    rh.ray.time = f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(top, &ctx, &rh);
+    (*rays)++;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0.0f;   /* nothing: black */
+
+    int inst = (int)rh.hit.instID[0];
+    evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), f);
+    evr_surface s;
+    evr_surface_at(rs, inst, rh.hit.primID, rh.hit.u, rh.hit.v, &xf, ray, rh.ray.tfar, &s);
+    float acc[3] = {0.0f, 0.0f, 0.0f};
+    evr_v3 org = evr_offset_point(&s, rs->ray_eps);
+    int l;
+    for (l = 0; l < rs->num_lights; l++) {
+        evr_v3 wi;
+        float dist, e[3];
+        if (!evr_light_incident(rs, &rs->lights[l], f, s.p, &wi, &dist, e)) continue;
+        if (evr_v3_dot(wi, s.n) <= 0.0f) continue;
+        (*rays)++;
+        if (occluded(top, org, wi, dist * (1.0f - 1e-4f), f)) continue;
+        evr_accumulate_lambert(&s, wi, e, acc);
+    }
+    return evr_surface_intensity(&s, acc, rs->ambient);
+}
+
+static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    const evr_segment *seg = b->seg;
+    const int w = b->setup.width, h = b->setup.height, n = b->setup.samples_per_frame;
+    const float dt = (float)(seg->t1 - seg->t0);
+    int tx = tile % b->tiles_x, ty = tile / b->tiles_x;
+    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w, y1 = y0 + TILE < h ? y0 + TILE : h;
+    evr_event_vec *out = &b->tile_events[tile];
+    evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
+    int x, y, k;
+    out->n = 0;
+    for (y = y0; y < y1; y++) {
+        for (x = x0; x < x1; x++) {
+            evr_pixel_state *st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
+            float phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
+            for (k = 0; k < n; k++) {
+                float f = ((float)k + phi) / (float)n;
+                evr_m34 pose = seg->camera_static ? pose_static : evr_rs_camera_pose(rs, f);
+                float intensity = sample_intensity(rs, b->top, &pose, x, y, f, rays);
+                evr_pixel_span sp;
+                float te;
+                int pol;
+                if (!evr_pixel_begin(st, &b->setup.pixel, f * dt, intensity, &sp)) continue;
+                while (evr_pixel_next(st, &b->setup.pixel, &sp, &te, &pol)) {
+                    evr_event e;
+                    e.t = llround((seg->t0 + (double)te) * 1e6);
+                    e.x = (uint16_t)x;
+                    e.y = (uint16_t)y;
+                    e.p = (int8_t)pol;
+                    if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+                }
+                evr_pixel_end(st, &sp);
+            }
+            evr_pixel_end_segment(st, dt);
+        }
+    }
+    *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
+}
+
+static void *worker(void *arg)
+{
+    cpu_backend *b = (cpu_backend *)arg;
+    unsigned long long samples = 0, rays = 0;
+    int ntiles = b->tiles_x * b->tiles_y, t;
+    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) render_tile(b, t, &samples, &rays);
+    atomic_fetch_add(&b->samples, samples);
+    atomic_fetch_add(&b->rays, rays);
+    return NULL;
+}
+
+static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_error *err)
+{
+    int i, k;
+    for (i = 0; i < b->host.rs.num_instances; i++) {
+        int track = b->host.rs.instances[i].track;
+        int n = seg->track_count[track];
+        RTCGeometry g = rtcGetGeometry(b->top, (unsigned)i);
+        rtcSetGeometryTimeStepCount(g, (unsigned)n);
+        for (k = 0; k < n; k++) {
+            struct RTCQuaternionDecomposition q;
+            to_embree(&seg->keys[seg->track_offset[track] + k], &q);
+            rtcSetGeometryTransformQuaternion(g, (unsigned)k, &q);
+        }
+        rtcCommitGeometry(g);
+    }
+    rtcCommitScene(b->top);
+    if (b->embree_error[0]) {
+        snprintf(err->msg, sizeof err->msg, "%s", b->embree_error);
+        return EVR_ERR_BACKEND;
+    }
+    return EVR_OK;
+}
+
+static evr_status cpu_render(evr_backend *base, const evr_segment *seg, evr_event_vec *out, evr_error *err)
+{
+    cpu_backend *b = (cpu_backend *)base;
+    evr_status st;
+    int nthreads = b->setup.threads, i, ntiles = b->tiles_x * b->tiles_y;
+    b->host.rs.keys = seg->keys;
+    b->host.rs.track_offset = seg->track_offset;
+    b->host.rs.track_count = seg->track_count;
+    if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
+    b->seg = seg;
+    atomic_store(&b->next_tile, 0);
+    atomic_store(&b->samples, 0);
+    atomic_store(&b->rays, 0);
+    atomic_store(&b->failed, 0);
+    pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
+    if (!th) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    int started = 0;
+    for (i = 1; i < nthreads; i++) {
+        if (pthread_create(&th[i], NULL, worker, b) != 0) break;
+        started++;
+    }
+    worker(b);   /* the calling thread works too */
+    for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
+    free(th);
+    base->samples += atomic_load(&b->samples);
+    base->rays += atomic_load(&b->rays);
+    if (atomic_load(&b->failed)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    if (b->embree_error[0]) {
+        snprintf(err->msg, sizeof err->msg, "%s", b->embree_error);
+        return EVR_ERR_BACKEND;
+    }
+    for (i = 0; i < ntiles; i++) {   /* tile order: deterministic whatever the thread count */
+        if (!evr_event_vec_append(out, b->tile_events[i].data, b->tile_events[i].n)) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for events");
+            return EVR_ERR_NOMEM;
+        }
+    }
+    return EVR_OK;
+}
+
+static void cpu_intensity(evr_backend *base, float *out)
+{
+    cpu_backend *b = (cpu_backend *)base;
+    size_t i, n = (size_t)b->setup.width * (size_t)b->setup.height;
+    for (i = 0; i < n; i++) out[i] = b->pixels[i].intensity;
+}
+
+static void cpu_release(evr_backend *base)
+{
+    cpu_backend *b = (cpu_backend *)base;
+    int i;
+    if (!b) return;
+    if (b->top) rtcReleaseScene(b->top);
+    if (b->mesh_scenes) {
+        for (i = 0; i < b->scene->num_meshes; i++)
+            if (b->mesh_scenes[i]) rtcReleaseScene(b->mesh_scenes[i]);
+    }
+    free(b->mesh_scenes);
+    if (b->device) rtcReleaseDevice(b->device);
+    if (b->tile_events) {
+        for (i = 0; i < b->tiles_x * b->tiles_y; i++) evr_event_vec_free(&b->tile_events[i]);
+    }
+    free(b->tile_events);
+    free(b->pixels);
+    free(b->phase);
+    free(b);
+}
+
+static RTCScene build_mesh_scene(RTCDevice dev, const evr_mesh *m)
+{
+    RTCScene sc = rtcNewScene(dev);
+    if (!sc) return NULL;
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) {
+        rtcReleaseScene(sc);
+        return NULL;
+    }
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+    if (vb && ib) {
+        memcpy(vb, m->positions, sizeof(float) * 3 * m->num_vertices);
+        memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc, g, 0);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(sc);
+    return sc;
+}
+
+evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
+                               evr_backend **out, evr_error *err)
+{
+    cpu_backend *b = calloc(1, sizeof *b);
+    size_t npix = (size_t)setup->width * (size_t)setup->height, i;
+    int m, x, y;
+    if (!b) goto nomem;
+    b->base.name = "cpu";
+    b->base.render = cpu_render;
+    b->base.intensity = cpu_intensity;
+    b->base.release = cpu_release;
+    b->scene = s;
+    b->host = *h;
+    b->setup = *setup;
+    if (b->setup.threads <= 0) {
+        long nc = sysconf(_SC_NPROCESSORS_ONLN);
+        b->setup.threads = nc > 0 ? (int)nc : 1;
+    }
+    b->tiles_x = (setup->width + TILE - 1) / TILE;
+    b->tiles_y = (setup->height + TILE - 1) / TILE;
+    b->pixels = malloc(npix * sizeof *b->pixels);
+    b->phase = malloc(npix * sizeof *b->phase);
+    b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
+    b->mesh_scenes = calloc((size_t)s->num_meshes + 1, sizeof *b->mesh_scenes);
+    if (!b->pixels || !b->phase || !b->tile_events || !b->mesh_scenes) goto nomem;
+    for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
+    for (y = 0; y < setup->height; y++)
+        for (x = 0; x < setup->width; x++)
+            b->phase[(size_t)y * (size_t)setup->width + (size_t)x] = evr_pixel_phase(setup->seed, x, y);
+
+    b->device = rtcNewDevice(NULL);
+    if (!b->device) {
+        snprintf(err->msg, sizeof err->msg, "cannot create the Embree device (error %d)", (int)rtcGetDeviceError(NULL));
+        cpu_release(&b->base);
+        return EVR_ERR_BACKEND;
+    }
+    rtcSetDeviceErrorFunction(b->device, embree_error, b);
+    for (m = 0; m < s->num_meshes; m++) {
+        b->mesh_scenes[m] = build_mesh_scene(b->device, &s->meshes[m]);
+        if (!b->mesh_scenes[m] || b->embree_error[0]) goto embree_fail;
+    }
+    b->top = rtcNewScene(b->device);
+    if (!b->top) goto embree_fail;
+    rtcSetSceneFlags(b->top, RTC_SCENE_FLAG_DYNAMIC);
+    rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_LOW);
+    for (i = 0; i < (size_t)s->num_instances; i++) {
+        RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (!g) goto embree_fail;
+        rtcSetGeometryInstancedScene(g, b->mesh_scenes[s->instances[i].mesh]);
+        rtcAttachGeometryByID(b->top, g, (unsigned)i);
+        rtcReleaseGeometry(g);
+    }
+    if (b->embree_error[0]) goto embree_fail;
+    *out = &b->base;
+    return EVR_OK;
+embree_fail:
+    snprintf(err->msg, sizeof err->msg, "%s", b->embree_error[0] ? b->embree_error : "Embree failed to build the scene");
+    cpu_release(&b->base);
+    return EVR_ERR_BACKEND;
+nomem:
+    snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d image", setup->width, setup->height);
+    cpu_release(b ? &b->base : NULL);
+    return EVR_ERR_NOMEM;
+}

@@ -1,0 +1,88 @@
+#include "events.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+int evr_event_vec_reserve(evr_event_vec *v, size_t extra)
+{
+    if (v->n + extra <= v->cap) return 1;
+    size_t cap = v->cap ? v->cap : 1024;
+    while (cap < v->n + extra) cap *= 2;
+    evr_event *p = realloc(v->data, cap * sizeof *p);
+    if (!p) return 0;
+    v->data = p;
+    v->cap = cap;
+    return 1;
+}
+
+int evr_event_vec_append(evr_event_vec *v, const evr_event *e, size_t n)
+{
+    if (!n) return 1;
+    if (!evr_event_vec_reserve(v, n)) return 0;
+    memcpy(v->data + v->n, e, n * sizeof *e);
+    v->n += n;
+    return 1;
+}
+
+void evr_event_vec_free(evr_event_vec *v)
+{
+    free(v->data);
+    v->data = NULL;
+    v->n = v->cap = 0;
+}
+
+/* LSD radix sort on 16-bit digits of the key (t - t_min, y, x); passes whose digit is the same for
+ * every event are skipped, so a segment typically needs four or five passes. */
+int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
+{
+    size_t n = v->n, i;
+    if (n < 2) return 1;
+    int64_t tmin = v->data[0].t, tmax = v->data[0].t;
+    for (i = 1; i < n; i++) {
+        if (v->data[i].t < tmin) tmin = v->data[i].t;
+        if (v->data[i].t > tmax) tmax = v->data[i].t;
+    }
+    uint64_t span = (uint64_t)(tmax - tmin);
+    int tdigits = 0;
+    while (span >> (16 * tdigits)) tdigits++;
+    scratch->n = 0;
+    if (!evr_event_vec_reserve(scratch, n)) return 0;
+    size_t *count = malloc(65536 * sizeof *count);
+    if (!count) return 0;
+    evr_event *src = v->data, *dst = scratch->data;
+    int pass;
+    for (pass = 0; pass < 2 + tdigits; pass++) {
+        memset(count, 0, 65536 * sizeof *count);
+        for (i = 0; i < n; i++) {
+            unsigned d = pass == 0 ? src[i].x : pass == 1 ? src[i].y
+                       : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
+            count[d]++;
+        }
+        size_t sum = 0, d;
+        int trivial = 0;
+        for (d = 0; d < 65536; d++) {
+            size_t c = count[d];
+            if (c == n) trivial = 1;
+            count[d] = sum;
+            sum += c;
+        }
+        if (trivial) continue;
+        for (i = 0; i < n; i++) {
+            unsigned dg = pass == 0 ? src[i].x : pass == 1 ? src[i].y
+                        : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
+            dst[count[dg]++] = src[i];
+        }
+        evr_event *tmp = src; src = dst; dst = tmp;
+    }
+    free(count);
+    if (src != v->data) {   /* result sits in scratch: swap the buffers */
+        evr_event *d = v->data;
+        size_t c = v->cap;
+        v->data = scratch->data;
+        v->cap = scratch->cap;
+        scratch->data = d;
+        scratch->cap = c;
+    }
+    scratch->n = 0;
+    return 1;
+}

@@ -1,0 +1,28 @@
+/* Growable event arrays and the stable time sort every backend's output goes through. */
+#ifndef EVR_EVENTS_H
+#define EVR_EVENTS_H
+
+#include <stddef.h>
+#include "evray.h"
+
+typedef struct {
+    evr_event *data;
+    size_t n, cap;
+} evr_event_vec;
+
+/* Makes room for at least extra more events; returns 0 when out of memory. */
+int evr_event_vec_reserve(evr_event_vec *v, size_t extra);
+static inline int evr_event_vec_push(evr_event_vec *v, evr_event e)
+{
+    if (v->n == v->cap && !evr_event_vec_reserve(v, 1)) return 0;
+    v->data[v->n++] = e;
+    return 1;
+}
+int evr_event_vec_append(evr_event_vec *v, const evr_event *e, size_t n);
+void evr_event_vec_free(evr_event_vec *v);
+
+/* Sorts by (t, y, x), stable, so equal keys keep their input order (deterministic when the input
+ * order is). scratch is grown as needed and may be reused between calls. */
+int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch);
+
+#endif

@@ -1,0 +1,368 @@
+/* HDF5 event files in the layout of the DSEC data sets:
+ *
+ *   /events/x  uint16   /events/y  uint16   /events/t  int64 (us)   /events/p  int8 (1 ON, 0 OFF)
+ *   /ms_to_idx uint64   index of the first event with t >= i ms, i = 0 .. ceil(duration/1 ms)
+ *   /t_offset  int64    0 (our timestamps start at the simulation start)
+ *   attributes on /: width, height (int32), config (JSON text), complete (int8, 1 once finished)
+ *
+ * The event datasets and ms_to_idx are extendible and chunked (shuffle + deflate). Events are
+ * buffered and appended in large blocks; flush() appends what is buffered and flushes the file,
+ * so the temporary file of an interrupted run is readable up to the last flush. HDF5's automatic
+ * error printing is switched off around every call (H5E_BEGIN_TRY) and its error stack is turned
+ * into the message instead. */
+#include "io/event_writer.h"
+
+#include <hdf5.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define H5W_BUFFER (1u << 16)    /* events per block appended to the datasets */
+#define H5W_CHUNK (1u << 16)     /* elements per chunk */
+#define H5W_MS_CHUNK 4096u
+#define H5W_DEFLATE 3
+
+typedef struct {
+    evr_event_writer base;       /* first: the interface pointer is the writer pointer */
+    char *path, *tmp;
+    hid_t file, group;
+    hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
+    /* buffered events, column by column */
+    uint16_t *bx, *by;
+    int64_t *bt;
+    int8_t *bp;
+    size_t nbuf;
+    uint64_t written;            /* events in the datasets */
+    uint64_t total;              /* events received (written + buffered) */
+    int64_t last_t;
+    int have_last;
+    /* ms_to_idx entries computed but not yet appended */
+    uint64_t *ms;
+    size_t nms, cap_ms;
+    uint64_t ms_written;         /* entries in the dataset */
+    uint64_t next_ms;            /* index of the next entry to compute */
+} h5_writer;
+
+/* Collects the innermost HDF5 error description (the stack is walked from the API call down). */
+typedef struct { char desc[200]; int got; } h5_walk_data;
+
+static herr_t h5_walk(unsigned n, const H5E_error2_t *e, void *data)
+{
+    h5_walk_data *d = (h5_walk_data *)data;
+    (void)n;
+    if (e->desc && e->desc[0]) {
+        snprintf(d->desc, sizeof d->desc, "%s", e->desc);
+        d->got = 1;
+    }
+    return 0;
+}
+
+static evr_status h5_fail(evr_error *err, const char *what, const char *path)
+{
+    h5_walk_data d;
+    d.desc[0] = 0;
+    d.got = 0;
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, &d);
+    H5Eclear2(H5E_DEFAULT);
+    if (d.got) snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, d.desc);
+    else snprintf(err->msg, sizeof err->msg, "hdf5: %s %s", what, path);
+    return EVR_ERR_IO;
+}
+
+static hid_t make_extendible(hid_t loc, const char *name, hid_t type, hsize_t chunk)
+{
+    hsize_t dims[1] = {0}, maxdims[1] = {H5S_UNLIMITED}, ch[1] = {chunk};
+    hid_t space = H5Screate_simple(1, dims, maxdims);
+    hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+    hid_t ds = -1;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, 1, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
+        H5Pset_deflate(dcpl, H5W_DEFLATE) >= 0)
+        ds = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (dcpl >= 0) H5Pclose(dcpl);
+    if (space >= 0) H5Sclose(space);
+    return ds;
+}
+
+/* Appends n elements of memory type mtype to the 1-D dataset ds that holds old elements. */
+static herr_t append(hid_t ds, hid_t mtype, const void *data, uint64_t old, size_t n)
+{
+    hsize_t size[1] = {(hsize_t)(old + n)}, start[1] = {(hsize_t)old}, count[1] = {(hsize_t)n};
+    hid_t fspace = -1, mspace = -1;
+    herr_t r = -1;
+    if (n == 0) return 0;
+    if (H5Dset_extent(ds, size) < 0) return -1;
+    fspace = H5Dget_space(ds);
+    mspace = H5Screate_simple(1, count, NULL);
+    if (fspace >= 0 && mspace >= 0 && H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, count, NULL) >= 0)
+        r = H5Dwrite(ds, mtype, mspace, fspace, H5P_DEFAULT, data);
+    if (mspace >= 0) H5Sclose(mspace);
+    if (fspace >= 0) H5Sclose(fspace);
+    return r;
+}
+
+static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, const void *value)
+{
+    hid_t space = H5Screate(H5S_SCALAR), a = -1;
+    herr_t r = -1;
+    if (space >= 0) {
+        if (H5Aexists(loc, name) > 0) a = H5Aopen(loc, name, H5P_DEFAULT);
+        else a = H5Acreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT);
+    }
+    if (a >= 0) r = H5Awrite(a, mtype, value);
+    if (a >= 0) H5Aclose(a);
+    if (space >= 0) H5Sclose(space);
+    return r;
+}
+
+static herr_t write_string_attr(hid_t loc, const char *name, const char *text)
+{
+    hid_t type = H5Tcopy(H5T_C_S1);
+    herr_t r = -1;
+    if (type >= 0 && H5Tset_size(type, H5T_VARIABLE) >= 0 && H5Tset_cset(type, H5T_CSET_UTF8) >= 0)
+        r = write_scalar_attr(loc, name, type, type, &text);
+    if (type >= 0) H5Tclose(type);
+    return r;
+}
+
+static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid_t mtype, const void *value)
+{
+    hid_t space = H5Screate(H5S_SCALAR), ds = -1;
+    herr_t r = -1;
+    if (space >= 0) ds = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (ds >= 0) r = H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, value);
+    if (ds >= 0) H5Dclose(ds);
+    if (space >= 0) H5Sclose(space);
+    return r;
+}
+
+static void close_all(h5_writer *w)
+{
+    hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms};
+    H5E_BEGIN_TRY {
+        for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
+            if (*ids[i] >= 0) { H5Dclose(*ids[i]); *ids[i] = -1; }
+        if (w->group >= 0) { H5Gclose(w->group); w->group = -1; }
+        if (w->file >= 0) { H5Fclose(w->file); w->file = -1; }
+        H5Eclear2(H5E_DEFAULT);
+    } H5E_END_TRY;
+}
+
+static void free_writer(h5_writer *w)
+{
+    free(w->path);
+    free(w->tmp);
+    free(w->bx);
+    free(w->by);
+    free(w->bt);
+    free(w->bp);
+    free(w->ms);
+    free(w);
+}
+
+static int push_ms(h5_writer *w, uint64_t value)
+{
+    if (w->nms == w->cap_ms) {
+        size_t cap = w->cap_ms ? w->cap_ms * 2 : 1024;
+        uint64_t *p = realloc(w->ms, cap * sizeof *p);
+        if (!p) return 0;
+        w->ms = p;
+        w->cap_ms = cap;
+    }
+    w->ms[w->nms++] = value;
+    w->next_ms++;
+    return 1;
+}
+
+/* Appends the buffered events and ms_to_idx entries to the datasets. */
+static evr_status drain(h5_writer *w, evr_error *err)
+{
+    herr_t r = 0;
+    H5E_BEGIN_TRY {
+        if (w->nbuf) {
+            if (append(w->ds_x, H5T_NATIVE_UINT16, w->bx, w->written, w->nbuf) < 0 ||
+                append(w->ds_y, H5T_NATIVE_UINT16, w->by, w->written, w->nbuf) < 0 ||
+                append(w->ds_t, H5T_NATIVE_INT64, w->bt, w->written, w->nbuf) < 0 ||
+                append(w->ds_p, H5T_NATIVE_INT8, w->bp, w->written, w->nbuf) < 0)
+                r = -1;
+        }
+        if (r >= 0 && w->nms && append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, w->nms) < 0)
+            r = -1;
+    } H5E_END_TRY;
+    if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
+    w->written += w->nbuf;
+    w->nbuf = 0;
+    w->ms_written += w->nms;
+    w->nms = 0;
+    return EVR_OK;
+}
+
+static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
+{
+    h5_writer *w = (h5_writer *)base;
+    for (size_t i = 0; i < n; i++) {
+        const evr_event *e = &ev[i];
+        if (w->have_last && e->t < w->last_t) {
+            snprintf(err->msg, sizeof err->msg, "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
+                     e->t, w->last_t);
+            return EVR_ERR_ARG;
+        }
+        w->last_t = e->t;
+        w->have_last = 1;
+        /* every millisecond boundary up to this event starts here */
+        while (e->t >= 0 && (int64_t)w->next_ms <= e->t / 1000)
+            if (!push_ms(w, w->total)) goto nomem;
+        if (w->nbuf == H5W_BUFFER) {
+            evr_status st = drain(w, err);
+            if (st != EVR_OK) return st;
+        }
+        w->bx[w->nbuf] = e->x;
+        w->by[w->nbuf] = e->y;
+        w->bt[w->nbuf] = e->t;
+        w->bp[w->nbuf] = e->p ? 1 : 0;
+        w->nbuf++;
+        w->total++;
+    }
+    return EVR_OK;
+nomem:
+    snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
+    return EVR_ERR_NOMEM;
+}
+
+static evr_status h5_flush(evr_event_writer *base, evr_error *err)
+{
+    h5_writer *w = (h5_writer *)base;
+    herr_t r;
+    evr_status st = drain(w, err);
+    if (st != EVR_OK) return st;
+    H5E_BEGIN_TRY {
+        r = H5Fflush(w->file, H5F_SCOPE_GLOBAL);
+    } H5E_END_TRY;
+    if (r < 0) return h5_fail(err, "cannot flush", w->tmp);
+    return EVR_OK;
+}
+
+static void h5_abort(evr_event_writer *base)
+{
+    h5_writer *w = (h5_writer *)base;
+    close_all(w);
+    remove(w->tmp);
+    free_writer(w);
+}
+
+static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
+{
+    h5_writer *w = (h5_writer *)base;
+    evr_status st = EVR_OK;
+    herr_t r = 0;
+    /* entries up to ceil(duration / 1 ms) inclusive (more if events run past the duration) */
+    uint64_t last = duration_us > 0 ? (uint64_t)((duration_us + 999) / 1000) : 0;
+    while (w->next_ms <= last)
+        if (!push_ms(w, w->total)) {
+            snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
+            st = EVR_ERR_NOMEM;
+            goto fail;
+        }
+    st = drain(w, err);
+    if (st != EVR_OK) goto fail;
+    H5E_BEGIN_TRY {
+        int8_t complete = 1;
+        r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
+        if (r >= 0) {
+            /* closing the datasets first lets H5Fclose really close the file */
+            hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
+            for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
+                if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
+                *ids[i] = -1;
+            }
+            if (H5Fclose(w->file) < 0) r = -1;
+            w->file = -1;
+        }
+    } H5E_END_TRY;
+    if (r < 0) {
+        st = h5_fail(err, "cannot complete", w->tmp);
+        goto fail;
+    }
+    if (rename(w->tmp, w->path) != 0) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot rename %s to %s", w->tmp, w->path);
+        st = EVR_ERR_IO;
+        goto fail;
+    }
+    free_writer(w);
+    return EVR_OK;
+fail:
+    close_all(w);
+    remove(w->tmp);
+    free_writer(w);
+    return st;
+}
+
+evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
+{
+    h5_writer *w;
+    size_t len;
+    herr_t r = -1;
+    const char *what = "cannot create";
+
+    *out = NULL;
+    if (!path || !*path || !meta) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: no path or metadata given");
+        return EVR_ERR_ARG;
+    }
+    w = calloc(1, sizeof *w);
+    len = strlen(path);
+    if (w) {
+        w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_ms = -1;
+        w->path = malloc(len + 1);
+        w->tmp = malloc(len + 5);
+        w->bx = malloc(H5W_BUFFER * sizeof *w->bx);
+        w->by = malloc(H5W_BUFFER * sizeof *w->by);
+        w->bt = malloc(H5W_BUFFER * sizeof *w->bt);
+        w->bp = malloc(H5W_BUFFER * sizeof *w->bp);
+    }
+    if (!w || !w->path || !w->tmp || !w->bx || !w->by || !w->bt || !w->bp) {
+        if (w) free_writer(w);
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    memcpy(w->path, path, len + 1);
+    memcpy(w->tmp, path, len);
+    memcpy(w->tmp + len, ".tmp", 5);
+
+    H5E_BEGIN_TRY {
+        int32_t width = meta->width, height = meta->height;
+        int64_t zero = 0;
+        int8_t incomplete = 0;
+        w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+        if (w->file >= 0) {
+            what = "cannot lay out";
+            w->group = H5Gcreate2(w->file, "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+        }
+        if (w->group >= 0) w->ds_x = make_extendible(w->group, "x", H5T_STD_U16LE, H5W_CHUNK);
+        if (w->ds_x >= 0) w->ds_y = make_extendible(w->group, "y", H5T_STD_U16LE, H5W_CHUNK);
+        if (w->ds_y >= 0) w->ds_t = make_extendible(w->group, "t", H5T_STD_I64LE, H5W_CHUNK);
+        if (w->ds_t >= 0) w->ds_p = make_extendible(w->group, "p", H5T_STD_I8LE, H5W_CHUNK);
+        if (w->ds_p >= 0) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
+        if (w->ds_ms >= 0 &&
+            write_scalar_dataset(w->file, "t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &zero) >= 0 &&
+            write_scalar_attr(w->file, "width", H5T_STD_I32LE, H5T_NATIVE_INT32, &width) >= 0 &&
+            write_scalar_attr(w->file, "height", H5T_STD_I32LE, H5T_NATIVE_INT32, &height) >= 0 &&
+            write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &incomplete) >= 0 &&
+            write_string_attr(w->file, "config", meta->config_json ? meta->config_json : "{}") >= 0)
+            r = H5Fflush(w->file, H5F_SCOPE_GLOBAL);
+    } H5E_END_TRY;
+    if (r < 0) {
+        evr_status st = h5_fail(err, what, w->tmp);
+        int created = w->file >= 0;
+        close_all(w);
+        if (created) remove(w->tmp);
+        free_writer(w);
+        return st;
+    }
+    w->base.write = h5_write;
+    w->base.flush = h5_flush;
+    w->base.finish = h5_finish;
+    w->base.abort = h5_abort;
+    *out = &w->base;
+    return EVR_OK;
+}

@@ -1,0 +1,199 @@
+/* NumPy .npy (format 1.0) event files: one 1-D structured array of packed 13-byte records,
+ * dtype [('t','<i8'), ('x','<u2'), ('y','<u2'), ('p','|i1')], which numpy.load reads as is.
+ *
+ * The count is known only at the end, so the header is written with room for a 20-digit shape
+ * (padded with spaces, total header a multiple of 64 bytes) and rewritten in place at every
+ * flush() and at finish(): the temporary file of an interrupted run is a valid array holding
+ * every event up to the last flush. */
+#include "io/event_writer.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NPY_RECORD 13
+#define NPY_BUFFER_RECORDS (1u << 16)
+#define NPY_DESCR "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1')]"
+
+typedef struct {
+    evr_event_writer base;       /* first: the interface pointer is the writer pointer */
+    char *path, *tmp;
+    FILE *f;
+    unsigned char *buf;
+    size_t nbuf;                 /* records in buf */
+    uint64_t count;              /* records in the file */
+    size_t header_len;           /* bytes before the first record */
+    int64_t last_t;
+    int have_last;
+} npy_writer;
+
+/* Builds the whole header (magic, version, length, dict, padding, newline) for count records.
+ * total 0: the smallest multiple of 64 with room for any 64-bit count; else exactly total bytes. */
+static size_t build_header(char *out, size_t cap, uint64_t count, size_t total)
+{
+    char dict[256];
+    int n = snprintf(dict, sizeof dict, "{'descr': %s, 'fortran_order': False, 'shape': (%" PRIu64 ",), }", NPY_DESCR,
+                     count);
+    size_t digits = (size_t)snprintf(NULL, 0, "%" PRIu64, count);
+    if (total == 0) total = ((10 + (size_t)n - digits + 20 + 1) + 63) / 64 * 64;
+    if (total > cap || 10 + (size_t)n + 1 > total) return 0;
+    memcpy(out, "\x93NUMPY\x01\x00", 8);
+    out[8] = (char)((total - 10) & 0xff);
+    out[9] = (char)((total - 10) >> 8);
+    memcpy(out + 10, dict, (size_t)n);
+    memset(out + 10 + n, ' ', total - 10 - (size_t)n - 1);
+    out[total - 1] = '\n';
+    return total;
+}
+
+static evr_status write_header(npy_writer *w, evr_error *err)
+{
+    char h[256];
+    size_t n = build_header(h, sizeof h, w->count, w->header_len);
+    if (n != w->header_len || fseek(w->f, 0, SEEK_SET) != 0 || fwrite(h, 1, n, w->f) != n ||
+        fseek(w->f, 0, SEEK_END) != 0) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write the header of %s", w->tmp);
+        return EVR_ERR_IO;
+    }
+    return EVR_OK;
+}
+
+static evr_status drain(npy_writer *w, evr_error *err)
+{
+    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        return EVR_ERR_IO;
+    }
+    w->count += w->nbuf;
+    w->nbuf = 0;
+    return EVR_OK;
+}
+
+static void free_writer(npy_writer *w)
+{
+    free(w->path);
+    free(w->tmp);
+    free(w->buf);
+    free(w);
+}
+
+static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
+{
+    npy_writer *w = (npy_writer *)base;
+    for (size_t i = 0; i < n; i++) {
+        const evr_event *e = &ev[i];
+        unsigned char *r;
+        uint64_t t = (uint64_t)e->t;
+        if (w->have_last && e->t < w->last_t) {
+            snprintf(err->msg, sizeof err->msg, "npy writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
+                     e->t, w->last_t);
+            return EVR_ERR_ARG;
+        }
+        w->last_t = e->t;
+        w->have_last = 1;
+        if (w->nbuf == NPY_BUFFER_RECORDS) {
+            evr_status st = drain(w, err);
+            if (st != EVR_OK) return st;
+        }
+        r = w->buf + w->nbuf * NPY_RECORD;   /* little-endian whatever the host */
+        for (int b = 0; b < 8; b++) r[b] = (unsigned char)(t >> (8 * b));
+        r[8] = (unsigned char)(e->x & 0xff);
+        r[9] = (unsigned char)(e->x >> 8);
+        r[10] = (unsigned char)(e->y & 0xff);
+        r[11] = (unsigned char)(e->y >> 8);
+        r[12] = e->p ? 1 : 0;
+        w->nbuf++;
+    }
+    return EVR_OK;
+}
+
+static evr_status npy_flush(evr_event_writer *base, evr_error *err)
+{
+    npy_writer *w = (npy_writer *)base;
+    evr_status st = drain(w, err);
+    if (st == EVR_OK) st = write_header(w, err);
+    if (st == EVR_OK && fflush(w->f) != 0) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        st = EVR_ERR_IO;
+    }
+    return st;
+}
+
+static void npy_abort(evr_event_writer *base)
+{
+    npy_writer *w = (npy_writer *)base;
+    fclose(w->f);
+    remove(w->tmp);
+    free_writer(w);
+}
+
+static evr_status npy_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
+{
+    npy_writer *w = (npy_writer *)base;
+    evr_status st = drain(w, err);
+    int closed;
+    (void)duration_us;
+    if (st == EVR_OK) st = write_header(w, err);
+    closed = fclose(w->f) == 0;
+    if (st == EVR_OK && !closed) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        st = EVR_ERR_IO;
+    }
+    if (st == EVR_OK && rename(w->tmp, w->path) != 0) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot rename %s to %s", w->tmp, w->path);
+        st = EVR_ERR_IO;
+    }
+    if (st != EVR_OK) remove(w->tmp);
+    free_writer(w);
+    return st;
+}
+
+evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
+{
+    npy_writer *w;
+    size_t len;
+    char h[256];
+    (void)meta;
+    *out = NULL;
+    if (!path || !*path) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: no path given");
+        return EVR_ERR_ARG;
+    }
+    len = strlen(path);
+    w = calloc(1, sizeof *w);
+    if (w) {
+        w->path = malloc(len + 1);
+        w->tmp = malloc(len + 5);
+        w->buf = malloc((size_t)NPY_BUFFER_RECORDS * NPY_RECORD);
+    }
+    if (!w || !w->path || !w->tmp || !w->buf) {
+        if (w) free_writer(w);
+        snprintf(err->msg, sizeof err->msg, "npy writer: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    memcpy(w->path, path, len + 1);
+    memcpy(w->tmp, path, len);
+    memcpy(w->tmp + len, ".tmp", 5);
+    w->header_len = build_header(h, sizeof h, 0, 0);
+    w->f = fopen(w->tmp, "wb");
+    if (!w->f) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot create %s: %s", w->tmp, strerror(errno));
+        free_writer(w);
+        return EVR_ERR_IO;
+    }
+    if (fwrite(h, 1, w->header_len, w->f) != w->header_len) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        fclose(w->f);
+        remove(w->tmp);
+        free_writer(w);
+        return EVR_ERR_IO;
+    }
+    w->base.write = npy_write;
+    w->base.flush = npy_flush;
+    w->base.finish = npy_finish;
+    w->base.abort = npy_abort;
+    *out = &w->base;
+    return EVR_OK;
+}

@@ -1,0 +1,295 @@
+#include "io/preview.h"
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/png.h"
+
+/* ---- event frames ---- */
+
+evr_status evr_event_frame_init(evr_event_frame *f, int width, int height, evr_error *err)
+{
+    size_t n;
+    memset(f, 0, sizeof *f);
+    if (width <= 0 || height <= 0 || width > 65536 || height > 65536) {
+        snprintf(err->msg, sizeof err->msg, "event frame: bad size %dx%d", width, height);
+        return EVR_ERR_ARG;
+    }
+    n = (size_t)width * (size_t)height;
+    f->width = width;
+    f->height = height;
+    f->on = calloc(n, sizeof *f->on);
+    f->off = calloc(n, sizeof *f->off);
+    f->last = calloc(n, sizeof *f->last);
+    if (!f->on || !f->off || !f->last) {
+        evr_event_frame_release(f);
+        snprintf(err->msg, sizeof err->msg, "event frame: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    return EVR_OK;
+}
+
+void evr_event_frame_clear(evr_event_frame *f)
+{
+    size_t n = (size_t)f->width * (size_t)f->height;
+    memset(f->on, 0, n * sizeof *f->on);
+    memset(f->off, 0, n * sizeof *f->off);
+    memset(f->last, 0, n * sizeof *f->last);
+    f->events = 0;
+}
+
+void evr_event_frame_add(evr_event_frame *f, const evr_event *ev, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        size_t k;
+        if (ev[i].x >= f->width || ev[i].y >= f->height) continue;
+        k = (size_t)ev[i].y * (size_t)f->width + ev[i].x;
+        if (ev[i].p) { if (f->on[k] < UINT32_MAX) f->on[k]++; }
+        else if (f->off[k] < UINT32_MAX) f->off[k]++;
+        f->last[k] = ev[i].p ? 1 : 0;
+        f->events++;
+    }
+}
+
+void evr_event_frame_render(const evr_event_frame *f, uint8_t *rgb)
+{
+    size_t n = (size_t)f->width * (size_t)f->height;
+    for (size_t k = 0; k < n; k++) {
+        uint8_t *c = rgb + 3 * k;
+        uint32_t on = f->on[k], off = f->off[k];
+        if (!on && !off) { c[0] = c[1] = c[2] = 255; continue; }
+        int is_on = on != off ? on > off : f->last[k];
+        c[0] = is_on ? 0 : 255;
+        c[1] = 0;
+        c[2] = is_on ? 255 : 0;
+    }
+}
+
+evr_status evr_event_frame_write_png(const evr_event_frame *f, const char *path, evr_error *err)
+{
+    uint8_t *rgb = malloc((size_t)f->width * (size_t)f->height * 3);
+    evr_status st;
+    if (!rgb) {
+        snprintf(err->msg, sizeof err->msg, "event frame: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    evr_event_frame_render(f, rgb);
+    st = evr_png_write(path, rgb, f->width, f->height, 3, 8, err);
+    free(rgb);
+    return st;
+}
+
+void evr_event_frame_release(evr_event_frame *f)
+{
+    free(f->on);
+    free(f->off);
+    free(f->last);
+    memset(f, 0, sizeof *f);
+}
+
+/* ---- series of event frames ---- */
+
+struct evr_event_preview {
+    evr_event_frame frame;
+    int64_t window_us;
+    int64_t index;               /* window the frame accumulates */
+    char *dir, *prefix;
+    int frames;
+};
+
+evr_status evr_event_preview_new(int width, int height, int64_t window_us, const char *dir, const char *prefix,
+                                 evr_event_preview **out, evr_error *err)
+{
+    evr_event_preview *p;
+    evr_status st;
+    *out = NULL;
+    if (window_us <= 0 || !dir || !prefix) {
+        snprintf(err->msg, sizeof err->msg, "event preview: bad window %lld us or no folder", (long long)window_us);
+        return EVR_ERR_ARG;
+    }
+    p = calloc(1, sizeof *p);
+    if (!p) {
+        snprintf(err->msg, sizeof err->msg, "event preview: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    st = evr_event_frame_init(&p->frame, width, height, err);
+    if (st != EVR_OK) {
+        free(p);
+        return st;
+    }
+    p->window_us = window_us;
+    p->dir = malloc(strlen(dir) + 1);
+    p->prefix = malloc(strlen(prefix) + 1);
+    if (!p->dir || !p->prefix) {
+        evr_event_preview_release(p);
+        snprintf(err->msg, sizeof err->msg, "event preview: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    strcpy(p->dir, dir);
+    strcpy(p->prefix, prefix);
+    *out = p;
+    return EVR_OK;
+}
+
+/* Writes the open window's frame and opens the next one. */
+static evr_status emit(evr_event_preview *p, evr_error *err)
+{
+    size_t len = strlen(p->dir) + strlen(p->prefix) + 32;
+    char *path = malloc(len);
+    evr_status st;
+    if (!path) {
+        snprintf(err->msg, sizeof err->msg, "event preview: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    snprintf(path, len, "%s/%s_%06lld.png", p->dir, p->prefix, (long long)p->index);
+    st = evr_event_frame_write_png(&p->frame, path, err);
+    free(path);
+    if (st != EVR_OK) return st;
+    evr_event_frame_clear(&p->frame);
+    p->index++;
+    p->frames++;
+    return EVR_OK;
+}
+
+evr_status evr_event_preview_advance(evr_event_preview *p, int64_t t_us, evr_error *err)
+{
+    while ((p->index + 1) * p->window_us <= t_us) {
+        evr_status st = emit(p, err);
+        if (st != EVR_OK) return st;
+    }
+    return EVR_OK;
+}
+
+evr_status evr_event_preview_add(evr_event_preview *p, const evr_event *ev, size_t n, evr_error *err)
+{
+    size_t i = 0;
+    while (i < n && ev[i].t < 0) i++;
+    while (i < n) {
+        int64_t end = (p->index + 1) * p->window_us;
+        size_t j = i;
+        while (j < n && ev[j].t < end) j++;
+        evr_event_frame_add(&p->frame, ev + i, j - i);
+        if (j == n) break;
+        evr_status st = evr_event_preview_advance(p, ev[j].t, err);
+        if (st != EVR_OK) return st;
+        i = j;
+    }
+    return EVR_OK;
+}
+
+evr_status evr_event_preview_finish(evr_event_preview *p, int64_t end_us, evr_error *err)
+{
+    while (p->index * p->window_us < end_us) {
+        evr_status st = emit(p, err);
+        if (st != EVR_OK) return st;
+    }
+    return EVR_OK;
+}
+
+int evr_event_preview_frames(const evr_event_preview *p) { return p->frames; }
+
+void evr_event_preview_release(evr_event_preview *p)
+{
+    if (!p) return;
+    evr_event_frame_release(&p->frame);
+    free(p->dir);
+    free(p->prefix);
+    free(p);
+}
+
+/* ---- intensity frames ---- */
+
+/* The k-th smallest of v[0..n-1] (v is reordered; no NaN): Hoare's selection, expected linear
+ * time, and fine with many equal values (black backgrounds). */
+static float select_kth(float *v, size_t n, size_t k)
+{
+    ptrdiff_t lo = 0, hi = (ptrdiff_t)n - 1, kk = (ptrdiff_t)k;
+    while (lo < hi) {
+        float pivot = v[lo + (hi - lo) / 2];
+        ptrdiff_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot) i++;
+            while (v[j] > pivot) j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i] = v[j];
+                v[j] = t;
+                i++;
+                j--;
+            }
+        }
+        /* now v[lo..j] <= pivot <= v[i..hi], and everything between equals the pivot */
+        if (kk <= j) hi = j;
+        else if (kk >= i) lo = i;
+        else break;
+    }
+    return v[kk];
+}
+
+/* Negative and NaN values count as black, +infinity as the largest float. */
+static float clean(float v)
+{
+    if (v > 0.0f) return v <= FLT_MAX ? v : FLT_MAX;
+    return 0.0f;
+}
+
+evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr_error *err)
+{
+    float *tmp;
+    double sum_log = 0.0, white, delta, scale, lw;
+    if (n == 0) return EVR_OK;
+    tmp = malloc(n * sizeof *tmp);
+    if (!tmp) {
+        snprintf(err->msg, sizeof err->msg, "tone mapping: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++) tmp[i] = clean(linear[i]);
+    white = select_kth(tmp, n, (size_t)floor(0.995 * (double)(n - 1) + 0.5));
+    if (!(white > 0.0)) {               /* mostly black: take the brightest value */
+        white = 0.0;
+        for (size_t i = 0; i < n; i++) if (tmp[i] > white) white = tmp[i];
+    }
+    free(tmp);
+    if (!(white > 0.0)) {
+        memset(out, 0, n);
+        return EVR_OK;
+    }
+    /* log-average with a floor relative to the white point, so the result is scale invariant */
+    delta = 1e-4 * white;
+    for (size_t i = 0; i < n; i++) sum_log += log(delta + (double)clean(linear[i]));
+    scale = 0.18 / exp(sum_log / (double)n);
+    lw = white * scale;
+    for (size_t i = 0; i < n; i++) {
+        double l = (double)clean(linear[i]) * scale, v;
+        if (l >= lw) v = 1.0;           /* the curve reaches 1 at the white point */
+        else v = l * (1.0 + l / (lw * lw)) / (1.0 + l);
+        if (v > 1.0) v = 1.0;
+        v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+        long q = lround(v * 255.0);
+        out[i] = (uint8_t)(q < 0 ? 0 : q > 255 ? 255 : q);
+    }
+    return EVR_OK;
+}
+
+evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h, evr_error *err)
+{
+    uint8_t *gray;
+    evr_status st;
+    if (w <= 0 || h <= 0 || !linear) {
+        snprintf(err->msg, sizeof err->msg, "intensity preview: bad size %dx%d", w, h);
+        return EVR_ERR_ARG;
+    }
+    gray = malloc((size_t)w * (size_t)h);
+    if (!gray) {
+        snprintf(err->msg, sizeof err->msg, "intensity preview: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    st = evr_tonemap_reinhard(linear, (size_t)w * (size_t)h, gray, err);
+    if (st == EVR_OK) st = evr_png_write(path, gray, w, h, 1, 8, err);
+    free(gray);
+    return st;
+}

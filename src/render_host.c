@@ -1,0 +1,87 @@
+#include "backend.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width, int height,
+                                float ambient, evr_error *err)
+{
+    int i;
+    memset(h, 0, sizeof *h);
+    h->meshes = calloc((size_t)s->num_meshes + 1, sizeof *h->meshes);
+    h->materials = calloc((size_t)s->num_materials + 1, sizeof *h->materials);
+    h->textures = calloc((size_t)s->num_textures + 1, sizeof *h->textures);
+    h->instances = calloc((size_t)s->num_instances + 1, sizeof *h->instances);
+    h->lights = calloc((size_t)s->num_lights + 1, sizeof *h->lights);
+    if (!h->meshes || !h->materials || !h->textures || !h->instances || !h->lights) {
+        evr_render_host_free(h);
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    for (i = 0; i < s->num_meshes; i++) {
+        const evr_mesh *m = &s->meshes[i];
+        h->meshes[i].positions = m->positions;
+        h->meshes[i].normals = m->normals;
+        h->meshes[i].uvs = m->uvs;
+        h->meshes[i].indices = m->indices;
+        h->meshes[i].num_triangles = m->num_triangles;
+        h->meshes[i].material = m->material;
+    }
+    for (i = 0; i < s->num_materials; i++) {
+        const evr_material *m = &s->materials[i];
+        memcpy(h->materials[i].base_color, m->base_color, sizeof m->base_color);
+        h->materials[i].base_texture = m->base_texture;
+        memcpy(h->materials[i].emissive, m->emissive, sizeof m->emissive);
+    }
+    for (i = 0; i < s->num_textures; i++) {
+        h->textures[i].width = s->textures[i].width;
+        h->textures[i].height = s->textures[i].height;
+        h->textures[i].rgba = s->textures[i].rgba;
+    }
+    for (i = 0; i < s->num_instances; i++) {
+        h->instances[i].mesh = s->instances[i].mesh;
+        h->instances[i].track = s->instances[i].node;
+    }
+    for (i = 0; i < s->num_lights; i++) {
+        const evr_light *l = &s->lights[i];
+        h->lights[i].type = (int)l->type;
+        h->lights[i].track = l->node;
+        memcpy(h->lights[i].color, l->color, sizeof l->color);
+        h->lights[i].pos = l->position;
+        h->lights[i].dir = evr_v3_norm(l->direction);
+        h->lights[i].cos_inner = cosf(l->inner_cone);
+        h->lights[i].cos_outer = cosf(l->outer_cone);
+    }
+    evr_v3 ext = evr_v3_sub(s->bounds_max, s->bounds_min);
+    h->scene_size = evr_v3_len(ext);
+    if (!(h->scene_size > 0.0f) || !isfinite(h->scene_size)) h->scene_size = 1.0f;
+
+    const evr_camera_desc *cam = &s->cameras[camera];
+    evr_render_scene *rs = &h->rs;
+    rs->meshes = h->meshes;
+    rs->materials = h->materials;
+    rs->textures = h->textures;
+    rs->instances = h->instances;
+    rs->lights = h->lights;
+    rs->num_instances = s->num_instances;
+    rs->num_lights = s->num_lights;
+    /* Track i is node i; track num_nodes is the fixed world frame (identity). */
+    rs->camera_track = cam->node >= 0 ? cam->node : s->num_nodes;
+    rs->camera_local = cam->local;
+    rs->camera = evr_camera_intr_make(width, height, cam->yfov);
+    rs->ambient = ambient;
+    rs->ray_eps = 1e-5f * h->scene_size;
+    return EVR_OK;
+}
+
+void evr_render_host_free(evr_render_host *h)
+{
+    free(h->meshes);
+    free(h->materials);
+    free(h->textures);
+    free(h->instances);
+    free(h->lights);
+    memset(h, 0, sizeof *h);
+}

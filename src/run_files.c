@@ -1,0 +1,306 @@
+#include "run_files.h"
+#include "io/json.h"
+#include "io/preview.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <assimp/version.h>
+#include <embree3/rtcore_config.h>
+#include <H5public.h>
+
+static evr_status path_join(char *out, size_t n, const char *dir, const char *name, evr_error *err)
+{
+    if ((size_t)snprintf(out, n, "%s/%s", dir, name) >= n) {
+        snprintf(err->msg, sizeof err->msg, "output path too long: %s/%s", dir, name);
+        return EVR_ERR_ARG;
+    }
+    return EVR_OK;
+}
+
+static int mkdir_p(const char *path)
+{
+    char tmp[4096];
+    size_t i, n = strlen(path);
+    if (n >= sizeof tmp) return -1;
+    memcpy(tmp, path, n + 1);
+    for (i = 1; i < n; i++) {
+        if (tmp[i] != '/') continue;
+        tmp[i] = 0;
+        if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
+        tmp[i] = '/';
+    }
+    if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
+    return 0;
+}
+
+evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
+{
+    struct stat sb;
+    char p[4200];
+    if (stat(sim->out_dir, &sb) == 0) {
+        if (!S_ISDIR(sb.st_mode)) {
+            snprintf(err->msg, sizeof err->msg, "output path %s exists and is not a folder", sim->out_dir);
+            return EVR_ERR_ARG;
+        }
+        DIR *d = opendir(sim->out_dir);
+        struct dirent *de;
+        int empty = 1;
+        if (!d) {
+            snprintf(err->msg, sizeof err->msg, "cannot open output folder %s: %s", sim->out_dir, strerror(errno));
+            return EVR_ERR_IO;
+        }
+        while ((de = readdir(d)) != NULL)
+            if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..")) empty = 0;
+        closedir(d);
+        if (!empty && !sim->cfg.force) {
+            snprintf(err->msg, sizeof err->msg, "run folder %s already exists and is not empty (use --force to overwrite)", sim->out_dir);
+            return EVR_ERR_ARG;
+        }
+    } else {
+        if (mkdir_p(sim->out_dir) != 0) {
+            snprintf(err->msg, sizeof err->msg, "cannot create output folder %s: %s", sim->out_dir, strerror(errno));
+            return EVR_ERR_IO;
+        }
+        sim->created_dir = 1;
+    }
+    if (sim->cfg.preview_window > 0.0) {
+        if (path_join(p, sizeof p, sim->out_dir, "preview", err) != EVR_OK) return EVR_ERR_ARG;
+        if (mkdir_p(p) != 0) {
+            snprintf(err->msg, sizeof err->msg, "cannot create %s: %s", p, strerror(errno));
+            return EVR_ERR_IO;
+        }
+        size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
+        evr_status st = evr_event_frame_init(&sim->preview, sim->cfg.width, sim->cfg.height, err);
+        if (st != EVR_OK) return st;
+        sim->preview_intensity = malloc(npix * sizeof *sim->preview_intensity);
+        if (!sim->preview_intensity) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for previews");
+            return EVR_ERR_NOMEM;
+        }
+        sim->preview_window_us = (int64_t)llround(sim->cfg.preview_window * 1e6);
+        if (sim->preview_window_us < 1) sim->preview_window_us = 1;
+    }
+    return EVR_OK;
+}
+
+evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
+{
+    static const struct { int bit; const char *file; } kinds[] = {
+        {EVR_FORMAT_H5, "events.h5"}, {EVR_FORMAT_TXT, "events.txt"}, {EVR_FORMAT_NPY, "events.npy"}};
+    evr_writer_meta meta;
+    char p[4200];
+    int i;
+    evr_status st;
+    meta.width = sim->cfg.width;
+    meta.height = sim->cfg.height;
+    meta.config_json = sim->config_json;
+    for (i = 0; i < 3; i++) {
+        if (!(sim->cfg.formats & kinds[i].bit)) continue;
+        if ((st = path_join(p, sizeof p, sim->out_dir, kinds[i].file, err)) != EVR_OK) return st;
+        evr_event_writer *w = NULL;
+        if (kinds[i].bit == EVR_FORMAT_H5) st = evr_h5_writer_open(p, &meta, &w, err);
+        else if (kinds[i].bit == EVR_FORMAT_TXT) st = evr_txt_writer_open(p, &meta, &w, err);
+        else st = evr_npy_writer_open(p, &meta, &w, err);
+        if (st != EVR_OK) return st;
+        sim->writers[sim->num_writers] = w;
+        sim->writer_names[sim->num_writers] = kinds[i].file;
+        sim->num_writers++;
+    }
+    return EVR_OK;
+}
+
+static evr_status write_event_frame(evr_sim *sim, evr_error *err)
+{
+    char name[64], p[4200];
+    evr_status st;
+    snprintf(name, sizeof name, "preview/events_%06lld.png", (long long)sim->preview_frame);
+    if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
+    st = evr_event_frame_write_png(&sim->preview, p, err);
+    evr_event_frame_clear(&sim->preview);
+    sim->previews_written++;
+    return st;
+}
+
+evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, evr_error *err)
+{
+    size_t i = 0, j;
+    evr_status st;
+    if (!sim->preview.width) return EVR_OK;
+    int64_t start_us = (int64_t)llround(sim->cfg.start * 1e6);
+    while (i < n) {
+        int64_t frame = (ev[i].t - start_us) / sim->preview_window_us;
+        while (frame > sim->preview_frame) {   /* frames with no events are written too */
+            if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
+            sim->preview_frame++;
+        }
+        int64_t end_us = start_us + (sim->preview_frame + 1) * sim->preview_window_us;
+        for (j = i; j < n && ev[j].t < end_us; j++) {}
+        evr_event_frame_add(&sim->preview, ev + i, j - i);
+        i = j;
+    }
+    return EVR_OK;
+}
+
+evr_status evr_run_preview_intensity(evr_sim *sim, double t, int last, evr_error *err)
+{
+    char name[64], p[4200];
+    evr_status st;
+    int fetched = 0;
+    if (!sim->preview_intensity) return EVR_OK;
+    /* one intensity frame per preview window, taken at the first segment end at or after the
+     * window's end (the pixels' latest samples); the last window may be partial */
+    int64_t rel_us = (int64_t)llround((t - sim->cfg.start) * 1e6);
+    while ((sim->intensity_frame + 1) * sim->preview_window_us <= rel_us ||
+           (last && sim->intensity_frame * sim->preview_window_us < rel_us)) {
+        if (!fetched) sim->backend->intensity(sim->backend, sim->preview_intensity);
+        fetched = 1;
+        snprintf(name, sizeof name, "preview/intensity_%06lld.png", (long long)sim->intensity_frame);
+        if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
+        if ((st = evr_preview_intensity_png(p, sim->preview_intensity, sim->cfg.width, sim->cfg.height, err)) != EVR_OK)
+            return st;
+        sim->intensity_frame++;
+    }
+    return EVR_OK;
+}
+
+static char *run_json(const evr_sim *sim)
+{
+    const evr_stats *s = &sim->st;
+    const evr_scene *sc = sim->scene;
+    evr_json j;
+    int i;
+    long tris = 0;
+    char buf[64];
+    for (i = 0; i < sc->num_instances; i++) tris += (long)sc->meshes[sc->instances[i].mesh].num_triangles;
+    evr_json_init(&j, 1);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "evray_version"); evr_json_string(&j, EVR_VERSION);
+    evr_json_key(&j, "versions"); evr_json_begin_object(&j);
+    snprintf(buf, sizeof buf, "%u.%u.%u", aiGetVersionMajor(), aiGetVersionMinor(), aiGetVersionPatch());
+    evr_json_key(&j, "assimp"); evr_json_string(&j, buf);
+    evr_json_key(&j, "embree"); evr_json_string(&j, RTC_VERSION_STRING);
+    snprintf(buf, sizeof buf, "%d.%d.%d", H5_VERS_MAJOR, H5_VERS_MINOR, H5_VERS_RELEASE);
+    evr_json_key(&j, "hdf5"); evr_json_string(&j, buf);
+    evr_json_end_object(&j);
+    evr_json_key(&j, "config"); evr_json_begin_object(&j);
+    evr_json_end_object(&j);   /* replaced below by the full configuration text */
+    evr_json_key(&j, "scene"); evr_json_begin_object(&j);
+    evr_json_key(&j, "source"); evr_json_string(&j, sc->source);
+    evr_json_key(&j, "camera"); evr_json_string(&j, sc->cameras[sim->camera].name);
+    evr_json_key(&j, "automatic_camera"); evr_json_boolean(&j, sc->cameras[sim->camera].automatic);
+    evr_json_key(&j, "default_light"); evr_json_boolean(&j, sc->default_light);
+    evr_json_key(&j, "instances"); evr_json_integer(&j, sc->num_instances);
+    evr_json_key(&j, "triangles"); evr_json_integer(&j, tris);
+    evr_json_key(&j, "lights"); evr_json_integer(&j, sc->num_lights);
+    evr_json_key(&j, "animation_end"); evr_json_number(&j, sc->anim_end);
+    evr_json_end_object(&j);
+    evr_json_key(&j, "outputs"); evr_json_begin_array(&j);
+    for (i = 0; i < sim->num_writers; i++) evr_json_string(&j, sim->writer_names[i]);
+    evr_json_end_array(&j);
+    evr_json_key(&j, "stats"); evr_json_begin_object(&j);
+    evr_json_key(&j, "events"); evr_json_unsigned(&j, s->events_on + s->events_off);
+    evr_json_key(&j, "events_on"); evr_json_unsigned(&j, s->events_on);
+    evr_json_key(&j, "events_off"); evr_json_unsigned(&j, s->events_off);
+    evr_json_key(&j, "unique_timestamps"); evr_json_unsigned(&j, s->unique_timestamps);
+    evr_json_key(&j, "samples"); evr_json_unsigned(&j, s->samples);
+    evr_json_key(&j, "rays"); evr_json_unsigned(&j, s->rays);
+    evr_json_key(&j, "segments"); evr_json_integer(&j, s->segments_done);
+    evr_json_key(&j, "segments_planned"); evr_json_integer(&j, s->segments_total);
+    evr_json_key(&j, "interrupted"); evr_json_boolean(&j, s->interrupted);
+    evr_json_key(&j, "simulated_seconds"); evr_json_number(&j, s->sim_time);
+    evr_json_key(&j, "wall_seconds"); evr_json_number(&j, s->wall_time);
+    evr_json_key(&j, "samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
+    evr_json_key(&j, "rays_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->rays / s->wall_time : 0.0);
+    evr_json_key(&j, "realtime_factor"); evr_json_number(&j, s->wall_time > 0 ? s->sim_time / s->wall_time : 0.0);
+    evr_json_key(&j, "mean_sample_interval_seconds"); evr_json_number(&j, 1.0 / (sim->fps * sim->cfg.samples_per_frame));
+    evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
+    evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, sim->time_sort);
+    evr_json_key(&j, "time_write_seconds"); evr_json_number(&j, sim->time_write);
+    evr_json_key(&j, "time_preview_seconds"); evr_json_number(&j, sim->time_preview);
+    evr_json_key(&j, "preview_frames"); evr_json_integer(&j, sim->previews_written);
+    evr_json_end_object(&j);
+    evr_json_end_object(&j);
+    char *text = evr_json_take(&j);
+    if (!text) return NULL;
+    /* splice the configuration object in place of the empty one */
+    const char *marker = "\"config\": {}";
+    char *at = strstr(text, marker);
+    if (!at) return text;
+    size_t before = (size_t)(at - text), clen = strlen(sim->config_json), mlen = strlen(marker);
+    char *out = malloc(strlen(text) + clen + 16);
+    if (!out) { free(text); return NULL; }
+    memcpy(out, text, before);
+    memcpy(out + before, "\"config\": ", 10);
+    memcpy(out + before + 10, sim->config_json, clen);
+    strcpy(out + before + 10 + clen, at + mlen);
+    free(text);
+    return out;
+}
+
+evr_status evr_run_finish(evr_sim *sim, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    int w;
+    int64_t dur_us = (int64_t)llround(sim->st.sim_time * 1e6);
+    for (w = 0; w < sim->num_writers; w++) {
+        evr_event_writer *wr = sim->writers[w];
+        sim->writers[w] = NULL;
+        evr_status s2 = wr->finish(wr, dur_us, err);
+        if (s2 != EVR_OK && st == EVR_OK) st = s2;
+    }
+    if (st != EVR_OK) return st;
+    if (sim->preview.width) {
+        int64_t end_frame = (dur_us - 1) / sim->preview_window_us;
+        while (sim->preview_frame <= end_frame)
+            if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
+            else sim->preview_frame++;
+    }
+    char *text = run_json(sim);
+    char p[4200], tmp[4300];
+    if (!text) {
+        snprintf(err->msg, sizeof err->msg, "out of memory writing run.json");
+        return EVR_ERR_NOMEM;
+    }
+    if ((st = path_join(p, sizeof p, sim->out_dir, "run.json", err)) != EVR_OK) { free(text); return st; }
+    snprintf(tmp, sizeof tmp, "%s.tmp", p);
+    FILE *f = fopen(tmp, "w");
+    int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    if (f) ok = (fclose(f) == 0) && ok;
+    free(text);
+    if (!ok || rename(tmp, p) != 0) {
+        remove(tmp);
+        snprintf(err->msg, sizeof err->msg, "cannot write %s", p);
+        return EVR_ERR_IO;
+    }
+    return EVR_OK;
+}
+
+void evr_run_dir_discard(evr_sim *sim)
+{
+    int w;
+    char p[4200];
+    for (w = 0; w < sim->num_writers; w++) {
+        if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
+        sim->writers[w] = NULL;
+    }
+    /* previews of this run */
+    snprintf(p, sizeof p, "%s/preview", sim->out_dir);
+    DIR *d = opendir(p);
+    if (d) {
+        struct dirent *de;
+        char f[4600];
+        while ((de = readdir(d)) != NULL) {
+            if (strncmp(de->d_name, "events_", 7) && strncmp(de->d_name, "intensity_", 10)) continue;
+            snprintf(f, sizeof f, "%s/%s", p, de->d_name);
+            remove(f);
+        }
+        closedir(d);
+        rmdir(p);
+    }
+    if (sim->created_dir) rmdir(sim->out_dir);
+}

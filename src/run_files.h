@@ -1,0 +1,18 @@
+/* The run folder: its creation, the event writers, previews, run.json, and cleanup on failure. */
+#ifndef EVR_RUN_FILES_H
+#define EVR_RUN_FILES_H
+
+#include "sim_internal.h"
+
+evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
+evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);
+/* Accumulates time-ordered events into event preview frames, writing each finished frame. */
+evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, evr_error *err);
+/* At a segment end (absolute time t): writes an intensity preview when a window has ended. */
+evr_status evr_run_preview_intensity(evr_sim *sim, double t, int last, evr_error *err);
+/* Completes every writer, the last preview and run.json. */
+evr_status evr_run_finish(evr_sim *sim, evr_error *err);
+/* Removes what this run wrote (temporary files, previews, the folder if it made it). */
+void evr_run_dir_discard(evr_sim *sim);
+
+#endif

@@ -1,0 +1,830 @@
+/* glTF 2.0 builder and GLB serializer. Objects that nothing refers back to (meshes, materials,
+ * cameras, lights, images, accessors, buffer views) are written to their JSON arrays as soon as
+ * they are added; nodes and animations are kept as structs because later calls change them
+ * (children, channels), and are written by evr_gltf_glb. */
+#include "scene/gltf_writer.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/png.h"
+
+#define GLTF_FLOAT 5126
+#define GLTF_UINT 5125
+#define GLTF_ARRAY_BUFFER 34962
+#define GLTF_ELEMENT_ARRAY_BUFFER 34963
+#define GLTF_LINEAR 9729
+#define GLTF_REPEAT 10497
+
+/* A growing text buffer holding the comma-separated elements of one JSON array. */
+typedef struct {
+    char *p;
+    size_t n, cap;
+    int count;
+} sbuf;
+
+typedef struct {
+    char *name;
+    int parent;
+    float t[3], r[4], s[3];
+    int has_t, has_r, has_s;
+    int mesh, camera, light;
+} gnode;
+
+typedef struct {
+    char *name;
+    sbuf channels, samplers;
+    int *targets;          /* node * 3 + path of each channel, to refuse duplicates */
+    int num_targets, cap_targets;
+} ganim;
+
+struct evr_gltf {
+    evr_status status;
+    char msg[sizeof(((evr_error *)0)->msg)];
+    char *scene_name;
+    unsigned char *bin;
+    size_t bin_n, bin_cap;
+    sbuf accessors, views, meshes, materials, textures, images, cameras, lights;
+    int has_sampler;
+    gnode *nodes;
+    int num_nodes, cap_nodes;
+    ganim *anims;
+    int num_anims, cap_anims;
+};
+
+static void fail(evr_gltf *g, evr_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void fail(evr_gltf *g, evr_status st, const char *fmt, ...)
+{
+    va_list ap;
+    int n;
+    if (g->status != EVR_OK) return;   /* keep the first failure */
+    g->status = st;
+    n = snprintf(g->msg, sizeof g->msg, "gltf: ");
+    va_start(ap, fmt);
+    vsnprintf(g->msg + n, sizeof g->msg - (size_t)n, fmt, ap);
+    va_end(ap);
+}
+
+static int grow(evr_gltf *g, void **p, size_t elem, size_t need, size_t *cap)
+{
+    size_t c;
+    void *q;
+    if (need <= *cap) return 1;
+    c = *cap ? *cap : 16;
+    while (c < need) c *= 2;
+    q = realloc(*p, c * elem);
+    if (!q) {
+        fail(g, EVR_ERR_NOMEM, "out of memory");
+        return 0;
+    }
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+static int grow_int(evr_gltf *g, void **p, size_t elem, int need, int *cap)
+{
+    size_t c = (size_t)*cap;
+    if (!grow(g, p, elem, (size_t)need, &c)) return 0;
+    *cap = (int)c;
+    return 1;
+}
+
+static char *dup_str(evr_gltf *g, const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (!d) {
+        fail(g, EVR_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    memcpy(d, s, n);
+    return d;
+}
+
+/* ---- JSON text ---- */
+
+static void sb_cat_n(evr_gltf *g, sbuf *b, const char *s, size_t n)
+{
+    if (g->status != EVR_OK) return;
+    if (!grow(g, (void **)&b->p, 1, b->n + n + 1, &b->cap)) return;
+    memcpy(b->p + b->n, s, n);
+    b->n += n;
+    b->p[b->n] = 0;
+}
+
+static void sb_cat(evr_gltf *g, sbuf *b, const char *s) { sb_cat_n(g, b, s, strlen(s)); }
+
+static void sb_printf(evr_gltf *g, sbuf *b, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void sb_printf(evr_gltf *g, sbuf *b, const char *fmt, ...)
+{
+    char tmp[256];
+    va_list ap;
+    int n;
+    va_start(ap, fmt);
+    n = vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= sizeof tmp) {
+        fail(g, EVR_ERR_ARG, "internal: formatted text too long");
+        return;
+    }
+    sb_cat_n(g, b, tmp, (size_t)n);
+}
+
+/* A number as JSON: 9 significant digits round-trip a float exactly. The decimal separator is
+ * forced to '.' whatever the C locale says. */
+static void sb_num(evr_gltf *g, sbuf *b, double v)
+{
+    char tmp[40];
+    char *c;
+    if (!isfinite(v)) {
+        fail(g, EVR_ERR_ARG, "non-finite number");
+        v = 0.0;
+    }
+    snprintf(tmp, sizeof tmp, "%.9g", v);
+    for (c = tmp; *c; c++)
+        if (*c == ',') *c = '.';
+    sb_cat(g, b, tmp);
+}
+
+static void sb_nums(evr_gltf *g, sbuf *b, const float *v, int n)
+{
+    int i;
+    sb_cat(g, b, "[");
+    for (i = 0; i < n; i++) {
+        if (i) sb_cat(g, b, ",");
+        sb_num(g, b, v[i]);
+    }
+    sb_cat(g, b, "]");
+}
+
+static void sb_str(evr_gltf *g, sbuf *b, const char *s)
+{
+    sb_cat(g, b, "\"");
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\') {
+            char e[3] = {'\\', (char)c, 0};
+            sb_cat(g, b, e);
+        } else if (c < 0x20) {
+            sb_printf(g, b, "\\u%04x", c);
+        } else {
+            sb_cat_n(g, b, (const char *)&c, 1);
+        }
+    }
+    sb_cat(g, b, "\"");
+}
+
+/* Starts the next element of an array; returns its index. */
+static int sb_elem(evr_gltf *g, sbuf *b)
+{
+    if (b->count) sb_cat(g, b, ",");
+    return b->count++;
+}
+
+static void sb_free(sbuf *b) { free(b->p); }
+
+/* ---- binary data ---- */
+
+static int host_is_little_endian(void)
+{
+    const uint16_t probe = 1;
+    return *(const unsigned char *)&probe == 1;
+}
+
+/* Appends n bytes (as 4-byte words swapped to little-endian when word is set) in a new
+ * 4-byte-aligned buffer view; returns the view index. */
+static int add_view(evr_gltf *g, const void *data, size_t n, int word, int target)
+{
+    size_t off = (g->bin_n + 3) & ~(size_t)3;
+    int v;
+    if (g->status != EVR_OK) return -1;
+    if (off + n > 0x7fffffffu) {
+        fail(g, EVR_ERR_ARG, "binary data larger than 2 GiB");
+        return -1;
+    }
+    if (!grow(g, (void **)&g->bin, 1, off + n + 4, &g->bin_cap)) return -1;
+    memset(g->bin + g->bin_n, 0, off - g->bin_n);
+    memcpy(g->bin + off, data, n);
+    if (word && !host_is_little_endian()) {
+        size_t i;
+        for (i = 0; i + 4 <= n; i += 4) {
+            unsigned char *w = g->bin + off + i, t0 = w[0], t1 = w[1];
+            w[0] = w[3]; w[1] = w[2]; w[2] = t1; w[3] = t0;
+        }
+    }
+    g->bin_n = off + n;
+    v = sb_elem(g, &g->views);
+    sb_printf(g, &g->views, "{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu",
+              (unsigned long)off, (unsigned long)n);
+    if (target) sb_printf(g, &g->views, ",\"target\":%d", target);
+    sb_cat(g, &g->views, "}");
+    return g->status == EVR_OK ? v : -1;
+}
+
+/* An accessor over a whole view of count elements of type ("SCALAR", "VEC3", ...);
+ * min/max (ncomp values each) or NULL. */
+static int add_accessor(evr_gltf *g, int view, int component, uint32_t count, const char *type,
+                        const float *min, const float *max, int ncomp)
+{
+    int a;
+    if (view < 0) return -1;
+    a = sb_elem(g, &g->accessors);
+    sb_printf(g, &g->accessors, "{\"bufferView\":%d,\"componentType\":%d,\"count\":%lu,\"type\":\"%s\"",
+              view, component, (unsigned long)count, type);
+    if (min && max) {
+        sb_cat(g, &g->accessors, ",\"min\":");
+        sb_nums(g, &g->accessors, min, ncomp);
+        sb_cat(g, &g->accessors, ",\"max\":");
+        sb_nums(g, &g->accessors, max, ncomp);
+    }
+    sb_cat(g, &g->accessors, "}");
+    return g->status == EVR_OK ? a : -1;
+}
+
+static int float_accessor(evr_gltf *g, const float *v, uint32_t count, int ncomp, int target,
+                          int with_bounds)
+{
+    static const char *const types[5] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
+    float mn[4] = {0, 0, 0, 0}, mx[4] = {0, 0, 0, 0};
+    uint32_t i;
+    int c;
+    for (i = 0; i < count; i++) {
+        for (c = 0; c < ncomp; c++) {
+            float x = v[(size_t)i * (size_t)ncomp + (size_t)c];
+            if (!isfinite(x)) {
+                fail(g, EVR_ERR_ARG, "non-finite value in vertex or key data");
+                return -1;
+            }
+            if (i == 0 || x < mn[c]) mn[c] = x;
+            if (i == 0 || x > mx[c]) mx[c] = x;
+        }
+    }
+    return add_accessor(g, add_view(g, v, (size_t)count * (size_t)ncomp * sizeof(float), 1, target),
+                        GLTF_FLOAT, count, types[ncomp], with_bounds ? mn : NULL,
+                        with_bounds ? mx : NULL, ncomp);
+}
+
+/* ---- public API ---- */
+
+evr_gltf *evr_gltf_new(const char *scene_name)
+{
+    evr_gltf *g = calloc(1, sizeof *g);
+    if (!g) return NULL;
+    g->status = EVR_OK;
+    if (scene_name && *scene_name) {
+        g->scene_name = dup_str(g, scene_name);
+        if (!g->scene_name) {
+            free(g);
+            return NULL;
+        }
+    }
+    return g;
+}
+
+void evr_gltf_free(evr_gltf *g)
+{
+    int i;
+    if (!g) return;
+    free(g->scene_name);
+    free(g->bin);
+    sb_free(&g->accessors);
+    sb_free(&g->views);
+    sb_free(&g->meshes);
+    sb_free(&g->materials);
+    sb_free(&g->textures);
+    sb_free(&g->images);
+    sb_free(&g->cameras);
+    sb_free(&g->lights);
+    for (i = 0; i < g->num_nodes; i++) free(g->nodes[i].name);
+    free(g->nodes);
+    for (i = 0; i < g->num_anims; i++) {
+        free(g->anims[i].name);
+        sb_free(&g->anims[i].channels);
+        sb_free(&g->anims[i].samplers);
+        free(g->anims[i].targets);
+    }
+    free(g->anims);
+    free(g);
+}
+
+evr_status evr_gltf_status(const evr_gltf *g, evr_error *err)
+{
+    if (err && g->status != EVR_OK) snprintf(err->msg, sizeof err->msg, "%s", g->msg);
+    return g->status;
+}
+
+static int check_name(evr_gltf *g, const char *what, const char *name)
+{
+    if (g->status != EVR_OK) return 0;
+    if (!name || !*name) {
+        fail(g, EVR_ERR_ARG, "every %s needs a name", what);
+        return 0;
+    }
+    return 1;
+}
+
+int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width, int height,
+                         int channels)
+{
+    void *png = NULL;
+    size_t png_n = 0;
+    evr_error e;
+    evr_status st;
+    int view, img, tex;
+    if (!check_name(g, "texture", name)) return -1;
+    if (!pixels || (channels != 3 && channels != 4) || width <= 0 || height <= 0) {
+        fail(g, EVR_ERR_ARG, "texture \"%s\": bad image %dx%d with %d channels", name, width, height, channels);
+        return -1;
+    }
+    e.msg[0] = 0;
+    st = evr_png_encode(pixels, width, height, channels, 8, &png, &png_n, &e);
+    if (st != EVR_OK) {
+        fail(g, st, "texture \"%s\": %s", name, e.msg);
+        return -1;
+    }
+    view = add_view(g, png, png_n, 0, 0);
+    free(png);
+    if (view < 0) return -1;
+    g->has_sampler = 1;
+    img = sb_elem(g, &g->images);
+    sb_cat(g, &g->images, "{\"name\":");
+    sb_str(g, &g->images, name);
+    sb_printf(g, &g->images, ",\"mimeType\":\"image/png\",\"bufferView\":%d}", view);
+    tex = sb_elem(g, &g->textures);
+    sb_cat(g, &g->textures, "{\"name\":");
+    sb_str(g, &g->textures, name);
+    sb_printf(g, &g->textures, ",\"sampler\":0,\"source\":%d}", img);
+    return g->status == EVR_OK ? tex : -1;
+}
+
+void evr_gltf_material_init(evr_gltf_material *m, const char *name)
+{
+    memset(m, 0, sizeof *m);
+    m->name = name;
+    m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
+    m->base_texture = -1;
+    m->metallic = 0.0f;
+    m->roughness = 1.0f;
+}
+
+static int unit_range(const float *v, int n)
+{
+    int i;
+    for (i = 0; i < n; i++)
+        if (!(v[i] >= 0.0f && v[i] <= 1.0f)) return 0;
+    return 1;
+}
+
+int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m)
+{
+    sbuf *b = &g->materials;
+    int idx;
+    if (!check_name(g, "material", m->name)) return -1;
+    if (!unit_range(m->base_color, 4) || !unit_range(&m->metallic, 1) || !unit_range(&m->roughness, 1) ||
+        !unit_range(m->emissive, 3)) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": colour, metallic, roughness and emissive factors must lie in [0,1]",
+             m->name);
+        return -1;
+    }
+    if (m->base_texture < -1 || m->base_texture >= g->textures.count) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": no texture %d", m->name, m->base_texture);
+        return -1;
+    }
+    idx = sb_elem(g, b);
+    sb_cat(g, b, "{\"name\":");
+    sb_str(g, b, m->name);
+    sb_cat(g, b, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
+    sb_nums(g, b, m->base_color, 4);
+    if (m->base_texture >= 0) sb_printf(g, b, ",\"baseColorTexture\":{\"index\":%d}", m->base_texture);
+    sb_cat(g, b, ",\"metallicFactor\":");
+    sb_num(g, b, m->metallic);
+    sb_cat(g, b, ",\"roughnessFactor\":");
+    sb_num(g, b, m->roughness);
+    sb_cat(g, b, "}");
+    if (m->emissive[0] > 0.0f || m->emissive[1] > 0.0f || m->emissive[2] > 0.0f) {
+        sb_cat(g, b, ",\"emissiveFactor\":");
+        sb_nums(g, b, m->emissive, 3);
+    }
+    if (m->double_sided) sb_cat(g, b, ",\"doubleSided\":true");
+    sb_cat(g, b, "}");
+    return g->status == EVR_OK ? idx : -1;
+}
+
+int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const float *normals,
+                  const float *texcoords, uint32_t num_vertices, const uint32_t *indices,
+                  uint32_t num_indices, int material)
+{
+    sbuf *b = &g->meshes;
+    int apos, anrm = -1, auv = -1, aidx, idx;
+    uint32_t i;
+    if (!check_name(g, "mesh", name)) return -1;
+    if (!positions || !indices || num_vertices == 0 || num_indices == 0 || num_indices % 3 != 0) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": needs positions and a multiple of 3 indices", name);
+        return -1;
+    }
+    if (material < -1 || material >= g->materials.count) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": no material %d", name, material);
+        return -1;
+    }
+    for (i = 0; i < num_indices; i++) {
+        if (indices[i] >= num_vertices) {
+            fail(g, EVR_ERR_ARG, "mesh \"%s\": index %lu out of range", name, (unsigned long)indices[i]);
+            return -1;
+        }
+    }
+    apos = float_accessor(g, positions, num_vertices, 3, GLTF_ARRAY_BUFFER, 1);
+    if (normals) anrm = float_accessor(g, normals, num_vertices, 3, GLTF_ARRAY_BUFFER, 0);
+    if (texcoords) auv = float_accessor(g, texcoords, num_vertices, 2, GLTF_ARRAY_BUFFER, 0);
+    aidx = add_accessor(g, add_view(g, indices, (size_t)num_indices * sizeof(uint32_t), 1,
+                                    GLTF_ELEMENT_ARRAY_BUFFER),
+                        GLTF_UINT, num_indices, "SCALAR", NULL, NULL, 1);
+    if (g->status != EVR_OK) return -1;
+    idx = sb_elem(g, b);
+    sb_cat(g, b, "{\"name\":");
+    sb_str(g, b, name);
+    sb_printf(g, b, ",\"primitives\":[{\"attributes\":{\"POSITION\":%d", apos);
+    if (anrm >= 0) sb_printf(g, b, ",\"NORMAL\":%d", anrm);
+    if (auv >= 0) sb_printf(g, b, ",\"TEXCOORD_0\":%d", auv);
+    sb_printf(g, b, "},\"indices\":%d", aidx);
+    if (material >= 0) sb_printf(g, b, ",\"material\":%d", material);
+    sb_cat(g, b, ",\"mode\":4}]}");
+    return g->status == EVR_OK ? idx : -1;
+}
+
+int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear, float zfar)
+{
+    sbuf *b = &g->cameras;
+    int idx;
+    if (!check_name(g, "camera", name)) return -1;
+    if (!(yfov > 0.0f && yfov < 3.14159265f) || !(znear > 0.0f) || !isfinite(aspect) ||
+        (zfar > 0.0f && !(zfar > znear))) {
+        fail(g, EVR_ERR_ARG, "camera \"%s\": needs 0 < yfov < pi, znear > 0, zfar > znear", name);
+        return -1;
+    }
+    idx = sb_elem(g, b);
+    sb_cat(g, b, "{\"name\":");
+    sb_str(g, b, name);
+    sb_cat(g, b, ",\"type\":\"perspective\",\"perspective\":{\"yfov\":");
+    sb_num(g, b, yfov);
+    if (aspect > 0.0f) {
+        sb_cat(g, b, ",\"aspectRatio\":");
+        sb_num(g, b, aspect);
+    }
+    sb_cat(g, b, ",\"znear\":");
+    sb_num(g, b, znear);
+    if (zfar > 0.0f) {
+        sb_cat(g, b, ",\"zfar\":");
+        sb_num(g, b, zfar);
+    }
+    sb_cat(g, b, "}}");
+    return g->status == EVR_OK ? idx : -1;
+}
+
+int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, const float color[3],
+                   float intensity, float inner_cone, float outer_cone)
+{
+    static const char *const types[3] = {"point", "spot", "directional"};
+    static const float white[3] = {1.0f, 1.0f, 1.0f};
+    sbuf *b = &g->lights;
+    int idx;
+    if (!check_name(g, "light", name)) return -1;
+    if (!color) color = white;
+    if ((int)type < 0 || (int)type > 2 || !(intensity >= 0.0f) || !isfinite(intensity) ||
+        !unit_range(color, 3)) {
+        fail(g, EVR_ERR_ARG, "light \"%s\": bad type, colour or intensity", name);
+        return -1;
+    }
+    if (type == EVR_GLTF_SPOT && !(inner_cone >= 0.0f && inner_cone < outer_cone && outer_cone <= 1.5707964f)) {
+        fail(g, EVR_ERR_ARG, "light \"%s\": spot cone angles need 0 <= inner < outer <= pi/2", name);
+        return -1;
+    }
+    idx = sb_elem(g, b);
+    sb_cat(g, b, "{\"name\":");
+    sb_str(g, b, name);
+    sb_printf(g, b, ",\"type\":\"%s\",\"color\":", types[type]);
+    sb_nums(g, b, color, 3);
+    sb_cat(g, b, ",\"intensity\":");
+    sb_num(g, b, intensity);
+    if (type == EVR_GLTF_SPOT) {
+        sb_cat(g, b, ",\"spot\":{\"innerConeAngle\":");
+        sb_num(g, b, inner_cone);
+        sb_cat(g, b, ",\"outerConeAngle\":");
+        sb_num(g, b, outer_cone);
+        sb_cat(g, b, "}");
+    }
+    sb_cat(g, b, "}");
+    return g->status == EVR_OK ? idx : -1;
+}
+
+int evr_gltf_node(evr_gltf *g, const char *name, int parent)
+{
+    gnode *n;
+    if (!check_name(g, "node", name)) return -1;
+    if (parent < -1 || parent >= g->num_nodes) {
+        fail(g, EVR_ERR_ARG, "node \"%s\": no parent node %d", name, parent);
+        return -1;
+    }
+    if (!grow_int(g, (void **)&g->nodes, sizeof *g->nodes, g->num_nodes + 1, &g->cap_nodes)) return -1;
+    n = &g->nodes[g->num_nodes];
+    memset(n, 0, sizeof *n);
+    n->name = dup_str(g, name);
+    if (!n->name) return -1;
+    n->parent = parent;
+    n->mesh = n->camera = n->light = -1;
+    n->r[3] = 1.0f;
+    n->s[0] = n->s[1] = n->s[2] = 1.0f;
+    return g->num_nodes++;
+}
+
+static gnode *node_ref(evr_gltf *g, int node)
+{
+    if (g->status != EVR_OK) return NULL;
+    if (node < 0 || node >= g->num_nodes) {
+        fail(g, EVR_ERR_ARG, "no node %d", node);
+        return NULL;
+    }
+    return &g->nodes[node];
+}
+
+void evr_gltf_node_translation(evr_gltf *g, int node, float x, float y, float z)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    n->t[0] = x; n->t[1] = y; n->t[2] = z;
+    n->has_t = 1;
+}
+
+void evr_gltf_node_rotation(evr_gltf *g, int node, float x, float y, float z, float w)
+{
+    gnode *n = node_ref(g, node);
+    float l = sqrtf(x * x + y * y + z * z + w * w);
+    if (!n) return;
+    if (!(fabsf(l - 1.0f) < 1e-3f)) {
+        fail(g, EVR_ERR_ARG, "node \"%s\": rotation is not a unit quaternion", n->name);
+        return;
+    }
+    n->r[0] = x / l; n->r[1] = y / l; n->r[2] = z / l; n->r[3] = w / l;
+    n->has_r = 1;
+}
+
+void evr_gltf_node_scale(evr_gltf *g, int node, float x, float y, float z)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    n->s[0] = x; n->s[1] = y; n->s[2] = z;
+    n->has_s = 1;
+}
+
+void evr_gltf_node_mesh(evr_gltf *g, int node, int mesh)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    if (mesh < 0 || mesh >= g->meshes.count) fail(g, EVR_ERR_ARG, "node \"%s\": no mesh %d", n->name, mesh);
+    else n->mesh = mesh;
+}
+
+void evr_gltf_node_camera(evr_gltf *g, int node, int camera)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    if (camera < 0 || camera >= g->cameras.count) fail(g, EVR_ERR_ARG, "node \"%s\": no camera %d", n->name, camera);
+    else n->camera = camera;
+}
+
+void evr_gltf_node_light(evr_gltf *g, int node, int light)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    if (light < 0 || light >= g->lights.count) fail(g, EVR_ERR_ARG, "node \"%s\": no light %d", n->name, light);
+    else n->light = light;
+}
+
+int evr_gltf_animation(evr_gltf *g, const char *name)
+{
+    ganim *a;
+    if (!check_name(g, "animation", name)) return -1;
+    if (!grow_int(g, (void **)&g->anims, sizeof *g->anims, g->num_anims + 1, &g->cap_anims)) return -1;
+    a = &g->anims[g->num_anims];
+    memset(a, 0, sizeof *a);
+    a->name = dup_str(g, name);
+    if (!a->name) return -1;
+    return g->num_anims++;
+}
+
+void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, const float *times,
+                      const float *values, int count, evr_gltf_interp interp)
+{
+    static const char *const paths[3] = {"translation", "rotation", "scale"};
+    ganim *a;
+    int ncomp, i, in, out, s, target;
+    if (g->status != EVR_OK) return;
+    if (animation < 0 || animation >= g->num_anims || node < 0 || node >= g->num_nodes ||
+        (int)path < 0 || (int)path > 2 || (interp != EVR_GLTF_LINEAR && interp != EVR_GLTF_STEP) ||
+        !times || !values || count < 1) {
+        fail(g, EVR_ERR_ARG, "channel: bad animation, node, path, interpolation or keys");
+        return;
+    }
+    a = &g->anims[animation];
+    ncomp = path == EVR_GLTF_ROTATION ? 4 : 3;
+    target = node * 3 + (int)path;
+    for (i = 0; i < a->num_targets; i++) {
+        if (a->targets[i] == target) {
+            fail(g, EVR_ERR_ARG, "animation \"%s\": node \"%s\" has two %s channels", a->name,
+                 g->nodes[node].name, paths[path]);
+            return;
+        }
+    }
+    for (i = 0; i < count; i++) {
+        if (!(times[i] >= 0.0f) || !isfinite(times[i]) || (i > 0 && !(times[i] > times[i - 1]))) {
+            fail(g, EVR_ERR_ARG, "animation \"%s\": key times must be finite, >= 0 and increasing", a->name);
+            return;
+        }
+        if (path == EVR_GLTF_ROTATION) {
+            const float *q = values + 4 * (size_t)i;
+            float l = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+            if (!(fabsf(l - 1.0f) < 1e-3f)) {
+                fail(g, EVR_ERR_ARG, "animation \"%s\": rotation key %d is not a unit quaternion", a->name, i);
+                return;
+            }
+        }
+    }
+    if (!grow_int(g, (void **)&a->targets, sizeof *a->targets, a->num_targets + 1, &a->cap_targets)) return;
+    a->targets[a->num_targets++] = target;
+    in = float_accessor(g, times, (uint32_t)count, 1, 0, 1);       /* input needs min/max */
+    out = float_accessor(g, values, (uint32_t)count, ncomp, 0, 0);
+    if (g->status != EVR_OK) return;
+    s = sb_elem(g, &a->samplers);
+    sb_printf(g, &a->samplers, "{\"input\":%d,\"output\":%d,\"interpolation\":\"%s\"}", in, out,
+              interp == EVR_GLTF_STEP ? "STEP" : "LINEAR");
+    sb_elem(g, &a->channels);
+    sb_printf(g, &a->channels, "{\"sampler\":%d,\"target\":{\"node\":%d,\"path\":\"%s\"}}", s, node, paths[path]);
+}
+
+/* ---- serialization ---- */
+
+static void put_array(evr_gltf *g, sbuf *j, const char *key, const sbuf *arr)
+{
+    if (!arr->count) return;
+    sb_printf(g, j, ",\"%s\":[", key);
+    sb_cat_n(g, j, arr->p, arr->n);
+    sb_cat(g, j, "]");
+}
+
+static void put_node(evr_gltf *g, sbuf *j, int i)
+{
+    const gnode *n = &g->nodes[i];
+    int c, first = 1;
+    sb_cat(g, j, "{\"name\":");
+    sb_str(g, j, n->name);
+    for (c = i + 1; c < g->num_nodes; c++) {   /* children always come after their parent */
+        if (g->nodes[c].parent != i) continue;
+        sb_printf(g, j, first ? ",\"children\":[%d" : ",%d", c);
+        first = 0;
+    }
+    if (!first) sb_cat(g, j, "]");
+    if (n->mesh >= 0) sb_printf(g, j, ",\"mesh\":%d", n->mesh);
+    if (n->camera >= 0) sb_printf(g, j, ",\"camera\":%d", n->camera);
+    if (n->has_t) {
+        sb_cat(g, j, ",\"translation\":");
+        sb_nums(g, j, n->t, 3);
+    }
+    if (n->has_r) {
+        sb_cat(g, j, ",\"rotation\":");
+        sb_nums(g, j, n->r, 4);
+    }
+    if (n->has_s) {
+        sb_cat(g, j, ",\"scale\":");
+        sb_nums(g, j, n->s, 3);
+    }
+    if (n->light >= 0) sb_printf(g, j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
+    sb_cat(g, j, "}");
+}
+
+static void put_u32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)(v & 0xff);
+    p[1] = (unsigned char)((v >> 8) & 0xff);
+    p[2] = (unsigned char)((v >> 16) & 0xff);
+    p[3] = (unsigned char)((v >> 24) & 0xff);
+}
+
+evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
+{
+    sbuf j = {NULL, 0, 0, 0};
+    size_t json_len, bin_len, total;
+    unsigned char *out, *p;
+    int i, first;
+    *glb = NULL;
+    *size = 0;
+    for (i = 0; i < g->num_anims && g->status == EVR_OK; i++)
+        if (!g->anims[i].channels.count) fail(g, EVR_ERR_ARG, "animation \"%s\" has no channels", g->anims[i].name);
+    if (g->status != EVR_OK) return evr_gltf_status(g, err);
+
+    sb_cat(g, &j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"evray gltf_writer\"}");
+    if (g->lights.count) {
+        sb_cat(g, &j, ",\"extensionsUsed\":[\"KHR_lights_punctual\"]");
+        sb_cat(g, &j, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
+        sb_cat_n(g, &j, g->lights.p, g->lights.n);
+        sb_cat(g, &j, "]}}");
+    }
+    sb_cat(g, &j, ",\"scene\":0,\"scenes\":[{");
+    if (g->scene_name) {
+        sb_cat(g, &j, "\"name\":");
+        sb_str(g, &j, g->scene_name);
+    }
+    for (i = 0, first = 1; i < g->num_nodes; i++) {
+        if (g->nodes[i].parent >= 0) continue;
+        if (first) sb_printf(g, &j, "%s\"nodes\":[%d", g->scene_name ? "," : "", i);
+        else sb_printf(g, &j, ",%d", i);
+        first = 0;
+    }
+    sb_cat(g, &j, first ? "}]" : "]}]");
+    if (g->num_nodes) {
+        sb_cat(g, &j, ",\"nodes\":[");
+        for (i = 0; i < g->num_nodes; i++) {
+            if (i) sb_cat(g, &j, ",");
+            put_node(g, &j, i);
+        }
+        sb_cat(g, &j, "]");
+    }
+    put_array(g, &j, "meshes", &g->meshes);
+    put_array(g, &j, "materials", &g->materials);
+    put_array(g, &j, "textures", &g->textures);
+    put_array(g, &j, "images", &g->images);
+    if (g->has_sampler)
+        sb_printf(g, &j, ",\"samplers\":[{\"magFilter\":%d,\"minFilter\":%d,\"wrapS\":%d,\"wrapT\":%d}]",
+                  GLTF_LINEAR, GLTF_LINEAR, GLTF_REPEAT, GLTF_REPEAT);
+    put_array(g, &j, "cameras", &g->cameras);
+    if (g->num_anims) {
+        sb_cat(g, &j, ",\"animations\":[");
+        for (i = 0; i < g->num_anims; i++) {
+            const ganim *a = &g->anims[i];
+            if (i) sb_cat(g, &j, ",");
+            sb_cat(g, &j, "{\"name\":");
+            sb_str(g, &j, a->name);
+            sb_cat(g, &j, ",\"channels\":[");
+            sb_cat_n(g, &j, a->channels.p, a->channels.n);
+            sb_cat(g, &j, "],\"samplers\":[");
+            sb_cat_n(g, &j, a->samplers.p, a->samplers.n);
+            sb_cat(g, &j, "]}");
+        }
+        sb_cat(g, &j, "]");
+    }
+    put_array(g, &j, "accessors", &g->accessors);
+    put_array(g, &j, "bufferViews", &g->views);
+    bin_len = (g->bin_n + 3) & ~(size_t)3;
+    if (bin_len) sb_printf(g, &j, ",\"buffers\":[{\"byteLength\":%lu}]", (unsigned long)bin_len);
+    sb_cat(g, &j, "}");
+    if (g->status != EVR_OK) {
+        sb_free(&j);
+        return evr_gltf_status(g, err);
+    }
+
+    json_len = (j.n + 3) & ~(size_t)3;
+    total = 12 + 8 + json_len + (bin_len ? 8 + bin_len : 0);
+    if (total > 0xffffffffu) {
+        sb_free(&j);
+        fail(g, EVR_ERR_ARG, "scene larger than 4 GiB");
+        return evr_gltf_status(g, err);
+    }
+    out = malloc(total);
+    if (!out) {
+        sb_free(&j);
+        if (err) snprintf(err->msg, sizeof err->msg, "gltf: out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    p = out;
+    memcpy(p, "glTF", 4);
+    put_u32(p + 4, 2);
+    put_u32(p + 8, (uint32_t)total);
+    p += 12;
+    put_u32(p, (uint32_t)json_len);
+    memcpy(p + 4, "JSON", 4);
+    memcpy(p + 8, j.p, j.n);
+    memset(p + 8 + j.n, ' ', json_len - j.n);
+    p += 8 + json_len;
+    if (bin_len) {
+        put_u32(p, (uint32_t)bin_len);
+        memcpy(p + 4, "BIN\0", 4);
+        memcpy(p + 8, g->bin, g->bin_n);
+        memset(p + 8 + g->bin_n, 0, bin_len - g->bin_n);
+    }
+    sb_free(&j);
+    *glb = out;
+    *size = total;
+    return EVR_OK;
+}

@@ -1,0 +1,99 @@
+/* A small builder for glTF 2.0 scenes, serialized to binary glTF (GLB).
+ *
+ * The built-in scenes are generated with it and then imported through Assimp like any user file,
+ * so that the demo exercises the same path as real scenes and can be exported as-is.
+ *
+ *     evr_gltf *g = evr_gltf_new("my scene");
+ *     int tex = evr_gltf_texture_png(g, "checker", pixels, 64, 64, 3);
+ *     evr_gltf_material m;
+ *     evr_gltf_material_init(&m, "paint");
+ *     m.base_texture = tex;
+ *     int mat = evr_gltf_add_material(g, &m);
+ *     int mesh = evr_gltf_mesh(g, "quad", pos, nrm, uv, 4, idx, 6, mat);
+ *     int node = evr_gltf_node(g, "quad", -1);
+ *     evr_gltf_node_mesh(g, node, mesh);
+ *     evr_gltf_node_translation(g, node, 0, 0, -2);
+ *     ...
+ *     st = evr_gltf_glb(g, &bytes, &size, err);
+ *     evr_gltf_free(g);
+ *
+ * Every function returning an index returns -1 on failure; the first failure is remembered
+ * (later calls do nothing) and reported by evr_gltf_glb, so callers check once at the end.
+ * All arrays passed in are copied. Names are required (non-empty) on everything named.
+ * Units and conventions are glTF's: metres, +Y up, right-handed, cameras and lights look along
+ * their node's -Z, quaternions in x, y, z, w order, texture coordinates with (0,0) at the
+ * top-left of the image, times in seconds. */
+#ifndef EVR_SCENE_GLTF_WRITER_H
+#define EVR_SCENE_GLTF_WRITER_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "evray.h"
+
+typedef struct evr_gltf evr_gltf;
+
+typedef enum { EVR_GLTF_POINT = 0, EVR_GLTF_SPOT = 1, EVR_GLTF_DIRECTIONAL = 2 } evr_gltf_light_type;
+typedef enum { EVR_GLTF_TRANSLATION = 0, EVR_GLTF_ROTATION = 1, EVR_GLTF_SCALE = 2 } evr_gltf_path;
+typedef enum { EVR_GLTF_LINEAR = 0, EVR_GLTF_STEP = 1 } evr_gltf_interp;
+
+/* A metallic-roughness material; base_color is linear RGBA, multiplied by the texture. */
+typedef struct {
+    const char *name;
+    float base_color[4];
+    int base_texture;          /* texture index from evr_gltf_texture_png, -1: none */
+    float metallic, roughness;
+    float emissive[3];         /* linear RGB */
+    int double_sided;
+} evr_gltf_material;
+
+/* Returns NULL when out of memory. scene_name may be NULL. */
+evr_gltf *evr_gltf_new(const char *scene_name);
+void evr_gltf_free(evr_gltf *g);
+
+/* Encodes 8-bit pixels (rows top to bottom, sRGB-encoded colour; channels 3 or 4) as a PNG
+ * stored in the BIN chunk, with an image, and a texture that samples it with linear filtering
+ * and repeat wrapping. Returns the texture index. */
+int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width, int height,
+                         int channels);
+
+/* Defaults: white, no texture, metallic 0, roughness 1, no emission, single-sided. */
+void evr_gltf_material_init(evr_gltf_material *m, const char *name);
+int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m);
+
+/* One triangle primitive. positions: 3 floats per vertex; normals (3, unit) and texcoords
+ * (2, TEXCOORD_0) per vertex or NULL; indices: 3 per triangle, uint32. */
+int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const float *normals,
+                  const float *texcoords, uint32_t num_vertices, const uint32_t *indices,
+                  uint32_t num_indices, int material);
+
+/* Perspective camera; yfov in radians; aspect <= 0: not given; zfar <= 0: infinite. */
+int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear, float zfar);
+
+/* KHR_lights_punctual light. color: linear RGB (NULL: white); intensity in candela (point,
+ * spot) or lux (directional); cone half-angles in radians (spot only; 0 <= inner < outer <= pi/2). */
+int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, const float color[3],
+                   float intensity, float inner_cone, float outer_cone);
+
+/* A node; parent is an existing node index or -1 for a root of the scene. */
+int evr_gltf_node(evr_gltf *g, const char *name, int parent);
+void evr_gltf_node_translation(evr_gltf *g, int node, float x, float y, float z);
+void evr_gltf_node_rotation(evr_gltf *g, int node, float x, float y, float z, float w);  /* unit */
+void evr_gltf_node_scale(evr_gltf *g, int node, float x, float y, float z);
+void evr_gltf_node_mesh(evr_gltf *g, int node, int mesh);
+void evr_gltf_node_camera(evr_gltf *g, int node, int camera);
+void evr_gltf_node_light(evr_gltf *g, int node, int light);
+
+/* An animation, then its channels: one sampler each, count keys with strictly increasing times
+ * (seconds, >= 0) and values 3 (translation, scale) or 4 (rotation x y z w) floats per key. */
+int evr_gltf_animation(evr_gltf *g, const char *name);
+void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, const float *times,
+                      const float *values, int count, evr_gltf_interp interp);
+
+/* The first failure so far (EVR_OK if none), its message copied into err when err is not NULL. */
+evr_status evr_gltf_status(const evr_gltf *g, evr_error *err);
+
+/* Serializes to GLB: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded), all
+ * 4-byte aligned. *glb is malloc'ed; free() it. The builder stays usable afterwards. */
+evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err);
+
+#endif

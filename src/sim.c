@@ -1,0 +1,243 @@
+/* The segment loop: scene motion per segment -> backend -> time-ordered events -> writers,
+ * previews and run statistics. */
+#include "sim_internal.h"
+#include "config_json.h"
+#include "io/json.h"
+#include "io/preview.h"
+#include "run_files.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+const char *evr_version(void) { return EVR_VERSION; }
+
+static evr_status nomem(evr_error *err)
+{
+    snprintf(err->msg, sizeof err->msg, "out of memory");
+    return EVR_ERR_NOMEM;
+}
+
+static void mark_used(evr_sim *sim, int node)
+{
+    /* a node's motion depends on its ancestors, but keys are computed for the node's world
+     * transform, so only the node itself needs a track */
+    if (node >= 0) sim->node_used[node] = 1;
+}
+
+evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err)
+{
+    evr_status st;
+    int i;
+    *out = NULL;
+    if ((st = evr_config_validate(c, s, err)) != EVR_OK) return st;
+    evr_sim *sim = calloc(1, sizeof *sim);
+    if (!sim) return nomem(err);
+    sim->scene = s;
+    sim->cfg = *c;
+    snprintf(sim->out_dir, sizeof sim->out_dir, "%s", c->out_dir);
+    sim->cfg.out_dir = sim->out_dir;
+    sim->cfg.camera = NULL;   /* not owned; the index below is what counts */
+    sim->camera = c->camera ? evr_scene_find_camera(s, c->camera) : 0;
+    sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
+    if (c->duration > 0.0) sim->duration = c->duration;
+    else if (s->anim_end > c->start) sim->duration = s->anim_end - c->start;
+    else sim->duration = 1.0;   /* a static scene: one second unless told */
+    sim->num_segments = (int)ceil(sim->duration * sim->fps - 1e-9);
+    if (sim->num_segments < 1) sim->num_segments = 1;
+
+    if ((st = evr_render_host_init(&sim->host, s, sim->camera, c->width, c->height, c->ambient, err)) != EVR_OK) {
+        free(sim);
+        return st;
+    }
+    sim->setup.width = c->width;
+    sim->setup.height = c->height;
+    sim->setup.samples_per_frame = c->samples_per_frame;
+    sim->setup.seed = c->seed;
+    sim->setup.pixel.pos_thres = c->pos_thres;
+    sim->setup.pixel.neg_thres = c->neg_thres;
+    sim->setup.pixel.refractory = c->refractory;
+    sim->setup.pixel.log_floor = c->log_floor;
+    sim->setup.threads = c->threads;
+
+    int ntracks = s->num_nodes + 1;
+    sim->keys = malloc(sizeof *sim->keys * (size_t)ntracks * EVR_MAX_KEYS);
+    sim->track_offset = malloc(sizeof(int) * (size_t)ntracks);
+    sim->track_count = malloc(sizeof(int) * (size_t)ntracks);
+    sim->node_used = calloc((size_t)ntracks, sizeof(int));
+    if (!sim->keys || !sim->track_offset || !sim->track_count || !sim->node_used) {
+        evr_sim_release(sim);
+        return nomem(err);
+    }
+    for (i = 0; i < s->num_instances; i++) mark_used(sim, s->instances[i].node);
+    for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
+    mark_used(sim, s->cameras[sim->camera].node);
+
+    sim->config_json = evr_config_to_json(&sim->cfg, sim->duration, sim->fps, s->source,
+                                          s->cameras[sim->camera].name, 0);
+    if (!sim->config_json) {
+        evr_sim_release(sim);
+        return nomem(err);
+    }
+    if ((st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+        evr_sim_release(sim);
+        return st;
+    }
+    if ((st = evr_cpu_backend_new(s, &sim->host, &sim->setup, &sim->backend, err)) != EVR_OK ||
+        (st = evr_run_writers_open(sim, err)) != EVR_OK) {
+        evr_run_dir_discard(sim);
+        evr_sim_release(sim);
+        return st;
+    }
+    sim->st.segments_total = sim->num_segments;
+    sim->last_t = INT64_MIN;
+    *out = sim;
+    return EVR_OK;
+}
+
+/* Motion keys of every used node over [t0, t1]; the extra last track is the fixed world frame. */
+static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
+{
+    const evr_scene *s = sim->scene;
+    int i, off = 0;
+    float tol = 1e-5f;
+    for (i = 0; i <= s->num_nodes; i++) {
+        evr_motion_key *k = sim->keys + off;
+        int n = 1;
+        if (i < s->num_nodes && sim->node_used[i]) {
+            n = evr_node_motion_keys(s, i, t0, t1, tol, k, EVR_MAX_KEYS);
+        } else {
+            evr_m34 id = evr_m34_identity();
+            *k = evr_motion_key_from_matrix(&id);
+        }
+        sim->track_offset[i] = off;
+        sim->track_count[i] = n;
+        off += n;
+    }
+    seg->keys = sim->keys;
+    seg->track_offset = sim->track_offset;
+    seg->track_count = sim->track_count;
+    seg->camera_static = sim->track_count[sim->host.rs.camera_track] == 1;
+}
+
+/* Hands events up to (not including) limit_us to the writers and statistics. */
+static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
+{
+    evr_event_vec *v = &sim->pending;
+    size_t n = 0, i;
+    int w;
+    evr_status st;
+    while (n < v->n && v->data[n].t < limit_us) n++;
+    if (n == 0) return EVR_OK;
+    double t = now_seconds();
+    for (i = 0; i < n; i++) {
+        const evr_event *e = &v->data[i];
+        if (e->p) sim->st.events_on++;
+        else sim->st.events_off++;
+        if (e->t != sim->last_t) sim->st.unique_timestamps++;
+        sim->last_t = e->t;
+    }
+    for (w = 0; w < sim->num_writers; w++) {
+        if ((st = sim->writers[w]->write(sim->writers[w], v->data, n, err)) != EVR_OK) return st;
+    }
+    sim->time_write += now_seconds() - t;
+    t = now_seconds();
+    if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
+    sim->time_preview += now_seconds() - t;
+    memmove(v->data, v->data + n, (v->n - n) * sizeof *v->data);
+    v->n -= n;
+    return EVR_OK;
+}
+
+evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    double wall0 = now_seconds();
+    int i, w, stop = 0;
+    const int n = sim->cfg.samples_per_frame;
+    for (i = 0; i < sim->num_segments && !stop; i++) {
+        double t0 = sim->cfg.start + (double)i / sim->fps;
+        double t1 = i + 1 == sim->num_segments ? sim->cfg.start + sim->duration
+                                               : sim->cfg.start + (double)(i + 1) / sim->fps;
+        evr_segment seg;
+        seg.index = i;
+        seg.t0 = t0;
+        seg.t1 = t1;
+        compute_motion(sim, t0, t1, &seg);
+        double t = now_seconds();
+        if ((st = sim->backend->render(sim->backend, &seg, &sim->pending, err)) != EVR_OK) break;
+        sim->time_render += now_seconds() - t;
+        t = now_seconds();
+        if (!evr_events_sort(&sim->pending, &sim->scratch)) { st = nomem(err); break; }
+        sim->time_sort += now_seconds() - t;
+        /* Later segments can still produce events back to every pixel's last sample here, which
+         * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
+        int last = i + 1 == sim->num_segments;
+        int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+        if ((st = emit_events(sim, safe, err)) != EVR_OK) break;
+        for (w = 0; w < sim->num_writers; w++)
+            if ((st = sim->writers[w]->flush(sim->writers[w], err)) != EVR_OK) break;
+        if (st != EVR_OK) break;
+        t = now_seconds();
+        if ((st = evr_run_preview_intensity(sim, t1, last, err)) != EVR_OK) break;
+        sim->time_preview += now_seconds() - t;
+
+        sim->st.segments_done = i + 1;
+        sim->st.samples = sim->backend->samples;
+        sim->st.rays = sim->backend->rays;
+        sim->st.sim_time = t1 - sim->cfg.start;
+        sim->st.wall_time = now_seconds() - wall0;
+        sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
+        sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
+        sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
+        if (progress && progress(user, &sim->st)) stop = 1;
+    }
+    if (st != EVR_OK) {
+        /* a failed run leaves nothing behind that looks complete */
+        evr_run_dir_discard(sim);
+        return st;
+    }
+    if (stop && sim->pending.n) {   /* interrupted: keep every event of the finished segments */
+        if ((st = emit_events(sim, INT64_MAX, err)) != EVR_OK) {
+            evr_run_dir_discard(sim);
+            return st;
+        }
+    }
+    sim->st.interrupted = stop && sim->st.segments_done < sim->num_segments;
+    sim->st.wall_time = now_seconds() - wall0;
+    if ((st = evr_run_finish(sim, err)) != EVR_OK) return st;
+    return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
+}
+
+const evr_stats *evr_sim_stats(const evr_sim *sim) { return &sim->st; }
+
+void evr_sim_release(evr_sim *sim)
+{
+    int w;
+    if (!sim) return;
+    for (w = 0; w < sim->num_writers; w++)
+        if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
+    if (sim->backend) sim->backend->release(sim->backend);
+    evr_render_host_free(&sim->host);
+    evr_event_vec_free(&sim->pending);
+    evr_event_vec_free(&sim->scratch);
+    free(sim->keys);
+    free(sim->track_offset);
+    free(sim->track_count);
+    free(sim->node_used);
+    free(sim->config_json);
+    evr_event_frame_release(&sim->preview);
+    free(sim->preview_intensity);
+    free(sim);
+}

@@ -1,0 +1,46 @@
+/* The simulation object behind evr_sim: the segment loop's state. */
+#ifndef EVR_SIM_INTERNAL_H
+#define EVR_SIM_INTERNAL_H
+
+#include "backend.h"
+#include "io/event_writer.h"
+#include "io/preview.h"
+
+#define EVR_MAX_WRITERS 3
+#define EVR_MAX_KEYS 65
+
+struct evr_sim {
+    const evr_scene *scene;
+    evr_config cfg;
+    char out_dir[4096];
+    int created_dir;
+    int camera;
+    double fps, duration;
+    int num_segments;
+    evr_render_host host;
+    evr_run_setup setup;
+    evr_backend *backend;
+    evr_event_writer *writers[EVR_MAX_WRITERS];
+    const char *writer_names[EVR_MAX_WRITERS];
+    int num_writers;
+    char *config_json;
+    /* per-segment motion */
+    evr_motion_key *keys;
+    int *track_offset, *track_count;
+    int *node_used;
+    /* events */
+    evr_event_vec pending, scratch;
+    int64_t last_t;
+    /* previews */
+    evr_event_frame preview;     /* event frame being accumulated (width 0: previews off) */
+    float *preview_intensity;
+    int64_t preview_window_us;
+    int64_t preview_frame;       /* index of the event frame being accumulated */
+    int64_t intensity_frame;     /* index of the next intensity frame due */
+    int previews_written;
+    /* statistics */
+    evr_stats st;
+    double time_render, time_sort, time_write, time_preview;
+};
+
+#endif

@@ -1,0 +1,658 @@
+/* Event writers (HDF5, text, NPY), the event reader, the JSON builder and the preview images.
+ * Python (h5py, numpy) reads the files as an independent check when it is installed. */
+#include <dirent.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <stb/stb_image.h>
+
+#include "check.h"
+#include "evray.h"
+#include "io/event_reader.h"
+#include "io/event_writer.h"
+#include "io/json.h"
+#include "io/preview.h"
+
+#define W 640
+#define H 480
+
+typedef evr_status (*open_fn)(const char *, const evr_writer_meta *, evr_event_writer **, evr_error *);
+
+static const struct { const char *ext; open_fn open; int stores_size; } formats[] = {
+    {"h5", evr_h5_writer_open, 1},
+    {"txt", evr_txt_writer_open, 0},
+    {"npy", evr_npy_writer_open, 0},
+};
+#define NFORMATS (sizeof formats / sizeof formats[0])
+
+static uint64_t rng_next(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    return *s >> 33;
+}
+
+static int file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+static int dir_entries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int n = 0;
+    if (!d) return -1;
+    while ((e = readdir(d)))
+        if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) n++;
+    closedir(d);
+    return n;
+}
+
+static void remove_tree(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    char p[1024];
+    if (!d) return;
+    while ((e = readdir(d))) {
+        struct stat st;
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+        snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+        if (stat(p, &st) == 0 && S_ISDIR(st.st_mode)) remove_tree(p);
+        else remove(p);
+    }
+    closedir(d);
+    rmdir(dir);
+}
+
+static int copy_file(const char *from, const char *to)
+{
+    FILE *a = fopen(from, "rb"), *b = a ? fopen(to, "wb") : NULL;
+    char buf[65536];
+    size_t n;
+    int ok = a && b;
+    while (ok && (n = fread(buf, 1, sizeof buf, a)) > 0) ok = fwrite(buf, 1, n, b) == n;
+    if (a) fclose(a);
+    if (b && fclose(b) != 0) ok = 0;
+    return ok;
+}
+
+/* Sorted events with runs of equal timestamps, events on exact millisecond boundaries, gaps of
+ * several empty milliseconds, and extreme coordinates. */
+static evr_event *make_events(size_t n, int64_t *last_t)
+{
+    evr_event *ev = calloc(n, sizeof *ev);
+    uint64_t s = 12345;
+    int64_t t = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t r = rng_next(&s) % 100;
+        if (i > 0) {
+            if (r < 30) t += 0;                                  /* same timestamp */
+            else if (r < 45) t = (t / 1000 + 1) * 1000;          /* next millisecond boundary */
+            else if (r < 48) t = (t / 1000 + 4) * 1000 + 999;    /* skip empty milliseconds */
+            else t += (int64_t)(rng_next(&s) % 300) + 1;
+        }
+        ev[i].t = t;
+        ev[i].x = (uint16_t)(rng_next(&s) % W);
+        ev[i].y = (uint16_t)(rng_next(&s) % H);
+        ev[i].p = (int8_t)(rng_next(&s) & 1);
+    }
+    ev[n / 2].x = 65535;
+    ev[n / 2].y = 65535;
+    ev[n / 3].x = 0;
+    ev[n / 3].y = 0;
+    *last_t = t;
+    return ev;
+}
+
+static int same_events(const evr_event *a, const evr_event *b, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (a[i].t != b[i].t || a[i].x != b[i].x || a[i].y != b[i].y || a[i].p != b[i].p) {
+            fprintf(stderr, "event %zu differs: %lld %u %u %d vs %lld %u %u %d\n", i, (long long)a[i].t, a[i].x,
+                    a[i].y, a[i].p, (long long)b[i].t, b[i].x, b[i].y, b[i].p);
+            return 0;
+        }
+    return 1;
+}
+
+static char *make_config(void)
+{
+    evr_json j;
+    evr_json_init(&j, 1);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "width"); evr_json_integer(&j, W);
+    evr_json_key(&j, "height"); evr_json_integer(&j, H);
+    evr_json_key(&j, "scene"); evr_json_string(&j, "demo \"spheres\"");
+    evr_json_key(&j, "pos_thres"); evr_json_float(&j, 0.2f);
+    evr_json_end_object(&j);
+    return evr_json_take(&j);
+}
+
+/* Writes the events in uneven segments (one empty) through one writer, checking along the way
+ * that the temporary file is readable after each flush, then reads the result back. */
+static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n, int64_t duration_us,
+                        const char *config)
+{
+    char path[512], tmp[600], partial[600];
+    evr_writer_meta meta;
+    evr_event_writer *w = NULL;
+    evr_error err;
+    evr_status st;
+    size_t at = 0, seg = 0;
+    int checked_partial = 0;
+
+    meta.width = W;
+    meta.height = H;
+    meta.config_json = config;
+    snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    snprintf(partial, sizeof partial, "%s/partial.%s", dir, formats[f].ext);
+    st = formats[f].open(path, &meta, &w, &err);
+    CHECK(st == EVR_OK);
+    if (st != EVR_OK) { fprintf(stderr, "%s\n", err.msg); return; }
+    CHECK(file_exists(tmp));
+    for (;;) {
+        size_t len = seg == 3 ? 0 : (seg * 397 + 11) % 1500;   /* segment 3 is empty */
+        if (len > n - at) len = n - at;
+        st = w->write(w, ev + at, len, &err);
+        CHECK(st == EVR_OK);
+        st = w->flush(w, &err);
+        CHECK(st == EVR_OK);
+        at += len;
+        seg++;
+        CHECK(!file_exists(path));
+        /* an interrupted run keeps every flushed event: read a copy of the temporary file */
+        if (at > 0 && at > n / 2 && !checked_partial) {
+            evr_event *got = NULL;
+            size_t ngot = 0;
+            checked_partial = 1;
+            CHECK(copy_file(tmp, partial));
+            st = evr_events_read(partial, &got, &ngot, NULL, NULL, &err);
+            CHECK(st == EVR_OK);
+            if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+            CHECK(ngot == at);
+            if (st == EVR_OK && ngot == at) CHECK(same_events(got, ev, at));
+            free(got);
+            remove(partial);
+        }
+        if (at == n && seg >= 5) break;
+    }
+    CHECK(seg > 4);
+    /* out-of-order events are refused */
+    if (n > 0) {
+        evr_event early = ev[0];
+        early.t = ev[n - 1].t - 1;
+        if (early.t < ev[n - 1].t) {
+            st = w->write(w, &early, 1, &err);
+            CHECK(st == EVR_ERR_ARG);
+        }
+    }
+    st = w->finish(w, duration_us, &err);
+    CHECK(st == EVR_OK);
+    if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+    CHECK(file_exists(path));
+    CHECK(!file_exists(tmp));
+
+    {
+        evr_event *got = NULL;
+        size_t ngot = 0;
+        int width = 0, height = 0;
+        st = evr_events_read(path, &got, &ngot, &width, &height, &err);
+        CHECK(st == EVR_OK);
+        if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+        CHECK(ngot == n);
+        if (st == EVR_OK && ngot == n) CHECK(same_events(got, ev, n));
+        CHECK(width == (formats[f].stores_size ? W : -1));
+        CHECK(height == (formats[f].stores_size ? H : -1));
+        free(got);
+    }
+}
+
+/* ms_to_idx[i] = first event with t >= i ms, i = 0 .. ceil(duration / 1 ms). */
+static void check_ms_to_idx(const char *path, const evr_event *ev, size_t n, int64_t duration_us)
+{
+    uint64_t *idx = NULL;
+    size_t nidx = 0, expect_n = (size_t)((duration_us + 999) / 1000) + 1, bad = 0;
+    evr_error err;
+    evr_status st = evr_h5_read_ms_to_idx(path, &idx, &nidx, &err);
+    CHECK(st == EVR_OK);
+    if (st != EVR_OK) { fprintf(stderr, "%s\n", err.msg); return; }
+    CHECK(nidx == expect_n);
+    for (size_t i = 0; i < nidx; i++) {
+        size_t k = 0;
+        while (k < n && ev[k].t < (int64_t)i * 1000) k++;
+        if (idx[i] != k) bad++;
+    }
+    CHECK(bad == 0);
+    /* entries past the last event hold the count */
+    if (nidx && (n == 0 || ev[n - 1].t < (int64_t)(nidx - 1) * 1000)) CHECK(idx[nidx - 1] == n);
+    free(idx);
+}
+
+static void test_writers(const char *root, int *python_ok)
+{
+    const size_t n = 5000;
+    int64_t last_t;
+    evr_event *ev = make_events(n, &last_t);
+    char *config = make_config();
+    int64_t duration = last_t + 2500;   /* not a whole number of milliseconds */
+    char dir[512], path[600];
+    CHECK(config != NULL);
+
+    /* all events, an exact boundary count */
+    snprintf(dir, sizeof dir, "%s/full", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    for (size_t f = 0; f < NFORMATS; f++) test_format(dir, f, ev, n, duration, config);
+    snprintf(path, sizeof path, "%s/events.h5", dir);
+    check_ms_to_idx(path, ev, n, duration);
+    CHECK(dir_entries(dir) == 3);
+
+    /* a duration that ends on a millisecond, equal to the last event's time */
+    {
+        int64_t d2 = (last_t / 1000) * 1000;
+        size_t n2 = 0;
+        while (n2 < n && ev[n2].t <= d2) n2++;
+        snprintf(dir, sizeof dir, "%s/boundary", root);
+        CHECK(mkdir(dir, 0700) == 0);
+        test_format(dir, 0, ev, n2, d2, config);
+        snprintf(path, sizeof path, "%s/events.h5", dir);
+        check_ms_to_idx(path, ev, n2, d2);
+    }
+
+    /* no events at all */
+    snprintf(dir, sizeof dir, "%s/empty", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    for (size_t f = 0; f < NFORMATS; f++) test_format(dir, f, ev, 0, 0, NULL);
+    snprintf(path, sizeof path, "%s/events.h5", dir);
+    check_ms_to_idx(path, ev, 0, 0);
+
+    /* abort leaves nothing behind */
+    snprintf(dir, sizeof dir, "%s/aborted", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    for (size_t f = 0; f < NFORMATS; f++) {
+        evr_writer_meta meta = {W, H, config};
+        evr_event_writer *w = NULL;
+        snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
+        CHECK_OK(formats[f].open(path, &meta, &w, &e_));
+        if (!w) continue;
+        CHECK_OK(w->write(w, ev, n / 2, &e_));
+        CHECK_OK(w->flush(w, &e_));
+        CHECK_OK(w->write(w, ev + n / 2, 10, &e_));
+        w->abort(w);
+    }
+    CHECK(dir_entries(dir) == 0);
+
+    /* a folder that does not exist: a clear error, no crash */
+    for (size_t f = 0; f < NFORMATS; f++) {
+        evr_writer_meta meta = {W, H, config};
+        evr_event_writer *w = NULL;
+        evr_error err;
+        err.msg[0] = 0;
+        snprintf(path, sizeof path, "%s/no/such/dir/events.%s", root, formats[f].ext);
+        CHECK(formats[f].open(path, &meta, &w, &err) == EVR_ERR_IO);
+        CHECK(w == NULL);
+        CHECK(err.msg[0] != 0);
+    }
+
+    /* the reader refuses what it does not know */
+    {
+        evr_event *got = NULL;
+        size_t ngot = 0;
+        evr_error err;
+        FILE *fp;
+        CHECK(evr_events_read("x.csv", &got, &ngot, NULL, NULL, &err) == EVR_ERR_ARG);
+        snprintf(path, sizeof path, "%s/bad.txt", root);
+        fp = fopen(path, "w");
+        if (fp) { fputs("# comment\n0.000001 1 2 1\n0.5 3\n", fp); fclose(fp); }
+        CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_FORMAT);
+        CHECK(strstr(err.msg, ":3:") != NULL);
+        fp = fopen(path, "w");
+        if (fp) { fputs("# other tools' files\n\n1.5 3 4 -1\n2.0000005 5 6 1\n", fp); fclose(fp); }
+        CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_OK);
+        CHECK(ngot == 2);
+        if (ngot == 2) {
+            CHECK(got[0].t == 1500000 && got[0].x == 3 && got[0].y == 4 && got[0].p == 0);
+            CHECK(got[1].t == 2000001 && got[1].p == 1);
+        }
+        free(got);
+        got = NULL;
+        snprintf(path, sizeof path, "%s/bad.npy", root);
+        fp = fopen(path, "w");
+        if (fp) { fputs("not numpy", fp); fclose(fp); }
+        CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_FORMAT);
+        snprintf(path, sizeof path, "%s/bad.h5", root);
+        CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_IO);
+        CHECK(strstr(err.msg, "bad.h5") != NULL);
+        remove(path);
+        snprintf(path, sizeof path, "%s/bad.npy", root);
+        remove(path);
+        snprintf(path, sizeof path, "%s/bad.txt", root);
+        remove(path);
+    }
+
+    /* an independent reader */
+    if (system("/usr/bin/python3 -c 'import h5py, numpy' >/dev/null 2>&1") == 0) {
+        static const char script[] =
+            "import json, sys, warnings\n"
+            "warnings.simplefilter('ignore', UserWarning)\n"
+            "import h5py, numpy as np\n"
+            "def check(d, n):\n"
+            "    with h5py.File(d + '/events.h5', 'r') as f:\n"
+            "        e = f['events']\n"
+            "        x, y, t, p = e['x'][:], e['y'][:], e['t'][:], e['p'][:]\n"
+            "        assert x.dtype == np.uint16 and y.dtype == np.uint16, (x.dtype, y.dtype)\n"
+            "        assert t.dtype == np.int64 and p.dtype == np.int8, (t.dtype, p.dtype)\n"
+            "        assert len(x) == len(y) == len(t) == len(p) == n, (len(t), n)\n"
+            "        assert np.all(np.diff(t) >= 0)\n"
+            "        assert set(np.unique(p)) <= {0, 1}\n"
+            "        ms = f['ms_to_idx'][:]\n"
+            "        assert ms.dtype == np.uint64\n"
+            "        assert np.array_equal(ms, np.searchsorted(t, np.arange(len(ms)) * 1000, 'left'))\n"
+            "        assert f['t_offset'][()] == 0 and f['t_offset'].dtype == np.int64\n"
+            "        assert int(f.attrs['width']) == 640 and int(f.attrs['height']) == 480\n"
+            "        assert int(f.attrs['complete']) == 1\n"
+            "        cfg = f.attrs['config']\n"
+            "        cfg = cfg.decode() if isinstance(cfg, bytes) else cfg\n"
+            "        json.loads(cfg)\n"
+            "        assert e['t'].compression == 'gzip' and e['t'].shuffle\n"
+            "    a = np.load(d + '/events.npy')\n"
+            "    assert a.dtype == np.dtype([('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', 'i1')]), a.dtype\n"
+            "    assert a.dtype.itemsize == 13 and a.shape == (n,), a.shape\n"
+            "    assert np.array_equal(a['t'], t) and np.array_equal(a['x'], x)\n"
+            "    assert np.array_equal(a['y'], y) and np.array_equal(a['p'], p)\n"
+            "    m = np.loadtxt(d + '/events.txt', ndmin=2).reshape(-1, 4)\n"
+            "    assert m.shape == (n, 4), m.shape\n"
+            "    assert np.array_equal(np.round(m[:, 0] * 1e6).astype(np.int64), t)\n"
+            "    assert np.array_equal(m[:, 1], x) and np.array_equal(m[:, 2], y) and np.array_equal(m[:, 3], p)\n"
+            "    assert np.all(np.diff(m[:, 0]) >= 0)\n"
+            "check(sys.argv[1] + '/full', int(sys.argv[2]))\n"
+            "check(sys.argv[1] + '/empty', 0)\n"
+            "print('python readers agree')\n";
+        char cmd[1400];
+        FILE *fp;
+        snprintf(path, sizeof path, "%s/check.py", root);
+        fp = fopen(path, "w");
+        CHECK(fp != NULL);
+        if (fp) {
+            fputs(script, fp);
+            fclose(fp);
+            snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %s %zu", path, root, n);
+            fflush(stdout);
+            CHECK(system(cmd) == 0);
+            *python_ok = 1;
+        }
+    } else {
+        printf("test_writers: python3 with h5py and numpy not found; skipping the independent reader\n");
+    }
+    free(config);
+    free(ev);
+}
+
+/* ---- JSON ---- */
+
+static void check_json(char *got, const char *expect)
+{
+    CHECK(got != NULL);
+    if (got && strcmp(got, expect) != 0) {
+        fprintf(stderr, "json: got      %s\njson: expected %s\n", got, expect);
+        CHECK(0);
+    }
+    free(got);
+}
+
+static void test_json(void)
+{
+    evr_json j;
+
+    evr_json_init(&j, 0);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "s"); evr_json_string(&j, "q\"b\\n\nt\tc\x01\x1f" "e\xc3\xa9");
+    evr_json_key(&j, "a"); evr_json_begin_array(&j);
+    evr_json_integer(&j, 1);
+    evr_json_begin_object(&j); evr_json_end_object(&j);
+    evr_json_begin_array(&j); evr_json_end_array(&j);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "k"); evr_json_begin_array(&j); evr_json_boolean(&j, 1); evr_json_boolean(&j, 0);
+    evr_json_null(&j); evr_json_end_array(&j);
+    evr_json_end_object(&j);
+    evr_json_end_array(&j);
+    evr_json_key(&j, "n"); evr_json_begin_array(&j);
+    evr_json_number(&j, 0.1); evr_json_number(&j, 1.0 / 3.0); evr_json_number(&j, 1e300);
+    evr_json_number(&j, 0.0 / 0.0); evr_json_number(&j, -1.0 / 0.0); evr_json_number(&j, -2.5);
+    evr_json_float(&j, 0.2f); evr_json_float(&j, 1e-7f);
+    evr_json_integer(&j, INT64_MIN); evr_json_unsigned(&j, UINT64_MAX);
+    evr_json_end_array(&j);
+    evr_json_key(&j, "z"); evr_json_string(&j, NULL);
+    evr_json_end_object(&j);
+    check_json(evr_json_take(&j),
+               "{\"s\":\"q\\\"b\\\\n\\nt\\tc\\u0001\\u001fe\xc3\xa9\",\"a\":[1,{},[],{\"k\":[true,false,null]}],"
+               "\"n\":[0.1,0.3333333333333333,1e+300,null,null,-2.5,0.2,1e-07,-9223372036854775808,"
+               "18446744073709551615],\"z\":null}");
+
+    evr_json_init(&j, 1);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "a"); evr_json_integer(&j, 1);
+    evr_json_key(&j, "b"); evr_json_begin_array(&j); evr_json_integer(&j, 2);
+    evr_json_begin_object(&j); evr_json_key(&j, "c"); evr_json_string(&j, "d"); evr_json_end_object(&j);
+    evr_json_end_array(&j);
+    evr_json_key(&j, "e"); evr_json_begin_object(&j); evr_json_end_object(&j);
+    evr_json_end_object(&j);
+    check_json(evr_json_take(&j), "{\n  \"a\": 1,\n  \"b\": [\n    2,\n    {\n      \"c\": \"d\"\n    }\n  ],\n"
+                                  "  \"e\": {}\n}");
+
+    /* a builder can be reused after take */
+    evr_json_begin_array(&j); evr_json_end_array(&j);
+    check_json(evr_json_take(&j), "[]");
+    evr_json_string(&j, "top");
+    check_json(evr_json_take(&j), "\"top\"");
+
+    /* misuse: value without key, key in an array, mismatched end, unclosed, two top-level values */
+    evr_json_init(&j, 0);
+    evr_json_begin_object(&j); evr_json_integer(&j, 1); evr_json_end_object(&j);
+    CHECK(evr_json_take(&j) == NULL);
+    evr_json_begin_array(&j); evr_json_key(&j, "k"); evr_json_end_array(&j);
+    CHECK(evr_json_take(&j) == NULL);
+    evr_json_begin_array(&j); evr_json_end_object(&j);
+    CHECK(evr_json_take(&j) == NULL);
+    evr_json_begin_object(&j); evr_json_key(&j, "k");
+    CHECK(evr_json_take(&j) == NULL);
+    evr_json_begin_object(&j); evr_json_key(&j, "k"); evr_json_end_object(&j);
+    CHECK(evr_json_take(&j) == NULL);
+    evr_json_integer(&j, 1); evr_json_integer(&j, 2);
+    CHECK(evr_json_take(&j) == NULL);
+    for (int i = 0; i < EVR_JSON_MAX_DEPTH + 1; i++) evr_json_begin_array(&j);
+    for (int i = 0; i < EVR_JSON_MAX_DEPTH + 1; i++) evr_json_end_array(&j);
+    CHECK(evr_json_take(&j) == NULL);
+    for (int i = 0; i < EVR_JSON_MAX_DEPTH; i++) evr_json_begin_array(&j);
+    for (int i = 0; i < EVR_JSON_MAX_DEPTH; i++) evr_json_end_array(&j);
+    {
+        char *t = evr_json_take(&j);
+        CHECK(t != NULL && strlen(t) == 2 * EVR_JSON_MAX_DEPTH);
+        free(t);
+    }
+    /* a long string grows the buffer */
+    {
+        char *big = malloc(100001), *t;
+        memset(big, 'a', 100000);
+        big[100000] = 0;
+        big[500] = '"';
+        evr_json_string(&j, big);
+        t = evr_json_take(&j);
+        CHECK(t != NULL && strlen(t) == 100003);
+        free(t);
+        free(big);
+    }
+}
+
+/* ---- previews ---- */
+
+static void test_tonemap(const char *root)
+{
+    enum { N = 4096 };
+    float *v = malloc(N * sizeof *v);
+    uint8_t *o = malloc(N);
+    evr_error err;
+    uint64_t s = 99;
+    int mono = 1;
+
+    /* random values: the map must be monotonic */
+    for (int i = 0; i < N; i++) v[i] = (float)(rng_next(&s) % 100000) * 1e-3f * (i % 7 == 0 ? 50.0f : 1.0f);
+    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
+    for (int i = 0; i < N; i++)
+        for (int k = i + 1; k < N; k += 97)
+            if ((v[i] < v[k] && o[i] > o[k]) || (v[i] > v[k] && o[i] < o[k])) mono = 0;
+    CHECK(mono);
+
+    /* a ramp: non-decreasing, black stays black, the top reaches white */
+    for (int i = 0; i < N; i++) v[i] = (float)i / (N - 1) * 10.0f;
+    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
+    mono = 1;
+    for (int i = 1; i < N; i++) if (o[i] < o[i - 1]) mono = 0;
+    CHECK(mono);
+    CHECK(o[0] == 0);
+    CHECK(o[N - 1] == 255);
+    CHECK(o[N / 2] > 0 && o[N / 2] < 255);
+
+    /* scale invariance (the key is the log-average) */
+    {
+        uint8_t *o2 = malloc(N);
+        int same = 1;
+        for (int i = 0; i < N; i++) v[i] *= 1000.0f;
+        CHECK_OK(evr_tonemap_reinhard(v, N, o2, &e_));
+        for (int i = 0; i < N; i++) if (abs((int)o[i] - (int)o2[i]) > 1) same = 0;
+        CHECK(same);
+        free(o2);
+    }
+
+    /* a few hot pixels do not darken the rest; NaN, negative and infinite values are handled */
+    for (int i = 0; i < N; i++) v[i] = 0.5f + 0.5f * (float)(i % 64) / 63.0f;
+    v[10] = 1e9f;
+    v[11] = 1e9f;
+    v[12] = 0.0f / 0.0f;
+    v[13] = -3.0f;
+    v[14] = 1.0f / 0.0f;
+    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
+    CHECK(o[63] == 255);           /* value 1.0: at the 99.5th percentile */
+    CHECK(o[64] > 100);            /* value 0.5: bright, not pushed to black by the hot pixels */
+    CHECK(o[10] == 255 && o[14] == 255);
+    CHECK(o[12] == 0 && o[13] == 0);
+
+    /* all black */
+    memset(v, 0, N * sizeof *v);
+    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
+    {
+        int black = 1;
+        for (int i = 0; i < N; i++) if (o[i]) black = 0;
+        CHECK(black);
+    }
+
+    /* a PNG: 64 x 48, brighter towards the bottom; y = 0 is the top row */
+    {
+        char path[600];
+        int w = 64, h = 48, iw = 0, ih = 0, ic = 0;
+        unsigned char *img;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) v[y * w + x] = 0.01f + (float)y * 0.1f + (float)x * 0.001f;
+        snprintf(path, sizeof path, "%s/intensity.png", root);
+        CHECK_OK(evr_preview_intensity_png(path, v, w, h, &e_));
+        CHECK(evr_preview_intensity_png(path, v, 0, h, &err) == EVR_ERR_ARG);
+        img = stbi_load(path, &iw, &ih, &ic, 0);
+        CHECK(img != NULL);
+        if (img) {
+            CHECK(iw == w && ih == h && ic == 1);
+            if (iw == w && ih == h && ic == 1) {
+                CHECK(img[0] < img[(h - 1) * w]);
+                CHECK(img[0] <= img[w - 1]);
+            }
+            stbi_image_free(img);
+        }
+    }
+    free(v);
+    free(o);
+}
+
+static void test_event_frames(const char *root)
+{
+    evr_event_frame f;
+    evr_event ev[16];
+    char path[600];
+    int iw = 0, ih = 0, ic = 0, n = 0;
+    unsigned char *img;
+    memset(ev, 0, sizeof ev);
+    /* (1,2): ON; (3,4): OFF; (5,6): two OFF one ON -> OFF; (7,0): one each, ON last -> ON */
+#define EV(T, X, Y, P) do { ev[n].t = (T); ev[n].x = (X); ev[n].y = (Y); ev[n].p = (P); n++; } while (0)
+    EV(0, 1, 2, 1); EV(1, 3, 4, 0); EV(2, 5, 6, 0); EV(3, 5, 6, 1); EV(4, 5, 6, 0);
+    EV(5, 7, 0, 0); EV(6, 7, 0, 1); EV(7, 100, 100, 1);   /* the last one is outside the image */
+#undef EV
+    CHECK_OK(evr_event_frame_init(&f, 10, 8, &e_));
+    evr_event_frame_add(&f, ev, (size_t)n);
+    CHECK(f.events == 7);
+    snprintf(path, sizeof path, "%s/events.png", root);
+    CHECK_OK(evr_event_frame_write_png(&f, path, &e_));
+    img = stbi_load(path, &iw, &ih, &ic, 0);
+    CHECK(img != NULL);
+    if (img && iw == 10 && ih == 8 && ic == 3) {
+#define PX(X, Y) (img + 3 * ((Y) * 10 + (X)))
+        CHECK(PX(1, 2)[0] == 0 && PX(1, 2)[1] == 0 && PX(1, 2)[2] == 255);
+        CHECK(PX(3, 4)[0] == 255 && PX(3, 4)[1] == 0 && PX(3, 4)[2] == 0);
+        CHECK(PX(5, 6)[0] == 255 && PX(5, 6)[2] == 0);
+        CHECK(PX(7, 0)[0] == 0 && PX(7, 0)[2] == 255);
+        CHECK(PX(0, 0)[0] == 255 && PX(0, 0)[1] == 255 && PX(0, 0)[2] == 255);
+        CHECK(PX(9, 7)[0] == 255 && PX(9, 7)[1] == 255 && PX(9, 7)[2] == 255);
+#undef PX
+    } else CHECK(0);
+    if (img) stbi_image_free(img);
+    evr_event_frame_clear(&f);
+    CHECK(f.events == 0 && f.on[2 * 10 + 1] == 0);
+    evr_event_frame_release(&f);
+
+    /* a series of windows */
+    {
+        evr_event_preview *p = NULL;
+        evr_event e2[5];
+        char dir[560];
+        memset(e2, 0, sizeof e2);
+        e2[0].t = 10; e2[1].t = 999; e2[2].t = 1000; e2[3].t = 3500; e2[4].t = 3999;
+        snprintf(dir, sizeof dir, "%s/series", root);
+        CHECK(mkdir(dir, 0700) == 0);
+        CHECK_OK(evr_event_preview_new(4, 4, 1000, dir, "ev", &p, &e_));
+        if (p) {
+            CHECK_OK(evr_event_preview_add(p, e2, 3, &e_));
+            CHECK(evr_event_preview_frames(p) == 1);
+            CHECK_OK(evr_event_preview_advance(p, 2000, &e_));
+            CHECK(evr_event_preview_frames(p) == 2);
+            CHECK_OK(evr_event_preview_add(p, e2 + 3, 2, &e_));
+            CHECK(evr_event_preview_frames(p) == 3);
+            CHECK_OK(evr_event_preview_finish(p, 4500, &e_));
+            CHECK(evr_event_preview_frames(p) == 5);
+            evr_event_preview_release(p);
+        }
+        CHECK(dir_entries(dir) == 5);
+        snprintf(path, sizeof path, "%s/ev_000004.png", dir);
+        CHECK(file_exists(path));
+    }
+}
+
+int main(void)
+{
+    char root[] = "/tmp/evr_test_writers_XXXXXX";
+    int python_ok = 0;
+    if (!mkdtemp(root)) {
+        perror("mkdtemp");
+        return 1;
+    }
+    test_json();
+    test_writers(root, &python_ok);
+    test_tonemap(root);
+    test_event_frames(root);
+    if (check_failures == 0) remove_tree(root);
+    else fprintf(stderr, "test_writers: files kept in %s\n", root);
+    (void)python_ok;
+    return check_report("test_writers");
+}
