@@ -133,10 +133,12 @@ EVR_HD static inline float evr_surface_intensity(const evr_surface *s, const flo
     return evr_luminance(r, g, b);
 }
 
-/* Shadow ray start: the hit point pushed off the surface along the normal. */
-EVR_HD static inline evr_v3 evr_offset_point(const evr_surface *s, float eps)
+/* Where a shadow ray along wi starts, as a distance from the hit point: far enough that the
+ * point is eps above the surface. The ray stays on the exact line from the hit to the light (an
+ * offset along the normal would shift that line sideways and misjudge shadows near edges). */
+EVR_HD static inline float evr_shadow_tnear(const evr_surface *s, evr_v3 wi, float eps)
 {
-    return evr_v3_add(s->p, evr_v3_scale(s->n, eps));
+    return eps / fmaxf(evr_v3_dot(s->n, wi), 0.05f);
 }
 
 #endif

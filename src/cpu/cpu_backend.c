@@ -59,14 +59,14 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
     q->translation_z = k->trans.z;
 }
 
-static int occluded(RTCScene top, evr_v3 org, evr_v3 dir, float tfar, float time)
+static int occluded(RTCScene top, evr_v3 org, evr_v3 dir, float tnear, float tfar, float time)
 {
     struct RTCIntersectContext ctx;
     struct RTCRay r;
     rtcInitIntersectContext(&ctx);
     r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
     r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
-    r.tnear = 0.0f;
+    r.tnear = tnear;
     r.tfar = tfar;
     r.time = time;
     r.mask = 0xffffffffu;
@@ -103,7 +103,6 @@ static float sample_intensity(const evr_render_scene *rs, RTCScene top, const ev
     evr_surface s;
     evr_surface_at(rs, inst, rh.hit.primID, rh.hit.u, rh.hit.v, &xf, ray, rh.ray.tfar, &s);
     float acc[3] = {0.0f, 0.0f, 0.0f};
-    evr_v3 org = evr_offset_point(&s, rs->ray_eps);
     int l;
     for (l = 0; l < rs->num_lights; l++) {
         evr_v3 wi;
@@ -111,7 +110,7 @@ static float sample_intensity(const evr_render_scene *rs, RTCScene top, const ev
         if (!evr_light_incident(rs, &rs->lights[l], f, s.p, &wi, &dist, e)) continue;
         if (evr_v3_dot(wi, s.n) <= 0.0f) continue;
         (*rays)++;
-        if (occluded(top, org, wi, dist * (1.0f - 1e-4f), f)) continue;
+        if (occluded(top, s.p, wi, evr_shadow_tnear(&s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f)) continue;
         evr_accumulate_lambert(&s, wi, e, acc);
     }
     return evr_surface_intensity(&s, acc, rs->ambient);

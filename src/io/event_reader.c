@@ -359,7 +359,7 @@ static herr_t h5r_walk(unsigned i, const H5E_error2_t *e, void *data)
 {
     h5r_walk_data *d = (h5r_walk_data *)data;
     (void)i;
-    if (e->desc && e->desc[0]) {
+    if (!d->got && e->desc && e->desc[0]) {    /* keep the most specific one */
         snprintf(d->desc, sizeof d->desc, "%s", e->desc);
         d->got = 1;
     }

@@ -44,14 +44,14 @@ typedef struct {
     uint64_t next_ms;            /* index of the next entry to compute */
 } h5_writer;
 
-/* Collects the innermost HDF5 error description (the stack is walked from the API call down). */
+/* Collects the most specific HDF5 error description (the walk starts where the error arose). */
 typedef struct { char desc[200]; int got; } h5_walk_data;
 
 static herr_t h5_walk(unsigned n, const H5E_error2_t *e, void *data)
 {
     h5_walk_data *d = (h5_walk_data *)data;
     (void)n;
-    if (e->desc && e->desc[0]) {
+    if (!d->got && e->desc && e->desc[0]) {    /* keep the most specific one */
         snprintf(d->desc, sizeof d->desc, "%s", e->desc);
         d->got = 1;
     }

@@ -321,6 +321,11 @@ void evr_gltf_free(evr_gltf *g)
     free(g);
 }
 
+void evr_gltf_fail(evr_gltf *g, evr_status status, const char *msg)
+{
+    fail(g, status == EVR_OK ? EVR_ERR_ARG : status, "%s", msg ? msg : "failed");
+}
+
 evr_status evr_gltf_status(const evr_gltf *g, evr_error *err)
 {
     if (err && g->status != EVR_OK) snprintf(err->msg, sizeof err->msg, "%s", g->msg);

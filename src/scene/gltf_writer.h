@@ -89,6 +89,10 @@ int evr_gltf_animation(evr_gltf *g, const char *name);
 void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, const float *times,
                       const float *values, int count, evr_gltf_interp interp);
 
+/* Records a failure found by the caller (e.g. out of memory while generating data) unless one
+ * is already recorded. */
+void evr_gltf_fail(evr_gltf *g, evr_status status, const char *msg);
+
 /* The first failure so far (EVR_OK if none), its message copied into err when err is not NULL. */
 evr_status evr_gltf_status(const evr_gltf *g, evr_error *err);
 
