@@ -12,6 +12,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#if defined(__SSE__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
 
 #define TILE 16
 
@@ -21,7 +25,15 @@ typedef struct {
     evr_render_host host;          /* copy of the views; keys are set per segment */
     evr_run_setup setup;
     RTCDevice device;
-    RTCScene *mesh_scenes;
+    /* Instances are grouped: every instance whose node never moves goes, baked into world space,
+     * into one static group; the instances of each moving node share one group. One Embree
+     * instance per group keeps overlapping instances (lids over an eyeball) out of each other's
+     * way in the top-level BVH. */
+    int num_groups;
+    RTCScene *group_scenes;
+    int *group_track;              /* motion track of the group, -1 for the static group */
+    int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
+    int *members;                  /* scene instance index of each geometry */
     RTCScene top;
     evr_pixel_state *pixels;
     float *phase;                  /* per-pixel sample-time offset in [0, 1) */
@@ -77,9 +89,11 @@ static int occluded(RTCScene top, evr_v3 org, evr_v3 dir, float tnear, float tfa
 }
 
 /* Intensity seen by one sample at normalized segment time f; counts the rays it traces. */
-static float sample_intensity(const evr_render_scene *rs, RTCScene top, const evr_m34 *pose, int x, int y,
-                              float f, unsigned long long *rays)
+static float sample_intensity(const cpu_backend *b, const evr_m34 *pose, int x, int y, float f,
+                              unsigned long long *rays)
 {
+    const evr_render_scene *rs = &b->host.rs;
+    RTCScene top = b->top;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
     struct RTCIntersectContext ctx;
     struct RTCRayHit rh;
@@ -98,7 +112,7 @@ static float sample_intensity(const evr_render_scene *rs, RTCScene top, const ev
     (*rays)++;
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0.0f;   /* nothing: black */
 
-    int inst = (int)rh.hit.instID[0];
+    int inst = b->members[b->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), f);
     evr_surface s;
     evr_surface_at(rs, inst, rh.hit.primID, rh.hit.u, rh.hit.v, &xf, ray, rh.ray.tfar, &s);
@@ -135,7 +149,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             for (k = 0; k < n; k++) {
                 float f = ((float)k + phi) / (float)n;
                 evr_m34 pose = seg->camera_static ? pose_static : evr_rs_camera_pose(rs, f);
-                float intensity = sample_intensity(rs, b->top, &pose, x, y, f, rays);
+                float intensity = sample_intensity(b, &pose, x, y, f, rays);
                 evr_pixel_span sp;
                 float te;
                 int pol;
@@ -160,6 +174,11 @@ static void *worker(void *arg)
 {
     cpu_backend *b = (cpu_backend *)arg;
     unsigned long long samples = 0, rays = 0;
+#if defined(__SSE__)
+    /* Embree asks for flush-to-zero and denormals-are-zero on every thread that traces */
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
     int ntiles = b->tiles_x * b->tiles_y, t;
     while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) render_tile(b, t, &samples, &rays);
     atomic_fetch_add(&b->samples, samples);
@@ -169,18 +188,19 @@ static void *worker(void *arg)
 
 static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_error *err)
 {
-    int i, k;
-    for (i = 0; i < b->host.rs.num_instances; i++) {
-        int track = b->host.rs.instances[i].track;
+    int g, k;
+    for (g = 0; g < b->num_groups; g++) {
+        int track = b->group_track[g];
+        if (track < 0) continue;   /* static group: set once */
         int n = seg->track_count[track];
-        RTCGeometry g = rtcGetGeometry(b->top, (unsigned)i);
-        rtcSetGeometryTimeStepCount(g, (unsigned)n);
+        RTCGeometry geom = rtcGetGeometry(b->top, (unsigned)g);
+        rtcSetGeometryTimeStepCount(geom, (unsigned)n);
         for (k = 0; k < n; k++) {
             struct RTCQuaternionDecomposition q;
             to_embree(&seg->keys[seg->track_offset[track] + k], &q);
-            rtcSetGeometryTransformQuaternion(g, (unsigned)k, &q);
+            rtcSetGeometryTransformQuaternion(geom, (unsigned)k, &q);
         }
-        rtcCommitGeometry(g);
+        rtcCommitGeometry(geom);
     }
     rtcCommitScene(b->top);
     if (b->embree_error[0]) {
@@ -249,11 +269,14 @@ static void cpu_release(evr_backend *base)
     int i;
     if (!b) return;
     if (b->top) rtcReleaseScene(b->top);
-    if (b->mesh_scenes) {
-        for (i = 0; i < b->scene->num_meshes; i++)
-            if (b->mesh_scenes[i]) rtcReleaseScene(b->mesh_scenes[i]);
+    if (b->group_scenes) {
+        for (i = 0; i < b->num_groups; i++)
+            if (b->group_scenes[i]) rtcReleaseScene(b->group_scenes[i]);
     }
-    free(b->mesh_scenes);
+    free(b->group_scenes);
+    free(b->group_track);
+    free(b->group_first);
+    free(b->members);
     if (b->device) rtcReleaseDevice(b->device);
     if (b->tile_events) {
         for (i = 0; i < b->tiles_x * b->tiles_y; i++) evr_event_vec_free(&b->tile_events[i]);
@@ -264,28 +287,84 @@ static void cpu_release(evr_backend *base)
     free(b);
 }
 
-static RTCScene build_mesh_scene(RTCDevice dev, const evr_mesh *m)
+/* Adds a mesh to an Embree scene as geometry geom_id, its vertices transformed by xf (NULL:
+ * object space). */
+static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf, unsigned geom_id)
 {
-    RTCScene sc = rtcNewScene(dev);
-    if (!sc) return NULL;
-    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+    uint32_t v;
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    if (!g) {
-        rtcReleaseScene(sc);
-        return NULL;
-    }
+    if (!g) return 0;
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
     float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
     unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
-    if (vb && ib) {
-        memcpy(vb, m->positions, sizeof(float) * 3 * m->num_vertices);
-        memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+    if (!vb || !ib) {
+        rtcReleaseGeometry(g);
+        return 0;
     }
+    for (v = 0; v < m->num_vertices; v++) {
+        evr_v3 p = evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
+        if (xf) p = evr_m34_point(xf, p);
+        vb[3 * v] = p.x;
+        vb[3 * v + 1] = p.y;
+        vb[3 * v + 2] = p.z;
+    }
+    memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
     rtcCommitGeometry(g);
-    rtcAttachGeometryByID(sc, g, 0);
+    rtcAttachGeometryByID(sc, g, geom_id);
     rtcReleaseGeometry(g);
-    rtcCommitScene(sc);
-    return sc;
+    return 1;
+}
+
+static int node_never_moves(const evr_scene *s, int node)
+{
+    for (; node >= 0; node = s->nodes[node].parent)
+        if (s->nodes[node].animated) return 0;
+    return 1;
+}
+
+/* Groups the instances (see cpu_backend) and builds one Embree scene per group. */
+static int build_groups(cpu_backend *b, const evr_scene *s)
+{
+    int n = s->num_instances, i, j, g;
+    int *group_of = malloc(sizeof(int) * (size_t)(n + 1));
+    b->group_track = malloc(sizeof(int) * (size_t)(n + 1));
+    b->group_first = calloc((size_t)n + 2, sizeof(int));
+    b->members = malloc(sizeof(int) * (size_t)(n + 1));
+    if (!group_of || !b->group_track || !b->group_first || !b->members) {
+        free(group_of);
+        return 0;
+    }
+    b->num_groups = 0;
+    for (i = 0; i < n; i++) {
+        int node = s->instances[i].node, track = node_never_moves(s, node) ? -1 : node;
+        for (g = 0; g < b->num_groups && b->group_track[g] != track; g++) {}
+        if (g == b->num_groups) b->group_track[b->num_groups++] = track;
+        group_of[i] = g;
+    }
+    for (g = 0, j = 0; g < b->num_groups; g++) {
+        b->group_first[g] = j;
+        for (i = 0; i < n; i++)
+            if (group_of[i] == g) b->members[j++] = i;
+    }
+    b->group_first[b->num_groups] = j;
+    free(group_of);
+    b->group_scenes = calloc((size_t)b->num_groups + 1, sizeof *b->group_scenes);
+    if (!b->group_scenes) return 0;
+    for (g = 0; g < b->num_groups; g++) {
+        RTCScene sc = rtcNewScene(b->device);
+        if (!sc) return 0;
+        b->group_scenes[g] = sc;
+        rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+        for (j = b->group_first[g]; j < b->group_first[g + 1]; j++) {
+            const evr_instance *in = &s->instances[b->members[j]];
+            evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
+            if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh], b->group_track[g] < 0 ? &world : NULL,
+                                   (unsigned)(j - b->group_first[g])))
+                return 0;
+        }
+        rtcCommitScene(sc);
+    }
+    return 1;
 }
 
 evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
@@ -311,8 +390,7 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     b->pixels = malloc(npix * sizeof *b->pixels);
     b->phase = malloc(npix * sizeof *b->phase);
     b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
-    b->mesh_scenes = calloc((size_t)s->num_meshes + 1, sizeof *b->mesh_scenes);
-    if (!b->pixels || !b->phase || !b->tile_events || !b->mesh_scenes) goto nomem;
+    if (!b->pixels || !b->phase || !b->tile_events) goto nomem;
     for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
     for (y = 0; y < setup->height; y++)
         for (x = 0; x < setup->width; x++)
@@ -325,19 +403,21 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         return EVR_ERR_BACKEND;
     }
     rtcSetDeviceErrorFunction(b->device, embree_error, b);
-    for (m = 0; m < s->num_meshes; m++) {
-        b->mesh_scenes[m] = build_mesh_scene(b->device, &s->meshes[m]);
-        if (!b->mesh_scenes[m] || b->embree_error[0]) goto embree_fail;
-    }
+    if (!build_groups(b, s) || b->embree_error[0]) goto embree_fail;
     b->top = rtcNewScene(b->device);
     if (!b->top) goto embree_fail;
-    rtcSetSceneFlags(b->top, RTC_SCENE_FLAG_DYNAMIC);
-    rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_LOW);
-    for (i = 0; i < (size_t)s->num_instances; i++) {
+    /* rebuilt every segment, but over a handful of instances: quality costs nothing */
+    rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_HIGH);
+    for (m = 0; m < b->num_groups; m++) {
         RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
         if (!g) goto embree_fail;
-        rtcSetGeometryInstancedScene(g, b->mesh_scenes[s->instances[i].mesh]);
-        rtcAttachGeometryByID(b->top, g, (unsigned)i);
+        rtcSetGeometryInstancedScene(g, b->group_scenes[m]);
+        if (b->group_track[m] < 0) {   /* baked into world space: identity, no motion */
+            evr_m34 id = evr_m34_identity();
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &id.m[0][0]);
+            rtcCommitGeometry(g);
+        }
+        rtcAttachGeometryByID(b->top, g, (unsigned)m);
         rtcReleaseGeometry(g);
     }
     if (b->embree_error[0]) goto embree_fail;
