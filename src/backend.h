@@ -20,22 +20,28 @@ typedef struct {
     int threads;
 } evr_run_setup;
 
-/* One segment: absolute times and the motion keys of every track (one track per scene node). */
+/* One segment: absolute times and the motion keys of every track (one track per scene node, and
+ * a last one for the fixed world frame). The arrays are only valid during submit(). */
 typedef struct {
     int index;
     double t0, t1;
     const evr_motion_key *keys;
     const int *track_offset, *track_count;
+    int num_tracks, num_keys;
     int camera_static;            /* the camera does not move in this segment */
+    int want_intensity;           /* return every pixel's intensity at the segment's end */
 } evr_segment;
 
 typedef struct evr_backend evr_backend;
 struct evr_backend {
     const char *name;
-    /* Renders a segment and appends its events (unsorted) to out. */
-    evr_status (*render)(evr_backend *b, const evr_segment *seg, evr_event_vec *out, evr_error *err);
-    /* Copies every pixel's last linear intensity (row-major, top row first). */
-    void (*intensity)(evr_backend *b, float *out);
+    /* Starts rendering a segment; segments are submitted in order, at most two ahead of collect(),
+     * so a backend can render one while the host writes the previous one. */
+    evr_status (*submit)(evr_backend *b, const evr_segment *seg, evr_error *err);
+    /* Waits for the oldest submitted segment and appends its events, sorted by (t, y, x), to out.
+     * *intensity is set to every pixel's last linear intensity (row-major, top row first) when the
+     * segment asked for it, else NULL; it stays valid until the next collect(). */
+    evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, evr_error *err);
     void (*release)(evr_backend *b);
     uint64_t samples, rays;       /* totals so far */
 };

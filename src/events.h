@@ -25,4 +25,8 @@ void evr_event_vec_free(evr_event_vec *v);
  * order is). scratch is grown as needed and may be reused between calls. */
 int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch);
 
+/* Merges n events sorted by (t, y, x) into v, also sorted; events of v come first among equal
+ * keys. */
+int evr_events_merge(evr_event_vec *v, const evr_event *ev, size_t n, evr_event_vec *scratch);
+
 #endif

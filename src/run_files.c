@@ -146,22 +146,32 @@ evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, e
     return EVR_OK;
 }
 
-evr_status evr_run_preview_intensity(evr_sim *sim, double t, int last, evr_error *err)
+/* Intensity frame k is taken at the end of the first segment that ends at or after the end of
+ * preview window k (the pixels' latest samples); the last window may be partial. */
+static int intensity_frame_due(const evr_sim *sim, int64_t frame, double t, int last)
+{
+    int64_t rel_us = (int64_t)llround((t - sim->cfg.start) * 1e6);
+    return (frame + 1) * sim->preview_window_us <= rel_us || (last && frame * sim->preview_window_us < rel_us);
+}
+
+int evr_run_preview_due(const evr_sim *sim, double t, int last)
+{
+    if (!sim->preview_intensity) return 0;
+    /* frames already due at an earlier segment end are written when that one is collected */
+    int64_t next = sim->intensity_frame;
+    while (sim->preview_window_us > 0 && intensity_frame_due(sim, next, t - 1.0 / sim->fps, 0)) next++;
+    return intensity_frame_due(sim, next, t, last);
+}
+
+evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last, evr_error *err)
 {
     char name[64], p[4200];
     evr_status st;
-    int fetched = 0;
     if (!sim->preview_intensity) return EVR_OK;
-    /* one intensity frame per preview window, taken at the first segment end at or after the
-     * window's end (the pixels' latest samples); the last window may be partial */
-    int64_t rel_us = (int64_t)llround((t - sim->cfg.start) * 1e6);
-    while ((sim->intensity_frame + 1) * sim->preview_window_us <= rel_us ||
-           (last && sim->intensity_frame * sim->preview_window_us < rel_us)) {
-        if (!fetched) sim->backend->intensity(sim->backend, sim->preview_intensity);
-        fetched = 1;
+    while (intensity_frame_due(sim, sim->intensity_frame, t, last)) {
         snprintf(name, sizeof name, "preview/intensity_%06lld.png", (long long)sim->intensity_frame);
         if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
-        if ((st = evr_preview_intensity_png(p, sim->preview_intensity, sim->cfg.width, sim->cfg.height, err)) != EVR_OK)
+        if ((st = evr_preview_intensity_png(p, intensity, sim->cfg.width, sim->cfg.height, err)) != EVR_OK)
             return st;
         sim->intensity_frame++;
     }

@@ -8,8 +8,10 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);
 /* Accumulates time-ordered events into event preview frames, writing each finished frame. */
 evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, evr_error *err);
-/* At a segment end (absolute time t): writes an intensity preview when a window has ended. */
-evr_status evr_run_preview_intensity(evr_sim *sim, double t, int last, evr_error *err);
+/* Whether a segment ending at absolute time t ends a preview window (so its intensities are due). */
+int evr_run_preview_due(const evr_sim *sim, double t, int last);
+/* At a segment end (absolute time t): writes the intensity previews of the windows it ends. */
+evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last, evr_error *err);
 /* Completes every writer, the last preview and run.json. */
 evr_status evr_run_finish(evr_sim *sim, evr_error *err);
 /* Removes what this run wrote (temporary files, previews, the folder if it made it). */

@@ -128,6 +128,8 @@ static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
     seg->keys = sim->keys;
     seg->track_offset = sim->track_offset;
     seg->track_count = sim->track_count;
+    seg->num_tracks = s->num_nodes + 1;
+    seg->num_keys = off;
     seg->camera_static = sim->track_count[sim->host.rs.camera_track] == 1;
 }
 
@@ -160,47 +162,70 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     return EVR_OK;
 }
 
+static double segment_start(const evr_sim *sim, int i) { return sim->cfg.start + (double)i / sim->fps; }
+static double segment_end(const evr_sim *sim, int i)
+{
+    return i + 1 == sim->num_segments ? sim->cfg.start + sim->duration : segment_start(sim, i + 1);
+}
+
+static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
+{
+    evr_segment seg;
+    seg.index = i;
+    seg.t0 = segment_start(sim, i);
+    seg.t1 = segment_end(sim, i);
+    compute_motion(sim, seg.t0, seg.t1, &seg);
+    seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
+    return sim->backend->submit(sim->backend, &seg, err);
+}
+
+/* Segment i's events: merged into the pending (time-ordered) events, of which those that no
+ * later segment can precede go to the writers. */
+static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, evr_error *err)
+{
+    const int n = sim->cfg.samples_per_frame;
+    const float *intensity = NULL;
+    double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
+    evr_status st;
+    int w;
+    double t = now_seconds();
+    if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, err)) != EVR_OK) return st;
+    sim->time_render += now_seconds() - t;
+    /* Later segments can still produce events back to every pixel's last sample here, which
+     * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
+    int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+    if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;
+    for (w = 0; w < sim->num_writers; w++)
+        if ((st = sim->writers[w]->flush(sim->writers[w], err)) != EVR_OK) return st;
+    if (intensity) {
+        t = now_seconds();
+        if ((st = evr_run_preview_intensity(sim, intensity, t1, last, err)) != EVR_OK) return st;
+        sim->time_preview += now_seconds() - t;
+    }
+    sim->st.segments_done = i + 1;
+    sim->st.samples = sim->backend->samples;
+    sim->st.rays = sim->backend->rays;
+    sim->st.sim_time = t1 - sim->cfg.start;
+    sim->st.wall_time = now_seconds() - wall0;
+    sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
+    sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
+    sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
+    return EVR_OK;
+}
+
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err)
 {
     evr_status st = EVR_OK;
     double wall0 = now_seconds();
-    int i, w, stop = 0;
-    const int n = sim->cfg.samples_per_frame;
-    for (i = 0; i < sim->num_segments && !stop; i++) {
-        double t0 = sim->cfg.start + (double)i / sim->fps;
-        double t1 = i + 1 == sim->num_segments ? sim->cfg.start + sim->duration
-                                               : sim->cfg.start + (double)(i + 1) / sim->fps;
-        evr_segment seg;
-        seg.index = i;
-        seg.t0 = t0;
-        seg.t1 = t1;
-        compute_motion(sim, t0, t1, &seg);
-        double t = now_seconds();
-        if ((st = sim->backend->render(sim->backend, &seg, &sim->pending, err)) != EVR_OK) break;
-        sim->time_render += now_seconds() - t;
-        t = now_seconds();
-        if (!evr_events_sort(&sim->pending, &sim->scratch)) { st = nomem(err); break; }
-        sim->time_sort += now_seconds() - t;
-        /* Later segments can still produce events back to every pixel's last sample here, which
-         * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
-        int last = i + 1 == sim->num_segments;
-        int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
-        if ((st = emit_events(sim, safe, err)) != EVR_OK) break;
-        for (w = 0; w < sim->num_writers; w++)
-            if ((st = sim->writers[w]->flush(sim->writers[w], err)) != EVR_OK) break;
-        if (st != EVR_OK) break;
-        t = now_seconds();
-        if ((st = evr_run_preview_intensity(sim, t1, last, err)) != EVR_OK) break;
-        sim->time_preview += now_seconds() - t;
-
-        sim->st.segments_done = i + 1;
-        sim->st.samples = sim->backend->samples;
-        sim->st.rays = sim->backend->rays;
-        sim->st.sim_time = t1 - sim->cfg.start;
-        sim->st.wall_time = now_seconds() - wall0;
-        sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
-        sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
-        sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
+    int submitted = 0, i, stop = 0;
+    /* keep one segment in flight while the previous one is written */
+    if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
+    for (i = 0; st == EVR_OK && i < submitted; i++) {
+        if (!stop && submitted < sim->num_segments) {
+            if ((st = submit_segment(sim, submitted, err)) != EVR_OK) break;
+            submitted++;
+        }
+        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, wall0, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
     if (st != EVR_OK) {
@@ -208,13 +233,13 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         evr_run_dir_discard(sim);
         return st;
     }
-    if (stop && sim->pending.n) {   /* interrupted: keep every event of the finished segments */
+    if (sim->pending.n) {   /* interrupted: keep every event of the finished segments */
         if ((st = emit_events(sim, INT64_MAX, err)) != EVR_OK) {
             evr_run_dir_discard(sim);
             return st;
         }
     }
-    sim->st.interrupted = stop && sim->st.segments_done < sim->num_segments;
+    sim->st.interrupted = sim->st.segments_done < sim->num_segments;
     sim->st.wall_time = now_seconds() - wall0;
     if ((st = evr_run_finish(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;

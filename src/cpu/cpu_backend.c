@@ -39,6 +39,11 @@ typedef struct {
     float *phase;                  /* per-pixel sample-time offset in [0, 1) */
     int tiles_x, tiles_y;
     evr_event_vec *tile_events;
+    /* results of submitted segments not yet collected (a ring of two) */
+    evr_event_vec done[2], scratch;
+    float *done_intensity[2];
+    int done_has_intensity[2];
+    int head, queued;
     char embree_error[256];
     /* per-segment work */
     const evr_segment *seg;
@@ -210,9 +215,16 @@ static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_erro
     return EVR_OK;
 }
 
-static evr_status cpu_render(evr_backend *base, const evr_segment *seg, evr_event_vec *out, evr_error *err)
+static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_error *err)
 {
     cpu_backend *b = (cpu_backend *)base;
+    if (b->queued == 2) {
+        snprintf(err->msg, sizeof err->msg, "internal error: more than two segments submitted");
+        return EVR_ERR_BACKEND;
+    }
+    int slot = (b->head + b->queued) % 2;
+    evr_event_vec *out = &b->done[slot];
+    out->n = 0;
     evr_status st;
     int nthreads = b->setup.threads, i, ntiles = b->tiles_x * b->tiles_y;
     b->host.rs.keys = seg->keys;
@@ -253,14 +265,35 @@ static evr_status cpu_render(evr_backend *base, const evr_segment *seg, evr_even
             return EVR_ERR_NOMEM;
         }
     }
+    if (!evr_events_sort(out, &b->scratch)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory sorting events");
+        return EVR_ERR_NOMEM;
+    }
+    b->done_has_intensity[slot] = seg->want_intensity;
+    if (seg->want_intensity) {
+        size_t p, npix = (size_t)b->setup.width * (size_t)b->setup.height;
+        for (p = 0; p < npix; p++) b->done_intensity[slot][p] = b->pixels[p].intensity;
+    }
+    b->queued++;
     return EVR_OK;
 }
 
-static void cpu_intensity(evr_backend *base, float *out)
+static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float **intensity, evr_error *err)
 {
     cpu_backend *b = (cpu_backend *)base;
-    size_t i, n = (size_t)b->setup.width * (size_t)b->setup.height;
-    for (i = 0; i < n; i++) out[i] = b->pixels[i].intensity;
+    if (!b->queued) {
+        snprintf(err->msg, sizeof err->msg, "internal error: collect without a submitted segment");
+        return EVR_ERR_BACKEND;
+    }
+    int slot = b->head;
+    b->head = (b->head + 1) % 2;
+    b->queued--;
+    *intensity = b->done_has_intensity[slot] ? b->done_intensity[slot] : NULL;
+    if (!evr_events_merge(out, b->done[slot].data, b->done[slot].n, &b->scratch)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    return EVR_OK;
 }
 
 static void cpu_release(evr_backend *base)
@@ -282,6 +315,11 @@ static void cpu_release(evr_backend *base)
         for (i = 0; i < b->tiles_x * b->tiles_y; i++) evr_event_vec_free(&b->tile_events[i]);
     }
     free(b->tile_events);
+    for (i = 0; i < 2; i++) {
+        evr_event_vec_free(&b->done[i]);
+        free(b->done_intensity[i]);
+    }
+    evr_event_vec_free(&b->scratch);
     free(b->pixels);
     free(b->phase);
     free(b);
@@ -375,8 +413,8 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     int m, x, y;
     if (!b) goto nomem;
     b->base.name = "cpu";
-    b->base.render = cpu_render;
-    b->base.intensity = cpu_intensity;
+    b->base.submit = cpu_submit;
+    b->base.collect = cpu_collect;
     b->base.release = cpu_release;
     b->scene = s;
     b->host = *h;
@@ -390,7 +428,9 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     b->pixels = malloc(npix * sizeof *b->pixels);
     b->phase = malloc(npix * sizeof *b->phase);
     b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
-    if (!b->pixels || !b->phase || !b->tile_events) goto nomem;
+    b->done_intensity[0] = malloc(npix * sizeof(float));
+    b->done_intensity[1] = malloc(npix * sizeof(float));
+    if (!b->pixels || !b->phase || !b->tile_events || !b->done_intensity[0] || !b->done_intensity[1]) goto nomem;
     for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
     for (y = 0; y < setup->height; y++)
         for (x = 0; x < setup->width; x++)
