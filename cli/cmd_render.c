@@ -74,6 +74,7 @@ static void help(void)
          "  --fps F                    segments per second (default: the scene's frame rate, else 30)\n"
          "  --samples-per-frame N      samples per pixel per segment (default 10)\n"
          "  --threads N                worker threads (default: all cores)\n"
+         "  --backend B                auto (default: CUDA when a GPU is usable, else CPU), cpu or cuda\n"
          "sensor:\n"
          "  --pos-thres C, --neg-thres C   ON/OFF contrast thresholds in log intensity (default 0.2)\n"
          "  --thres C                  both thresholds\n"
@@ -109,6 +110,11 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         else if (opt_is(a, "--fps")) { VAL("--fps"); if (!opt_double("--fps", v, &cfg.fps)) return 2;
             if (cfg.fps <= 0) { cli_error("--fps must be a positive number (got %s)", v); return 2; } }
         else if (opt_is(a, "--samples-per-frame")) { VAL("--samples-per-frame"); if (!opt_int("--samples-per-frame", v, &cfg.samples_per_frame)) return 2; }
+        else if (opt_is(a, "--backend")) { VAL("--backend");
+            if (!strcmp(v, "auto")) cfg.backend = EVR_BACKEND_AUTO;
+            else if (!strcmp(v, "cpu")) cfg.backend = EVR_BACKEND_CPU;
+            else if (!strcmp(v, "cuda")) cfg.backend = EVR_BACKEND_CUDA;
+            else { cli_error("--backend: unknown backend '%s' (auto, cpu, cuda)", v); return 2; } }
         else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return 2; }
         else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return 2; }
         else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return 2; }
@@ -140,6 +146,8 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         evr_scene_release(scene);
         return st == EVR_ERR_ARG ? 2 : 1;
     }
+    const evr_stats *stats = evr_sim_stats(sim);
+    if (stats->notice[0] && !quiet) fprintf(stderr, "evray: note: %s\n", stats->notice);
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -150,7 +158,6 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     ps.show = !quiet && isatty(2);
     ps.started = wall();
     ps.duration = 0;
-    const evr_stats *stats = evr_sim_stats(sim);
     ps.duration = cfg.duration;
     st = evr_sim_run(sim, on_progress, &ps, &err);
     if (ps.show) fputc('\n', stderr);
@@ -164,6 +171,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
             printf("%s: %llu events (%llu ON, %llu OFF), %llu unique timestamps, %.3f s simulated\n",
                    cfg.out_dir, ev, (unsigned long long)stats->events_on, (unsigned long long)stats->events_off,
                    (unsigned long long)stats->unique_timestamps, stats->sim_time);
+            printf("backend %s (%s)\n", stats->backend, stats->device);
             printf("%llu samples, %llu rays in %.2f s: %.2f M samples/s, %.2f M rays/s, real-time factor %.4f\n",
                    (unsigned long long)stats->samples, (unsigned long long)stats->rays, stats->wall_time,
                    stats->samples_per_second / 1e6, stats->rays_per_second / 1e6, stats->realtime_factor);

@@ -58,6 +58,9 @@ char *evr_scene_describe(const evr_scene *s);
 /* ---- simulation ---- */
 typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
 
+/* auto: CUDA when this build has it and a usable GPU is present, else the CPU (with a notice). */
+typedef enum { EVR_BACKEND_AUTO = 0, EVR_BACKEND_CPU = 1, EVR_BACKEND_CUDA = 2 } evr_backend_kind;
+
 typedef struct {
     /* image and time */
     int width, height;            /* pixels */
@@ -74,6 +77,7 @@ typedef struct {
     float ambient;                /* ambient fraction of the base colour */
     uint64_t seed;
     int threads;                  /* 0: all cores */
+    evr_backend_kind backend;
     /* output */
     const char *out_dir;
     int formats;                  /* evr_format bits */
@@ -93,6 +97,9 @@ typedef struct {
     double samples_per_second, rays_per_second, realtime_factor;
     int segments_done, segments_total;
     int interrupted;
+    char backend[16];             /* the backend that ran: "cpu" or "cuda" */
+    char device[128];             /* CPU threads or the GPU's name */
+    char notice[256];             /* e.g. why auto fell back to the CPU; empty if nothing to say */
 } evr_stats;
 
 typedef struct evr_sim evr_sim;

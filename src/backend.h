@@ -63,5 +63,6 @@ void evr_render_host_free(evr_render_host *h);
 
 evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
                                evr_backend **out, evr_error *err);
+int evr_cpu_backend_threads(const evr_backend *b);
 
 #endif

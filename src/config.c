@@ -49,6 +49,8 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (!isfinite(c->duration) || c->duration < 0.0) BAD("duration must be a positive number of seconds (got %g)", c->duration);
     if (!isfinite(c->start) || c->start < 0.0) BAD("start time must be >= 0 seconds (got %g)", c->start);
     if (c->preview_window < 0.0 || !isfinite(c->preview_window)) BAD("preview window must be >= 0 seconds (got %g)", c->preview_window);
+    if (c->backend != EVR_BACKEND_AUTO && c->backend != EVR_BACKEND_CPU && c->backend != EVR_BACKEND_CUDA)
+        BAD("unknown backend %d", (int)c->backend);
     if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
     if (!c->out_dir || !c->out_dir[0]) BAD("no output folder given");
     if (!c->formats || (c->formats & ~(EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY))) BAD("no valid output format selected");
@@ -73,7 +75,8 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     return EVR_OK;
 }
 
-char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene, const char *camera, int pretty)
+char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene, const char *camera,
+                         const char *backend, int pretty)
 {
     evr_json j;
     evr_json_init(&j, pretty);
@@ -93,7 +96,7 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "log_floor"); evr_json_float(&j, c->log_floor);
     evr_json_key(&j, "ambient"); evr_json_float(&j, c->ambient);
     evr_json_key(&j, "seed"); evr_json_unsigned(&j, c->seed);
-    evr_json_key(&j, "backend"); evr_json_string(&j, "cpu");
+    evr_json_key(&j, "backend"); evr_json_string(&j, backend);
     evr_json_key(&j, "gi"); evr_json_string(&j, "none");
     evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);
     evr_json_key(&j, "formats"); evr_json_begin_array(&j);

@@ -212,6 +212,9 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "outputs"); evr_json_begin_array(&j);
     for (i = 0; i < sim->num_writers; i++) evr_json_string(&j, sim->writer_names[i]);
     evr_json_end_array(&j);
+    evr_json_key(&j, "backend"); evr_json_string(&j, s->backend);
+    evr_json_key(&j, "device"); evr_json_string(&j, s->device);
+    if (s->notice[0]) { evr_json_key(&j, "notice"); evr_json_string(&j, s->notice); }
     evr_json_key(&j, "stats"); evr_json_begin_object(&j);
     evr_json_key(&j, "events"); evr_json_unsigned(&j, s->events_on + s->events_off);
     evr_json_key(&j, "events_on"); evr_json_unsigned(&j, s->events_on);

@@ -5,6 +5,9 @@
 #include "io/json.h"
 #include "io/preview.h"
 #include "run_files.h"
+#ifdef EVR_HAVE_CUDA
+#include "cuda/cuda_backend.h"
+#endif
 
 #include <errno.h>
 #include <math.h>
@@ -34,6 +37,40 @@ static void mark_used(evr_sim *sim, int node)
     /* a node's motion depends on its ancestors, but keys are computed for the node's world
      * transform, so only the node itself needs a track */
     if (node >= 0) sim->node_used[node] = 1;
+}
+
+/* The backend the configuration asks for; auto tries CUDA first and says why it did not. */
+static evr_status make_backend(evr_sim *sim, evr_error *err)
+{
+    const evr_scene *s = sim->scene;
+    evr_backend_kind kind = sim->cfg.backend;
+    evr_status st;
+#ifdef EVR_HAVE_CUDA
+    if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
+        evr_error cerr;
+        cerr.msg[0] = 0;
+        st = evr_cuda_backend_new(s, &sim->host, &sim->setup, &sim->backend, &cerr);
+        if (st == EVR_OK) {
+            snprintf(sim->st.backend, sizeof sim->st.backend, "cuda");
+            snprintf(sim->st.device, sizeof sim->st.device, "%s", evr_cuda_device_name(sim->backend));
+            return EVR_OK;
+        }
+        if (kind == EVR_BACKEND_CUDA) {
+            *err = cerr;
+            return st;
+        }
+        snprintf(sim->st.notice, sizeof sim->st.notice, "CUDA backend not used: %s; running on the CPU", cerr.msg);
+    }
+#else
+    if (kind == EVR_BACKEND_CUDA) {
+        snprintf(err->msg, sizeof err->msg, "this evray was built without CUDA (nvcc was not found at build time)");
+        return EVR_ERR_BACKEND;
+    }
+#endif
+    if ((st = evr_cpu_backend_new(s, &sim->host, &sim->setup, &sim->backend, err)) != EVR_OK) return st;
+    snprintf(sim->st.backend, sizeof sim->st.backend, "cpu");
+    snprintf(sim->st.device, sizeof sim->st.device, "%d CPU threads", evr_cpu_backend_threads(sim->backend));
+    return EVR_OK;
 }
 
 evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err)
@@ -84,8 +121,12 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
     mark_used(sim, s->cameras[sim->camera].node);
 
+    if ((st = make_backend(sim, err)) != EVR_OK) {
+        evr_sim_release(sim);
+        return st;
+    }
     sim->config_json = evr_config_to_json(&sim->cfg, sim->duration, sim->fps, s->source,
-                                          s->cameras[sim->camera].name, 0);
+                                          s->cameras[sim->camera].name, sim->backend->name, 0);
     if (!sim->config_json) {
         evr_sim_release(sim);
         return nomem(err);
@@ -94,8 +135,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
-    if ((st = evr_cpu_backend_new(s, &sim->host, &sim->setup, &sim->backend, err)) != EVR_OK ||
-        (st = evr_run_writers_open(sim, err)) != EVR_OK) {
+    if ((st = evr_run_writers_open(sim, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;

@@ -118,5 +118,29 @@ EVR_HD static inline evr_v3 evr_m34_normal(const evr_m34 *a, evr_v3 n)
     evr_v3 out = evr_v3_add(evr_v3_add(evr_v3_scale(r0, n.x), evr_v3_scale(r1, n.y)), evr_v3_scale(r2, n.z));
     return evr_v3_norm(det < 0.0f ? evr_v3_scale(out, -1.0f) : out);
 }
+/* Inverse of an affine transform, through the adjugate of the linear part. A singular matrix
+ * (a zero scale) gives the zero matrix: nothing maps onto it, so rays through it hit nothing. */
+EVR_HD static inline evr_m34 evr_m34_inverse(const evr_m34 *a)
+{
+    evr_v3 c0 = evr_v3_make(a->m[0][0], a->m[1][0], a->m[2][0]);
+    evr_v3 c1 = evr_v3_make(a->m[0][1], a->m[1][1], a->m[2][1]);
+    evr_v3 c2 = evr_v3_make(a->m[0][2], a->m[1][2], a->m[2][2]);
+    evr_v3 r[3];
+    evr_m34 inv;
+    int i;
+    r[0] = evr_v3_cross(c1, c2);   /* rows of the inverse, times det */
+    r[1] = evr_v3_cross(c2, c0);
+    r[2] = evr_v3_cross(c0, c1);
+    float det = evr_v3_dot(c0, r[0]);
+    float s = det != 0.0f ? 1.0f / det : 0.0f;
+    for (i = 0; i < 3; i++) {
+        evr_v3 row = evr_v3_scale(r[i], s);
+        inv.m[i][0] = row.x;
+        inv.m[i][1] = row.y;
+        inv.m[i][2] = row.z;
+        inv.m[i][3] = -(row.x * a->m[0][3] + row.y * a->m[1][3] + row.z * a->m[2][3]);
+    }
+    return inv;
+}
 
 #endif

@@ -472,3 +472,5 @@ nomem:
     cpu_release(b ? &b->base : NULL);
     return EVR_ERR_NOMEM;
 }
+
+int evr_cpu_backend_threads(const evr_backend *b) { return ((const cpu_backend *)b)->setup.threads; }

@@ -1,0 +1,530 @@
+/* Ray queries against the structure of gpu_bvh.h, written once for the host C compiler and
+ * for nvcc (EVR_HD, no recursion, fixed-size stacks, no dynamically indexed arrays in the hot
+ * loops except the stack).
+ *
+ *   evr_trace_closest  nearest hit of a world ray at normalized segment time f in [0, 1]
+ *   evr_trace_any      whether anything lies between tnear and tfar (shadow rays)
+ *
+ * The answers are Embree's (cpu backend): the instance is the scene's instance index, the
+ * primitive the original triangle index of its mesh, barycentrics (u, v) such that
+ * p = (1-u-v) p0 + u p1 + v p2, t the distance along the world ray (in units of its direction,
+ * unit for the camera's rays).
+ *
+ * Each instance's transform is evaluated at the ray's time exactly as the CPU backend does
+ * (evr_motion_eval of its track), inverted, and the ray moved into object space without
+ * normalizing its direction, so t stays the world parameter. Triangles are intersected with the
+ * watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge or vertex
+ * hits at least one of the triangles. Its edge functions must be evaluated without fused
+ * multiply-adds (exactly antisymmetric): on the device through __fmul_rn/__fsub_rn, on the host
+ * by the C compiler's default (ISO C mode, -ffp-contract=off); do not build this with
+ * -ffast-math. Box tests widen their far distances by 1 + 2 gamma(3) (Ize 2013, pbrt), which
+ * with boxes that contain their triangles exactly (see gpu_bvh.h) makes traversal conservative. */
+#ifndef EVR_CUDA_GPU_TRAVERSE_H
+#define EVR_CUDA_GPU_TRAVERSE_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+#include "core/hd.h"
+#include "core/vec.h"
+#include "core/motion.h"
+#include "core/camera.h"
+#include "core/render_scene.h"
+#include "cuda/gpu_bvh.h"
+
+typedef struct {
+    float t, u, v;
+    int instance;          /* scene instance index */
+    uint32_t prim;         /* triangle index in the instance's mesh */
+} evr_gpu_hit;
+
+#ifdef __CUDACC__
+#define EVR__UNROLL _Pragma("unroll")
+#else
+#define EVR__UNROLL
+#endif
+
+/* 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24 */
+#define EVR__BOX_WIDEN 1.00000036f
+
+/* ---- small helpers ---- */
+
+EVR_HD static inline float evr__minf(float a, float b) { return a < b ? a : b; }
+EVR_HD static inline float evr__maxf(float a, float b) { return a > b ? a : b; }
+EVR_HD static inline float evr__sel3(float x, float y, float z, int k) { return k == 0 ? x : (k == 1 ? y : z); }
+
+/* 1/d, with |d| raised to 1e-18 first (no infinities, no 0 * inf in the slab test) */
+EVR_HD static inline float evr__rcp_safe(float d)
+{
+    float a = fabsf(d) < 1e-18f ? (d < 0.0f ? -1e-18f : 1e-18f) : d;
+    return 1.0f / a;
+}
+
+EVR_HD static inline int evr__msb(uint32_t x)   /* x != 0 */
+{
+#ifdef __CUDA_ARCH__
+    return 31 - __clz((int)x);
+#else
+    return 31 - __builtin_clz(x);
+#endif
+}
+
+EVR_HD static inline int evr__popc(uint32_t x)
+{
+#ifdef __CUDA_ARCH__
+    return __popc(x);
+#else
+    return __builtin_popcount(x);
+#endif
+}
+
+EVR_HD static inline uint32_t evr__f2u(float f)
+{
+#ifdef __CUDA_ARCH__
+    return __float_as_uint(f);
+#else
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+#endif
+}
+
+EVR_HD static inline float evr__u2f(uint32_t u)
+{
+#ifdef __CUDA_ARCH__
+    return __uint_as_float(u);
+#else
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+#endif
+}
+
+/* a * b - c * d with each product rounded (no fused multiply-add): exactly antisymmetric */
+EVR_HD static inline float evr__cross2(float a, float b, float c, float d)
+{
+#ifdef __CUDA_ARCH__
+    return __fsub_rn(__fmul_rn(a, b), __fmul_rn(c, d));
+#else
+    return a * b - c * d;
+#endif
+}
+
+/* a - s * b, the same way for every vertex */
+EVR_HD static inline float evr__shear(float a, float s, float b)
+{
+#ifdef __CUDA_ARCH__
+    return __fmaf_rn(-s, b, a);
+#else
+    return a - s * b;
+#endif
+}
+
+/* ---- rays ---- */
+
+typedef struct {
+    float ox, oy, oz, dx, dy, dz;
+    float ix, iy, iz;          /* safe reciprocals of the direction */
+    int kx, ky, kz;            /* watertight test: kz the dominant axis */
+    float sx, sy, sz;          /* its shear */
+    int oct_inv;               /* CW8: 7 - octant of the direction */
+} evr__tray;
+
+EVR_HD static inline void evr__tray_init(evr__tray *r, evr_v3 o, evr_v3 d)
+{
+    float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z), dz;
+    int kx, ky, kz, t;
+    r->ox = o.x; r->oy = o.y; r->oz = o.z;
+    r->dx = d.x; r->dy = d.y; r->dz = d.z;
+    r->ix = evr__rcp_safe(d.x);
+    r->iy = evr__rcp_safe(d.y);
+    r->iz = evr__rcp_safe(d.z);
+    kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    dz = evr__sel3(d.x, d.y, d.z, kz);
+    if (dz < 0.0f) { t = kx; kx = ky; ky = t; }   /* keeps the winding */
+    r->kx = kx; r->ky = ky; r->kz = kz;
+    r->sx = evr__sel3(d.x, d.y, d.z, kx) / dz;
+    r->sy = evr__sel3(d.x, d.y, d.z, ky) / dz;
+    r->sz = 1.0f / dz;
+    r->oct_inv = 7 - ((d.x < 0.0f ? 1 : 0) | (d.y < 0.0f ? 2 : 0) | (d.z < 0.0f ? 4 : 0));
+}
+
+/* Slab test of the box [lo, hi]: entry distance in *tn when the ray's [tnear, tfar] meets it. */
+EVR_HD static inline int evr__box(const evr__tray *r, float lox, float loy, float loz, float hix, float hiy,
+                                  float hiz, float tnear, float tfar, float *tn)
+{
+    float nx = ((r->ix >= 0.0f ? lox : hix) - r->ox) * r->ix;
+    float ny = ((r->iy >= 0.0f ? loy : hiy) - r->oy) * r->iy;
+    float nz = ((r->iz >= 0.0f ? loz : hiz) - r->oz) * r->iz;
+    float fx = ((r->ix >= 0.0f ? hix : lox) - r->ox) * r->ix;
+    float fy = ((r->iy >= 0.0f ? hiy : loy) - r->oy) * r->iy;
+    float fz = ((r->iz >= 0.0f ? hiz : loz) - r->oz) * r->iz;
+    float a = evr__maxf(evr__maxf(nx, ny), evr__maxf(nz, tnear));
+    float b = evr__minf(evr__minf(fx * EVR__BOX_WIDEN, fy * EVR__BOX_WIDEN), evr__minf(fz * EVR__BOX_WIDEN, tfar));
+    *tn = a;
+    return a <= b;
+}
+
+/* Watertight ray/triangle test (two-sided): t in (tnear, tfar], barycentrics as Embree's. */
+EVR_HD static inline int evr__tri(const evr__tray *r, const evr_gpu_tri *tri, float tnear, float tfar, float *t_out,
+                                  float *u_out, float *v_out)
+{
+    float a0 = tri->v0[0] - r->ox, a1 = tri->v0[1] - r->oy, a2 = tri->v0[2] - r->oz;
+    float b0 = tri->v1[0] - r->ox, b1 = tri->v1[1] - r->oy, b2 = tri->v1[2] - r->oz;
+    float c0 = tri->v2[0] - r->ox, c1 = tri->v2[1] - r->oy, c2 = tri->v2[2] - r->oz;
+    float akz = evr__sel3(a0, a1, a2, r->kz), bkz = evr__sel3(b0, b1, b2, r->kz), ckz = evr__sel3(c0, c1, c2, r->kz);
+    float ax = evr__shear(evr__sel3(a0, a1, a2, r->kx), r->sx, akz);
+    float ay = evr__shear(evr__sel3(a0, a1, a2, r->ky), r->sy, akz);
+    float bx = evr__shear(evr__sel3(b0, b1, b2, r->kx), r->sx, bkz);
+    float by = evr__shear(evr__sel3(b0, b1, b2, r->ky), r->sy, bkz);
+    float cx = evr__shear(evr__sel3(c0, c1, c2, r->kx), r->sx, ckz);
+    float cy = evr__shear(evr__sel3(c0, c1, c2, r->ky), r->sy, ckz);
+    float u = evr__cross2(cx, by, cy, bx);   /* weight of v0 */
+    float v = evr__cross2(ax, cy, ay, cx);   /* weight of v1 */
+    float w = evr__cross2(bx, ay, by, ax);   /* weight of v2 */
+    float det, tt, adet;
+    if (u == 0.0f || v == 0.0f || w == 0.0f) {   /* on an edge in float: decide exactly */
+        u = (float)((double)cx * (double)by - (double)cy * (double)bx);
+        v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+        w = (float)((double)bx * (double)ay - (double)by * (double)ax);
+    }
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return 0;
+    det = u + v + w;
+    if (det == 0.0f) return 0;
+    tt = u * (r->sz * akz) + v * (r->sz * bkz) + w * (r->sz * ckz);
+    adet = fabsf(det);
+    if (det < 0.0f) tt = -tt;
+    if (!(tt > tnear * adet && tt <= tfar * adet)) return 0;
+    *t_out = tt / adet;
+    *u_out = v / det;
+    *v_out = w / det;
+    return 1;
+}
+
+typedef struct { uint32_t a, b; } evr__stack_entry;
+
+/* What a bottom-level search reports besides the distance. */
+typedef struct {
+    uint32_t prim;
+    float u, v;
+} evr__tri_hit;
+
+/* ---- BVH4 ---- */
+
+#define EVR__CSWAP(i, j)                                                        \
+    do {                                                                        \
+        if (ct[j] < ct[i]) {                                                    \
+            float t_ = ct[i]; int c_ = ci[i];                                   \
+            ct[i] = ct[j]; ci[i] = ci[j]; ct[j] = t_; ci[j] = c_;               \
+        }                                                                       \
+    } while (0)
+
+/* Children of a BVH4 node that the ray meets, inner ones sorted by entry distance into
+ * (ci, ct) (misses at +inf); leaves are handed back through leaf_first/leaf_count in slot
+ * order (count 0: none). */
+EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r, float tnear, float tfar, int ci[4],
+                                     float ct[4], int leaf_first[4], uint32_t leaf_count[4])
+{
+    int i;
+    EVR__UNROLL
+    for (i = 0; i < 4; i++) {
+        float tn;
+        int c = n->child[i];
+        uint32_t cnt = n->count[i];
+        int hit = c >= 0 && evr__box(r, n->lo_x[i], n->lo_y[i], n->lo_z[i], n->hi_x[i], n->hi_y[i], n->hi_z[i],
+                                     tnear, tfar, &tn);
+        ci[i] = c;
+        ct[i] = hit && cnt == 0 ? tn : INFINITY;
+        leaf_first[i] = c;
+        leaf_count[i] = hit ? cnt : 0u;
+    }
+    EVR__CSWAP(0, 1);
+    EVR__CSWAP(2, 3);
+    EVR__CSWAP(0, 2);
+    EVR__CSWAP(1, 3);
+    EVR__CSWAP(1, 2);
+}
+
+/* Nearest (any != 0: first) triangle of one mesh in (tnear, *tfar]; shrinks *tfar. Uses the
+ * stack above sp0. */
+EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
+                                    float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0,
+                                    evr__tri_hit *th)
+{
+    int node = root, sp = sp0, found = 0;
+    for (;;) {
+        int ci[4], lf[4], i, j;
+        float ct[4];
+        uint32_t lc[4], k;
+        evr__node4(&nodes[node], r, tnear, *tfar, ci, ct, lf, lc);
+        EVR__UNROLL
+        for (i = 0; i < 4; i++) {
+            for (k = 0; k < lc[i]; k++) {
+                const evr_gpu_tri *tri = &tris[(uint32_t)lf[i] + k];
+                float t, u, v;
+                if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+                    *tfar = t;
+                    th->prim = tri->prim;
+                    th->u = u;
+                    th->v = v;
+                    found = 1;
+                    if (any) return 1;
+                }
+            }
+        }
+        if (ct[0] <= *tfar) {
+            node = ci[0];
+            for (j = 3; j >= 1; j--) {
+                if (ct[j] <= *tfar && sp < EVR_GPU_STACK_SIZE) {
+                    stack[sp].a = (uint32_t)ci[j];
+                    stack[sp].b = evr__f2u(ct[j]);
+                    sp++;
+                }
+            }
+            continue;
+        }
+        node = -1;
+        while (sp > sp0) {
+            sp--;
+            if (evr__u2f(stack[sp].b) <= *tfar) {
+                node = (int)stack[sp].a;
+                break;
+            }
+        }
+        if (node < 0) break;
+    }
+    return found;
+}
+
+/* ---- CW8 ---- */
+
+EVR_HD static inline float evr__exp2_biased(uint8_t e)   /* 2^(e - 127), e in 1..254 */
+{
+    return evr__u2f((uint32_t)e << 23);
+}
+
+/* Hit mask of a CW8 node: bits 24 + (slot ^ oct_inv) for inner children, the item bits of leaf
+ * children below 24. */
+EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear, float tfar)
+{
+    float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]), sz = evr__exp2_biased(n->e[2]);
+    float px = n->p[0], py = n->p[1], pz = n->p[2];
+    uint32_t hits = 0;
+    int i;
+    EVR__UNROLL
+    for (i = 0; i < 8; i++) {
+        uint32_t m = n->meta[i], idx;
+        float tn;
+        if (!m) continue;
+        if (!evr__box(r, px + (float)n->qlo[0][i] * sx, py + (float)n->qlo[1][i] * sy, pz + (float)n->qlo[2][i] * sz,
+                      px + (float)n->qhi[0][i] * sx, py + (float)n->qhi[1][i] * sy, pz + (float)n->qhi[2][i] * sz,
+                      tnear, tfar, &tn))
+            continue;
+        idx = m & 31u;
+        if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
+        hits |= (m >> 5) << idx;
+    }
+    return hits;
+}
+
+/* Next node of a node group (base, hits with imask in the low byte): takes the highest hit bit
+ * and pushes what remains. */
+EVR_HD static inline uint32_t evr__group_next(uint32_t *base, uint32_t *hits, const evr__tray *r,
+                                              evr__stack_entry *stack, int *sp)
+{
+    int bit = evr__msb(*hits);
+    uint32_t imask, slot, index;
+    *hits &= ~(1u << bit);
+    imask = *hits & 0xffu;
+    slot = (uint32_t)(bit - 24) ^ (uint32_t)r->oct_inv;
+    index = *base + (uint32_t)evr__popc(imask & ((1u << slot) - 1u));
+    if (*hits > 0x00ffffffu && *sp < EVR_GPU_STACK_SIZE) {
+        stack[*sp].a = *base;
+        stack[*sp].b = *hits;
+        (*sp)++;
+    }
+    return index;
+}
+
+EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
+                                    float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0,
+                                    evr__tri_hit *th)
+{
+    uint32_t ng_base = (uint32_t)root, ng_hits = 0x80000000u, tg_base = 0, tg_hits = 0;
+    int sp = sp0, found = 0;
+    for (;;) {
+        if (ng_hits > 0x00ffffffu) {
+            const evr_gpu_node8 *n = &nodes[evr__group_next(&ng_base, &ng_hits, r, stack, &sp)];
+            uint32_t h = evr__node8(n, r, tnear, *tfar);
+            ng_base = n->child_base;
+            ng_hits = (h & 0xff000000u) | n->imask;
+            tg_base = n->item_base;
+            tg_hits = h & 0x00ffffffu;
+        }
+        while (tg_hits) {
+            int bit = evr__msb(tg_hits);
+            const evr_gpu_tri *tri = &tris[tg_base + (uint32_t)bit];
+            float t, u, v;
+            tg_hits &= ~(1u << bit);
+            if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+                *tfar = t;
+                th->prim = tri->prim;
+                th->u = u;
+                th->v = v;
+                found = 1;
+                if (any) return 1;
+            }
+        }
+        if (ng_hits <= 0x00ffffffu) {
+            if (sp == sp0) break;
+            sp--;
+            ng_base = stack[sp].a;
+            ng_hits = stack[sp].b;
+        }
+    }
+    return found;
+}
+
+/* ---- instances ---- */
+
+/* Searches one instance with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
+ * and fills hit (when not NULL). */
+EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
+                                       evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
+                                       evr__stack_entry *stack, int sp, evr_gpu_hit *hit)
+{
+    evr_m34 inv;
+    evr_v3 oo, od;
+    evr__tray r;
+    evr__tri_hit th;
+    int found;
+    if (in->moving) {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, in->track), f);
+        inv = evr_m34_inverse(&xf);
+    } else {
+        inv = in->inv;
+    }
+    oo = evr_m34_point(&inv, o);
+    od = evr_m34_vector(&inv, d);
+    if (od.x == 0.0f && od.y == 0.0f && od.z == 0.0f) return 0;   /* a zero scale: nothing there */
+    evr__tray_init(&r, oo, od);
+    th.prim = 0;
+    th.u = th.v = 0.0f;
+    if (v->layout == EVR_GPU_LAYOUT_CW8)
+        found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
+    else
+        found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
+    if (found && hit) {
+        hit->t = *tfar;
+        hit->u = th.u;
+        hit->v = th.v;
+        hit->prim = th.prim;
+        hit->instance = in->instance;
+    }
+    return found;
+}
+
+/* ---- top level ---- */
+
+EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
+                                     float tfar, float f, int any, evr_gpu_hit *hit)
+{
+    evr__stack_entry stack[EVR_GPU_STACK_SIZE];
+    evr__tray r;
+    int node = 0, sp = 0, found = 0;
+    evr__tray_init(&r, ray.org, ray.dir);
+    for (;;) {
+        int ci[4], lf[4], i, j;
+        float ct[4];
+        uint32_t lc[4], k;
+        evr__node4(&v->top4[node], &r, tnear, tfar, ci, ct, lf, lc);
+        for (i = 0; i < 4; i++) {
+            for (k = 0; k < lc[i]; k++) {
+                if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear, &tfar, any,
+                                  stack, sp, hit)) {
+                    found = 1;
+                    if (any) return 1;
+                }
+            }
+        }
+        if (ct[0] <= tfar) {
+            node = ci[0];
+            for (j = 3; j >= 1; j--) {
+                if (ct[j] <= tfar && sp < EVR_GPU_STACK_SIZE) {
+                    stack[sp].a = (uint32_t)ci[j];
+                    stack[sp].b = evr__f2u(ct[j]);
+                    sp++;
+                }
+            }
+            continue;
+        }
+        node = -1;
+        while (sp > 0) {
+            sp--;
+            if (evr__u2f(stack[sp].b) <= tfar) {
+                node = (int)stack[sp].a;
+                break;
+            }
+        }
+        if (node < 0) break;
+    }
+    return found;
+}
+
+EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
+                                     float tfar, float f, int any, evr_gpu_hit *hit)
+{
+    evr__stack_entry stack[EVR_GPU_STACK_SIZE];
+    evr__tray r;
+    uint32_t ng_base = 0, ng_hits = 0x80000000u, tg_base = 0, tg_hits = 0;
+    int sp = 0, found = 0;
+    evr__tray_init(&r, ray.org, ray.dir);
+    for (;;) {
+        if (ng_hits > 0x00ffffffu) {
+            const evr_gpu_node8 *n = &v->top8[evr__group_next(&ng_base, &ng_hits, &r, stack, &sp)];
+            uint32_t h = evr__node8(n, &r, tnear, tfar);
+            ng_base = n->child_base;
+            ng_hits = (h & 0xff000000u) | n->imask;
+            tg_base = n->item_base;
+            tg_hits = h & 0x00ffffffu;
+        }
+        while (tg_hits) {
+            int bit = evr__msb(tg_hits);
+            tg_hits &= ~(1u << bit);
+            if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear, &tfar, any, stack,
+                              sp, hit)) {
+                found = 1;
+                if (any) return 1;
+            }
+        }
+        if (ng_hits <= 0x00ffffffu) {
+            if (sp == 0) break;
+            sp--;
+            ng_base = stack[sp].a;
+            ng_hits = stack[sp].b;
+        }
+    }
+    return found;
+}
+
+/* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
+EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
+                                           float tmax, float f, evr_gpu_hit *hit)
+{
+    if (v->num_top_nodes == 0) return 0;
+    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit);
+    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit);
+}
+
+/* Whether anything lies along the world ray in (tnear, tfar] at time f (stops at the first hit). */
+EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
+                                       float tnear, float tfar, float f)
+{
+    if (v->num_top_nodes == 0) return 0;
+    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0);
+    return evr__trace4(v, rs, ray, tnear, tfar, f, 1, 0);
+}
+
+#endif
