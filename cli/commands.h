@@ -5,5 +5,6 @@
 int cmd_render(int argc, char **argv, const char *default_demo);
 int cmd_info(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
 
 #endif

@@ -75,7 +75,7 @@ T.check("eye_camera" in info and "ir_led" in info, "info lists the demo's camera
 # a static scene gives no events, and says so
 static = os.path.join(tmp, "static.gltf")
 quad_gltf(static)
-out = os.path.join(tmp, "static-run")
+out = static_out = os.path.join(tmp, "static-run")
 p = T.run("render", static, "-o", out, "--res", "32x32", "--duration", "0.2", "--format", "npy")
 T.check(T.load_run_json(out)["stats"]["events"] == 0, "static scene: zero events")
 T.check("no events" in p.stdout, "static scene: says so")
@@ -85,6 +85,15 @@ quad_gltf(moving, animated=True)
 out = os.path.join(tmp, "moving-run")
 T.run("render", moving, "-o", out, "--res", "32x32", "--format", "npy", "--quiet")
 T.check(T.load_run_json(out)["stats"]["events"] > 0, "moving quad: events")
+
+# compare: a run against itself, and against the same run in another format
+out2 = os.path.join(tmp, "moving-run2")
+T.run("render", moving, "-o", out2, "--res", "32x32", "--format", "txt,h5", "--quiet")
+r = json.loads(T.run("compare", os.path.join(out, "events.npy"), os.path.join(out2, "events.txt"), "--json").stdout)
+T.check(r["f1"] == 1.0 and r["count_ratio"] == 1.0, f"compare: identical runs match fully ({r})")
+r = json.loads(T.run("compare", os.path.join(out, "events.npy"), os.path.join(static_out, "events.npy"), "--json").stdout)
+T.check(r["recall"] == 0.0, "compare: nothing matches an empty stream")
+expect_error(["compare", os.path.join(out, "events.npy")], "compare with one file")
 
 # bad input
 noout = os.path.join(tmp, "never")
