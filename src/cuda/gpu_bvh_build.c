@@ -29,10 +29,10 @@ typedef struct {
     uint32_t prim[];
 } build_leaf;
 
-/* What the split callback needs: the triangles of the mesh being built. */
+/* What the split callback needs: the mesh's triangles, 9 floats each (no index indirection:
+ * Embree calls the callback ~100 times per triangle). */
 typedef struct {
-    const float *positions;
-    const uint32_t *indices;
+    const float *tri;
 } split_source;
 
 static void *cb_create_node(RTCThreadLocalAllocator alloc, unsigned int n, void *user)
@@ -92,65 +92,68 @@ static float round_up(double x)
     return (double)f < x ? nextafterf(f, INFINITY) : f;
 }
 
+static inline float min_f(float a, float b) { return a < b ? a : b; }
+static inline float max_f(float a, float b) { return a > b ? a : b; }
+
 /* Spatial split: the boxes of the parts of the triangle on either side of the plane x[dim] =
- * pos, clipped to the reference's current box. Edge crossings are computed in double and
- * rounded outwards, so each box holds its part of the triangle. */
+ * pos, clipped to the reference's current box. Edge crossings are computed in float and the
+ * boxes widened by their rounding error (a few ulps), so each box holds its part of the
+ * triangle. Embree calls this for every candidate split: it must be cheap. */
 static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, float pos, struct RTCBounds *lb,
                      struct RTCBounds *rb, void *user)
 {
     const split_source *src = user;
     const float pb[6] = {prim->lower_x, prim->lower_y, prim->lower_z, prim->upper_x, prim->upper_y, prim->upper_z};
-    double v[3][3], l[6], r[6];
-    float lf[6], rf[6];
+    const float *t = src->tri + 9 * (size_t)prim->primID, *v[3];
+    float l[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    float r[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     int i, k;
+    v[0] = t;
+    v[1] = t + 3;
+    v[2] = t + 6;
     for (i = 0; i < 3; i++) {
-        uint32_t vi = src->indices[3 * (size_t)prim->primID + (size_t)i];
-        for (k = 0; k < 3; k++) v[i][k] = src->positions[3 * (size_t)vi + (size_t)k];
-    }
-    for (k = 0; k < 3; k++) {
-        l[k] = r[k] = INFINITY;
-        l[k + 3] = r[k + 3] = -INFINITY;
-    }
-    for (i = 0; i < 3; i++) {
-        const double *a = v[i], *b = v[(i + 1) % 3];
-        if (a[dim] <= pos)
-            for (k = 0; k < 3; k++) { l[k] = fmin(l[k], a[k]); l[k + 3] = fmax(l[k + 3], a[k]); }
-        if (a[dim] >= pos)
-            for (k = 0; k < 3; k++) { r[k] = fmin(r[k], a[k]); r[k + 3] = fmax(r[k + 3], a[k]); }
-        if ((a[dim] < pos && b[dim] > pos) || (a[dim] > pos && b[dim] < pos)) {
-            double f = ((double)pos - a[dim]) / (b[dim] - a[dim]), p[3];
-            for (k = 0; k < 3; k++) p[k] = a[k] + f * (b[k] - a[k]);
-            p[dim] = pos;
+        const float *a = v[i], *b = v[i == 2 ? 0 : i + 1];
+        float ad = a[dim], bd = b[dim];
+        if (ad <= pos)
+            for (k = 0; k < 3; k++) { l[k] = min_f(l[k], a[k]); l[k + 3] = max_f(l[k + 3], a[k]); }
+        if (ad >= pos)
+            for (k = 0; k < 3; k++) { r[k] = min_f(r[k], a[k]); r[k + 3] = max_f(r[k + 3], a[k]); }
+        if ((ad < pos && bd > pos) || (ad > pos && bd < pos)) {
+            float f = (pos - ad) / (bd - ad);
             for (k = 0; k < 3; k++) {
-                l[k] = fmin(l[k], p[k]); l[k + 3] = fmax(l[k + 3], p[k]);
-                r[k] = fmin(r[k], p[k]); r[k + 3] = fmax(r[k + 3], p[k]);
+                float x = a[k] + f * (b[k] - a[k]);
+                /* |error| <= a few ulps of the larger endpoint coordinate */
+                float e = 16.0f * FLT_EPSILON * max_f(fabsf(a[k]), fabsf(b[k])) + FLT_MIN;
+                float lo = k == (int)dim ? pos : x - e, hi = k == (int)dim ? pos : x + e;
+                l[k] = min_f(l[k], lo); l[k + 3] = max_f(l[k + 3], hi);
+                r[k] = min_f(r[k], lo); r[k + 3] = max_f(r[k + 3], hi);
             }
         }
     }
-    for (k = 0; k < 3; k++) {
-        lf[k] = fmaxf(round_down(l[k]), pb[k]);
-        lf[k + 3] = fminf(round_up(l[k + 3]), pb[k + 3]);
-        rf[k] = fmaxf(round_down(r[k]), pb[k]);
-        rf[k + 3] = fminf(round_up(r[k + 3]), pb[k + 3]);
+    for (k = 0; k < 3; k++) {   /* clip to the reference's box */
+        l[k] = max_f(l[k], pb[k]);
+        l[k + 3] = min_f(l[k + 3], pb[k + 3]);
+        r[k] = max_f(r[k], pb[k]);
+        r[k + 3] = min_f(r[k + 3], pb[k + 3]);
     }
-    lf[dim + 3] = fminf(lf[dim + 3], pos);
-    rf[dim] = fmaxf(rf[dim], pos);
+    l[dim + 3] = min_f(l[dim + 3], pos);
+    r[dim] = max_f(r[dim], pos);
     /* a side the clipped triangle does not reach: the reference's box cut at the plane, which
      * is larger than needed but never wrong */
-    if (!(lf[0] <= lf[3] && lf[1] <= lf[4] && lf[2] <= lf[5])) {
-        memcpy(lf, pb, sizeof lf);
-        lf[dim + 3] = fminf(pos, pb[dim + 3]);
-        if (lf[dim] > lf[dim + 3]) lf[dim] = lf[dim + 3];
+    if (!(l[0] <= l[3] && l[1] <= l[4] && l[2] <= l[5])) {
+        memcpy(l, pb, sizeof l);
+        l[dim + 3] = min_f(pos, pb[dim + 3]);
+        if (l[dim] > l[dim + 3]) l[dim] = l[dim + 3];
     }
-    if (!(rf[0] <= rf[3] && rf[1] <= rf[4] && rf[2] <= rf[5])) {
-        memcpy(rf, pb, sizeof rf);
-        rf[dim] = fmaxf(pos, pb[dim]);
-        if (rf[dim + 3] < rf[dim]) rf[dim + 3] = rf[dim];
+    if (!(r[0] <= r[3] && r[1] <= r[4] && r[2] <= r[5])) {
+        memcpy(r, pb, sizeof r);
+        r[dim] = max_f(pos, pb[dim]);
+        if (r[dim + 3] < r[dim]) r[dim + 3] = r[dim];
     }
-    lb->lower_x = lf[0]; lb->lower_y = lf[1]; lb->lower_z = lf[2];
-    lb->upper_x = lf[3]; lb->upper_y = lf[4]; lb->upper_z = lf[5];
-    rb->lower_x = rf[0]; rb->lower_y = rf[1]; rb->lower_z = rf[2];
-    rb->upper_x = rf[3]; rb->upper_y = rf[4]; rb->upper_z = rf[5];
+    lb->lower_x = l[0]; lb->lower_y = l[1]; lb->lower_z = l[2];
+    lb->upper_x = l[3]; lb->upper_y = l[4]; lb->upper_z = l[5];
+    rb->lower_x = r[0]; rb->lower_y = r[1]; rb->lower_z = r[2];
+    rb->upper_x = r[3]; rb->upper_y = r[4]; rb->upper_z = r[5];
 }
 
 /* ---- flattening ---- */
@@ -612,6 +615,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         size_t nt = mesh->num_triangles, n = 0, t;
         float box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
         struct RTCBuildPrimitive *prims;
+        float *tri;
         split_source split;
         uint32_t root, first = c.num_nodes;
         int k, need;
@@ -623,7 +627,10 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
             break;
         }
         prims = alloc_prims(2 * nt);   /* room for spatial splits */
-        if (!prims) {
+        tri = malloc(sizeof(float) * 9 * nt);
+        if (!prims || !tri) {
+            free(prims);
+            free(tri);
             st = fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
             break;
         }
@@ -641,6 +648,9 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
                 }
             }
             if (!ok) continue;   /* Embree skips such triangles too */
+            for (v = 0; v < 3; v++)
+                memcpy(tri + 9 * t + 3 * (size_t)v, mesh->positions + 3 * (size_t)mesh->indices[3 * t + (size_t)v],
+                       3 * sizeof(float));
             prims[n].lower_x = lo[0]; prims[n].lower_y = lo[1]; prims[n].lower_z = lo[2];
             prims[n].upper_x = hi[0]; prims[n].upper_y = hi[1]; prims[n].upper_z = hi[2];
             prims[n].geomID = 0;
@@ -653,15 +663,16 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         }
         if (n == 0) {
             free(prims);
+            free(tri);
             continue;
         }
         c.positions = mesh->positions;
         c.indices = mesh->indices;
-        split.positions = mesh->positions;
-        split.indices = mesh->indices;
+        split.tri = tri;
         st = build_tree(dev, &c, prims, n, 2 * n, RTC_BUILD_QUALITY_HIGH, layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4,
                         &split, box, &root, err);
         free(prims);
+        free(tri);
         if (st != EVR_OK) break;
         need = stack_need(&c, first, c.num_nodes);
         if (need < 0) {
@@ -723,52 +734,68 @@ void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_tra
                             float out_hi[3])
 {
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double margin = 0.0, mag = 0.0;
+    double mag = 0.0;
     int i, j, k;
     if (tr.n <= 1) {
         evr_m34 m = evr_motion_key_matrix(&tr.keys[0]);
         extend_corners(&m, lo, hi, blo, bhi);
     }
     for (i = 0; i + 1 < tr.n; i++) {
-        const evr_motion_key *a = &tr.keys[i], *b = &tr.keys[i + 1];
-        /* Speed bound of any point c of the box, x(s) = T(s) + R(s) U(s) c for s in [0, 1]:
-         * |dx/ds| <= |dT| + w max|U(s) c| + |dU c|, w the rotation's angular speed (slerp:
-         * constant, the angle between the keys; normalized lerp for close keys: at most
-         * 1.0003 times that). |U(s) c| is convex in s and c, so its maximum is at an end key
-         * and a corner of the box. */
-        double dt = sqrt(((double)b->trans.x - a->trans.x) * ((double)b->trans.x - a->trans.x) +
-                         ((double)b->trans.y - a->trans.y) * ((double)b->trans.y - a->trans.y) +
-                         ((double)b->trans.z - a->trans.z) * ((double)b->trans.z - a->trans.z));
-        double d = fabs((double)evr_quat_dot(a->rot, b->rot));
-        double qa = sqrt((double)evr_quat_dot(a->rot, a->rot)), qb = sqrt((double)evr_quat_dot(b->rot, b->rot));
-        double w, umax = 0.0, dumax = 0.0, L, size;
+        /* x(s) = T(s) + Q(s) c, Q = R U, for s in [0, 1] and c in the box. Between two samples
+         * s0 < s1: T is linear, so T(s) lies in the box of T(s0), T(s1); Q(s) c lies within
+         * L h / 2 (h = s1 - s0) of Q(s0) c or Q(s1) c, L a bound on its speed:
+         * |d(Q c)/ds| <= w max|U(s) c| + |dU c|, w the rotation's angular speed (slerp:
+         * constant, the angle between the keys; normalized lerp for close keys: at most 1.0003
+         * times that); |U(s) c| is convex in s and c, so its maximum is at an end key and a
+         * corner of the box. Each step's box is the sum of the two; the result their union.
+         * Translation needs no samples: the samples follow the rotation and scaling only. */
+        evr_motion_key a = tr.keys[i], b = tr.keys[i + 1];
+        double plo[3], phi[3], pt[3];   /* previous sample: Q box and T */
+        double d = fabs((double)evr_quat_dot(a.rot, b.rot));
+        double qa = sqrt((double)evr_quat_dot(a.rot, a.rot)), qb = sqrt((double)evr_quat_dot(b.rot, b.rot));
+        double w, umax = 0.0, dumax = 0.0, L, margin;
+        evr_v3 ta = a.trans, tb = b.trans;
         int steps, c;
         d = qa > 0.0 && qb > 0.0 ? d / (qa * qb) : 1.0;
         w = 2.0 * acos(d > 1.0 ? 1.0 : d) * 1.01 + 1e-6;
         for (c = 0; c < 8; c++) {
             double p[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
-            umax = fmax(umax, fmax(upper_apply_len(a, p, 0, NULL), upper_apply_len(b, p, 0, NULL)));
-            dumax = fmax(dumax, upper_apply_len(a, p, 1, b));
+            umax = fmax(umax, fmax(upper_apply_len(&a, p, 0, NULL), upper_apply_len(&b, p, 0, NULL)));
+            dumax = fmax(dumax, upper_apply_len(&a, p, 1, &b));
         }
-        L = dt + w * umax + dumax;
-        /* samples close enough that the margin is a thousandth of the object's size */
-        size = umax > 0.0 ? umax : 1.0;
-        steps = (int)ceil(L / (2e-3 * size));
+        L = w * umax + dumax;
+        /* samples close enough that the widening is 1% of the object's size */
+        steps = (int)ceil(L / (2e-2 * (umax > 0.0 ? umax : 1.0)));
         if (steps < 1) steps = 1;
-        if (steps > 256) steps = 256;
+        if (steps > 64) steps = 64;
+        margin = L / (2.0 * steps);
+        a.trans = b.trans = evr_v3_make(0.0f, 0.0f, 0.0f);
         for (j = 0; j <= steps; j++) {
-            evr_motion_key key = evr_motion_key_lerp(a, b, (float)j / (float)steps);
+            float f = (float)j / (float)steps;
+            evr_motion_key key = evr_motion_key_lerp(&a, &b, f);
             evr_m34 m = evr_motion_key_matrix(&key);
-            extend_corners(&m, lo, hi, blo, bhi);
+            evr_v3 t = evr_v3_lerp(ta, tb, f);
+            double qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double tt[3] = {t.x, t.y, t.z};
+            extend_corners(&m, lo, hi, qlo, qhi);
+            if (j > 0)
+                for (k = 0; k < 3; k++) {
+                    blo[k] = fmin(blo[k], fmin(pt[k], tt[k]) + fmin(plo[k], qlo[k]) - margin);
+                    bhi[k] = fmax(bhi[k], fmax(pt[k], tt[k]) + fmax(phi[k], qhi[k]) + margin);
+                }
+            for (k = 0; k < 3; k++) {
+                plo[k] = qlo[k];
+                phi[k] = qhi[k];
+                pt[k] = tt[k];
+            }
         }
-        margin = fmax(margin, L / (2.0 * steps));
     }
     for (k = 0; k < 3; k++) mag = fmax(mag, fmax(fabs(blo[k]), fabs(bhi[k])));
-    /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
-    margin += 1e-6 * mag + 1e-30;
     for (k = 0; k < 3; k++) {
-        out_lo[k] = round_down(blo[k] - margin);
-        out_hi[k] = round_up(bhi[k] + margin);
+        /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
+        double slack = 1e-6 * mag + 1e-30;
+        out_lo[k] = round_down(blo[k] - slack);
+        out_hi[k] = round_up(bhi[k] + slack);
     }
 }
 

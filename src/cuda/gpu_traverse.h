@@ -38,7 +38,7 @@ typedef struct {
     uint32_t prim;         /* triangle index in the instance's mesh */
 } evr_gpu_hit;
 
-#ifdef __CUDACC__
+#ifdef __CUDA_ARCH__
 #define EVR__UNROLL _Pragma("unroll")
 #else
 #define EVR__UNROLL
@@ -274,10 +274,10 @@ EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tr
                 }
             }
         }
-        if (ct[0] <= *tfar) {
+        if (ct[0] < INFINITY && ct[0] <= *tfar) {
             node = ci[0];
             for (j = 3; j >= 1; j--) {
-                if (ct[j] <= *tfar && sp < EVR_GPU_STACK_SIZE) {
+                if (ct[j] < INFINITY && ct[j] <= *tfar && sp < EVR_GPU_STACK_SIZE) {
                     stack[sp].a = (uint32_t)ci[j];
                     stack[sp].b = evr__f2u(ct[j]);
                     sp++;
@@ -449,10 +449,10 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
                 }
             }
         }
-        if (ct[0] <= tfar) {
+        if (ct[0] < INFINITY && ct[0] <= tfar) {
             node = ci[0];
             for (j = 3; j >= 1; j--) {
-                if (ct[j] <= tfar && sp < EVR_GPU_STACK_SIZE) {
+                if (ct[j] < INFINITY && ct[j] <= tfar && sp < EVR_GPU_STACK_SIZE) {
                     stack[sp].a = (uint32_t)ci[j];
                     stack[sp].b = evr__f2u(ct[j]);
                     sp++;

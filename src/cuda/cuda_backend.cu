@@ -1,0 +1,618 @@
+/* CUDA backend: the same simulation as the CPU backend on an NVIDIA GPU.
+ *
+ * Per segment: the host builds the top-level BVH over the instances (bounds over the whole
+ * segment) and uploads it with the motion keys; one kernel runs every pixel's samples of the
+ * segment (one thread per pixel, its samples in a loop): camera ray, our own BVH traversal with
+ * motion transforms (cuda/gpu_traverse.h), shading and the pixel model from src/core, the very
+ * functions the CPU backend runs. Events are appended with warp-aggregated atomics as 64-bit
+ * keys (time, y, x, polarity), sorted on the GPU with CUB's radix sort and copied to pinned host
+ * memory on a second stream while the next segment renders.
+ *
+ * Pixel states live in a ring of three device arrays: segment i reads ring[i % 3] and writes
+ * ring[(i + 1) % 3], so when segment i's event buffer overflows (found at collect, when segment
+ * i + 1 may already be rendering) segment i can be rendered again from its unchanged input with
+ * a larger buffer: events are never dropped. */
+#include <cuda_runtime.h>
+#include <cub/device/device_radix_sort.cuh>
+
+extern "C" {
+#include "backend.h"
+#include "cuda/cuda_backend.h"
+#include "cuda/gpu_bvh.h"
+}
+#include "core/rng.h"
+#include "core/shading.h"
+#include "cuda/gpu_traverse.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CK(call)                                                                                          \
+    do {                                                                                                  \
+        cudaError_t e_ = (call);                                                                          \
+        if (e_ != cudaSuccess) {                                                                          \
+            snprintf(err->msg, sizeof err->msg, "CUDA: %s failed: %s", #call, cudaGetErrorString(e_));   \
+            return e_ == cudaErrorMemoryAllocation ? EVR_ERR_NOMEM : EVR_ERR_BACKEND;                     \
+        }                                                                                                 \
+    } while (0)
+
+#define BLOCK 128
+
+/* Everything one launch reads, by value. */
+struct kernel_args {
+    evr_render_scene rs;           /* device pointers */
+    evr_gpu_scene_view view;       /* device pointers */
+    const evr_pixel_state *state_in;
+    evr_pixel_state *state_out;
+    const float *phase;
+    float *intensity;              /* NULL unless the segment's intensities are wanted */
+    evr_pixel_params pixel;
+    int width, height, samples;
+    float dt;                      /* segment length, seconds */
+    double t0;                     /* segment start, seconds */
+    long long base_us;             /* event keys hold t_us - base_us */
+    int camera_static;
+    unsigned long long *keys;      /* event keys */
+    unsigned int capacity;
+    unsigned int *count;
+    unsigned long long *rays;
+};
+
+/* Intensity of one sample: as sample_intensity in cpu/cpu_backend.c, with our traversal. */
+__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays)
+{
+    const evr_render_scene *rs = &a.rs;
+    evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
+    evr_gpu_hit hit;
+    (*rays)++;
+    if (!evr_trace_closest(&a.view, rs, ray, 1e30f, f, &hit)) return 0.0f;
+    evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
+    evr_surface s;
+    evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, ray, hit.t, &s);
+    float acc[3] = {0.0f, 0.0f, 0.0f};
+    for (int l = 0; l < rs->num_lights; l++) {
+        evr_v3 wi;
+        float dist, e[3];
+        if (!evr_light_incident(rs, &rs->lights[l], f, s.p, &wi, &dist, e)) continue;
+        if (evr_v3_dot(wi, s.n) <= 0.0f) continue;
+        (*rays)++;
+        evr_ray sr;
+        sr.org = s.p;
+        sr.dir = wi;
+        if (evr_trace_any(&a.view, rs, sr, evr_shadow_tnear(&s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f)) continue;
+        evr_accumulate_lambert(&s, wi, e, acc);
+    }
+    return evr_surface_intensity(&s, acc, rs->ambient);
+}
+
+__device__ static unsigned long long pack_event(const kernel_args &a, float te, int x, int y, int p)
+{
+    long long t_us = llround((a.t0 + (double)te) * 1e6) - a.base_us;
+    return ((unsigned long long)t_us << 33) | ((unsigned long long)y << 17) | ((unsigned long long)x << 1) |
+           (unsigned long long)p;
+}
+
+__global__ void __launch_bounds__(BLOCK) render_kernel(kernel_args a)
+{
+    const int npix = a.width * a.height;
+    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    const bool active = pix < npix;      /* inactive threads still take part in warp votes */
+    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    const unsigned lane = threadIdx.x & 31u;
+    evr_pixel_state st;
+    evr_pixel_reset(&st);
+    float phi = 0.0f;
+    if (active) {
+        st = a.state_in[pix];
+        phi = a.phase[pix];
+    }
+    unsigned rays = 0;
+    evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
+    for (int k = 0; k < a.samples; k++) {
+        float f = ((float)k + phi) / (float)a.samples;
+        evr_pixel_span sp;
+        int more = 0;
+        if (active) {
+            evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
+            float intensity = gpu_sample(a, &pose, x, y, f, &rays);
+            more = evr_pixel_begin(&st, &a.pixel, f * a.dt, intensity, &sp);
+        }
+        const int began = more;
+        for (;;) {
+            float te = 0.0f;
+            int pol = 0, has = 0;
+            if (more) {
+                has = evr_pixel_next(&st, &a.pixel, &sp, &te, &pol);
+                more = has;
+            }
+            unsigned mask = __ballot_sync(0xffffffffu, has);
+            if (!mask) break;
+            unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
+            if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
+            base = __shfl_sync(0xffffffffu, base, leader);
+            if (has) {
+                unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+                if (idx < a.capacity) a.keys[idx] = pack_event(a, te, x, y, pol);   /* else: re-run */
+            }
+        }
+        if (began) evr_pixel_end(&st, &sp);
+    }
+    if (active) {
+        evr_pixel_end_segment(&st, a.dt);
+        a.state_out[pix] = st;
+        if (a.intensity) a.intensity[pix] = st.intensity;
+    }
+    unsigned long long r = rays;
+    for (int o = 16; o > 0; o >>= 1) r += __shfl_down_sync(0xffffffffu, r, o);
+    if (lane == 0 && r) atomicAdd(a.rays, r);
+}
+
+/* A device buffer that grows. */
+template <typename T> struct dbuf {
+    T *p = nullptr;
+    size_t cap = 0;
+    cudaError_t reserve(size_t n)
+    {
+        if (n <= cap) return cudaSuccess;
+        size_t c = cap ? cap : 1;
+        while (c < n) c *= 2;
+        if (p) cudaFree(p);
+        p = nullptr;
+        cap = 0;
+        cudaError_t e = cudaMalloc(&p, c * sizeof(T));
+        if (e == cudaSuccess) cap = c;
+        return e;
+    }
+    void release()
+    {
+        if (p) cudaFree(p);
+        p = nullptr;
+        cap = 0;
+    }
+};
+
+/* Pinned host buffer that grows (contents not kept). */
+template <typename T> struct hbuf {
+    T *p = nullptr;
+    size_t cap = 0;
+    cudaError_t reserve(size_t n)
+    {
+        if (n <= cap) return cudaSuccess;
+        size_t c = cap ? cap : 1;
+        while (c < n) c *= 2;
+        if (p) cudaFreeHost(p);
+        p = nullptr;
+        cap = 0;
+        cudaError_t e = cudaMallocHost(&p, c * sizeof(T));
+        if (e == cudaSuccess) cap = c;
+        return e;
+    }
+    void release()
+    {
+        if (p) cudaFreeHost(p);
+        p = nullptr;
+        cap = 0;
+    }
+};
+
+/* One segment in flight. */
+struct slot {
+    int index;
+    double t0, t1;
+    int camera_static, want_intensity;
+    long long base_us;
+    int end_bit;
+    hbuf<evr_motion_key> h_keys;
+    hbuf<int> h_tracks;                /* offsets then counts */
+    dbuf<evr_motion_key> d_keys;
+    dbuf<int> d_tracks;
+    evr_gpu_top top;                   /* host top level */
+    dbuf<evr_gpu_node4> d_top4;
+    dbuf<evr_gpu_node8> d_top8;
+    dbuf<evr_gpu_inst> d_insts;
+    dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
+    dbuf<unsigned char> d_sort_temp;
+    dbuf<unsigned int> d_count;
+    dbuf<unsigned long long> d_rays;
+    dbuf<float> d_intensity;
+    hbuf<unsigned int> h_count;
+    hbuf<unsigned long long> h_rays;
+    hbuf<unsigned long long> h_sorted;
+    hbuf<float> h_intensity;
+    cudaStream_t copy = nullptr;
+    cudaEvent_t rendered = nullptr, counted = nullptr;
+    int num_tracks, num_keys;
+};
+
+struct cuda_backend {
+    evr_backend base;
+    const evr_scene *scene;
+    evr_render_host host;
+    evr_run_setup setup;
+    evr_gpu_bvh bvh;
+    int device;
+    char device_name[256];
+    /* scene on the device */
+    dbuf<float> d_floats;                  /* all vertex data */
+    dbuf<uint32_t> d_indices;
+    dbuf<evr_mesh_view> d_meshes;
+    dbuf<evr_material_view> d_materials;
+    dbuf<evr_texture_view> d_textures;
+    dbuf<float> d_texels;
+    dbuf<evr_instance_view> d_instances;
+    dbuf<evr_light_view> d_lights;
+    dbuf<evr_gpu_node4> d_nodes4;
+    dbuf<evr_gpu_node8> d_nodes8;
+    dbuf<evr_gpu_tri> d_tris;
+    dbuf<evr_pixel_state> d_state[3];
+    dbuf<float> d_phase;
+    cudaStream_t render = nullptr;
+    slot slots[2];
+    int head, queued;
+    size_t capacity;                       /* event keys per segment */
+    evr_event_vec decoded, scratch;
+};
+
+static evr_status upload_scene(cuda_backend *b, evr_error *err)
+{
+    const evr_scene *s = b->scene;
+    size_t nf = 0, ni = 0, nt = 0;
+    int i;
+    for (i = 0; i < s->num_meshes; i++) {
+        const evr_mesh *m = &s->meshes[i];
+        nf += (size_t)m->num_vertices * (m->uvs ? 8 : 6);
+        ni += (size_t)m->num_triangles * 3;
+    }
+    for (i = 0; i < s->num_textures; i++) nt += (size_t)s->textures[i].width * s->textures[i].height * 4;
+    CK(b->d_floats.reserve(nf + 1));
+    CK(b->d_indices.reserve(ni + 1));
+    CK(b->d_texels.reserve(nt + 1));
+    evr_mesh_view *mv = (evr_mesh_view *)calloc((size_t)s->num_meshes + 1, sizeof *mv);
+    evr_texture_view *tv = (evr_texture_view *)calloc((size_t)s->num_textures + 1, sizeof *tv);
+    if (!mv || !tv) {
+        free(mv);
+        free(tv);
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    size_t of = 0, oi = 0, ot = 0;
+    cudaError_t e = cudaSuccess;
+    for (i = 0; i < s->num_meshes && e == cudaSuccess; i++) {
+        const evr_mesh *m = &s->meshes[i];
+        size_t nv = m->num_vertices;
+        mv[i] = b->host.meshes[i];
+        e = cudaMemcpy(b->d_floats.p + of, m->positions, nv * 3 * sizeof(float), cudaMemcpyHostToDevice);
+        mv[i].positions = b->d_floats.p + of;
+        of += nv * 3;
+        if (e == cudaSuccess) e = cudaMemcpy(b->d_floats.p + of, m->normals, nv * 3 * sizeof(float), cudaMemcpyHostToDevice);
+        mv[i].normals = b->d_floats.p + of;
+        of += nv * 3;
+        mv[i].uvs = NULL;
+        if (m->uvs && e == cudaSuccess) {
+            e = cudaMemcpy(b->d_floats.p + of, m->uvs, nv * 2 * sizeof(float), cudaMemcpyHostToDevice);
+            mv[i].uvs = b->d_floats.p + of;
+            of += nv * 2;
+        }
+        if (e == cudaSuccess)
+            e = cudaMemcpy(b->d_indices.p + oi, m->indices, (size_t)m->num_triangles * 3 * sizeof(uint32_t), cudaMemcpyHostToDevice);
+        mv[i].indices = b->d_indices.p + oi;
+        oi += (size_t)m->num_triangles * 3;
+    }
+    for (i = 0; i < s->num_textures && e == cudaSuccess; i++) {
+        size_t n = (size_t)s->textures[i].width * s->textures[i].height * 4;
+        tv[i] = b->host.textures[i];
+        e = cudaMemcpy(b->d_texels.p + ot, s->textures[i].rgba, n * sizeof(float), cudaMemcpyHostToDevice);
+        tv[i].rgba = b->d_texels.p + ot;
+        ot += n;
+    }
+    if (e == cudaSuccess) e = b->d_meshes.reserve((size_t)s->num_meshes + 1);
+    if (e == cudaSuccess) e = cudaMemcpy(b->d_meshes.p, mv, ((size_t)s->num_meshes + 1) * sizeof *mv, cudaMemcpyHostToDevice);
+    if (e == cudaSuccess) e = b->d_textures.reserve((size_t)s->num_textures + 1);
+    if (e == cudaSuccess) e = cudaMemcpy(b->d_textures.p, tv, ((size_t)s->num_textures + 1) * sizeof *tv, cudaMemcpyHostToDevice);
+    free(mv);
+    free(tv);
+    CK(e);
+    CK(b->d_materials.reserve((size_t)s->num_materials + 1));
+    CK(cudaMemcpy(b->d_materials.p, b->host.materials, ((size_t)s->num_materials + 1) * sizeof(evr_material_view), cudaMemcpyHostToDevice));
+    CK(b->d_instances.reserve((size_t)s->num_instances + 1));
+    CK(cudaMemcpy(b->d_instances.p, b->host.instances, ((size_t)s->num_instances + 1) * sizeof(evr_instance_view), cudaMemcpyHostToDevice));
+    CK(b->d_lights.reserve((size_t)s->num_lights + 1));
+    CK(cudaMemcpy(b->d_lights.p, b->host.lights, ((size_t)s->num_lights + 1) * sizeof(evr_light_view), cudaMemcpyHostToDevice));
+    if (b->bvh.nodes4) {
+        CK(b->d_nodes4.reserve(b->bvh.num_nodes + 1));
+        CK(cudaMemcpy(b->d_nodes4.p, b->bvh.nodes4, b->bvh.num_nodes * sizeof(evr_gpu_node4), cudaMemcpyHostToDevice));
+    }
+    if (b->bvh.nodes8) {
+        CK(b->d_nodes8.reserve(b->bvh.num_nodes + 1));
+        CK(cudaMemcpy(b->d_nodes8.p, b->bvh.nodes8, b->bvh.num_nodes * sizeof(evr_gpu_node8), cudaMemcpyHostToDevice));
+    }
+    CK(b->d_tris.reserve(b->bvh.num_tris + 1));
+    CK(cudaMemcpy(b->d_tris.p, b->bvh.tris, b->bvh.num_tris * sizeof(evr_gpu_tri), cudaMemcpyHostToDevice));
+    return EVR_OK;
+}
+
+static kernel_args make_args(cuda_backend *b, slot *sl)
+{
+    kernel_args a;
+    memset(&a, 0, sizeof a);
+    a.rs = b->host.rs;
+    a.rs.meshes = b->d_meshes.p;
+    a.rs.materials = b->d_materials.p;
+    a.rs.textures = b->d_textures.p;
+    a.rs.instances = b->d_instances.p;
+    a.rs.lights = b->d_lights.p;
+    a.rs.keys = sl->d_keys.p;
+    a.rs.track_offset = sl->d_tracks.p;
+    a.rs.track_count = sl->d_tracks.p + sl->num_tracks;
+    a.view.layout = b->bvh.layout;
+    a.view.nodes4 = b->d_nodes4.p;
+    a.view.nodes8 = b->d_nodes8.p;
+    a.view.tris = b->d_tris.p;
+    a.view.top4 = sl->d_top4.p;
+    a.view.top8 = sl->d_top8.p;
+    a.view.insts = sl->d_insts.p;
+    a.view.num_nodes = b->bvh.num_nodes;
+    a.view.num_tris = b->bvh.num_tris;
+    a.view.num_top_nodes = sl->top.num_nodes;
+    a.view.num_insts = sl->top.num_insts;
+    a.state_in = b->d_state[sl->index % 3].p;
+    a.state_out = b->d_state[(sl->index + 1) % 3].p;
+    a.phase = b->d_phase.p;
+    a.intensity = sl->want_intensity ? sl->d_intensity.p : NULL;
+    a.pixel = b->setup.pixel;
+    a.width = b->setup.width;
+    a.height = b->setup.height;
+    a.samples = b->setup.samples_per_frame;
+    a.dt = (float)(sl->t1 - sl->t0);
+    a.t0 = sl->t0;
+    a.base_us = sl->base_us;
+    a.camera_static = sl->camera_static;
+    a.keys = sl->d_keys_ev.p;
+    a.capacity = (unsigned)sl->d_keys_ev.cap;
+    a.count = sl->d_count.p;
+    a.rays = sl->d_rays.p;
+    return a;
+}
+
+/* Renders a slot's segment on the render stream and queues the read-back of its event count. */
+static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
+{
+    CK(cudaMemsetAsync(sl->d_count.p, 0, sizeof(unsigned int), b->render));
+    CK(cudaMemsetAsync(sl->d_rays.p, 0, sizeof(unsigned long long), b->render));
+    kernel_args a = make_args(b, sl);
+    int npix = b->setup.width * b->setup.height;
+    render_kernel<<<(npix + BLOCK - 1) / BLOCK, BLOCK, 0, b->render>>>(a);
+    CK(cudaGetLastError());
+    CK(cudaEventRecord(sl->rendered, b->render));
+    CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
+    CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaEventRecord(sl->counted, sl->copy));
+    return EVR_OK;
+}
+
+static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err)
+{
+    cuda_backend *b = (cuda_backend *)base;
+    evr_status st;
+    if (b->queued == 2) {
+        snprintf(err->msg, sizeof err->msg, "internal error: more than two segments submitted");
+        return EVR_ERR_BACKEND;
+    }
+    slot *sl = &b->slots[(b->head + b->queued) % 2];
+    /* the slot's previous segment was collected, so its copy stream is idle */
+    sl->index = seg->index;
+    sl->t0 = seg->t0;
+    sl->t1 = seg->t1;
+    sl->camera_static = seg->camera_static;
+    sl->want_intensity = seg->want_intensity;
+    double dt = seg->t1 - seg->t0, back = 2.0 * dt + 1.0;   /* events reach back to the previous segment */
+    sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
+    double span_us = (back + dt) * 1e6 + 2.0;
+    int tbits = 1;
+    while (tbits < 31 && (double)(1ull << tbits) < span_us) tbits++;
+    sl->end_bit = 33 + tbits;
+    sl->num_tracks = seg->num_tracks;
+    sl->num_keys = seg->num_keys;
+    CK(sl->h_keys.reserve((size_t)seg->num_keys));
+    CK(sl->h_tracks.reserve(2 * (size_t)seg->num_tracks));
+    memcpy(sl->h_keys.p, seg->keys, (size_t)seg->num_keys * sizeof(evr_motion_key));
+    memcpy(sl->h_tracks.p, seg->track_offset, (size_t)seg->num_tracks * sizeof(int));
+    memcpy(sl->h_tracks.p + seg->num_tracks, seg->track_count, (size_t)seg->num_tracks * sizeof(int));
+    /* top level over the instances, bounds over the whole segment */
+    evr_render_scene hrs = b->host.rs;
+    hrs.keys = sl->h_keys.p;
+    hrs.track_offset = sl->h_tracks.p;
+    hrs.track_count = sl->h_tracks.p + seg->num_tracks;
+    if ((st = evr_gpu_top_build(&b->bvh, &hrs, &sl->top, err)) != EVR_OK) return st;
+    CK(sl->d_keys.reserve((size_t)seg->num_keys));
+    CK(sl->d_tracks.reserve(2 * (size_t)seg->num_tracks));
+    CK(sl->d_insts.reserve(sl->top.num_insts + 1));
+    CK(cudaMemcpyAsync(sl->d_keys.p, sl->h_keys.p, (size_t)seg->num_keys * sizeof(evr_motion_key), cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_tracks.p, sl->h_tracks.p, 2 * (size_t)seg->num_tracks * sizeof(int), cudaMemcpyHostToDevice, b->render));
+    if (sl->top.nodes4) {
+        CK(sl->d_top4.reserve(sl->top.num_nodes + 1));
+        CK(cudaMemcpyAsync(sl->d_top4.p, sl->top.nodes4, sl->top.num_nodes * sizeof(evr_gpu_node4), cudaMemcpyHostToDevice, b->render));
+    }
+    if (sl->top.nodes8) {
+        CK(sl->d_top8.reserve(sl->top.num_nodes + 1));
+        CK(cudaMemcpyAsync(sl->d_top8.p, sl->top.nodes8, sl->top.num_nodes * sizeof(evr_gpu_node8), cudaMemcpyHostToDevice, b->render));
+    }
+    CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst), cudaMemcpyHostToDevice, b->render));
+    /* the host top-level arrays are reused by the next build of this slot only after collect,
+     * by which time these copies are done (collect synchronizes) */
+    if ((st = launch(b, sl, err)) != EVR_OK) return st;
+    b->queued++;
+    return EVR_OK;
+}
+
+static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, evr_error *err)
+{
+    cuda_backend *b = (cuda_backend *)base;
+    evr_status st;
+    if (!b->queued) {
+        snprintf(err->msg, sizeof err->msg, "internal error: collect without a submitted segment");
+        return EVR_ERR_BACKEND;
+    }
+    slot *sl = &b->slots[b->head];
+    CK(cudaEventSynchronize(sl->counted));
+    size_t n = *sl->h_count.p;
+    while (n > sl->d_keys_ev.cap) {
+        /* overflow: grow and render this segment again from its unchanged input states (the
+         * next segment, if rendering, reads states this re-run rewrites identically: wait) */
+        CK(cudaDeviceSynchronize());
+        CK(sl->d_keys_ev.reserve(n + n / 4));
+        if ((st = launch(b, sl, err)) != EVR_OK) return st;
+        CK(cudaEventSynchronize(sl->counted));
+        n = *sl->h_count.p;
+    }
+    base->rays += *sl->h_rays.p;
+    base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
+    if (n) {
+        size_t temp = 0;
+        CK(sl->d_keys_sorted.reserve(n));
+        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->d_sort_temp.reserve(temp));
+        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->h_sorted.reserve(n));
+        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->want_intensity) {
+        size_t npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_intensity.reserve(npix));
+        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    CK(cudaStreamSynchronize(sl->copy));
+    b->decoded.n = 0;
+    if (!evr_event_vec_reserve(&b->decoded, n)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++) {
+        unsigned long long k = sl->h_sorted.p[i];
+        evr_event e;
+        e.t = sl->base_us + (long long)(k >> 33);
+        e.y = (uint16_t)((k >> 17) & 0xffffu);
+        e.x = (uint16_t)((k >> 1) & 0xffffu);
+        e.p = (int8_t)(k & 1u);
+        b->decoded.data[i] = e;
+    }
+    b->decoded.n = n;
+    if (!evr_events_merge(out, b->decoded.data, n, &b->scratch)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
+    b->head = (b->head + 1) % 2;
+    b->queued--;
+    return EVR_OK;
+}
+
+static void cuda_release(evr_backend *base)
+{
+    cuda_backend *b = (cuda_backend *)base;
+    if (!b) return;
+    cudaDeviceSynchronize();
+    for (int i = 0; i < 2; i++) {
+        slot *sl = &b->slots[i];
+        sl->h_keys.release(); sl->h_tracks.release(); sl->d_keys.release(); sl->d_tracks.release();
+        evr_gpu_top_free(&sl->top);
+        sl->d_top4.release(); sl->d_top8.release(); sl->d_insts.release();
+        sl->d_keys_ev.release(); sl->d_keys_sorted.release(); sl->d_sort_temp.release();
+        sl->d_count.release(); sl->d_rays.release(); sl->d_intensity.release();
+        sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
+        if (sl->copy) cudaStreamDestroy(sl->copy);
+        if (sl->rendered) cudaEventDestroy(sl->rendered);
+        if (sl->counted) cudaEventDestroy(sl->counted);
+    }
+    b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
+    b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
+    b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release();
+    for (int i = 0; i < 3; i++) b->d_state[i].release();
+    if (b->render) cudaStreamDestroy(b->render);
+    evr_gpu_bvh_free(&b->bvh);
+    evr_event_vec_free(&b->decoded);
+    evr_event_vec_free(&b->scratch);
+    delete b;
+}
+
+__global__ void init_pixels(evr_pixel_state *st, float *phase, int width, int height, unsigned long long seed)
+{
+    int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    if (pix >= width * height) return;
+    evr_pixel_reset(&st[pix]);
+    phase[pix] = evr_pixel_phase(seed, pix % width, pix / width);
+}
+
+static evr_status init(cuda_backend *b, evr_error *err)
+{
+    int count = 0;
+    cudaError_t e = cudaGetDeviceCount(&count);
+    if (e != cudaSuccess || count == 0) {
+        snprintf(err->msg, sizeof err->msg, "no usable CUDA device (%s)",
+                 e != cudaSuccess ? cudaGetErrorString(e) : "none found");
+        return EVR_ERR_BACKEND;
+    }
+    CK(cudaGetDevice(&b->device));
+    cudaDeviceProp prop;
+    CK(cudaGetDeviceProperties(&prop, b->device));
+    snprintf(b->device_name, sizeof b->device_name, "%s", prop.name);
+    evr_status st;
+    if ((st = evr_gpu_bvh_build(b->scene, 0, &b->bvh, err)) != EVR_OK) return st;
+    if ((st = upload_scene(b, err)) != EVR_OK) return st;
+    size_t npix = (size_t)b->setup.width * b->setup.height;
+    for (int i = 0; i < 3; i++) CK(b->d_state[i].reserve(npix));
+    CK(b->d_phase.reserve(npix));
+    init_pixels<<<(unsigned)((npix + 255) / 256), 256>>>(b->d_state[0].p, b->d_phase.p, b->setup.width, b->setup.height,
+                                                        (unsigned long long)b->setup.seed);
+    CK(cudaGetLastError());
+    CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
+    b->capacity = npix * 2 > (1u << 20) ? npix * 2 : (1u << 20);
+    for (int i = 0; i < 2; i++) {
+        slot *sl = &b->slots[i];
+        CK(cudaStreamCreateWithFlags(&sl->copy, cudaStreamNonBlocking));
+        CK(cudaEventCreateWithFlags(&sl->rendered, cudaEventDisableTiming));
+        CK(cudaEventCreateWithFlags(&sl->counted, cudaEventDisableTiming));
+        CK(sl->d_keys_ev.reserve(b->capacity));
+        CK(sl->d_count.reserve(1));
+        CK(sl->d_rays.reserve(1));
+        CK(sl->d_intensity.reserve(npix));
+        CK(sl->h_count.reserve(1));
+        CK(sl->h_rays.reserve(1));
+    }
+    CK(cudaDeviceSynchronize());
+    return EVR_OK;
+}
+
+extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
+                                           evr_backend **out, evr_error *err)
+{
+    cuda_backend *b = new (std::nothrow) cuda_backend();
+    if (!b) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return EVR_ERR_NOMEM;
+    }
+    b->base.name = "cuda";
+    b->base.submit = cuda_submit;
+    b->base.collect = cuda_collect;
+    b->base.release = cuda_release;
+    b->base.samples = 0;
+    b->base.rays = 0;
+    b->scene = s;
+    b->host = *h;
+    b->setup = *setup;
+    evr_status st = init(b, err);
+    if (st != EVR_OK) {
+        cuda_release(&b->base);
+        return st;
+    }
+    *out = &b->base;
+    return EVR_OK;
+}
+
+extern "C" const char *evr_cuda_device_name(const evr_backend *base)
+{
+    return ((const cuda_backend *)base)->device_name;
+}

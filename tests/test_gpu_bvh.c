@@ -1,0 +1,1058 @@
+/* The GPU backend's BVH and traversal (src/cuda), run on the host: against Embree built exactly
+ * as the CPU backend builds it, on the built-in scenes during motion (a saccade, a blink, the
+ * moving square), for both node layouts:
+ *   - closest hits of camera rays, shadow-like rays between scene points and random rays agree
+ *     (hit or miss, instance, triangle, distance to 1e-4, barycentrics); disagreements are
+ *     allowed only for rays within a float epsilon of an edge or at a tie between surfaces,
+ *     and must stay below 1e-4 of the rays;
+ *   - occlusion (evr_trace_any) agrees with rtcOccluded1 in the same way;
+ *   - the top level's per-segment instance boxes hold the instance at every time of the
+ *     segment (also for synthetic tracks with large rotations, scaling and skew);
+ *   - no ray leaks through a closed mesh, not even when aimed exactly at its vertices.
+ * Prints traversal speed next to Embree's, for information. */
+#include "check.h"
+#include "backend.h"
+#include "core/rng.h"
+#include "cuda/gpu_bvh.h"
+#include "cuda/gpu_traverse.h"
+#include "scene/scene.h"
+
+#include <embree3/rtcore.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* Fewer rays where the build is slow (sanitizers, no optimization). */
+#if defined(__SANITIZE_ADDRESS__)
+#define RAY_SCALE 8
+#elif !defined(__OPTIMIZE__)
+#define RAY_SCALE 4
+#else
+#define RAY_SCALE 1
+#endif
+
+#define MAX_KEYS 65          /* as the segment loop (sim_internal.h) */
+#define EDGE_EPS 1e-4f       /* barycentric distance to an edge that counts as "on the edge" */
+#define MAX_MISMATCH_RATE 1e-4
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the segment's motion, as src/sim.c's compute_motion makes it ---- */
+
+typedef struct {
+    evr_motion_key *keys;
+    int *offset, *count;
+} motion;
+
+static void motion_compute(const evr_scene *s, int camera, double t0, double t1, motion *m)
+{
+    int i, off = 0;
+    int *used = calloc((size_t)s->num_nodes + 1, sizeof(int));
+    m->keys = malloc(sizeof *m->keys * ((size_t)s->num_nodes + 1) * MAX_KEYS);
+    m->offset = malloc(sizeof(int) * ((size_t)s->num_nodes + 1));
+    m->count = malloc(sizeof(int) * ((size_t)s->num_nodes + 1));
+    for (i = 0; i < s->num_instances; i++) used[s->instances[i].node] = 1;
+    for (i = 0; i < s->num_lights; i++)
+        if (s->lights[i].node >= 0) used[s->lights[i].node] = 1;
+    if (s->cameras[camera].node >= 0) used[s->cameras[camera].node] = 1;
+    for (i = 0; i <= s->num_nodes; i++) {
+        evr_motion_key *k = m->keys + off;
+        int n = 1;
+        if (i < s->num_nodes && used[i]) {
+            n = evr_node_motion_keys(s, i, t0, t1, 1e-5f, k, MAX_KEYS);
+        } else {
+            evr_m34 id = evr_m34_identity();
+            *k = evr_motion_key_from_matrix(&id);
+        }
+        m->offset[i] = off;
+        m->count[i] = n;
+        off += n;
+    }
+    free(used);
+}
+
+static void motion_free(motion *m)
+{
+    free(m->keys);
+    free(m->offset);
+    free(m->count);
+}
+
+/* ---- the Embree reference, built as src/cpu/cpu_backend.c builds it ---- */
+
+typedef struct {
+    RTCDevice dev;
+    RTCScene top;
+    int num_groups;
+    RTCScene *group_scenes;
+    int *group_track, *group_first, *members;
+} reference;
+
+static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
+{
+    rtcInitQuaternionDecomposition(q);
+    q->scale_x = k->scale[0]; q->scale_y = k->scale[1]; q->scale_z = k->scale[2];
+    q->skew_xy = k->skew[0]; q->skew_xz = k->skew[1]; q->skew_yz = k->skew[2];
+    q->quaternion_r = k->rot.w; q->quaternion_i = k->rot.x; q->quaternion_j = k->rot.y; q->quaternion_k = k->rot.z;
+    q->translation_x = k->trans.x; q->translation_y = k->trans.y; q->translation_z = k->trans.z;
+}
+
+static void add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf, unsigned geom_id)
+{
+    uint32_t v;
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+    for (v = 0; v < m->num_vertices; v++) {
+        evr_v3 p = evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
+        if (xf) p = evr_m34_point(xf, p);
+        vb[3 * v] = p.x;
+        vb[3 * v + 1] = p.y;
+        vb[3 * v + 2] = p.z;
+    }
+    memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc, g, geom_id);
+    rtcReleaseGeometry(g);
+}
+
+static int node_never_moves(const evr_scene *s, int node)
+{
+    for (; node >= 0; node = s->nodes[node].parent)
+        if (s->nodes[node].animated) return 0;
+    return 1;
+}
+
+static void reference_build(reference *r, const evr_scene *s, const motion *mo)
+{
+    int n = s->num_instances, i, j, g, k;
+    int *group_of = malloc(sizeof(int) * ((size_t)n + 1));
+    memset(r, 0, sizeof *r);
+    r->dev = rtcNewDevice(NULL);
+    r->group_track = malloc(sizeof(int) * ((size_t)n + 1));
+    r->group_first = calloc((size_t)n + 2, sizeof(int));
+    r->members = malloc(sizeof(int) * ((size_t)n + 1));
+    for (i = 0; i < n; i++) {
+        int node = s->instances[i].node, track = node_never_moves(s, node) ? -1 : node;
+        for (g = 0; g < r->num_groups && r->group_track[g] != track; g++) {}
+        if (g == r->num_groups) r->group_track[r->num_groups++] = track;
+        group_of[i] = g;
+    }
+    for (g = 0, j = 0; g < r->num_groups; g++) {
+        r->group_first[g] = j;
+        for (i = 0; i < n; i++)
+            if (group_of[i] == g) r->members[j++] = i;
+    }
+    r->group_first[r->num_groups] = j;
+    free(group_of);
+    r->group_scenes = calloc((size_t)r->num_groups + 1, sizeof *r->group_scenes);
+    for (g = 0; g < r->num_groups; g++) {
+        RTCScene sc = rtcNewScene(r->dev);
+        r->group_scenes[g] = sc;
+        rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+        for (j = r->group_first[g]; j < r->group_first[g + 1]; j++) {
+            const evr_instance *in = &s->instances[r->members[j]];
+            evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
+            add_mesh_geometry(r->dev, sc, &s->meshes[in->mesh], r->group_track[g] < 0 ? &world : NULL,
+                              (unsigned)(j - r->group_first[g]));
+        }
+        rtcCommitScene(sc);
+    }
+    r->top = rtcNewScene(r->dev);
+    rtcSetSceneBuildQuality(r->top, RTC_BUILD_QUALITY_HIGH);
+    for (g = 0; g < r->num_groups; g++) {
+        RTCGeometry geom = rtcNewGeometry(r->dev, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(geom, r->group_scenes[g]);
+        if (r->group_track[g] < 0) {
+            evr_m34 id = evr_m34_identity();
+            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &id.m[0][0]);
+        } else {
+            int track = r->group_track[g], nk = mo->count[track];
+            rtcSetGeometryTimeStepCount(geom, (unsigned)nk);
+            for (k = 0; k < nk; k++) {
+                struct RTCQuaternionDecomposition q;
+                to_embree(&mo->keys[mo->offset[track] + k], &q);
+                rtcSetGeometryTransformQuaternion(geom, (unsigned)k, &q);
+            }
+        }
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(r->top, geom, (unsigned)g);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(r->top);
+}
+
+static void reference_free(reference *r)
+{
+    int g;
+    rtcReleaseScene(r->top);
+    for (g = 0; g < r->num_groups; g++) rtcReleaseScene(r->group_scenes[g]);
+    free(r->group_scenes);
+    free(r->group_track);
+    free(r->group_first);
+    free(r->members);
+    rtcReleaseDevice(r->dev);
+}
+
+static int reference_closest(const reference *r, evr_ray ray, float tmax, float f, evr_gpu_hit *hit)
+{
+    struct RTCIntersectContext ctx;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&ctx);
+    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.time = f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(r->top, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    hit->instance = r->members[r->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
+    hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->t = rh.ray.tfar;
+    return 1;
+}
+
+static int reference_occluded(const reference *r, evr_ray ray, float tnear, float tfar, float f)
+{
+    struct RTCIntersectContext ctx;
+    struct RTCRay q;
+    rtcInitIntersectContext(&ctx);
+    q.org_x = ray.org.x; q.org_y = ray.org.y; q.org_z = ray.org.z;
+    q.dir_x = ray.dir.x; q.dir_y = ray.dir.y; q.dir_z = ray.dir.z;
+    q.tnear = tnear;
+    q.tfar = tfar;
+    q.time = f;
+    q.mask = 0xffffffffu;
+    q.id = 0;
+    q.flags = 0;
+    rtcOccluded1(r->top, &ctx, &q);
+    return q.tfar < 0.0f;
+}
+
+/* ---- rays ---- */
+
+typedef struct {
+    evr_ray ray;
+    float tnear, tfar, f;
+} test_ray;
+
+static float rnd(uint64_t *c) { return evr_uniform(evr_hash4(0x627668ull, (*c)++, 0, 0)); }
+
+/* A random point on a random instance's surface at time f, in world space, and the surface's
+ * (geometric) normal there. */
+static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, float f, uint64_t *c, evr_v3 *normal)
+{
+    for (;;) {
+        int i = (int)(rnd(c) * (float)s->num_instances) % s->num_instances;
+        const evr_mesh *m = &s->meshes[s->instances[i].mesh];
+        uint32_t t;
+        float a, b;
+        evr_v3 p[3];
+        evr_m34 xf;
+        int k;
+        if (!m->num_triangles) continue;
+        t = (uint32_t)(rnd(c) * (float)m->num_triangles) % m->num_triangles;
+        xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
+        for (k = 0; k < 3; k++) {
+            uint32_t vi = m->indices[3 * t + (uint32_t)k];
+            p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1], m->positions[3 * vi + 2]));
+        }
+        *normal = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
+        if (evr_v3_dot(*normal, *normal) == 0.0f) continue;   /* a degenerate triangle */
+        a = rnd(c);
+        b = rnd(c);
+        if (a + b > 1.0f) { a = 1.0f - a; b = 1.0f - b; }
+        return evr_v3_add(evr_v3_add(evr_v3_scale(p[0], 1 - a - b), evr_v3_scale(p[1], a)), evr_v3_scale(p[2], b));
+    }
+}
+
+/* Camera rays through random image positions at random times; shadow-like rays between two
+ * surface points, leaving the first and stopping short of the second as the renderer's shadow
+ * rays leave a surface (evr_shadow_tnear: eps / max(cos, 0.05) along the ray), not along the
+ * first surface's plane; random rays
+ * through the scene's box. */
+static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n_cam, int n_shadow, int n_random,
+                           uint64_t seed)
+{
+    test_ray *r = malloc(sizeof *r * (size_t)(n_cam + n_shadow + n_random));
+    uint64_t c = seed;
+    int i;
+    float eps = rs->ray_eps;
+    for (i = 0; i < n_cam; i++) {
+        float f = rnd(&c);
+        evr_m34 pose = evr_rs_camera_pose(rs, f);
+        r[i].ray = evr_camera_ray(&rs->camera, &pose, rnd(&c) * (float)rs->camera.width, rnd(&c) * (float)rs->camera.height);
+        r[i].tnear = 0.0f;
+        r[i].tfar = INFINITY;
+        r[i].f = f;
+    }
+    for (; i < n_cam + n_shadow; i++) {
+        float f = rnd(&c), d, off_a, off_b;
+        evr_v3 na, nb, a = surface_point(s, rs, f, &c, &na), b = surface_point(s, rs, f, &c, &nb);
+        evr_v3 dir = evr_v3_sub(b, a);
+        d = evr_v3_len(dir);
+        if (!(d > 0.0f)) { i--; continue; }
+        dir = evr_v3_scale(dir, 1.0f / d);
+        /* a ray lying in its start surface's plane: which side it passes is rounding, and the
+         * renderer never traces one (it skips lights with dot(wi, n) <= 0) */
+        if (fabsf(evr_v3_dot(na, dir)) < 1e-3f) { i--; continue; }
+        off_a = eps / fmaxf(fabsf(evr_v3_dot(na, dir)), 0.05f);
+        off_b = eps / fmaxf(fabsf(evr_v3_dot(nb, dir)), 0.05f);
+        if (!(d > 2.0f * (off_a + off_b))) { i--; continue; }
+        r[i].ray.org = a;
+        r[i].ray.dir = dir;
+        r[i].tnear = off_a;
+        r[i].tfar = d - off_b;
+        r[i].f = f;
+    }
+    for (; i < n_cam + n_shadow + n_random; i++) {
+        evr_v3 lo = s->bounds_min, hi = s->bounds_max, o, d;
+        o = evr_v3_make(lo.x + (hi.x - lo.x) * (1.4f * rnd(&c) - 0.2f), lo.y + (hi.y - lo.y) * (1.4f * rnd(&c) - 0.2f),
+                        lo.z + (hi.z - lo.z) * (1.4f * rnd(&c) - 0.2f));
+        do d = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
+        while (evr_v3_dot(d, d) > 1.0f || evr_v3_dot(d, d) < 1e-4f);
+        r[i].ray.org = o;
+        r[i].ray.dir = evr_v3_norm(d);
+        r[i].tnear = 0.0f;
+        r[i].tfar = INFINITY;
+        r[i].f = rnd(&c);
+    }
+    return r;
+}
+
+/* ---- comparing ----
+ *
+ * The two tracers place a surface identically only to float precision: Embree and we evaluate
+ * the same motion keys with different arithmetic, and the watertight test rounds differently
+ * from Embree's. A position tolerance DELTA = 1e-6 of the scene's size (~8 float epsilons)
+ * says which disagreements a float epsilon explains:
+ *   edge     a hit within EDGE_EPS (barycentric) of its triangle's edge;
+ *   contact  a hit within DELTA of the surface the ray starts or ends on: its distance from
+ *            the range's end, times the cosine to the triangle, is below DELTA (shadow-like
+ *            rays leave and reach surfaces, often at grazing angles);
+ *   tie      two surfaces within DELTA of each other along the ray.
+ * Distances of the same triangle agree when |dt| <= 1e-4 t or |dt| cos <= DELTA (the latter for
+ * short or grazing rays, whose t is ill-conditioned). Anything else is a failure. */
+
+enum { EX_NONE = 0, EX_EDGE = 1, EX_CONTACT = 2, EX_TIE = 3 };
+
+typedef struct {
+    const evr_mesh *meshes;        /* by rs->instances[i].mesh */
+    const evr_render_scene *rs;
+    float delta;
+} judge;
+
+static float edge_distance(const evr_gpu_hit *h) { return fminf(fminf(h->u, h->v), 1.0f - h->u - h->v); }
+
+/* |cosine| between a ray and the (world-space) triangle it hit. */
+static float hit_cosine(const judge *j, const evr_gpu_hit *h, evr_ray ray, float f)
+{
+    const evr_mesh *m = &j->meshes[j->rs->instances[h->instance].mesh];
+    evr_m34 xf = evr_motion_eval(evr_rs_track(j->rs, j->rs->instances[h->instance].track), f);
+    evr_v3 p[3], n;
+    int k;
+    for (k = 0; k < 3; k++) {
+        uint32_t vi = m->indices[3 * h->prim + (uint32_t)k];
+        p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1], m->positions[3 * vi + 2]));
+    }
+    n = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
+    return fabsf(evr_v3_dot(n, evr_v3_norm(ray.dir)));
+}
+
+static int t_agrees(float t1, float t2, float cosine, float delta)
+{
+    float dt = fabsf(t1 - t2);
+    return dt <= 1e-4f * fmaxf(t1, t2) || dt * cosine <= delta;
+}
+
+static int same_hit(const judge *j, const evr_gpu_hit *a, const evr_gpu_hit *b, evr_ray ray, float f)
+{
+    float c;
+    if (a->instance != b->instance || a->prim != b->prim) return 0;
+    c = hit_cosine(j, b, ray, f);
+    if (!t_agrees(a->t, b->t, c, j->delta)) return 0;
+    /* barycentrics move with t along grazing rays */
+    return c < 0.05f || (fabsf(a->u - b->u) <= 1e-3f && fabsf(a->v - b->v) <= 1e-3f);
+}
+
+/* How float epsilons explain hits a and b (either may be absent) of a ray over [0, tmax]. */
+static int explain(const judge *j, evr_ray ray, float f, float tmax, int h1, const evr_gpu_hit *a, int h2,
+                   const evr_gpu_hit *b)
+{
+    const evr_gpu_hit *h[2];
+    int n = 0, k;
+    if (h1) h[n++] = a;
+    if (h2) h[n++] = b;
+    for (k = 0; k < n; k++)
+        if (edge_distance(h[k]) < EDGE_EPS) return EX_EDGE;
+    for (k = 0; k < n; k++) {
+        float c = hit_cosine(j, h[k], ray, f);
+        if (h[k]->t * c <= j->delta || (isfinite(tmax) && (tmax - h[k]->t) * c <= j->delta)) return EX_CONTACT;
+    }
+    if (n == 2 && (t_agrees(a->t, b->t, hit_cosine(j, a, ray, f), j->delta) ||
+                   t_agrees(a->t, b->t, hit_cosine(j, b, ray, f), j->delta)))
+        return EX_TIE;
+    return EX_NONE;
+}
+
+/* A hit of the unshifted ray on an edge, or within DELTA of where the ray starts (tnear). */
+static int near_start(const judge *j, const evr_gpu_hit *h, const test_ray *r)
+{
+    if (edge_distance(h) < EDGE_EPS) return EX_EDGE;
+    if (fabsf(h->t - r->tnear) * hit_cosine(j, h, r->ray, r->f) <= j->delta) return EX_CONTACT;
+    return EX_NONE;
+}
+
+enum { RAY_CAMERA = 0, RAY_SHADOW = 1, RAY_RANDOM = 2 };
+static const char *const ray_kind_name[3] = {"camera", "shadow-like", "random"};
+
+typedef struct {
+    long rays[3], hits[3];
+    long closest[3][4];     /* mismatches by ray kind and explanation (EX_NONE: unexplained) */
+    long occluded[3][4];
+} tally;
+
+static long sum4(const long *x) { return x[0] + x[1] + x[2] + x[3]; }
+
+static void report_line(int kind, const tally *ty)
+{
+    const long *c = ty->closest[kind], *o = ty->occluded[kind];
+    printf("    %-11s %7ld rays (%ld hit): closest differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld), "
+           "occlusion differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld)\n",
+           ray_kind_name[kind], ty->rays[kind], ty->hits[kind], sum4(c), c[EX_EDGE], c[EX_CONTACT], c[EX_TIE], c[EX_NONE],
+           sum4(o), o[EX_EDGE], o[EX_CONTACT], o[EX_TIE], o[EX_NONE]);
+}
+
+static void compare(const char *what, const judge *j, const evr_gpu_scene_view *v, const reference *ref,
+                    const test_ray *rays, const int *kind, int n, tally *ty)
+{
+    const evr_render_scene *rs = j->rs;
+    int i, printed = 0;
+    int dump = getenv("EVR_DUMP") != NULL;
+    for (i = 0; i < n; i++) {
+        const test_ray *r = &rays[i];
+        int kd = kind[i];
+        evr_gpu_hit a, b;
+        evr_ray cr = r->ray;
+        int h1, h2, o1, o2;
+        float tmax = r->tfar;
+        /* closest hits start at tnear: move the origin there (both tracers start at t = 0) */
+        if (r->tnear > 0.0f) {
+            cr.org = evr_v3_add(cr.org, evr_v3_scale(cr.dir, r->tnear));
+            tmax = r->tfar - r->tnear;
+        }
+        memset(&a, 0, sizeof a);
+        memset(&b, 0, sizeof b);
+        h1 = evr_trace_closest(v, rs, cr, tmax, r->f, &a);
+        h2 = reference_closest(ref, cr, tmax, r->f, &b);
+        ty->rays[kd]++;
+        ty->hits[kd] += h2;
+        if (h1 != h2 || (h1 && !same_hit(j, &a, &b, cr, r->f))) {
+            int ex = explain(j, cr, r->f, tmax, h1, &a, h2, &b);
+            ty->closest[kd][ex]++;
+            if (dump || (ex == EX_NONE && printed++ < 5))
+                printf("%s %s ray %d (class %d): ours %d inst %d prim %u t %.9g uv %.6g %.6g, Embree %d inst %d prim %u "
+                       "t %.9g uv %.6g %.6g\n", ex == EX_NONE ? "FAIL" : "note", what, i, ex, h1, a.instance, a.prim,
+                       a.t, a.u, a.v, h2, b.instance, b.prim, b.t, b.u, b.v);
+        }
+        o1 = evr_trace_any(v, rs, r->ray, r->tnear, r->tfar, r->f);
+        o2 = reference_occluded(ref, r->ray, r->tnear, r->tfar, r->f);
+        if (o1 != o2) {
+            /* the nearest surfaces after tnear and after the origin explain it */
+            evr_gpu_hit c1, c2, d1, d2;
+            int g1, g2, k1, k2, ex;
+            float range = (r->tfar - r->tnear) * 1.001f;
+            memset(&c1, 0, sizeof c1);
+            memset(&c2, 0, sizeof c2);
+            memset(&d1, 0, sizeof d1);
+            memset(&d2, 0, sizeof d2);
+            g1 = evr_trace_closest(v, rs, cr, range, r->f, &c1);
+            g2 = reference_closest(ref, cr, range, r->f, &c2);
+            ex = explain(j, cr, r->f, r->tfar - r->tnear, g1, &c1, g2, &c2);
+            if (ex == EX_NONE && r->tnear > 0.0f) {
+                k1 = evr_trace_closest(v, rs, r->ray, r->tfar, r->f, &d1);
+                k2 = reference_closest(ref, r->ray, r->tfar, r->f, &d2);
+                /* a surface the ray starts on, seen from the unshifted origin */
+                if (k1) ex = near_start(j, &d1, r);
+                if (ex == EX_NONE && k2) ex = near_start(j, &d2, r);
+            }
+            ty->occluded[kd][ex]++;
+            if (dump || (ex == EX_NONE && printed++ < 5))
+                printf("%s %s ray %d (class %d): occluded ours %d Embree %d (tnear %g tfar %g)\n",
+                       ex == EX_NONE ? "FAIL" : "note", what, i, ex, o1, o2, r->tnear, r->tfar);
+        }
+    }
+}
+
+static void timing(const char *what, const evr_gpu_scene_view *v, const evr_render_scene *rs, const reference *ref,
+                   const test_ray *rays, int n)
+{
+    double t0, t1, t2;
+    long h1 = 0, h2 = 0;
+    int i;
+    evr_gpu_hit h;
+    t0 = now();
+    for (i = 0; i < n; i++) h1 += evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
+    t1 = now();
+    for (i = 0; i < n; i++) h2 += reference_closest(ref, rays[i].ray, rays[i].tfar, rays[i].f, &h);
+    t2 = now();
+    printf("  %-34s %7.2f Mrays/s (Embree %6.2f Mrays/s, one thread; hits %ld / %ld)\n", what,
+           1e-6 * n / (t1 - t0), 1e-6 * n / (t2 - t1), h1, h2);
+}
+
+/* ---- conservative motion bounds ---- */
+
+static int inside(evr_v3 p, const float *lo, const float *hi)
+{
+    return p.x >= lo[0] && p.y >= lo[1] && p.z >= lo[2] && p.x <= hi[0] && p.y <= hi[1] && p.z <= hi[2];
+}
+
+static long check_box_holds(const float box[6], const float *lo, const float *hi, evr_motion_track tr, int samples,
+                            uint64_t *c)
+{
+    long bad = 0;
+    int j, k;
+    for (j = 0; j <= samples; j++) {
+        float f = j < samples / 2 ? (float)j / (float)(samples / 2) : rnd(c);
+        evr_m34 xf = evr_motion_eval(tr, f);
+        for (k = 0; k < 8; k++) {
+            evr_v3 p = evr_v3_make((k & 1) ? box[3] : box[0], (k & 2) ? box[4] : box[1], (k & 4) ? box[5] : box[2]);
+            if (!inside(evr_m34_point(&xf, p), lo, hi)) bad++;
+        }
+    }
+    return bad;
+}
+
+static void test_synthetic_bounds(void)
+{
+    uint64_t c = 7;
+    long bad = 0, tested = 0;
+    double ratio = 0.0;
+    int set, i;
+    for (set = 0; set < 300; set++) {
+        evr_motion_key keys[6];
+        int n = 1 + set % 6;
+        float box[6], lo[3], hi[3];
+        for (i = 0; i < 3; i++) {
+            float a = 4.0f * rnd(&c) - 2.0f, b = a + 0.01f + 3.0f * rnd(&c);
+            box[i] = a;
+            box[i + 3] = b;
+        }
+        for (i = 0; i < n; i++) {
+            evr_motion_key *k = &keys[i];
+            int a;
+            for (a = 0; a < 3; a++) {
+                k->scale[a] = 0.2f + 2.0f * rnd(&c);
+                k->skew[a] = 0.5f * rnd(&c) - 0.25f;
+            }
+            if (set % 5 == 0) k->scale[2] = -k->scale[2];   /* mirrored */
+            k->trans = evr_v3_make(10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f);
+            k->rot = evr_quat_normalize(evr_quat_make(rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f));
+            if (i > 0) {
+                /* up to ~120 degrees from the previous key (what evr_node_motion_keys allows), or
+                 * nearly the same (the normalized-lerp branch of the slerp) */
+                float amount = set % 3 == 0 ? 0.002f * rnd(&c) : rnd(&c) * 0.6f;
+                k->rot = evr_quat_slerp(keys[i - 1].rot, k->rot, amount);
+                if (evr_quat_dot(keys[i - 1].rot, k->rot) < 0.0f)
+                    k->rot = evr_quat_make(-k->rot.w, -k->rot.x, -k->rot.y, -k->rot.z);
+            }
+        }
+        {
+            evr_motion_track tr;
+            double exact_vol = 1.0, vol = 1.0;
+            double elo[3] = {INFINITY, INFINITY, INFINITY}, ehi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            int j, k, a;
+            tr.keys = keys;
+            tr.n = n;
+            evr_gpu_segment_bounds(box, box + 3, tr, lo, hi);
+            bad += check_box_holds(box, lo, hi, tr, 4000, &c);
+            tested++;
+            /* how tight: against the union of densely sampled boxes */
+            for (j = 0; j <= 2000; j++) {
+                evr_m34 xf = evr_motion_eval(tr, (float)j / 2000.0f);
+                for (k = 0; k < 8; k++) {
+                    evr_v3 p = evr_m34_point(&xf, evr_v3_make((k & 1) ? box[3] : box[0], (k & 2) ? box[4] : box[1],
+                                                              (k & 4) ? box[5] : box[2]));
+                    float q[3] = {p.x, p.y, p.z};
+                    for (a = 0; a < 3; a++) {
+                        elo[a] = fmin(elo[a], q[a]);
+                        ehi[a] = fmax(ehi[a], q[a]);
+                    }
+                }
+            }
+            for (a = 0; a < 3; a++) {
+                exact_vol *= ehi[a] - elo[a];
+                vol *= (double)hi[a] - lo[a];
+            }
+            ratio += vol / exact_vol;
+        }
+    }
+    printf("synthetic tracks: %ld corner samples outside their segment box (of %ld tracks); boxes %.4f x the "
+           "sampled volume on average\n", bad, tested, ratio / (double)tested);
+    CHECK(bad == 0);
+}
+
+typedef struct {
+    long rays, mismatches, edge, contact, unexplained, well_rays, well_mismatches;
+} totals;
+
+static const char *layout_name(int layout) { return layout == EVR_GPU_LAYOUT_CW8 ? "CW8" : "BVH4"; }
+
+/* ---- synthetic scenes ---- */
+
+/* A closed mesh: a cube's faces subdivided n x n and pushed onto the unit sphere, vertices
+ * shared by index (as an importer welds them). */
+static void make_sphere(int n, evr_mesh *mesh)
+{
+    int nv = 6 * (n + 1) * (n + 1), nt = 6 * n * n * 2, f, i, j, k, vi = 0, ti = 0, u, w;
+    float *pos = malloc(sizeof(float) * 3 * (size_t)nv);
+    uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (size_t)nt);
+    int *remap = malloc(sizeof(int) * (size_t)nv);
+    for (f = 0; f < 6; f++)
+        for (j = 0; j <= n; j++)
+            for (i = 0; i <= n; i++) {
+                float a = 2.0f * (float)i / (float)n - 1.0f, b = 2.0f * (float)j / (float)n - 1.0f, p[3], l;
+                int ax = f % 3, sg = f < 3 ? 1 : -1;
+                p[ax] = (float)sg;
+                p[(ax + 1) % 3] = sg > 0 ? a : b;
+                p[(ax + 2) % 3] = sg > 0 ? b : a;
+                l = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+                for (k = 0; k < 3; k++) pos[3 * vi + k] = p[k] / l;
+                vi++;
+            }
+    for (u = 0; u < nv; u++) {   /* weld the copies along the cube's edges */
+        remap[u] = u;
+        for (w = 0; w < u; w++)
+            if (fabsf(pos[3 * w] - pos[3 * u]) < 1e-6f && fabsf(pos[3 * w + 1] - pos[3 * u + 1]) < 1e-6f &&
+                fabsf(pos[3 * w + 2] - pos[3 * u + 2]) < 1e-6f) {
+                remap[u] = remap[w];
+                break;
+            }
+    }
+    for (f = 0; f < 6; f++)
+        for (j = 0; j < n; j++)
+            for (i = 0; i < n; i++) {
+                int b0 = f * (n + 1) * (n + 1);
+                int v00 = remap[b0 + j * (n + 1) + i], v10 = remap[b0 + j * (n + 1) + i + 1];
+                int v01 = remap[b0 + (j + 1) * (n + 1) + i], v11 = remap[b0 + (j + 1) * (n + 1) + i + 1];
+                idx[3 * ti] = (uint32_t)v00; idx[3 * ti + 1] = (uint32_t)v10; idx[3 * ti + 2] = (uint32_t)v11; ti++;
+                idx[3 * ti] = (uint32_t)v00; idx[3 * ti + 1] = (uint32_t)v11; idx[3 * ti + 2] = (uint32_t)v01; ti++;
+            }
+    free(remap);
+    memset(mesh, 0, sizeof *mesh);
+    mesh->num_vertices = (uint32_t)nv;
+    mesh->num_triangles = (uint32_t)nt;
+    mesh->positions = pos;
+    mesh->normals = calloc((size_t)nv * 3, sizeof(float));
+    mesh->indices = idx;
+    for (k = 0; k < 3; k++) {
+        (&mesh->bounds_min.x)[k] = -1.0f;
+        (&mesh->bounds_max.x)[k] = 1.0f;
+    }
+}
+
+/* A flat, open mesh: an n x n grid over [-1, 1]^2 in the plane z = 0, gently waved. */
+static void make_sheet(int n, evr_mesh *mesh)
+{
+    int nv = (n + 1) * (n + 1), nt = 2 * n * n, i, j, ti = 0;
+    float *pos = malloc(sizeof(float) * 3 * (size_t)nv);
+    uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (size_t)nt);
+    for (j = 0; j <= n; j++)
+        for (i = 0; i <= n; i++) {
+            float x = 2.0f * (float)i / (float)n - 1.0f, y = 2.0f * (float)j / (float)n - 1.0f;
+            pos[3 * (j * (n + 1) + i)] = x;
+            pos[3 * (j * (n + 1) + i) + 1] = y;
+            pos[3 * (j * (n + 1) + i) + 2] = 0.1f * sinf(3.0f * x) * cosf(2.0f * y);
+        }
+    for (j = 0; j < n; j++)
+        for (i = 0; i < n; i++) {
+            uint32_t v00 = (uint32_t)(j * (n + 1) + i), v10 = v00 + 1, v01 = v00 + (uint32_t)(n + 1), v11 = v01 + 1;
+            idx[3 * ti] = v00; idx[3 * ti + 1] = v10; idx[3 * ti + 2] = v11; ti++;
+            idx[3 * ti] = v00; idx[3 * ti + 1] = v11; idx[3 * ti + 2] = v01; ti++;
+        }
+    memset(mesh, 0, sizeof *mesh);
+    mesh->num_vertices = (uint32_t)nv;
+    mesh->num_triangles = (uint32_t)nt;
+    mesh->positions = pos;
+    mesh->normals = calloc((size_t)nv * 3, sizeof(float));
+    mesh->indices = idx;
+}
+
+static void free_mesh(evr_mesh *m)
+{
+    free(m->positions);
+    free(m->normals);
+    free(m->indices);
+}
+
+/* Rays from inside a closed mesh, aimed exactly at its vertices, at its edges' midpoints and
+ * anywhere, must all hit it. */
+static void test_watertight(int layout)
+{
+    evr_mesh mesh;
+    evr_scene sc;
+    evr_gpu_bvh bvh;
+    evr_gpu_top top;
+    evr_gpu_scene_view view;
+    evr_render_scene rs;
+    evr_instance_view inst;
+    evr_motion_key key;
+    int off = 0, cnt = 1, missed = 0, rays = 0, k;
+    uint64_t c = 11;
+    evr_m34 id = evr_m34_identity();
+    make_sphere(24, &mesh);
+    memset(&sc, 0, sizeof sc);
+    sc.num_meshes = 1;
+    sc.meshes = &mesh;
+    memset(&rs, 0, sizeof rs);
+    memset(&top, 0, sizeof top);
+    inst.mesh = 0;
+    inst.track = 0;
+    key = evr_motion_key_from_matrix(&id);
+    rs.instances = &inst;
+    rs.num_instances = 1;
+    rs.keys = &key;
+    rs.track_offset = &off;
+    rs.track_count = &cnt;
+    CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+    CHECK_OK(evr_gpu_top_build(&bvh, &rs, &top, &e_));
+    evr_gpu_scene_view_host(&bvh, &top, &view);
+    for (k = 0; k < 60000 / RAY_SCALE; k++) {
+        evr_ray r;
+        evr_gpu_hit h;
+        uint32_t t = (uint32_t)(rnd(&c) * (float)mesh.num_triangles) % mesh.num_triangles;
+        const float *p0 = mesh.positions + 3 * mesh.indices[3 * t], *p1 = mesh.positions + 3 * mesh.indices[3 * t + 1];
+        evr_v3 target;
+        int kind = k % 3;
+        if (kind == 0) target = evr_v3_make(p0[0], p0[1], p0[2]);                       /* a vertex */
+        else if (kind == 1) target = evr_v3_make(0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2]));
+        else target = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
+        r.org = k % 2 ? evr_v3_make(0, 0, 0) : evr_v3_make(0.5f * rnd(&c) - 0.25f, 0.5f * rnd(&c) - 0.25f, 0.5f * rnd(&c) - 0.25f);
+        r.dir = evr_v3_norm(evr_v3_sub(target, r.org));
+        if (evr_v3_dot(r.dir, r.dir) == 0.0f) continue;
+        rays++;
+        if (!evr_trace_closest(&view, &rs, r, INFINITY, 0.5f, &h)) missed++;
+        else if (!evr_trace_any(&view, &rs, r, 0.0f, INFINITY, 0.5f)) missed++;
+    }
+    printf("watertight (layout %s): %d of %d rays from inside a closed mesh escaped\n",
+           layout == EVR_GPU_LAYOUT_CW8 ? "CW8" : "BVH4", missed, rays);
+    CHECK(missed == 0);
+    evr_gpu_top_free(&top);
+    evr_gpu_bvh_free(&bvh);
+    free_mesh(&mesh);
+}
+
+/* A random motion key; rotations near prev when given (up to ~120 degrees away). */
+static evr_motion_key random_key(uint64_t *c, const evr_motion_key *prev)
+{
+    evr_motion_key k;
+    int a;
+    for (a = 0; a < 3; a++) {
+        k.scale[a] = 0.3f + 0.7f * rnd(c);
+        k.skew[a] = 0.4f * rnd(c) - 0.2f;
+    }
+    k.rot = evr_quat_normalize(evr_quat_make(rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f));
+    k.trans = evr_v3_make(16.0f * rnd(c) - 8.0f, 16.0f * rnd(c) - 8.0f, 16.0f * rnd(c) - 8.0f);
+    if (prev) {
+        k.rot = evr_quat_slerp(prev->rot, k.rot, 0.6f * rnd(c));
+        if (evr_quat_dot(prev->rot, k.rot) < 0.0f) k.rot = evr_quat_make(-k.rot.w, -k.rot.x, -k.rot.y, -k.rot.z);
+        k.trans = evr_v3_lerp(prev->trans, k.trans, 0.1f);
+    }
+    return k;
+}
+
+/* Many instances on random motion tracks (static ones too): exercises the top level (its boxes
+ * over the segment, its traversal and stack) against Embree with one motion-blurred instance
+ * per scene instance. */
+static void test_many_instances(int n_inst, int n_rays, totals *tot)
+{
+    evr_mesh meshes[2];
+    evr_scene sc;
+    evr_render_scene rs;
+    evr_instance_view *inst = malloc(sizeof *inst * (size_t)n_inst);
+    evr_motion_key *keys = malloc(sizeof *keys * (size_t)n_inst * 5);
+    int *off = malloc(sizeof(int) * (size_t)n_inst), *cnt = malloc(sizeof(int) * (size_t)n_inst);
+    int *kind = malloc(sizeof(int) * (size_t)n_rays);
+    test_ray *rays = malloc(sizeof *rays * (size_t)n_rays);
+    reference ref;
+    RTCScene mesh_scene[2];
+    uint64_t c = 21;
+    int i, k, li, nk = 0;
+    judge j;
+
+    make_sphere(6, &meshes[0]);
+    make_sheet(8, &meshes[1]);
+    memset(&sc, 0, sizeof sc);
+    sc.num_meshes = 2;
+    sc.meshes = meshes;
+    memset(&rs, 0, sizeof rs);
+    for (i = 0; i < n_inst; i++) {
+        int n = i % 4 == 0 ? 1 : 2 + i % 4;   /* a quarter static, the rest 3 to 5 keys */
+        inst[i].mesh = i % 3 == 0;
+        inst[i].track = i;
+        off[i] = nk;
+        cnt[i] = n;
+        for (k = 0; k < n; k++, nk++) keys[nk] = random_key(&c, k ? &keys[nk - 1] : NULL);
+    }
+    rs.instances = inst;
+    rs.num_instances = n_inst;
+    rs.keys = keys;
+    rs.track_offset = off;
+    rs.track_count = cnt;
+
+    /* the reference: each scene instance its own Embree instance (geomID = instance index) */
+    memset(&ref, 0, sizeof ref);
+    ref.dev = rtcNewDevice(NULL);
+    for (k = 0; k < 2; k++) {
+        mesh_scene[k] = rtcNewScene(ref.dev);
+        add_mesh_geometry(ref.dev, mesh_scene[k], &meshes[k], NULL, 0);
+        rtcCommitScene(mesh_scene[k]);
+    }
+    ref.top = rtcNewScene(ref.dev);
+    ref.num_groups = n_inst;
+    ref.group_first = malloc(sizeof(int) * ((size_t)n_inst + 1));
+    ref.members = malloc(sizeof(int) * (size_t)n_inst);
+    for (i = 0; i < n_inst; i++) {
+        RTCGeometry g = rtcNewGeometry(ref.dev, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, mesh_scene[inst[i].mesh]);
+        rtcSetGeometryTimeStepCount(g, (unsigned)cnt[i]);
+        for (k = 0; k < cnt[i]; k++) {
+            struct RTCQuaternionDecomposition q;
+            to_embree(&keys[off[i] + k], &q);
+            rtcSetGeometryTransformQuaternion(g, (unsigned)k, &q);
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(ref.top, g, (unsigned)i);
+        rtcReleaseGeometry(g);
+        ref.group_first[i] = i;
+        ref.members[i] = i;
+    }
+    ref.group_first[n_inst] = n_inst;
+    rtcCommitScene(ref.top);
+
+    for (i = 0; i < n_rays; i++) {
+        evr_v3 d;
+        rays[i].ray.org = evr_v3_make(24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f);
+        do d = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
+        while (evr_v3_dot(d, d) > 1.0f || evr_v3_dot(d, d) < 1e-4f);
+        rays[i].ray.dir = evr_v3_norm(d);
+        rays[i].f = rnd(&c);
+        rays[i].tnear = i % 2 ? 0.0f : 0.5f * rnd(&c);
+        rays[i].tfar = i % 4 == 1 ? INFINITY : 2.0f + 20.0f * rnd(&c);
+        kind[i] = RAY_RANDOM;
+    }
+    j.meshes = meshes;
+    j.rs = &rs;
+    j.delta = 1e-6f * 40.0f;
+    sc.num_instances = 0;
+    for (li = 0; li < 2; li++) {
+        int layout = li ? EVR_GPU_LAYOUT_BVH4 : EVR_GPU_LAYOUT_CW8;
+        evr_gpu_bvh bvh;
+        evr_gpu_top top;
+        evr_gpu_scene_view view;
+        tally ty;
+        long bad = 0, m;
+        char what[64];
+        memset(&top, 0, sizeof top);
+        memset(&ty, 0, sizeof ty);
+        CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+        CHECK_OK(evr_gpu_top_build(&bvh, &rs, &top, &e_));
+        evr_gpu_scene_view_host(&bvh, &top, &view);
+        for (i = 0; i < n_inst; i++)
+            bad += check_box_holds(bvh.mesh_bounds + 6 * inst[i].mesh, top.inst_bounds + 6 * i,
+                                   top.inst_bounds + 6 * i + 3, evr_rs_track(&rs, i), 200, &c);
+        CHECK(bad == 0);
+        snprintf(what, sizeof what, "instances/%s", layout_name(layout));
+        compare(what, &j, &view, &ref, rays, kind, n_rays, &ty);
+        printf("%d instances (%d static), layout %s: top level %u nodes, stack %d of %d\n", n_inst, (n_inst + 3) / 4,
+               layout_name(layout), top.num_nodes, top.stack_need, EVR_GPU_STACK_SIZE);
+        report_line(RAY_RANDOM, &ty);
+        CHECK(ty.closest[RAY_RANDOM][EX_NONE] == 0);
+        CHECK(ty.occluded[RAY_RANDOM][EX_NONE] == 0);
+        m = sum4(ty.closest[RAY_RANDOM]) + sum4(ty.occluded[RAY_RANDOM]);
+        tot->rays += ty.rays[RAY_RANDOM];
+        tot->mismatches += m;
+        tot->well_rays += ty.rays[RAY_RANDOM];
+        tot->well_mismatches += m;
+        tot->edge += ty.closest[RAY_RANDOM][EX_EDGE] + ty.occluded[RAY_RANDOM][EX_EDGE];
+        tot->contact += ty.closest[RAY_RANDOM][EX_CONTACT] + ty.occluded[RAY_RANDOM][EX_CONTACT];
+        tot->unexplained += ty.closest[RAY_RANDOM][EX_NONE] + ty.occluded[RAY_RANDOM][EX_NONE];
+        snprintf(what, sizeof what, "random rays, %s", layout_name(layout));
+        timing(what, &view, &rs, &ref, rays, n_rays);
+        evr_gpu_top_free(&top);
+        evr_gpu_bvh_free(&bvh);
+    }
+    rtcReleaseScene(ref.top);
+    for (k = 0; k < 2; k++) rtcReleaseScene(mesh_scene[k]);
+    rtcReleaseDevice(ref.dev);
+    free(ref.group_first);
+    free(ref.members);
+    free_mesh(&meshes[0]);
+    free_mesh(&meshes[1]);
+    free(inst);
+    free(keys);
+    free(off);
+    free(cnt);
+    free(kind);
+    free(rays);
+}
+
+/* ---- one scene segment ---- */
+
+/* A scene's bottom level is built once per layout; every segment rebuilds the top level in place
+ * (as the backend will) and is checked against an Embree scene with that segment's keys. */
+static void test_scene(const char *name, const double *t0s, int nseg, int n_cam, int n_shadow, int n_random, totals *tot)
+{
+    evr_scene *s = NULL;
+    evr_render_host host;
+    evr_error err;
+    evr_gpu_bvh bvh[2];
+    evr_gpu_top top[2];
+    const int layouts[2] = {EVR_GPU_LAYOUT_CW8, EVR_GPU_LAYOUT_BVH4};
+    int li, i, seg, n = n_cam + n_shadow + n_random;
+    unsigned ntri = 0;
+    uint64_t c = 3;
+
+    CHECK_OK(evr_demo_load(name, &s, &err));
+    if (!s) return;
+    CHECK_OK(evr_render_host_init(&host, s, 0, 640, 480, 0.02f, &err));
+    for (i = 0; i < s->num_meshes; i++) ntri += s->meshes[i].num_triangles;
+    for (li = 0; li < 2; li++) {
+        double tb = now();
+        memset(&top[li], 0, sizeof top[li]);
+        CHECK_OK(evr_gpu_bvh_build(s, layouts[li], &bvh[li], &err));
+        printf("%s, layout %s: %u nodes of %zu bytes, %u triangle references for %u triangles, stack %d; build %.1f ms\n",
+               name, layout_name(layouts[li]), bvh[li].num_nodes,
+               layouts[li] == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4), bvh[li].num_tris, ntri,
+               bvh[li].max_stack, 1e3 * (now() - tb));
+    }
+
+    for (seg = 0; seg < nseg; seg++) {
+        double t0 = t0s[seg], t1 = t0 + 1.0 / 30.0;
+        motion mo;
+        reference ref;
+        test_ray *rays;
+        int *kind, moving = 0;
+        judge j;
+        motion_compute(s, 0, t0, t1, &mo);
+        host.rs.keys = mo.keys;
+        host.rs.track_offset = mo.offset;
+        host.rs.track_count = mo.count;
+        for (i = 0; i < s->num_instances; i++) moving += mo.count[host.rs.instances[i].track] > 1;
+        reference_build(&ref, s, &mo);
+        rays = make_rays(s, &host.rs, n_cam, n_shadow, n_random, 0x5eedull + (uint64_t)(t0 * 1000));
+        kind = malloc(sizeof(int) * (size_t)n);
+        for (i = 0; i < n; i++) kind[i] = i < n_cam ? RAY_CAMERA : (i < n_cam + n_shadow ? RAY_SHADOW : RAY_RANDOM);
+        j.meshes = s->meshes;
+        j.rs = &host.rs;
+        j.delta = 1e-6f * host.scene_size;
+        printf("%s, segment %.4f .. %.4f s: %d instances (%d moving), %d rays\n", name, t0, t1, s->num_instances,
+               moving, n);
+
+        for (li = 0; li < 2; li++) {
+            evr_gpu_scene_view view;
+            tally ty;
+            double tt = now();
+            char what[96];
+            long bad = 0, well = 0, well_bad = 0, all_bad = 0;
+            int k;
+            memset(&ty, 0, sizeof ty);
+            CHECK_OK(evr_gpu_top_build(&bvh[li], &host.rs, &top[li], &err));
+            evr_gpu_scene_view_host(&bvh[li], &top[li], &view);
+            printf("  layout %s: top level %u nodes, %u instances, stack %d of %d, built in %.3f ms\n",
+                   layout_name(layouts[li]), top[li].num_nodes, top[li].num_insts, top[li].stack_need,
+                   EVR_GPU_STACK_SIZE, 1e3 * (now() - tt));
+
+            /* segment boxes hold every instance at every time */
+            for (i = 0; i < s->num_instances; i++) {
+                int m = s->instances[i].mesh;
+                if (bvh[li].mesh_root[m] < 0) continue;
+                bad += check_box_holds(bvh[li].mesh_bounds + 6 * m, top[li].inst_bounds + 6 * i,
+                                       top[li].inst_bounds + 6 * i + 3,
+                                       evr_rs_track(&host.rs, host.rs.instances[i].track), 2000, &c);
+            }
+            CHECK(bad == 0);
+
+            snprintf(what, sizeof what, "%s/%s", name, layout_name(layouts[li]));
+            compare(what, &j, &view, &ref, rays, kind, n, &ty);
+            for (k = 0; k < 3; k++) report_line(k, &ty);
+            for (k = 0; k < 3; k++) {
+                long m = sum4(ty.closest[k]) + sum4(ty.occluded[k]);
+                all_bad += m;
+                tot->edge += ty.closest[k][EX_EDGE] + ty.occluded[k][EX_EDGE];
+                tot->contact += ty.closest[k][EX_CONTACT] + ty.occluded[k][EX_CONTACT];
+                tot->unexplained += ty.closest[k][EX_NONE] + ty.occluded[k][EX_NONE];
+                CHECK(ty.closest[k][EX_NONE] == 0);
+                CHECK(ty.occluded[k][EX_NONE] == 0);
+                if (k != RAY_SHADOW) {
+                    well += ty.rays[k];
+                    well_bad += m;
+                }
+            }
+            tot->rays += ty.rays[0] + ty.rays[1] + ty.rays[2];
+            tot->mismatches += all_bad;
+            tot->well_rays += well;
+            tot->well_mismatches += well_bad;
+            snprintf(what, sizeof what, "camera rays, %s", layout_name(layouts[li]));
+            timing(what, &view, &host.rs, &ref, rays, n_cam);
+        }
+        free(kind);
+        free(rays);
+        reference_free(&ref);
+        motion_free(&mo);
+    }
+    for (li = 0; li < 2; li++) {
+        evr_gpu_top_free(&top[li]);
+        evr_gpu_bvh_free(&bvh[li]);
+    }
+    evr_render_host_free(&host);
+    evr_scene_release(s);
+}
+
+int main(void)
+{
+    totals tot;
+    memset(&tot, 0, sizeof tot);
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    double t = now();
+    test_synthetic_bounds();
+    test_watertight(EVR_GPU_LAYOUT_CW8);
+    test_watertight(EVR_GPU_LAYOUT_BVH4);
+    printf("(%.1f s)\n", now() - t);
+    test_many_instances(600, 20000 / RAY_SCALE, &tot);   /* Embree takes ~1.5 ms per quaternion-motion instance */
+    printf("(%.1f s)\n", now() - t);
+    {
+        /* a saccade starts at 1.025 s; a blink closes the upper lid over 0.665 .. 0.765 s */
+        static const double eye_t0[2] = {1.0, 0.72}, square_t0[1] = {0.5};
+        test_scene("eye", eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE, &tot);
+        printf("(%.1f s)\n", now() - t);
+        test_scene("square", square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE, 10000 / RAY_SCALE, &tot);
+        printf("(%.1f s)\n", now() - t);
+    }
+    /* each ray is asked twice (closest and occlusion): rates are per question */
+    printf("all: %ld rays x 2 queries; disagreements %.2e per query (edge %.2e, contact %.2e, unexplained %ld); "
+           "camera and random rays alone %.2e\n",
+           tot.rays, (double)tot.mismatches / (2.0 * (double)tot.rays), (double)tot.edge / (2.0 * (double)tot.rays),
+           (double)tot.contact / (2.0 * (double)tot.rays), tot.unexplained,
+           (double)tot.well_mismatches / (2.0 * (double)tot.well_rays));
+    CHECK(tot.rays >= 200000 / RAY_SCALE);
+    CHECK(tot.unexplained == 0);
+    CHECK((double)tot.mismatches / (2.0 * (double)tot.rays) < MAX_MISMATCH_RATE);
+    CHECK((double)tot.edge / (2.0 * (double)tot.rays) < MAX_MISMATCH_RATE);
+    CHECK((double)tot.well_mismatches / (2.0 * (double)tot.well_rays) < MAX_MISMATCH_RATE);
+    return check_report("test_gpu_bvh");
+}
