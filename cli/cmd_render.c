@@ -75,6 +75,7 @@ static void help(void)
          "  --samples-per-frame N      samples per pixel per segment (default 10)\n"
          "  --threads N                worker threads (default: all cores)\n"
          "  --backend B                auto (default: CUDA when a GPU is usable, else CPU), cpu or cuda\n"
+         "  --gpu-bvh L                GPU BVH node layout: cw8 (default, compressed 8-wide) or bvh4\n"
          "sensor:\n"
          "  --pos-thres C, --neg-thres C   ON/OFF contrast thresholds in log intensity (default 0.2)\n"
          "  --thres C                  both thresholds\n"
@@ -115,6 +116,10 @@ int cmd_render(int argc, char **argv, const char *default_demo)
             else if (!strcmp(v, "cpu")) cfg.backend = EVR_BACKEND_CPU;
             else if (!strcmp(v, "cuda")) cfg.backend = EVR_BACKEND_CUDA;
             else { cli_error("--backend: unknown backend '%s' (auto, cpu, cuda)", v); return 2; } }
+        else if (opt_is(a, "--gpu-bvh")) { VAL("--gpu-bvh");
+            if (!strcmp(v, "bvh4")) cfg.gpu_bvh = 4;
+            else if (!strcmp(v, "cw8")) cfg.gpu_bvh = 8;
+            else { cli_error("--gpu-bvh: unknown layout '%s' (bvh4, cw8)", v); return 2; } }
         else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return 2; }
         else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return 2; }
         else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return 2; }

@@ -78,6 +78,7 @@ typedef struct {
     uint64_t seed;
     int threads;                  /* 0: all cores */
     evr_backend_kind backend;
+    int gpu_bvh;                  /* GPU node layout: 0 default, 4 (BVH4, float boxes), 8 (CW8, compressed) */
     /* output */
     const char *out_dir;
     int formats;                  /* evr_format bits */

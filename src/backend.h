@@ -18,6 +18,7 @@ typedef struct {
     uint64_t seed;
     evr_pixel_params pixel;
     int threads;
+    int gpu_bvh;                  /* GPU node layout (0: default) */
 } evr_run_setup;
 
 /* One segment: absolute times and the motion keys of every track (one track per scene node, and
@@ -44,6 +45,7 @@ struct evr_backend {
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, evr_error *err);
     void (*release)(evr_backend *b);
     uint64_t samples, rays;       /* totals so far */
+    double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
 };
 
 /* Host arrays behind an evr_render_scene (everything but the per-segment keys). */

@@ -107,6 +107,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.pixel.refractory = c->refractory;
     sim->setup.pixel.log_floor = c->log_floor;
     sim->setup.threads = c->threads;
+    sim->setup.gpu_bvh = c->gpu_bvh;
 
     int ntracks = s->num_nodes + 1;
     sim->keys = malloc(sizeof *sim->keys * (size_t)ntracks * EVR_MAX_KEYS);
@@ -121,7 +122,10 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
     mark_used(sim, s->cameras[sim->camera].node);
 
-    if ((st = make_backend(sim, err)) != EVR_OK) {
+    double t_setup = now_seconds();
+    st = make_backend(sim, err);
+    sim->time_setup = now_seconds() - t_setup;
+    if (st != EVR_OK) {
         evr_sim_release(sim);
         return st;
     }

@@ -40,7 +40,7 @@ struct evr_sim {
     int previews_written;
     /* statistics */
     evr_stats st;
-    double time_render, time_sort, time_write, time_preview;
+    double time_setup, time_render, time_sort, time_write, time_preview;
 };
 
 #endif

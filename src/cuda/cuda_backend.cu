@@ -222,7 +222,7 @@ struct slot {
     hbuf<unsigned long long> h_sorted;
     hbuf<float> h_intensity;
     cudaStream_t copy = nullptr;
-    cudaEvent_t rendered = nullptr, counted = nullptr;
+    cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr;
     int num_tracks, num_keys;
 };
 
@@ -383,6 +383,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     CK(cudaMemsetAsync(sl->d_rays.p, 0, sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
     int npix = b->setup.width * b->setup.height;
+    CK(cudaEventRecord(sl->started, b->render));
     render_kernel<<<(npix + BLOCK - 1) / BLOCK, BLOCK, 0, b->render>>>(a);
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
@@ -469,6 +470,9 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         n = *sl->h_count.p;
     }
     base->rays += *sl->h_rays.p;
+    float ms = 0.0f;
+    CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
+    base->device_seconds += 1e-3 * (double)ms;
     base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
     if (n) {
         size_t temp = 0;
@@ -524,6 +528,7 @@ static void cuda_release(evr_backend *base)
         sl->d_count.release(); sl->d_rays.release(); sl->d_intensity.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         if (sl->copy) cudaStreamDestroy(sl->copy);
+        if (sl->started) cudaEventDestroy(sl->started);
         if (sl->rendered) cudaEventDestroy(sl->rendered);
         if (sl->counted) cudaEventDestroy(sl->counted);
     }
@@ -560,7 +565,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaGetDeviceProperties(&prop, b->device));
     snprintf(b->device_name, sizeof b->device_name, "%s", prop.name);
     evr_status st;
-    if ((st = evr_gpu_bvh_build(b->scene, 0, &b->bvh, err)) != EVR_OK) return st;
+    if ((st = evr_gpu_bvh_build(b->scene, b->setup.gpu_bvh, &b->bvh, err)) != EVR_OK) return st;
     if ((st = upload_scene(b, err)) != EVR_OK) return st;
     size_t npix = (size_t)b->setup.width * b->setup.height;
     for (int i = 0; i < 3; i++) CK(b->d_state[i].reserve(npix));
@@ -573,7 +578,8 @@ static evr_status init(cuda_backend *b, evr_error *err)
     for (int i = 0; i < 2; i++) {
         slot *sl = &b->slots[i];
         CK(cudaStreamCreateWithFlags(&sl->copy, cudaStreamNonBlocking));
-        CK(cudaEventCreateWithFlags(&sl->rendered, cudaEventDisableTiming));
+        CK(cudaEventCreate(&sl->started));
+        CK(cudaEventCreate(&sl->rendered));
         CK(cudaEventCreateWithFlags(&sl->counted, cudaEventDisableTiming));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(1));
@@ -600,6 +606,7 @@ extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_
     b->base.release = cuda_release;
     b->base.samples = 0;
     b->base.rays = 0;
+    b->base.device_seconds = 0.0;
     b->scene = s;
     b->host = *h;
     b->setup = *setup;
