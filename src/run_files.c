@@ -236,7 +236,8 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "time_device_seconds"); evr_json_number(&j, sim->backend->device_seconds);
     evr_json_key(&j, "device_samples_per_second"); evr_json_number(&j, sim->backend->device_seconds > 0 ? (double)s->samples / sim->backend->device_seconds : 0.0);
     evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, sim->time_sort);
-    evr_json_key(&j, "time_write_seconds"); evr_json_number(&j, sim->time_write);
+    evr_json_key(&j, "time_write_wait_seconds"); evr_json_number(&j, sim->time_write);
+    evr_json_key(&j, "time_write_thread_seconds"); evr_json_number(&j, sim->time_write_thread);
     evr_json_key(&j, "time_preview_seconds"); evr_json_number(&j, sim->time_preview);
     evr_json_key(&j, "preview_frames"); evr_json_integer(&j, sim->previews_written);
     evr_json_end_object(&j);
@@ -263,6 +264,14 @@ evr_status evr_run_finish(evr_sim *sim, evr_error *err)
     evr_status st = EVR_OK;
     int w;
     int64_t dur_us = (int64_t)llround(sim->st.sim_time * 1e6);
+    if (sim->wq) {
+        st = evr_write_queue_drain(sim->wq, err);
+        sim->time_write = evr_write_queue_wait_seconds(sim->wq);
+        sim->time_write_thread = evr_write_queue_busy_seconds(sim->wq);
+        evr_write_queue_stop(sim->wq);
+        sim->wq = NULL;
+        if (st != EVR_OK) return st;
+    }
     for (w = 0; w < sim->num_writers; w++) {
         evr_event_writer *wr = sim->writers[w];
         sim->writers[w] = NULL;
@@ -300,6 +309,8 @@ void evr_run_dir_discard(evr_sim *sim)
 {
     int w;
     char p[4200];
+    evr_write_queue_stop(sim->wq);   /* the thread must be done with the writers */
+    sim->wq = NULL;
     for (w = 0; w < sim->num_writers; w++) {
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
         sim->writers[w] = NULL;

@@ -139,7 +139,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
-    if ((st = evr_run_writers_open(sim, err)) != EVR_OK) {
+    if ((st = evr_run_writers_open(sim, err)) != EVR_OK ||
+        (st = evr_write_queue_start(sim->writers, sim->num_writers, &sim->wq, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -182,7 +183,6 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
 {
     evr_event_vec *v = &sim->pending;
     size_t n = 0, i;
-    int w;
     evr_status st;
     while (n < v->n && v->data[n].t < limit_us) n++;
     if (n == 0) return EVR_OK;
@@ -194,9 +194,7 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
         if (e->t != sim->last_t) sim->st.unique_timestamps++;
         sim->last_t = e->t;
     }
-    for (w = 0; w < sim->num_writers; w++) {
-        if ((st = sim->writers[w]->write(sim->writers[w], v->data, n, err)) != EVR_OK) return st;
-    }
+    if ((st = evr_write_queue_push(sim->wq, v->data, n, err)) != EVR_OK) return st;
     sim->time_write += now_seconds() - t;
     t = now_seconds();
     if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
@@ -231,16 +229,13 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     const float *intensity = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
     evr_status st;
-    int w;
     double t = now_seconds();
     if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, err)) != EVR_OK) return st;
     sim->time_render += now_seconds() - t;
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
     int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
-    if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;
-    for (w = 0; w < sim->num_writers; w++)
-        if ((st = sim->writers[w]->flush(sim->writers[w], err)) != EVR_OK) return st;
+    if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;   /* written and flushed on the writer thread */
     if (intensity) {
         t = now_seconds();
         if ((st = evr_run_preview_intensity(sim, intensity, t1, last, err)) != EVR_OK) return st;
@@ -295,6 +290,7 @@ void evr_sim_release(evr_sim *sim)
 {
     int w;
     if (!sim) return;
+    evr_write_queue_stop(sim->wq);
     for (w = 0; w < sim->num_writers; w++)
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
     if (sim->backend) sim->backend->release(sim->backend);

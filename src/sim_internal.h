@@ -5,6 +5,7 @@
 #include "backend.h"
 #include "io/event_writer.h"
 #include "io/preview.h"
+#include "write_queue.h"
 
 #define EVR_MAX_WRITERS 3
 #define EVR_MAX_KEYS 65
@@ -23,6 +24,7 @@ struct evr_sim {
     evr_event_writer *writers[EVR_MAX_WRITERS];
     const char *writer_names[EVR_MAX_WRITERS];
     int num_writers;
+    evr_write_queue *wq;         /* writes on its own thread */
     char *config_json;
     /* per-segment motion */
     evr_motion_key *keys;
@@ -40,7 +42,7 @@ struct evr_sim {
     int previews_written;
     /* statistics */
     evr_stats st;
-    double time_setup, time_render, time_sort, time_write, time_preview;
+    double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 
 #endif

@@ -1,0 +1,24 @@
+/* Writes event batches on a thread of its own, so that the host writes segment i while the
+ * backend renders segment i + 1. Batches are written in the order pushed; each batch is followed
+ * by a flush of every writer (a valid file after every segment). At most two batches wait. */
+#ifndef EVR_WRITE_QUEUE_H
+#define EVR_WRITE_QUEUE_H
+
+#include <stddef.h>
+#include "io/event_writer.h"
+
+typedef struct evr_write_queue evr_write_queue;
+
+evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, evr_write_queue **out, evr_error *err);
+/* Copies the events and returns (waits only while two batches are pending). Fails with the
+ * writer thread's first error, if any. */
+evr_status evr_write_queue_push(evr_write_queue *q, const evr_event *ev, size_t n, evr_error *err);
+/* Waits until everything pushed is written and flushed; returns the first error, if any. */
+evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err);
+/* Seconds the writer thread spent writing, and the caller spent waiting in push/drain. */
+double evr_write_queue_busy_seconds(evr_write_queue *q);
+double evr_write_queue_wait_seconds(evr_write_queue *q);
+/* Stops the thread (after the pending batches) and frees the queue. */
+void evr_write_queue_stop(evr_write_queue *q);
+
+#endif
