@@ -51,6 +51,7 @@ static int on_progress(void *user, const evr_stats *st)
     return interrupted ? 1 : 0;
 }
 
+void render_options_help(void);
 static void help(void)
 {
     puts("usage: evray render SCENE [options]\n"
@@ -89,49 +90,17 @@ static void help(void)
 int cmd_render(int argc, char **argv, const char *default_demo)
 {
     evr_config cfg;
-    const char *scene_path = NULL, *v;
-    int quiet = 0, i;
+    const char *scene_path = NULL;
+    int quiet = 0, i, r;
     evr_config_defaults(&cfg);
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-#define VAL(name) if (!(v = opt_value(argc, argv, &i, name))) return 2
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); return 0; }
-        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
-        else if (!strcmp(a, "--force")) cfg.force = 1;
-        else if (!strcmp(a, "--no-preview")) cfg.preview_window = 0.0;
-        else if (!strcmp(a, "-o")) { VAL("-o"); cfg.out_dir = v; }
-        else if (opt_is(a, "--out")) { VAL("--out"); cfg.out_dir = v; }
-        else if (opt_is(a, "--format")) { VAL("--format"); if (!opt_formats(v, &cfg.formats)) return 2; }
-        else if (opt_is(a, "--preview-window")) { VAL("--preview-window"); if (!opt_double(a, v, &cfg.preview_window)) return 2; }
-        else if (opt_is(a, "--res")) { VAL("--res"); if (!opt_size("--res", v, &cfg.width, &cfg.height)) return 2; }
-        else if (opt_is(a, "--camera")) { VAL("--camera"); cfg.camera = v; }
-        else if (opt_is(a, "--duration")) { VAL("--duration"); if (!opt_double("--duration", v, &cfg.duration)) return 2;
-            if (cfg.duration <= 0) { cli_error("--duration must be a positive number of seconds (got %s)", v); return 2; } }
-        else if (opt_is(a, "--start")) { VAL("--start"); if (!opt_double("--start", v, &cfg.start)) return 2; }
-        else if (opt_is(a, "--fps")) { VAL("--fps"); if (!opt_double("--fps", v, &cfg.fps)) return 2;
-            if (cfg.fps <= 0) { cli_error("--fps must be a positive number (got %s)", v); return 2; } }
-        else if (opt_is(a, "--samples-per-frame")) { VAL("--samples-per-frame"); if (!opt_int("--samples-per-frame", v, &cfg.samples_per_frame)) return 2; }
-        else if (opt_is(a, "--backend")) { VAL("--backend");
-            if (!strcmp(v, "auto")) cfg.backend = EVR_BACKEND_AUTO;
-            else if (!strcmp(v, "cpu")) cfg.backend = EVR_BACKEND_CPU;
-            else if (!strcmp(v, "cuda")) cfg.backend = EVR_BACKEND_CUDA;
-            else { cli_error("--backend: unknown backend '%s' (auto, cpu, cuda)", v); return 2; } }
-        else if (opt_is(a, "--gpu-bvh")) { VAL("--gpu-bvh");
-            if (!strcmp(v, "bvh4")) cfg.gpu_bvh = 4;
-            else if (!strcmp(v, "cw8")) cfg.gpu_bvh = 8;
-            else { cli_error("--gpu-bvh: unknown layout '%s' (bvh4, cw8)", v); return 2; } }
-        else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return 2; }
-        else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return 2; }
-        else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return 2; }
-        else if (opt_is(a, "--thres")) { VAL("--thres"); if (!opt_float("--thres", v, &cfg.pos_thres)) return 2; cfg.neg_thres = cfg.pos_thres; }
-        else if (opt_is(a, "--refractory")) { VAL("--refractory"); if (!opt_float("--refractory", v, &cfg.refractory)) return 2; }
-        else if (opt_is(a, "--log-floor")) { VAL("--log-floor"); if (!opt_float("--log-floor", v, &cfg.log_floor)) return 2; }
-        else if (opt_is(a, "--ambient")) { VAL("--ambient"); if (!opt_float("--ambient", v, &cfg.ambient)) return 2; }
-        else if (opt_is(a, "--seed")) { VAL("--seed"); if (!opt_u64("--seed", v, &cfg.seed)) return 2; }
+        else if ((r = parse_render_option(argc, argv, &i, &cfg, &quiet)) < 0) return 2;
+        else if (r > 0) continue;
         else if (a[0] == '-' && a[1]) { cli_error("unknown option '%s' (see evray render --help)", a); return 2; }
         else if (!scene_path && !default_demo) scene_path = a;
         else { cli_error("unexpected argument '%s'", a); return 2; }
-#undef VAL
     }
     if (!scene_path && !default_demo) {
         cli_error("render needs a scene file (evray render SCENE [options]; evray demo for the built-in scene)");

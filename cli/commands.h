@@ -6,5 +6,9 @@ int cmd_render(int argc, char **argv, const char *default_demo);
 int cmd_info(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
+
+#include "evray.h"
+int parse_render_option(int argc, char **argv, int *i, evr_config *cfg, int *quiet);
 
 #endif

@@ -98,6 +98,13 @@ typedef struct {
     double samples_per_second, rays_per_second, realtime_factor;
     int segments_done, segments_total;
     int interrupted;
+    /* where the time went (seconds; filled at the end of a run) */
+    double time_setup;            /* scene to backend: BVH builds, uploads */
+    double time_render;           /* waiting for and taking in the backend's segments */
+    double time_device;           /* GPU kernels (0 on the CPU) */
+    double time_sort, time_copy;  /* event sort and device-to-host copy inside the backend */
+    double time_write;            /* the writer thread's busy time (overlaps rendering) */
+    uint64_t device_memory;       /* bytes the backend holds on the GPU (0 on the CPU) */
     char backend[16];             /* the backend that ran: "cpu" or "cuda" */
     char device[128];             /* CPU threads or the GPU's name */
     char notice[256];             /* e.g. why auto fell back to the CPU; empty if nothing to say */

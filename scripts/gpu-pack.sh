@@ -16,5 +16,6 @@ cp build-gpu/evray gpu-carry/
 ldd build-gpu/evray | awk '/=> \// {print $3}' | sort -u | \
     grep -v -E '/(libc|libm|libpthread|libdl|librt|libresolv|ld-linux[^/]*|libgcc_s|libstdc\+\+|libcuda)\.so' | \
     grep -v -E '/(libz|libzstd|libcrypto|libssl|libgnutls|libp11-kit|libunistring|libidn2|libffi|libgmp|libtasn1|libnettle|libhogweed|libcom_err|libkeyutils|libkrb5|libkrb5support|libk5crypto|libgssapi_krb5)\.so' | \
+    grep -v -E '/(libcurl|libssh2|libldap-[0-9.]*|liblber-[0-9.]*|libsasl2|libnghttp2|libpsl|librtmp|libbrotli[a-z]*|libaec|libsz|libpng16)\.so' | \
     while read -r lib; do cp -L "$lib" gpu-carry/lib/; done
 du -sh gpu-carry

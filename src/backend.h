@@ -46,6 +46,8 @@ struct evr_backend {
     void (*release)(evr_backend *b);
     uint64_t samples, rays;       /* totals so far */
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
+    double sort_seconds, copy_seconds;
+    uint64_t device_bytes;        /* memory held on the device */
 };
 
 /* Host arrays behind an evr_render_scene (everything but the per-segment keys). */

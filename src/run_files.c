@@ -235,7 +235,9 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
     evr_json_key(&j, "time_device_seconds"); evr_json_number(&j, sim->backend->device_seconds);
     evr_json_key(&j, "device_samples_per_second"); evr_json_number(&j, sim->backend->device_seconds > 0 ? (double)s->samples / sim->backend->device_seconds : 0.0);
-    evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, sim->time_sort);
+    evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, s->time_sort);
+    evr_json_key(&j, "time_copy_seconds"); evr_json_number(&j, s->time_copy);
+    evr_json_key(&j, "device_memory_bytes"); evr_json_unsigned(&j, s->device_memory);
     evr_json_key(&j, "time_write_wait_seconds"); evr_json_number(&j, sim->time_write);
     evr_json_key(&j, "time_write_thread_seconds"); evr_json_number(&j, sim->time_write_thread);
     evr_json_key(&j, "time_preview_seconds"); evr_json_number(&j, sim->time_preview);
@@ -264,10 +266,17 @@ evr_status evr_run_finish(evr_sim *sim, evr_error *err)
     evr_status st = EVR_OK;
     int w;
     int64_t dur_us = (int64_t)llround(sim->st.sim_time * 1e6);
+    sim->st.time_setup = sim->time_setup;
+    sim->st.time_render = sim->time_render;
+    sim->st.time_device = sim->backend->device_seconds;
+    sim->st.time_sort = sim->backend->sort_seconds;
+    sim->st.time_copy = sim->backend->copy_seconds;
+    sim->st.device_memory = sim->backend->device_bytes;
     if (sim->wq) {
         st = evr_write_queue_drain(sim->wq, err);
         sim->time_write = evr_write_queue_wait_seconds(sim->wq);
         sim->time_write_thread = evr_write_queue_busy_seconds(sim->wq);
+        sim->st.time_write = sim->time_write_thread;
         evr_write_queue_stop(sim->wq);
         sim->wq = NULL;
         if (st != EVR_OK) return st;

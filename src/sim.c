@@ -218,7 +218,10 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.t1 = segment_end(sim, i);
     compute_motion(sim, seg.t0, seg.t1, &seg);
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
-    return sim->backend->submit(sim->backend, &seg, err);
+    double t = now_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
+    evr_status st = sim->backend->submit(sim->backend, &seg, err);
+    sim->time_render += now_seconds() - t;
+    return st;
 }
 
 /* Segment i's events: merged into the pending (time-ordered) events, of which those that no

@@ -95,6 +95,11 @@ r = json.loads(T.run("compare", os.path.join(out, "events.npy"), os.path.join(st
 T.check(r["recall"] == 0.0, "compare: nothing matches an empty stream")
 expect_error(["compare", os.path.join(out, "events.npy")], "compare with one file")
 
+# bench: one row of figures
+b = json.loads(T.run("bench", "--scene", "square", "--res", "32x32", "--duration", "0.5", "--json").stdout.splitlines()[0])
+T.check(b["events"] > 0 and b["samples_per_second"] > 0 and b["rays_per_second"] >= b["samples_per_second"], f"bench row {b}")
+T.check(abs(b["temporal_resolution_us"] - 1e6 / 300) < 0.1, "bench: 30 fps x 10 samples = 3333 us between a pixel's samples")
+
 # bad input
 noout = os.path.join(tmp, "never")
 expect_error(["render", os.path.join(tmp, "missing.glb"), "-o", noout], "missing file", noout)

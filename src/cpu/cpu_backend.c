@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #if defined(__SSE__)
 #include <pmmintrin.h>
@@ -265,7 +266,12 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
             return EVR_ERR_NOMEM;
         }
     }
-    if (!evr_events_sort(out, &b->scratch)) {
+    struct timespec ts0, ts1;
+    clock_gettime(CLOCK_MONOTONIC, &ts0);
+    int sorted = evr_events_sort(out, &b->scratch);
+    clock_gettime(CLOCK_MONOTONIC, &ts1);
+    base->sort_seconds += (double)(ts1.tv_sec - ts0.tv_sec) + 1e-9 * (double)(ts1.tv_nsec - ts0.tv_nsec);
+    if (!sorted) {
         snprintf(err->msg, sizeof err->msg, "out of memory sorting events");
         return EVR_ERR_NOMEM;
     }

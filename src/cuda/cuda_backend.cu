@@ -239,7 +239,7 @@ struct slot {
     hbuf<unsigned long long> h_sorted;
     hbuf<float> h_intensity;
     cudaStream_t copy = nullptr;
-    cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr;
+    cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr, copied = nullptr;
     int num_tracks, num_keys;
 };
 
@@ -469,6 +469,23 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     return EVR_OK;
 }
 
+template <typename T> static uint64_t bytes(const dbuf<T> &d) { return (uint64_t)d.cap * sizeof(T); }
+
+static uint64_t device_bytes(const cuda_backend *b)
+{
+    uint64_t n = bytes(b->d_floats) + bytes(b->d_indices) + bytes(b->d_meshes) + bytes(b->d_materials) +
+                 bytes(b->d_textures) + bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
+                 bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase);
+    for (int i = 0; i < 3; i++) n += bytes(b->d_state[i]);
+    for (int i = 0; i < 2; i++) {
+        const slot *sl = &b->slots[i];
+        n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
+             bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
+             bytes(sl->d_rays) + bytes(sl->d_intensity);
+    }
+    return n;
+}
+
 static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, evr_error *err)
 {
     cuda_backend *b = (cuda_backend *)base;
@@ -494,6 +511,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
     base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
+    CK(cudaEventRecord(sl->counted, sl->copy));   /* start of sort and copy */
     if (n) {
         size_t temp = 0;
         CK(sl->d_keys_sorted.reserve(n));
@@ -501,6 +519,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(sl->d_sort_temp.reserve(temp));
         CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
         CK(sl->h_sorted.reserve(n));
+        CK(cudaEventRecord(sl->sorted, sl->copy));
         CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
     }
     if (sl->want_intensity) {
@@ -508,7 +527,15 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(sl->h_intensity.reserve(npix));
         CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
     }
+    CK(cudaEventRecord(sl->copied, sl->copy));
     CK(cudaStreamSynchronize(sl->copy));
+    if (n) {
+        float sort_ms = 0.0f, copy_ms = 0.0f;
+        CK(cudaEventElapsedTime(&sort_ms, sl->counted, sl->sorted));
+        CK(cudaEventElapsedTime(&copy_ms, sl->sorted, sl->copied));
+        base->sort_seconds += 1e-3 * (double)sort_ms;
+        base->copy_seconds += 1e-3 * (double)copy_ms;
+    }
     b->decoded.n = 0;
     if (!evr_event_vec_reserve(&b->decoded, n)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
@@ -529,6 +556,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         return EVR_ERR_NOMEM;
     }
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
+    base->device_bytes = device_bytes(b);
     b->head = (b->head + 1) % 2;
     b->queued--;
     return EVR_OK;
@@ -551,6 +579,8 @@ static void cuda_release(evr_backend *base)
         if (sl->started) cudaEventDestroy(sl->started);
         if (sl->rendered) cudaEventDestroy(sl->rendered);
         if (sl->counted) cudaEventDestroy(sl->counted);
+        if (sl->sorted) cudaEventDestroy(sl->sorted);
+        if (sl->copied) cudaEventDestroy(sl->copied);
     }
     b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
@@ -600,7 +630,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaStreamCreateWithFlags(&sl->copy, cudaStreamNonBlocking));
         CK(cudaEventCreate(&sl->started));
         CK(cudaEventCreate(&sl->rendered));
-        CK(cudaEventCreateWithFlags(&sl->counted, cudaEventDisableTiming));
+        CK(cudaEventCreate(&sl->counted));
+        CK(cudaEventCreate(&sl->sorted));
+        CK(cudaEventCreate(&sl->copied));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(1));
         CK(sl->d_rays.reserve(1));
