@@ -6,12 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <stb/stb_image.h>
+#include <zlib.h>
 
 #include "check.h"
 #include "evray.h"
+#include "io/chunk_compress.h"
 #include "io/event_reader.h"
 #include "io/event_writer.h"
 #include "io/json.h"
@@ -224,8 +227,7 @@ static void check_ms_to_idx(const char *path, const evr_event *ev, size_t n, int
     CHECK(st == EVR_OK);
     if (st != EVR_OK) { fprintf(stderr, "%s\n", err.msg); return; }
     CHECK(nidx == expect_n);
-    for (size_t i = 0; i < nidx; i++) {
-        size_t k = 0;
+    for (size_t i = 0, k = 0; i < nidx; i++) {
         while (k < n && ev[k].t < (int64_t)i * 1000) k++;
         if (idx[i] != k) bad++;
     }
@@ -233,6 +235,152 @@ static void check_ms_to_idx(const char *path, const evr_event *ev, size_t n, int
     /* entries past the last event hold the count */
     if (nidx && (n == 0 || ev[n - 1].t < (int64_t)(nidx - 1) * 1000)) CHECK(idx[nidx - 1] == n);
     free(idx);
+}
+
+/* The HDF5 writer stores its event chunks itself (compressed in parallel, H5Dwrite_chunk): more
+ * than five chunks of events in uneven batches, partial chunks stored by a flush and completed
+ * later, a flush on a chunk boundary, flushes with nothing new, one batch larger than the
+ * writer's stage on small machines; the temporary file is read after a flush, the result after
+ * finish. Python compares its chunks with those HDF5's own filter pipeline makes. */
+static const size_t large_n = 400000;
+
+static void test_h5_large(const char *root)
+{
+    static const struct { size_t len; int flush; } steps[] = {
+        {1, 1}, {65535, 1}, {0, 1}, {0, 1}, {3, 0}, {300000, 1}, {7, 0}, {20000, 1}, {14454, 1},
+    };
+    evr_writer_meta meta = {W, H, "{}"};
+    evr_event_writer *w = NULL;
+    evr_event *ev, *got = NULL;
+    int64_t last_t;
+    size_t at = 0, ngot = 0;
+    char dir[512], path[600], tmp[620], partial[600];
+    evr_error err;
+    evr_status st;
+
+    ev = make_events(large_n, &last_t);
+    CHECK(ev != NULL);
+    if (!ev) return;
+    snprintf(dir, sizeof dir, "%s/large", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    snprintf(path, sizeof path, "%s/events.h5", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    snprintf(partial, sizeof partial, "%s/partial.h5", root);
+    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &e_));
+    if (!w) { free(ev); return; }
+    for (size_t s = 0; s < sizeof steps / sizeof steps[0]; s++) {
+        CHECK(at + steps[s].len <= large_n);
+        CHECK_OK(w->write(w, ev + at, steps[s].len, &e_));
+        at += steps[s].len;
+        if (!steps[s].flush) continue;
+        CHECK_OK(w->flush(w, &e_));
+        /* after the big batch: what an interrupted run would leave */
+        if (steps[s].len == 300000) {
+            CHECK(copy_file(tmp, partial));
+            st = evr_events_read(partial, &got, &ngot, NULL, NULL, &err);
+            CHECK(st == EVR_OK);
+            if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+            CHECK(ngot == at);
+            if (st == EVR_OK && ngot == at) CHECK(same_events(got, ev, at));
+            free(got);
+            got = NULL;
+            remove(partial);
+        }
+    }
+    CHECK(at == large_n);
+    st = w->finish(w, last_t + 1, &err);
+    CHECK(st == EVR_OK);
+    if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+    st = evr_events_read(path, &got, &ngot, NULL, NULL, &err);
+    CHECK(st == EVR_OK);
+    if (st != EVR_OK) fprintf(stderr, "%s\n", err.msg);
+    CHECK(ngot == large_n);
+    if (st == EVR_OK && ngot == large_n) CHECK(same_events(got, ev, large_n));
+    free(got);
+    check_ms_to_idx(path, ev, large_n, last_t + 1);
+    free(ev);
+}
+
+/* Chunk compression: the shuffled layout, zero padding, and the pool's output equal to one
+ * thread's. */
+static void test_chunk_compress(void)
+{
+    enum { CE = 4096, NCH = 7 };
+    evr_event *ev = calloc((size_t)CE * NCH, sizeof *ev);
+    unsigned char *raw = malloc((size_t)CE * 8), *scratch = malloc((size_t)CE * 8);
+    size_t bound = evr_chunk_bound((size_t)CE * 8);
+    unsigned char *dst = malloc(bound * 3 * NCH), *ref = malloc(bound * 3 * NCH);
+    evr_chunk_job jobs[3 * NCH];
+    uint64_t s = 4242;
+    CHECK(ev && raw && scratch && dst && ref);
+    if (!ev || !raw || !scratch || !dst || !ref) goto done;
+    for (size_t i = 0; i < (size_t)CE * NCH; i++) {
+        ev[i].t = (int64_t)(i * 37 + rng_next(&s) % 50) - 1000;
+        ev[i].x = (uint16_t)rng_next(&s);
+        ev[i].p = (int8_t)(rng_next(&s) & 1);
+    }
+    /* t, x and p of each chunk; the last chunk of each is partial */
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < NCH; k++) {
+            evr_chunk_job *j = &jobs[c * NCH + k];
+            size_t off = c == 0 ? offsetof(evr_event, t) : c == 1 ? offsetof(evr_event, x) : offsetof(evr_event, p);
+            memset(j, 0, sizeof *j);
+            j->src = (const unsigned char *)(ev + (size_t)k * CE) + off;
+            j->stride = sizeof(evr_event);
+            j->elem_size = c == 0 ? 8 : c == 1 ? 2 : 1;
+            j->count = k == NCH - 1 ? 1234 : CE;
+            j->chunk_elems = CE;
+            j->level = 3;
+            j->dst = ref + (size_t)(c * NCH + k) * bound;
+        }
+    for (int i = 0; i < 3 * NCH; i++) {
+        evr_chunk_job *j = &jobs[i];
+        uLongf len = (uLongf)(CE * 8);
+        size_t bad = 0, es = j->elem_size;
+        CHECK(evr_chunk_compress(j, scratch));
+        CHECK(j->ok && j->dst_size > 0 && j->dst_size <= bound);
+        CHECK(uncompress(raw, &len, j->dst, (uLong)j->dst_size) == Z_OK);
+        CHECK(len == CE * es);
+        for (size_t e = 0; e < CE; e++)
+            for (size_t b = 0; b < es; b++) {
+                unsigned char want = e < j->count ? ((const unsigned char *)j->src)[e * j->stride + b] : 0;
+                if (raw[b * CE + e] != want) bad++;
+            }
+        CHECK(bad == 0);
+    }
+    /* the pool, with several threads and with the caller alone, makes the same bytes */
+    for (int threads = 1; threads <= 3; threads += 2) {
+        evr_chunk_pool *pool = evr_chunk_pool_new(threads, (size_t)CE * 8);
+        CHECK(pool != NULL);
+        if (!pool) continue;
+        CHECK(evr_chunk_pool_threads(pool) >= 1 && evr_chunk_pool_threads(pool) <= threads);
+        CHECK(evr_chunk_pool_run(pool, jobs, 0));
+        for (int round = 0; round < 3; round++) {
+            memset(dst, 0xa5, bound * 3 * NCH);
+            for (int i = 0; i < 3 * NCH; i++) {
+                jobs[i].dst = dst + (size_t)i * bound;
+                jobs[i].ok = 0;
+            }
+            CHECK(evr_chunk_pool_run(pool, jobs, 3 * NCH));
+            for (int i = 0; i < 3 * NCH; i++) {
+                evr_chunk_job one = jobs[i];
+                one.dst = ref + (size_t)i * bound;
+                CHECK(evr_chunk_compress(&one, scratch));
+                CHECK(jobs[i].ok && jobs[i].dst_size == one.dst_size);
+                if (jobs[i].dst_size == one.dst_size) CHECK(memcmp(jobs[i].dst, one.dst, one.dst_size) == 0);
+            }
+        }
+        evr_chunk_pool_free(pool);
+    }
+    evr_chunk_pool_free(NULL);
+    CHECK(evr_chunk_threads(16) >= 1 && evr_chunk_threads(16) <= 16);
+    CHECK(evr_chunk_threads(1) == 1);
+done:
+    free(ev);
+    free(raw);
+    free(scratch);
+    free(dst);
+    free(ref);
 }
 
 static void test_writers(const char *root, int *python_ok)
@@ -336,12 +484,48 @@ static void test_writers(const char *root, int *python_ok)
         remove(path);
     }
 
+    test_h5_large(root);
+
     /* an independent reader */
     if (system("/usr/bin/python3 -c 'import h5py, numpy' >/dev/null 2>&1") == 0) {
         static const char script[] =
             "import json, sys, warnings\n"
             "warnings.simplefilter('ignore', UserWarning)\n"
             "import h5py, numpy as np\n"
+            "def same_chunks(path, n):\n"
+            "    # the layout DSEC tools expect, and chunks byte for byte as HDF5's filters make them\n"
+            "    ref_path = path + '.ref.h5'\n"
+            "    with h5py.File(path, 'r') as f, h5py.File(ref_path, 'w') as r:\n"
+            "        for name, dt in (('x', np.uint16), ('y', np.uint16), ('t', np.int64), ('p', np.int8)):\n"
+            "            d = f['events'][name]\n"
+            "            assert d.dtype == dt and d.shape == (n,) and d.maxshape == (None,), (name, d.dtype, d.shape)\n"
+            "            assert d.chunks == (65536,), d.chunks\n"
+            "            assert d.compression == 'gzip' and d.compression_opts == 3 and d.shuffle, name\n"
+            "            assert not d.fletcher32 and d.scaleoffset is None, name\n"
+            "            dcpl = d.id.get_create_plist()\n"
+            "            assert dcpl.get_nfilters() == 2\n"
+            "            assert [dcpl.get_filter(i)[0] for i in range(2)] == [h5py.h5z.FILTER_SHUFFLE, h5py.h5z.FILTER_DEFLATE]\n"
+            "            data = d[:]\n"
+            "            g = r.create_dataset(name, data=data, chunks=(65536,), maxshape=(None,), shuffle=True,\n"
+            "                                 compression='gzip', compression_opts=3)\n"
+            "            for off in range(0, n, 65536):\n"
+            "                mask, raw = d.id.read_direct_chunk((off,))\n"
+            "                rmask, rraw = g.id.read_direct_chunk((off,))\n"
+            "                assert mask == 0 and rmask == 0, (name, off, mask, rmask)\n"
+            "                assert raw == rraw, ('chunk bytes differ from HDF5 filters', name, off, len(raw), len(rraw))\n"
+            "    import os\n"
+            "    os.remove(ref_path)\n"
+            "    with h5py.File(path, 'r') as f:\n"
+            "        assert f['ms_to_idx'].chunks == (4096,) and f['ms_to_idx'].compression == 'gzip'\n"
+            "        assert f['ms_to_idx'].shuffle and f['ms_to_idx'].maxshape == (None,)\n"
+            "def check_large(d, n):\n"
+            "    with h5py.File(d + '/events.h5', 'r') as f:\n"
+            "        t = f['events']['t'][:]\n"
+            "        assert len(t) == n and np.all(np.diff(t) >= 0)\n"
+            "        ms = f['ms_to_idx'][:]\n"
+            "        assert np.array_equal(ms, np.searchsorted(t, np.arange(len(ms)) * 1000, 'left'))\n"
+            "        assert int(f.attrs['complete']) == 1\n"
+            "    same_chunks(d + '/events.h5', n)\n"
             "def check(d, n):\n"
             "    with h5py.File(d + '/events.h5', 'r') as f:\n"
             "        e = f['events']\n"
@@ -360,7 +544,7 @@ static void test_writers(const char *root, int *python_ok)
             "        cfg = f.attrs['config']\n"
             "        cfg = cfg.decode() if isinstance(cfg, bytes) else cfg\n"
             "        json.loads(cfg)\n"
-            "        assert e['t'].compression == 'gzip' and e['t'].shuffle\n"
+            "    same_chunks(d + '/events.h5', n)\n"
             "    a = np.load(d + '/events.npy')\n"
             "    assert a.dtype == np.dtype([('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', 'i1')]), a.dtype\n"
             "    assert a.dtype.itemsize == 13 and a.shape == (n,), a.shape\n"
@@ -373,6 +557,7 @@ static void test_writers(const char *root, int *python_ok)
             "    assert np.all(np.diff(m[:, 0]) >= 0)\n"
             "check(sys.argv[1] + '/full', int(sys.argv[2]))\n"
             "check(sys.argv[1] + '/empty', 0)\n"
+            "check_large(sys.argv[1] + '/large', int(sys.argv[3]))\n"
             "print('python readers agree')\n";
         char cmd[1400];
         FILE *fp;
@@ -382,7 +567,7 @@ static void test_writers(const char *root, int *python_ok)
         if (fp) {
             fputs(script, fp);
             fclose(fp);
-            snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %s %zu", path, root, n);
+            snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s %s %zu %zu", path, root, n, large_n);
             fflush(stdout);
             CHECK(system(cmd) == 0);
             *python_ok = 1;
@@ -639,6 +824,66 @@ static void test_event_frames(const char *root)
     }
 }
 
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Write speed of the HDF5 writer, as the simulation drives it: 10 M events per simulated second
+ * in segments of 1/30 s, each written and flushed. 10 M events in optimized builds, 1 M
+ * otherwise; EVR_H5_BENCH_EVENTS sets another count (0 skips). */
+static void bench_h5(const char *root)
+{
+#ifdef NDEBUG
+    size_t n = 10000000;
+#else
+    size_t n = 1000000;
+#endif
+    const size_t seg = 333333;
+    const char *env = getenv("EVR_H5_BENCH_EVENTS");
+    evr_writer_meta meta = {W, H, "{}"};
+    evr_event_writer *w = NULL;
+    evr_event *ev;
+    int64_t last_t;
+    char path[600];
+    double t0, t1;
+    if (env) n = (size_t)strtoull(env, NULL, 10);
+    if (n == 0) return;
+    /* 10 events per microsecond, as the GPU backend makes them, over the whole image */
+    ev = malloc(n * sizeof *ev);
+    CHECK(ev != NULL);
+    if (!ev) return;
+    {
+        uint64_t s = 777;
+        for (size_t i = 0; i < n; i++) {
+            ev[i].t = (int64_t)(i / 10);
+            ev[i].x = (uint16_t)(rng_next(&s) % W);
+            ev[i].y = (uint16_t)(rng_next(&s) % H);
+            ev[i].p = (int8_t)(rng_next(&s) & 1);
+        }
+        last_t = ev[n - 1].t;
+    }
+    snprintf(path, sizeof path, "%s/bench.h5", root);
+    t0 = now_s();
+    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &e_));
+    for (size_t at = 0; w && at < n; at += seg) {
+        CHECK_OK(w->write(w, ev + at, n - at < seg ? n - at : seg, &e_));
+        CHECK_OK(w->flush(w, &e_));
+    }
+    if (w) CHECK_OK(w->finish(w, last_t + 1, &e_));
+    t1 = now_s();
+    {
+        struct stat st;
+        long long size = stat(path, &st) == 0 ? (long long)st.st_size : -1;
+        printf("test_writers: hdf5 writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n", n, t1 - t0,
+               (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
+    }
+    remove(path);
+    free(ev);
+}
+
 int main(void)
 {
     char root[] = "/tmp/evr_test_writers_XXXXXX";
@@ -648,9 +893,11 @@ int main(void)
         return 1;
     }
     test_json();
+    test_chunk_compress();
     test_writers(root, &python_ok);
     test_tonemap(root);
     test_event_frames(root);
+    bench_h5(root);
     if (check_failures == 0) remove_tree(root);
     else fprintf(stderr, "test_writers: files kept in %s\n", root);
     (void)python_ok;

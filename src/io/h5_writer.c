@@ -5,36 +5,50 @@
  *   /t_offset  int64    0 (our timestamps start at the simulation start)
  *   attributes on /: width, height (int32), config (JSON text), complete (int8, 1 once finished)
  *
- * The event datasets and ms_to_idx are extendible and chunked (shuffle + deflate). Events are
- * buffered and appended in large blocks; flush() appends what is buffered and flushes the file,
- * so the temporary file of an interrupted run is readable up to the last flush. HDF5's automatic
- * error printing is switched off around every call (H5E_BEGIN_TRY) and its error stack is turned
- * into the message instead. */
+ * The event datasets and ms_to_idx are extendible and chunked (shuffle + deflate). HDF5 runs
+ * its filters serially inside H5Dwrite, which cannot keep up with the GPU backend, so the event
+ * chunks are filtered here instead, by a pool of threads (chunk_compress.c makes the very bytes
+ * HDF5's shuffle and deflate filters would make), and stored with H5Dwrite_chunk: readers see
+ * the same datasets, filters and chunks. Events are staged until a batch of chunks is full;
+ * flush() also stores the partial last chunk (zero beyond the data, as HDF5 fills it) and
+ * flushes the file, so the temporary file of an interrupted run is readable up to the last
+ * flush; the next store of that chunk replaces it. ms_to_idx is small and goes through H5Dwrite.
+ * HDF5's automatic error printing is switched off around every call (H5E_BEGIN_TRY) and its
+ * error stack is turned into the message instead. */
 #include "io/event_writer.h"
+#include "io/chunk_compress.h"
 
 #include <hdf5.h>
 #include <inttypes.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define H5W_BUFFER (1u << 16)    /* events per block appended to the datasets */
 #define H5W_CHUNK (1u << 16)     /* elements per chunk */
 #define H5W_MS_CHUNK 4096u
 #define H5W_DEFLATE 3
+#define H5W_MAX_THREADS 16       /* compression threads, the caller included */
+#define H5W_MIN_BATCH 4          /* chunks staged before they are stored, at least */
+#define H5W_COLUMNS 4            /* t, x, y, p: the largest elements first */
 
 typedef struct {
     evr_event_writer base;       /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     hid_t file, group;
     hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
-    /* buffered events, column by column */
-    uint16_t *bx, *by;
-    int64_t *bt;
-    int8_t *bp;
-    size_t nbuf;
-    uint64_t written;            /* events in the datasets */
-    uint64_t total;              /* events received (written + buffered) */
+    /* staged events, from dataset index written on (p already 0 or 1) */
+    evr_event *stage;
+    size_t nstage, cap_stage;    /* cap_stage: a whole number of chunks */
+    uint64_t written;            /* events in full chunks stored (a multiple of H5W_CHUNK) */
+    uint64_t tail_stored;        /* events of the partial chunk at written stored by a flush */
+    uint64_t extent;             /* length of the event datasets */
+    uint64_t total;              /* events received (written + staged) */
+    /* compression: one job per column and chunk, each with its output room in zbuf */
+    evr_chunk_pool *pool;
+    evr_chunk_job *jobs;
+    unsigned char *zbuf;
+    size_t batch;                /* chunks in a full stage */
     int64_t last_t;
     int have_last;
     /* ms_to_idx entries computed but not yet appended */
@@ -150,12 +164,12 @@ static void close_all(h5_writer *w)
 
 static void free_writer(h5_writer *w)
 {
+    evr_chunk_pool_free(w->pool);
     free(w->path);
     free(w->tmp);
-    free(w->bx);
-    free(w->by);
-    free(w->bt);
-    free(w->bp);
+    free(w->stage);
+    free(w->jobs);
+    free(w->zbuf);
     free(w->ms);
     free(w);
 }
@@ -174,24 +188,101 @@ static int push_ms(h5_writer *w, uint64_t value)
     return 1;
 }
 
-/* Appends the buffered events and ms_to_idx entries to the datasets. */
+/* Element size, byte offset in evr_event and dataset of column c (largest elements first). */
+static size_t column_size(int c)
+{
+    static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t), sizeof(int8_t)};
+    return size[c];
+}
+
+static size_t column_offset(int c)
+{
+    static const size_t off[H5W_COLUMNS] = {offsetof(evr_event, t), offsetof(evr_event, x), offsetof(evr_event, y),
+                                            offsetof(evr_event, p)};
+    return off[c];
+}
+
+static hid_t column_dataset(const h5_writer *w, int c)
+{
+    return c == 0 ? w->ds_t : c == 1 ? w->ds_x : c == 2 ? w->ds_y : w->ds_p;
+}
+
+/* Bytes of zbuf that the compressed chunks of one column take in a full batch. */
+static size_t column_room(const h5_writer *w, int c)
+{
+    return w->batch * evr_chunk_bound(H5W_CHUNK * column_size(c));
+}
+
+/* Stores the full chunks of the stage and, with tail set, the partial chunk after them (when it
+ * holds events not stored yet), then keeps only that partial chunk's events in the stage. */
+static evr_status store(h5_writer *w, int tail, evr_error *err)
+{
+    size_t nfull = w->nstage / H5W_CHUNK, rest = w->nstage % H5W_CHUNK;
+    size_t nchunks, njobs = 0;
+    uint64_t done = nfull ? 0 : w->tail_stored;   /* events of the partial chunk on file */
+    uint64_t extent;
+    herr_t r = 0;
+    if (!(tail && rest > done)) tail = 0;
+    nchunks = nfull + (tail ? 1 : 0);
+    if (nchunks == 0) return EVR_OK;
+    /* nchunks <= batch: a full stage has no partial chunk, and flush() finds the stage less
+     * than full (write() stores a full one at once) */
+    {
+        unsigned char *room = w->zbuf;
+        for (int c = 0; c < H5W_COLUMNS; c++) {
+            size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(c));
+            for (size_t k = 0; k < nchunks; k++) {
+                evr_chunk_job *j = &w->jobs[njobs++];
+                j->src = (const unsigned char *)(w->stage + k * H5W_CHUNK) + column_offset(c);
+                j->stride = sizeof(evr_event);
+                j->elem_size = column_size(c);
+                j->count = k < nfull ? H5W_CHUNK : rest;
+                j->chunk_elems = H5W_CHUNK;
+                j->level = H5W_DEFLATE;
+                j->dst = room + k * bound;
+            }
+            room += column_room(w, c);
+        }
+    }
+    if (!evr_chunk_pool_run(w->pool, w->jobs, njobs)) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory compressing events");
+        return EVR_ERR_NOMEM;
+    }
+    extent = w->written + nfull * H5W_CHUNK + (tail ? rest : 0);
+    if (extent < w->extent) extent = w->extent;
+    H5E_BEGIN_TRY {
+        hsize_t size[1] = {(hsize_t)extent};
+        for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
+            if (extent != w->extent && H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
+        for (size_t k = 0; k < nchunks && r >= 0; k++)
+            for (int c = 0; c < H5W_COLUMNS && r >= 0; c++) {
+                const evr_chunk_job *j = &w->jobs[(size_t)c * nchunks + k];
+                hsize_t offset[1] = {(hsize_t)(w->written + k * H5W_CHUNK)};
+                r = H5Dwrite_chunk(column_dataset(w, c), H5P_DEFAULT, 0, offset, j->dst_size, j->dst);
+            }
+    } H5E_END_TRY;
+    if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
+    w->extent = extent;
+    if (nfull) {
+        w->written += nfull * H5W_CHUNK;
+        memmove(w->stage, w->stage + nfull * H5W_CHUNK, rest * sizeof *w->stage);
+        w->nstage = rest;
+        w->tail_stored = 0;
+    }
+    if (tail) w->tail_stored = rest;
+    return EVR_OK;
+}
+
+/* Stores every staged event and appends the ms_to_idx entries computed so far. */
 static evr_status drain(h5_writer *w, evr_error *err)
 {
     herr_t r = 0;
+    evr_status st = store(w, 1, err);
+    if (st != EVR_OK) return st;
     H5E_BEGIN_TRY {
-        if (w->nbuf) {
-            if (append(w->ds_x, H5T_NATIVE_UINT16, w->bx, w->written, w->nbuf) < 0 ||
-                append(w->ds_y, H5T_NATIVE_UINT16, w->by, w->written, w->nbuf) < 0 ||
-                append(w->ds_t, H5T_NATIVE_INT64, w->bt, w->written, w->nbuf) < 0 ||
-                append(w->ds_p, H5T_NATIVE_INT8, w->bp, w->written, w->nbuf) < 0)
-                r = -1;
-        }
-        if (r >= 0 && w->nms && append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, w->nms) < 0)
-            r = -1;
+        if (w->nms && append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, w->nms) < 0) r = -1;
     } H5E_END_TRY;
     if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
-    w->written += w->nbuf;
-    w->nbuf = 0;
     w->ms_written += w->nms;
     w->nms = 0;
     return EVR_OK;
@@ -200,33 +291,56 @@ static evr_status drain(h5_writer *w, evr_error *err)
 static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     h5_writer *w = (h5_writer *)base;
-    for (size_t i = 0; i < n; i++) {
-        const evr_event *e = &ev[i];
-        if (w->have_last && e->t < w->last_t) {
-            snprintf(err->msg, sizeof err->msg, "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
-                     e->t, w->last_t);
-            return EVR_ERR_ARG;
+    while (n > 0) {
+        size_t m = w->cap_stage - w->nstage, k;
+        evr_event *dst = w->stage + w->nstage;
+        int64_t last_t = w->last_t;
+        /* the first millisecond boundary not passed yet (ms entries stay below 2^63 / 1000 as
+         * long as timestamps are int64) */
+        int64_t next_ms_t = (int64_t)w->next_ms * 1000;
+        if (m > n) m = n;
+        if (!w->have_last && m > 0) last_t = ev[0].t;
+        for (k = 0; k < m; k++) {
+            const evr_event *e = &ev[k];
+            if (e->t < last_t) {
+                w->nstage += k;
+                w->total += k;
+                w->last_t = last_t;
+                w->have_last = 1;
+                snprintf(err->msg, sizeof err->msg,
+                         "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)", e->t, last_t);
+                return EVR_ERR_ARG;
+            }
+            last_t = e->t;
+            /* every millisecond boundary up to this event starts here */
+            while (e->t >= next_ms_t) {
+                if (!push_ms(w, w->total + k)) {
+                    w->nstage += k;
+                    w->total += k;
+                    w->last_t = last_t;
+                    w->have_last = 1;
+                    snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
+                    return EVR_ERR_NOMEM;
+                }
+                next_ms_t += 1000;
+            }
+            dst[k].t = e->t;
+            dst[k].x = e->x;
+            dst[k].y = e->y;
+            dst[k].p = e->p ? 1 : 0;
         }
-        w->last_t = e->t;
+        w->nstage += m;
+        w->total += m;
+        w->last_t = last_t;
         w->have_last = 1;
-        /* every millisecond boundary up to this event starts here */
-        while (e->t >= 0 && (int64_t)w->next_ms <= e->t / 1000)
-            if (!push_ms(w, w->total)) goto nomem;
-        if (w->nbuf == H5W_BUFFER) {
-            evr_status st = drain(w, err);
+        ev += m;
+        n -= m;
+        if (w->nstage == w->cap_stage) {
+            evr_status st = store(w, 0, err);
             if (st != EVR_OK) return st;
         }
-        w->bx[w->nbuf] = e->x;
-        w->by[w->nbuf] = e->y;
-        w->bt[w->nbuf] = e->t;
-        w->bp[w->nbuf] = e->p ? 1 : 0;
-        w->nbuf++;
-        w->total++;
     }
     return EVR_OK;
-nomem:
-    snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
-    return EVR_ERR_NOMEM;
 }
 
 static evr_status h5_flush(evr_event_writer *base, evr_error *err)
@@ -312,15 +426,21 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     w = calloc(1, sizeof *w);
     len = strlen(path);
     if (w) {
+        /* a batch gives every thread a chunk of each column; about 40 MB with 16 threads */
+        int threads = evr_chunk_threads(H5W_MAX_THREADS);
+        size_t room = 0;
         w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_ms = -1;
+        w->batch = threads < H5W_MIN_BATCH ? H5W_MIN_BATCH : (size_t)threads;
+        w->cap_stage = w->batch * H5W_CHUNK;
+        for (int c = 0; c < H5W_COLUMNS; c++) room += column_room(w, c);
         w->path = malloc(len + 1);
         w->tmp = malloc(len + 5);
-        w->bx = malloc(H5W_BUFFER * sizeof *w->bx);
-        w->by = malloc(H5W_BUFFER * sizeof *w->by);
-        w->bt = malloc(H5W_BUFFER * sizeof *w->bt);
-        w->bp = malloc(H5W_BUFFER * sizeof *w->bp);
+        w->stage = malloc(w->cap_stage * sizeof *w->stage);
+        w->jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->jobs);
+        w->zbuf = malloc(room);
+        w->pool = evr_chunk_pool_new(threads, H5W_CHUNK * sizeof(int64_t));
     }
-    if (!w || !w->path || !w->tmp || !w->bx || !w->by || !w->bt || !w->bp) {
+    if (!w || !w->path || !w->tmp || !w->stage || !w->jobs || !w->zbuf || !w->pool) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
         return EVR_ERR_NOMEM;

@@ -1,0 +1,59 @@
+/* Chunks of 1-D datasets compressed the way HDF5's filter pipeline does it with the shuffle and
+ * deflate filters (H5Pset_shuffle, then H5Pset_deflate), so that they can be stored with
+ * H5Dwrite_chunk and read by any HDF5 reader as if HDF5 had filtered them itself:
+ *
+ *   shuffle  the chunk's element bytes transposed: every element's first byte, then every
+ *            element's second byte, ... (HDF5 leaves 1-byte elements as they are)
+ *   deflate  zlib's compress2 at the given level (zlib format, header and Adler-32 included)
+ *
+ * A chunk always holds the dataset's full chunk size; elements past the data (the last chunk of a
+ * dataset whose length is not a multiple of it) are zero, HDF5's default fill value, which is
+ * what HDF5 itself puts there.
+ *
+ * A pool of threads compresses a list of chunks in parallel; the calling thread works too, so a
+ * pool of one thread starts no thread at all. The pool is owned by one writer at a time. */
+#ifndef EVR_IO_CHUNK_COMPRESS_H
+#define EVR_IO_CHUNK_COMPRESS_H
+
+#include <stddef.h>
+
+typedef struct {
+    /* in */
+    const void *src;        /* first element's bytes */
+    size_t stride;          /* bytes from one element to the next in src */
+    size_t elem_size;       /* bytes per element */
+    size_t count;           /* elements taken from src (at most chunk_elems) */
+    size_t chunk_elems;     /* elements in a chunk: the rest is zero */
+    int level;              /* deflate level, 0 .. 9 */
+    unsigned char *dst;     /* room for evr_chunk_bound(chunk_elems * elem_size) bytes */
+    /* out */
+    size_t dst_size;        /* compressed bytes */
+    int ok;                 /* 0: zlib failed (out of memory) */
+} evr_chunk_job;
+
+typedef struct evr_chunk_pool evr_chunk_pool;
+
+/* Bytes that the compressed form of a chunk of raw_bytes bytes can take at most. */
+size_t evr_chunk_bound(size_t raw_bytes);
+
+/* Compresses one chunk; scratch holds chunk_elems * elem_size bytes. Returns job->ok. */
+int evr_chunk_compress(evr_chunk_job *job, unsigned char *scratch);
+
+/* The number of threads a pool should have here: the processors this process may run on, at
+ * most max. */
+int evr_chunk_threads(int max);
+
+/* A pool of threads (the caller counted) for chunks of at most max_chunk_bytes raw bytes.
+ * NULL when out of memory or when no thread can be started. */
+evr_chunk_pool *evr_chunk_pool_new(int threads, size_t max_chunk_bytes);
+
+/* Compresses jobs[0 .. n) and returns when all are done: 1 when every job succeeded. Jobs are
+ * taken in order, so list the largest first. */
+int evr_chunk_pool_run(evr_chunk_pool *pool, evr_chunk_job *jobs, size_t n);
+
+int evr_chunk_pool_threads(const evr_chunk_pool *pool);
+
+/* Stops the threads and frees the pool (NULL is fine). */
+void evr_chunk_pool_free(evr_chunk_pool *pool);
+
+#endif
