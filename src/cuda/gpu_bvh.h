@@ -1,16 +1,29 @@
 /* Our own ray-tracing acceleration structure, for the CUDA backend (and for host tests that
  * check it against Embree where there is no GPU).
  *
- * Two levels, as in the CPU backend:
- *   bottom  one BVH per mesh, in object space, built once per run by Embree's rtcBuildBVH
- *           (SAH with spatial splits, RTC_BUILD_QUALITY_HIGH) and flattened into wide nodes;
- *           every mesh's nodes and triangles live in one node array and one triangle array.
- *   top     one BVH over the scene's instances, rebuilt on the host for every segment (Embree's
- *           binned SAH, one instance per leaf; about 0.1 ms for the eye scene, 0.25 s for 100k
- *           instances half of them moving, on 2 cores); an instance's box encloses its mesh's
- *           box moved by the instance's motion keys over the WHOLE segment (a proven bound, not
- *           samples only), so a ray at any time inside the segment finds every instance it can
- *           hit.
+ * Two levels over GROUPS of instances, grouped exactly as the CPU backend groups them
+ * (cpu_backend.c, build_groups):
+ *   static group  every instance whose node never moves (no animated node on its parent chain),
+ *                 its mesh's triangles baked into world space with the node's transform at
+ *                 evr_scene.anim_start; one group, identity transform, no motion;
+ *   moving group  the instances of one moving node, their meshes' triangles together in that
+ *                 node's object space; moved by the node's track.
+ * A ray that crosses overlapping instances (skin and orbit around an eyeball) then searches one
+ * tree instead of one per instance.
+ *   bottom  one BVH per group, built once per run by Embree's rtcBuildBVH (SAH with spatial
+ *           splits, RTC_BUILD_QUALITY_HIGH) and flattened into wide nodes; every group's nodes
+ *           and triangles live in one node array and one triangle array. Moving groups whose
+ *           members are consecutive scene instances with the same sequence of meshes (many
+ *           instances of one mesh, each on its own node) share one BVH.
+ *   top     one BVH over the groups, rebuilt on the host for every segment (Embree's binned
+ *           SAH, one group per leaf); a moving group's box encloses its object-space box moved
+ *           by its track's motion keys over the WHOLE segment (a proven bound, not samples
+ *           only), so a ray at any time inside the segment finds every group it can hit. The
+ *           traversal searches a node's groups in a fixed order, set at the build: smallest box
+ *           first, so that their hits shorten the ray before the large groups around them.
+ * Each triangle carries its scene instance (relative to its group's first member in a BVH that
+ * groups share) and its index in that instance's mesh, so a hit reports the instance and
+ * triangle as Embree does.
  * Everything is flat arrays of plain structs that refer to each other by index: one memcpy
  * per array puts them on the device, and evr_gpu_scene_view (a struct of const pointers) is
  * what the traversal in gpu_traverse.h reads, filled with host pointers here and with device
@@ -26,8 +39,8 @@
  *                        memory traffic per ray, which is what limits GPU traversal on large
  *                        scenes. The default (EVR_GPU_LAYOUT_DEFAULT).
  * Leaves refer to a contiguous run of items stored in leaf order: triangles (three vertices,
- * ready for the watertight test, plus the original triangle index; leaves of <= 3 for CW8,
- * <= 4 for BVH4) at the bottom, instance records (one per leaf) at the top. Quantized boxes
+ * ready for the watertight test, plus instance and triangle index; leaves of <= 3 for CW8,
+ * <= 4 for BVH4) at the bottom, group records (one per leaf) at the top. Quantized boxes
  * are rounded outwards, checked in float arithmetic as the traversal decodes them, so they
  * always contain the exact child box. */
 #ifndef EVR_CUDA_GPU_BVH_H
@@ -50,9 +63,12 @@ extern "C" {
 #ifndef EVR_GPU_LAYOUT_DEFAULT
 #define EVR_GPU_LAYOUT_DEFAULT EVR_GPU_LAYOUT_CW8
 #endif
+/* Or'ed into evr_gpu_bvh_build's layout: no grouping, every instance a group of its own in its
+ * node's object space (the trees of one mesh shared), as before grouping; for comparisons. */
+#define EVR_GPU_BVH_UNGROUPED 0x100
 
 /* Entries of the traversal stack (one array per ray, shared by both levels). Builds check that
- * every tree fits: the top level's worst case plus the deepest mesh's worst case. */
+ * every tree fits: the top level's worst case plus the deepest group's worst case. */
 #define EVR_GPU_STACK_SIZE 64
 
 /* 4-wide node, 128 bytes. Child i: count[i] == 0: an inner node, child[i] its index;
@@ -82,24 +98,26 @@ typedef struct {
     uint8_t qhi[3][8];
 } evr_gpu_node8;
 
-/* A triangle in leaf order, object space, 48 bytes: vertices as the mesh gives them (the
- * watertight test needs the vertices themselves, not edges) and the triangle's index in its
- * mesh. With spatial splits one triangle may appear in several leaves. */
+/* A triangle in leaf order, in its group's space, 48 bytes: vertices (as the mesh gives them,
+ * or baked into world space for the static group; the watertight test needs the vertices
+ * themselves, not edges), the triangle's index in its mesh and its scene instance (plus the
+ * group's evr_gpu_inst.instance_base). With spatial splits one triangle may appear in several
+ * leaves. */
 typedef struct {
     EVR_ALIGN16 float v0[3];
-    uint32_t prim;
+    uint32_t prim;             /* triangle index in the instance's mesh */
     float v1[3];
-    uint32_t pad1;
+    int32_t instance;          /* scene instance, minus the group's instance_base */
     float v2[3];
-    uint32_t pad2;
+    uint32_t pad;
 } evr_gpu_tri;
 
-/* An instance in the top level's leaf order, 64 bytes. */
+/* A group in the top level's leaf order, 64 bytes. */
 typedef struct {
-    EVR_ALIGN16 evr_m34 inv;   /* world to object; valid when moving == 0 */
-    int32_t root;              /* root node of the mesh's bottom-level BVH */
-    int32_t track;             /* motion track (evr_render_scene) */
-    int32_t instance;          /* index into the scene's instances (and evr_render_scene's) */
+    EVR_ALIGN16 evr_m34 inv;   /* world to group space; valid when moving == 0 */
+    int32_t root;              /* root node of the group's bottom-level BVH */
+    int32_t track;             /* motion track (evr_render_scene), -1 in world space (static) */
+    int32_t instance_base;     /* added to a triangle's instance: the scene instance index */
     int32_t moving;            /* 1: the transform changes in the segment, evaluate per ray */
 } evr_gpu_inst;
 
@@ -117,14 +135,26 @@ typedef struct {
 
 /* ---- host side ---- */
 
-/* Bottom level of every mesh of a scene. */
+/* Bottom level of every group of a scene. Groups are numbered in the order of their first
+ * member, as the CPU backend numbers them. */
 typedef struct {
     int layout;
-    int num_meshes;
-    int32_t *mesh_root;        /* per mesh: root node, -1 for a mesh without usable triangles */
-    int *mesh_stack;           /* per mesh: stack entries its traversal needs at most */
-    float *mesh_bounds;        /* per mesh: object-space box of its triangles, lo xyz hi xyz */
-    int max_stack;             /* largest of mesh_stack */
+    int grouped;               /* 0: built with EVR_GPU_BVH_UNGROUPED */
+    int num_groups;
+    int num_scene_instances;
+    int static_group;          /* index of the static group, -1 when every instance moves */
+    int *group_node;           /* per group: the node whose object space it is in and whose track
+                                  moves it, -1: world space (the static group) */
+    int *group_first;          /* per group + 1: its members are members[group_first[g] ..
+                                  group_first[g + 1]), scene instance indices, ascending */
+    int *members;
+    int *instance_group;       /* per scene instance: its group */
+    int32_t *group_root;       /* per group: root node, -1 for a group without usable triangles */
+    int32_t *group_instance_base;  /* per group: evr_gpu_inst.instance_base */
+    int *group_stack;          /* per group: stack entries its traversal needs at most */
+    float *group_bounds;       /* per group: box of its triangles in its space, lo xyz hi xyz */
+    int num_trees;             /* bottom-level BVHs built (groups that share one count once) */
+    int max_stack;             /* largest of group_stack */
     evr_gpu_node4 *nodes4;
     evr_gpu_node8 *nodes8;
     uint32_t num_nodes;
@@ -139,21 +169,24 @@ typedef struct {
     evr_gpu_node4 *nodes4;
     evr_gpu_node8 *nodes8;
     uint32_t num_nodes, cap_nodes;
-    evr_gpu_inst *insts;
+    evr_gpu_inst *insts;       /* one per group with triangles, in leaf order */
     uint32_t num_insts, cap_insts;
-    float *inst_bounds;        /* per scene instance: world box over the segment, lo xyz hi xyz
-                                  (empty, lo > hi, for an instance left out) */
-    int num_scene_instances;
-    int stack_need;            /* top level's worst case plus the deepest mesh's */
+    float *group_bounds;       /* per group: world box over the segment, lo xyz hi xyz (empty,
+                                  lo > hi, for a group left out) */
+    int num_groups, cap_groups;
+    int stack_need;            /* top level's worst case plus the deepest group's */
 } evr_gpu_top;
 
-/* Builds the bottom level of every mesh of s with the given layout (0: EVR_GPU_LAYOUT_DEFAULT).
- * On failure *out is left empty (safe to free). */
+/* Groups the instances of s and builds the bottom level of every group with the given layout
+ * (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no grouping). Reads the meshes,
+ * the instances and the nodes (parent, animated, transforms at anim_start). On failure *out is
+ * left empty (safe to free). */
 evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err);
 void evr_gpu_bvh_free(evr_gpu_bvh *b);
 
-/* Builds the top level for the segment whose motion keys rs holds (rs->instances[i].mesh and
- * .track, rs->keys, rs->track_offset, rs->track_count; rs->num_instances). */
+/* Builds the top level for the segment whose motion keys rs holds (rs->num_instances, equal to
+ * the scene's; rs->instances[i].track, the same for every member of a moving group; rs->keys,
+ * rs->track_offset, rs->track_count). */
 evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top, evr_error *err);
 void evr_gpu_top_free(evr_gpu_top *top);
 

@@ -29,7 +29,7 @@ typedef struct {
     uint32_t prim[];
 } build_leaf;
 
-/* What the split callback needs: the mesh's triangles, 9 floats each (no index indirection:
+/* What the split callback needs: the group's triangles, 9 floats each (no index indirection:
  * Embree calls the callback ~100 times per triangle). */
 typedef struct {
     const float *tri;
@@ -173,10 +173,11 @@ typedef struct {
     evr_gpu_tri *tris;
     evr_gpu_inst *insts;
     uint32_t num_items, cap_items;
-    /* item sources */
-    const float *positions;
-    const uint32_t *indices;
-    const evr_gpu_inst *inst_src;  /* by scene instance index */
+    /* item sources, by primID */
+    const float *tri9;             /* a group's triangles, 9 floats each */
+    const uint32_t *tri_prim;      /* their indices in their meshes */
+    const int32_t *tri_inst;       /* their instance fields */
+    const evr_gpu_inst *inst_src;  /* the top level's groups */
     /* work list */
     flat_work *work;
     size_t num_work, cap_work;
@@ -253,12 +254,13 @@ static int emit_items(flat_ctx *c, const build_leaf *l, uint32_t *first)
             c->insts[c->num_items + i] = c->inst_src[p];
         } else {
             evr_gpu_tri *t = &c->tris[c->num_items + i];
-            const uint32_t *ix = c->indices + 3 * (size_t)p;
+            const float *v = c->tri9 + 9 * (size_t)p;
             memset(t, 0, sizeof *t);
-            memcpy(t->v0, c->positions + 3 * (size_t)ix[0], 3 * sizeof(float));
-            memcpy(t->v1, c->positions + 3 * (size_t)ix[1], 3 * sizeof(float));
-            memcpy(t->v2, c->positions + 3 * (size_t)ix[2], 3 * sizeof(float));
-            t->prim = p;
+            memcpy(t->v0, v, 3 * sizeof(float));
+            memcpy(t->v1, v + 3, 3 * sizeof(float));
+            memcpy(t->v2, v + 6, 3 * sizeof(float));
+            t->prim = c->tri_prim[p];
+            t->instance = c->tri_inst[p];
         }
     }
     c->num_items = need;
@@ -282,6 +284,28 @@ static unsigned node_children(const void *p, const float root_box[6], const void
     return b->n;
 }
 
+static float half_area(const float b[6])
+{
+    float x = b[3] - b[0], y = b[4] - b[1], z = b[5] - b[2];
+    return x * y + y * z + z * x;
+}
+
+/* Top level: the traversal searches a node's groups in the order of their slots (BVH4) or
+ * from the last item to the first (CW8), before descending. A group searched early meets the
+ * whole ray; one searched late only what is left of it. Small groups first: the large ones
+ * (the static group encloses the scene) then find the ray shortened by the small ones' hits.
+ * Returns the kids' indices by increasing box area. */
+static void order_by_area(unsigned n, float box[][6], unsigned *order)
+{
+    unsigned i, j;
+    for (i = 0; i < n; i++) {
+        unsigned k = i;
+        float a = half_area(box[i]);
+        for (j = i; j > 0 && half_area(box[order[j - 1]]) > a; j--) order[j] = order[j - 1];
+        order[j] = k;
+    }
+}
+
 static int flatten_node4(flat_ctx *c, const void *p, uint32_t index, const float root_box[6])
 {
     const void *kid[MAX_WIDTH];
@@ -291,6 +315,18 @@ static int flatten_node4(flat_ctx *c, const void *p, uint32_t index, const float
     if (n > 4) {
         c->fail = "the builder made a node wider than 4";
         return 0;
+    }
+    if (c->instances) {   /* slots by increasing area (inner children are sorted by distance anyway) */
+        const void *k2[MAX_WIDTH];
+        float b2[MAX_WIDTH][6];
+        unsigned order[MAX_WIDTH];
+        order_by_area(n, box, order);
+        for (i = 0; i < n; i++) {
+            k2[i] = kid[order[i]];
+            memcpy(b2[i], box[order[i]], sizeof b2[i]);
+        }
+        memcpy(kid, k2, sizeof(kid[0]) * n);
+        memcpy(box, b2, sizeof(box[0]) * n);
     }
     for (i = 0; i < 4; i++) {
         nd.lo_x[i] = nd.lo_y[i] = nd.lo_z[i] = INFINITY;
@@ -377,7 +413,7 @@ static int flatten_node8(flat_ctx *c, const void *p, uint32_t index, const float
     static const uint8_t unary[4] = {0, 1, 3, 7};
     const void *kid[MAX_WIDTH];
     float box[MAX_WIDTH][6], pbox[6], cost[MAX_WIDTH][8];
-    int slot_kid[8], kid_slot[MAX_WIDTH];
+    int slot_kid[8], kid_slot[MAX_WIDTH], leaf_order[MAX_WIDTH];
     unsigned n = node_children(p, root_box, kid, box), i, a, inner = 0;
     uint32_t child_base = 0, item_base = c->num_items, next_item_offset = 0;
     int s, k, done;
@@ -428,32 +464,44 @@ static int flatten_node8(flat_ctx *c, const void *p, uint32_t index, const float
     nd.child_base = child_base;
     nd.item_base = item_base;
     inner = 0;
-    for (s = 0; s < 8; s++) {
+    /* leaves in slot order, at the top level by decreasing area (the traversal takes the last
+     * item first: the smallest group) */
+    if (c->instances) {
+        unsigned order[MAX_WIDTH];
+        order_by_area(n, box, order);
+        for (i = 0; i < n; i++) leaf_order[i] = (int)order[n - 1 - i];
+    } else {
+        for (i = 0, s = 0; s < 8; s++)
+            if (slot_kid[s] >= 0) leaf_order[i++] = slot_kid[s];
+    }
+    for (i = 0; i < n; i++) {   /* leaves */
+        const build_leaf *l = kid[leaf_order[i]];
+        uint32_t at;
+        if (!l->leaf) continue;
+        if (l->n == 0 || l->n > 3) {
+            c->fail = "the builder made a leaf of more than 3 items";
+            return 0;
+        }
+        if (!emit_items(c, l, &at)) {
+            c->fail = "out of memory";
+            return 0;
+        }
+        nd.meta[kid_slot[leaf_order[i]]] = (uint8_t)((unary[l->n] << 5) | next_item_offset);
+        next_item_offset += l->n;
+    }
+    for (s = 0; s < 8; s++) {   /* inner children */
         const build_leaf *l;
         k = slot_kid[s];
         if (k < 0) continue;
         l = kid[k];
-        if (l->leaf) {
-            uint32_t at;
-            if (l->n == 0 || l->n > 3) {
-                c->fail = "the builder made a leaf of more than 3 items";
-                return 0;
-            }
-            if (!emit_items(c, l, &at)) {
-                c->fail = "out of memory";
-                return 0;
-            }
-            nd.meta[s] = (uint8_t)((unary[l->n] << 5) | next_item_offset);
-            next_item_offset += l->n;
-        } else {
-            nd.meta[s] = (uint8_t)(0x20 | (24 + s));
-            nd.imask |= (uint8_t)(1u << s);
-            if (!push_work(c, l, child_base + inner)) {
-                c->fail = "out of memory";
-                return 0;
-            }
-            inner++;
+        if (l->leaf) continue;
+        nd.meta[s] = (uint8_t)(0x20 | (24 + s));
+        nd.imask |= (uint8_t)(1u << s);
+        if (!push_work(c, l, child_base + inner)) {
+            c->fail = "out of memory";
+            return 0;
         }
+        inner++;
     }
     if (!quantize_node8(&nd, box, slot_kid, pbox)) {
         c->fail = "a node's box cannot be quantized (coordinates out of range)";
@@ -573,9 +621,14 @@ static evr_status build_tree(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimitiv
 void evr_gpu_bvh_free(evr_gpu_bvh *b)
 {
     if (!b) return;
-    free(b->mesh_root);
-    free(b->mesh_stack);
-    free(b->mesh_bounds);
+    free(b->group_node);
+    free(b->group_first);
+    free(b->members);
+    free(b->instance_group);
+    free(b->group_root);
+    free(b->group_instance_base);
+    free(b->group_stack);
+    free(b->group_bounds);
     free(b->nodes4);
     free(b->nodes8);
     free(b->tris);
@@ -583,65 +636,168 @@ void evr_gpu_bvh_free(evr_gpu_bvh *b)
     memset(b, 0, sizeof *b);
 }
 
-evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err)
+/* ---- grouping, as cpu_backend.c's build_groups ---- */
+
+static int node_never_moves(const evr_scene *s, int node)
 {
-    flat_ctx c;
-    evr_status st = EVR_OK;
-    RTCDevice dev;
-    int m;
-    memset(out, 0, sizeof *out);
-    memset(&c, 0, sizeof c);
-    if (layout == 0) layout = EVR_GPU_LAYOUT_DEFAULT;
-    if (layout != EVR_GPU_LAYOUT_BVH4 && layout != EVR_GPU_LAYOUT_CW8)
-        return fail(err, EVR_ERR_ARG, "unknown GPU BVH layout", NULL);
-    out->layout = layout;
-    out->num_meshes = s->num_meshes;
-    out->mesh_root = malloc(sizeof(int32_t) * ((size_t)s->num_meshes + 1));
-    out->mesh_stack = calloc((size_t)s->num_meshes + 1, sizeof(int));
-    out->mesh_bounds = malloc(sizeof(float) * 6 * ((size_t)s->num_meshes + 1));
-    if (!out->mesh_root || !out->mesh_stack || !out->mesh_bounds) {
-        evr_gpu_bvh_free(out);
-        return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
-    }
-    dev = rtcNewDevice(NULL);
-    if (!dev) {
-        evr_gpu_bvh_free(out);
-        return fail(err, EVR_ERR_BACKEND, "cannot create the Embree device", NULL);
-    }
-    out->device = dev;
-    c.layout = layout;
-    for (m = 0; m < s->num_meshes && st == EVR_OK; m++) {
-        const evr_mesh *mesh = &s->meshes[m];
-        size_t nt = mesh->num_triangles, n = 0, t;
-        float box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-        struct RTCBuildPrimitive *prims;
-        float *tri;
-        split_source split;
-        uint32_t root, first = c.num_nodes;
-        int k, need;
-        out->mesh_root[m] = -1;
-        memcpy(out->mesh_bounds + 6 * m, box, sizeof box);
-        if (nt == 0) continue;
-        if (nt > 0x3fffffff) {
-            st = fail(err, EVR_ERR_ARG, "a mesh has too many triangles for the GPU BVH", mesh->name);
-            break;
+    int guard = 0;
+    for (; node >= 0 && node < s->num_nodes && guard++ <= s->num_nodes; node = s->nodes[node].parent)
+        if (s->nodes[node].animated) return 0;
+    return 1;
+}
+
+/* Assigns every instance its group (numbered by first member) and lists the members. */
+static int make_groups(const evr_scene *s, evr_gpu_bvh *out, int grouped)
+{
+    int n = s->num_instances, i, g;
+    int *node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1)), *at;
+    if (!node_group) return 0;
+    for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
+    out->static_group = -1;
+    out->num_groups = 0;
+    for (i = 0; i < n; i++) {
+        int node = s->instances[i].node, moving = !node_never_moves(s, node);
+        int *grp = moving ? &node_group[node] : &out->static_group;
+        if (!grouped) {   /* a group of its own, in its node's space (none: the world) */
+            out->instance_group[i] = out->num_groups;
+            out->group_node[out->num_groups++] = node >= 0 && node < s->num_nodes ? node : -1;
+            continue;
         }
-        prims = alloc_prims(2 * nt);   /* room for spatial splits */
-        tri = malloc(sizeof(float) * 9 * nt);
-        if (!prims || !tri) {
-            free(prims);
-            free(tri);
-            st = fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
-            break;
+        if (*grp < 0) {
+            *grp = out->num_groups;
+            out->group_node[out->num_groups++] = moving ? node : -1;
         }
-        for (t = 0; t < nt; t++) {
+        out->instance_group[i] = *grp;
+    }
+    free(node_group);
+    /* members by group, ascending */
+    for (i = 0; i < n; i++) out->group_first[out->instance_group[i] + 1]++;
+    for (g = 0; g < out->num_groups; g++) out->group_first[g + 1] += out->group_first[g];
+    at = malloc(sizeof(int) * ((size_t)out->num_groups + 1));
+    if (!at) return 0;
+    memcpy(at, out->group_first, sizeof(int) * (size_t)out->num_groups);
+    for (i = 0; i < n; i++) out->members[at[out->instance_group[i]]++] = i;
+    free(at);
+    return 1;
+}
+
+/* A moving group whose members are consecutive scene instances can share its tree with another
+ * such group of the same meshes: its triangles hold instances relative to the first member. */
+static int consecutive(const evr_gpu_bvh *b, int g)
+{
+    int first = b->group_first[g], last = b->group_first[g + 1] - 1;
+    return b->group_node[g] >= 0 && last >= first && b->members[last] - b->members[first] == last - first;
+}
+
+static uint64_t mesh_signature(const evr_scene *s, const evr_gpu_bvh *b, int g)
+{
+    uint64_t h = 1469598103934665603ull;
+    int j;
+    for (j = b->group_first[g]; j < b->group_first[g + 1]; j++) {
+        h ^= (uint64_t)(uint32_t)s->instances[b->members[j]].mesh;
+        h *= 1099511628211ull;
+    }
+    return h ^ (h >> 29);
+}
+
+static int same_meshes(const evr_scene *s, const evr_gpu_bvh *b, int g, int h)
+{
+    const int *mg = b->members + b->group_first[g], *mh = b->members + b->group_first[h];
+    int n = b->group_first[g + 1] - b->group_first[g], j;
+    if (b->group_first[h + 1] - b->group_first[h] != n) return 0;
+    for (j = 0; j < n; j++)
+        if (s->instances[mg[j]].mesh != s->instances[mh[j]].mesh) return 0;
+    return 1;
+}
+
+static const char *group_name(const evr_scene *s, const evr_gpu_bvh *b, int g)
+{
+    return b->group_node[g] < 0 ? "the static instances" : s->nodes[b->group_node[g]].name;
+}
+
+/* A group's triangles for the builder (buffers reused from group to group). */
+typedef struct {
+    struct RTCBuildPrimitive *prims;   /* room for 2 per triangle (spatial splits) */
+    float *tri;                        /* 9 floats per triangle */
+    uint32_t *prim;
+    int32_t *inst;
+    size_t cap;
+    float *verts;                      /* a baked mesh's vertices */
+    size_t cap_verts;
+} group_tris;
+
+static void group_tris_free(group_tris *gt)
+{
+    free(gt->prims);
+    free(gt->tri);
+    free(gt->prim);
+    free(gt->inst);
+    free(gt->verts);
+}
+
+static int group_tris_reserve(group_tris *gt, size_t nt)
+{
+    if (nt <= gt->cap) return 1;
+    free(gt->prims);
+    free(gt->tri);
+    free(gt->prim);
+    free(gt->inst);
+    gt->prims = alloc_prims(2 * nt);
+    gt->tri = malloc(sizeof(float) * 9 * nt);
+    gt->prim = malloc(sizeof(uint32_t) * nt);
+    gt->inst = malloc(sizeof(int32_t) * nt);
+    gt->cap = gt->prims && gt->tri && gt->prim && gt->inst ? nt : 0;
+    return gt->cap != 0;
+}
+
+/* Collects the usable triangles of group g (baked into world space for the static group, as
+ * the CPU backend bakes them: each vertex through evr_m34_point in float) and their box.
+ * Returns their number, or (size_t)-1 when out of memory. */
+static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int32_t base, group_tris *gt,
+                           float box[6])
+{
+    int j, k;
+    size_t n = 0;
+    for (k = 0; k < 3; k++) {
+        box[k] = INFINITY;
+        box[k + 3] = -INFINITY;
+    }
+    for (j = b->group_first[g]; j < b->group_first[g + 1]; j++) {
+        int i = b->members[j], bake = b->group_node[g] < 0;
+        const evr_mesh *mesh;
+        const float *pos;
+        size_t t;
+        if (s->instances[i].mesh < 0 || s->instances[i].mesh >= s->num_meshes) continue;
+        mesh = &s->meshes[s->instances[i].mesh];
+        if (mesh->num_triangles == 0) continue;
+        pos = mesh->positions;
+        if (bake) {
+            evr_m34 world = evr_node_world_at(s, s->instances[i].node, s->anim_start);
+            uint32_t v;
+            if ((size_t)mesh->num_vertices > gt->cap_verts) {
+                float *nv = realloc(gt->verts, sizeof(float) * 3 * (size_t)mesh->num_vertices);
+                if (!nv) return (size_t)-1;
+                gt->verts = nv;
+                gt->cap_verts = mesh->num_vertices;
+            }
+            for (v = 0; v < mesh->num_vertices; v++) {
+                evr_v3 p = evr_m34_point(&world, evr_v3_make(pos[3 * (size_t)v], pos[3 * (size_t)v + 1],
+                                                             pos[3 * (size_t)v + 2]));
+                gt->verts[3 * (size_t)v] = p.x;
+                gt->verts[3 * (size_t)v + 1] = p.y;
+                gt->verts[3 * (size_t)v + 2] = p.z;
+            }
+            pos = gt->verts;
+        }
+        for (t = 0; t < mesh->num_triangles; t++) {
             float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            struct RTCBuildPrimitive *pr = &gt->prims[n];
             int ok = 1, v;
             for (v = 0; v < 3; v++) {
                 uint32_t vi = mesh->indices[3 * t + (size_t)v];
                 if (vi >= mesh->num_vertices) { ok = 0; break; }
                 for (k = 0; k < 3; k++) {
-                    float x = mesh->positions[3 * (size_t)vi + (size_t)k];
+                    float x = pos[3 * (size_t)vi + (size_t)k];
                     if (!isfinite(x)) ok = 0;
                     lo[k] = fminf(lo[k], x);
                     hi[k] = fmaxf(hi[k], x);
@@ -649,45 +805,140 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
             }
             if (!ok) continue;   /* Embree skips such triangles too */
             for (v = 0; v < 3; v++)
-                memcpy(tri + 9 * t + 3 * (size_t)v, mesh->positions + 3 * (size_t)mesh->indices[3 * t + (size_t)v],
+                memcpy(gt->tri + 9 * n + 3 * (size_t)v, pos + 3 * (size_t)mesh->indices[3 * t + (size_t)v],
                        3 * sizeof(float));
-            prims[n].lower_x = lo[0]; prims[n].lower_y = lo[1]; prims[n].lower_z = lo[2];
-            prims[n].upper_x = hi[0]; prims[n].upper_y = hi[1]; prims[n].upper_z = hi[2];
-            prims[n].geomID = 0;
-            prims[n].primID = (unsigned)t;
+            gt->prim[n] = (uint32_t)t;
+            gt->inst[n] = (int32_t)i - base;
+            pr->lower_x = lo[0]; pr->lower_y = lo[1]; pr->lower_z = lo[2];
+            pr->upper_x = hi[0]; pr->upper_y = hi[1]; pr->upper_z = hi[2];
+            pr->geomID = 0;
+            pr->primID = (unsigned)n;
             for (k = 0; k < 3; k++) {
                 box[k] = fminf(box[k], lo[k]);
                 box[k + 3] = fmaxf(box[k + 3], hi[k]);
             }
             n++;
         }
-        if (n == 0) {
-            free(prims);
-            free(tri);
-            continue;
+    }
+    return n;
+}
+
+evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err)
+{
+    flat_ctx c;
+    group_tris gt;
+    evr_status st = EVR_OK;
+    RTCDevice dev;
+    int n = s->num_instances, g, *table = NULL;
+    size_t table_mask = 0;
+    memset(out, 0, sizeof *out);
+    memset(&c, 0, sizeof c);
+    memset(&gt, 0, sizeof gt);
+    out->grouped = !(layout & EVR_GPU_BVH_UNGROUPED);
+    layout &= ~EVR_GPU_BVH_UNGROUPED;
+    if (layout == 0) layout = EVR_GPU_LAYOUT_DEFAULT;
+    if (layout != EVR_GPU_LAYOUT_BVH4 && layout != EVR_GPU_LAYOUT_CW8)
+        return fail(err, EVR_ERR_ARG, "unknown GPU BVH layout", NULL);
+    if (n < 0) return fail(err, EVR_ERR_ARG, "a negative instance count", NULL);
+    out->layout = layout;
+    out->num_scene_instances = n;
+    out->group_node = malloc(sizeof(int) * ((size_t)n + 1));
+    out->group_first = calloc((size_t)n + 2, sizeof(int));
+    out->members = malloc(sizeof(int) * ((size_t)n + 1));
+    out->instance_group = malloc(sizeof(int) * ((size_t)n + 1));
+    out->group_root = malloc(sizeof(int32_t) * ((size_t)n + 1));
+    out->group_instance_base = calloc((size_t)n + 1, sizeof(int32_t));
+    out->group_stack = calloc((size_t)n + 1, sizeof(int));
+    out->group_bounds = malloc(sizeof(float) * 6 * ((size_t)n + 1));
+    if (!out->group_node || !out->group_first || !out->members || !out->instance_group || !out->group_root ||
+        !out->group_instance_base || !out->group_stack || !out->group_bounds || !make_groups(s, out, out->grouped)) {
+        evr_gpu_bvh_free(out);
+        return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
+    }
+    /* moving groups that may share a tree, by their meshes: an open-addressing table */
+    for (table_mask = 1; table_mask < 2 * (size_t)out->num_groups; table_mask *= 2) {}
+    table = malloc(sizeof(int) * table_mask);
+    if (!table) {
+        evr_gpu_bvh_free(out);
+        return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
+    }
+    memset(table, 0xff, sizeof(int) * table_mask);   /* -1: empty */
+    table_mask--;
+    dev = rtcNewDevice(NULL);
+    if (!dev) {
+        free(table);
+        evr_gpu_bvh_free(out);
+        return fail(err, EVR_ERR_BACKEND, "cannot create the Embree device", NULL);
+    }
+    out->device = dev;
+    c.layout = layout;
+    for (g = 0; g < out->num_groups && st == EVR_OK; g++) {
+        float box[6];
+        size_t nt = 0, cnt;
+        uint32_t root, first = c.num_nodes;
+        int32_t base = 0;
+        int j, need;
+        split_source split;
+        out->group_root[g] = -1;
+        if (consecutive(out, g)) {
+            size_t h = (size_t)mesh_signature(s, out, g) & table_mask;
+            base = out->members[out->group_first[g]];
+            out->group_instance_base[g] = base;
+            while (table[h] >= 0 && !same_meshes(s, out, g, table[h])) h = (h + 1) & table_mask;
+            if (table[h] >= 0) {   /* the same meshes as an earlier group: its tree */
+                int o = table[h];
+                out->group_root[g] = out->group_root[o];
+                out->group_stack[g] = out->group_stack[o];
+                memcpy(out->group_bounds + 6 * g, out->group_bounds + 6 * o, 6 * sizeof(float));
+                continue;
+            }
+            table[h] = g;
         }
-        c.positions = mesh->positions;
-        c.indices = mesh->indices;
-        split.tri = tri;
-        st = build_tree(dev, &c, prims, n, 2 * n, RTC_BUILD_QUALITY_HIGH, layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4,
-                        &split, box, &root, err);
-        free(prims);
-        free(tri);
+        for (j = 0; j < 6; j++) out->group_bounds[6 * g + j] = j < 3 ? INFINITY : -INFINITY;
+        for (j = out->group_first[g]; j < out->group_first[g + 1]; j++) {
+            int m = s->instances[out->members[j]].mesh;
+            if (m >= 0 && m < s->num_meshes) nt += s->meshes[m].num_triangles;
+        }
+        if (nt == 0) continue;
+        if (nt > 0x3fffffff) {
+            st = fail(err, EVR_ERR_ARG, "a group of instances has too many triangles for the GPU BVH",
+                      group_name(s, out, g));
+            break;
+        }
+        if (!group_tris_reserve(&gt, nt)) {
+            st = fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
+            break;
+        }
+        cnt = gather_group(s, out, g, base, &gt, box);
+        if (cnt == (size_t)-1) {
+            st = fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
+            break;
+        }
+        if (cnt == 0) continue;
+        c.tri9 = gt.tri;
+        c.tri_prim = gt.prim;
+        c.tri_inst = gt.inst;
+        split.tri = gt.tri;
+        st = build_tree(dev, &c, gt.prims, cnt, 2 * cnt, RTC_BUILD_QUALITY_HIGH,
+                        layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4, &split, box, &root, err);
         if (st != EVR_OK) break;
+        out->num_trees++;
         need = stack_need(&c, first, c.num_nodes);
         if (need < 0) {
             st = fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
             break;
         }
         if (need >= EVR_GPU_STACK_SIZE) {
-            st = fail(err, EVR_ERR_BACKEND, "a mesh's BVH is too deep for the traversal stack", mesh->name);
+            st = fail(err, EVR_ERR_BACKEND, "a group's BVH is too deep for the traversal stack", group_name(s, out, g));
             break;
         }
-        out->mesh_root[m] = (int32_t)root;
-        out->mesh_stack[m] = need;
+        out->group_root[g] = (int32_t)root;
+        out->group_stack[g] = need;
         if (need > out->max_stack) out->max_stack = need;
-        memcpy(out->mesh_bounds + 6 * m, box, sizeof box);
+        memcpy(out->group_bounds + 6 * g, box, sizeof box);
     }
+    free(table);
+    group_tris_free(&gt);
     free(c.work);
     out->nodes4 = c.n4;
     out->nodes8 = c.n8;
@@ -807,13 +1058,13 @@ void evr_gpu_top_free(evr_gpu_top *top)
     free(top->nodes4);
     free(top->nodes8);
     free(top->insts);
-    free(top->inst_bounds);
+    free(top->group_bounds);
     memset(top, 0, sizeof *top);
 }
 
 evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top, evr_error *err)
 {
-    int n = rs->num_instances, i, k, need;
+    int ng = b->num_groups, g, k, need;
     size_t count = 0;
     evr_gpu_inst *src = NULL;
     struct RTCBuildPrimitive *prims = NULL;
@@ -827,31 +1078,54 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     top->num_nodes = 0;
     top->num_insts = 0;
     top->stack_need = 0;
-    if (n > top->num_scene_instances || !top->inst_bounds) {
-        float *ib = realloc(top->inst_bounds, sizeof(float) * 6 * ((size_t)n + 1));
-        if (!ib) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
-        top->inst_bounds = ib;
+    if (rs->num_instances != b->num_scene_instances)
+        return fail(err, EVR_ERR_ARG, "the render scene's instances are not those the GPU BVH was built for", NULL);
+    if (ng > top->cap_groups || !top->group_bounds) {
+        float *gb = realloc(top->group_bounds, sizeof(float) * 6 * ((size_t)ng + 1));
+        if (!gb) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
+        top->group_bounds = gb;
+        top->cap_groups = ng;
     }
-    top->num_scene_instances = n;
-    src = malloc(sizeof *src * ((size_t)n + 1));
-    prims = alloc_prims((size_t)n);
+    top->num_groups = ng;
+    src = malloc(sizeof *src * ((size_t)ng + 1));
+    prims = alloc_prims((size_t)ng);
     if (!src || !prims) {
         free(src);
         free(prims);
         return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
     }
-    for (i = 0; i < n; i++) {
-        const evr_instance_view *iv = &rs->instances[i];
-        float *ib = top->inst_bounds + 6 * i, lo[3], hi[3];
-        evr_motion_track tr;
+    for (g = 0; g < ng; g++) {
+        const float *gb = b->group_bounds + 6 * g;
+        float *ib = top->group_bounds + 6 * g, lo[3], hi[3];
+        evr_gpu_inst *in = &src[count];
         int ok = 1;
         for (k = 0; k < 3; k++) {
             ib[k] = INFINITY;
             ib[k + 3] = -INFINITY;
         }
-        if (iv->mesh < 0 || iv->mesh >= b->num_meshes || b->mesh_root[iv->mesh] < 0) continue;
-        tr = evr_rs_track(rs, iv->track);
-        evr_gpu_segment_bounds(b->mesh_bounds + 6 * iv->mesh, b->mesh_bounds + 6 * iv->mesh + 3, tr, lo, hi);
+        if (b->group_root[g] < 0) continue;
+        memset(in, 0, sizeof *in);
+        in->root = b->group_root[g];
+        in->instance_base = b->group_instance_base[g];
+        if (b->group_node[g] < 0) {   /* world space (the static group) */
+            for (k = 0; k < 3; k++) {
+                lo[k] = gb[k];
+                hi[k] = gb[k + 3];
+            }
+            in->track = -1;
+            in->moving = 0;
+            in->inv = evr_m34_identity();
+        } else {   /* every member is on the group's node: the first one's track is the group's */
+            int track = rs->instances[b->members[b->group_first[g]]].track;
+            evr_motion_track tr = evr_rs_track(rs, track);
+            evr_gpu_segment_bounds(gb, gb + 3, tr, lo, hi);
+            in->track = track;
+            in->moving = tr.n > 1;
+            if (!in->moving) {
+                evr_m34 xf = evr_motion_eval(tr, 0.0f);
+                in->inv = evr_m34_inverse(&xf);
+            }
+        }
         for (k = 0; k < 3; k++)
             if (!isfinite(lo[k]) || !isfinite(hi[k])) ok = 0;
         if (!ok) continue;
@@ -861,19 +1135,10 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
             box[k] = fminf(box[k], lo[k]);
             box[k + 3] = fmaxf(box[k + 3], hi[k]);
         }
-        memset(&src[i], 0, sizeof src[i]);
-        src[i].root = b->mesh_root[iv->mesh];
-        src[i].track = iv->track;
-        src[i].instance = i;
-        src[i].moving = tr.n > 1;
-        if (!src[i].moving) {
-            evr_m34 xf = evr_motion_eval(tr, 0.0f);
-            src[i].inv = evr_m34_inverse(&xf);
-        }
         prims[count].lower_x = lo[0]; prims[count].lower_y = lo[1]; prims[count].lower_z = lo[2];
         prims[count].upper_x = hi[0]; prims[count].upper_y = hi[1]; prims[count].upper_z = hi[2];
         prims[count].geomID = 0;
-        prims[count].primID = (unsigned)i;
+        prims[count].primID = (unsigned)count;
         count++;
     }
     if (count == 0) {
@@ -890,7 +1155,8 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     c.cap_nodes = top->cap_nodes;
     c.insts = top->insts;
     c.cap_items = top->cap_insts;
-    /* one instance per leaf: entering an instance costs far more than a box test */
+    /* one group per leaf: entering a group costs far more than a box test (and the CW8 traversal
+     * finds a top-level leaf's group through its slot, evr__trace8) */
     st = build_tree((RTCDevice)b->device, &c, prims, count, count, RTC_BUILD_QUALITY_MEDIUM, 1, NULL, box, &root,
                     err);
     free(c.work);

@@ -8,11 +8,13 @@
  * The answers are Embree's (cpu backend): the instance is the scene's instance index, the
  * primitive the original triangle index of its mesh, barycentrics (u, v) such that
  * p = (1-u-v) p0 + u p1 + v p2, t the distance along the world ray (in units of its direction,
- * unit for the camera's rays).
+ * unit for the camera's rays). The instance comes from the triangle record (plus its group's
+ * instance_base): a group's tree holds the triangles of all its instances.
  *
- * Each instance's transform is evaluated at the ray's time exactly as the CPU backend does
- * (evr_motion_eval of its track), inverted, and the ray moved into object space without
- * normalizing its direction, so t stays the world parameter. Triangles are intersected with the
+ * Each moving group's transform is evaluated at the ray's time exactly as the CPU backend does
+ * (evr_motion_eval of its track), inverted, and the ray moved into group space without
+ * normalizing its direction, so t stays the world parameter (the static group's space is the
+ * world: an identity transform, exact in float). Triangles are intersected with the
  * watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge or vertex
  * hits at least one of the triangles. Its edge functions must be evaluated without fused
  * multiply-adds (exactly antisymmetric): on the device through __fmul_rn/__fsub_rn, on the host
@@ -208,6 +210,7 @@ typedef struct { uint32_t a, b; } evr__stack_entry;
 /* What a bottom-level search reports besides the distance. */
 typedef struct {
     uint32_t prim;
+    int32_t inst;          /* the triangle's instance field */
     float u, v;
 } evr__tri_hit;
 
@@ -267,6 +270,7 @@ EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tr
                 if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
                     *tfar = t;
                     th->prim = tri->prim;
+                    th->inst = tri->instance;
                     th->u = u;
                     th->v = v;
                     found = 1;
@@ -371,6 +375,7 @@ EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tr
             if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
                 *tfar = t;
                 th->prim = tri->prim;
+                th->inst = tri->instance;
                 th->u = u;
                 th->v = v;
                 found = 1;
@@ -387,9 +392,9 @@ EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tr
     return found;
 }
 
-/* ---- instances ---- */
+/* ---- groups ---- */
 
-/* Searches one instance with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
+/* Searches one group with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
  * and fills hit (when not NULL). */
 EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
                                        evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
@@ -411,6 +416,7 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
     if (od.x == 0.0f && od.y == 0.0f && od.z == 0.0f) return 0;   /* a zero scale: nothing there */
     evr__tray_init(&r, oo, od);
     th.prim = 0;
+    th.inst = 0;
     th.u = th.v = 0.0f;
     if (v->layout == EVR_GPU_LAYOUT_CW8)
         found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
@@ -421,7 +427,7 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
         hit->u = th.u;
         hit->v = th.v;
         hit->prim = th.prim;
-        hit->instance = in->instance;
+        hit->instance = in->instance_base + th.inst;
     }
     return found;
 }
