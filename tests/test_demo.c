@@ -47,6 +47,22 @@ static const expectation expected[] = {
      "lamp", aiLightSource_POINT,
      {"square", NULL},
      2.0, 4, 4},
+    {"disk",
+     {"white_sectors", "black_sectors", "background", NULL},
+     {"white", "black", "background", NULL},
+     0, NULL,
+     "disk_camera", 4.0f / 3.0f, 0.05f, {0.0, 0.0, 2.0}, {0.0, 0.0, 0.0},
+     "lamp", aiLightSource_POINT,
+     {"disk", NULL},
+     2.0, 258, 258},
+    {"cornell",
+     {"floor", "ceiling", "back_wall", "left_wall", "right_wall", "tall_box", "short_box", NULL},
+     {"white", "red", "green", "light", NULL},
+     0, NULL,
+     "cornell_camera", 1.0f, 0.05f, {0.0, 0.5, 1.9}, {0.0, 0.5, 0.0},
+     "ceiling_light", aiLightSource_POINT,
+     {"short_box", NULL},
+     2.0, 36, 36},
 };
 
 static uint32_t rd_u32(const unsigned char *p)

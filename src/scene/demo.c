@@ -16,9 +16,11 @@ typedef struct {
 static const demo_entry demos[] = {
     {"eye", evr_demo_build_eye},
     {"square", evr_demo_build_square},
+    {"disk", evr_demo_build_disk},
+    {"cornell", evr_demo_build_cornell},
 };
 
-static const char *const demo_names[] = {"eye", "square", NULL};
+static const char *const demo_names[] = {"eye", "square", "disk", "cornell", NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 

@@ -10,6 +10,8 @@
 /* Each adds its whole scene to an empty builder; failures are recorded in the builder. */
 void evr_demo_build_eye(evr_gltf *g);
 void evr_demo_build_square(evr_gltf *g);
+void evr_demo_build_disk(evr_gltf *g);
+void evr_demo_build_cornell(evr_gltf *g);
 
 /* A growing triangle mesh: positions, unit normals and texture coordinates per vertex. */
 typedef struct {
