@@ -25,10 +25,12 @@ static void remove_run(const char *dir)
 int cmd_bench(int argc, char **argv)
 {
     evr_config cfg;
+    render_options ro;
     const char *scene_path = NULL, *demo = "eye";
-    int json = 0, quiet = 1, keep = 0, i, r;
+    int json = 0, keep = 0, i, r;
     evr_config_defaults(&cfg);
     cfg.preview_window = 0.0;
+    if (!render_options_init(&ro, &cfg, 1, argc)) return 1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -40,16 +42,21 @@ int cmd_bench(int argc, char **argv)
                  "(writing runs on its own thread, overlapping rendering).\n"
                  "Render options are those of evray render (--res, --samples-per-frame, --duration,\n"
                  "--backend, --format, ...).");
+            render_options_free(&ro);
             return 0;
         }
         if (!strcmp(a, "--json")) json = 1;
-        else if (opt_is(a, "--scene")) { if (!(demo = opt_value(argc, argv, &i, "--scene"))) return 2; }
-        else if ((r = parse_render_option(argc, argv, &i, &cfg, &quiet)) < 0) return 2;
+        else if (opt_is(a, "--scene")) { if (!(demo = opt_value(argc, argv, &i, "--scene"))) { render_options_free(&ro); return 2; } }
+        else if ((r = parse_render_option(argc, argv, &i, &ro)) < 0) { render_options_free(&ro); return 2; }
         else if (r > 0) { if (!strcmp(a, "-o") || opt_is(a, "--out")) keep = 1; }
-        else if (a[0] == '-' && a[1]) { cli_error("bench: unknown option '%s'", a); return 2; }
+        else if (a[0] == '-' && a[1]) { cli_error("bench: unknown option '%s'", a); render_options_free(&ro); return 2; }
         else if (!scene_path) scene_path = a;
-        else { cli_error("bench: unexpected argument '%s'", a); return 2; }
+        else { cli_error("bench: unexpected argument '%s'", a); render_options_free(&ro); return 2; }
     }
+    r = render_options_finish(&ro, argc, argv);
+    cfg = ro.cfg;
+    render_options_free(&ro);
+    if (!r) return 2;
     char tmpdir[] = "/tmp/evray-bench-XXXXXX";
     if (!keep) {
         if (!mkdtemp(tmpdir)) { cli_error("cannot create a temporary folder"); return 1; }

@@ -77,12 +77,29 @@ static void help(void)
          "  --threads N                worker threads (default: all cores)\n"
          "  --backend B                auto (default: CUDA when a GPU is usable, else CPU), cpu or cuda\n"
          "  --gpu-bvh L                GPU BVH node layout: cw8 (default, compressed 8-wide) or bvh4\n"
-         "sensor:\n"
+         "sensor (laws, presets and their sources: docs/sensors.md; the default is the ideal sensor):\n"
+         "  --sensor NAME              preset: ideal, davis346, dvxplorer or prophesee-gen4; it sets the\n"
+         "                             defaults (and the resolution) that the options below override,\n"
+         "                             whatever their order\n"
          "  --pos-thres C, --neg-thres C   ON/OFF contrast thresholds in log intensity (default 0.2)\n"
          "  --thres C                  both thresholds\n"
+         "  --sigma-thres S            threshold mismatch: per-pixel thresholds drawn once from\n"
+         "                             N(threshold, S), a fixed pattern (default 0)\n"
          "  --refractory S             refractory period in seconds (default 0)\n"
+         "  --cutoff-hz F              photoreceptor low-pass cutoff at full brightness, falling to 7%\n"
+         "                             of F for black (default 0: no filter)\n"
+         "  --full-intensity I         intensity that counts as full brightness (default 1)\n"
+         "  --leak-rate-hz R           leak ON events per second per pixel (default 0)\n"
+         "  --leak-jitter J            relative spread of the per-pixel leak rates (default 0.1)\n"
+         "  --shot-noise-rate-hz R     shot-noise events per second (ON + OFF) of a black pixel; a pixel\n"
+         "                             at full brightness has R/4 (default 0)\n"
+         "  --hot-pixel-fraction F     fraction of hot pixels (default 0)\n"
+         "  --hot-pixel-rate-hz R      ON events per second of a hot pixel (default 100)\n"
+         "  --time-res S               timestamp resolution in seconds, whole microseconds (default 1e-6)\n"
+         "  --time-jitter S            std dev of Gaussian timestamp jitter in seconds (default 0)\n"
          "  --log-floor I              intensity below which the response is linear (default 0.02)\n"
-         "  --seed N                   seed of the per-pixel sample phases (default 1)\n"
+         "  --seed N                   seed of the per-pixel sample phases and of the sensor's fixed\n"
+         "                             pattern and noise (default 1)\n"
          "shading:\n"
          "  --ambient A                ambient light as a fraction of the base colour (default 0.02)");
 }
@@ -90,18 +107,25 @@ static void help(void)
 int cmd_render(int argc, char **argv, const char *default_demo)
 {
     evr_config cfg;
+    render_options ro;
     const char *scene_path = NULL;
-    int quiet = 0, i, r;
+    int quiet, i, r;
     evr_config_defaults(&cfg);
+    if (!render_options_init(&ro, &cfg, 0, argc)) return 1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); return 0; }
-        else if ((r = parse_render_option(argc, argv, &i, &cfg, &quiet)) < 0) return 2;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); render_options_free(&ro); return 0; }
+        else if ((r = parse_render_option(argc, argv, &i, &ro)) < 0) { render_options_free(&ro); return 2; }
         else if (r > 0) continue;
-        else if (a[0] == '-' && a[1]) { cli_error("unknown option '%s' (see evray render --help)", a); return 2; }
+        else if (a[0] == '-' && a[1]) { cli_error("unknown option '%s' (see evray render --help)", a); render_options_free(&ro); return 2; }
         else if (!scene_path && !default_demo) scene_path = a;
-        else { cli_error("unexpected argument '%s'", a); return 2; }
+        else { cli_error("unexpected argument '%s'", a); render_options_free(&ro); return 2; }
     }
+    r = render_options_finish(&ro, argc, argv);
+    cfg = ro.cfg;
+    quiet = ro.quiet;
+    render_options_free(&ro);
+    if (!r) return 2;
     if (!scene_path && !default_demo) {
         cli_error("render needs a scene file (evray render SCENE [options]; evray demo for the built-in scene)");
         return 2;
@@ -151,7 +175,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
                    stats->samples_per_second / 1e6, stats->rays_per_second / 1e6, stats->realtime_factor);
             if (ev == 0)
                 printf("no events: nothing in view changed brightness by a threshold over the simulated time "
-                       "(a static scene gives none; noise is off)\n");
+                       "(a static scene gives none with the ideal sensor)\n");
         }
         if (st == EVR_ERR_INTERRUPTED) {
             fprintf(stderr, "evray: interrupted: %s holds every event of the first %.3f s\n", cfg.out_dir, stats->sim_time);

@@ -1,15 +1,73 @@
 #include "commands.h"
 #include "options.h"
 
+#include <stdlib.h>
 #include <string.h>
 
-/* One option shared by render, demo and bench: returns 1 when argv[*i] (and its value) was
- * consumed, 0 when it is not a render option, -1 after printing an error. */
-int parse_render_option(int argc, char **argv, int *ip, evr_config *cfg_, int *quiet)
+int render_options_init(render_options *ro, const evr_config *base, int quiet, int argc)
 {
-    evr_config cfg = *cfg_;
+    memset(ro, 0, sizeof *ro);
+    ro->cfg = *base;
+    ro->base = *base;
+    ro->quiet = quiet;
+    ro->argc = argc;
+    ro->starts = calloc((size_t)argc + 1, 1);
+    if (!ro->starts) {
+        cli_error("out of memory");
+        return 0;
+    }
+    return 1;
+}
+
+void render_options_free(render_options *ro)
+{
+    free(ro->starts);
+    ro->starts = NULL;
+}
+
+/* Parses the sensor options; 1 consumed, 0 not one of them, -1 error. */
+static int sensor_option(int argc, char **argv, int *ip, evr_config *cfg, const char **sensor)
+{
     int i = *ip;
     const char *a = argv[i], *v;
+    float f;
+    double d;
+#define VAL(name) if (!(v = opt_value(argc, argv, &i, name))) return -1
+    if (opt_is(a, "--sensor")) {
+        const char *const *names = evr_sensor_names();
+        int k;
+        VAL("--sensor");
+        for (k = 0; names[k] && strcmp(names[k], v); k++) {}
+        if (!names[k]) { cli_error("--sensor: unknown sensor '%s' (ideal, davis346, dvxplorer, prophesee-gen4)", v); return -1; }
+        *sensor = names[k];
+    }
+    else if (opt_is(a, "--sigma-thres")) { VAL("--sigma-thres"); if (!opt_float("--sigma-thres", v, &f)) return -1; cfg->sigma_thres = f; }
+    else if (opt_is(a, "--cutoff-hz")) { VAL("--cutoff-hz"); if (!opt_float("--cutoff-hz", v, &f)) return -1; cfg->cutoff_hz = f; }
+    else if (opt_is(a, "--full-intensity")) { VAL("--full-intensity"); if (!opt_float("--full-intensity", v, &f)) return -1; cfg->full_intensity = f; }
+    else if (opt_is(a, "--leak-rate-hz")) { VAL("--leak-rate-hz"); if (!opt_float("--leak-rate-hz", v, &f)) return -1; cfg->leak_rate = f; }
+    else if (opt_is(a, "--leak-jitter")) { VAL("--leak-jitter"); if (!opt_float("--leak-jitter", v, &f)) return -1; cfg->leak_jitter = f; }
+    else if (opt_is(a, "--shot-noise-rate-hz")) { VAL("--shot-noise-rate-hz"); if (!opt_float("--shot-noise-rate-hz", v, &f)) return -1; cfg->shot_rate = f; }
+    else if (opt_is(a, "--hot-pixel-fraction")) { VAL("--hot-pixel-fraction"); if (!opt_float("--hot-pixel-fraction", v, &f)) return -1; cfg->hot_fraction = f; }
+    else if (opt_is(a, "--hot-pixel-rate-hz")) { VAL("--hot-pixel-rate-hz"); if (!opt_float("--hot-pixel-rate-hz", v, &f)) return -1; cfg->hot_rate = f; }
+    else if (opt_is(a, "--time-res")) { VAL("--time-res"); if (!opt_double("--time-res", v, &d)) return -1; cfg->time_res = d; }
+    else if (opt_is(a, "--time-jitter")) { VAL("--time-jitter"); if (!opt_double("--time-jitter", v, &d)) return -1; cfg->time_jitter = d; }
+    else return 0;
+#undef VAL
+    *ip = i;
+    return 1;
+}
+
+static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *quiet, const char **sensor)
+{
+    evr_config cfg = *cfg_;
+    int i = *ip, r;
+    const char *a = argv[i], *v;
+    if ((r = sensor_option(argc, argv, &i, &cfg, sensor)) != 0) {
+        if (r < 0) return -1;
+        *cfg_ = cfg;
+        *ip = i;
+        return 1;
+    }
 #define VAL(name) if (!(v = opt_value(argc, argv, &i, name))) return -1
     if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) *quiet = 1;
     else if (!strcmp(a, "--force")) cfg.force = 1;
@@ -47,5 +105,32 @@ int parse_render_option(int argc, char **argv, int *ip, evr_config *cfg_, int *q
 #undef VAL
     *cfg_ = cfg;
     *ip = i;
+    return 1;
+}
+
+int parse_render_option(int argc, char **argv, int *ip, render_options *ro)
+{
+    int start = *ip, r = one_option(argc, argv, ip, &ro->cfg, &ro->quiet, &ro->sensor);
+    if (r > 0 && start < ro->argc) ro->starts[start] = 1;
+    return r;
+}
+
+int render_options_finish(render_options *ro, int argc, char **argv)
+{
+    evr_config cfg = ro->base;
+    evr_error err;
+    const char *sensor = NULL;
+    int quiet = ro->quiet, i;
+    if (!ro->sensor) return 1;   /* no preset: the options as given */
+    if (evr_config_sensor(&cfg, ro->sensor, &err) != EVR_OK) {
+        cli_error("%s", err.msg);
+        return 0;
+    }
+    for (i = 1; i < argc && i < ro->argc; i++) {
+        if (!ro->starts[i]) continue;
+        if (one_option(argc, argv, &i, &cfg, &quiet, &sensor) < 0) return 0;   /* parsed once already */
+    }
+    cfg.sensor = ro->sensor;
+    ro->cfg = cfg;
     return 1;
 }

@@ -73,6 +73,19 @@ typedef struct {
     float pos_thres, neg_thres;   /* contrast thresholds in log intensity */
     float refractory;             /* seconds */
     float log_floor;              /* intensity below which log response turns linear */
+    /* sensor non-idealities (laws, sources and presets in docs/sensors.md); 0 turns each off,
+     * and with all of them off the sensor is ideal (the default) */
+    const char *sensor;           /* name of the preset applied by evr_config_sensor, NULL: none */
+    float sigma_thres;            /* threshold mismatch: std dev of the per-pixel thresholds, log units */
+    float cutoff_hz;              /* photoreceptor low-pass cutoff at full brightness, Hz */
+    float full_intensity;         /* intensity that counts as full brightness (bandwidth, shot noise) */
+    float leak_rate;              /* leak ON events per second per pixel, mean */
+    float leak_jitter;            /* relative std dev of the per-pixel leak rate */
+    float shot_rate;              /* shot-noise events (ON + OFF) per second of a black pixel */
+    float hot_fraction;           /* fraction of pixels that are hot */
+    float hot_rate;               /* ON events per second of a hot pixel */
+    double time_res;              /* timestamp resolution, seconds (a whole number of microseconds) */
+    double time_jitter;           /* std dev of Gaussian timestamp jitter, seconds */
     /* shading */
     float ambient;                /* ambient fraction of the base colour */
     uint64_t seed;
@@ -87,6 +100,11 @@ typedef struct {
 } evr_config;
 
 void evr_config_defaults(evr_config *c);
+/* Names of the sensor presets, NULL-terminated: ideal, davis346, dvxplorer, prophesee-gen4. */
+const char *const *evr_sensor_names(void);
+/* Applies a sensor preset: thresholds, mismatch, refractory period, bandwidth, noise, timestamp
+ * resolution and (except for ideal) the resolution; other fields are kept. */
+evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err);
 /* Checks every value; fills err with the first problem. */
 evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_error *err);
 

@@ -22,6 +22,17 @@ void evr_config_defaults(evr_config *c)
     c->neg_thres = 0.2f;
     c->refractory = 0.0f;
     c->log_floor = 0.02f;
+    c->sensor = NULL;             /* the ideal sensor: every non-ideality off */
+    c->sigma_thres = 0.0f;
+    c->cutoff_hz = 0.0f;
+    c->full_intensity = 1.0f;     /* a white diffuse surface under unit irradiance / pi */
+    c->leak_rate = 0.0f;
+    c->leak_jitter = 0.1f;        /* v2e's leak_jitter_fraction */
+    c->shot_rate = 0.0f;
+    c->hot_fraction = 0.0f;
+    c->hot_rate = 100.0f;
+    c->time_res = 1e-6;
+    c->time_jitter = 0.0;
     c->ambient = 0.02f;
     c->seed = 1;
     c->threads = 0;
@@ -29,6 +40,65 @@ void evr_config_defaults(evr_config *c)
     c->formats = EVR_FORMAT_H5;
     c->preview_window = 0.05;
     c->force = 0;
+}
+
+/* Sensor presets; docs/sensors.md gives the source of every value (keep the two in step). */
+typedef struct {
+    const char *name;
+    int width, height;            /* 0: keep the resolution */
+    float pos_thres, neg_thres, sigma_thres, refractory, cutoff_hz;
+    float leak_rate, leak_jitter, shot_rate, hot_fraction, hot_rate;
+    double time_res;
+} sensor_preset;
+
+static const sensor_preset presets[] = {
+    /* name            w     h    ON      OFF     sigma  refr    cutoff  leak   jit   shot  hot    hot Hz  t res */
+    {"ideal",          0,    0,   0.2f,   0.2f,   0.0f,  0.0f,   0.0f,   0.0f,  0.1f, 0.0f, 0.0f,  100.0f, 1e-6},
+    {"davis346",       346,  260, 0.134f, 0.255f, 0.03f, 1e-4f,  200.0f, 0.1f,  0.1f, 1.0f, 1e-4f, 100.0f, 1e-6},
+    {"dvxplorer",      640,  480, 0.2f,   0.2f,   0.03f, 1e-4f,  200.0f, 0.05f, 0.1f, 0.5f, 1e-4f, 100.0f, 1e-4},
+    {"prophesee-gen4", 1280, 720, 0.223f, 0.288f, 0.02f, 1e-4f,  500.0f, 0.05f, 0.1f, 0.1f, 1e-5f, 100.0f, 1e-6},
+};
+#define NUM_PRESETS ((int)(sizeof presets / sizeof presets[0]))
+
+const char *const *evr_sensor_names(void)
+{
+    static const char *const names[NUM_PRESETS + 1] = {"ideal", "davis346", "dvxplorer", "prophesee-gen4", NULL};
+    return names;
+}
+
+static const sensor_preset *find_preset(const char *name)
+{
+    int i;
+    for (i = 0; name && i < NUM_PRESETS; i++)
+        if (!strcmp(presets[i].name, name)) return &presets[i];
+    return NULL;
+}
+
+evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err)
+{
+    const sensor_preset *p = find_preset(name);
+    if (!p) {
+        snprintf(err->msg, sizeof err->msg, "unknown sensor '%s' (ideal, davis346, dvxplorer, prophesee-gen4)", name ? name : "");
+        return EVR_ERR_ARG;
+    }
+    c->sensor = p->name;
+    if (p->width > 0) {
+        c->width = p->width;
+        c->height = p->height;
+    }
+    c->pos_thres = p->pos_thres;
+    c->neg_thres = p->neg_thres;
+    c->sigma_thres = p->sigma_thres;
+    c->refractory = p->refractory;
+    c->cutoff_hz = p->cutoff_hz;
+    c->leak_rate = p->leak_rate;
+    c->leak_jitter = p->leak_jitter;
+    c->shot_rate = p->shot_rate;
+    c->hot_fraction = p->hot_fraction;
+    c->hot_rate = p->hot_rate;
+    c->time_res = p->time_res;
+    c->time_jitter = 0.0;
+    return EVR_OK;
 }
 
 #define BAD(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
@@ -44,6 +114,29 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (!(c->neg_thres > 0.0f) || !isfinite(c->neg_thres)) BAD("OFF threshold must be a positive number (got %g)", (double)c->neg_thres);
     if (!(c->refractory >= 0.0f) || !isfinite(c->refractory)) BAD("refractory period must be >= 0 seconds (got %g)", (double)c->refractory);
     if (!(c->log_floor > 0.0f) || !isfinite(c->log_floor)) BAD("log floor must be a positive intensity (got %g)", (double)c->log_floor);
+    if (c->sensor && !find_preset(c->sensor))
+        BAD("unknown sensor '%s' (ideal, davis346, dvxplorer, prophesee-gen4)", c->sensor);
+    if (!(c->sigma_thres >= 0.0f) || !isfinite(c->sigma_thres))
+        BAD("threshold mismatch must be >= 0 (got %g)", (double)c->sigma_thres);
+    if (!(c->cutoff_hz >= 0.0f) || !(c->cutoff_hz <= 1e6f))
+        BAD("photoreceptor cutoff must be between 0 (off) and 1e6 Hz (got %g)", (double)c->cutoff_hz);
+    if (!(c->full_intensity > 0.0f) || !isfinite(c->full_intensity))
+        BAD("full intensity must be a positive intensity (got %g)", (double)c->full_intensity);
+    if (!(c->leak_rate >= 0.0f) || !(c->leak_rate <= 1e5f))
+        BAD("leak rate must be between 0 (off) and 1e5 Hz (got %g)", (double)c->leak_rate);
+    if (!(c->leak_jitter >= 0.0f) || !isfinite(c->leak_jitter))
+        BAD("leak jitter must be >= 0 (got %g)", (double)c->leak_jitter);
+    if (!(c->shot_rate >= 0.0f) || !(c->shot_rate <= 1e5f))
+        BAD("shot noise rate must be between 0 (off) and 1e5 Hz (got %g)", (double)c->shot_rate);
+    if (!(c->hot_fraction >= 0.0f) || !(c->hot_fraction <= 1.0f))
+        BAD("hot pixel fraction must be between 0 and 1 (got %g)", (double)c->hot_fraction);
+    if (!(c->hot_rate >= 0.0f) || !(c->hot_rate <= 1e5f))
+        BAD("hot pixel rate must be between 0 and 1e5 Hz (got %g)", (double)c->hot_rate);
+    if (!(c->time_res >= 1e-6 * (1.0 - 1e-9)) || !(c->time_res <= 0.1) ||
+        fabs(c->time_res * 1e6 - floor(c->time_res * 1e6 + 0.5)) > 1e-6 * c->time_res * 1e6)
+        BAD("timestamp resolution must be a whole number of microseconds from 1e-6 to 0.1 s (got %g)", c->time_res);
+    if (!(c->time_jitter >= 0.0) || !(c->time_jitter <= 0.1))
+        BAD("timestamp jitter must be between 0 and 0.1 s (got %g)", c->time_jitter);
     if (!(c->ambient >= 0.0f) || !isfinite(c->ambient)) BAD("ambient must be >= 0 (got %g)", (double)c->ambient);
     if (!isfinite(c->fps) || c->fps < 0.0 || c->fps > 1e6) BAD("fps must be a positive number of segments per second (got %g)", c->fps);
     if (!isfinite(c->duration) || c->duration < 0.0) BAD("duration must be a positive number of seconds (got %g)", c->duration);
@@ -95,6 +188,17 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "neg_thres"); evr_json_float(&j, c->neg_thres);
     evr_json_key(&j, "refractory"); evr_json_float(&j, c->refractory);
     evr_json_key(&j, "log_floor"); evr_json_float(&j, c->log_floor);
+    evr_json_key(&j, "sensor"); evr_json_string(&j, c->sensor);
+    evr_json_key(&j, "sigma_thres"); evr_json_float(&j, c->sigma_thres);
+    evr_json_key(&j, "cutoff_hz"); evr_json_float(&j, c->cutoff_hz);
+    evr_json_key(&j, "full_intensity"); evr_json_float(&j, c->full_intensity);
+    evr_json_key(&j, "leak_rate_hz"); evr_json_float(&j, c->leak_rate);
+    evr_json_key(&j, "leak_jitter"); evr_json_float(&j, c->leak_jitter);
+    evr_json_key(&j, "shot_noise_rate_hz"); evr_json_float(&j, c->shot_rate);
+    evr_json_key(&j, "hot_pixel_fraction"); evr_json_float(&j, c->hot_fraction);
+    evr_json_key(&j, "hot_pixel_rate_hz"); evr_json_float(&j, c->hot_rate);
+    evr_json_key(&j, "time_res"); evr_json_number(&j, c->time_res);
+    evr_json_key(&j, "time_jitter"); evr_json_number(&j, c->time_jitter);
     evr_json_key(&j, "ambient"); evr_json_float(&j, c->ambient);
     evr_json_key(&j, "seed"); evr_json_unsigned(&j, c->seed);
     evr_json_key(&j, "backend"); evr_json_string(&j, backend);

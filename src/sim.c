@@ -86,6 +86,11 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     snprintf(sim->out_dir, sizeof sim->out_dir, "%s", c->out_dir);
     sim->cfg.out_dir = sim->out_dir;
     sim->cfg.camera = NULL;   /* not owned; the index below is what counts */
+    if (c->sensor) {          /* not owned either: keep the library's own copy of the name */
+        const char *const *names = evr_sensor_names();
+        for (i = 0; names[i]; i++)
+            if (!strcmp(names[i], c->sensor)) sim->cfg.sensor = names[i];
+    }
     sim->camera = c->camera ? evr_scene_find_camera(s, c->camera) : 0;
     sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
     if (c->duration > 0.0) sim->duration = c->duration;
@@ -106,6 +111,17 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.pixel.neg_thres = c->neg_thres;
     sim->setup.pixel.refractory = c->refractory;
     sim->setup.pixel.log_floor = c->log_floor;
+    sim->setup.pixel.sigma_thres = c->sigma_thres;
+    sim->setup.pixel.cutoff_hz = c->cutoff_hz;
+    sim->setup.pixel.full_intensity = c->full_intensity;
+    sim->setup.pixel.leak_rate = c->leak_rate;
+    sim->setup.pixel.leak_jitter = c->leak_jitter;
+    sim->setup.pixel.shot_rate = c->shot_rate;
+    sim->setup.pixel.hot_fraction = c->hot_fraction;
+    sim->setup.pixel.hot_rate = c->hot_rate;
+    sim->setup.pixel.time_jitter = (float)c->time_jitter;
+    sim->setup.pixel.time_res_us = (int)llround(c->time_res * 1e6);
+    sim->setup.pixel.seed = c->seed;
     sim->setup.threads = c->threads;
     sim->setup.gpu_bvh = c->gpu_bvh;
 
@@ -238,6 +254,9 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
     int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+    /* timestamp jitter and rounding to the resolution can move a later event earlier still */
+    if (!last && (sim->cfg.time_jitter > 0.0 || sim->setup.pixel.time_res_us > 1))
+        safe -= (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
     if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;   /* written and flushed on the writer thread */
     if (intensity) {
         t = now_seconds();

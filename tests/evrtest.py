@@ -1,6 +1,8 @@
 """Shared helpers for the Python tests: run the evray binary, load its outputs."""
+import base64
 import json
 import os
+import struct
 import subprocess
 import sys
 import tempfile
@@ -39,6 +41,44 @@ def load_h5(path):
         ms = f["ms_to_idx"][()]
         attrs = dict(f.attrs)
     return ev, ms, attrs
+
+
+def quad_gltf(path, with_triangles=True, animated=False):
+    """A lit grey quad facing +Z seen by a camera at z = 3; optionally moving."""
+    pos = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
+    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    times = struct.pack("<2f", 0.0, 1.0)
+    trans = struct.pack("<6f", 0, 0, 0, 0.5, 0, 0)
+    blob = pos + idx + times + trans
+    g = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 3]}, {"name": "quad"}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+                        {"buffer": 0, "byteOffset": 60, "byteLength": 8},
+                        {"buffer": 0, "byteOffset": 68, "byteLength": 24}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+                       "min": [-1, -1, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+                      {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
+                      {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],
+        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+    }
+    if with_triangles:
+        g["nodes"][1]["mesh"] = 0
+    else:
+        del g["meshes"]
+    if animated:
+        g["animations"] = [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
+                            "samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}]}]
+    with open(path, "w") as f:
+        json.dump(g, f)
 
 
 def finish(name):

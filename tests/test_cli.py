@@ -1,6 +1,5 @@
 """The command line: help, version, export, info, a static scene, and bad input (one clear line,
 non-zero exit, no crash, nothing half-written left behind)."""
-import base64
 import json
 import os
 import struct
@@ -8,44 +7,6 @@ import struct
 import evrtest as T
 
 tmp = T.tmpdir()
-
-
-def quad_gltf(path, with_triangles=True, animated=False):
-    """A lit grey quad facing +Z seen by a camera at z = 3; optionally moving."""
-    pos = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
-    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
-    times = struct.pack("<2f", 0.0, 1.0)
-    trans = struct.pack("<6f", 0, 0, 0, 0.5, 0, 0)
-    blob = pos + idx + times + trans
-    g = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 3]}, {"name": "quad"}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
-        "buffers": [{"byteLength": len(blob),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
-                        {"buffer": 0, "byteOffset": 48, "byteLength": 12},
-                        {"buffer": 0, "byteOffset": 60, "byteLength": 8},
-                        {"buffer": 0, "byteOffset": 68, "byteLength": 24}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-                       "min": [-1, -1, 0], "max": [1, 1, 0]},
-                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
-                      {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
-                      {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],
-        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-    }
-    if with_triangles:
-        g["nodes"][1]["mesh"] = 0
-    else:
-        del g["meshes"]
-    if animated:
-        g["animations"] = [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
-                            "samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}]}]
-    with open(path, "w") as f:
-        json.dump(g, f)
 
 
 def expect_error(args, what, out_dir=None):
@@ -74,14 +35,14 @@ T.check("eye_camera" in info and "ir_led" in info, "info lists the demo's camera
 
 # a static scene gives no events, and says so
 static = os.path.join(tmp, "static.gltf")
-quad_gltf(static)
+T.quad_gltf(static)
 out = static_out = os.path.join(tmp, "static-run")
 p = T.run("render", static, "-o", out, "--res", "32x32", "--duration", "0.2", "--format", "npy")
 T.check(T.load_run_json(out)["stats"]["events"] == 0, "static scene: zero events")
 T.check("no events" in p.stdout, "static scene: says so")
 # the same quad moving gives events
 moving = os.path.join(tmp, "moving.gltf")
-quad_gltf(moving, animated=True)
+T.quad_gltf(moving, animated=True)
 out = os.path.join(tmp, "moving-run")
 T.run("render", moving, "-o", out, "--res", "32x32", "--format", "npy", "--quiet")
 T.check(T.load_run_json(out)["stats"]["events"] > 0, "moving quad: events")
@@ -114,7 +75,7 @@ with open(trunc, "wb") as f:
     f.write(data[: len(data) // 3])
 expect_error(["render", trunc, "-o", noout], "truncated glb", noout)
 empty = os.path.join(tmp, "empty.gltf")
-quad_gltf(empty, with_triangles=False)
+T.quad_gltf(empty, with_triangles=False)
 expect_error(["render", empty, "-o", noout], "no triangles", noout)
 expect_error(["render", glb, "-o", noout, "--camera", "nope"], "unknown camera", noout)
 expect_error(["render", glb, "-o", noout, "--pos-thres", "-0.2"], "negative threshold", noout)

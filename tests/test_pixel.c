@@ -31,7 +31,7 @@ static int run_ramp(const evr_pixel_params *p, float l0, float slope, float T, i
 
 int main(void)
 {
-    evr_pixel_params p = {0.2f, 0.25f, 0.0f, 1e-3f};
+    evr_pixel_params p = {.pos_thres = 0.2f, .neg_thres = 0.25f, .refractory = 0.0f, .log_floor = 1e-3f};
     ev_t ev[512];
     int i, n;
 
@@ -85,7 +85,7 @@ int main(void)
      * blind 2.5 ms, then its reference resets to the level at wake-up, so events come every
      * 3.5 ms: at 1, 4.5, 8, ... ms; never two closer than the period */
     {
-        evr_pixel_params pr = {0.2f, 0.2f, 2.5e-3f, 1e-3f};
+        evr_pixel_params pr = {.pos_thres = 0.2f, .neg_thres = 0.2f, .refractory = 2.5e-3f, .log_floor = 1e-3f};
         float slope = 0.2f / 1e-3f;   /* one threshold per ms */
         n = run_ramp(&pr, 0.0f, slope, 0.02f, 200, ev, 512);
         CHECK(n == 6);   /* 1, 4.5, 8, 11.5, 15, 18.5 ms */

@@ -146,12 +146,16 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
     int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w, y1 = y0 + TILE < h ? y0 + TILE : h;
     evr_event_vec *out = &b->tile_events[tile];
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
+    const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
     int x, y, k;
     out->n = 0;
     for (y = y0; y < y1; y++) {
         for (x = x0; x < x1; x++) {
             evr_pixel_state *st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
             float phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
+            evr_pixel_params pp;   /* this pixel's thresholds, leak and noise (a fixed pattern) */
+            if (ideal) pp = b->setup.pixel;
+            else evr_pixel_params_at(&b->setup.pixel, x, y, &pp);
             for (k = 0; k < n; k++) {
                 float f = ((float)k + phi) / (float)n;
                 evr_m34 pose = seg->camera_static ? pose_static : evr_rs_camera_pose(rs, f);
@@ -159,16 +163,16 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                 evr_pixel_span sp;
                 float te;
                 int pol;
-                if (!evr_pixel_begin(st, &b->setup.pixel, f * dt, intensity, &sp)) continue;
-                while (evr_pixel_next(st, &b->setup.pixel, &sp, &te, &pol)) {
+                if (!evr_pixel_begin_s(st, &pp, f * dt, intensity, &sp, !ideal)) continue;
+                while (evr_pixel_next_s(st, &pp, &sp, &te, &pol, !ideal)) {
                     evr_event e;
-                    e.t = llround((seg->t0 + (double)te) * 1e6);
+                    e.t = evr_event_time_us_s(&pp, seg->t0 + (double)te, x, y, !ideal);
                     e.x = (uint16_t)x;
                     e.y = (uint16_t)y;
                     e.p = (int8_t)pol;
                     if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
                 }
-                evr_pixel_end(st, &sp);
+                evr_pixel_end_s(st, &sp, !ideal);
             }
             evr_pixel_end_segment(st, dt);
         }

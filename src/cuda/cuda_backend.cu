@@ -51,7 +51,7 @@ struct kernel_args {
     evr_pixel_state *state_out;
     const float *phase;
     float *intensity;              /* NULL unless the segment's intensities are wanted */
-    evr_pixel_params pixel;
+    float pos_thres, neg_thres, refractory, log_floor;   /* the ideal pixel's parameters */
     int width, height, samples;
     float dt;                      /* segment length, seconds */
     double t0;                     /* segment start, seconds */
@@ -61,6 +61,10 @@ struct kernel_args {
     unsigned int capacity;
     unsigned int *count;
     unsigned long long *rays;
+    /* the sensor kernel's full parameters stay in device memory: this struct is copied per
+     * thread (the traversal takes its address), so it is kept small, and this comes last so
+     * that the ideal kernel sees the same layout as before the sensor model */
+    const evr_pixel_params *sensor;
 };
 
 /* One traversal body for primary and shadow rays, not inlined: a kernel with four inlined copies
@@ -103,14 +107,19 @@ __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, in
     return evr_surface_intensity(&s, acc, rs->ambient);
 }
 
-__device__ static unsigned long long pack_event(const kernel_args &a, float te, int x, int y, int p)
+__device__ static unsigned long long pack_event(const kernel_args &a, long long t_abs_us, int x, int y, int p)
 {
-    long long t_us = llround((a.t0 + (double)te) * 1e6) - a.base_us;
+    long long t_us = t_abs_us - a.base_us;
     return ((unsigned long long)t_us << 33) | ((unsigned long long)y << 17) | ((unsigned long long)x << 1) |
            (unsigned long long)p;
 }
 
-template <int LAYOUT>
+/* SENSOR: 1 for the full sensor model of core/pixel.h (mismatch, bandwidth, leak, noise,
+ * timestamps), 0 for the ideal sensor: then the kernel runs the ideal model's own functions on the
+ * ideal part of the state and compiles to the same code as before the sensor model existed (same
+ * size and layout: measured on an H100, the same time on the eye and square demos; an earlier
+ * version a few instructions longer was 40% slower on the square through instruction fetch). */
+template <int LAYOUT, int SENSOR>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a)
 {
     const int npix = a.width * a.height;
@@ -121,8 +130,22 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
     evr_pixel_state st;
     evr_pixel_reset(&st);
     float phi = 0.0f;
+    evr_pixel_params own;                /* the sensor kernel's parameters of this pixel */
+    if (SENSOR) own = *a.sensor;
     if (active) {
-        st = a.state_in[pix];
+        if (SENSOR) {
+            st = a.state_in[pix];
+            evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
+        } else {                         /* the ideal model's state only */
+            const evr_pixel_state *in = &a.state_in[pix];
+            st.ref = in->ref;
+            st.l_prev = in->l_prev;
+            st.t_prev = in->t_prev;
+            st.refr_end = in->refr_end;
+            st.intensity = in->intensity;
+            st.started = in->started;
+            st.blind = in->blind;
+        }
         phi = a.phase[pix];
     }
     unsigned rays = 0;
@@ -134,14 +157,16 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
         if (active) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             float intensity = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays);
-            more = evr_pixel_begin(&st, &a.pixel, f * a.dt, intensity, &sp);
+            more = SENSOR ? evr_pixel_begin_s(&st, &own, f * a.dt, intensity, &sp, 1)
+                          : evr_pixel_begin_ideal(&st, a.log_floor, f * a.dt, intensity, &sp);
         }
         const int began = more;
         for (;;) {
             float te = 0.0f;
             int pol = 0, has = 0;
             if (more) {
-                has = evr_pixel_next(&st, &a.pixel, &sp, &te, &pol);
+                has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
+                             : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
                 more = has;
             }
             unsigned mask = __ballot_sync(0xffffffffu, has);
@@ -151,14 +176,27 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
             base = __shfl_sync(0xffffffffu, base, leader);
             if (has) {
                 unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
-                if (idx < a.capacity) a.keys[idx] = pack_event(a, te, x, y, pol);   /* else: re-run */
+                long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
+                                        : llround((a.t0 + (double)te) * 1e6);
+                if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
             }
         }
-        if (began) evr_pixel_end(&st, &sp);
+        if (began) evr_pixel_end_s(&st, &sp, SENSOR);
     }
     if (active) {
         evr_pixel_end_segment(&st, a.dt);
-        a.state_out[pix] = st;
+        if (SENSOR) {
+            a.state_out[pix] = st;
+        } else {
+            evr_pixel_state *out = &a.state_out[pix];
+            out->ref = st.ref;
+            out->l_prev = st.l_prev;
+            out->t_prev = st.t_prev;
+            out->refr_end = st.refr_end;
+            out->intensity = st.intensity;
+            out->started = st.started;
+            out->blind = st.blind;
+        }
         if (a.intensity) a.intensity[pix] = st.intensity;
     }
     unsigned long long r = rays;
@@ -265,6 +303,7 @@ struct cuda_backend {
     dbuf<evr_gpu_tri> d_tris;
     dbuf<evr_pixel_state> d_state[3];
     dbuf<float> d_phase;
+    dbuf<evr_pixel_params> d_sensor;       /* the run's pixel parameters, for the sensor kernel */
     cudaStream_t render = nullptr;
     slot slots[2];
     int head, queued;
@@ -378,7 +417,11 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.state_out = b->d_state[(sl->index + 1) % 3].p;
     a.phase = b->d_phase.p;
     a.intensity = sl->want_intensity ? sl->d_intensity.p : NULL;
-    a.pixel = b->setup.pixel;
+    a.pos_thres = b->setup.pixel.pos_thres;
+    a.neg_thres = b->setup.pixel.neg_thres;
+    a.refractory = b->setup.pixel.refractory;
+    a.log_floor = b->setup.pixel.log_floor;
+    a.sensor = b->d_sensor.p;
     a.width = b->setup.width;
     a.height = b->setup.height;
     a.samples = b->setup.samples_per_frame;
@@ -401,10 +444,15 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     kernel_args a = make_args(b, sl);
     int npix = b->setup.width * b->setup.height;
     CK(cudaEventRecord(sl->started, b->render));
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
-        render_kernel<EVR_GPU_LAYOUT_CW8><<<(npix + BLOCK - 1) / BLOCK, BLOCK, 0, b->render>>>(a);
-    else
-        render_kernel<EVR_GPU_LAYOUT_BVH4><<<(npix + BLOCK - 1) / BLOCK, BLOCK, 0, b->render>>>(a);
+    const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
+    const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
+        if (ideal) render_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a);
+        else render_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a);
+    } else {
+        if (ideal) render_kernel<EVR_GPU_LAYOUT_BVH4, 0><<<grid, BLOCK, 0, b->render>>>(a);
+        else render_kernel<EVR_GPU_LAYOUT_BVH4, 1><<<grid, BLOCK, 0, b->render>>>(a);
+    }
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
@@ -429,9 +477,13 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     sl->t1 = seg->t1;
     sl->camera_static = seg->camera_static;
     sl->want_intensity = seg->want_intensity;
-    double dt = seg->t1 - seg->t0, back = 2.0 * dt + 1.0;   /* events reach back to the previous segment */
+    /* events reach back to the previous segment, and timestamp jitter and rounding move them by
+     * up to EVR_JITTER_CLIP sigma plus one resolution step either way */
+    const evr_pixel_params *px = &b->setup.pixel;
+    double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter + (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
+    double dt = seg->t1 - seg->t0, back = 2.0 * dt + 1.0 + slack;
     sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
-    double span_us = (back + dt) * 1e6 + 2.0;
+    double span_us = (back + dt + slack) * 1e6 + 2.0;
     int tbits = 1;
     while (tbits < 31 && (double)(1ull << tbits) < span_us) tbits++;
     sl->end_bit = 33 + tbits;
@@ -475,7 +527,8 @@ static uint64_t device_bytes(const cuda_backend *b)
 {
     uint64_t n = bytes(b->d_floats) + bytes(b->d_indices) + bytes(b->d_meshes) + bytes(b->d_materials) +
                  bytes(b->d_textures) + bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
-                 bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase);
+                 bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) +
+                 bytes(b->d_sensor);
     for (int i = 0; i < 3; i++) n += bytes(b->d_state[i]);
     for (int i = 0; i < 2; i++) {
         const slot *sl = &b->slots[i];
@@ -585,6 +638,7 @@ static void cuda_release(evr_backend *base)
     b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
     b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release();
+    b->d_sensor.release();
     for (int i = 0; i < 3; i++) b->d_state[i].release();
     if (b->render) cudaStreamDestroy(b->render);
     evr_gpu_bvh_free(&b->bvh);
@@ -620,6 +674,8 @@ static evr_status init(cuda_backend *b, evr_error *err)
     size_t npix = (size_t)b->setup.width * b->setup.height;
     for (int i = 0; i < 3; i++) CK(b->d_state[i].reserve(npix));
     CK(b->d_phase.reserve(npix));
+    CK(b->d_sensor.reserve(1));
+    CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params), cudaMemcpyHostToDevice));
     init_pixels<<<(unsigned)((npix + 255) / 256), 256>>>(b->d_state[0].p, b->d_phase.p, b->setup.width, b->setup.height,
                                                         (unsigned long long)b->setup.seed);
     CK(cudaGetLastError());
