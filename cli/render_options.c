@@ -75,6 +75,13 @@ static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *qui
     else if (!strcmp(a, "-o")) { VAL("-o"); cfg.out_dir = v; }
     else if (opt_is(a, "--out")) { VAL("--out"); cfg.out_dir = v; }
     else if (opt_is(a, "--format")) { VAL("--format"); if (!opt_formats(v, &cfg.formats)) return -1; }
+    else if (opt_is(a, "--frames-out")) { VAL("--frames-out"); if (!v[0]) { cli_error("--frames-out needs a folder"); return -1; } cfg.frames_out = v; }
+    else if (opt_is(a, "--frames-fps")) { VAL("--frames-fps"); if (!opt_double("--frames-fps", v, &cfg.frames_fps)) return -1;
+            if (!(cfg.frames_fps > 0)) { cli_error("--frames-fps must be a positive number (got %s)", v); return -1; } }
+    else if (opt_is(a, "--frames-exposure")) { VAL("--frames-exposure"); if (!opt_float("--frames-exposure", v, &cfg.frames_exposure)) return -1;
+            if (!(cfg.frames_exposure > 0)) { cli_error("--frames-exposure must be a positive number (got %s)", v); return -1; } }
+    else if (opt_is(a, "--frames-max")) { VAL("--frames-max"); if (!opt_float("--frames-max", v, &cfg.frames_max)) return -1;
+            if (!(cfg.frames_max > 0)) { cli_error("--frames-max must be a positive intensity (got %s)", v); return -1; } }
     else if (opt_is(a, "--preview-window")) { VAL("--preview-window"); if (!opt_double(a, v, &cfg.preview_window)) return -1; }
     else if (opt_is(a, "--res")) { VAL("--res"); if (!opt_size("--res", v, &cfg.width, &cfg.height)) return -1; }
     else if (opt_is(a, "--camera")) { VAL("--camera"); cfg.camera = v; }

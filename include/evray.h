@@ -96,7 +96,17 @@ typedef struct {
     const char *out_dir;
     int formats;                  /* evr_format bits */
     double preview_window;        /* seconds per preview frame; <= 0: no previews */
-    int force;                    /* overwrite an existing run folder */
+    int force;                    /* overwrite an existing run folder (and frames in frames_out) */
+    /* intensity frames for frame-based tools (v2e and the like): frame k is every pixel's
+     * intensity at exactly t_k = start + k / frames_fps (one sample at the pixel centre, not seen
+     * by the pixel model), for every t_k <= start + duration (both ends included), written to
+     * frames_out as frame_NNNNNN.png (8-bit gray, sRGB-encoded: intensity * frames_exposure
+     * clamped to [0, 1]), frame_NNNNNN_linear16.png (16-bit gray, linear:
+     * round(intensity * 65535 / frames_max) clamped) and frames.csv (index, time, files) */
+    const char *frames_out;       /* folder; NULL: no frames */
+    double frames_fps;            /* frames per second; <= 0: the segment rate (fps) */
+    float frames_exposure;        /* 8-bit frames: intensity that maps to white is 1 / this */
+    float frames_max;             /* 16-bit frames: intensity that maps to 65535 */
 } evr_config;
 
 void evr_config_defaults(evr_config *c);

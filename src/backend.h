@@ -31,6 +31,13 @@ typedef struct {
     int num_tracks, num_keys;
     int camera_static;            /* the camera does not move in this segment */
     int want_intensity;           /* return every pixel's intensity at the segment's end */
+    /* Intensity frames wanted inside this segment: num_frames absolute times in [t0, t1] (t1 only
+     * for the last segment). Each frame is every pixel's intensity at exactly that time, one
+     * sample through the pixel centre with the samples' own camera, motion and shading code; the
+     * pixel model never sees these samples (events are the same with or without frames) and
+     * they are not counted in samples or rays. */
+    const double *frame_times;
+    int num_frames;
 } evr_segment;
 
 typedef struct evr_backend evr_backend;
@@ -41,8 +48,11 @@ struct evr_backend {
     evr_status (*submit)(evr_backend *b, const evr_segment *seg, evr_error *err);
     /* Waits for the oldest submitted segment and appends its events, sorted by (t, y, x), to out.
      * *intensity is set to every pixel's last linear intensity (row-major, top row first) when the
-     * segment asked for it, else NULL; it stays valid until the next collect(). */
-    evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, evr_error *err);
+     * segment asked for it, else NULL; *frames to the segment's num_frames intensity frames, one
+     * after the other (each row-major, top row first), or NULL when it asked for none. Both stay
+     * valid until the next collect(). */
+    evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, const float **frames,
+                          evr_error *err);
     void (*release)(evr_backend *b);
     uint64_t samples, rays;       /* totals so far */
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */

@@ -40,6 +40,10 @@ void evr_config_defaults(evr_config *c)
     c->formats = EVR_FORMAT_H5;
     c->preview_window = 0.05;
     c->force = 0;
+    c->frames_out = NULL;
+    c->frames_fps = 0.0;
+    c->frames_exposure = 1.0f;
+    c->frames_max = 4.0f;
 }
 
 /* Sensor presets; docs/sensors.md gives the source of every value (keep the two in step). */
@@ -148,6 +152,13 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
     if (!c->out_dir || !c->out_dir[0]) BAD("no output folder given");
     if (!c->formats || (c->formats & ~(EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY))) BAD("no valid output format selected");
+    if (c->frames_out && !c->frames_out[0]) BAD("frames folder is an empty path");
+    if (!isfinite(c->frames_fps) || c->frames_fps < 0.0 || c->frames_fps > 1e6)
+        BAD("frames fps must be a positive number of frames per second (got %g)", c->frames_fps);
+    if (!(c->frames_exposure > 0.0f) || !isfinite(c->frames_exposure))
+        BAD("frames exposure must be a positive number (got %g)", (double)c->frames_exposure);
+    if (!(c->frames_max > 0.0f) || !isfinite(c->frames_max))
+        BAD("frames max must be a positive intensity (got %g)", (double)c->frames_max);
     if (s) {
         if (c->camera && evr_scene_find_camera(s, c->camera) < 0) {
             char names[256] = "";
@@ -205,6 +216,12 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "gpu_bvh"); evr_json_string(&j, c->gpu_bvh == 4 ? "bvh4" : c->gpu_bvh == 8 ? "cw8" : "default");
     evr_json_key(&j, "gi"); evr_json_string(&j, "none");
     evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);
+    evr_json_key(&j, "frames_out"); evr_json_string(&j, c->frames_out);
+    if (c->frames_out) {
+        evr_json_key(&j, "frames_fps"); evr_json_number(&j, c->frames_fps > 0.0 ? c->frames_fps : fps);
+        evr_json_key(&j, "frames_exposure"); evr_json_float(&j, c->frames_exposure);
+        evr_json_key(&j, "frames_max"); evr_json_float(&j, c->frames_max);
+    }
     evr_json_key(&j, "formats"); evr_json_begin_array(&j);
     if (c->formats & EVR_FORMAT_H5) evr_json_string(&j, "h5");
     if (c->formats & EVR_FORMAT_TXT) evr_json_string(&j, "txt");

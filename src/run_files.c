@@ -1,4 +1,5 @@
 #include "run_files.h"
+#include "frames_out.h"
 #include "io/json.h"
 #include "io/preview.h"
 
@@ -22,7 +23,7 @@ static evr_status path_join(char *out, size_t n, const char *dir, const char *na
     return EVR_OK;
 }
 
-static int mkdir_p(const char *path)
+int evr_mkdir_p(const char *path)
 {
     char tmp[4096];
     size_t i, n = strlen(path);
@@ -62,7 +63,7 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
             return EVR_ERR_ARG;
         }
     } else {
-        if (mkdir_p(sim->out_dir) != 0) {
+        if (evr_mkdir_p(sim->out_dir) != 0) {
             snprintf(err->msg, sizeof err->msg, "cannot create output folder %s: %s", sim->out_dir, strerror(errno));
             return EVR_ERR_IO;
         }
@@ -70,7 +71,7 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
     }
     if (sim->cfg.preview_window > 0.0) {
         if (path_join(p, sizeof p, sim->out_dir, "preview", err) != EVR_OK) return EVR_ERR_ARG;
-        if (mkdir_p(p) != 0) {
+        if (evr_mkdir_p(p) != 0) {
             snprintf(err->msg, sizeof err->msg, "cannot create %s: %s", p, strerror(errno));
             return EVR_ERR_IO;
         }
@@ -242,6 +243,7 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "time_write_thread_seconds"); evr_json_number(&j, sim->time_write_thread);
     evr_json_key(&j, "time_preview_seconds"); evr_json_number(&j, sim->time_preview);
     evr_json_key(&j, "preview_frames"); evr_json_integer(&j, sim->previews_written);
+    if (sim->num_frames) { evr_json_key(&j, "intensity_frames"); evr_json_integer(&j, sim->frames_written); }
     evr_json_end_object(&j);
     evr_json_end_object(&j);
     char *text = evr_json_take(&j);
@@ -294,6 +296,7 @@ evr_status evr_run_finish(evr_sim *sim, evr_error *err)
             if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
             else sim->preview_frame++;
     }
+    if ((st = evr_frames_finish(sim, err)) != EVR_OK) return st;
     char *text = run_json(sim);
     char p[4200], tmp[4300];
     if (!text) {
@@ -318,6 +321,7 @@ void evr_run_dir_discard(evr_sim *sim)
 {
     int w;
     char p[4200];
+    evr_frames_discard(sim);
     evr_write_queue_stop(sim->wq);   /* the thread must be done with the writers */
     sim->wq = NULL;
     for (w = 0; w < sim->num_writers; w++) {

@@ -4,6 +4,8 @@
 
 #include "sim_internal.h"
 
+/* mkdir -p: 0 on success, -1 with errno set. */
+int evr_mkdir_p(const char *path);
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);
 /* Accumulates time-ordered events into event preview frames, writing each finished frame. */

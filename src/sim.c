@@ -5,6 +5,7 @@
 #include "io/json.h"
 #include "io/preview.h"
 #include "run_files.h"
+#include "frames_out.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -134,6 +135,10 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
+    if ((st = evr_frames_plan(sim, err)) != EVR_OK) {
+        evr_sim_release(sim);
+        return st;
+    }
     for (i = 0; i < s->num_instances; i++) mark_used(sim, s->instances[i].node);
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
     mark_used(sim, s->cameras[sim->camera].node);
@@ -151,7 +156,12 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
-    if ((st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_check(sim, err)) != EVR_OK || (st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+        evr_sim_release(sim);
+        return st;
+    }
+    if ((st = evr_frames_prepare(sim, err)) != EVR_OK) {
+        evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
     }
@@ -234,6 +244,9 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.t1 = segment_end(sim, i);
     compute_motion(sim, seg.t0, seg.t1, &seg);
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
+    int first;
+    evr_frames_of_segment(sim, i, &first, &seg.num_frames);
+    seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
     double t = now_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
     sim->time_render += now_seconds() - t;
@@ -245,11 +258,11 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, evr_error *err)
 {
     const int n = sim->cfg.samples_per_frame;
-    const float *intensity = NULL;
+    const float *intensity = NULL, *frames = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
     evr_status st;
     double t = now_seconds();
-    if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, err)) != EVR_OK) return st;
+    if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, &frames, err)) != EVR_OK) return st;
     sim->time_render += now_seconds() - t;
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
@@ -263,6 +276,18 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
         if ((st = evr_run_preview_intensity(sim, intensity, t1, last, err)) != EVR_OK) return st;
         sim->time_preview += now_seconds() - t;
     }
+    int first, count, k;
+    evr_frames_of_segment(sim, i, &first, &count);
+    if (count && !frames) {
+        snprintf(err->msg, sizeof err->msg, "internal error: the backend returned no intensity frames");
+        return EVR_ERR_BACKEND;
+    }
+    t = now_seconds();
+    for (k = 0; k < count; k++) {
+        size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
+        if ((st = evr_frames_write(sim, first + k, frames + (size_t)k * npix, err)) != EVR_OK) return st;
+    }
+    sim->time_preview += now_seconds() - t;
     sim->st.segments_done = i + 1;
     sim->st.samples = sim->backend->samples;
     sim->st.rays = sim->backend->rays;
@@ -326,5 +351,6 @@ void evr_sim_release(evr_sim *sim)
     free(sim->config_json);
     evr_event_frame_release(&sim->preview);
     free(sim->preview_intensity);
+    evr_frames_free(sim);
     free(sim);
 }

@@ -40,6 +40,16 @@ struct evr_sim {
     int64_t preview_frame;       /* index of the event frame being accumulated */
     int64_t intensity_frame;     /* index of the next intensity frame due */
     int previews_written;
+    /* intensity frames for other tools (frames_out.h); num_frames 0: none */
+    char frames_dir[4096];
+    double frames_fps;
+    int num_frames;
+    double *frame_times;         /* absolute time of every frame */
+    int *seg_first_frame;        /* segment i renders frames seg_first_frame[i] .. seg_first_frame[i + 1] - 1 */
+    int frames_written;          /* frames 0 .. frames_written - 1 are on disk */
+    int created_frames_dir;
+    uint8_t *frame8;
+    uint16_t *frame16;
     /* statistics */
     evr_stats st;
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;

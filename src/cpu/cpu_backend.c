@@ -44,10 +44,16 @@ typedef struct {
     evr_event_vec done[2], scratch;
     float *done_intensity[2];
     int done_has_intensity[2];
+    float *done_frames[2];         /* intensity frames of the segment (done_num_frames images) */
+    size_t done_frames_cap[2];     /* images done_frames has room for */
+    int done_num_frames[2];
     int head, queued;
     char embree_error[256];
     /* per-segment work */
     const evr_segment *seg;
+    float *frame_f;                /* normalized segment time of each wanted frame */
+    int frame_f_cap;
+    float *frame_out;              /* where the segment's frames go */
     atomic_int next_tile;
     atomic_ullong samples, rays;
     atomic_int failed;
@@ -177,6 +183,16 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             evr_pixel_end_segment(st, dt);
         }
     }
+    /* intensity frames: one sample per pixel at each frame's exact time, kept away from the
+     * pixel model and out of the sample and ray counts */
+    for (k = 0; k < seg->num_frames; k++) {
+        const float f = b->frame_f[k];
+        evr_m34 pose = evr_rs_camera_pose(rs, f);
+        float *img = b->frame_out + (size_t)k * (size_t)w * (size_t)h;
+        unsigned long long frame_rays = 0;
+        for (y = y0; y < y1; y++)
+            for (x = x0; x < x1; x++) img[(size_t)y * (size_t)w + (size_t)x] = sample_intensity(b, &pose, x, y, f, &frame_rays);
+    }
     *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
 }
 
@@ -236,6 +252,33 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->host.rs.track_offset = seg->track_offset;
     b->host.rs.track_count = seg->track_count;
     if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
+    if (seg->num_frames > 0) {
+        size_t npix = (size_t)b->setup.width * (size_t)b->setup.height, nf = (size_t)seg->num_frames;
+        if (seg->num_frames > b->frame_f_cap) {
+            float *ff = realloc(b->frame_f, nf * sizeof *ff);
+            if (!ff) {
+                snprintf(err->msg, sizeof err->msg, "out of memory for intensity frames");
+                return EVR_ERR_NOMEM;
+            }
+            b->frame_f = ff;
+            b->frame_f_cap = seg->num_frames;
+        }
+        if (nf > b->done_frames_cap[slot]) {
+            float *img = realloc(b->done_frames[slot], nf * npix * sizeof *img);
+            if (!img) {
+                snprintf(err->msg, sizeof err->msg, "out of memory for intensity frames");
+                return EVR_ERR_NOMEM;
+            }
+            b->done_frames[slot] = img;
+            b->done_frames_cap[slot] = nf;
+        }
+        for (i = 0; i < seg->num_frames; i++) {
+            double f = seg->t1 > seg->t0 ? (seg->frame_times[i] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            b->frame_f[i] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+        }
+        b->frame_out = b->done_frames[slot];
+    }
+    b->done_num_frames[slot] = seg->num_frames > 0 ? seg->num_frames : 0;
     b->seg = seg;
     atomic_store(&b->next_tile, 0);
     atomic_store(&b->samples, 0);
@@ -288,7 +331,8 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     return EVR_OK;
 }
 
-static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float **intensity, evr_error *err)
+static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float **intensity, const float **frames,
+                              evr_error *err)
 {
     cpu_backend *b = (cpu_backend *)base;
     if (!b->queued) {
@@ -299,6 +343,7 @@ static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float
     b->head = (b->head + 1) % 2;
     b->queued--;
     *intensity = b->done_has_intensity[slot] ? b->done_intensity[slot] : NULL;
+    *frames = b->done_num_frames[slot] > 0 ? b->done_frames[slot] : NULL;
     if (!evr_events_merge(out, b->done[slot].data, b->done[slot].n, &b->scratch)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
@@ -328,10 +373,12 @@ static void cpu_release(evr_backend *base)
     for (i = 0; i < 2; i++) {
         evr_event_vec_free(&b->done[i]);
         free(b->done_intensity[i]);
+        free(b->done_frames[i]);
     }
     evr_event_vec_free(&b->scratch);
     free(b->pixels);
     free(b->phase);
+    free(b->frame_f);
     free(b);
 }
 

@@ -204,6 +204,25 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
     if (lane == 0 && r) atomicAdd(a.rays, r);
 }
 
+/* Intensity frames: frame k is every pixel's intensity at normalized segment time frame_f[k], one
+ * sample through the pixel centre (the same gpu_sample as the segment's samples), written to
+ * frames[k * npix + pix]. A kernel of its own so that the render kernel and the pixel states are
+ * untouched: events are the same with or without frames. Its rays are not counted. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float *frame_f, int num_frames, float *frames)
+{
+    const int npix = a.width * a.height;
+    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    if (pix >= npix) return;
+    const int x = pix % a.width, y = pix / a.width;
+    unsigned rays = 0;
+    for (int k = 0; k < num_frames; k++) {
+        const float f = frame_f[k];
+        evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
+        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays);
+    }
+}
+
 /* A device buffer that grows. */
 template <typename T> struct dbuf {
     T *p = nullptr;
@@ -257,6 +276,7 @@ struct slot {
     int index;
     double t0, t1;
     int camera_static, want_intensity;
+    int num_frames;                    /* intensity frames wanted in this segment */
     long long base_us;
     int end_bit;
     hbuf<evr_motion_key> h_keys;
@@ -276,7 +296,12 @@ struct slot {
     hbuf<unsigned long long> h_rays;
     hbuf<unsigned long long> h_sorted;
     hbuf<float> h_intensity;
+    hbuf<float> h_frame_f;             /* normalized times of the frames */
+    dbuf<float> d_frame_f;
+    dbuf<float> d_frames;
+    hbuf<float> h_frames;
     cudaStream_t copy = nullptr;
+    cudaEvent_t framed = nullptr;      /* the frame kernel is done */
     cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr, copied = nullptr;
     int num_tracks, num_keys;
 };
@@ -455,6 +480,14 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     }
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
+    if (sl->num_frames > 0) {   /* after the timed render: device time stays the events' */
+        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
+            frame_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, b->render>>>(a, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p);
+        else
+            frame_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, b->render>>>(a, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p);
+        CK(cudaGetLastError());
+        CK(cudaEventRecord(sl->framed, b->render));
+    }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
@@ -477,6 +510,18 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     sl->t1 = seg->t1;
     sl->camera_static = seg->camera_static;
     sl->want_intensity = seg->want_intensity;
+    sl->num_frames = seg->num_frames > 0 ? seg->num_frames : 0;
+    if (sl->num_frames) {
+        size_t nf = (size_t)sl->num_frames, npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_frame_f.reserve(nf));
+        CK(sl->d_frame_f.reserve(nf));
+        CK(sl->d_frames.reserve(nf * npix));
+        for (int k = 0; k < sl->num_frames; k++) {
+            double f = seg->t1 > seg->t0 ? (seg->frame_times[k] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            sl->h_frame_f.p[k] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+        }
+        CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float), cudaMemcpyHostToDevice, b->render));
+    }
     /* events reach back to the previous segment, and timestamp jitter and rounding move them by
      * up to EVR_JITTER_CLIP sigma plus one resolution step either way */
     const evr_pixel_params *px = &b->setup.pixel;
@@ -534,12 +579,13 @@ static uint64_t device_bytes(const cuda_backend *b)
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
-             bytes(sl->d_rays) + bytes(sl->d_intensity);
+             bytes(sl->d_rays) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames);
     }
     return n;
 }
 
-static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, evr_error *err)
+static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, const float **frames,
+                               evr_error *err)
 {
     cuda_backend *b = (cuda_backend *)base;
     evr_status st;
@@ -580,6 +626,12 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(sl->h_intensity.reserve(npix));
         CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
     }
+    if (sl->num_frames) {
+        size_t nf = (size_t)sl->num_frames * (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_frames.reserve(nf));
+        CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
+        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
     CK(cudaEventRecord(sl->copied, sl->copy));
     CK(cudaStreamSynchronize(sl->copy));
     if (n) {
@@ -609,6 +661,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         return EVR_ERR_NOMEM;
     }
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
+    *frames = sl->num_frames ? sl->h_frames.p : NULL;
     base->device_bytes = device_bytes(b);
     b->head = (b->head + 1) % 2;
     b->queued--;
@@ -628,6 +681,8 @@ static void cuda_release(evr_backend *base)
         sl->d_keys_ev.release(); sl->d_keys_sorted.release(); sl->d_sort_temp.release();
         sl->d_count.release(); sl->d_rays.release(); sl->d_intensity.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
+        sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
+        if (sl->framed) cudaEventDestroy(sl->framed);
         if (sl->copy) cudaStreamDestroy(sl->copy);
         if (sl->started) cudaEventDestroy(sl->started);
         if (sl->rendered) cudaEventDestroy(sl->rendered);
@@ -689,6 +744,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaEventCreate(&sl->counted));
         CK(cudaEventCreate(&sl->sorted));
         CK(cudaEventCreate(&sl->copied));
+        CK(cudaEventCreate(&sl->framed));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(1));
         CK(sl->d_rays.reserve(1));
