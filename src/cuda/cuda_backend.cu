@@ -715,8 +715,11 @@ static evr_status init(cuda_backend *b, evr_error *err)
     int count = 0;
     cudaError_t e = cudaGetDeviceCount(&count);
     if (e != cudaSuccess || count == 0) {
-        snprintf(err->msg, sizeof err->msg, "no usable CUDA device (%s)",
-                 e != cudaSuccess ? cudaGetErrorString(e) : "none found");
+        /* without an NVIDIA driver the runtime says "driver version is insufficient": say it plainly */
+        const char *why = e == cudaSuccess || e == cudaErrorNoDevice ? "no NVIDIA GPU found"
+                        : e == cudaErrorInsufficientDriver ? "no NVIDIA driver, or one too old for CUDA 13"
+                        : cudaGetErrorString(e);
+        snprintf(err->msg, sizeof err->msg, "no usable CUDA device (%s)", why);
         return EVR_ERR_BACKEND;
     }
     CK(cudaGetDevice(&b->device));
