@@ -142,6 +142,82 @@ static float sample_intensity(const cpu_backend *b, const evr_m34 *pose, int x, 
     return evr_surface_intensity(&s, acc, rs->ambient);
 }
 
+
+/* Eight samples at once (neighbouring pixels of a row, each at its own time): Embree's packet
+ * traversal for the primary rays and for each light's shadow rays; shading as in
+ * sample_intensity, lane by lane. */
+#define PACKET 8
+static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
+                              const int *valid, float *out, unsigned long long *rays)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    struct RTCIntersectContext ctx;
+    struct RTCRayHit8 rh;
+    struct RTCRay8 sr;
+    evr_ray ray[PACKET];
+    evr_surface s[PACKET];
+    float acc[PACKET][3];
+    _Alignas(32) int vmask[PACKET];   /* Embree reads the valid mask with aligned vector loads */
+    int hit[PACKET], i, l;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (i = 0; i < PACKET; i++) {
+        evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
+        ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)y + 0.5f);
+        vmask[i] = valid[i] ? -1 : 0;
+        rh.ray.org_x[i] = ray[i].org.x; rh.ray.org_y[i] = ray[i].org.y; rh.ray.org_z[i] = ray[i].org.z;
+        rh.ray.dir_x[i] = ray[i].dir.x; rh.ray.dir_y[i] = ray[i].dir.y; rh.ray.dir_z[i] = ray[i].dir.z;
+        rh.ray.tnear[i] = 0.0f;
+        rh.ray.tfar[i] = INFINITY;
+        rh.ray.time[i] = fs[i];
+        rh.ray.mask[i] = 0xffffffffu;
+        rh.ray.id[i] = (unsigned)i;
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        if (valid[i]) (*rays)++;
+    }
+    rtcIntersect8(vmask, b->top, &ctx, &rh);
+    for (i = 0; i < PACKET; i++) {
+        out[i] = 0.0f;   /* nothing: black */
+        acc[i][0] = acc[i][1] = acc[i][2] = 0.0f;
+        hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (!hit[i]) continue;
+        int inst = b->members[b->group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
+        evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
+    }
+    for (l = 0; l < rs->num_lights; l++) {
+        float e[PACKET][3];
+        evr_v3 wi[PACKET];
+        int any = 0;
+        for (i = 0; i < PACKET; i++) {
+            float dist;
+            vmask[i] = 0;
+            if (!hit[i] || !evr_light_incident(rs, &rs->lights[l], fs[i], s[i].p, &wi[i], &dist, e[i]) ||
+                evr_v3_dot(wi[i], s[i].n) <= 0.0f)
+                continue;
+            vmask[i] = -1;
+            any = 1;
+            (*rays)++;
+            sr.org_x[i] = s[i].p.x; sr.org_y[i] = s[i].p.y; sr.org_z[i] = s[i].p.z;
+            sr.dir_x[i] = wi[i].x; sr.dir_y[i] = wi[i].y; sr.dir_z[i] = wi[i].z;
+            sr.tnear[i] = evr_shadow_tnear(&s[i], wi[i], rs->ray_eps);
+            sr.tfar[i] = dist * (1.0f - 1e-4f);
+            sr.time[i] = fs[i];
+            sr.mask[i] = 0xffffffffu;
+            sr.id[i] = (unsigned)i;
+            sr.flags[i] = 0;
+        }
+        if (!any) continue;
+        rtcOccluded8(vmask, b->top, &ctx, &sr);
+        for (i = 0; i < PACKET; i++)
+            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
+    }
+    for (i = 0; i < PACKET; i++)
+        if (hit[i]) out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
+}
+
 static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
@@ -156,31 +232,41 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
     int x, y, k;
     out->n = 0;
     for (y = y0; y < y1; y++) {
-        for (x = x0; x < x1; x++) {
-            evr_pixel_state *st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
-            float phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
-            evr_pixel_params pp;   /* this pixel's thresholds, leak and noise (a fixed pattern) */
-            if (ideal) pp = b->setup.pixel;
-            else evr_pixel_params_at(&b->setup.pixel, x, y, &pp);
-            for (k = 0; k < n; k++) {
-                float f = ((float)k + phi) / (float)n;
-                evr_m34 pose = seg->camera_static ? pose_static : evr_rs_camera_pose(rs, f);
-                float intensity = sample_intensity(b, &pose, x, y, f, rays);
-                evr_pixel_span sp;
-                float te;
-                int pol;
-                if (!evr_pixel_begin_s(st, &pp, f * dt, intensity, &sp, !ideal)) continue;
-                while (evr_pixel_next_s(st, &pp, &sp, &te, &pol, !ideal)) {
-                    evr_event e;
-                    e.t = evr_event_time_us_s(&pp, seg->t0 + (double)te, x, y, !ideal);
-                    e.x = (uint16_t)x;
-                    e.y = (uint16_t)y;
-                    e.p = (int8_t)pol;
-                    if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
-                }
-                evr_pixel_end_s(st, &sp, !ideal);
+        for (x = x0; x < x1; x += PACKET) {
+            evr_pixel_state *st[PACKET];
+            evr_pixel_params pp[PACKET];   /* each pixel's thresholds, leak and noise (a fixed pattern) */
+            float phi[PACKET], fs[PACKET], intensity[PACKET];
+            int xs[PACKET], valid[PACKET], i;
+            for (i = 0; i < PACKET; i++) {
+                xs[i] = x + i < x1 ? x + i : x1 - 1;
+                valid[i] = x + i < x1;
+                st[i] = &b->pixels[(size_t)y * (size_t)w + (size_t)xs[i]];
+                phi[i] = b->phase[(size_t)y * (size_t)w + (size_t)xs[i]];
+                if (ideal) pp[i] = b->setup.pixel;
+                else evr_pixel_params_at(&b->setup.pixel, xs[i], y, &pp[i]);
             }
-            evr_pixel_end_segment(st, dt);
+            for (k = 0; k < n; k++) {
+                for (i = 0; i < PACKET; i++) fs[i] = ((float)k + phi[i]) / (float)n;
+                sample_intensity8(b, seg->camera_static ? &pose_static : NULL, xs, y, fs, valid, intensity, rays);
+                for (i = 0; i < PACKET; i++) {
+                    evr_pixel_span sp;
+                    float te;
+                    int pol;
+                    if (!valid[i]) continue;
+                    if (!evr_pixel_begin_s(st[i], &pp[i], fs[i] * dt, intensity[i], &sp, !ideal)) continue;
+                    while (evr_pixel_next_s(st[i], &pp[i], &sp, &te, &pol, !ideal)) {
+                        evr_event e;
+                        e.t = evr_event_time_us_s(&pp[i], seg->t0 + (double)te, xs[i], y, !ideal);
+                        e.x = (uint16_t)xs[i];
+                        e.y = (uint16_t)y;
+                        e.p = (int8_t)pol;
+                        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+                    }
+                    evr_pixel_end_s(st[i], &sp, !ideal);
+                }
+            }
+            for (i = 0; i < PACKET; i++)
+                if (valid[i]) evr_pixel_end_segment(st[i], dt);
         }
     }
     /* intensity frames: one sample per pixel at each frame's exact time, kept away from the
