@@ -223,32 +223,17 @@ __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float
     }
 }
 
-/* A device buffer that grows. */
-template <typename T> struct dbuf {
-    T *p = nullptr;
-    size_t cap = 0;
-    cudaError_t reserve(size_t n)
-    {
-        if (n <= cap) return cudaSuccess;
-        size_t c = cap ? cap : 1;
-        while (c < n) c *= 2;
-        if (p) cudaFree(p);
-        p = nullptr;
-        cap = 0;
-        cudaError_t e = cudaMalloc(&p, c * sizeof(T));
-        if (e == cudaSuccess) cap = c;
-        return e;
-    }
-    void release()
-    {
-        if (p) cudaFree(p);
-        p = nullptr;
-        cap = 0;
-    }
+/* A buffer that grows (contents not kept), in device memory or in pinned host memory. */
+struct device_memory {
+    static cudaError_t alloc(void **p, size_t n) { return cudaMalloc(p, n); }
+    static void release(void *p) { cudaFree(p); }
+};
+struct pinned_memory {
+    static cudaError_t alloc(void **p, size_t n) { return cudaMallocHost(p, n); }
+    static void release(void *p) { cudaFreeHost(p); }
 };
 
-/* Pinned host buffer that grows (contents not kept). */
-template <typename T> struct hbuf {
+template <typename T, typename M> struct growing_buffer {
     T *p = nullptr;
     size_t cap = 0;
     cudaError_t reserve(size_t n)
@@ -256,20 +241,24 @@ template <typename T> struct hbuf {
         if (n <= cap) return cudaSuccess;
         size_t c = cap ? cap : 1;
         while (c < n) c *= 2;
-        if (p) cudaFreeHost(p);
-        p = nullptr;
-        cap = 0;
-        cudaError_t e = cudaMallocHost(&p, c * sizeof(T));
-        if (e == cudaSuccess) cap = c;
+        release();
+        void *q = nullptr;
+        cudaError_t e = M::alloc(&q, c * sizeof(T));
+        if (e == cudaSuccess) {
+            p = (T *)q;
+            cap = c;
+        }
         return e;
     }
     void release()
     {
-        if (p) cudaFreeHost(p);
+        if (p) M::release(p);
         p = nullptr;
         cap = 0;
     }
 };
+template <typename T> using dbuf = growing_buffer<T, device_memory>;
+template <typename T> using hbuf = growing_buffer<T, pinned_memory>;
 
 /* One segment in flight. */
 struct slot {

@@ -6,6 +6,7 @@
  * flush() and at finish(): the temporary file of an interrupted run is a valid array holding
  * every event up to the last flush. */
 #include "io/event_writer.h"
+#include "io/file_commit.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -133,19 +134,10 @@ static evr_status npy_finish(evr_event_writer *base, int64_t duration_us, evr_er
 {
     npy_writer *w = (npy_writer *)base;
     evr_status st = drain(w, err);
-    int closed;
     (void)duration_us;
     if (st == EVR_OK) st = write_header(w, err);
-    closed = fclose(w->f) == 0;
-    if (st == EVR_OK && !closed) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-        st = EVR_ERR_IO;
-    }
-    if (st == EVR_OK && rename(w->tmp, w->path) != 0) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot rename %s to %s", w->tmp, w->path);
-        st = EVR_ERR_IO;
-    }
-    if (st != EVR_OK) remove(w->tmp);
+    st = evr_file_commit(w->f, w->tmp, w->path, st, "npy writer", err);
+    w->f = NULL;
     free_writer(w);
     return st;
 }

@@ -2,6 +2,7 @@
  * from the integer microseconds, so no rounding), p 1 (ON) or 0 (OFF). No header line, so that
  * numpy.loadtxt and the usual event-camera tools read the file as is. */
 #include "io/event_writer.h"
+#include "io/file_commit.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -114,17 +115,9 @@ static evr_status txt_finish(evr_event_writer *base, int64_t duration_us, evr_er
 {
     txt_writer *w = (txt_writer *)base;
     evr_status st = drain(w, err);
-    int closed = fclose(w->f) == 0;
     (void)duration_us;
-    if (st == EVR_OK && !closed) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s", w->tmp);
-        st = EVR_ERR_IO;
-    }
-    if (st == EVR_OK && rename(w->tmp, w->path) != 0) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot rename %s to %s", w->tmp, w->path);
-        st = EVR_ERR_IO;
-    }
-    if (st != EVR_OK) remove(w->tmp);
+    st = evr_file_commit(w->f, w->tmp, w->path, st, "text writer", err);
+    w->f = NULL;
     free_writer(w);
     return st;
 }
