@@ -17,6 +17,7 @@ static void usage(FILE *f)
           "  info SCENE               describe a scene: cameras, lights, animations, meshes, triangles\n"
           "  demo [--scene NAME] ...  render a built-in scene, or export it with --export FILE.glb\n"
           "  bench [--scene NAME] ... one run, one row of speed figures (samples/s, rays/s, real-time factor)\n"
+          "  plot EVENTS [-o PNG]     event rate over time (ON/OFF per bin) and an events-per-pixel heat map\n"
           "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
           "\n"
           "  evray COMMAND --help     options of a command\n"
@@ -40,6 +41,7 @@ int main(int argc, char **argv)
     if (!strcmp(c, "demo")) return cmd_demo(argc - 1, argv + 1);
     if (!strcmp(c, "compare")) return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(c, "bench")) return cmd_bench(argc - 1, argv + 1);
+    if (!strcmp(c, "plot")) return cmd_plot(argc - 1, argv + 1);
     if (c[0] == '-') return cmd_render(argc, argv, "eye");   /* options for the default job */
     fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
     return 2;

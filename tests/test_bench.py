@@ -1,0 +1,94 @@
+"""evray bench --sweep (CSV and PNG), --suite seed (shortened), and evray plot (rate and heat map
+PNGs; bad input gives one error line)."""
+import csv
+import json
+import os
+import struct
+import zlib
+
+import evrtest as T
+
+tmp = T.tmpdir()
+
+
+def png_size(path):
+    """Width and height from a PNG's IHDR, after checking the signature and the IHDR's CRC."""
+    with open(path, "rb") as f:
+        data = f.read()
+    T.check(data[:8] == b"\x89PNG\r\n\x1a\n", f"{path}: PNG signature")
+    length, kind = struct.unpack(">I4s", data[8:16])
+    T.check(kind == b"IHDR" and length == 13, f"{path}: IHDR first")
+    body = data[16:16 + 13]
+    T.check(struct.unpack(">I", data[29:33])[0] == zlib.crc32(b"IHDR" + body), f"{path}: IHDR CRC")
+    w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
+    T.check(depth == 8 and ctype == 2, f"{path}: RGB8 (got depth {depth}, colour type {ctype})")
+    # the image data inflates to the expected size: one filter byte per row + 3 bytes per pixel
+    pos, idat = 8, b""
+    while pos < len(data):
+        n, k = struct.unpack(">I4s", data[pos:pos + 8])
+        if k == b"IDAT":
+            idat += data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+    T.check(len(zlib.decompress(idat)) == h * (1 + 3 * w), f"{path}: image data of {w}x{h}")
+    return w, h
+
+
+def expect_error(args, what):
+    p = T.run(*args, expect=None)
+    lines = [l for l in p.stderr.splitlines() if l.strip()]
+    T.check(p.returncode > 0, f"{what}: non-zero exit without a crash (got {p.returncode})")
+    T.check(len(lines) == 1 and lines[0].startswith("evray: error: "), f"{what}: one error line (got {lines!r})")
+
+
+# --sweep res, tiny: 80x60 and 160x120 over 0.05 s
+out = os.path.join(tmp, "sweep")
+os.makedirs(out)
+T.run("bench", "--sweep", "res", "--sweep-max-res", "160x120", "--duration", "0.05", "--backend", "cpu", "-o", out)
+with open(os.path.join(out, "sweep_res.csv")) as f:
+    rows = list(csv.DictReader(f))
+T.check(len(rows) == 2, f"sweep res: 2 rows up to 160x120 (got {len(rows)})")
+q = [float(r["pixels"]) for r in rows]
+T.check(q == sorted(q) and len(set(q)) == len(q), f"sweep res: the quantity grows ({q})")
+T.check(all(float(r["wall_s"]) > 0 and float(r["ns_per_sample"]) > 0 and float(r["samples_per_s"]) > 0 for r in rows),
+        "sweep res: positive times")
+T.check(all(int(r["samples"]) == int(r["width"]) * int(r["height"]) * 10 * 2 for r in rows),
+        "sweep res: samples = pixels x 10 per frame x 2 frames (0.05 s at 30 fps)")
+T.check(png_size(os.path.join(out, "sweep_res.png")) == (800, 480), "sweep res: an 800x480 plot")
+expect_error(["bench", "--sweep", "triangles"], "sweep triangles (no growing scene yet)")
+expect_error(["bench", "--sweep", "bogus"], "unknown sweep")
+expect_error(["bench", "--sweep", "res", "--sweep-max-res", "10x10", "--duration", "0.05"], "sweep res: nothing fits")
+
+# --suite seed, shortened and small
+p = T.run("bench", "--suite", "seed", "--res", "48x32", "--duration", "0.05", "--backend", "cpu", "--json")
+suite = json.loads(p.stdout)
+T.check([r["row"] for r in suite] == ["Standard", "Slow", "Extra", "Photon"], f"suite rows {[r['row'] for r in suite]}")
+std, slow, extra, photon = suite
+T.check(all(abs(r["simulated_seconds"] - 0.05) < 1e-6 for r in suite[:3]), "suite: every row simulates --duration")
+T.check(abs(std["temporal_resolution_us"] - 1e6 / 300) < 0.1, "suite Standard: 3333 us between a pixel's samples")
+T.check(abs(slow["temporal_resolution_us"] - 1e6 / 3000) < 0.1 and abs(extra["temporal_resolution_us"] - 1e6 / 3000) < 0.1,
+        "suite Slow and Extra: 333 us")
+T.check(all(r["wall_seconds"] > 0 and r["samples_per_second"] > 0 for r in suite[:3]), "suite: positive times")
+T.check(photon.get("available") is False, "suite Photon: not available")
+p = T.run("bench", "--suite", "seed", "--res", "48x32", "--duration", "0.05", "--backend", "cpu")
+T.check("not available (--gi photon not implemented)" in p.stdout, "suite table: the Photon row says why it is missing")
+expect_error(["bench", "--suite", "seed", "--samples-per-frame", "5"], "suite with --samples-per-frame")
+expect_error(["bench", "--suite", "other"], "unknown suite")
+
+# plot: a small run's events, as HDF5 and text
+run = os.path.join(tmp, "run")
+T.run("demo", "--scene", "eye", "--res", "64x48", "--duration", "0.5", "--backend", "cpu", "--no-preview", "--format", "h5,txt",
+      "-o", run, "-q")
+rate, heat = os.path.join(tmp, "rate.png"), os.path.join(tmp, "heat.png")
+T.run("plot", os.path.join(run, "events.h5"), "-o", rate, "--bin-ms", "2", "--heatmap", heat)
+T.check(png_size(rate) == (1000, 420), "plot: a 1000x420 rate plot")
+hw, hh = png_size(heat)
+T.check(hw >= 64 and hh >= 48, f"plot: heat map at least the sensor's size (got {hw}x{hh})")
+rate2 = os.path.join(tmp, "rate2.png")
+T.run("plot", os.path.join(run, "events.txt"), "-o", rate2, "--size", "400x300")
+T.check(png_size(rate2) == (400, 300), "plot: text events, --size")
+expect_error(["plot", os.path.join(tmp, "missing.h5"), "-o", os.path.join(tmp, "x.png")], "plot: missing file")
+T.check(not os.path.exists(os.path.join(tmp, "x.png")), "plot: nothing written for a missing file")
+expect_error(["plot"], "plot: no file")
+expect_error(["plot", os.path.join(run, "events.h5"), "--bin-ms", "0"], "plot: bad --bin-ms")
+
+T.finish("test_bench")
