@@ -92,6 +92,8 @@ typedef struct {
     int threads;                  /* 0: all cores */
     evr_backend_kind backend;
     int gpu_bvh;                  /* GPU node layout: 0 default, 4 (BVH4, float boxes), 8 (CW8, compressed) */
+    int64_t gpu_event_capacity;   /* events a GPU segment buffer holds at first (0: automatic); it grows
+                                     and the segment is rendered again when it overflows */
     /* output */
     const char *out_dir;
     int formats;                  /* evr_format bits */

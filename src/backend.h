@@ -19,6 +19,7 @@ typedef struct {
     evr_pixel_params pixel;
     int threads;
     int gpu_bvh;                  /* GPU node layout (0: default) */
+    int64_t gpu_event_capacity;   /* initial GPU event buffer (0: automatic) */
 } evr_run_setup;
 
 /* One segment: absolute times and the motion keys of every track (one track per scene node, and

@@ -149,6 +149,8 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (c->backend != EVR_BACKEND_AUTO && c->backend != EVR_BACKEND_CPU && c->backend != EVR_BACKEND_CUDA)
         BAD("unknown backend %d", (int)c->backend);
     if (c->gpu_bvh != 0 && c->gpu_bvh != 4 && c->gpu_bvh != 8) BAD("unknown GPU BVH layout %d (4 or 8)", c->gpu_bvh);
+    if (c->gpu_event_capacity < 0 || c->gpu_event_capacity > ((int64_t)1 << 31))
+        BAD("GPU event capacity must be between 0 (automatic) and 2^31 (got %lld)", (long long)c->gpu_event_capacity);
     if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
     if (!c->out_dir || !c->out_dir[0]) BAD("no output folder given");
     if (!c->formats || (c->formats & ~(EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY))) BAD("no valid output format selected");
@@ -213,6 +215,7 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "ambient"); evr_json_float(&j, c->ambient);
     evr_json_key(&j, "seed"); evr_json_unsigned(&j, c->seed);
     evr_json_key(&j, "backend"); evr_json_string(&j, backend);
+    evr_json_key(&j, "gpu_event_capacity"); evr_json_integer(&j, c->gpu_event_capacity);
     evr_json_key(&j, "gpu_bvh"); evr_json_string(&j, c->gpu_bvh == 4 ? "bvh4" : c->gpu_bvh == 8 ? "cw8" : "default");
     evr_json_key(&j, "gi"); evr_json_string(&j, "none");
     evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);

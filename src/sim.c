@@ -125,6 +125,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.pixel.seed = c->seed;
     sim->setup.threads = c->threads;
     sim->setup.gpu_bvh = c->gpu_bvh;
+    sim->setup.gpu_event_capacity = c->gpu_event_capacity;
 
     int ntracks = s->num_nodes + 1;
     sim->keys = malloc(sizeof *sim->keys * (size_t)ntracks * EVR_MAX_KEYS);

@@ -37,4 +37,15 @@ for case, (scene, extra) in enumerate(cases):
     T.check(ncpu > 0, f"{scene}: events")
     T.check(abs(ngpu - ncpu) <= 0.005 * ncpu, f"{scene}: counts within 0.5% ({ncpu} vs {ngpu})")
     T.check(r["f1"] >= 0.99, f"{scene}: F1 {r['f1']} >= 0.99")
+
+# an event buffer far too small: every segment overflows, is rendered again with a larger buffer,
+# and the events are exactly those of a run that never overflowed (nothing dropped)
+runs = {}
+for label, extra in (("auto", []), ("tiny", ["--gpu-event-capacity", "1000"])):
+    d = os.path.join(tmp, f"overflow-{label}")
+    T.run("demo", "--scene", "eye", "-o", d, "--backend", "cuda", "--res", "200x150", "--duration", "1.0",
+          "--format", "npy", "--no-preview", "--quiet", *extra)
+    runs[label] = open(os.path.join(d, "events.npy"), "rb").read()
+T.check(len(runs["auto"]) > 100000 and runs["auto"] == runs["tiny"],
+        "overflowing event buffers are re-rendered: identical events with a 1000-event initial buffer")
 T.finish("test_cuda")

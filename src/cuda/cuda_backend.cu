@@ -728,6 +728,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaGetLastError());
     CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
     b->capacity = npix * 2 > (1u << 20) ? npix * 2 : (1u << 20);
+    if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     for (int i = 0; i < 2; i++) {
         slot *sl = &b->slots[i];
         CK(cudaStreamCreateWithFlags(&sl->copy, cudaStreamNonBlocking));
