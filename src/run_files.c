@@ -75,14 +75,8 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
             snprintf(err->msg, sizeof err->msg, "cannot create %s: %s", p, strerror(errno));
             return EVR_ERR_IO;
         }
-        size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
         evr_status st = evr_event_frame_init(&sim->preview, sim->cfg.width, sim->cfg.height, err);
         if (st != EVR_OK) return st;
-        sim->preview_intensity = malloc(npix * sizeof *sim->preview_intensity);
-        if (!sim->preview_intensity) {
-            snprintf(err->msg, sizeof err->msg, "out of memory for previews");
-            return EVR_ERR_NOMEM;
-        }
         sim->preview_window_us = (int64_t)llround(sim->cfg.preview_window * 1e6);
         if (sim->preview_window_us < 1) sim->preview_window_us = 1;
     }
@@ -157,7 +151,7 @@ static int intensity_frame_due(const evr_sim *sim, int64_t frame, double t, int 
 
 int evr_run_preview_due(const evr_sim *sim, double t, int last)
 {
-    if (!sim->preview_intensity) return 0;
+    if (!sim->preview.width) return 0;   /* previews off */
     /* frames already due at an earlier segment end are written when that one is collected */
     int64_t next = sim->intensity_frame;
     while (sim->preview_window_us > 0 && intensity_frame_due(sim, next, t - 1.0 / sim->fps, 0)) next++;
@@ -168,7 +162,7 @@ evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, doubl
 {
     char name[64], p[4200];
     evr_status st;
-    if (!sim->preview_intensity) return EVR_OK;
+    if (!sim->preview.width) return EVR_OK;
     while (intensity_frame_due(sim, sim->intensity_frame, t, last)) {
         snprintf(name, sizeof name, "preview/intensity_%06lld.png", (long long)sim->intensity_frame);
         if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;

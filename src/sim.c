@@ -351,7 +351,6 @@ void evr_sim_release(evr_sim *sim)
     free(sim->node_used);
     free(sim->config_json);
     evr_event_frame_release(&sim->preview);
-    free(sim->preview_intensity);
     evr_frames_free(sim);
     free(sim);
 }

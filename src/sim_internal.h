@@ -35,7 +35,6 @@ struct evr_sim {
     int64_t last_t;
     /* previews */
     evr_event_frame preview;     /* event frame being accumulated (width 0: previews off) */
-    float *preview_intensity;
     int64_t preview_window_us;
     int64_t preview_frame;       /* index of the event frame being accumulated */
     int64_t intensity_frame;     /* index of the next intensity frame due */

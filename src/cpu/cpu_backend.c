@@ -83,69 +83,9 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
     q->translation_z = k->trans.z;
 }
 
-static int occluded(RTCScene top, evr_v3 org, evr_v3 dir, float tnear, float tfar, float time)
-{
-    struct RTCIntersectContext ctx;
-    struct RTCRay r;
-    rtcInitIntersectContext(&ctx);
-    r.org_x = org.x; r.org_y = org.y; r.org_z = org.z;
-    r.dir_x = dir.x; r.dir_y = dir.y; r.dir_z = dir.z;
-    r.tnear = tnear;
-    r.tfar = tfar;
-    r.time = time;
-    r.mask = 0xffffffffu;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(top, &ctx, &r);
-    return r.tfar < 0.0f;
-}
-
-/* Intensity seen by one sample at normalized segment time f; counts the rays it traces. */
-static float sample_intensity(const cpu_backend *b, const evr_m34 *pose, int x, int y, float f,
-                              unsigned long long *rays)
-{
-    const evr_render_scene *rs = &b->host.rs;
-    RTCScene top = b->top;
-    evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
-    struct RTCIntersectContext ctx;
-    struct RTCRayHit rh;
-    rtcInitIntersectContext(&ctx);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = INFINITY;
-    rh.ray.time = f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(top, &ctx, &rh);
-    (*rays)++;
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0.0f;   /* nothing: black */
-
-    int inst = b->members[b->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
-    evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), f);
-    evr_surface s;
-    evr_surface_at(rs, inst, rh.hit.primID, rh.hit.u, rh.hit.v, &xf, ray, rh.ray.tfar, &s);
-    float acc[3] = {0.0f, 0.0f, 0.0f};
-    int l;
-    for (l = 0; l < rs->num_lights; l++) {
-        evr_v3 wi;
-        float dist, e[3];
-        if (!evr_light_incident(rs, &rs->lights[l], f, s.p, &wi, &dist, e)) continue;
-        if (evr_v3_dot(wi, s.n) <= 0.0f) continue;
-        (*rays)++;
-        if (occluded(top, s.p, wi, evr_shadow_tnear(&s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f)) continue;
-        evr_accumulate_lambert(&s, wi, e, acc);
-    }
-    return evr_surface_intensity(&s, acc, rs->ambient);
-}
-
-
-/* Eight samples at once (neighbouring pixels of a row, each at its own time): Embree's packet
- * traversal for the primary rays and for each light's shadow rays; shading as in
- * sample_intensity, lane by lane. */
+/* Intensity of eight samples at once (neighbouring pixels of a row, each at its own time):
+ * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
+ * shared shading of src/core lane by lane. Counts the rays it traces. */
 #define PACKET 8
 static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
                               const int *valid, float *out, unsigned long long *rays)
@@ -276,8 +216,19 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
         evr_m34 pose = evr_rs_camera_pose(rs, f);
         float *img = b->frame_out + (size_t)k * (size_t)w * (size_t)h;
         unsigned long long frame_rays = 0;
-        for (y = y0; y < y1; y++)
-            for (x = x0; x < x1; x++) img[(size_t)y * (size_t)w + (size_t)x] = sample_intensity(b, &pose, x, y, f, &frame_rays);
+        for (y = y0; y < y1; y++) {
+            for (x = x0; x < x1; x += PACKET) {
+                float fs[PACKET], intensity[PACKET];
+                int xs[PACKET], valid[PACKET], i;
+                for (i = 0; i < PACKET; i++) {
+                    xs[i] = x + i < x1 ? x + i : x1 - 1;
+                    valid[i] = x + i < x1;
+                    fs[i] = f;
+                }
+                sample_intensity8(b, &pose, xs, y, fs, valid, intensity, &frame_rays);
+                for (i = 0; i < PACKET && x + i < x1; i++) img[(size_t)y * (size_t)w + (size_t)(x + i)] = intensity[i];
+            }
+        }
     }
     *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
 }
