@@ -2,14 +2,18 @@
  * seed); how the cost per sample grows (--sweep, CSV and PNG plot). */
 #include "commands.h"
 #include "evray.h"
+#include "io/event_reader.h"
 #include "io/plot.h"
 #include "options.h"
+#include "scene/demo_scenes.h"
+#include "scene/scene.h"
 
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <time.h>
 #include <unistd.h>
 
 static void remove_run(const char *dir)
@@ -32,11 +36,32 @@ typedef struct {
     double temporal_us;           /* mean time between a pixel's samples */
     double render_s;              /* device kernels on the GPU, else the render wait */
     double peak_mb;
+    int skip;                     /* change-driven sampling was on */
 } bench_figures;
 
-/* Runs cfg on scene, into a temporary folder unless keep (then into cfg->out_dir), and fills f.
- * Returns the process exit code (0 ok; a message was printed otherwise). */
-static int bench_run(const evr_scene *scene, const evr_config *cfg_in, int keep, bench_figures *f)
+/* Reads the run's events (its first event file) into *ev. */
+static int read_run_events(const char *dir, evr_event **ev, size_t *n)
+{
+    static const char *files[] = {"events.h5", "events.npy", "events.txt", NULL};
+    char p[4200];
+    int i;
+    for (i = 0; files[i]; i++) {
+        evr_error err = {{0}};
+        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+        if (access(p, R_OK) != 0) continue;
+        if (evr_events_read(p, ev, n, NULL, NULL, &err) == EVR_OK) return 1;
+        cli_error("%s", err.msg);
+        return 0;
+    }
+    cli_error("bench: the run wrote no event file to compare");
+    return 0;
+}
+
+/* Runs cfg on scene, into a temporary folder unless keep (then into cfg->out_dir), and fills f;
+ * with ev, also reads the run's events back. Returns the process exit code (0 ok; a message was
+ * printed otherwise). */
+static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, int keep, bench_figures *f,
+                            evr_event **ev, size_t *nev)
 {
     evr_config cfg = *cfg_in;
     char tmpdir[] = "/tmp/evray-bench-XXXXXX";
@@ -67,6 +92,7 @@ static int bench_run(const evr_scene *scene, const evr_config *cfg_in, int keep,
         f->width = cfg.width;
         f->height = cfg.height;
         f->samples_per_frame = cfg.samples_per_frame;
+        f->skip = !cfg.no_skip;
         /* the set frame rate; else the scene's, as segments per simulated second (the last segment
          * may be partial, so this is approximate for short runs) */
         f->fps = cfg.fps > 0 ? cfg.fps : s->segments_total > 0 && s->sim_time > 0 ? s->segments_total / s->sim_time : 0.0;
@@ -75,8 +101,14 @@ static int bench_run(const evr_scene *scene, const evr_config *cfg_in, int keep,
         f->peak_mb = (double)ru.ru_maxrss / 1024.0;
     }
     evr_sim_release(sim);
+    if (rc == 0 && ev && !read_run_events(cfg.out_dir, ev, nev)) rc = 1;
     if (!keep) remove_run(tmpdir);
     return rc;
+}
+
+static int bench_run(const evr_scene *scene, const evr_config *cfg_in, int keep, bench_figures *f)
+{
+    return bench_run_events(scene, cfg_in, keep, f, NULL, NULL);
 }
 
 static void print_row(const char *name, const bench_figures *f, int json)
@@ -89,12 +121,18 @@ static void print_row(const char *name, const bench_figures *f, int json)
                "\"realtime_factor\": %.5f, \"samples_per_second\": %.6g, \"rays_per_second\": %.6g, "
                "\"temporal_resolution_us\": %.2f, \"unique_timestamps\": %llu, \"peak_host_mb\": %.1f, "
                "\"device_memory_mb\": %.1f, \"setup_seconds\": %.4f, \"render_seconds\": %.4f, "
-               "\"sort_seconds\": %.4f, \"copy_seconds\": %.4f, \"write_seconds\": %.4f}\n",
+               "\"sort_seconds\": %.4f, \"copy_seconds\": %.4f, \"write_seconds\": %.4f, "
+               "\"skip\": %s, \"samples_traced\": %llu, \"traced_samples_per_second\": %.6g, "
+               "\"equivalent_samples_per_second\": %.6g, \"rays\": %llu, \"pixels_skipped\": %llu, "
+               "\"pixels_skipped_per_segment\": %.1f}\n",
                name, s->backend, s->device, f->width, f->height, f->samples_per_frame, s->sim_time,
                (unsigned long long)(s->events_on + s->events_off), s->wall_time, s->realtime_factor,
-               s->samples_per_second, s->rays_per_second, f->temporal_us, (unsigned long long)s->unique_timestamps,
+               (double)s->samples / w, (double)s->rays / w, f->temporal_us, (unsigned long long)s->unique_timestamps,
                f->peak_mb, (double)s->device_memory / 1048576.0, s->time_setup, f->render_s, s->time_sort, s->time_copy,
-               s->time_write);
+               s->time_write, f->skip ? "true" : "false", (unsigned long long)s->samples_traced,
+               (double)s->samples_traced / w, (double)s->samples / w, (unsigned long long)s->rays,
+               (unsigned long long)s->pixels_skipped,
+               s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0);
     } else {
         char res[32];
         printf("%-8s %-5s %9s %4s %12s %9s %9s %12s %12s %9s %12s %9s %8s  %s\n", "scene", "bknd", "res", "spf",
@@ -103,11 +141,63 @@ static void print_row(const char *name, const bench_figures *f, int json)
         snprintf(res, sizeof res, "%dx%d", f->width, f->height);
         printf("%-8.8s %-5s %9s %4d %12llu %9.3f %9.4f %12.4g %12.4g %9.1f %12llu %9.1f %8.1f  %.2f/%.2f/%.2f/%.2f\n",
                name, s->backend, res, f->samples_per_frame, (unsigned long long)(s->events_on + s->events_off),
-               s->wall_time, s->realtime_factor, s->samples_per_second, s->rays_per_second, f->temporal_us,
+               s->wall_time, s->realtime_factor, (double)s->samples / w, (double)s->rays / w, f->temporal_us,
                (unsigned long long)s->unique_timestamps, f->peak_mb, (double)s->device_memory / 1048576.0,
                f->render_s / w, s->time_sort / w, s->time_copy / w, s->time_write / w);
         printf("(%s; %.3f s simulated; setup %.2f s not in wall_s)\n", s->device, s->sim_time, s->time_setup);
+        if (f->skip) {
+            double npix = (double)f->width * f->height * (s->segments_done > 0 ? s->segments_done : 1);
+            printf("change-driven sampling: %.1f%% of pixel-segments skipped (%.0f pixels per segment), "
+                   "%.4g samples traced (%.4g/s), %llu rays; equivalent samples/s %.4g (samples brute force "
+                   "takes / wall time)\n",
+                   100.0 * (double)s->pixels_skipped / npix, s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0,
+                   (double)s->samples_traced, (double)s->samples_traced / w, (unsigned long long)s->rays,
+                   (double)s->samples / w);
+        } else {
+            printf("brute force (--no-skip): every sample traced\n");
+        }
     }
+}
+
+/* ---- --vs-brute: change-driven sampling against brute force, same build, same run ---- */
+
+static size_t first_difference(const evr_event *a, size_t na, const evr_event *b, size_t nb)
+{
+    size_t i, n = na < nb ? na : nb;
+    for (i = 0; i < n; i++)
+        if (a[i].t != b[i].t || a[i].x != b[i].x || a[i].y != b[i].y || a[i].p != b[i].p) return i;
+    return na == nb ? (size_t)-1 : n;
+}
+
+static int run_vs_brute(const evr_scene *scene, const evr_config *base, const char *name, int json)
+{
+    evr_config cfg = *base;
+    bench_figures fs, fb;
+    evr_event *es = NULL, *eb = NULL;
+    size_t ns = 0, nb = 0, d;
+    int rc;
+    cfg.no_skip = 0;
+    if ((rc = bench_run_events(scene, &cfg, 0, &fs, &es, &ns)) != 0) return rc;
+    cfg.no_skip = 1;
+    if ((rc = bench_run_events(scene, &cfg, 0, &fb, &eb, &nb)) != 0) {
+        free(es);
+        return rc;
+    }
+    print_row(name, &fs, json);
+    print_row(name, &fb, json);
+    d = first_difference(es, ns, eb, nb);
+    if (json) {
+        printf("{\"identical\": %s, \"events\": %zu, \"events_brute\": %zu, \"speedup\": %.4f}\n",
+               d == (size_t)-1 ? "true" : "false", ns, nb, fs.s.wall_time > 0 ? fb.s.wall_time / fs.s.wall_time : 0.0);
+    } else {
+        printf("speedup over brute force: %.2fx (wall %.3f s vs %.3f s)\n",
+               fs.s.wall_time > 0 ? fb.s.wall_time / fs.s.wall_time : 0.0, fs.s.wall_time, fb.s.wall_time);
+        if (d == (size_t)-1) printf("events: identical (%zu events)\n", ns);
+        else printf("events: DIFFERENT (%zu vs %zu events, first difference at event %zu)\n", ns, nb, d);
+    }
+    free(es);
+    free(eb);
+    return d == (size_t)-1 ? 0 : 3;
 }
 
 /* ---- --suite seed: the rows of the reference design's Table 4.2 ---- */
@@ -121,8 +211,8 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
     };
     int i, rc;
     if (!json) {
-        printf("suite seed: eye scene, %dx%d, backend %s; the reference design ran 30 s of its eye animation,\n"
-               "ours is 3 s long and is not looped: every row simulates the animation's length (or --duration)\n",
+        printf("suite seed: eye scene, %dx%d, backend %s; every row simulates the whole 30 s animation (as the\n"
+               "reference design's eye did) or --duration\n",
                base->width, base->height,
                base->backend == EVR_BACKEND_CPU ? "cpu" : base->backend == EVR_BACKEND_CUDA ? "cuda" : "auto");
         printf("%-8s %5s %4s %10s %12s %9s %10s %12s %12s %8s\n", "row", "fps", "spf", "simulated", "events", "wall_s",
@@ -164,10 +254,11 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
     return 0;
 }
 
-/* ---- --sweep res|samples ---- */
+/* ---- --sweep res|samples|triangles|instances ---- */
 
+/* extra_head (NULL: none) names columns appended to every row from extra[i] (",a,b"). */
 static int write_sweep(const char *dir, const char *kind, const char *qname, const double *q, const bench_figures *f,
-                       int n, const char *scene_name)
+                       int n, const char *scene_name, const char *extra_head, char (*extra)[200])
 {
     char path[4200], title[200], xlabel[200];
     double *ns = malloc((size_t)n * sizeof *ns);
@@ -177,12 +268,13 @@ static int write_sweep(const char *dir, const char *kind, const char *qname, con
     if (!ns) { cli_error("out of memory"); return 1; }
     snprintf(path, sizeof path, "%s/sweep_%s.csv", dir, kind);
     if (!(fp = fopen(path, "w"))) { cli_error("cannot write %s", path); free(ns); return 1; }
-    fprintf(fp, "%s,width,height,samples_per_frame,samples,wall_s,ns_per_sample,samples_per_s,events\n", qname);
+    fprintf(fp, "%s,width,height,samples_per_frame,samples,wall_s,ns_per_sample,samples_per_s,events%s\n", qname,
+            extra_head ? extra_head : "");
     for (i = 0; i < n; i++) {
         ns[i] = f[i].s.samples > 0 ? f[i].s.wall_time * 1e9 / (double)f[i].s.samples : 0.0;
-        fprintf(fp, "%.10g,%d,%d,%d,%llu,%.6f,%.4f,%.6g,%llu\n", q[i], f[i].width, f[i].height, f[i].samples_per_frame,
+        fprintf(fp, "%.10g,%d,%d,%d,%llu,%.6f,%.4f,%.6g,%llu%s\n", q[i], f[i].width, f[i].height, f[i].samples_per_frame,
                 (unsigned long long)f[i].s.samples, f[i].s.wall_time, ns[i], f[i].s.samples_per_second,
-                (unsigned long long)(f[i].s.events_on + f[i].s.events_off));
+                (unsigned long long)(f[i].s.events_on + f[i].s.events_off), extra_head ? extra[i] : "");
     }
     if (fclose(fp) != 0) { cli_error("cannot write %s", path); free(ns); return 1; }
     printf("wrote %s\n", path);
@@ -246,24 +338,91 @@ static int run_sweep(const evr_scene *scene, const evr_config *base, const char 
         n++;
     }
     if (n == 0) { cli_error("--sweep res: no resolution fits within --sweep-max-res %dx%d (the smallest is 80x60)", max_w, max_h); return 2; }
-    return write_sweep(dir, kind, is_res ? "pixels" : "samples_per_frame", q, f, n, scene_name);
+    return write_sweep(dir, kind, is_res ? "pixels" : "samples_per_frame", q, f, n, scene_name, NULL, NULL);
+}
+
+/* --sweep triangles: the city's buildings tessellated finer (detail 1, 2, 3, 4, 6, 8 up to
+ * max_detail; 4096 buildings); --sweep instances: more buildings (64 .. 65536 up to
+ * max_buildings; detail 1). Each point generates and loads its city, then runs as any sweep.
+ * The static instances are instanced at every point (EVR_STATIC_BAKE_LIMIT=0 unless set), so
+ * that small points are not baked into one tree while large ones are. */
+static int run_city_sweep(const evr_config *base, const char *kind, const char *dir, int max_detail, int max_buildings)
+{
+    static const int details[] = {1, 2, 3, 4, 6, 8};
+    static const int counts[] = {64, 256, 1024, 4096, 16384, 65536};
+    bench_figures f[8];
+    double q[8];
+    char extra[8][200];
+    int n = 0, i, rc = 0, is_tri = !strcmp(kind, "triangles");
+    int count = is_tri ? (int)(sizeof details / sizeof details[0]) : (int)(sizeof counts / sizeof counts[0]);
+    setenv("EVR_STATIC_BAKE_LIMIT", "0", 0);
+    printf("sweep %s: city, %s, %.3g s per run, %dx%d, %d samples per frame (static instances %s)\n", kind,
+           is_tri ? "4096 buildings, detail growing" : "detail 1, buildings growing", base->duration, base->width,
+           base->height, base->samples_per_frame,
+           strcmp(getenv("EVR_STATIC_BAKE_LIMIT"), "0") ? "as EVR_STATIC_BAKE_LIMIT says" : "instanced, not baked");
+    printf("%7s %9s %11s %13s %7s %7s %12s %9s %10s %12s %10s\n", "detail", "buildings", "mesh_tris", "scene_tris",
+           "load_s", "setup_s", "samples", "wall_s", "ns/sample", "samples/s", "events");
+    for (i = 0; i < count; i++) {
+        evr_config cfg = *base;
+        evr_scene *scene = NULL;
+        evr_error err = {{0}};
+        struct timespec t0, t1;
+        unsigned long long mesh_tris = 0, scene_tris = 0;
+        double load_s;
+        int ninst, detail = is_tri ? details[i] : EVR_CITY_DETAIL, buildings = is_tri ? EVR_CITY_BUILDINGS : counts[i], k;
+        if (is_tri ? detail > max_detail : buildings > max_buildings) continue;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        if (evr_demo_city_load(detail, buildings, &scene, &err) != EVR_OK) {
+            cli_error("%s", err.msg);
+            return 1;
+        }
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        for (k = 0; k < scene->num_meshes; k++) mesh_tris += scene->meshes[k].num_triangles;
+        for (k = 0; k < scene->num_instances; k++) scene_tris += scene->meshes[scene->instances[k].mesh].num_triangles;
+        ninst = scene->num_instances;
+        rc = bench_run(scene, &cfg, 0, &f[n]);
+        evr_scene_release(scene);
+        if (rc != 0) return rc;
+        q[n] = is_tri ? (double)scene_tris : (double)ninst;
+        snprintf(extra[n], sizeof extra[n], ",%d,%d,%llu,%llu,%.4f,%.4f", detail, buildings,
+                 mesh_tris, scene_tris, load_s, f[n].s.time_setup);
+        printf("%7d %9d %11llu %13llu %7.2f %7.2f %12llu %9.3f %10.2f %12.4g %10llu\n", detail, buildings, mesh_tris,
+               scene_tris, load_s, f[n].s.time_setup, (unsigned long long)f[n].s.samples, f[n].s.wall_time,
+               f[n].s.samples ? f[n].s.wall_time * 1e9 / (double)f[n].s.samples : 0.0, f[n].s.samples_per_second,
+               (unsigned long long)(f[n].s.events_on + f[n].s.events_off));
+        fflush(stdout);
+        n++;
+    }
+    if (n == 0) {
+        cli_error("--sweep %s: no point fits within %s", kind, is_tri ? "--sweep-max-detail" : "--sweep-max-buildings");
+        return 2;
+    }
+    return write_sweep(dir, kind, is_tri ? "triangles" : "instances", q, f, n, "city",
+                       ",detail,buildings,mesh_triangles,scene_triangles,load_s,setup_s", extra);
 }
 
 static int bench_usage(void)
 {
-    puts("usage: evray bench [--scene NAME | SCENE] [render options] [--json]\n"
+    puts("usage: evray bench [--scene NAME | SCENE] [render options] [--vs-brute] [--json]\n"
          "       evray bench --suite seed [--res WxH] [--duration S] [--backend B] [--json]\n"
          "       evray bench --sweep res|samples [--scene NAME] [--duration S] [--backend B] [-o DIR]\n"
-         "                   [--sweep-max-res WxH]\n\n"
+         "                   [--sweep-max-res WxH]\n"
+         "       evray bench --sweep triangles|instances [--res WxH] [--duration S] [--backend B] [-o DIR]\n"
+         "                   [--sweep-max-detail D] [--sweep-max-buildings N]\n\n"
          "Runs one simulation (no previews; into a temporary folder unless -o is given) and prints\n"
          "one row: events, processing time, real-time factor, samples/s, rays/s, the mean time\n"
          "between a pixel's samples (temporal resolution), unique timestamps, peak host and GPU\n"
          "memory, and the share of the wall time spent rendering, sorting, copying and writing\n"
          "(writing runs on its own thread, overlapping rendering).\n"
          "Render options are those of evray render (--res, --samples-per-frame, --duration,\n"
-         "--backend, --format, ...).\n\n"
+         "--backend, --format, --no-skip, ...). With change-driven sampling (the default) the row\n"
+         "also gives the share of pixel-segments skipped, the samples actually traced and the\n"
+         "equivalent samples/s (samples brute force takes / wall time; samples/s is that figure).\n"
+         "--vs-brute     runs the row twice, with change-driven sampling and with --no-skip, prints\n"
+         "               both, the speedup, and whether the events are identical (exit 3 if not)\n\n"
          "--suite seed   the rows of the reference design's Table 4.2 on the eye scene, default 1280x720\n"
-         "               over the whole animation (3 s; not looped to the reference's 30 s; --duration\n"
+         "               over the whole 30 s animation (as the reference design's; --duration\n"
          "               shortens it, --res changes the size). Each row prints the simulated time,\n"
          "               total events, processing (wall) time, temporal resolution (mean time between a\n"
          "               pixel's samples), unique timestamps and samples/s:\n"
@@ -283,8 +442,17 @@ static int bench_usage(void)
          "                 res       80x60, 160x120, 320x240, 640x360, 960x540, 1280x720 (up to\n"
          "                           --sweep-max-res WxH), at --samples-per-frame (default 10)\n"
          "                 samples   1, 2, 5, 10, 20, 50 samples per frame at --res (default 346x260)\n"
-         "               triangles and instances need a scene that grows (the city scene, not there\n"
-         "               yet) and are refused.");
+         "                 triangles the city scene (4096 buildings) with its buildings tessellated\n"
+         "                           finer: detail 1, 2, 3, 4, 6, 8 (up to --sweep-max-detail, default\n"
+         "                           6; a building's triangles grow as detail^2, its shape unchanged);\n"
+         "                           the quantity is the scene's (instanced) triangles\n"
+         "                 instances the city at detail 1 with 64, 256, 1024, 4096, 16384, 65536\n"
+         "                           buildings (up to --sweep-max-buildings, default 16384)\n"
+         "               triangles and instances (quantity: the scene's triangles, instances) add the\n"
+         "               columns detail, buildings, mesh_triangles (distinct), scene_triangles\n"
+         "               (instanced; the ground is one more instance), load_s (generate and\n"
+         "               import) and setup_s; they instance the static buildings at every point\n"
+         "               (EVR_STATIC_BAKE_LIMIT=0 unless set; see docs/benchmarks.md).");
     return 0;
 }
 
@@ -294,7 +462,8 @@ int cmd_bench(int argc, char **argv)
     render_options ro;
     const char *scene_path = NULL, *demo = "eye", *suite = NULL, *sweep = NULL, *v;
     int json = 0, keep = 0, i, r, set_res = 0, set_spf = 0, set_fps = 0, set_dur = 0, max_w = 1280, max_h = 720;
-    int set_scene = 0;
+    int set_scene = 0, vs_brute = 0;
+    int max_detail = 6, max_buildings = 16384, city_sweep = 0;
     evr_config_defaults(&cfg);
     cfg.preview_window = 0.0;
     if (!render_options_init(&ro, &cfg, 1, argc)) return 1;
@@ -309,9 +478,16 @@ int cmd_bench(int argc, char **argv)
         if (opt_is(a, "--fps")) set_fps = 1;
         if (opt_is(a, "--duration")) set_dur = 1;
         if (!strcmp(a, "--json")) json = 1;
+        else if (!strcmp(a, "--vs-brute")) vs_brute = 1;
         else if (opt_is(a, "--scene")) { set_scene = 1; if (!(demo = opt_value(argc, argv, &i, "--scene"))) { render_options_free(&ro); return 2; } }
         else if (opt_is(a, "--suite")) { if (!(suite = opt_value(argc, argv, &i, "--suite"))) { render_options_free(&ro); return 2; } }
         else if (opt_is(a, "--sweep")) { if (!(sweep = opt_value(argc, argv, &i, "--sweep"))) { render_options_free(&ro); return 2; } }
+        else if (opt_is(a, "--sweep-max-detail")) {
+            if (!(v = opt_value(argc, argv, &i, "--sweep-max-detail")) || !opt_int("--sweep-max-detail", v, &max_detail)) { render_options_free(&ro); return 2; }
+        }
+        else if (opt_is(a, "--sweep-max-buildings")) {
+            if (!(v = opt_value(argc, argv, &i, "--sweep-max-buildings")) || !opt_int("--sweep-max-buildings", v, &max_buildings)) { render_options_free(&ro); return 2; }
+        }
         else if (opt_is(a, "--sweep-max-res")) {
             if (!(v = opt_value(argc, argv, &i, "--sweep-max-res")) || !opt_size("--sweep-max-res", v, &max_w, &max_h)) { render_options_free(&ro); return 2; }
         }
@@ -326,6 +502,10 @@ int cmd_bench(int argc, char **argv)
     render_options_free(&ro);
     if (!r) return 2;
     if (suite && sweep) { cli_error("bench: --suite and --sweep cannot be combined"); return 2; }
+    if (vs_brute && (suite || sweep || keep || cfg.no_skip)) {
+        cli_error("bench: --vs-brute runs one row twice (with and without skipping); drop --suite, --sweep, -o and --no-skip");
+        return 2;
+    }
     if (suite) {
         if (strcmp(suite, "seed")) { cli_error("--suite: unknown suite '%s' (seed)", suite); return 2; }
         if (scene_path || set_scene) { cli_error("--suite seed runs the eye scene; drop --scene/SCENE"); return 2; }
@@ -334,17 +514,23 @@ int cmd_bench(int argc, char **argv)
         if (!set_res) { cfg.width = 1280; cfg.height = 720; }
     }
     if (sweep) {
-        if (!strcmp(sweep, "triangles") || !strcmp(sweep, "instances")) {
-            cli_error("--sweep %s needs a scene that grows (the city scene), which is not there yet; use res or samples", sweep);
+        city_sweep = !strcmp(sweep, "triangles") || !strcmp(sweep, "instances");
+        if (strcmp(sweep, "res") && strcmp(sweep, "samples") && !city_sweep) {
+            cli_error("--sweep: unknown kind '%s' (res, samples, triangles, instances)", sweep);
             return 2;
         }
-        if (strcmp(sweep, "res") && strcmp(sweep, "samples")) {
-            cli_error("--sweep: unknown kind '%s' (res, samples; triangles and instances need the city scene)", sweep);
+        if (city_sweep && (scene_path || set_scene)) {
+            cli_error("--sweep %s grows the city scene itself; drop --scene/SCENE", sweep);
             return 2;
         }
         if (!strcmp(sweep, "res") && set_res) { cli_error("--sweep res sets the resolution; use --sweep-max-res to cap it"); return 2; }
         if (!strcmp(sweep, "samples") && set_spf) { cli_error("--sweep samples sets --samples-per-frame itself"); return 2; }
         if (!set_dur) cfg.duration = 0.2;
+    }
+    if (city_sweep) {
+        const char *dir = keep && cfg.out_dir ? cfg.out_dir : ".";
+        cfg.out_dir = NULL;
+        return run_city_sweep(&cfg, sweep, dir, max_detail, max_buildings);
     }
     evr_error err = {{0}};
     evr_scene *scene = NULL;
@@ -360,6 +546,8 @@ int cmd_bench(int argc, char **argv)
         const char *dir = keep && cfg.out_dir ? cfg.out_dir : ".";
         cfg.out_dir = NULL;
         rc = run_sweep(scene, &cfg, sweep, dir, max_w, max_h, scene_path ? scene_path : demo);
+    } else if (vs_brute) {
+        rc = run_vs_brute(scene, &cfg, scene_path ? scene_path : demo, json);
     } else {
         bench_figures f;
         rc = bench_run(scene, &cfg, keep, &f);

@@ -93,6 +93,8 @@ static void help(void)
          "  --gpu-bvh L                GPU BVH node layout: cw8 (default, compressed 8-wide) or bvh4\n"
          "  --gpu-event-capacity N     events a GPU segment buffer holds at first (default: automatic; it\n"
          "                             grows and the segment is rendered again whenever it overflows)\n"
+         "  --no-skip                  trace every sample (brute force); by default a pixel that nothing\n"
+         "                             moving can reach keeps its last intensity (identical events)\n"
          "sensor (laws, presets and their sources: docs/sensors.md; the default is the ideal sensor):\n"
          "  --sensor NAME              preset: ideal, davis346, dvxplorer or prophesee-gen4; it sets the\n"
          "                             defaults (and the resolution) that the options below override,\n"

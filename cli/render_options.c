@@ -104,6 +104,7 @@ static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *qui
             uint64_t cap;
             if (!opt_u64("--gpu-event-capacity", v, &cap)) return -1;
             cfg.gpu_event_capacity = cap > ((uint64_t)1 << 40) ? ((int64_t)1 << 40) : (int64_t)cap; }
+    else if (!strcmp(a, "--no-skip")) cfg.no_skip = 1;
     else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return -1; }
     else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return -1; }
     else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return -1; }

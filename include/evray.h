@@ -94,6 +94,8 @@ typedef struct {
     int gpu_bvh;                  /* GPU node layout: 0 default, 4 (BVH4, float boxes), 8 (CW8, compressed) */
     int64_t gpu_event_capacity;   /* events a GPU segment buffer holds at first (0: automatic); it grows
                                      and the segment is rendered again when it overflows */
+    int no_skip;                  /* 1: trace every sample (brute force) instead of reusing the
+                                     intensity of pixels nothing moving can reach (identical events) */
     /* output */
     const char *out_dir;
     int formats;                  /* evr_format bits */
@@ -122,7 +124,9 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
 
 typedef struct {
     uint64_t events_on, events_off, unique_timestamps;
-    uint64_t samples, rays;
+    uint64_t samples, rays;       /* samples: every pixel sample, as brute force would take them */
+    uint64_t samples_traced;      /* samples that traced rays; the rest reused a cached intensity */
+    uint64_t pixels_skipped;      /* pixel-segments that traced nothing (change-driven sampling) */
     double sim_time;              /* seconds simulated */
     double wall_time;             /* seconds */
     double samples_per_second, rays_per_second, realtime_factor;

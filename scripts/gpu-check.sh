@@ -14,14 +14,18 @@ export PATH="$PATH:/usr/local/cuda/bin"
     "$E" --version
 } > "$OUT/env.log" 2>&1
 python3 tests/test_cuda.py "$E" > "$OUT/test_cuda.log" 2>&1; echo "test_cuda exit $?" >> "$OUT/test_cuda.log"
-compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.2 \
-    -o "$OUT/cs-eye" --no-preview -q > "$OUT/sanitizer.log" 2>&1; echo "memcheck exit $?" >> "$OUT/sanitizer.log"
+python3 tests/test_skip.py "$E" > "$OUT/test_skip.log" 2>&1; echo "test_skip exit $?" >> "$OUT/test_skip.log"
+# memcheck over segments that skip (the eye in a fixation) and that trace (a saccade), ideal and davis346
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.5 \
+    --start 0.9 -o "$OUT/cs-eye" --no-preview -q > "$OUT/sanitizer.log" 2>&1; echo "memcheck exit $?" >> "$OUT/sanitizer.log"
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.3 \
+    --sensor davis346 --start 0.9 -o "$OUT/cs-eye2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck davis346 exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x64 --duration 0.1 \
     -o "$OUT/cs-sq" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck exit $?" >> "$OUT/sanitizer.log"
-for spf in 10; do
-    "$E" demo --scene eye --backend cuda --res 1280x720 --samples-per-frame $spf -o "$OUT/bench-eye-720-$spf" \
-        --no-preview --format h5 > "$OUT/bench.log" 2>&1
-done
-"$E" demo --scene eye --backend cpu --res 1280x720 --samples-per-frame 10 --duration 0.5 -o "$OUT/bench-eye-720-cpu" \
-    --no-preview --format h5 >> "$OUT/bench.log" 2>&1
+# issue 7's figure: the eye at 1280x720, 10 samples per frame, 30 fps, the whole 30 s, ideal
+# sensor, change-driven sampling against brute force in the same run, with the identity check
+"$E" bench --scene eye --backend cuda --res 1280x720 --samples-per-frame 10 --vs-brute > "$OUT/bench.log" 2>&1
+echo "bench exit $?" >> "$OUT/bench.log"
+"$E" bench --scene eye-drift --backend cuda --res 1280x720 --samples-per-frame 10 --duration 3 --vs-brute >> "$OUT/bench.log" 2>&1
+echo "bench exit $?" >> "$OUT/bench.log"
 cat "$OUT"/*.log

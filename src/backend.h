@@ -9,6 +9,7 @@
 #include "events.h"
 #include "core/render_scene.h"
 #include "core/pixel.h"
+#include "core/skip.h"
 #include "scene/scene.h"
 
 /* Everything fixed for a whole run. */
@@ -39,6 +40,9 @@ typedef struct {
      * they are not counted in samples or rays. */
     const double *frame_times;
     int num_frames;
+    /* Change-driven sampling (core/skip.h): which pixels may keep their cached intensity, and
+     * which may cache one. Never NULL; a plan that neither reuses nor caches is brute force. */
+    const evr_skip_plan *skip;
 } evr_segment;
 
 typedef struct evr_backend evr_backend;
@@ -55,7 +59,9 @@ struct evr_backend {
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, const float **frames,
                           evr_error *err);
     void (*release)(evr_backend *b);
-    uint64_t samples, rays;       /* totals so far */
+    uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not) */
+    uint64_t samples_traced;      /* samples that traced rays (the others reused a cached intensity) */
+    uint64_t pixels_skipped;      /* pixel-segments that reused their cached intensity */
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
     double sort_seconds, copy_seconds;
     uint64_t device_bytes;        /* memory held on the device */

@@ -216,6 +216,7 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "seed"); evr_json_unsigned(&j, c->seed);
     evr_json_key(&j, "backend"); evr_json_string(&j, backend);
     evr_json_key(&j, "gpu_event_capacity"); evr_json_integer(&j, c->gpu_event_capacity);
+    evr_json_key(&j, "skip"); evr_json_string(&j, c->no_skip ? "off" : "exact");
     evr_json_key(&j, "gpu_bvh"); evr_json_string(&j, c->gpu_bvh == 4 ? "bvh4" : c->gpu_bvh == 8 ? "cw8" : "default");
     evr_json_key(&j, "gi"); evr_json_string(&j, "none");
     evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);

@@ -217,6 +217,18 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "unique_timestamps"); evr_json_unsigned(&j, s->unique_timestamps);
     evr_json_key(&j, "samples"); evr_json_unsigned(&j, s->samples);
     evr_json_key(&j, "rays"); evr_json_unsigned(&j, s->rays);
+    /* change-driven sampling: samples is what brute force takes, samples_traced what was traced */
+    evr_json_key(&j, "samples_traced"); evr_json_unsigned(&j, s->samples_traced);
+    evr_json_key(&j, "pixels_skipped"); evr_json_unsigned(&j, s->pixels_skipped);
+    evr_json_key(&j, "equivalent_samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
+    evr_json_key(&j, "traced_samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples_traced / s->wall_time : 0.0);
+    if (sim->skipped_per_segment) {
+        int seg;
+        evr_json_key(&j, "pixels_skipped_per_segment");
+        evr_json_begin_array(&j);
+        for (seg = 0; seg < s->segments_done; seg++) evr_json_unsigned(&j, sim->skipped_per_segment[seg]);
+        evr_json_end_array(&j);
+    }
     evr_json_key(&j, "segments"); evr_json_integer(&j, s->segments_done);
     evr_json_key(&j, "segments_planned"); evr_json_integer(&j, s->segments_total);
     evr_json_key(&j, "interrupted"); evr_json_boolean(&j, s->interrupted);

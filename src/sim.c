@@ -132,7 +132,9 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->track_offset = malloc(sizeof(int) * (size_t)ntracks);
     sim->track_count = malloc(sizeof(int) * (size_t)ntracks);
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
-    if (!sim->keys || !sim->track_offset || !sim->track_count || !sim->node_used) {
+    if (!sim->keys || !sim->track_offset || !sim->track_count || !sim->node_used ||
+        !evr_skip_tracker_init(&sim->skip, ntracks) ||
+        !(sim->skipped_per_segment = calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
         evr_sim_release(sim);
         return nomem(err);
     }
@@ -203,6 +205,21 @@ static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
     seg->num_tracks = s->num_nodes + 1;
     seg->num_keys = off;
     seg->camera_static = sim->track_count[sim->host.rs.camera_track] == 1;
+    evr_skip_tracker_update(&sim->skip, sim->keys, sim->track_offset, sim->track_count, sim->host.scene_size);
+    {
+        evr_render_scene rs = sim->host.rs;
+        rs.keys = sim->keys;
+        rs.track_offset = sim->track_offset;
+        rs.track_count = sim->track_count;
+        evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip, &sim->plan);
+        if (getenv("EVR_DEBUG_SKIP")) {
+            fprintf(stderr, "seg %.3f reuse %d cache %d boxes %d moved:", t0, sim->plan.reuse, sim->plan.cache, sim->plan.num_boxes);
+            for (i = 0; i < s->num_nodes; i++)
+                if (sim->skip.moved[i]) fprintf(stderr, " %s(%d)", s->nodes[i].name, sim->track_count[i]);
+            fprintf(stderr, "\n");
+        }
+    }
+    seg->skip = &sim->plan;
 }
 
 /* Hands events up to (not including) limit_us to the writers and statistics. */
@@ -292,6 +309,9 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     sim->st.segments_done = i + 1;
     sim->st.samples = sim->backend->samples;
     sim->st.rays = sim->backend->rays;
+    sim->st.samples_traced = sim->backend->samples_traced;
+    sim->skipped_per_segment[i] = (uint32_t)(sim->backend->pixels_skipped - sim->st.pixels_skipped);
+    sim->st.pixels_skipped = sim->backend->pixels_skipped;
     sim->st.sim_time = t1 - sim->cfg.start;
     sim->st.wall_time = now_seconds() - wall0;
     sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
@@ -349,6 +369,8 @@ void evr_sim_release(evr_sim *sim)
     free(sim->track_offset);
     free(sim->track_count);
     free(sim->node_used);
+    evr_skip_tracker_free(&sim->skip);
+    free(sim->skipped_per_segment);
     free(sim->config_json);
     evr_event_frame_release(&sim->preview);
     evr_frames_free(sim);

@@ -3,6 +3,7 @@
 #define EVR_SIM_INTERNAL_H
 
 #include "backend.h"
+#include "skip_plan.h"
 #include "io/event_writer.h"
 #include "io/preview.h"
 #include "write_queue.h"
@@ -30,6 +31,10 @@ struct evr_sim {
     evr_motion_key *keys;
     int *track_offset, *track_count;
     int *node_used;
+    /* change-driven sampling */
+    evr_skip_tracker skip;
+    evr_skip_plan plan;
+    uint32_t *skipped_per_segment;   /* pixels that traced nothing, per segment */
     /* events */
     evr_event_vec pending, scratch;
     int64_t last_t;

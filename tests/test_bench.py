@@ -54,7 +54,6 @@ T.check(all(float(r["wall_s"]) > 0 and float(r["ns_per_sample"]) > 0 and float(r
 T.check(all(int(r["samples"]) == int(r["width"]) * int(r["height"]) * 10 * 2 for r in rows),
         "sweep res: samples = pixels x 10 per frame x 2 frames (0.05 s at 30 fps)")
 T.check(png_size(os.path.join(out, "sweep_res.png")) == (800, 480), "sweep res: an 800x480 plot")
-expect_error(["bench", "--sweep", "triangles"], "sweep triangles (no growing scene yet)")
 expect_error(["bench", "--sweep", "bogus"], "unknown sweep")
 expect_error(["bench", "--sweep", "res", "--sweep-max-res", "10x10", "--duration", "0.05"], "sweep res: nothing fits")
 

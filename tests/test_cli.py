@@ -58,7 +58,15 @@ expect_error(["compare", os.path.join(out, "events.npy")], "compare with one fil
 
 # bench: one row of figures
 b = json.loads(T.run("bench", "--scene", "square", "--res", "32x32", "--duration", "0.5", "--json").stdout.splitlines()[0])
-T.check(b["events"] > 0 and b["samples_per_second"] > 0 and b["rays_per_second"] >= b["samples_per_second"], f"bench row {b}")
+T.check(b["events"] > 0 and b["samples_per_second"] > 0 and b["rays"] >= b["samples_traced"] > 0, f"bench row {b}")
+T.check(b["skip"] and b["samples_traced"] < b["samples_per_second"] * b["wall_seconds"] and b["pixels_skipped"] > 0,
+        f"bench: the square's still background is skipped ({b})")
+T.check(abs(b["equivalent_samples_per_second"] - b["samples_per_second"]) <= 1e-6 * b["samples_per_second"],
+        "bench: samples/s is the equivalent (brute-force) rate")
+vs = T.run("bench", "--scene", "square", "--res", "32x32", "--duration", "0.5", "--vs-brute", "--json").stdout.splitlines()
+rows = [json.loads(l) for l in vs]
+T.check(len(rows) == 3 and rows[0]["skip"] and not rows[1]["skip"] and rows[2]["identical"]
+        and rows[2]["events"] == rows[0]["events"], f"bench --vs-brute: two rows and an identity check ({vs})")
 T.check(abs(b["temporal_resolution_us"] - 1e6 / 300) < 0.1, "bench: 30 fps x 10 samples = 3333 us between a pixel's samples")
 
 # bad input

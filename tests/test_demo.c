@@ -38,7 +38,15 @@ static const expectation expected[] = {
      "eye_camera", 4.0f / 3.0f, 0.001f, {0.0, -0.010, 0.040}, {0.0, 0.0, 0.0},
      "ir_led", aiLightSource_POINT,
      {"eyeball", "upper_lid", "lower_lid", NULL},
-     3.0, 10000, 40000},
+     30.0, 10000, 40000},
+    {"eye-drift",
+     {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", NULL},
+     {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "orbit", NULL},
+     5, "iris",
+     "eye_camera", 4.0f / 3.0f, 0.001f, {0.0, -0.010, 0.040}, {0.0, 0.0, 0.0},
+     "ir_led", aiLightSource_POINT,
+     {"eyeball", "upper_lid", "lower_lid", NULL},
+     30.0, 10000, 40000},
     {"square",
      {"background", "square", NULL},
      {"background", "square", NULL},
@@ -63,6 +71,14 @@ static const expectation expected[] = {
      "ceiling_light", aiLightSource_POINT,
      {"short_box", NULL},
      2.0, 36, 36},
+    {"city",   /* 12 building meshes, each stored once (4096 nodes share them), and the ground */
+     {"building_00", "building_07", "building_11", "ground", NULL},
+     {"facade_00", "facade_11", "asphalt", NULL},
+     0, NULL,
+     "city_camera", 4.0f / 3.0f, 0.5f, {0.0, 34.0, 100.0}, {4.854101966, 25.0, 40.0},
+     "sun", aiLightSource_DIRECTIONAL,
+     {"city_camera", NULL},
+     5.0, 40000, 80000},
 };
 
 static uint32_t rd_u32(const unsigned char *p)

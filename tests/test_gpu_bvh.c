@@ -1,7 +1,9 @@
 /* The GPU backend's BVH and traversal (src/cuda), run on the host: against Embree built exactly
  * as the CPU backend builds it (instances grouped: the static ones baked into world space, those
  * of each moving node together), on the built-in scenes during motion (a saccade, a blink, the
- * moving square) and on a synthetic scene of many instances, for both node layouts:
+ * moving square) and on a synthetic scene of many instances, for both node layouts (and there
+ * also with the static instances instanced, not baked, as both backends do past
+ * EVR_STATIC_BAKE_LIMIT triangles: a group per static instance, one tree per mesh):
  *   - the GPU BVH groups the instances as the CPU backend does (the eye's groups by name);
  *   - closest hits of camera rays, shadow-like rays between scene points and random rays agree
  *     (hit or miss, instance, triangle, distance to 1e-4, barycentrics); disagreements are
@@ -94,6 +96,7 @@ typedef struct {
     int num_groups;
     RTCScene *group_scenes;
     int *group_track, *group_first, *members;
+    int *group_instanced;   /* 1: a static instance of its mesh's scene (past the bake limit) */
 } reference;
 
 static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
@@ -132,7 +135,9 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
-static void reference_build(reference *r, const evr_scene *s, const motion *mo)
+/* instance_static: the static instances are not baked but each a group of its own, an instance
+ * of its mesh's scene with its node's transform (the CPU backend past EVR_STATIC_BAKE_LIMIT) */
+static void reference_build(reference *r, const evr_scene *s, const motion *mo, int instance_static)
 {
     int n = s->num_instances, i, j, g, k;
     int *group_of = malloc(sizeof(int) * ((size_t)n + 1));
@@ -141,9 +146,16 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo)
     r->group_track = malloc(sizeof(int) * ((size_t)n + 1));
     r->group_first = calloc((size_t)n + 2, sizeof(int));
     r->members = malloc(sizeof(int) * ((size_t)n + 1));
+    r->group_instanced = calloc((size_t)n + 1, sizeof(int));
     for (i = 0; i < n; i++) {
         int node = s->instances[i].node, track = node_never_moves(s, node) ? -1 : node;
-        for (g = 0; g < r->num_groups && r->group_track[g] != track; g++) {}
+        if (track < 0 && instance_static) {
+            r->group_instanced[r->num_groups] = 1;
+            r->group_track[r->num_groups] = -1;
+            group_of[i] = r->num_groups++;
+            continue;
+        }
+        for (g = 0; g < r->num_groups && (r->group_track[g] != track || r->group_instanced[g]); g++) {}
         if (g == r->num_groups) r->group_track[r->num_groups++] = track;
         group_of[i] = g;
     }
@@ -162,7 +174,8 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo)
         for (j = r->group_first[g]; j < r->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[r->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
-            add_mesh_geometry(r->dev, sc, &s->meshes[in->mesh], r->group_track[g] < 0 ? &world : NULL,
+            add_mesh_geometry(r->dev, sc, &s->meshes[in->mesh],
+                              r->group_track[g] < 0 && !r->group_instanced[g] ? &world : NULL,
                               (unsigned)(j - r->group_first[g]));
         }
         rtcCommitScene(sc);
@@ -173,8 +186,10 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo)
         RTCGeometry geom = rtcNewGeometry(r->dev, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(geom, r->group_scenes[g]);
         if (r->group_track[g] < 0) {
-            evr_m34 id = evr_m34_identity();
-            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &id.m[0][0]);
+            evr_m34 xf = r->group_instanced[g]
+                             ? evr_node_world_at(s, s->instances[r->members[r->group_first[g]]].node, s->anim_start)
+                             : evr_m34_identity();
+            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
         } else {
             int track = r->group_track[g], nk = mo->count[track];
             rtcSetGeometryTimeStepCount(geom, (unsigned)nk);
@@ -198,18 +213,21 @@ static void reference_free(reference *r)
     for (g = 0; g < r->num_groups; g++) rtcReleaseScene(r->group_scenes[g]);
     free(r->group_scenes);
     free(r->group_track);
+    free(r->group_instanced);
     free(r->group_first);
     free(r->members);
     rtcReleaseDevice(r->dev);
 }
 
 /* The GPU BVH's groups are the reference's (the CPU backend's): same order, nodes and members. */
-static int same_groups(const evr_gpu_bvh *b, const reference *r)
+static int same_groups(const evr_scene *s, const evr_gpu_bvh *b, const reference *r)
 {
     int g, j;
     if (b->num_groups != r->num_groups) return 0;
     for (g = 0; g < r->num_groups; g++) {
-        if (b->group_node[g] != r->group_track[g] || b->group_first[g + 1] != r->group_first[g + 1]) return 0;
+        /* an instanced static group is in its node's space */
+        int node = r->group_instanced[g] ? s->instances[r->members[r->group_first[g]]].node : r->group_track[g];
+        if (b->group_node[g] != node || b->group_first[g + 1] != r->group_first[g + 1]) return 0;
         for (j = r->group_first[g]; j < r->group_first[g + 1]; j++)
             if (b->members[j] != r->members[j] || b->instance_group[r->members[j]] != g) return 0;
     }
@@ -847,7 +865,7 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     int *off = malloc(sizeof(int) * ((size_t)n_inst + 1)), *cnt = malloc(sizeof(int) * ((size_t)n_inst + 1));
     int *kind = malloc(sizeof(int) * (size_t)n_rays);
     test_ray *rays = malloc(sizeof *rays * (size_t)n_rays);
-    reference ref;
+    reference ref, ref_inst;
     motion mo;
     evr_m34 id = evr_m34_identity();
     uint64_t c = 21;
@@ -901,7 +919,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     mo.keys = keys;
     mo.offset = off;
     mo.count = cnt;
-    reference_build(&ref, &sc, &mo);
+    reference_build(&ref, &sc, &mo, 0);
+    reference_build(&ref_inst, &sc, &mo, 1);
 
     for (i = 0; i < n_rays; i++) {
         evr_v3 d;
@@ -917,7 +936,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     j.meshes = meshes;
     j.rs = &rs;
     j.delta = 1e-6f * 40.0f;
-    for (li = 0; li < 3; li++) {   /* both layouts, and without grouping */
+    /* both layouts, without grouping, and with the static instances instanced (CW8, BVH4) */
+    for (li = 0; li < 5; li++) {
         int layout = li == 1 ? EVR_GPU_LAYOUT_BVH4 : EVR_GPU_LAYOUT_CW8;
         evr_gpu_bvh bvh;
         evr_gpu_top top;
@@ -926,11 +946,21 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         long bad, m;
         char what[64];
         if (li == 2) layout |= EVR_GPU_BVH_UNGROUPED;
+        if (li == 4) layout = EVR_GPU_LAYOUT_BVH4;
         memset(&top, 0, sizeof top);
         memset(&ty, 0, sizeof ty);
+        if (li >= 3) setenv("EVR_STATIC_BAKE_LIMIT", "0", 1);   /* past the limit: instance */
         CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
-        if (li < 2) {
-            CHECK(bvh.grouped && same_groups(&bvh, &ref));
+        unsetenv("EVR_STATIC_BAKE_LIMIT");
+        if (li >= 3) {
+            CHECK(bvh.grouped && bvh.static_instanced && bvh.static_group < 0);
+            CHECK(same_groups(&sc, &bvh, &ref_inst));
+            /* trees: one per mesh for every single-mesh group, static or moving, and the two
+             * two-mesh groups' (mesh orders 0 1 and 1 0) */
+            CHECK(bvh.num_trees == 4);
+        } else if (li < 2) {
+            CHECK(!bvh.static_instanced);
+            CHECK(bvh.grouped && same_groups(&sc, &bvh, li < 3 ? &ref : &ref_inst));
             CHECK(bvh.static_group >= 0 &&
                   bvh.group_first[bvh.static_group + 1] - bvh.group_first[bvh.static_group] == n_static);
             /* trees: the static group's, one per mesh for the single-mesh groups, two for the
@@ -945,9 +975,11 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         bad = check_group_boxes(&bvh, &top, &rs, 200, &c);
         CHECK(bad == 0);
         snprintf(what, sizeof what, "instances/%s", layout_name(layout));
-        compare(what, &j, &view, &ref, rays, kind, n_rays, &ty);
-        printf("%d instances on %d nodes, layout %s: %d groups (%d instances static), %d trees, %u triangle "
-               "references; top level %u nodes, stack %d of %d\n", n_inst, nn, layout_name(layout), bvh.num_groups,
+        if (li >= 3) snprintf(what, sizeof what, "instances/%s static instanced", layout_name(layout));
+        compare(what, &j, &view, li >= 3 ? &ref_inst : &ref, rays, kind, n_rays, &ty);
+        printf("%d instances on %d nodes, layout %s%s: %d groups (%d instances static), %d trees, %u triangle "
+               "references; top level %u nodes, stack %d of %d\n", n_inst, nn, layout_name(layout),
+               li >= 3 ? " (static instanced)" : "", bvh.num_groups,
                n_static, bvh.num_trees, bvh.num_tris, top.num_nodes, top.stack_need, EVR_GPU_STACK_SIZE);
         report_line(RAY_RANDOM, &ty);
         CHECK(ty.closest[RAY_RANDOM][EX_NONE] == 0);
@@ -961,11 +993,12 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         tot->contact += ty.closest[RAY_RANDOM][EX_CONTACT] + ty.occluded[RAY_RANDOM][EX_CONTACT];
         tot->unexplained += ty.closest[RAY_RANDOM][EX_NONE] + ty.occluded[RAY_RANDOM][EX_NONE];
         snprintf(what, sizeof what, "random rays, %s", layout_name(layout));
-        timing(what, &view, &rs, &ref, rays, n_rays);
+        timing(what, &view, &rs, li >= 3 ? &ref_inst : &ref, rays, n_rays);
         evr_gpu_top_free(&top);
         evr_gpu_bvh_free(&bvh);
     }
     reference_free(&ref);
+    reference_free(&ref_inst);
     free_mesh(&meshes[0]);
     free_mesh(&meshes[1]);
     free(nodes);
@@ -1040,8 +1073,8 @@ static void test_scene(const char *name, const char *expect_groups, const double
         host.rs.track_offset = mo.offset;
         host.rs.track_count = mo.count;
         for (i = 0; i < s->num_instances; i++) moving += mo.count[host.rs.instances[i].track] > 1;
-        reference_build(&ref, s, &mo);
-        CHECK(same_groups(&bvh[0], &ref) && same_groups(&bvh[1], &ref));
+        reference_build(&ref, s, &mo, 0);
+        CHECK(same_groups(s, &bvh[0], &ref) && same_groups(s, &bvh[1], &ref));
         rays = make_rays(s, &host.rs, n_cam, n_shadow, n_random, 0x5eedull + (uint64_t)(t0 * 1000));
         kind = malloc(sizeof(int) * (size_t)n);
         for (i = 0; i < n; i++) kind[i] = i < n_cam ? RAY_CAMERA : (i < n_cam + n_shadow ? RAY_SHADOW : RAY_RANDOM);

@@ -97,6 +97,9 @@ typedef struct {
     /* noise */
     float noise_t;      /* time of the next noise candidate */
     uint32_t noise_n;   /* index of that candidate in the pixel's noise stream */
+    /* change-driven sampling (core/skip.h) */
+    float cache_dist;   /* hit distance of the last traced sample when its intensity may be reused
+                           (INFINITY: it hit nothing), negative when it may not */
 } evr_pixel_state;
 
 /* One sample interval being turned into events. The levels are in the frame of the drifting
@@ -204,6 +207,7 @@ EVR_HD static inline void evr_pixel_reset(evr_pixel_state *s)
     s->noise_n = 0;
     s->started = 0;
     s->blind = 0;
+    s->cache_dist = -1.0f;
 }
 
 /* The functions below come in two forms: evr_pixel_X(...) runs the full model, checking which

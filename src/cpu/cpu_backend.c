@@ -3,6 +3,7 @@
 #include "backend.h"
 #include "core/rng.h"
 #include "core/shading.h"
+#include "core/skip.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -29,10 +30,13 @@ typedef struct {
     /* Instances are grouped: every instance whose node never moves goes, baked into world space,
      * into one static group; the instances of each moving node share one group. One Embree
      * instance per group keeps overlapping instances (lids over an eyeball) out of each other's
-     * way in the top-level BVH. */
+     * way in the top-level BVH. Past a size (evr_static_bake_limit, build_groups) the static
+     * instances are not baked: each is a group of its own, an Embree instance with its node's
+     * fixed transform of one scene per mesh that all its instances share. */
     int num_groups;
     RTCScene *group_scenes;
-    int *group_track;              /* motion track of the group, -1 for the static group */
+    int *group_track;              /* motion track of the group, -1 for a static group */
+    int *group_instanced;          /* 1: a static instance of a shared per-mesh scene, not baked */
     int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
     int *members;                  /* scene instance index of each geometry */
     RTCScene top;
@@ -47,6 +51,7 @@ typedef struct {
     float *done_frames[2];         /* intensity frames of the segment (done_num_frames images) */
     size_t done_frames_cap[2];     /* images done_frames has room for */
     int done_num_frames[2];
+    unsigned long long done_counts[2][4];   /* samples, rays, samples traced, pixels skipped */
     int head, queued;
     char embree_error[256];
     /* per-segment work */
@@ -55,7 +60,7 @@ typedef struct {
     int frame_f_cap;
     float *frame_out;              /* where the segment's frames go */
     atomic_int next_tile;
-    atomic_ullong samples, rays;
+    atomic_ullong samples, rays, samples_traced, pixels_skipped;
     atomic_int failed;
 } cpu_backend;
 
@@ -85,10 +90,11 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
 
 /* Intensity of eight samples at once (neighbouring pixels of a row, each at its own time):
  * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
- * shared shading of src/core lane by lane. Counts the rays it traces. */
+ * shared shading of src/core lane by lane. Counts the rays it traces; t_hit (may be NULL) gets
+ * each primary ray's hit distance (INFINITY: none). */
 #define PACKET 8
 static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
-                              const int *valid, float *out, unsigned long long *rays)
+                              const int *valid, float *out, float *t_hit, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -122,6 +128,7 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
         out[i] = 0.0f;   /* nothing: black */
         acc[i][0] = acc[i][1] = acc[i][2] = 0.0f;
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (!hit[i]) continue;
         int inst = b->members[b->group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
@@ -158,10 +165,12 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
         if (hit[i]) out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
 }
 
-static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
+static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays,
+                        unsigned long long *traced, unsigned long long *skipped)
 {
     const evr_render_scene *rs = &b->host.rs;
     const evr_segment *seg = b->seg;
+    const evr_skip_plan *plan = seg->skip;
     const int w = b->setup.width, h = b->setup.height, n = b->setup.samples_per_frame;
     const float dt = (float)(seg->t1 - seg->t0);
     int tx = tile % b->tiles_x, ty = tile / b->tiles_x;
@@ -175,8 +184,9 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
         for (x = x0; x < x1; x += PACKET) {
             evr_pixel_state *st[PACKET];
             evr_pixel_params pp[PACKET];   /* each pixel's thresholds, leak and noise (a fixed pattern) */
-            float phi[PACKET], fs[PACKET], intensity[PACKET];
-            int xs[PACKET], valid[PACKET], i;
+            float phi[PACKET], fs[PACKET], intensity[PACKET], t_hit[PACKET];
+            int xs[PACKET], valid[PACKET], trace[PACKET], any_trace = 0, i;
+            evr_ray ray[PACKET];
             for (i = 0; i < PACKET; i++) {
                 xs[i] = x + i < x1 ? x + i : x1 - 1;
                 valid[i] = x + i < x1;
@@ -184,10 +194,24 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                 phi[i] = b->phase[(size_t)y * (size_t)w + (size_t)xs[i]];
                 if (ideal) pp[i] = b->setup.pixel;
                 else evr_pixel_params_at(&b->setup.pixel, xs[i], y, &pp[i]);
+                /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
+                ray[i] = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)y + 0.5f);
+                trace[i] = valid[i] && !evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]);
+                any_trace |= trace[i];
+                if (valid[i] && !trace[i]) (*skipped)++;
             }
             for (k = 0; k < n; k++) {
-                for (i = 0; i < PACKET; i++) fs[i] = ((float)k + phi[i]) / (float)n;
-                sample_intensity8(b, seg->camera_static ? &pose_static : NULL, xs, y, fs, valid, intensity, rays);
+                for (i = 0; i < PACKET; i++) {
+                    fs[i] = ((float)k + phi[i]) / (float)n;
+                    intensity[i] = st[i]->intensity;   /* what a skipped pixel keeps */
+                }
+                if (any_trace) {
+                    float traced_intensity[PACKET];
+                    sample_intensity8(b, seg->camera_static ? &pose_static : NULL, xs, y, fs, trace, traced_intensity,
+                                      t_hit, rays);
+                    for (i = 0; i < PACKET; i++)
+                        if (trace[i]) intensity[i] = traced_intensity[i];
+                }
                 for (i = 0; i < PACKET; i++) {
                     evr_pixel_span sp;
                     float te;
@@ -205,8 +229,14 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                     evr_pixel_end_s(st[i], &sp, !ideal);
                 }
             }
-            for (i = 0; i < PACKET; i++)
-                if (valid[i]) evr_pixel_end_segment(st[i], dt);
+            for (i = 0; i < PACKET; i++) {
+                if (!valid[i]) continue;
+                if (trace[i]) {
+                    st[i]->cache_dist = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
+                    *traced += (unsigned long long)n;
+                }
+                evr_pixel_end_segment(st[i], dt);
+            }
         }
     }
     /* intensity frames: one sample per pixel at each frame's exact time, kept away from the
@@ -225,7 +255,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                     valid[i] = x + i < x1;
                     fs[i] = f;
                 }
-                sample_intensity8(b, &pose, xs, y, fs, valid, intensity, &frame_rays);
+                sample_intensity8(b, &pose, xs, y, fs, valid, intensity, NULL, &frame_rays);
                 for (i = 0; i < PACKET && x + i < x1; i++) img[(size_t)y * (size_t)w + (size_t)(x + i)] = intensity[i];
             }
         }
@@ -236,16 +266,18 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
 static void *worker(void *arg)
 {
     cpu_backend *b = (cpu_backend *)arg;
-    unsigned long long samples = 0, rays = 0;
+    unsigned long long samples = 0, rays = 0, traced = 0, skipped = 0;
 #if defined(__SSE__)
     /* Embree asks for flush-to-zero and denormals-are-zero on every thread that traces */
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 #endif
     int ntiles = b->tiles_x * b->tiles_y, t;
-    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) render_tile(b, t, &samples, &rays);
+    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) render_tile(b, t, &samples, &rays, &traced, &skipped);
     atomic_fetch_add(&b->samples, samples);
     atomic_fetch_add(&b->rays, rays);
+    atomic_fetch_add(&b->samples_traced, traced);
+    atomic_fetch_add(&b->pixels_skipped, skipped);
     return NULL;
 }
 
@@ -320,6 +352,8 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     atomic_store(&b->next_tile, 0);
     atomic_store(&b->samples, 0);
     atomic_store(&b->rays, 0);
+    atomic_store(&b->samples_traced, 0);
+    atomic_store(&b->pixels_skipped, 0);
     atomic_store(&b->failed, 0);
     pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
     if (!th) {
@@ -334,8 +368,12 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     worker(b);   /* the calling thread works too */
     for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
     free(th);
-    base->samples += atomic_load(&b->samples);
-    base->rays += atomic_load(&b->rays);
+    /* counted when collected, so that the totals after a collect are those of the segments
+     * collected so far */
+    b->done_counts[slot][0] = atomic_load(&b->samples);
+    b->done_counts[slot][1] = atomic_load(&b->rays);
+    b->done_counts[slot][2] = atomic_load(&b->samples_traced);
+    b->done_counts[slot][3] = atomic_load(&b->pixels_skipped);
     if (atomic_load(&b->failed)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
@@ -379,6 +417,10 @@ static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float
     int slot = b->head;
     b->head = (b->head + 1) % 2;
     b->queued--;
+    base->samples += b->done_counts[slot][0];
+    base->rays += b->done_counts[slot][1];
+    base->samples_traced += b->done_counts[slot][2];
+    base->pixels_skipped += b->done_counts[slot][3];
     *intensity = b->done_has_intensity[slot] ? b->done_intensity[slot] : NULL;
     *frames = b->done_num_frames[slot] > 0 ? b->done_frames[slot] : NULL;
     if (!evr_events_merge(out, b->done[slot].data, b->done[slot].n, &b->scratch)) {
@@ -400,6 +442,7 @@ static void cpu_release(evr_backend *base)
     }
     free(b->group_scenes);
     free(b->group_track);
+    free(b->group_instanced);
     free(b->group_first);
     free(b->members);
     if (b->device) rtcReleaseDevice(b->device);
@@ -454,49 +497,113 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
-/* Groups the instances (see cpu_backend) and builds one Embree scene per group. */
+/* Baking copies every static instance's triangles into one world-space tree. Past
+ * EVR_STATIC_BAKE_LIMIT_DEFAULT triangles so copied (counted per instance), the static instances
+ * are instanced instead (the same rule as the GPU BVH, gpu_bvh_build.c). The environment
+ * variable EVR_STATIC_BAKE_LIMIT (a triangle count; 0: always instance, for tests and
+ * comparisons) overrides the limit. */
+#define EVR_STATIC_BAKE_LIMIT_DEFAULT 1000000ull
+static unsigned long long static_bake_limit(void)
+{
+    const char *v = getenv("EVR_STATIC_BAKE_LIMIT");
+    char *end;
+    unsigned long long x;
+    if (!v || !*v) return EVR_STATIC_BAKE_LIMIT_DEFAULT;
+    x = strtoull(v, &end, 10);
+    return *end ? EVR_STATIC_BAKE_LIMIT_DEFAULT : x;
+}
+
+/* Groups the instances (see cpu_backend), numbered in the order of their first member, and
+ * builds one Embree scene per group (per mesh for instanced static groups). */
 static int build_groups(cpu_backend *b, const evr_scene *s)
 {
-    int n = s->num_instances, i, j, g;
+    int n = s->num_instances, i, j, g, ok = 1, static_group = -1;
+    unsigned long long static_tris = 0;
+    int instance_static;
     int *group_of = malloc(sizeof(int) * (size_t)(n + 1));
+    int *node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1));
+    int *at = NULL;
+    RTCScene *mesh_scenes = calloc((size_t)s->num_meshes + 1, sizeof *mesh_scenes);
     b->group_track = malloc(sizeof(int) * (size_t)(n + 1));
+    b->group_instanced = calloc((size_t)n + 1, sizeof(int));
     b->group_first = calloc((size_t)n + 2, sizeof(int));
     b->members = malloc(sizeof(int) * (size_t)(n + 1));
-    if (!group_of || !b->group_track || !b->group_first || !b->members) {
+    if (!group_of || !node_group || !mesh_scenes || !b->group_track || !b->group_instanced || !b->group_first ||
+        !b->members) {
         free(group_of);
+        free(node_group);
+        free(mesh_scenes);
         return 0;
     }
+    for (i = 0; i < n; i++)
+        if (node_never_moves(s, s->instances[i].node)) static_tris += s->meshes[s->instances[i].mesh].num_triangles;
+    instance_static = static_tris > static_bake_limit();
+    for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
     b->num_groups = 0;
     for (i = 0; i < n; i++) {
-        int node = s->instances[i].node, track = node_never_moves(s, node) ? -1 : node;
-        for (g = 0; g < b->num_groups && b->group_track[g] != track; g++) {}
-        if (g == b->num_groups) b->group_track[b->num_groups++] = track;
-        group_of[i] = g;
+        int node = s->instances[i].node, moving = !node_never_moves(s, node);
+        int *grp = moving ? &node_group[node] : &static_group;
+        if (!moving && instance_static) {   /* a group of its own */
+            b->group_instanced[b->num_groups] = 1;
+            b->group_track[b->num_groups] = -1;
+            group_of[i] = b->num_groups++;
+            continue;
+        }
+        if (*grp < 0) {
+            *grp = b->num_groups;
+            b->group_track[b->num_groups++] = moving ? node : -1;
+        }
+        group_of[i] = *grp;
     }
-    for (g = 0, j = 0; g < b->num_groups; g++) {
-        b->group_first[g] = j;
-        for (i = 0; i < n; i++)
-            if (group_of[i] == g) b->members[j++] = i;
+    free(node_group);
+    /* members by group, ascending */
+    for (i = 0; i < n; i++) b->group_first[group_of[i] + 1]++;
+    for (g = 0; g < b->num_groups; g++) b->group_first[g + 1] += b->group_first[g];
+    at = malloc(sizeof(int) * ((size_t)b->num_groups + 1));
+    if (!at) {
+        free(group_of);
+        free(mesh_scenes);
+        return 0;
     }
-    b->group_first[b->num_groups] = j;
+    memcpy(at, b->group_first, sizeof(int) * (size_t)b->num_groups);
+    for (i = 0; i < n; i++) b->members[at[group_of[i]]++] = i;
+    free(at);
     free(group_of);
     b->group_scenes = calloc((size_t)b->num_groups + 1, sizeof *b->group_scenes);
-    if (!b->group_scenes) return 0;
-    for (g = 0; g < b->num_groups; g++) {
-        RTCScene sc = rtcNewScene(b->device);
-        if (!sc) return 0;
+    if (!b->group_scenes) ok = 0;
+    for (g = 0; ok && g < b->num_groups; g++) {
+        RTCScene sc;
+        if (b->group_instanced[g]) {   /* the mesh's scene, built once, one reference per group */
+            int mesh = s->instances[b->members[b->group_first[g]]].mesh;
+            if (!mesh_scenes[mesh]) {
+                if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
+                mesh_scenes[mesh] = sc;
+                rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+                if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0)) { ok = 0; break; }
+                rtcCommitScene(sc);
+            }
+            rtcRetainScene(mesh_scenes[mesh]);
+            b->group_scenes[g] = mesh_scenes[mesh];
+            continue;
+        }
+        if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
         b->group_scenes[g] = sc;
         rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
         for (j = b->group_first[g]; j < b->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[b->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
             if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh], b->group_track[g] < 0 ? &world : NULL,
-                                   (unsigned)(j - b->group_first[g])))
-                return 0;
+                                   (unsigned)(j - b->group_first[g]))) {
+                ok = 0;
+                break;
+            }
         }
-        rtcCommitScene(sc);
+        if (ok) rtcCommitScene(sc);
     }
-    return 1;
+    for (i = 0; i < s->num_meshes; i++)
+        if (mesh_scenes[i]) rtcReleaseScene(mesh_scenes[i]);
+    free(mesh_scenes);
+    return ok;
 }
 
 evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
@@ -540,15 +647,19 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     if (!build_groups(b, s) || b->embree_error[0]) goto embree_fail;
     b->top = rtcNewScene(b->device);
     if (!b->top) goto embree_fail;
-    /* rebuilt every segment, but over a handful of instances: quality costs nothing */
+    /* rebuilt every segment, but over a handful of instances (thousands when static instances are
+     * not baked: then nothing in it moves and Embree does not rebuild it): quality costs little */
     rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_HIGH);
     for (m = 0; m < b->num_groups; m++) {
         RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
         if (!g) goto embree_fail;
         rtcSetGeometryInstancedScene(g, b->group_scenes[m]);
-        if (b->group_track[m] < 0) {   /* baked into world space: identity, no motion */
-            evr_m34 id = evr_m34_identity();
-            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &id.m[0][0]);
+        if (b->group_track[m] < 0) {   /* static: baked into world space (identity), or the node's fixed
+                                          transform; no motion */
+            evr_m34 xf = b->group_instanced[m]
+                             ? evr_node_world_at(s, s->instances[b->members[b->group_first[m]]].node, s->anim_start)
+                             : evr_m34_identity();
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
             rtcCommitGeometry(g);
         }
         rtcAttachGeometryByID(b->top, g, (unsigned)m);

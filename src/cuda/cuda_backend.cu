@@ -22,6 +22,7 @@ extern "C" {
 }
 #include "core/rng.h"
 #include "core/shading.h"
+#include "core/skip.h"
 #include "cuda/gpu_traverse.h"
 
 #include <math.h>
@@ -60,7 +61,12 @@ struct kernel_args {
     unsigned long long *keys;      /* event keys */
     unsigned int capacity;
     unsigned int *count;
-    unsigned long long *rays;
+    unsigned long long *rays;      /* [0] rays traced, [1] pixels that reused their intensity */
+    /* change-driven sampling: the segment's plan; with reuse, the skip kernel lists the pixels
+     * that must trace (list, list_count) and the render kernel runs those only */
+    const evr_skip_plan *plan;
+    int *list;
+    unsigned int *list_count;
     /* the sensor kernel's full parameters stay in device memory: this struct is copied per
      * thread (the traversal takes its address), so it is kept small, and this comes last so
      * that the ideal kernel sees the same layout as before the sensor model */
@@ -80,13 +86,16 @@ __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_
 
 /* Intensity of one sample: as sample_intensity in cpu/cpu_backend.c, with our traversal. */
 template <int LAYOUT>
-__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays)
+__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
+                                  float *t_hit)
 {
     const evr_render_scene *rs = &a.rs;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
     evr_gpu_hit hit;
     (*rays)++;
+    *t_hit = INFINITY;
     if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &hit)) return 0.0f;
+    *t_hit = hit.t;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
     evr_surface s;
     evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, ray, hit.t, &s);
@@ -114,17 +123,139 @@ __device__ static unsigned long long pack_event(const kernel_args &a, long long 
            (unsigned long long)p;
 }
 
+/* The pixel's state: all of it for the sensor kernel, the ideal model's part (and the cache of
+ * change-driven sampling) for the ideal kernel. */
+template <int SENSOR>
+__device__ __forceinline__ void load_state(const kernel_args &a, int pix, evr_pixel_state &st)
+{
+    if (SENSOR) {
+        st = a.state_in[pix];
+    } else {
+        const evr_pixel_state *in = &a.state_in[pix];
+        st.ref = in->ref;
+        st.l_prev = in->l_prev;
+        st.t_prev = in->t_prev;
+        st.refr_end = in->refr_end;
+        st.intensity = in->intensity;
+        st.started = in->started;
+        st.blind = in->blind;
+        st.cache_dist = in->cache_dist;
+    }
+}
+
+template <int SENSOR>
+__device__ __forceinline__ void store_state(const kernel_args &a, int pix, const evr_pixel_state &st)
+{
+    if (SENSOR) {
+        a.state_out[pix] = st;
+    } else {
+        evr_pixel_state *out = &a.state_out[pix];
+        out->ref = st.ref;
+        out->l_prev = st.l_prev;
+        out->t_prev = st.t_prev;
+        out->refr_end = st.refr_end;
+        out->intensity = st.intensity;
+        out->started = st.started;
+        out->blind = st.blind;
+        out->cache_dist = st.cache_dist;
+    }
+    if (a.intensity) a.intensity[pix] = st.intensity;
+}
+
+/* One sample (intensity at normalized time f) through the pixel model; its events are appended
+ * with warp-aggregated atomics. Every lane of the warp calls it together; live: this lane has a
+ * sample. */
+template <int SENSOR>
+__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
+                                             bool live, float f, float intensity, int x, int y, unsigned lane)
+{
+    evr_pixel_span sp;
+    int more = 0;
+    if (live)
+        more = SENSOR ? evr_pixel_begin_s(&st, &own, f * a.dt, intensity, &sp, 1)
+                      : evr_pixel_begin_ideal(&st, a.log_floor, f * a.dt, intensity, &sp);
+    const int began = more;
+    for (;;) {
+        float te = 0.0f;
+        int pol = 0, has = 0;
+        if (more) {
+            has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
+                         : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
+            more = has;
+        }
+        unsigned mask = __ballot_sync(0xffffffffu, has);
+        if (!mask) break;
+        unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
+        if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
+        base = __shfl_sync(0xffffffffu, base, leader);
+        if (has) {
+            unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+            long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
+                                    : llround((a.t0 + (double)te) * 1e6);
+            if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
+        }
+    }
+    if (began) evr_pixel_end_s(&st, &sp, SENSOR);
+}
+
+/* Change-driven sampling, first pass: a pixel that keeps its cached intensity runs its samples
+ * through the pixel model here (no rays); the others are listed for the render kernel. */
+template <int SENSOR>
+__global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
+{
+    const int npix = a.width * a.height;
+    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    const bool active = pix < npix;
+    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    const unsigned lane = threadIdx.x & 31u;
+    evr_pixel_state st;
+    evr_pixel_reset(&st);
+    evr_pixel_params own;
+    if (SENSOR) own = *a.sensor;
+    bool skip = false;
+    float phi = 0.0f;
+    if (active) {
+        load_state<SENSOR>(a, pix, st);
+        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
+        phi = a.phase[pix];
+        evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
+        evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
+        skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
+    }
+    const unsigned traced = __ballot_sync(0xffffffffu, active && !skip);
+    if (traced) {
+        unsigned leader = (unsigned)__ffs(traced) - 1u, base = 0;
+        if (lane == leader) base = atomicAdd(a.list_count, (unsigned)__popc(traced));
+        base = __shfl_sync(0xffffffffu, base, leader);
+        if (active && !skip) a.list[base + (unsigned)__popc(traced & ((1u << lane) - 1u))] = pix;
+    }
+    const unsigned skipped = __ballot_sync(0xffffffffu, skip);
+    if (!skipped) return;   /* the whole warp */
+    if (lane == 0) atomicAdd(&a.rays[1], (unsigned long long)__popc(skipped));
+    const float kept = st.intensity;
+    for (int k = 0; k < a.samples; k++)
+        pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y, lane);
+    if (skip) {
+        evr_pixel_end_segment(&st, a.dt);
+        store_state<SENSOR>(a, pix, st);
+    }
+}
+
 /* SENSOR: 1 for the full sensor model of core/pixel.h (mismatch, bandwidth, leak, noise,
  * timestamps), 0 for the ideal sensor: then the kernel runs the ideal model's own functions on the
  * ideal part of the state and compiles to the same code as before the sensor model existed (same
  * size and layout: measured on an H100, the same time on the eye and square demos; an earlier
- * version a few instructions longer was 40% slower on the square through instruction fetch). */
+ * version a few instructions longer was 40% slower on the square through instruction fetch).
+ * With a list (change-driven sampling), thread i renders pixel list[i]. */
 template <int LAYOUT, int SENSOR>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a)
 {
     const int npix = a.width * a.height;
-    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
-    const bool active = pix < npix;      /* inactive threads still take part in warp votes */
+    const int n = a.list ? (int)*a.list_count : npix;
+    const int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if ((int)(blockIdx.x * blockDim.x) >= n) return;   /* the whole block */
+    const bool active = i < n;           /* inactive threads still take part in warp votes */
+    const int pix = active ? (a.list ? a.list[i] : i) : 0;
     const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
@@ -133,71 +264,26 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
     evr_pixel_params own;                /* the sensor kernel's parameters of this pixel */
     if (SENSOR) own = *a.sensor;
     if (active) {
-        if (SENSOR) {
-            st = a.state_in[pix];
-            evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
-        } else {                         /* the ideal model's state only */
-            const evr_pixel_state *in = &a.state_in[pix];
-            st.ref = in->ref;
-            st.l_prev = in->l_prev;
-            st.t_prev = in->t_prev;
-            st.refr_end = in->refr_end;
-            st.intensity = in->intensity;
-            st.started = in->started;
-            st.blind = in->blind;
-        }
+        load_state<SENSOR>(a, pix, st);
+        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
         phi = a.phase[pix];
     }
     unsigned rays = 0;
+    float t_hit = INFINITY;
     evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     for (int k = 0; k < a.samples; k++) {
-        float f = ((float)k + phi) / (float)a.samples;
-        evr_pixel_span sp;
-        int more = 0;
+        float f = ((float)k + phi) / (float)a.samples, intensity = 0.0f;
         if (active) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            float intensity = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays);
-            more = SENSOR ? evr_pixel_begin_s(&st, &own, f * a.dt, intensity, &sp, 1)
-                          : evr_pixel_begin_ideal(&st, a.log_floor, f * a.dt, intensity, &sp);
+            intensity = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit);
         }
-        const int began = more;
-        for (;;) {
-            float te = 0.0f;
-            int pol = 0, has = 0;
-            if (more) {
-                has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
-                             : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
-                more = has;
-            }
-            unsigned mask = __ballot_sync(0xffffffffu, has);
-            if (!mask) break;
-            unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
-            if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
-            base = __shfl_sync(0xffffffffu, base, leader);
-            if (has) {
-                unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
-                long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
-                                        : llround((a.t0 + (double)te) * 1e6);
-                if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
-            }
-        }
-        if (began) evr_pixel_end_s(&st, &sp, SENSOR);
+        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
     }
     if (active) {
+        evr_ray ray = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+        st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray, t_hit);
         evr_pixel_end_segment(&st, a.dt);
-        if (SENSOR) {
-            a.state_out[pix] = st;
-        } else {
-            evr_pixel_state *out = &a.state_out[pix];
-            out->ref = st.ref;
-            out->l_prev = st.l_prev;
-            out->t_prev = st.t_prev;
-            out->refr_end = st.refr_end;
-            out->intensity = st.intensity;
-            out->started = st.started;
-            out->blind = st.blind;
-        }
-        if (a.intensity) a.intensity[pix] = st.intensity;
+        store_state<SENSOR>(a, pix, st);
     }
     unsigned long long r = rays;
     for (int o = 16; o > 0; o >>= 1) r += __shfl_down_sync(0xffffffffu, r, o);
@@ -219,7 +305,8 @@ __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float
     for (int k = 0; k < num_frames; k++) {
         const float f = frame_f[k];
         evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
-        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays);
+        float t_hit;
+        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit);
     }
 }
 
@@ -279,7 +366,11 @@ struct slot {
     dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
     dbuf<unsigned char> d_sort_temp;
     dbuf<unsigned int> d_count;
-    dbuf<unsigned long long> d_rays;
+    dbuf<unsigned long long> d_rays;   /* rays, pixels skipped */
+    dbuf<evr_skip_plan> d_plan;
+    hbuf<evr_skip_plan> h_plan;
+    dbuf<int> d_list;                  /* pixels that trace (change-driven sampling) */
+    int reuse;                         /* the plan lets pixels reuse their intensity */
     dbuf<float> d_intensity;
     hbuf<unsigned int> h_count;
     hbuf<unsigned long long> h_rays;
@@ -447,19 +538,27 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.capacity = (unsigned)sl->d_keys_ev.cap;
     a.count = sl->d_count.p;
     a.rays = sl->d_rays.p;
+    a.plan = sl->d_plan.p;
+    a.list = sl->reuse ? sl->d_list.p : NULL;
+    a.list_count = sl->d_count.p + 1;
     return a;
 }
 
 /* Renders a slot's segment on the render stream and queues the read-back of its event count. */
 static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 {
-    CK(cudaMemsetAsync(sl->d_count.p, 0, sizeof(unsigned int), b->render));
-    CK(cudaMemsetAsync(sl->d_rays.p, 0, sizeof(unsigned long long), b->render));
+    CK(cudaMemsetAsync(sl->d_count.p, 0, 2 * sizeof(unsigned int), b->render));
+    CK(cudaMemsetAsync(sl->d_rays.p, 0, 2 * sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
     int npix = b->setup.width * b->setup.height;
     CK(cudaEventRecord(sl->started, b->render));
     const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
     const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
+    if (sl->reuse) {
+        if (ideal) skip_kernel<0><<<grid, BLOCK, 0, b->render>>>(a);
+        else skip_kernel<1><<<grid, BLOCK, 0, b->render>>>(a);
+        CK(cudaGetLastError());
+    }
     if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
         if (ideal) render_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a);
         else render_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a);
@@ -479,7 +578,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
-    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, 2 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaEventRecord(sl->counted, sl->copy));
     return EVR_OK;
 }
@@ -499,6 +598,9 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     sl->t1 = seg->t1;
     sl->camera_static = seg->camera_static;
     sl->want_intensity = seg->want_intensity;
+    sl->reuse = seg->skip->reuse;
+    *sl->h_plan.p = *seg->skip;
+    CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice, b->render));
     sl->num_frames = seg->num_frames > 0 ? seg->num_frames : 0;
     if (sl->num_frames) {
         size_t nf = (size_t)sl->num_frames, npix = (size_t)b->setup.width * b->setup.height;
@@ -568,7 +670,7 @@ static uint64_t device_bytes(const cuda_backend *b)
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
-             bytes(sl->d_rays) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames);
+             bytes(sl->d_rays) + bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames);
     }
     return n;
 }
@@ -594,7 +696,10 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(cudaEventSynchronize(sl->counted));
         n = *sl->h_count.p;
     }
-    base->rays += *sl->h_rays.p;
+    base->rays += sl->h_rays.p[0];
+    base->pixels_skipped += sl->h_rays.p[1];
+    base->samples_traced += ((uint64_t)b->setup.width * (uint64_t)b->setup.height - sl->h_rays.p[1]) *
+                            (uint64_t)b->setup.samples_per_frame;
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
@@ -669,6 +774,7 @@ static void cuda_release(evr_backend *base)
         sl->d_top4.release(); sl->d_top8.release(); sl->d_insts.release();
         sl->d_keys_ev.release(); sl->d_keys_sorted.release(); sl->d_sort_temp.release();
         sl->d_count.release(); sl->d_rays.release(); sl->d_intensity.release();
+        sl->d_plan.release(); sl->h_plan.release(); sl->d_list.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
         if (sl->framed) cudaEventDestroy(sl->framed);
@@ -739,11 +845,14 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaEventCreate(&sl->copied));
         CK(cudaEventCreate(&sl->framed));
         CK(sl->d_keys_ev.reserve(b->capacity));
-        CK(sl->d_count.reserve(1));
-        CK(sl->d_rays.reserve(1));
+        CK(sl->d_count.reserve(2));
+        CK(sl->d_rays.reserve(2));
+        CK(sl->d_plan.reserve(1));
+        CK(sl->h_plan.reserve(1));
+        CK(sl->d_list.reserve((size_t)b->setup.width * (size_t)b->setup.height));
         CK(sl->d_intensity.reserve(npix));
         CK(sl->h_count.reserve(1));
-        CK(sl->h_rays.reserve(1));
+        CK(sl->h_rays.reserve(2));
     }
     CK(cudaDeviceSynchronize());
     return EVR_OK;

@@ -5,7 +5,12 @@
  * (cpu_backend.c, build_groups):
  *   static group  every instance whose node never moves (no animated node on its parent chain),
  *                 its mesh's triangles baked into world space with the node's transform at
- *                 evr_scene.anim_start; one group, identity transform, no motion;
+ *                 evr_scene.anim_start; one group, identity transform, no motion. Unless baking
+ *                 would copy more than 1M triangles (counted per instance; the environment
+ *                 variable EVR_STATIC_BAKE_LIMIT sets another limit, 0: always): then every
+ *                 static instance is a group of its own in its node's space (its node's fixed
+ *                 track, no motion), and the groups of one mesh share one tree (a city of
+ *                 thousands of instances of a dozen buildings stores each building once);
  *   moving group  the instances of one moving node, their meshes' triangles together in that
  *                 node's object space; moved by the node's track.
  * A ray that crosses overlapping instances (skin and orbit around an eyeball) then searches one
@@ -142,7 +147,10 @@ typedef struct {
     int grouped;               /* 0: built with EVR_GPU_BVH_UNGROUPED */
     int num_groups;
     int num_scene_instances;
-    int static_group;          /* index of the static group, -1 when every instance moves */
+    int static_group;          /* index of the static group, -1 when every instance moves or the
+                                  static instances are instanced */
+    int static_instanced;      /* 1: the static instances were past the bake limit: each is a group
+                                  of its own in its node's space, the trees shared by mesh */
     int *group_node;           /* per group: the node whose object space it is in and whose track
                                   moves it, -1: world space (the static group) */
     int *group_first;          /* per group + 1: its members are members[group_first[g] ..

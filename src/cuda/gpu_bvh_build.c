@@ -646,19 +646,41 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
+/* The static group's size limit, as the CPU backend's (cpu_backend.c, static_bake_limit): past
+ * EVR_STATIC_BAKE_LIMIT_DEFAULT triangles baked (counted per instance; the environment variable
+ * EVR_STATIC_BAKE_LIMIT overrides it, 0: always instance), the static instances are not baked. */
+#define EVR_STATIC_BAKE_LIMIT_DEFAULT 1000000ull
+static unsigned long long static_bake_limit(void)
+{
+    const char *v = getenv("EVR_STATIC_BAKE_LIMIT");
+    char *end;
+    unsigned long long x;
+    if (!v || !*v) return EVR_STATIC_BAKE_LIMIT_DEFAULT;
+    x = strtoull(v, &end, 10);
+    return *end ? EVR_STATIC_BAKE_LIMIT_DEFAULT : x;
+}
+
 /* Assigns every instance its group (numbered by first member) and lists the members. */
 static int make_groups(const evr_scene *s, evr_gpu_bvh *out, int grouped)
 {
     int n = s->num_instances, i, g;
     int *node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1)), *at;
+    unsigned long long static_tris = 0;
     if (!node_group) return 0;
     for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
+    for (i = 0; i < n; i++) {
+        int m = s->instances[i].mesh;
+        if (m >= 0 && m < s->num_meshes && node_never_moves(s, s->instances[i].node))
+            static_tris += s->meshes[m].num_triangles;
+    }
+    out->static_instanced = grouped && static_tris > static_bake_limit();
     out->static_group = -1;
     out->num_groups = 0;
     for (i = 0; i < n; i++) {
         int node = s->instances[i].node, moving = !node_never_moves(s, node);
         int *grp = moving ? &node_group[node] : &out->static_group;
-        if (!grouped) {   /* a group of its own, in its node's space (none: the world) */
+        if (!grouped || (!moving && out->static_instanced)) {
+            /* a group of its own, in its node's space (none: the world) */
             out->instance_group[i] = out->num_groups;
             out->group_node[out->num_groups++] = node >= 0 && node < s->num_nodes ? node : -1;
             continue;

@@ -34,7 +34,9 @@ static evr_v3 curve_v3(const evr_curve *c, double t)
         const float *a = v + 3 * i, *b = v + 3 * (i + 1);
         double dt = c->times[i + 1] - c->times[i];
         float f;
-        if (c->interp == EVR_INTERP_STEP || dt <= 0.0) return evr_v3_make(a[0], a[1], a[2]);
+        /* a value held between two equal keys is held exactly (float lerp can be off in the last
+         * bit, which would count as motion) */
+        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 3 * sizeof *a)) return evr_v3_make(a[0], a[1], a[2]);
         f = (float)((t - c->times[i]) / dt);
         return evr_v3_lerp(evr_v3_make(a[0], a[1], a[2]), evr_v3_make(b[0], b[1], b[2]), f);
     }
@@ -55,7 +57,7 @@ static evr_quat curve_quat(const evr_curve *c, double t)
         const float *a = v + 4 * i, *b = v + 4 * (i + 1);
         double dt = c->times[i + 1] - c->times[i];
         evr_quat qa = evr_quat_make(a[0], a[1], a[2], a[3]);
-        if (c->interp == EVR_INTERP_STEP || dt <= 0.0) return qa;
+        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 4 * sizeof *a)) return qa;   /* held exactly */
         return evr_quat_slerp(qa, evr_quat_make(b[0], b[1], b[2], b[3]), (float)((t - c->times[i]) / dt));
     }
 }
@@ -248,8 +250,10 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
         }
 
         if (ok && n == 2) {
-            /* Still in the segment (every checked point where the first key is): one key. */
-            evr_m34 a = evr_motion_key_matrix(&keys[0]), b = evr_motion_key_matrix(&keys[1]);
+            /* Still in the segment (every checked point where the first key is): one key. The
+             * world matrices are compared, not the keys' matrices (a key's rebuilt matrix is off
+             * by rounding from the matrix it came from). */
+            evr_m34 a = evr_node_world_at(s, node, t0), b = evr_node_world_at(s, node, t1);
             if (probe_error(&a, &b, probes, np) <= limit * 1e-3f) {
                 int still = 1;
                 for (i = 0; i < ninner && still; i++) {

@@ -15,12 +15,14 @@ typedef struct {
 
 static const demo_entry demos[] = {
     {"eye", evr_demo_build_eye},
+    {"eye-drift", evr_demo_build_eye_drift},
     {"square", evr_demo_build_square},
     {"disk", evr_demo_build_disk},
     {"cornell", evr_demo_build_cornell},
+    {"city", evr_demo_build_city},
 };
 
-static const char *const demo_names[] = {"eye", "square", "disk", "cornell", NULL};
+static const char *const demo_names[] = {"eye", "eye-drift", "square", "disk", "cornell", "city", NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 

@@ -1,4 +1,4 @@
-/* The "eye" scene: what a head-mounted eye tracker's camera sees. Units metres, +Y up, the
+/* The "eye" and "eye-drift" scenes: what a head-mounted eye tracker's camera sees. Units metres, +Y up, the
  * subject looks along +Z; glTF conventions. Sizes below are in millimetres. 31,856 triangles.
  *
  *   eyeball      node "eyeball" at the origin, animated rotation (gaze); children:
@@ -37,14 +37,24 @@
  *                2e-3 candela: a white Lambertian surface at the corneal apex (27.8 from the
  *                LED, facing it) gets radiance 0.82, the sclera, lids and skin 30-35 away about
  *                0.5-0.7 (times the cosine).
- *   animation    "gaze", 3 s, rotation channels of eyeball, upper_lid and lower_lid: fixations
- *                of 180-400 ms with slow drift (< 0.6 deg/s) and nine saccades of 2.8-18.3
- *                degrees (horizontal, vertical and oblique) lasting 2.2 ms/deg + 21 ms with a
- *                smooth, skewed velocity profile (peak 1.63 A/D: 170-490 deg/s); one blink at
- *                0.665 s (upper lid down 38 degrees in 100 ms, closed 30 ms, up in 170 ms; the
- *                lower lid rises 2.5 degrees and the eye dips 2 degrees). The upper lid follows
- *                vertical gaze at 0.7 of its angle, the lower lid at 0.3. LINEAR keys (451),
- *                every 2 ms during saccades and the blink, every <= 25 ms in fixations. */
+ *   animation    "gaze", 30 s, rotation channels of eyeball, upper_lid and lower_lid, from a gaze
+ *                plan made in code: the first ten fixations are the original hand-written 3 s
+ *                sequence, the rest is drawn from a fixed seed (splitmix64, EYE_PLAN_SEED). 84
+ *                fixations of 180-450 ms and 83 saccades of 2.0-19.1 degrees (mean 7.6; random
+ *                directions, small ones more likely; gaze within +-14.6 deg yaw, +-11.1 pitch)
+ *                lasting 2.2 ms/deg + 21 ms with a smooth, skewed velocity profile (peak 1.63 A/D:
+ *                130-490 deg/s); 8 blinks (at 0.665 s, then every 3.4-4.8 s), each 40 ms into a
+ *                fixation of 380-450 ms (upper lid down 38 degrees in 100 ms, closed 30 ms, up in
+ *                170 ms; the lower lid rises 2.5 degrees and the eye dips 2 degrees). The upper lid
+ *                follows vertical gaze at 0.7 of its angle, the lower lid at 0.3. Saccades take
+ *                3.12 s and blinks 2.40 s: the scene moves 18.4% of the time. LINEAR keys, every
+ *                2 ms during saccades and blinks.
+ *                "eye" (2,892 keys): no fixational drift, so during a fixation the eyeball and
+ *                lids are still: its keys (at both ends, and around a blink) hold bit-identical
+ *                rotations.
+ *                "eye-drift" (3,867 keys): the same plan plus slow drift throughout (two
+ *                sinusoids per axis, < 0.15 degrees, < 0.6 deg/s), keys every <= 25 ms in
+ *                fixations; its first 3 s are the original 3 s animation. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,18 +101,32 @@
 #define HOLE_LO 6.5
 
 /* animation */
-#define ANIM_LENGTH 3.0
-#define BLINK_FIX 2             /* the blink happens during this fixation ... */
-#define BLINK_DELAY 0.040       /* ... this long after it starts */
+#define ANIM_LENGTH 30.0
+#define EYE_PLAN_SEED 0x6579652d67617a65ull   /* the gaze plan's seed */
+#define FIX_MIN 0.180           /* fixation durations */
+#define FIX_MAX 0.450
+#define SACC_MIN_DEG 2.0        /* saccade amplitudes */
+#define SACC_MAX_DEG 20.0
+#define GAZE_YAW_MAX 15.0       /* gaze limits */
+#define GAZE_PITCH_MAX 12.0
+#define BLINK_FIX 2             /* the first blink happens during this fixation ... */
+#define BLINK_DELAY 0.040       /* ... this long after it starts (as all blinks) */
 #define BLINK_CLOSE 0.100
 #define BLINK_HOLD 0.030
 #define BLINK_OPEN 0.170
+#define BLINK_LEN (BLINK_CLOSE + BLINK_HOLD + BLINK_OPEN)
+#define BLINK_AFTER_MIN 0.040   /* a blink's fixation goes on at least this long after it */
+#define BLINK_GAP_MIN 2.5       /* from one blink to the next fixation that may hold one */
+#define BLINK_GAP_MAX 4.45
+#define DENSE_KEY_STEP 0.002    /* key spacing in saccades and blinks ... */
+#define FIX_KEY_STEP 0.025      /* ... and in fixations with drift */
 #define BLINK_UPPER_DEG 38.0
 #define BLINK_LOWER_DEG 2.5
 #define BLINK_EYE_DIP_DEG 2.0
 #define LID_FOLLOW_UP 0.7
 #define LID_FOLLOW_LO 0.3
-#define MAX_KEYS 2048
+#define MAX_FIX 256             /* 84 are used */
+#define MAX_KEYS 8192           /* 2,892 are used without drift, 3,867 with */
 
 /* ---- deterministic noise and painting ---- */
 
@@ -730,40 +754,121 @@ static int build_orbit(evr_gltf *g, int material)
 
 /* ---- animation ---- */
 
+/* The gaze plan: the first ten fixations are written by hand (the original 3 s sequence, with its
+ * blink in the third fixation); the rest, up to ANIM_LENGTH, is drawn from a fixed seed. */
 typedef struct {
     double yaw, pitch;   /* degrees; yaw towards +X, pitch up */
-    double duration;     /* seconds; < 0: until the end of the animation */
-} fixation;
+    double duration;     /* seconds; < 0: drawn like the generated ones */
+} fixation_spec;
 
-static const fixation gaze_plan[] = {
+static const fixation_spec plan_start[] = {
     {0.0, 0.0, 0.280}, {10.0, 3.0, 0.240}, {-8.0, 1.0, 0.400}, {-6.0, 9.0, 0.200}, {-3.0, -9.0, 0.380},
     {2.0, -6.0, 0.180}, {4.0, -4.0, 0.250}, {12.0, 2.0, 0.220}, {0.0, 0.0, 0.250}, {-2.0, 4.0, -1.0},
 };
-#define NUM_FIX ((int)(sizeof gaze_plan / sizeof gaze_plan[0]))
+#define NUM_START ((int)(sizeof plan_start / sizeof plan_start[0]))
 
 typedef struct {
-    double fix_start[NUM_FIX], fix_end[NUM_FIX];   /* saccade k runs from fix_end[k] to fix_start[k+1] */
-    double blink_start;
-} timeline;
+    double yaw, pitch;   /* degrees */
+    double start, end;   /* seconds; saccade k runs from fix[k].end to fix[k + 1].start */
+    double blink;        /* start of the blink in this fixation, < 0 for none */
+} fixation;
 
-static double saccade_duration(int k)
+typedef struct {
+    fixation fix[MAX_FIX];
+    int num_fix, num_blinks;
+    int drift;           /* 1: slow fixational drift added everywhere ("eye-drift") */
+} gaze_plan;
+
+/* splitmix64: a small deterministic generator, the same on every platform. */
+static uint64_t splitmix64(uint64_t *s)
 {
-    double a = hypot(gaze_plan[k + 1].yaw - gaze_plan[k].yaw, gaze_plan[k + 1].pitch - gaze_plan[k].pitch);
-    return (2.2 * a + 21.0) * 1e-3;   /* the main sequence */
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
 }
 
-static void make_timeline(timeline *tl)
+static double plan_uniform(uint64_t *s, double a, double b)
 {
-    double t = 0.0;
-    int k;
-    for (k = 0; k < NUM_FIX; k++) {
-        tl->fix_start[k] = t;
-        t += gaze_plan[k].duration >= 0.0 ? gaze_plan[k].duration : 0.0;
-        if (gaze_plan[k].duration < 0.0) t = ANIM_LENGTH;
-        tl->fix_end[k] = t;
-        if (k + 1 < NUM_FIX) t += saccade_duration(k);
+    return a + (b - a) * ((double)(splitmix64(s) >> 11) * (1.0 / 9007199254740992.0));
+}
+
+static double saccade_duration(double yaw0, double pitch0, double yaw1, double pitch1)
+{
+    return (2.2 * hypot(yaw1 - yaw0, pitch1 - pitch0) + 21.0) * 1e-3;   /* the main sequence */
+}
+
+/* The next saccade's target: amplitude SACC_MIN_DEG..SACC_MAX_DEG (small ones more likely), a
+ * uniformly random direction, redrawn until the target lies within the gaze limits. */
+static void next_target(uint64_t *s, double yaw, double pitch, double *ty, double *tp)
+{
+    int tries;
+    for (tries = 0; tries < 1000; tries++) {
+        double a = SACC_MIN_DEG + (SACC_MAX_DEG - SACC_MIN_DEG) * pow(plan_uniform(s, 0.0, 1.0), 1.5);
+        double dir = plan_uniform(s, -PI, PI);
+        *ty = yaw + a * cos(dir);
+        *tp = pitch + a * sin(dir);
+        if (fabs(*ty) <= GAZE_YAW_MAX && fabs(*tp) <= GAZE_PITCH_MAX) return;
     }
-    tl->blink_start = tl->fix_start[BLINK_FIX] + BLINK_DELAY;
+    *ty = 0.0;   /* not reached in practice: back to the centre */
+    *tp = 0.0;
+}
+
+/* Times are rounded to float, as the keys store them. */
+static double key_time(double t) { return (double)(float)t; }
+
+/* Builds the plan; 0 when it does not fit in MAX_FIX fixations. Every fixation lasts
+ * FIX_MIN..FIX_MAX; a blink comes BLINK_GAP_MIN..BLINK_GAP_MAX after the previous one (measured
+ * from the first fixation that starts late enough), BLINK_DELAY into a fixation that is made long
+ * enough to hold it. */
+static int make_plan(gaze_plan *p, int drift)
+{
+    uint64_t s = EYE_PLAN_SEED;
+    double t = 0.0, next_blink = 0.0, ny, np;
+    int k;
+    p->num_fix = 0;
+    p->num_blinks = 0;
+    p->drift = drift;
+    ny = plan_start[0].yaw;
+    np = plan_start[0].pitch;
+    for (k = 0;; k++) {
+        fixation *f = &p->fix[k];
+        double rest = ANIM_LENGTH - t, dur, sacc, need = BLINK_DELAY + BLINK_LEN + BLINK_AFTER_MIN;
+        int blink;
+        if (k >= MAX_FIX) return 0;
+        f->yaw = ny;
+        f->pitch = np;
+        f->start = t;
+        f->blink = -1.0;
+        p->num_fix = k + 1;
+        blink = k == BLINK_FIX || (k > BLINK_FIX && t + BLINK_DELAY >= next_blink);
+        if (k < NUM_START && plan_start[k].duration >= 0.0) dur = plan_start[k].duration;
+        else if (blink) dur = need + plan_uniform(&s, 0.0, FIX_MAX - need);
+        else dur = plan_uniform(&s, FIX_MIN, FIX_MAX);
+        if (k >= NUM_START && rest <= FIX_MAX) {   /* the last fixation runs to the end */
+            f->end = ANIM_LENGTH;
+            if (blink && rest >= need) {
+                f->blink = key_time(t + BLINK_DELAY);
+                p->num_blinks++;
+            }
+            return 1;
+        }
+        if (k + 1 < NUM_START) {
+            ny = plan_start[k + 1].yaw;
+            np = plan_start[k + 1].pitch;
+        } else {
+            next_target(&s, f->yaw, f->pitch, &ny, &np);
+        }
+        sacc = saccade_duration(f->yaw, f->pitch, ny, np);
+        if (dur > rest - sacc - FIX_MIN) dur = rest - sacc - FIX_MIN;   /* leave room for a last one */
+        if (blink && dur >= need - 1e-9) {
+            f->blink = key_time(t + BLINK_DELAY);
+            p->num_blinks++;
+            next_blink = f->blink + plan_uniform(&s, BLINK_GAP_MIN, BLINK_GAP_MAX);
+        }
+        f->end = key_time(t + dur);
+        t = key_time(f->end + sacc);
+    }
 }
 
 /* Position along a saccade: the integral of a velocity profile t (1-t)^1.5, normalized. Its peak
@@ -774,47 +879,59 @@ static double saccade_profile(double t)
     return 1.0 - 3.5 * pow(w, 2.5) + 2.5 * pow(w, 3.5);
 }
 
-/* Lid closure 0 (open) .. 1 (closed). */
-static double blink_at(const timeline *tl, double t)
+/* Lid closure 0 (open) .. 1 (closed). Exactly 0 outside the blinks (and where the closure is
+ * below 1e-9, so that a key at a blink's end rounded in time still holds the open pose). */
+static double blink_at(const gaze_plan *p, int k, double t)
 {
-    double s = t - tl->blink_start;
-    if (s <= 0.0 || s >= BLINK_CLOSE + BLINK_HOLD + BLINK_OPEN) return 0.0;
-    if (s < BLINK_CLOSE) return saccade_profile(s / BLINK_CLOSE);
-    if (s < BLINK_CLOSE + BLINK_HOLD) return 1.0;
-    return 1.0 - saccade_profile((s - BLINK_CLOSE - BLINK_HOLD) / BLINK_OPEN);
+    double s = t - p->fix[k].blink, b;
+    if (p->fix[k].blink < 0.0 || s <= 0.0 || s >= BLINK_LEN) return 0.0;
+    if (s < BLINK_CLOSE) b = saccade_profile(s / BLINK_CLOSE);
+    else if (s < BLINK_CLOSE + BLINK_HOLD) b = 1.0;
+    else b = 1.0 - saccade_profile((s - BLINK_CLOSE - BLINK_HOLD) / BLINK_OPEN);
+    return b < 1e-9 ? 0.0 : b;
 }
 
-static void gaze_at(const timeline *tl, double t, double *yaw, double *pitch)
+/* Gaze (degrees) and lid closure at time t. Inside a fixation without drift it is exactly the
+ * fixation's gaze (the blink's dip aside), so all keys of a fixation hold the same values. */
+static void gaze_at(const gaze_plan *p, double t, double *yaw, double *pitch, double *closure)
 {
     int k;
-    double b = blink_at(tl, t);
-    *yaw = gaze_plan[NUM_FIX - 1].yaw;
-    *pitch = gaze_plan[NUM_FIX - 1].pitch;
-    for (k = 0; k < NUM_FIX; k++) {
-        if (t <= tl->fix_end[k]) {
-            *yaw = gaze_plan[k].yaw;
-            *pitch = gaze_plan[k].pitch;
+    double b = 0.0;
+    *yaw = p->fix[p->num_fix - 1].yaw;
+    *pitch = p->fix[p->num_fix - 1].pitch;
+    for (k = 0; k < p->num_fix; k++) {
+        const fixation *f = &p->fix[k];
+        if (t <= f->end) {
+            *yaw = f->yaw;
+            *pitch = f->pitch;
+            b = blink_at(p, k, t);
             break;
         }
-        if (k + 1 < NUM_FIX && t < tl->fix_start[k + 1]) {
-            double f = saccade_profile((t - tl->fix_end[k]) / (tl->fix_start[k + 1] - tl->fix_end[k]));
-            *yaw = gaze_plan[k].yaw + (gaze_plan[k + 1].yaw - gaze_plan[k].yaw) * f;
-            *pitch = gaze_plan[k].pitch + (gaze_plan[k + 1].pitch - gaze_plan[k].pitch) * f;
+        if (k + 1 < p->num_fix && t < p->fix[k + 1].start) {
+            const fixation *g = &p->fix[k + 1];
+            double s = saccade_profile((t - f->end) / (g->start - f->end));
+            *yaw = f->yaw + (g->yaw - f->yaw) * s;
+            *pitch = f->pitch + (g->pitch - f->pitch) * s;
             break;
         }
     }
-    /* slow drift, continuous across the whole sequence (peak speed ~0.55 deg/s) */
-    *yaw += 0.06 * sin(2.0 * PI * 0.83 * t + 0.3) + 0.02 * sin(2.0 * PI * 2.1 * t + 1.1);
-    *pitch += 0.05 * sin(2.0 * PI * 0.61 * t + 2.0) + 0.02 * sin(2.0 * PI * 2.9 * t + 0.5);
+    if (p->drift) {   /* slow drift, continuous across the whole sequence (peak speed ~0.55 deg/s) */
+        *yaw += 0.06 * sin(2.0 * PI * 0.83 * t + 0.3) + 0.02 * sin(2.0 * PI * 2.1 * t + 1.1);
+        *pitch += 0.05 * sin(2.0 * PI * 0.61 * t + 2.0) + 0.02 * sin(2.0 * PI * 2.9 * t + 0.5);
+    }
     *pitch -= BLINK_EYE_DIP_DEG * b;   /* the eye dips during a blink */
+    *closure = b;
 }
 
-/* Adds n + 1 uniformly spaced times over [a, b] with spacing at most step. */
+/* Adds n + 1 uniformly spaced times over [a, b] (both ends exactly) with spacing at most step;
+ * returns -1 when MAX_KEYS would be exceeded. */
 static int add_times(double *times, int count, double a, double b, double step)
 {
     int n = (int)ceil((b - a) / step - 1e-9), i;
+    if (count < 0) return -1;
     if (n < 1) n = 1;
-    for (i = 0; i <= n && count < MAX_KEYS; i++) times[count++] = a + (b - a) * i / n;
+    if (count + n + 1 > MAX_KEYS) return -1;
+    for (i = 0; i <= n; i++) times[count++] = i == n ? b : a + (b - a) * i / n;
     return count;
 }
 
@@ -830,32 +947,42 @@ static void quat_axis(double ax, double ay, double az, double angle_deg, evr_qua
     *q = evr_quat_make((float)cos(h), (float)(ax * s), (float)(ay * s), (float)(az * s));
 }
 
-static void build_animation(evr_gltf *g, int eyeball, int upper, int lower)
+/* Keys: at both ends of every fixation and saccade, every 2 ms in saccades and blinks, and with
+ * drift every <= 25 ms in fixations. Without drift the keys of a fixation are bit-identical. */
+static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int drift)
 {
-    timeline tl;
+    gaze_plan *plan = malloc(sizeof *plan);
     double *t = malloc(sizeof(double) * MAX_KEYS);
     float *times = malloc(sizeof(float) * MAX_KEYS), *qe = malloc(sizeof(float) * 4 * MAX_KEYS);
     float *qu = malloc(sizeof(float) * 4 * MAX_KEYS), *ql = malloc(sizeof(float) * 4 * MAX_KEYS);
     int n = 0, m = 0, k, anim;
-    if (!t || !times || !qe || !qu || !ql) {
+    if (!plan || !t || !times || !qe || !qu || !ql) {
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while building the eye animation");
         goto done;
     }
-    make_timeline(&tl);
-    for (k = 0; k < NUM_FIX; k++) {
-        n = add_times(t, n, tl.fix_start[k], tl.fix_end[k], 0.025);
-        if (k + 1 < NUM_FIX) n = add_times(t, n, tl.fix_end[k], tl.fix_start[k + 1], 0.002);
+    if (!make_plan(plan, drift)) {
+        evr_gltf_fail(g, EVR_ERR_ARG, "eye animation: the gaze plan needs more than MAX_FIX fixations");
+        goto done;
     }
-    n = add_times(t, n, tl.blink_start, tl.blink_start + BLINK_CLOSE + BLINK_HOLD + BLINK_OPEN, 0.002);
+    for (k = 0; k < plan->num_fix; k++) {
+        const fixation *f = &plan->fix[k];
+        n = add_times(t, n, f->start, f->end, drift ? FIX_KEY_STEP : 2.0 * ANIM_LENGTH);
+        if (f->blink >= 0.0) n = add_times(t, n, f->blink, f->blink + BLINK_LEN, DENSE_KEY_STEP);
+        if (k + 1 < plan->num_fix) n = add_times(t, n, f->end, plan->fix[k + 1].start, DENSE_KEY_STEP);
+    }
+    if (n < 0) {
+        evr_gltf_fail(g, EVR_ERR_ARG, "eye animation: more than MAX_KEYS keys");
+        goto done;
+    }
     qsort(t, (size_t)n, sizeof(double), cmp_double);
-    for (k = 0; k < n; k++) {           /* merge times closer than 0.4 ms */
+    for (k = 0; k < n; k++) {           /* merge times closer than 0.4 ms (exact repeats at the ends) */
         if (m > 0 && t[k] - t[m - 1] < 4e-4) continue;
         t[m++] = t[k];
     }
     for (k = 0; k < m; k++) {
-        double yaw, pitch, b = blink_at(&tl, t[k]);
+        double yaw, pitch, b;
         evr_quat qy, qx, q;
-        gaze_at(&tl, t[k], &yaw, &pitch);
+        gaze_at(plan, t[k], &yaw, &pitch, &b);
         times[k] = (float)t[k];
         quat_axis(0, 1, 0, yaw, &qy);
         quat_axis(1, 0, 0, -pitch, &qx);   /* a positive turn about +X moves the front down */
@@ -875,6 +1002,7 @@ static void build_animation(evr_gltf *g, int eyeball, int upper, int lower)
     evr_gltf_channel(g, anim, upper, EVR_GLTF_ROTATION, times, qu, m, EVR_GLTF_LINEAR);
     evr_gltf_channel(g, anim, lower, EVR_GLTF_ROTATION, times, ql, m, EVR_GLTF_LINEAR);
 done:
+    free(plan);
     free(t);
     free(times);
     free(qe);
@@ -893,7 +1021,7 @@ static int add_material(evr_gltf *g, const char *name, int texture, float roughn
     return evr_gltf_add_material(g, &m);
 }
 
-void evr_demo_build_eye(evr_gltf *g)
+static void build_eye(evr_gltf *g, int drift)
 {
     static const double cam_pos[3] = {0.0, -10.0 * MM, 40.0 * MM}, target[3] = {0.0, 0.0, 0.0},
                         up[3] = {0.0, 1.0, 0.0};
@@ -944,5 +1072,9 @@ void evr_demo_build_eye(evr_gltf *g)
     evr_gltf_node_translation(g, node, (float)(5.0 * MM), (float)(-10.0 * MM), (float)(40.0 * MM));
     evr_gltf_node_light(g, node, led);
 
-    build_animation(g, eyeball, upper, lower);
+    build_animation(g, eyeball, upper, lower, drift);
 }
+
+void evr_demo_build_eye(evr_gltf *g) { build_eye(g, 0); }
+
+void evr_demo_build_eye_drift(evr_gltf *g) { build_eye(g, 1); }

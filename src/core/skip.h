@@ -1,0 +1,105 @@
+/* Change-driven sampling: which pixels can keep their last intensity for a whole segment.
+ *
+ * A pixel's intensity depends on its primary ray (up to the surface it hits) and on the shadow
+ * rays from that surface to the lights. While the camera and the lights hold still, the pixel's
+ * last traced sample is reused when none of those rays meets the swept bounds of anything that
+ * moves in the segment, and when that sample was itself taken with none of its rays meeting
+ * anything that moved in its own segment (the pixel's cache is "clean"). Then every sample of
+ * the segment would trace exactly the same rays against exactly the same triangles: the cached
+ * intensity is bit for bit what brute force computes, and the pixel model, run on it sample by
+ * sample, gives identical events (noise included). The host fills an evr_skip_plan per segment
+ * (src/skip_plan.c); both backends run these functions per pixel. */
+#ifndef EVR_CORE_SKIP_H
+#define EVR_CORE_SKIP_H
+
+#include "core/render_scene.h"
+#include "core/shading.h"
+
+#define EVR_SKIP_MAX_BOXES 64
+
+typedef struct {
+    int reuse;            /* clean caches may be reused this segment (camera and lights still, and
+                             unchanged since the previous segment) */
+    int cache;            /* samples traced this segment may become clean caches (camera and
+                             lights still in the segment) */
+    int num_boxes;
+    float pad;            /* added to every box on every side (float error of the tests) */
+    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+} evr_skip_plan;
+
+/* Whether the part [0, tmax] of the ray o + t d meets the box (padded): the slab test. Any NaN
+ * makes it answer yes, so that a doubtful case is traced. */
+EVR_HD static inline int evr_skip_segment_meets(evr_v3 o, evr_v3 d, float tmax, const float lo[3], const float hi[3],
+                                                float pad)
+{
+    const float org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
+    float t0 = 0.0f, t1 = tmax;
+    for (int a = 0; a < 3; a++) {
+        const float l = lo[a] - pad, h = hi[a] + pad;
+        if (dir[a] == 0.0f) {
+            if (org[a] < l || org[a] > h) return 0;
+            continue;
+        }
+        const float inv = 1.0f / dir[a];
+        float ta = (l - org[a]) * inv, tb = (h - org[a]) * inv;
+        if (ta > tb) {
+            float s = ta;
+            ta = tb;
+            tb = s;
+        }
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
+        if (t0 > t1) return 0;
+    }
+    return 1;
+}
+
+EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 o, evr_v3 d, float tmax)
+{
+    for (int b = 0; b < pl->num_boxes; b++)
+        if (evr_skip_segment_meets(o, d, tmax, pl->lo[b], pl->hi[b], pl->pad)) return 1;
+    return 0;
+}
+
+/* Whether a sample's rays meet anything that moves: the primary ray up to its hit at distance
+ * t_hit (INFINITY or more than 1e29: nothing hit, the whole ray) and, from the hit point computed
+ * exactly as the shading computes it, the segment to every light that sends light there (the
+ * lights do not move when this is asked: their position at time 0 is theirs). */
+EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const evr_skip_plan *pl, evr_ray ray, float t_hit)
+{
+    if (pl->num_boxes == 0) return 0;
+    const int hit = t_hit < 1e29f;
+    /* a little past the hit: the surface itself may lie on a box's face */
+    if (evr_skip_ray_meets_any(pl, ray.org, ray.dir, hit ? t_hit * 1.0001f + pl->pad : INFINITY)) return 1;
+    if (!hit) return 0;
+    const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
+    for (int l = 0; l < rs->num_lights; l++) {
+        evr_v3 wi;
+        float dist, e[3];
+        if (!evr_light_incident(rs, &rs->lights[l], 0.0f, p, &wi, &dist, e)) continue;
+        if (evr_skip_ray_meets_any(pl, p, wi, dist)) return 1;
+    }
+    return 0;
+}
+
+/* The pixel's cache as stored in its state: the distance of its last traced sample's hit
+ * (INFINITY: none) when clean, negative when not. */
+#define EVR_SKIP_DIRTY (-1.0f)
+
+/* 1 when a pixel whose camera ray is `ray` keeps its last intensity for the whole segment. */
+EVR_HD static inline int evr_skip_pixel(const evr_render_scene *rs, const evr_skip_plan *pl, int started,
+                                        float cache_dist, evr_ray ray)
+{
+    return pl->reuse && started && cache_dist >= 0.0f && !evr_skip_rays_meet(rs, pl, ray, cache_dist);
+}
+
+/* The cache a traced pixel keeps: its last sample's hit distance if clean, else EVR_SKIP_DIRTY. */
+EVR_HD static inline float evr_skip_cache_after_trace(const evr_render_scene *rs, const evr_skip_plan *pl, evr_ray ray,
+                                                      float t_hit)
+{
+    if (!pl->cache) return EVR_SKIP_DIRTY;
+    const float d = t_hit < 1e29f ? t_hit : INFINITY;
+    return evr_skip_rays_meet(rs, pl, ray, d) ? EVR_SKIP_DIRTY : d;
+}
+
+#endif

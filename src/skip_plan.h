@@ -1,0 +1,32 @@
+/* Per-segment plan of change-driven sampling (core/skip.h): which tracks moved, and the swept
+ * bounds of the instances they carry. */
+#ifndef EVR_SKIP_PLAN_H
+#define EVR_SKIP_PLAN_H
+
+#include "backend.h"
+#include "core/skip.h"
+
+typedef struct {
+    int num_tracks;
+    int have_prev;                /* a previous segment's keys are known */
+    evr_motion_key *prev_last;    /* per track: the last key of the previous segment */
+    int *prev_count;              /* per track: its key count there */
+    int *moved;                   /* per track: moves in this segment or changed since the last */
+} evr_skip_tracker;
+
+int evr_skip_tracker_init(evr_skip_tracker *t, int num_tracks);
+void evr_skip_tracker_free(evr_skip_tracker *t);
+
+/* Called with every segment's freshly computed keys (in order). A track that holds still in
+ * this segment and in the previous one, within a billionth of the scene size, keeps the
+ * previous segment's key bit for bit (re-evaluating a constant curve at another time can
+ * differ in the last bit, which would count as motion); then marks which tracks moved. */
+void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const int *track_offset,
+                             const int *track_count, float scene_size);
+
+/* Fills the plan of the segment whose keys the tracker saw last: enabled 0 (--no-skip) gives a
+ * plan that neither reuses nor caches. rs holds the segment's keys. */
+void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
+                         evr_skip_plan *pl);
+
+#endif

@@ -1,0 +1,46 @@
+"""Change-driven sampling gives exactly the events of brute force (--no-skip): every built-in scene
+and the moving square, ideal sensor and the davis346 noise model, on the CPU and (where a GPU is
+usable) on CUDA; and it really skips: run.json accounts for the samples traced and the pixels
+skipped per segment."""
+import os
+
+import evrtest as T
+
+tmp = T.tmpdir()
+names = T.run("demo", "--list").stdout.split()
+probe = T.run("demo", "--scene", "square", "-o", os.path.join(tmp, "probe"), "--res", "16x16", "--duration", "0.1",
+              "--backend", "cuda", "--quiet", "--no-preview", expect=None)
+backends = ["cpu"] + (["cuda"] if probe.returncode == 0 else [])
+print("backends:", backends)
+
+cases = [(n, ["--res", "64x48", "--duration", "0.4"]) for n in names]
+cases.append(("square", ["--res", "96x96", "--duration", "1.0", "--pos-thres", "0.3", "--neg-thres", "0.25"]))
+cases.append(("square", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
+cases.append(("cornell", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
+for backend in backends:
+    for case, (scene, extra) in enumerate(cases):
+        runs = {}
+        for mode in ("skip", "brute"):
+            d = os.path.join(tmp, f"{backend}-{scene}-{case}-{mode}")
+            T.run("demo", "--scene", scene, "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
+                  "--seed", "3", *extra, *(["--no-skip"] if mode == "brute" else []))
+            runs[mode] = (open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d))
+        (ev_s, js), (ev_b, jb) = runs["skip"], runs["brute"]
+        ss, sb = js["stats"], jb["stats"]
+        print(f"{backend} {scene} {' '.join(extra)}: {ss['events']} events; traced {ss['samples_traced']} of "
+              f"{ss['samples']} samples, {ss['pixels_skipped']} pixel-segments skipped; rays {ss['rays']} vs {sb['rays']}")
+        T.check(ss["events"] > 0, f"{backend} {scene} case {case}: events")
+        T.check(ev_s == ev_b, f"{backend} {scene} case {case}: identical events with and without skipping")
+        T.check(js["config"]["skip"] == "exact" and jb["config"]["skip"] == "off", f"{backend} {scene}: skip in config")
+        T.check(sb["samples_traced"] == sb["samples"] and sb["pixels_skipped"] == 0,
+                f"{backend} {scene}: brute force traces every sample")
+        T.check(ss["samples"] == sb["samples"], f"{backend} {scene}: the same samples counted")
+        per = ss["pixels_skipped_per_segment"]
+        T.check(len(per) == ss["segments"] and sum(per) == ss["pixels_skipped"],
+                f"{backend} {scene}: pixels skipped per segment add up")
+        T.check(ss["samples_traced"] + ss["pixels_skipped"] * 10 == ss["samples"],
+                f"{backend} {scene}: traced + skipped samples = all samples")
+        if scene in ("square", "cornell"):   # a small mover on a still background
+            T.check(ss["samples_traced"] < 0.5 * ss["samples"], f"{backend} {scene}: most samples skipped")
+            T.check(ss["rays"] < sb["rays"], f"{backend} {scene}: fewer rays")
+T.finish("test_skip")
