@@ -212,12 +212,6 @@ static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
         rs.track_offset = sim->track_offset;
         rs.track_count = sim->track_count;
         evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip, &sim->plan);
-        if (getenv("EVR_DEBUG_SKIP")) {
-            fprintf(stderr, "seg %.3f reuse %d cache %d boxes %d moved:", t0, sim->plan.reuse, sim->plan.cache, sim->plan.num_boxes);
-            for (i = 0; i < s->num_nodes; i++)
-                if (sim->skip.moved[i]) fprintf(stderr, " %s(%d)", s->nodes[i].name, sim->track_count[i]);
-            fprintf(stderr, "\n");
-        }
     }
     seg->skip = &sim->plan;
 }
@@ -260,7 +254,9 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.index = i;
     seg.t0 = segment_start(sim, i);
     seg.t1 = segment_end(sim, i);
+    double tm = now_seconds();
     compute_motion(sim, seg.t0, seg.t1, &seg);
+    sim->time_motion += now_seconds() - tm;
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);

@@ -56,6 +56,7 @@ struct evr_sim {
     uint16_t *frame16;
     /* statistics */
     evr_stats st;
+    double time_motion;          /* motion keys and the skip plan, per segment on the host */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 

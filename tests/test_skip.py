@@ -38,8 +38,12 @@ for backend in backends:
         per = ss["pixels_skipped_per_segment"]
         T.check(len(per) == ss["segments"] and sum(per) == ss["pixels_skipped"],
                 f"{backend} {scene}: pixels skipped per segment add up")
-        T.check(ss["samples_traced"] + ss["pixels_skipped"] * 10 == ss["samples"],
-                f"{backend} {scene}: traced + skipped samples = all samples")
+        # a pixel either skips the segment (no sample traced), settles after its first sample, or
+        # traces them all
+        untouched = ss["samples"] - ss["pixels_skipped"] * 10
+        T.check(ss["samples_traced"] <= untouched, f"{backend} {scene}: traced + skipped samples <= all samples")
+        if scene in ("square", "cornell"):
+            T.check(ss["samples_traced"] < untouched, f"{backend} {scene}: pixels settle after their first sample")
         if scene in ("square", "cornell"):   # a small mover on a still background
             T.check(ss["samples_traced"] < 0.5 * ss["samples"], f"{backend} {scene}: most samples skipped")
             T.check(ss["rays"] < sb["rays"], f"{backend} {scene}: fewer rays")

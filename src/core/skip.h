@@ -7,8 +7,11 @@
  * anything that moved in its own segment (the pixel's cache is "clean"). Then every sample of
  * the segment would trace exactly the same rays against exactly the same triangles: the cached
  * intensity is bit for bit what brute force computes, and the pixel model, run on it sample by
- * sample, gives identical events (noise included). The host fills an evr_skip_plan per segment
- * (src/skip_plan.c); both backends run these functions per pixel. */
+ * sample, gives identical events (noise included). A pixel that must trace traces its first
+ * sample; when that sample's rays meet nothing moving in the segment, every later sample would
+ * see the same triangles, so it keeps that intensity for the rest of the segment ("settles") and
+ * its cache is clean. The host fills an evr_skip_plan per segment (src/skip_plan.c); both
+ * backends run these functions per pixel. */
 #ifndef EVR_CORE_SKIP_H
 #define EVR_CORE_SKIP_H
 

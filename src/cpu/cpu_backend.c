@@ -203,14 +203,17 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             for (k = 0; k < n; k++) {
                 for (i = 0; i < PACKET; i++) {
                     fs[i] = ((float)k + phi[i]) / (float)n;
-                    intensity[i] = st[i]->intensity;   /* what a skipped pixel keeps */
+                    intensity[i] = st[i]->intensity;   /* what a skipped or settled pixel keeps */
                 }
                 if (any_trace) {
                     float traced_intensity[PACKET];
                     sample_intensity8(b, seg->camera_static ? &pose_static : NULL, xs, y, fs, trace, traced_intensity,
                                       t_hit, rays);
                     for (i = 0; i < PACKET; i++)
-                        if (trace[i]) intensity[i] = traced_intensity[i];
+                        if (trace[i]) {
+                            intensity[i] = traced_intensity[i];
+                            (*traced)++;
+                        }
                 }
                 for (i = 0; i < PACKET; i++) {
                     evr_pixel_span sp;
@@ -228,13 +231,24 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                     }
                     evr_pixel_end_s(st[i], &sp, !ideal);
                 }
+                if (k == 0 && any_trace) {
+                    /* settle: a pixel whose first sample's rays meet nothing that moves in the
+                     * segment sees the same triangles at every sample: it keeps that intensity */
+                    any_trace = 0;
+                    for (i = 0; i < PACKET; i++) {
+                        if (!trace[i]) continue;
+                        float c = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
+                        if (c >= 0.0f) {
+                            trace[i] = 0;
+                            st[i]->cache_dist = c;
+                        }
+                        any_trace |= trace[i];
+                    }
+                }
             }
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
-                if (trace[i]) {
-                    st[i]->cache_dist = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
-                    *traced += (unsigned long long)n;
-                }
+                if (trace[i]) st[i]->cache_dist = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
                 evr_pixel_end_segment(st[i], dt);
             }
         }

@@ -61,7 +61,7 @@ struct kernel_args {
     unsigned long long *keys;      /* event keys */
     unsigned int capacity;
     unsigned int *count;
-    unsigned long long *rays;      /* [0] rays traced, [1] pixels that reused their intensity */
+    unsigned long long *rays;      /* [0] rays traced, [1] pixels that reused their intensity, [2] samples traced */
     /* change-driven sampling: the segment's plan; with reuse, the skip kernel lists the pixels
      * that must trace (list, list_count) and the render kernel runs those only */
     const evr_skip_plan *plan;
@@ -268,26 +268,41 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
         if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
         phi = a.phase[pix];
     }
-    unsigned rays = 0;
+    unsigned rays = 0, traced = 0;
     float t_hit = INFINITY;
+    bool tracing = active;
     evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     for (int k = 0; k < a.samples; k++) {
-        float f = ((float)k + phi) / (float)a.samples, intensity = 0.0f;
-        if (active) {
+        float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled */
+        if (tracing) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             intensity = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit);
+            traced++;
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
+        if (k == 0 && tracing) {
+            /* settle: the first sample's rays meet nothing that moves in the segment, so every
+             * sample sees the same triangles: keep its intensity */
+            float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
+            if (c >= 0.0f) {
+                tracing = false;
+                st.cache_dist = c;
+            }
+        }
     }
     if (active) {
-        evr_ray ray = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-        st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray, t_hit);
+        if (tracing) st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
     }
-    unsigned long long r = rays;
-    for (int o = 16; o > 0; o >>= 1) r += __shfl_down_sync(0xffffffffu, r, o);
+    unsigned long long r = rays, ts = traced;
+    for (int o = 16; o > 0; o >>= 1) {
+        r += __shfl_down_sync(0xffffffffu, r, o);
+        ts += __shfl_down_sync(0xffffffffu, ts, o);
+    }
     if (lane == 0 && r) atomicAdd(a.rays, r);
+    if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
 }
 
 /* Intensity frames: frame k is every pixel's intensity at normalized segment time frame_f[k], one
@@ -548,7 +563,7 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
 static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 {
     CK(cudaMemsetAsync(sl->d_count.p, 0, 2 * sizeof(unsigned int), b->render));
-    CK(cudaMemsetAsync(sl->d_rays.p, 0, 2 * sizeof(unsigned long long), b->render));
+    CK(cudaMemsetAsync(sl->d_rays.p, 0, 3 * sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
     int npix = b->setup.width * b->setup.height;
     CK(cudaEventRecord(sl->started, b->render));
@@ -578,7 +593,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
-    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, 2 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, 3 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaEventRecord(sl->counted, sl->copy));
     return EVR_OK;
 }
@@ -698,8 +713,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     }
     base->rays += sl->h_rays.p[0];
     base->pixels_skipped += sl->h_rays.p[1];
-    base->samples_traced += ((uint64_t)b->setup.width * (uint64_t)b->setup.height - sl->h_rays.p[1]) *
-                            (uint64_t)b->setup.samples_per_frame;
+    base->samples_traced += sl->h_rays.p[2];
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
@@ -837,7 +851,13 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     for (int i = 0; i < 2; i++) {
         slot *sl = &b->slots[i];
-        CK(cudaStreamCreateWithFlags(&sl->copy, cudaStreamNonBlocking));
+        /* the sort and copy of segment i run while segment i + 1 renders: at the highest
+         * priority, so that their few blocks go first and the host can take in segment i's
+         * events while the GPU is still busy (at equal priority the sort waited for the whole
+         * render kernel and the GPU then idled while the host worked) */
+        int least = 0, greatest = 0;
+        CK(cudaDeviceGetStreamPriorityRange(&least, &greatest));
+        CK(cudaStreamCreateWithPriority(&sl->copy, cudaStreamNonBlocking, greatest));
         CK(cudaEventCreate(&sl->started));
         CK(cudaEventCreate(&sl->rendered));
         CK(cudaEventCreate(&sl->counted));
@@ -846,13 +866,13 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaEventCreate(&sl->framed));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(2));
-        CK(sl->d_rays.reserve(2));
+        CK(sl->d_rays.reserve(3));
         CK(sl->d_plan.reserve(1));
         CK(sl->h_plan.reserve(1));
         CK(sl->d_list.reserve((size_t)b->setup.width * (size_t)b->setup.height));
         CK(sl->d_intensity.reserve(npix));
         CK(sl->h_count.reserve(1));
-        CK(sl->h_rays.reserve(2));
+        CK(sl->h_rays.reserve(3));
     }
     CK(cudaDeviceSynchronize());
     return EVR_OK;
