@@ -19,6 +19,7 @@ static void usage(FILE *f)
           "  bench [--scene NAME] ... one run, one row of speed figures (samples/s, rays/s, real-time factor)\n"
           "  plot EVENTS [-o PNG]     event rate over time (ON/OFF per bin) and an events-per-pixel heat map\n"
           "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
+          "  still SCENE -o OUT.png   one image at one time, optionally with global illumination (--gi)\n"
           "\n"
           "  evray COMMAND --help     options of a command\n"
           "  evray --version          version of evray and its libraries\n", f);
@@ -42,6 +43,7 @@ int main(int argc, char **argv)
     if (!strcmp(c, "compare")) return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(c, "bench")) return cmd_bench(argc - 1, argv + 1);
     if (!strcmp(c, "plot")) return cmd_plot(argc - 1, argv + 1);
+    if (!strcmp(c, "still")) return cmd_still(argc - 1, argv + 1);
     if (c[0] == '-') return cmd_render(argc, argv, "eye");   /* options for the default job */
     fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
     return 2;

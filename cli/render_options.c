@@ -105,6 +105,31 @@ static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *qui
             if (!opt_u64("--gpu-event-capacity", v, &cap)) return -1;
             cfg.gpu_event_capacity = cap > ((uint64_t)1 << 40) ? ((int64_t)1 << 40) : (int64_t)cap; }
     else if (!strcmp(a, "--no-skip")) cfg.no_skip = 1;
+    else if (opt_is(a, "--sampling")) { VAL("--sampling");
+            if (!strcmp(v, "uniform")) cfg.sampling = EVR_SAMPLING_UNIFORM;
+            else if (!strcmp(v, "adaptive")) cfg.sampling = EVR_SAMPLING_ADAPTIVE;
+            else { cli_error("--sampling: unknown sampling '%s' (uniform, adaptive)", v); return -1; } }
+    else if (opt_is(a, "--adapt-frac")) { VAL("--adapt-frac"); if (!opt_float("--adapt-frac", v, &cfg.adapt_frac)) return -1;
+            if (!(cfg.adapt_frac > 0.0f) || !(cfg.adapt_frac <= 1.0f)) { cli_error("--adapt-frac must be in (0, 1] (got %s)", v); return -1; } }
+    else if (opt_is(a, "--min-dt")) { VAL("--min-dt"); if (!opt_double("--min-dt", v, &cfg.min_dt)) return -1;
+            if (!(cfg.min_dt >= 1e-6) || !(cfg.min_dt <= 1.0)) { cli_error("--min-dt must be between 1e-6 and 1 seconds (got %s)", v); return -1; } }
+    else if (opt_is(a, "--max-dt")) { VAL("--max-dt"); if (!opt_double("--max-dt", v, &cfg.max_dt)) return -1;
+            if (!(cfg.max_dt > 0.0) || !(cfg.max_dt <= 1.0)) { cli_error("--max-dt must be a number of seconds in (0, 1] (got %s)", v); return -1; } }
+    else if (opt_is(a, "--gi")) { VAL("--gi");
+            if (!strcmp(v, "none")) cfg.gi = 0;
+            else if (!strcmp(v, "photon")) cfg.gi = 1;
+            else if (!strcmp(v, "path")) { cli_error("--gi path renders one image: use evray still (render takes none or photon)"); return -1; }
+            else { cli_error("--gi: unknown mode '%s' (none, photon)", v); return -1; } }
+    else if (opt_is(a, "--photons")) { VAL("--photons");
+            uint64_t n;
+            if (!opt_u64("--photons", v, &n)) return -1;
+            if (n > (1u << 30)) { cli_error("--photons: at most 2^30 photons per segment (got %s)", v); return -1; }
+            cfg.photons = (uint32_t)n; }
+    else if (opt_is(a, "--gather-radius")) { VAL("--gather-radius"); if (!opt_float("--gather-radius", v, &cfg.gather_radius)) return -1; }
+    else if (opt_is(a, "--gather-max")) { VAL("--gather-max"); if (!opt_int("--gather-max", v, &cfg.gather_max)) return -1; }
+    else if (opt_is(a, "--gather-window")) { VAL("--gather-window"); if (!opt_int("--gather-window", v, &cfg.gather_window)) return -1; }
+    else if (opt_is(a, "--photon-layers")) { VAL("--photon-layers"); if (!opt_int("--photon-layers", v, &cfg.photon_layers)) return -1; }
+    else if (opt_is(a, "--gi-bounces")) { VAL("--gi-bounces"); if (!opt_int("--gi-bounces", v, &cfg.gi_bounces)) return -1; }
     else if (opt_is(a, "--threads")) { VAL("--threads"); if (!opt_int("--threads", v, &cfg.threads)) return -1; }
     else if (opt_is(a, "--pos-thres")) { VAL("--pos-thres"); if (!opt_float("--pos-thres", v, &cfg.pos_thres)) return -1; }
     else if (opt_is(a, "--neg-thres")) { VAL("--neg-thres"); if (!opt_float("--neg-thres", v, &cfg.neg_thres)) return -1; }

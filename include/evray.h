@@ -59,6 +59,8 @@ char *evr_scene_describe(const evr_scene *s);
 typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
 
 /* auto: CUDA when this build has it and a usable GPU is present, else the CPU (with a notice). */
+typedef enum { EVR_SAMPLING_UNIFORM = 0, EVR_SAMPLING_ADAPTIVE = 1 } evr_sampling;
+
 typedef enum { EVR_BACKEND_AUTO = 0, EVR_BACKEND_CPU = 1, EVR_BACKEND_CUDA = 2 } evr_backend_kind;
 
 typedef struct {
@@ -96,6 +98,14 @@ typedef struct {
                                      and the segment is rendered again when it overflows */
     int no_skip;                  /* 1: trace every sample (brute force) instead of reusing the
                                      intensity of pixels nothing moving can reach (identical events) */
+    /* sampling: EVR_SAMPLING_UNIFORM, samples_per_frame per pixel per segment at the pixel's own
+     * phase; EVR_SAMPLING_ADAPTIVE, each pixel picks its next sample time from how fast its log
+     * intensity changes (adapt_frac of a threshold between samples) and from a bound on how fast
+     * what its rays meet moves in the image (2 adapt_frac pixels between samples), within
+     * [min_dt, max_dt] (docs/architecture.md, "Adaptive sampling") */
+    int sampling;
+    float adapt_frac;             /* (0, 1] */
+    double min_dt, max_dt;        /* seconds; max_dt <= 0: one segment (1 / fps) */
     /* output */
     const char *out_dir;
     int formats;                  /* evr_format bits */
@@ -111,6 +121,14 @@ typedef struct {
     double frames_fps;            /* frames per second; <= 0: the segment rate (fps) */
     float frames_exposure;        /* 8-bit frames: intensity that maps to white is 1 / this */
     float frames_max;             /* 16-bit frames: intensity that maps to 65535 */
+    /* global illumination: image-space photon mapping (src/core/photon.h), CPU backend */
+    int gi;                       /* 0: direct light only, 1: photon mapping */
+    uint32_t photons;             /* photons per segment (0: one per pixel) */
+    float gather_radius;          /* distance filter r, world units (<= 0: 2% of the scene's diagonal) */
+    int gather_max;               /* photons per estimate at most */
+    int gather_window;            /* the gather window's half size at most, pixels */
+    int photon_layers;            /* photons each pixel of the buffer holds */
+    int gi_bounces;               /* indirect bounces of a photon */
 } evr_config;
 
 void evr_config_defaults(evr_config *c);
@@ -124,7 +142,8 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
 
 typedef struct {
     uint64_t events_on, events_off, unique_timestamps;
-    uint64_t samples, rays;       /* samples: every pixel sample, as brute force would take them */
+    uint64_t samples, rays;       /* samples: every pixel sample, as brute force would take them
+                                     (adaptive sampling: every sample taken, all traced) */
     uint64_t samples_traced;      /* samples that traced rays; the rest reused a cached intensity */
     uint64_t pixels_skipped;      /* pixel-segments that traced nothing (change-driven sampling) */
     double sim_time;              /* seconds simulated */

@@ -10,6 +10,7 @@
 #include "core/render_scene.h"
 #include "core/pixel.h"
 #include "core/skip.h"
+#include "core/adaptive.h"
 #include "scene/scene.h"
 
 /* Everything fixed for a whole run. */
@@ -21,6 +22,13 @@ typedef struct {
     int threads;
     int gpu_bvh;                  /* GPU node layout (0: default) */
     int64_t gpu_event_capacity;   /* initial GPU event buffer (0: automatic) */
+    /* global illumination (CPU backend): image-space photon mapping, 0 photons: one per pixel */
+    int gi;
+    uint32_t photons;
+    float gather_radius;          /* world units (resolved: > 0) */
+    int gather_max, gather_window, photon_layers, gi_bounces;
+    int adaptive;                 /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
+    evr_adapt_params adapt;       /* its parameters (max_dt resolved: > 0) */
 } evr_run_setup;
 
 /* One segment: absolute times and the motion keys of every track (one track per scene node, and
@@ -43,6 +51,8 @@ typedef struct {
     /* Change-driven sampling (core/skip.h): which pixels may keep their cached intensity, and
      * which may cache one. Never NULL; a plan that neither reuses nor caches is brute force. */
     const evr_skip_plan *skip;
+    /* Adaptive sampling (setup.adaptive): the segment's motion bounds; NULL otherwise. */
+    const evr_adapt_plan *adapt;
 } evr_segment;
 
 typedef struct evr_backend evr_backend;
@@ -59,9 +69,12 @@ struct evr_backend {
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, const float **frames,
                           evr_error *err);
     void (*release)(evr_backend *b);
-    uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not) */
+    uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not;
+                                     adaptive sampling: every sample taken) */
     uint64_t samples_traced;      /* samples that traced rays (the others reused a cached intensity) */
     uint64_t pixels_skipped;      /* pixel-segments that reused their cached intensity */
+    uint64_t photons_traced, photons_stored, photon_collisions, photon_passes;   /* GI */
+    double photon_seconds;
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
     double sort_seconds, copy_seconds;
     uint64_t device_bytes;        /* memory held on the device */

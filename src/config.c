@@ -17,6 +17,10 @@ void evr_config_defaults(evr_config *c)
     c->start = 0.0;
     c->fps = 0.0;
     c->samples_per_frame = 10;
+    c->sampling = EVR_SAMPLING_UNIFORM;
+    c->adapt_frac = 0.25f;
+    c->min_dt = 20e-6;
+    c->max_dt = 0.0;              /* one segment */
     c->camera = NULL;
     c->pos_thres = 0.2f;
     c->neg_thres = 0.2f;
@@ -44,6 +48,13 @@ void evr_config_defaults(evr_config *c)
     c->frames_fps = 0.0;
     c->frames_exposure = 1.0f;
     c->frames_max = 4.0f;
+    c->gi = 0;
+    c->photons = 0;
+    c->gather_radius = 0.0f;
+    c->gather_max = 64;
+    c->gather_window = 16;
+    c->photon_layers = 8;
+    c->gi_bounces = 4;
 }
 
 /* Sensor presets; docs/sensors.md gives the source of every value (keep the two in step). */
@@ -114,6 +125,14 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if ((double)c->width * (double)c->height > 1e9) BAD("resolution %dx%d is too large", c->width, c->height);
     if (c->samples_per_frame < 1 || c->samples_per_frame > 1000000)
         BAD("samples per frame must be between 1 and 1000000 (got %d)", c->samples_per_frame);
+    if (c->sampling != EVR_SAMPLING_UNIFORM && c->sampling != EVR_SAMPLING_ADAPTIVE)
+        BAD("unknown sampling %d (uniform, adaptive)", c->sampling);
+    if (!(c->adapt_frac > 0.0f) || !(c->adapt_frac <= 1.0f))
+        BAD("adapt fraction must be in (0, 1] (got %g)", (double)c->adapt_frac);
+    if (!(c->min_dt >= 1e-6) || !(c->min_dt <= 1.0))
+        BAD("min dt must be between 1e-6 and 1 s (got %g)", c->min_dt);
+    if (!(c->max_dt <= 1.0) || c->max_dt < 0.0 || !isfinite(c->max_dt) || (c->max_dt > 0.0 && c->max_dt < c->min_dt))
+        BAD("max dt must be between min dt (%g s) and 1 s, or 0 for one segment (got %g)", c->min_dt, c->max_dt);
     if (!(c->pos_thres > 0.0f) || !isfinite(c->pos_thres)) BAD("ON threshold must be a positive number (got %g)", (double)c->pos_thres);
     if (!(c->neg_thres > 0.0f) || !isfinite(c->neg_thres)) BAD("OFF threshold must be a positive number (got %g)", (double)c->neg_thres);
     if (!(c->refractory >= 0.0f) || !isfinite(c->refractory)) BAD("refractory period must be >= 0 seconds (got %g)", (double)c->refractory);
@@ -149,6 +168,14 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (c->backend != EVR_BACKEND_AUTO && c->backend != EVR_BACKEND_CPU && c->backend != EVR_BACKEND_CUDA)
         BAD("unknown backend %d", (int)c->backend);
     if (c->gpu_bvh != 0 && c->gpu_bvh != 4 && c->gpu_bvh != 8) BAD("unknown GPU BVH layout %d (4 or 8)", c->gpu_bvh);
+    if (c->gi != 0 && c->gi != 1) BAD("unknown global illumination mode %d", c->gi);
+    if (c->gi) {
+        if (c->gather_max < 1 || c->gather_max > 65536) BAD("--gather-max must be between 1 and 65536 (got %d)", c->gather_max);
+        if (c->gather_window < 0 || c->gather_window > 256) BAD("--gather-window must be between 0 and 256 pixels (got %d)", c->gather_window);
+        if (c->photon_layers < 1 || c->photon_layers > 64) BAD("--photon-layers must be between 1 and 64 (got %d)", c->photon_layers);
+        if (c->gi_bounces < 0 || c->gi_bounces > 64) BAD("--gi-bounces must be between 0 and 64 (got %d)", c->gi_bounces);
+        if (!isfinite(c->gather_radius) || c->gather_radius < 0.0f) BAD("--gather-radius must be a positive number or 0 (automatic), got %g", (double)c->gather_radius);
+    }
     if (c->gpu_event_capacity < 0 || c->gpu_event_capacity > ((int64_t)1 << 31))
         BAD("GPU event capacity must be between 0 (automatic) and 2^31 (got %lld)", (long long)c->gpu_event_capacity);
     if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
@@ -196,7 +223,14 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "duration"); evr_json_number(&j, duration);
     evr_json_key(&j, "fps"); evr_json_number(&j, fps);
     evr_json_key(&j, "samples_per_frame"); evr_json_integer(&j, c->samples_per_frame);
-    evr_json_key(&j, "sampling"); evr_json_string(&j, "uniform, per-pixel phase");
+    if (c->sampling == EVR_SAMPLING_ADAPTIVE) {
+        evr_json_key(&j, "sampling"); evr_json_string(&j, "adaptive");
+        evr_json_key(&j, "adapt_frac"); evr_json_float(&j, c->adapt_frac);
+        evr_json_key(&j, "min_dt"); evr_json_number(&j, c->min_dt);
+        evr_json_key(&j, "max_dt"); evr_json_number(&j, c->max_dt > 0.0 ? c->max_dt : 1.0 / fps);
+    } else {
+        evr_json_key(&j, "sampling"); evr_json_string(&j, "uniform, per-pixel phase");
+    }
     evr_json_key(&j, "pos_thres"); evr_json_float(&j, c->pos_thres);
     evr_json_key(&j, "neg_thres"); evr_json_float(&j, c->neg_thres);
     evr_json_key(&j, "refractory"); evr_json_float(&j, c->refractory);
@@ -218,7 +252,15 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     evr_json_key(&j, "gpu_event_capacity"); evr_json_integer(&j, c->gpu_event_capacity);
     evr_json_key(&j, "skip"); evr_json_string(&j, c->no_skip ? "off" : "exact");
     evr_json_key(&j, "gpu_bvh"); evr_json_string(&j, c->gpu_bvh == 4 ? "bvh4" : c->gpu_bvh == 8 ? "cw8" : "default");
-    evr_json_key(&j, "gi"); evr_json_string(&j, "none");
+    evr_json_key(&j, "gi"); evr_json_string(&j, c->gi ? "photon" : "none");
+    if (c->gi) {
+        evr_json_key(&j, "photons"); evr_json_unsigned(&j, c->photons);
+        evr_json_key(&j, "gather_radius"); evr_json_float(&j, c->gather_radius);
+        evr_json_key(&j, "gather_max"); evr_json_integer(&j, c->gather_max);
+        evr_json_key(&j, "gather_window"); evr_json_integer(&j, c->gather_window);
+        evr_json_key(&j, "photon_layers"); evr_json_integer(&j, c->photon_layers);
+        evr_json_key(&j, "gi_bounces"); evr_json_integer(&j, c->gi_bounces);
+    }
     evr_json_key(&j, "preview_window"); evr_json_number(&j, c->preview_window);
     evr_json_key(&j, "frames_out"); evr_json_string(&j, c->frames_out);
     if (c->frames_out) {

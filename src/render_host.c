@@ -34,6 +34,8 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         memcpy(h->materials[i].base_color, m->base_color, sizeof m->base_color);
         h->materials[i].base_texture = m->base_texture;
         memcpy(h->materials[i].emissive, m->emissive, sizeof m->emissive);
+        h->materials[i].t_diffuse = m->t_diffuse;
+        h->materials[i].t_specular = m->t_specular;
     }
     for (i = 0; i < s->num_textures; i++) {
         h->textures[i].width = s->textures[i].width;

@@ -229,6 +229,13 @@ static char *run_json(const evr_sim *sim)
         for (seg = 0; seg < s->segments_done; seg++) evr_json_unsigned(&j, sim->skipped_per_segment[seg]);
         evr_json_end_array(&j);
     }
+    if (sim->cfg.gi) {   /* the photon passes (a still segment reuses the previous segment's photons) */
+        evr_json_key(&j, "photon_passes"); evr_json_unsigned(&j, sim->backend->photon_passes);
+        evr_json_key(&j, "photons_traced"); evr_json_unsigned(&j, sim->backend->photons_traced);
+        evr_json_key(&j, "photons_stored"); evr_json_unsigned(&j, sim->backend->photons_stored);
+        evr_json_key(&j, "photon_collisions"); evr_json_unsigned(&j, sim->backend->photon_collisions);
+        evr_json_key(&j, "time_photons_seconds"); evr_json_number(&j, sim->backend->photon_seconds);
+    }
     evr_json_key(&j, "segments"); evr_json_integer(&j, s->segments_done);
     evr_json_key(&j, "segments_planned"); evr_json_integer(&j, s->segments_total);
     evr_json_key(&j, "interrupted"); evr_json_boolean(&j, s->interrupted);
@@ -237,7 +244,13 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
     evr_json_key(&j, "rays_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->rays / s->wall_time : 0.0);
     evr_json_key(&j, "realtime_factor"); evr_json_number(&j, s->wall_time > 0 ? s->sim_time / s->wall_time : 0.0);
-    evr_json_key(&j, "mean_sample_interval_seconds"); evr_json_number(&j, 1.0 / (sim->fps * sim->cfg.samples_per_frame));
+    {   /* adaptive sampling: samples are those taken (all traced), their rate varies per pixel */
+        double pix_s = (double)sim->cfg.width * (double)sim->cfg.height * s->sim_time;
+        double spps = pix_s > 0.0 ? (double)s->samples / pix_s : 0.0;
+        evr_json_key(&j, "samples_per_pixel_per_second"); evr_json_number(&j, spps);
+        evr_json_key(&j, "mean_sample_interval_seconds");
+        evr_json_number(&j, sim->setup.adaptive ? (spps > 0.0 ? 1.0 / spps : 0.0) : 1.0 / (sim->fps * sim->cfg.samples_per_frame));
+    }
     evr_json_key(&j, "time_setup_seconds"); evr_json_number(&j, sim->time_setup);
     evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
     evr_json_key(&j, "time_motion_seconds"); evr_json_number(&j, sim->time_motion);

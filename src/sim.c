@@ -46,6 +46,15 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
     const evr_scene *s = sim->scene;
     evr_backend_kind kind = sim->cfg.backend;
     evr_status st;
+    if (sim->cfg.gi && kind == EVR_BACKEND_CUDA) {
+        snprintf(err->msg, sizeof err->msg, "--gi photon runs on the CPU backend only (the GPU photon pass is not written yet); "
+                 "use --backend cpu or auto");
+        return EVR_ERR_ARG;
+    }
+    if (sim->cfg.gi && kind == EVR_BACKEND_AUTO) {
+        snprintf(sim->st.notice, sizeof sim->st.notice, "--gi photon runs on the CPU backend only; running on the CPU");
+        kind = EVR_BACKEND_CPU;
+    }
 #ifdef EVR_HAVE_CUDA
     if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
         evr_error cerr;
@@ -126,6 +135,18 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.threads = c->threads;
     sim->setup.gpu_bvh = c->gpu_bvh;
     sim->setup.gpu_event_capacity = c->gpu_event_capacity;
+    sim->setup.adaptive = c->sampling == EVR_SAMPLING_ADAPTIVE;
+    sim->setup.adapt.frac = c->adapt_frac;
+    sim->setup.adapt.min_dt = (float)c->min_dt;
+    sim->setup.adapt.max_dt = (float)(c->max_dt > 0.0 ? c->max_dt : 1.0 / sim->fps);
+    if (sim->setup.adapt.max_dt < sim->setup.adapt.min_dt) sim->setup.adapt.max_dt = sim->setup.adapt.min_dt;
+    sim->setup.gi = c->gi;
+    sim->setup.photons = c->photons;
+    sim->setup.gather_radius = c->gather_radius > 0.0f ? c->gather_radius : 0.02f * sim->host.scene_size;
+    sim->setup.gather_max = c->gather_max;
+    sim->setup.gather_window = c->gather_window;
+    sim->setup.photon_layers = c->photon_layers;
+    sim->setup.gi_bounces = c->gi_bounces;
 
     int ntracks = s->num_nodes + 1;
     sim->keys = malloc(sizeof *sim->keys * (size_t)ntracks * EVR_MAX_KEYS);
@@ -211,9 +232,12 @@ static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
         rs.keys = sim->keys;
         rs.track_offset = sim->track_offset;
         rs.track_count = sim->track_count;
-        evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip, &sim->plan);
+        evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip && !sim->setup.adaptive, &sim->plan);
+        if (sim->setup.adaptive)
+            evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &sim->adapt_plan);
     }
     seg->skip = &sim->plan;
+    seg->adapt = sim->setup.adaptive ? &sim->adapt_plan : NULL;
 }
 
 /* Hands events up to (not including) limit_us to the writers and statistics. */
@@ -281,6 +305,8 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
     int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+    /* adaptive sampling: a pixel's last sample here is no earlier than t1 - max_dt */
+    if (!last && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
     if (!last && (sim->cfg.time_jitter > 0.0 || sim->setup.pixel.time_res_us > 1))
         safe -= (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;

@@ -34,6 +34,7 @@ struct evr_sim {
     /* change-driven sampling */
     evr_skip_tracker skip;
     evr_skip_plan plan;
+    evr_adapt_plan adapt_plan;       /* adaptive sampling's plan of the segment being submitted */
     uint32_t *skipped_per_segment;   /* pixels that traced nothing, per segment */
     /* events */
     evr_event_vec pending, scratch;

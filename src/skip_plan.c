@@ -139,3 +139,74 @@ void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const ev
     pl->cache = cache;
     pl->reuse = cache && still;
 }
+
+/* Largest distance a point of box [lo, hi] (object space) moves between keys a and b: a point of
+ * the box is a convex combination of its corners, and the keys' transforms are affine. */
+static float corner_move(const float lo[3], const float hi[3], const evr_motion_key *a, const evr_motion_key *b)
+{
+    evr_m34 ma = evr_motion_key_matrix(a), mb = evr_motion_key_matrix(b);
+    float d = 0.0f;
+    int c;
+    for (c = 0; c < 8; c++) {
+        evr_v3 p = evr_v3_make(c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]);
+        evr_v3 q = evr_v3_sub(evr_m34_point(&mb, p), evr_m34_point(&ma, p));
+        d = fmaxf(d, sqrtf(evr_v3_dot(q, q)));
+    }
+    return d;
+}
+
+void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                          const evr_adapt_params *ap, double seconds, evr_adapt_plan *pl)
+{
+    int i, k;
+    memset(pl, 0, sizeof *pl);
+    pl->pad = rs->ray_eps;
+    int cam = rs->camera_track;
+    if (rs->track_count[cam] != 1 || t->moved[cam]) pl->all_min = 1;
+    for (i = 0; i < rs->num_lights; i++) {
+        int tr = rs->lights[i].track;
+        if (tr >= 0 && (rs->track_count[tr] != 1 || t->moved[tr])) pl->all_min = 1;
+    }
+    if (pl->all_min) return;
+    /* a world displacement d at distance r from the camera moves the image by at most
+     * d / r * f_px * (1 + tx^2 + ty^2) pixels (the pinhole's largest stretch, at the corners) */
+    evr_m34 pose = evr_rs_camera_pose(rs, 0.0f);
+    evr_v3 eye = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
+    const float ty = rs->camera.tan_half_y, tx = ty * rs->camera.aspect;
+    const float px_per_rad = 0.5f * (float)rs->camera.height / ty * (1.0f + tx * tx + ty * ty);
+    for (i = 0; i < rs->num_instances; i++) {
+        int tr = rs->instances[i].track, b;
+        if (!t->moved[tr]) continue;
+        const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
+        const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
+        const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
+        float blo[3], bhi[3], r2 = 0.0f, move = 0.0f, jump = 0.0f;
+        instance_box(t, s, rs, i, blo, bhi);
+        for (k = 0; k < 3; k++) {   /* distance from the camera to the box */
+            const float e = k == 0 ? eye.x : k == 1 ? eye.y : eye.z;
+            const float d = e < blo[k] ? blo[k] - e : e > bhi[k] ? e - bhi[k] : 0.0f;
+            r2 += d * d;
+        }
+        const evr_motion_track tk = evr_rs_track(rs, tr);
+        for (k = 0; k + 1 < tk.n; k++) move = fmaxf(move, corner_move(lo, hi, &tk.keys[k], &tk.keys[k + 1]));
+        if (t->prev_count[tr] > 0) jump = corner_move(lo, hi, &t->prev_last[tr], &tk.keys[0]);
+        const float r = sqrtf(r2);
+        /* keys are close (< 120 degrees apart, 1e-5 of the scene from the curves): 1.25 covers
+         * a point's arc between keys being longer than its chord */
+        float speed = tk.n > 1 ? 1.25f * move * (float)(tk.n - 1) / (float)seconds : 0.0f;
+        float jump_px = jump * px_per_rad / r;
+        speed = r > 0.0f ? speed * px_per_rad / r : INFINITY;
+        if (!(speed >= 0.0f)) speed = INFINITY;
+        if (pl->num_boxes < EVR_SKIP_MAX_BOXES) {
+            b = pl->num_boxes++;
+            memcpy(pl->lo[b], blo, sizeof blo);
+            memcpy(pl->hi[b], bhi, sizeof bhi);
+            pl->speed[b] = 0.0f;
+        } else {   /* too many: the last box holds the rest */
+            b = EVR_SKIP_MAX_BOXES - 1;
+            box_union(pl->lo[b], pl->hi[b], blo, bhi);
+        }
+        pl->speed[b] = fmaxf(pl->speed[b], speed);
+        if (!(jump_px <= EVR_ADAPT_PX_PER_FRAC * ap->frac)) pl->jump[b] = 1;
+    }
+}

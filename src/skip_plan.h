@@ -5,6 +5,7 @@
 
 #include "backend.h"
 #include "core/skip.h"
+#include "core/adaptive.h"
 
 typedef struct {
     int num_tracks;
@@ -28,5 +29,12 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
  * plan that neither reuses nor caches. rs holds the segment's keys. */
 void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
                          evr_skip_plan *pl);
+
+/* Fills the adaptive-sampling plan (core/adaptive.h) of the same segment: the swept bounds of
+ * every instance that moves in it or changed since the previous one (all of them in one box past
+ * EVR_SKIP_MAX_BOXES), each with a bound on its image speed; all_min when the camera or a light
+ * moves. seconds: the segment's length. */
+void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                          const evr_adapt_params *ap, double seconds, evr_adapt_plan *pl);
 
 #endif

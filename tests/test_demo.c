@@ -71,6 +71,14 @@ static const expectation expected[] = {
      "ceiling_light", aiLightSource_POINT,
      {"short_box", NULL},
      2.0, 36, 36},
+    {"cornell-still",   /* the same room; the short box's animation holds it still */
+     {"floor", "ceiling", "back_wall", "left_wall", "right_wall", "tall_box", "short_box", NULL},
+     {"white", "red", "green", "light", NULL},
+     0, NULL,
+     "cornell_camera", 1.0f, 0.05f, {0.0, 0.5, 1.9}, {0.0, 0.5, 0.0},
+     "ceiling_light", aiLightSource_POINT,
+     {"short_box", NULL},
+     2.0, 36, 36},
     {"city",   /* 12 building meshes, each stored once (4096 nodes share them), and the ground */
      {"building_00", "building_07", "building_11", "ground", NULL},
      {"facade_00", "facade_11", "asphalt", NULL},

@@ -18,6 +18,8 @@ typedef struct {
     float base_color[4];
     int base_texture;     /* -1: none */
     float emissive[3];
+    /* photon mapping (src/core/photon.h): 0 <= t_diffuse <= t_specular <= 1 */
+    float t_diffuse, t_specular;
 } evr_material_view;
 
 typedef struct {

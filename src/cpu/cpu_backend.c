@@ -4,6 +4,7 @@
 #include "core/rng.h"
 #include "core/shading.h"
 #include "core/skip.h"
+#include "cpu/cpu_gi.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -40,8 +41,11 @@ typedef struct {
     int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
     int *members;                  /* scene instance index of each geometry */
     RTCScene top;
+    int gi;                        /* global illumination on */
+    evr_cpu_gi gi_state;
     evr_pixel_state *pixels;
     float *phase;                  /* per-pixel sample-time offset in [0, 1) */
+    float *next_t;                 /* adaptive sampling: each pixel's next sample, segment-relative */
     int tiles_x, tiles_y;
     evr_event_vec *tile_events;
     /* results of submitted segments not yet collected (a ring of two) */
@@ -93,8 +97,8 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
  * shared shading of src/core lane by lane. Counts the rays it traces; t_hit (may be NULL) gets
  * each primary ray's hit distance (INFINITY: none). */
 #define PACKET 8
-static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
-                              const int *valid, float *out, float *t_hit, unsigned long long *rays)
+static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, const int *ys,
+                                   const float *fs, const int *valid, float *out, float *t_hit, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -104,12 +108,12 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
     evr_surface s[PACKET];
     float acc[PACKET][3];
     _Alignas(32) int vmask[PACKET];   /* Embree reads the valid mask with aligned vector loads */
-    int hit[PACKET], i, l;
+    int hit[PACKET], inst_of[PACKET], i, l;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (i = 0; i < PACKET; i++) {
         evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
-        ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)y + 0.5f);
+        ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
         vmask[i] = valid[i] ? -1 : 0;
         rh.ray.org_x[i] = ray[i].org.x; rh.ray.org_y[i] = ray[i].org.y; rh.ray.org_z[i] = ray[i].org.z;
         rh.ray.dir_x[i] = ray[i].dir.x; rh.ray.dir_y[i] = ray[i].dir.y; rh.ray.dir_z[i] = ray[i].dir.z;
@@ -131,6 +135,7 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (!hit[i]) continue;
         int inst = b->members[b->group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
+        inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
     }
@@ -161,9 +166,23 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
         for (i = 0; i < PACKET; i++)
             if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
     }
-    for (i = 0; i < PACKET; i++)
-        if (hit[i]) out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
+    for (i = 0; i < PACKET; i++) {
+        if (!hit[i]) continue;
+        out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
+        if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i]);
+    }
 }
+
+/* The same for eight pixels of one row. */
+static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
+                              const int *valid, float *out, float *t_hit, unsigned long long *rays)
+{
+    int ys[PACKET], i;
+    for (i = 0; i < PACKET; i++) ys[i] = y;
+    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, rays);
+}
+
+static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
 
 static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays,
                         unsigned long long *traced, unsigned long long *skipped)
@@ -196,7 +215,8 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                 else evr_pixel_params_at(&b->setup.pixel, xs[i], y, &pp[i]);
                 /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
                 ray[i] = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)y + 0.5f);
-                trace[i] = valid[i] && !evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]);
+                trace[i] = valid[i] && !(evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]) &&
+                                         !(b->gi && evr_cpu_gi_window_changed(&b->gi_state, xs[i], y)));
                 any_trace |= trace[i];
                 if (valid[i] && !trace[i]) (*skipped)++;
             }
@@ -253,8 +273,18 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             }
         }
     }
-    /* intensity frames: one sample per pixel at each frame's exact time, kept away from the
-     * pixel model and out of the sample and ray counts */
+    render_frames(b, x0, y0, x1, y1);
+    *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
+}
+
+/* Intensity frames: one sample per pixel at each frame's exact time, kept away from the pixel
+ * model and out of the sample and ray counts. */
+static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    const evr_segment *seg = b->seg;
+    const int w = b->setup.width, h = b->setup.height;
+    int x, y, k;
     for (k = 0; k < seg->num_frames; k++) {
         const float f = b->frame_f[k];
         evr_m34 pose = evr_rs_camera_pose(rs, f);
@@ -274,7 +304,92 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             }
         }
     }
-    *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
+}
+
+/* Adaptive sampling (core/adaptive.h): every pixel of the tile takes its samples at its own
+ * scheduled times; each round, the pixels that still have a sample due in the segment take their
+ * next one, eight at a time in packets (any pixels of the tile, each at its own time). */
+static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    const evr_segment *seg = b->seg;
+    const evr_adapt_plan *plan = seg->adapt;
+    const evr_adapt_params *ap = &b->setup.adapt;
+    const int w = b->setup.width, h = b->setup.height;
+    const float dt = (float)(seg->t1 - seg->t0);
+    int tx = tile % b->tiles_x, ty = tile / b->tiles_x;
+    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w, y1 = y0 + TILE < h ? y0 + TILE : h;
+    const int tw = x1 - x0, npx = tw * (y1 - y0);
+    evr_event_vec *out = &b->tile_events[tile];
+    evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
+    const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
+    evr_pixel_params pp[TILE * TILE];
+    float tnext[TILE * TILE];
+    int act[TILE * TILE], nact = 0, j;
+    out->n = 0;
+    for (j = 0; j < npx; j++) {
+        const int x = x0 + j % tw, y = y0 + j / tw;
+        const size_t pix = (size_t)y * (size_t)w + (size_t)x;
+        evr_pixel_state *st = &b->pixels[pix];
+        float speed = 0.0f;
+        int jump = 0;
+        if (ideal) pp[j] = b->setup.pixel;
+        else evr_pixel_params_at(&b->setup.pixel, x, y, &pp[j]);
+        if (st->started && !plan->all_min) {   /* what the last sample's rays meet in this segment */
+            evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+            speed = evr_adapt_rays_speed(rs, plan, ray, st->cache_dist, &jump);
+        }
+        tnext[j] = evr_adapt_first(ap, plan, st->started, b->next_t[pix], st->t_prev, b->phase[pix], speed, jump);
+        if (tnext[j] < dt) act[nact++] = j;
+    }
+    while (nact > 0) {
+        int base, kept = 0;
+        for (base = 0; base < nact; base += PACKET) {
+            int xs[PACKET], ys[PACKET], valid[PACKET], js[PACKET], i;
+            float fs[PACKET], intensity[PACKET], t_hit[PACKET];
+            for (i = 0; i < PACKET; i++) {
+                valid[i] = base + i < nact;
+                js[i] = act[valid[i] ? base + i : base];
+                xs[i] = x0 + js[i] % tw;
+                ys[i] = y0 + js[i] / tw;
+                fs[i] = tnext[js[i]] / dt;
+            }
+            sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, rays);
+            for (i = 0; i < PACKET; i++) {
+                if (!valid[i]) continue;
+                const int jj = js[i];
+                evr_pixel_state *st = &b->pixels[(size_t)ys[i] * (size_t)w + (size_t)xs[i]];
+                const float t = fs[i] * dt;
+                evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
+                const float step = evr_adapt_after_sample(rs, ap, plan, st, &pp[jj], ray, t_hit[i], t, intensity[i]);
+                evr_pixel_span sp;
+                float te;
+                int pol;
+                (*samples)++;
+                st->cache_dist = t_hit[i];
+                if (evr_pixel_begin_s(st, &pp[jj], t, intensity[i], &sp, !ideal)) {
+                    while (evr_pixel_next_s(st, &pp[jj], &sp, &te, &pol, !ideal)) {
+                        evr_event e;
+                        e.t = evr_event_time_us_s(&pp[jj], seg->t0 + (double)te, xs[i], ys[i], !ideal);
+                        e.x = (uint16_t)xs[i];
+                        e.y = (uint16_t)ys[i];
+                        e.p = (int8_t)pol;
+                        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+                    }
+                    evr_pixel_end_s(st, &sp, !ideal);
+                }
+                tnext[jj] = t + step;
+                if (tnext[jj] < dt) act[kept++] = jj;   /* kept <= base + i: in place */
+            }
+        }
+        nact = kept;
+    }
+    for (j = 0; j < npx; j++) {
+        const size_t pix = (size_t)(y0 + j / tw) * (size_t)w + (size_t)(x0 + j % tw);
+        b->next_t[pix] = tnext[j] - dt;
+        evr_pixel_end_segment(&b->pixels[pix], dt);
+    }
+    render_frames(b, x0, y0, x1, y1);
 }
 
 static void *worker(void *arg)
@@ -287,7 +402,11 @@ static void *worker(void *arg)
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 #endif
     int ntiles = b->tiles_x * b->tiles_y, t;
-    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) render_tile(b, t, &samples, &rays, &traced, &skipped);
+    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) {
+        if (b->setup.adaptive) render_tile_adaptive(b, t, &samples, &rays);
+        else render_tile(b, t, &samples, &rays, &traced, &skipped);
+    }
+    if (b->setup.adaptive) traced = samples;   /* adaptive sampling traces every sample it takes */
     atomic_fetch_add(&b->samples, samples);
     atomic_fetch_add(&b->rays, rays);
     atomic_fetch_add(&b->samples_traced, traced);
@@ -335,6 +454,10 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->host.rs.track_offset = seg->track_offset;
     b->host.rs.track_count = seg->track_count;
     if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
+    if (b->gi) {   /* the segment's photons: still when nothing moved since the previous segment */
+        int still = seg->skip->reuse && seg->skip->num_boxes == 0;
+        if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, still, b->setup.threads, base, err)) != EVR_OK) return st;
+    }
     if (seg->num_frames > 0) {
         size_t npix = (size_t)b->setup.width * (size_t)b->setup.height, nf = (size_t)seg->num_frames;
         if (seg->num_frames > b->frame_f_cap) {
@@ -449,6 +572,7 @@ static void cpu_release(evr_backend *base)
     cpu_backend *b = (cpu_backend *)base;
     int i;
     if (!b) return;
+    if (b->gi) evr_cpu_gi_free(&b->gi_state);
     if (b->top) rtcReleaseScene(b->top);
     if (b->group_scenes) {
         for (i = 0; i < b->num_groups; i++)
@@ -472,6 +596,7 @@ static void cpu_release(evr_backend *base)
     evr_event_vec_free(&b->scratch);
     free(b->pixels);
     free(b->phase);
+    free(b->next_t);
     free(b->frame_f);
     free(b);
 }
@@ -642,10 +767,11 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     b->tiles_y = (setup->height + TILE - 1) / TILE;
     b->pixels = malloc(npix * sizeof *b->pixels);
     b->phase = malloc(npix * sizeof *b->phase);
+    b->next_t = calloc(npix, sizeof *b->next_t);
     b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
     b->done_intensity[0] = malloc(npix * sizeof(float));
     b->done_intensity[1] = malloc(npix * sizeof(float));
-    if (!b->pixels || !b->phase || !b->tile_events || !b->done_intensity[0] || !b->done_intensity[1]) goto nomem;
+    if (!b->pixels || !b->phase || !b->next_t || !b->tile_events || !b->done_intensity[0] || !b->done_intensity[1]) goto nomem;
     for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
     for (y = 0; y < setup->height; y++)
         for (x = 0; x < setup->width; x++)
@@ -680,6 +806,18 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         rtcReleaseGeometry(g);
     }
     if (b->embree_error[0]) goto embree_fail;
+    if (setup->gi) {
+        evr_cpu_trace_ctx tc;
+        evr_status st;
+        tc.top = b->top;
+        tc.members = b->members;
+        tc.group_first = b->group_first;
+        b->gi = 1;
+        if ((st = evr_cpu_gi_init(&b->gi_state, &tc, &b->setup, s, err)) != EVR_OK) {
+            cpu_release(&b->base);
+            return st;
+        }
+    }
     *out = &b->base;
     return EVR_OK;
 embree_fail:

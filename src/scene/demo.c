@@ -19,10 +19,11 @@ static const demo_entry demos[] = {
     {"square", evr_demo_build_square},
     {"disk", evr_demo_build_disk},
     {"cornell", evr_demo_build_cornell},
+    {"cornell-still", evr_demo_build_cornell_still},
     {"city", evr_demo_build_city},
 };
 
-static const char *const demo_names[] = {"eye", "eye-drift", "square", "disk", "cornell", "city", NULL};
+static const char *const demo_names[] = {"eye", "eye-drift", "square", "disk", "cornell", "cornell-still", "city", NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 

@@ -1,4 +1,5 @@
-/* The "cornell" scene: a Cornell box with a moving box, for global illumination. A 1 m room
+/* The "cornell" scene: a Cornell box with a moving box, for global illumination ("cornell-still":
+ * the same with the short box held still by its animation). A 1 m room
  * (x in [-0.5, 0.5], y in [0, 1], z in [-0.5, 0.5], open at +z) with a red left wall (0.63, 0.065,
  * 0.05), a green right wall (0.14, 0.45, 0.091), white floor, ceiling and back wall (0.725, 0.71,
  * 0.68: the reflectances of the classic Cornell data); an emissive ceiling panel (0.25 m square,
@@ -69,7 +70,9 @@ static void place(evr_gltf *g, const char *name, int mesh, float x, float y, flo
     evr_gltf_node_translation(g, n, x, y, z);
 }
 
-void evr_demo_build_cornell(evr_gltf *g)
+/* moving 0: the short box's animation holds it where it starts (cornell-still: nothing moves,
+ * though the box is animated; with global illumination on it must make no events) */
+static void build_cornell(evr_gltf *g, int moving)
 {
     int white = material(g, "white", 0.725f, 0.71f, 0.68f, 0.0f);
     int red = material(g, "red", 0.63f, 0.065f, 0.05f, 0.0f);
@@ -97,8 +100,13 @@ void evr_demo_build_cornell(evr_gltf *g)
     evr_gltf_node_mesh(g, n_short, box(g, "short_box", short_h, white));
     evr_gltf_node_rotation(g, n_short, 0.0f, (float)sin(-0.5 * 0.3), 0.0f, (float)cos(-0.5 * 0.3));
     const float times[3] = {0.0f, 1.0f, 2.0f};
-    const float pos[9] = {0.18f, 0.15f, 0.12f, -0.17f, 0.15f, 0.2f, 0.18f, 0.15f, 0.12f};
-    evr_gltf_node_translation(g, n_short, pos[0], pos[1], pos[2]);
+    const float pos_moving[9] = {0.18f, 0.15f, 0.12f, -0.17f, 0.15f, 0.2f, 0.18f, 0.15f, 0.12f};
+    const float pos_still[9] = {0.18f, 0.15f, 0.12f, 0.18f, 0.15f, 0.12f, 0.18f, 0.15f, 0.12f};
+    const float *pos = moving ? pos_moving : pos_still;
+    /* cornell-still: the rest pose differs from the held one, so the importer keeps the curve
+     * and the box is an animated node that never moves */
+    if (moving) evr_gltf_node_translation(g, n_short, pos[0], pos[1], pos[2]);
+    else evr_gltf_node_translation(g, n_short, pos[0], pos[1] + 0.5f, pos[2]);
     int anim = evr_gltf_animation(g, "box_motion");
     evr_gltf_channel(g, anim, n_short, EVR_GLTF_TRANSLATION, times, pos, 3, EVR_GLTF_LINEAR);
 
@@ -114,3 +122,6 @@ void evr_demo_build_cornell(evr_gltf *g)
     int n_cam = evr_gltf_node(g, "cornell_camera", n_mount);
     evr_gltf_node_camera(g, n_cam, cam);
 }
+
+void evr_demo_build_cornell(evr_gltf *g) { build_cornell(g, 1); }
+void evr_demo_build_cornell_still(evr_gltf *g) { build_cornell(g, 0); }

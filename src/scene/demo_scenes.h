@@ -13,6 +13,7 @@ void evr_demo_build_eye_drift(evr_gltf *g);   /* the same with slow fixational d
 void evr_demo_build_square(evr_gltf *g);
 void evr_demo_build_disk(evr_gltf *g);
 void evr_demo_build_cornell(evr_gltf *g);
+void evr_demo_build_cornell_still(evr_gltf *g);
 void evr_demo_build_city(evr_gltf *g);
 
 /* The city (demo_city.c) at a tessellation detail (>= 1; a building's triangles grow as

@@ -52,6 +52,7 @@
 #include <stb/stb_image.h>
 
 #include "scene/scene.h"
+#include "core/photon.h"
 
 #define EVR_PI_D 3.14159265358979323846
 
@@ -462,6 +463,7 @@ typedef struct {
     int num_ch;
     int num_materials;
     float *emissive_strength;   /* KHR_materials_emissive_strength, 1 when absent */
+    float *t_extras;            /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
 } gltf_side;
 
 static void side_free(gltf_side *g)
@@ -471,6 +473,7 @@ static void side_free(gltf_side *g)
     free(g->node_names);
     free(g->ch);
     free(g->emissive_strength);
+    free(g->t_extras);
     memset(g, 0, sizeof *g);
 }
 
@@ -499,6 +502,7 @@ static int gltf_json_span(const unsigned char *data, size_t size, const char **j
 }
 
 #define NAME_CAP 1024
+#define T_ABSENT -1e30f
 
 static int j_count(const jdoc *d, int arr)
 {
@@ -535,7 +539,8 @@ static evr_status side_parse(const unsigned char *data, size_t size, gltf_side *
     g->num_materials = j_count(&d, mats);
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->emissive_strength = calloc((size_t)g->num_materials + 1, sizeof *g->emissive_strength);
-    if (!g->node_names || !g->emissive_strength) goto nomem;
+    g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
+    if (!g->node_names || !g->emissive_strength || !g->t_extras) goto nomem;
 
     for (i = 0, m = g->num_nodes ? d.v[nodes].first : -1; m >= 0; m = d.v[m].next, i++) {
         char buf[NAME_CAP];
@@ -580,6 +585,8 @@ static evr_status side_parse(const unsigned char *data, size_t size, gltf_side *
     for (i = 0, m = g->num_materials ? d.v[mats].first : -1; m >= 0; m = d.v[m].next, i++) {
         int es = j_get(&d, j_get(&d, j_get(&d, m, "extensions"), "KHR_materials_emissive_strength"), "emissiveStrength");
         g->emissive_strength[i] = (float)j_num(&d, es, 1.0);
+        g->t_extras[2 * i] = (float)j_num(&d, j_get(&d, j_get(&d, m, "extras"), "t_diffuse"), T_ABSENT);
+        g->t_extras[2 * i + 1] = (float)j_num(&d, j_get(&d, j_get(&d, m, "extras"), "t_specular"), T_ABSENT);
     }
     free(samplers);
     free(d.v);
@@ -853,6 +860,7 @@ static evr_status build_materials(importer *im)
         m->base_texture = -1;
         m->metallic = 0.0f;
         m->roughness = 1.0f;
+        evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
     }
     for (i = 0; i < ai->mNumMaterials; i++) {
         const struct aiMaterial *am = ai->mMaterials[i];
@@ -881,6 +889,19 @@ static evr_status build_materials(importer *im)
         if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, &one) == aiReturn_SUCCESS) m->metallic = (float)f;
         one = 1;
         if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, &one) == aiReturn_SUCCESS) m->roughness = (float)f;
+        evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
+        if (im->have_side && (int)i < im->side.num_materials &&
+            (im->side.t_extras[2 * i] != T_ABSENT || im->side.t_extras[2 * i + 1] != T_ABSENT)) {
+            float td = im->side.t_extras[2 * i], ts = im->side.t_extras[2 * i + 1];
+            if (td == T_ABSENT) td = m->t_diffuse;
+            if (ts == T_ABSENT) ts = td > m->t_specular ? td : m->t_specular;
+            if (!(td >= 0.0f && td <= ts && ts <= 1.0f))
+                return fail(im->err, EVR_ERR_FORMAT,
+                            "material '%s': extras need 0 <= t_diffuse <= t_specular <= 1 (got %g, %g)", m->name,
+                            (double)td, (double)ts);
+            m->t_diffuse = td;
+            m->t_specular = ts;
+        }
 
         for (tt = 0; tt < 2; tt++) {
             if (aiGetMaterialTextureCount(am, kinds[tt]) == 0) continue;

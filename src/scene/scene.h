@@ -27,6 +27,9 @@ typedef struct {
     int base_texture;       /* index into scene textures (sRGB-encoded source), -1 if none */
     float emissive[3];      /* linear RGB, radiance units */
     float metallic, roughness;
+    /* photon mapping thresholds (src/core/photon.h): from the material's extras "t_diffuse" and
+     * "t_specular" when the glTF gives them, else from base colour, metallic and roughness */
+    float t_diffuse, t_specular;
 } evr_material;
 
 typedef struct {

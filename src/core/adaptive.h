@@ -1,0 +1,137 @@
+/* Adaptive per-pixel sampling (--sampling adaptive): each pixel picks its own next sample time.
+ *
+ * After a sample at t (log intensity l; the previous sample at t_prev, l_prev) the next comes
+ * dt later, the smallest of
+ *  - frac * threshold / |l - l_prev| * (t - t_prev): at the present rate, the log intensity moves
+ *    by at most frac of a contrast threshold (the smaller of ON and OFF) between samples;
+ *  - EVR_ADAPT_PX_PER_FRAC * frac / speed: when the sample's rays (primary up to its hit, and the
+ *    shadow rays from there: exactly those of core/skip.h's evr_skip_rays_meet) meet the swept
+ *    bounds of something moving in the segment, speed is a bound on how fast that thing moves in
+ *    the image (pixels per second, the host's evr_adapt_plan), so it moves by at most
+ *    2 frac pixels (half a pixel at the default frac 0.25) between samples;
+ *  - max_dt,
+ * and at least min_dt. While the camera or a light moves every pixel samples every min_dt.
+ *
+ * Samples stay inside segments: a pixel's next scheduled time is carried across segments in
+ * segment-relative seconds (as t_prev). At a segment's start a pixel whose last sample's rays meet
+ * something moving in the new segment brings its next sample forward to t_prev + dt of that
+ * motion (not before the segment's start), and to the segment's start when the thing jumped
+ * between the segments: an edge entering a pixel that sampled long ago is not missed. A pixel
+ * nothing moving reaches samples every max_dt. Every sample goes through the pixel model
+ * (core/pixel.h) as uniform sampling's do, so noise and leak (continuous-time processes inside
+ * the model) are unchanged by longer spans. Both backends call these functions; the host fills an
+ * evr_adapt_plan per segment (evr_adapt_plan_build, src/skip_plan.c). */
+#ifndef EVR_CORE_ADAPTIVE_H
+#define EVR_CORE_ADAPTIVE_H
+
+#include <stdint.h>
+#include "core/pixel.h"
+#include "core/skip.h"
+
+#define EVR_ADAPT_PX_PER_FRAC 2.0f   /* image motion allowed between samples, pixels per unit of frac */
+
+typedef struct {
+    float frac;                      /* fraction of a threshold (and 2 frac pixels) between samples */
+    float min_dt, max_dt;            /* seconds */
+} evr_adapt_params;
+
+typedef struct {
+    int all_min;                     /* the camera or a light moves: every pixel samples every min_dt */
+    int num_boxes;
+    float pad;                       /* added to every box on every side */
+    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+    float speed[EVR_SKIP_MAX_BOXES]; /* bound on the image speed of what each box holds, pixels/s
+                                        (INFINITY: unbounded, e.g. the camera inside the box) */
+    int jump[EVR_SKIP_MAX_BOXES];    /* it moved between the previous segment and this one */
+} evr_adapt_plan;
+
+/* The fastest image speed (pixels per second) of the moving things that a sample's rays meet:
+ * the primary ray up to its hit at t_hit (1e29 or more: nothing hit, the whole ray) and the
+ * segments from the hit to every light that sends light there (as evr_skip_rays_meet). *jump is
+ * set when one of them moved between the segments. 0 when they meet nothing that moves. */
+EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs, const evr_adapt_plan *pl, evr_ray ray,
+                                                float t_hit, int *jump)
+{
+    float v = 0.0f;
+    uint64_t met = 0;
+    *jump = 0;
+    if (pl->num_boxes == 0) return 0.0f;
+    const int hit = t_hit < 1e29f;
+    const float tmax = hit ? t_hit * 1.0001f + pl->pad : INFINITY;
+    for (int b = 0; b < pl->num_boxes; b++)
+        if (evr_skip_segment_meets(ray.org, ray.dir, tmax, pl->lo[b], pl->hi[b], pl->pad)) met |= 1ull << b;
+    if (hit) {
+        const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
+        for (int l = 0; l < rs->num_lights; l++) {
+            evr_v3 wi;
+            float dist, e[3];
+            if (!evr_light_incident(rs, &rs->lights[l], 0.0f, p, &wi, &dist, e)) continue;
+            for (int b = 0; b < pl->num_boxes; b++)
+                if (!(met >> b & 1u) && evr_skip_segment_meets(p, wi, dist, pl->lo[b], pl->hi[b], pl->pad))
+                    met |= 1ull << b;
+        }
+    }
+    for (int b = 0; b < pl->num_boxes; b++) {
+        if (!(met >> b & 1u)) continue;
+        v = fmaxf(v, pl->speed[b]);
+        if (pl->jump[b]) *jump = 1;
+    }
+    return v;
+}
+
+/* Time between samples allowed by an image speed (pixels per second; 0: nothing moves). */
+EVR_HD static inline float evr_adapt_motion_dt(const evr_adapt_params *ap, float speed)
+{
+    return speed > 0.0f ? EVR_ADAPT_PX_PER_FRAC * ap->frac / speed : ap->max_dt;
+}
+
+/* min_dt <= dt <= max_dt (NaN: min_dt). */
+EVR_HD static inline float evr_adapt_clamp(const evr_adapt_params *ap, float dt)
+{
+    return dt >= ap->min_dt ? fminf(dt, ap->max_dt) : ap->min_dt;
+}
+
+/* The time to the next sample after one at t of log intensity l, the previous at t_prev with
+ * l_prev (have_prev 0: none), thres the pixel's smaller threshold, speed the image speed bound of
+ * what its rays meet (evr_adapt_rays_speed). */
+EVR_HD static inline float evr_adapt_next_dt(const evr_adapt_params *ap, const evr_adapt_plan *pl, int have_prev,
+                                             float t_prev, float l_prev, float t, float l, float thres, float speed)
+{
+    if (pl->all_min) return ap->min_dt;
+    float dt = evr_adapt_motion_dt(ap, speed);
+    const float dl = fabsf(l - l_prev);
+    if (have_prev && t > t_prev && dl > 0.0f) dt = fminf(dt, ap->frac * thres * (t - t_prev) / dl);
+    return evr_adapt_clamp(ap, dt);
+}
+
+/* The first sample of a segment (segment-relative seconds): next_t as carried from the previous
+ * segment, brought forward as the segment's motion asks (speed and jump: evr_adapt_rays_speed of
+ * the last sample's rays), never before the segment's start. A pixel's very first sample comes at
+ * phase * min_dt (phase in [0, 1), the pixel's own). */
+EVR_HD static inline float evr_adapt_first(const evr_adapt_params *ap, const evr_adapt_plan *pl, int started,
+                                           float next_t, float t_prev, float phase, float speed, int jump)
+{
+    if (!started) return phase * ap->min_dt;
+    if (pl->all_min) next_t = fminf(next_t, t_prev + ap->min_dt);
+    if (jump) next_t = 0.0f;
+    else if (speed > 0.0f) next_t = fminf(next_t, t_prev + evr_adapt_clamp(ap, evr_adapt_motion_dt(ap, speed)));
+    return fmaxf(next_t, 0.0f);
+}
+
+/* Everything a backend does after tracing a sample at segment time t (intensity, primary ray
+ * ray0 with hit distance t_hit) and before running it through the pixel model (s: the state
+ * before the sample): returns the time to the next sample. */
+EVR_HD static inline float evr_adapt_after_sample(const evr_render_scene *rs, const evr_adapt_params *ap,
+                                                  const evr_adapt_plan *pl, const evr_pixel_state *s,
+                                                  const evr_pixel_params *p, evr_ray ray0, float t_hit, float t,
+                                                  float intensity)
+{
+    if (pl->all_min) return ap->min_dt;
+    int jump;
+    const float speed = evr_adapt_rays_speed(rs, pl, ray0, t_hit, &jump);
+    const float l = evr_log_response(intensity, p->log_floor);
+    const float l_prev = evr_log_response(s->intensity, p->log_floor);
+    return evr_adapt_next_dt(ap, pl, s->started, s->t_prev, l_prev, t, l, fminf(p->pos_thres, p->neg_thres), speed);
+}
+
+#endif

@@ -1,0 +1,509 @@
+/* Image-space photon mapping (issue 5): every per-photon and per-pixel decision, written once
+ * for the CPU and for nvcc (EVR_HD, plain C, no allocation). The loops that trace rays live in
+ * the backends (src/cpu/photon_pass.c on the CPU); this file holds:
+ *   - the material mapping (glTF metallic/roughness -> t_diffuse, t_specular),
+ *   - the stay / diffuse / mirror decision and the flux update,
+ *   - cosine-distributed and mirror directions,
+ *   - the low-discrepancy numbers of a photon (a pure function of emitter and photon number),
+ *   - emission from point, spot and directional lights and from emissive triangles,
+ *   - the image-space buffer (projection, lock-free insertion),
+ *   - the ring search, the Gaussian kernel and the gather estimate.
+ *
+ * Light transport model. A surface reflects the fraction albedo * (1 - mirror) diffusely
+ * (Lambertian, the direct term's model) and albedo * mirror as a mirror, with
+ * mirror = (1 - t_specular) / (1 - t_diffuse). A photon arriving with flux F draws xi in [0, 1):
+ *   xi <  t_diffuse               stays: stored with flux F / t_diffuse (so the stored photons
+ *                                 estimate the incident flux without bias), path ends;
+ *   t_diffuse <= xi < t_specular  diffuse bounce (cosine distributed), flux F * albedo / (1 - t_diffuse);
+ *   xi >= t_specular              mirror bounce, flux F * albedo / (1 - t_diffuse).
+ * A photon from a light (point, spot, directional) never stays at its first hit: that light is
+ * the direct term's, already computed exactly with shadow rays; it bounces with flux F * albedo.
+ * Photons from emissive surfaces may stay at their first hit (the direct term has no area lights).
+ * Units: a light's colour is intensity (point, spot) or irradiance (directional), as in
+ * evr_light_incident; flux = intensity * solid angle, so photon flux / area is an irradiance in
+ * the units of the direct term's E and the estimate albedo * (1 - mirror) / pi * E adds to
+ * evr_surface_intensity's radiance directly (per RGB channel; the sensor takes the luminance). */
+#ifndef EVR_CORE_PHOTON_H
+#define EVR_CORE_PHOTON_H
+
+#include <stdint.h>
+#include "core/rng.h"
+#include "core/shading.h"
+
+#if defined(__CUDA_ARCH__)   /* nvcc's device pass; its host pass is the host compiler's */
+#define EVR_ATOMIC_INC_U32(p) atomicAdd((unsigned int *)(p), 1u)
+#else
+#define EVR_ATOMIC_INC_U32(p) __atomic_fetch_add((p), 1u, __ATOMIC_RELAXED)
+#endif
+
+/* ---- materials ---- */
+
+/* glTF metallic-roughness to the photon thresholds: reflectance R = max(base colour) clamped to
+ * [0.05, 0.95]; mirror = metallic * (1 - roughness);
+ * t_diffuse = 1 - R, t_specular = t_diffuse + R * (1 - mirror). */
+EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic, float roughness,
+                                                  float *t_diffuse, float *t_specular)
+{
+    float r = fmaxf(base_color[0], fmaxf(base_color[1], base_color[2]));
+    float m = fminf(fmaxf(metallic, 0.0f), 1.0f) * (1.0f - fminf(fmaxf(roughness, 0.0f), 1.0f));
+    r = fminf(fmaxf(r, 0.05f), 0.95f);
+    *t_diffuse = 1.0f - r;
+    *t_specular = *t_diffuse + r * (1.0f - m);
+}
+
+/* Share of the reflected light that is a mirror reflection. */
+EVR_HD static inline float evr_photon_mirror_share(float t_diffuse, float t_specular)
+{
+    float refl = 1.0f - t_diffuse;
+    return refl > 0.0f ? fminf(fmaxf((1.0f - t_specular) / refl, 0.0f), 1.0f) : 0.0f;
+}
+
+enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_DIFFUSE = 1, EVR_PHOTON_MIRROR = 2, EVR_PHOTON_ABSORB = 3 };
+
+/* The decision at a hit for random xi in [0, 1). *weight multiplies the flux: stay 1/t_diffuse,
+ * bounce 1/(1 - t_diffuse) (times the albedo, which the caller applies), 1 for a bounce when
+ * staying is not allowed. ABSORB only when nothing else is possible. */
+EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi, int allow_stay, float *weight)
+{
+    float td = fminf(fmaxf(t_diffuse, 0.0f), 1.0f), ts = fminf(fmaxf(t_specular, td), 1.0f);
+    if (allow_stay) {
+        if (xi < td) {
+            *weight = 1.0f / td;
+            return EVR_PHOTON_STAY;
+        }
+        if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+        *weight = 1.0f / (1.0f - td);
+        return xi < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
+    }
+    if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+    *weight = 1.0f;
+    /* xi spread over the bounce options only */
+    return td + xi * (1.0f - td) < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
+}
+
+/* Orthonormal basis around unit n (Duff et al. 2017). */
+EVR_HD static inline void evr_onb(evr_v3 n, evr_v3 *t, evr_v3 *b)
+{
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z), c = n.x * n.y * a;
+    *t = evr_v3_make(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    *b = evr_v3_make(c, s + n.y * n.y * a, -n.y);
+}
+
+/* Cosine-distributed direction around unit n from (u1, u2) in [0, 1)^2 (pdf cos / pi). */
+EVR_HD static inline evr_v3 evr_cosine_dir(evr_v3 n, float u1, float u2)
+{
+    evr_v3 t, b;
+    float r = sqrtf(u1), phi = 6.28318530718f * u2;
+    float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+    evr_onb(n, &t, &b);
+    return evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
+}
+
+/* Mirror direction of incoming d about unit n. */
+EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
+{
+    return evr_v3_sub(d, evr_v3_scale(n, 2.0f * evr_v3_dot(d, n)));
+}
+
+/* Uniform direction on the sphere. */
+EVR_HD static inline evr_v3 evr_sphere_dir(float u1, float u2)
+{
+    float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 6.28318530718f * u2;
+    return evr_v3_make(r * cosf(phi), r * sinf(phi), z);
+}
+
+/* ---- low-discrepancy numbers of a photon ---- */
+
+/* Radical inverse of i in a prime base (Halton), in [0, 1). */
+EVR_HD static inline float evr_radical_inverse(uint32_t i, uint32_t base)
+{
+    float inv = 1.0f / (float)base, f = inv, r = 0.0f;
+    while (i > 0) {
+        r += (float)(i % base) * f;
+        i /= base;
+        f *= inv;
+    }
+    return fminf(r, 0.99999994f);
+}
+
+/* Dimension dim of photon j of emitter e: dims 0-4 (the emission) are the Halton sequence
+ * (bases 2, 3, 5, 7, 11) at index j + 1, each shifted by a fixed per-emitter offset (Cranley-
+ * Patterson rotation) so that lights do not share points; later dims (the bounces) are
+ * counter-based hashes of (seed, e, j, dim). Either way a pure function of the photon number:
+ * the same photons every segment. */
+EVR_HD static inline float evr_photon_rand(uint64_t seed, int e, uint32_t j, int dim)
+{
+    if (dim < 5) {
+        const uint32_t bases[5] = {2, 3, 5, 7, 11};
+        float x = evr_radical_inverse(j + 1u, bases[dim]) +
+                  evr_uniform(evr_hash4(seed, (uint64_t)e, 0x73686966ull /* "shif" */, (uint64_t)dim));
+        x -= floorf(x);
+        return fminf(x, 0.99999994f);
+    }
+    return evr_uniform(evr_hash4(seed ^ 0x70686f746f6eull /* "photon" */, (uint64_t)e, (uint64_t)j, (uint64_t)dim));
+}
+
+/* Normalized segment time of photon j: f0 + (f1 - f0) * frac(j * golden ratio). */
+EVR_HD static inline float evr_photon_time(uint32_t j, float f0, float f1)
+{
+    float g = (float)j * 0.61803398875f;
+    g -= floorf(g);
+    return f0 + (f1 - f0) * g;
+}
+
+/* ---- emission ---- */
+
+typedef struct {
+    evr_ray ray;
+    float flux[3];
+    int from_light;   /* 1: a point, spot or directional light (never stays at the first hit) */
+} evr_photon_ray;
+
+/* Emitters of a pass: every light with power, then every instance with an emissive material. */
+typedef struct {
+    int kind;          /* 0: light, 1: emissive instance */
+    int index;         /* light index or instance index */
+    float power;       /* luminance flux (what the photons are split by) */
+    uint32_t first;    /* photons [first, first + count) of the pass are this emitter's */
+    uint32_t count;
+    int tri_first;     /* kind 1: triangles' cumulative areas at cdf[tri_first .. tri_first + ntri) */
+    int ntri;
+    float area;        /* kind 1: total area (world, at the pass's time) */
+} evr_photon_emitter;
+
+/* Scene bounds for directional lights: a sphere. */
+typedef struct { evr_v3 center; float radius; } evr_photon_bounds;
+
+/* Position and direction of light l at normalized segment time f. */
+EVR_HD static inline void evr_photon_light_pose(const evr_render_scene *rs, const evr_light_view *l, float f, evr_v3 *pos,
+                                                evr_v3 *dir)
+{
+    *pos = l->pos;
+    *dir = l->dir;
+    if (l->track >= 0) {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, l->track), f);
+        *pos = evr_m34_point(&xf, *pos);
+        *dir = evr_v3_norm(evr_m34_vector(&xf, *dir));
+    }
+}
+
+/* Cosine of the half angle of the cone from point p that holds the bounding sphere; -1 when p is
+ * inside the sphere (every direction). */
+EVR_HD static inline float evr_photon_sphere_cos(evr_v3 p, evr_photon_bounds bb)
+{
+    evr_v3 to = evr_v3_sub(bb.center, p);
+    float d2 = evr_v3_dot(to, to), r2 = bb.radius * bb.radius;
+    if (!(bb.radius > 0.0f) || d2 <= r2 * 1.0001f) return -1.0f;
+    return sqrtf(fmaxf(0.0f, 1.0f - r2 / d2));
+}
+
+/* Total flux (RGB) of light l towards the scene at time f: a point light outside the scene's
+ * bounding sphere 2 pi (1 - cos) I over the cone that holds the sphere (nothing outside it can
+ * hit anything), else 4 pi I; spot 2 pi (1 - cos_outer) I times the mean smooth falloff
+ * (approximate, for the split only: the photons carry the exact falloff); directional E pi R^2
+ * over a disk of the scene's bounding radius. */
+EVR_HD static inline void evr_photon_light_flux(const evr_render_scene *rs, const evr_light_view *l, float f,
+                                                evr_photon_bounds bb, float out[3])
+{
+    float k;
+    if (l->type == 2) k = EVR_PI * bb.radius * bb.radius;
+    else if (l->type == 1) k = 2.0f * EVR_PI * (1.0f - l->cos_outer) * 0.5f;
+    else {
+        evr_v3 lp, ld;
+        evr_photon_light_pose(rs, l, f, &lp, &ld);
+        k = 2.0f * EVR_PI * (1.0f - evr_photon_sphere_cos(lp, bb));
+    }
+    out[0] = l->color[0] * k;
+    out[1] = l->color[1] * k;
+    out[2] = l->color[2] * k;
+}
+
+/* Photon number j (of count) of light l at normalized segment time f, from the numbers u[0..3]. */
+EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const evr_light_view *l, float f,
+                                               evr_photon_bounds bb, const float u[4], uint32_t count,
+                                               evr_photon_ray *out)
+{
+    evr_v3 lp, ld;
+    float k;
+    evr_photon_light_pose(rs, l, f, &lp, &ld);
+    out->from_light = 1;
+    if (l->type == 2) {   /* directional: a disk across the scene's bounding sphere, upstream */
+        evr_v3 t, b;
+        float r = bb.radius * sqrtf(u[0]), phi = 6.28318530718f * u[1];
+        evr_onb(ld, &t, &b);
+        out->ray.org = evr_v3_add(evr_v3_sub(bb.center, evr_v3_scale(ld, 1.01f * bb.radius)),
+                                  evr_v3_add(evr_v3_scale(t, r * cosf(phi)), evr_v3_scale(b, r * sinf(phi))));
+        out->ray.dir = ld;
+        k = EVR_PI * bb.radius * bb.radius;
+    } else if (l->type == 1) {   /* spot: uniform in the outer cone, weighted by the falloff */
+        evr_v3 t, b;
+        float cz = 1.0f - u[0] * (1.0f - l->cos_outer), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
+        float phi = 6.28318530718f * u[1];
+        float a = (cz - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f);
+        a = fminf(fmaxf(a, 0.0f), 1.0f);
+        evr_onb(ld, &t, &b);
+        out->ray.org = lp;
+        out->ray.dir = evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
+                                              evr_v3_scale(ld, cz)));
+        k = 2.0f * EVR_PI * (1.0f - l->cos_outer) * a * a;
+    } else {   /* point: every direction, or only those towards the scene's sphere from outside it */
+        float cmax = evr_photon_sphere_cos(lp, bb);
+        out->ray.org = lp;
+        if (cmax > -1.0f) {
+            evr_v3 axis = evr_v3_norm(evr_v3_sub(bb.center, lp)), t, b;
+            float cz = 1.0f - u[0] * (1.0f - cmax), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
+            float phi = 6.28318530718f * u[1];
+            evr_onb(axis, &t, &b);
+            out->ray.dir = evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
+                                                  evr_v3_scale(axis, cz)));
+            k = 2.0f * EVR_PI * (1.0f - cmax);
+        } else {
+            out->ray.dir = evr_sphere_dir(u[0], u[1]);
+            k = 4.0f * EVR_PI;
+        }
+    }
+    k /= (float)(count ? count : 1u);
+    out->flux[0] = l->color[0] * k;
+    out->flux[1] = l->color[1] * k;
+    out->flux[2] = l->color[2] * k;
+    return k > 0.0f;
+}
+
+/* Photon number j (of count) of an emissive instance: a triangle by area (u[0], which also picks
+ * the side: both sides emit, as evr_surface_at's emission is two-sided), a point on it (u[1],
+ * u[2]), a cosine-distributed direction (u[3], u[4]); flux = 2 pi Le * area / count.
+ * cdf: the instance's cumulative world-space triangle areas (cdf[ntri - 1] == area). */
+EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs, const evr_photon_emitter *em,
+                                                 const float *cdf, const evr_m34 *xf, const float u[5],
+                                                 evr_photon_ray *out)
+{
+    const evr_mesh_view *m = &rs->meshes[rs->instances[em->index].mesh];
+    const evr_material_view *mat = &rs->materials[m->material];
+    const float *c = cdf + em->tri_first;
+    float side = u[0] < 0.5f ? 1.0f : -1.0f, x = (u[0] < 0.5f ? u[0] * 2.0f : u[0] * 2.0f - 1.0f) * em->area;
+    int lo = 0, hi = em->ntri - 1;
+    while (lo < hi) {   /* first triangle whose cumulative area exceeds x */
+        int mid = (lo + hi) / 2;
+        if (c[mid] > x) hi = mid;
+        else lo = mid + 1;
+    }
+    uint32_t i0 = m->indices[3 * lo], i1 = m->indices[3 * lo + 1], i2 = m->indices[3 * lo + 2];
+    evr_v3 p0 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1], m->positions[3 * i0 + 2]));
+    evr_v3 p1 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1], m->positions[3 * i1 + 2]));
+    evr_v3 p2 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1], m->positions[3 * i2 + 2]));
+    float su = sqrtf(u[1]), b1 = 1.0f - su, b2 = u[2] * su;
+    evr_v3 e1 = evr_v3_sub(p1, p0), e2 = evr_v3_sub(p2, p0);
+    evr_v3 n = evr_v3_scale(evr_v3_norm(evr_v3_cross(e1, e2)), side);
+    float k = 2.0f * EVR_PI * em->area / (float)(em->count ? em->count : 1u);
+    out->from_light = 0;
+    out->ray.org = evr_v3_add(p0, evr_v3_add(evr_v3_scale(e1, b1), evr_v3_scale(e2, b2)));
+    out->ray.dir = evr_cosine_dir(n, u[3], u[4]);
+    out->flux[0] = mat->emissive[0] * k;
+    out->flux[1] = mat->emissive[1] * k;
+    out->flux[2] = mat->emissive[2] * k;
+    return k > 0.0f;
+}
+
+/* ---- the image-space buffer ---- */
+
+typedef struct {
+    float p[3], n[3];     /* world position, normal on the side the photon came from */
+    float flux[3];        /* incident flux the photon stands for (RGB) */
+    uint32_t key;         /* photon number * 16 + bounce: a canonical order */
+} evr_photon;
+
+/* The image plus a guard band of `margin` pixels on every side (so that pixels near the image's
+ * border have photons all round them): width x height cells, width = image width + 2 margin,
+ * of `layers` photons each. Image pixel (x, y), -margin <= x < image width + margin, is cell
+ * i = (y + margin) * width + x + margin; layer k of cell i is slots[k * width * height + i];
+ * count[i] is how many photons arrived at cell i (those beyond `layers` were dropped and counted
+ * in *collisions). Host or device pointers; the owner zeroes count and *collisions. */
+typedef struct {
+    int width, height, layers, margin;
+    evr_photon *slots;
+    uint32_t *count;
+    uint32_t *collisions;
+    /* Optional (NULL: none): what the camera sees through each cell's centre, 8 floats per cell:
+     * position (3), normal facing the camera (3), the surface area the cell covers there, 0; a
+     * cell that sees nothing has area 0. evr_photon_gather then normalizes its kernel over the
+     * part of the disk that lies on surfaces like the query's, not the whole disk (no darkening
+     * at creases and silhouettes). */
+    float *gbuf;
+} evr_photon_buffer;
+
+/* Image pixel of world point p for the camera (world_to_cam = inverse pose), which may lie up
+ * to margin pixels outside the image; 0 when behind the camera or farther out. */
+EVR_HD static inline int evr_photon_pixel(const evr_camera_intr *c, const evr_m34 *world_to_cam, evr_v3 p, int margin,
+                                          int *x, int *y)
+{
+    float px = -1e9f, py = -1e9f, m = (float)margin;
+    if (!evr_camera_project(c, world_to_cam, p, &px, &py)) return 0;
+    if (!(px >= -m && py >= -m && px < (float)c->width + m && py < (float)c->height + m)) return 0;
+    *x = (int)floorf(px);
+    *y = (int)floorf(py);
+    if (*x >= c->width + margin) *x = c->width + margin - 1;
+    if (*y >= c->height + margin) *y = c->height + margin - 1;
+    return 1;
+}
+
+/* Lock-free insertion: an atomic increment claims a layer; a photon arriving at a full cell is
+ * dropped and counted as a collision. Returns 1 when stored. Threads inserting concurrently
+ * store the same set of photons whenever no cell overflows (the order of a cell's layers may
+ * differ: evr_photon_buffer_sort_cell restores the canonical order). */
+EVR_HD static inline int evr_photon_buffer_insert(evr_photon_buffer *b, int x, int y, const evr_photon *ph)
+{
+    size_t i = (size_t)(y + b->margin) * (size_t)b->width + (size_t)(x + b->margin);
+    uint32_t k = EVR_ATOMIC_INC_U32(&b->count[i]);
+    if (k >= (uint32_t)b->layers) {
+        EVR_ATOMIC_INC_U32(b->collisions);
+        return 0;
+    }
+    b->slots[(size_t)k * (size_t)b->width * (size_t)b->height + i] = *ph;
+    return 1;
+}
+
+/* Sorts one cell's layers by key (insertion sort over a handful). */
+EVR_HD static inline void evr_photon_buffer_sort_cell(evr_photon_buffer *b, size_t i)
+{
+    size_t npix = (size_t)b->width * (size_t)b->height;
+    int n = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers, a, c;
+    for (a = 1; a < n; a++) {
+        evr_photon v = b->slots[(size_t)a * npix + i];
+        for (c = a; c > 0 && b->slots[(size_t)(c - 1) * npix + i].key > v.key; c--)
+            b->slots[(size_t)c * npix + i] = b->slots[(size_t)(c - 1) * npix + i];
+        b->slots[(size_t)c * npix + i] = v;
+    }
+}
+
+/* ---- gather ---- */
+
+/* Cell k of the ring search: ring 0 is the centre (k = 0), ring r (r >= 1) the 8r cells at
+ * Chebyshev distance r, k = (2r-1)^2 .. (2r+1)^2 - 1, starting at (-r, -r) and going round
+ * clockwise in image coordinates (right along the top row, down the right column, left along
+ * the bottom row, up the left column). Returns the ring. */
+EVR_HD static inline int evr_ring_cell(int k, int *dx, int *dy)
+{
+    if (k <= 0) { *dx = 0; *dy = 0; return 0; }
+    int r = (int)((sqrtf((float)k) + 1.0f) * 0.5f);
+    while ((2 * r + 1) * (2 * r + 1) <= k) r++;   /* exact whatever sqrtf rounds to */
+    while (r > 1 && (2 * r - 1) * (2 * r - 1) > k) r--;
+    int j = k - (2 * r - 1) * (2 * r - 1), side = j / (2 * r), o = j % (2 * r);
+    switch (side) {
+    case 0: *dx = -r + o; *dy = -r; break;
+    case 1: *dx = r; *dy = -r + o; break;
+    case 2: *dx = r - o; *dy = r; break;
+    default: *dx = -r; *dy = r - o; break;
+    }
+    return r;
+}
+
+/* Gaussian kernel truncated at radius r, sigma = r / 2, normalized so that its integral over the
+ * disk of radius r is 1: K(d) = exp(-d^2 / (2 sigma^2)) / (2 pi sigma^2 (1 - exp(-r^2 / (2 sigma^2)))). */
+EVR_HD static inline float evr_gauss_kernel(float d2, float r)
+{
+    float s2 = 0.25f * r * r;
+    if (!(d2 <= r * r) || !(r > 0.0f)) return 0.0f;
+    return expf(-d2 / (2.0f * s2)) / (2.0f * EVR_PI * s2 * (1.0f - expf(-(r * r) / (2.0f * s2))));
+}
+
+typedef struct {
+    float radius;       /* distance filter r (world units): photons farther away are skipped */
+    int max_photons;    /* the search stops growing at this many photons (see evr_photon_gather) */
+    int max_window;     /* the window's half size in pixels is at most this */
+    float normal_cos;   /* photons whose normal differs more (cosine below) are skipped */
+} evr_gather_params;
+
+/* Sums the photons of rings 0 .. rings of the window around cell (cx, cy) that lie within
+ * sqrt(lim2) of p with a normal within the cosine; stops once max photons are counted (returns
+ * the ring where it stopped in *stop_ring, or -1 when it did not stop). */
+EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int cx, int cy, int rings, evr_v3 p,
+                                                 evr_v3 n, float lim2, float normal_cos, float s2, int max,
+                                                 float acc[3], int *stop_ring, float *area_w)
+{
+    const size_t npix = (size_t)b->width * (size_t)b->height;
+    int ncell = (2 * rings + 1) * (2 * rings + 1), k, used = 0;
+    acc[0] = acc[1] = acc[2] = 0.0f;
+    *stop_ring = -1;
+    *area_w = 0.0f;
+    for (k = 0; k < ncell; k++) {
+        int dx, dy, l, nl, ring = evr_ring_cell(k, &dx, &dy);
+        int x = cx + dx, y = cy + dy;
+        if (x < 0 || y < 0 || x >= b->width || y >= b->height) continue;
+        size_t i = (size_t)y * (size_t)b->width + (size_t)x;
+        if (b->gbuf) {   /* the kernel's integral over the surfaces the camera sees here */
+            const float *g = b->gbuf + 8 * i;
+            evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
+            float d2 = evr_v3_dot(d, d);
+            if (g[6] > 0.0f && d2 <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos)
+                *area_w += expf(-d2 / (2.0f * s2)) * g[6];
+        }
+        nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
+        for (l = 0; l < nl; l++) {
+            const evr_photon *ph = &b->slots[(size_t)l * npix + i];
+            evr_v3 d = evr_v3_make(ph->p[0] - p.x, ph->p[1] - p.y, ph->p[2] - p.z);
+            float d2 = evr_v3_dot(d, d);
+            if (d2 > lim2) continue;
+            if (ph->n[0] * n.x + ph->n[1] * n.y + ph->n[2] * n.z < normal_cos) continue;
+            float w = expf(-d2 / (2.0f * s2));
+            acc[0] += w * ph->flux[0];
+            acc[1] += w * ph->flux[1];
+            acc[2] += w * ph->flux[2];
+            if (++used >= max) {
+                *stop_ring = ring;
+                return used;
+            }
+        }
+    }
+    return used;
+}
+
+/* Irradiance at surface point p (normal n, seen at distance cam_dist from the camera through
+ * image pixel (px, py)) from the buffer. The window is the square of half size ceil(r / pixel
+ * size at the hit's distance) + 1 (at most max_window), searched ring by ring from the centre;
+ * photons farther than r or whose normal differs more than normal_cos are skipped; weights are
+ * the Gaussian kernel (sigma = r / 2) normalized over the disk searched. When max_photons is
+ * reached in ring k, the disk shrinks to the one that rings 0 .. k surely cover (radius k pixel
+ * sizes, at least half a pixel) and the estimate is every photon in that disk (rings 0 .. k + 1):
+ * on a surface seen at a grazing angle the window reaches far along the surface but not across,
+ * and the farthest photon taken would overstate the disk. Returns the photons used. */
+EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr_camera_intr *cam, int px, int py,
+                                           evr_v3 p, evr_v3 n, float cam_dist, const evr_gather_params *gp,
+                                           float e_rgb[3])
+{
+    const float r = gp->radius, r2 = r * r, s2 = 0.25f * r2;
+    float pix = 2.0f * cam->tan_half_y * fmaxf(cam_dist, 1e-6f) / (float)cam->height;   /* pixel size at the hit */
+    float hf = ceilf(r / pix) + 1.0f, acc[3], lim2 = r2;   /* + 1: nearer points project farther out */
+    int h = hf > (float)gp->max_window ? gp->max_window : (int)hf, stop, used;
+    int cx = px + b->margin, cy = py + b->margin;
+    float area_w;
+    used = evr_photon_gather_rings(b, cx, cy, h, p, n, r2, gp->normal_cos, s2, gp->max_photons, acc, &stop, &area_w);
+    if (stop >= 0) {   /* the limit: the disk the rings searched cover, all of its photons */
+        float rho = fminf(r, fmaxf((float)stop, 0.5f) * pix);
+        int rings = stop + 1;   /* p lies anywhere in its pixel: the disk may reach one ring further */
+        lim2 = rho * rho;
+        used = evr_photon_gather_rings(b, cx, cy, rings < h ? rings : h, p, n, lim2, gp->normal_cos, s2, 0x7fffffff, acc,
+                                       &stop, &area_w);
+    }
+    float z = 2.0f * EVR_PI * s2 * (1.0f - expf(-lim2 / (2.0f * s2)));
+    /* the share of the disk on such surfaces, where the disk spans enough cells to measure it */
+    if (b->gbuf && lim2 >= 9.0f * pix * pix) z *= fminf(fmaxf(area_w / z, 0.25f), 1.25f);
+    float inv = z > 0.0f ? 1.0f / z : 0.0f;
+    e_rgb[0] = acc[0] * inv;
+    e_rgb[1] = acc[1] * inv;
+    e_rgb[2] = acc[2] * inv;
+    return used;
+}
+
+/* Indirect radiance leaving surface s (material mat) from an irradiance estimate: the diffuse
+ * share of the albedo over pi, per RGB channel (add its luminance to evr_surface_intensity). */
+EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_view *mat, const float e_rgb[3],
+                                              float out_rgb[3])
+{
+    float k = (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
+    out_rgb[0] = s->albedo[0] * k * e_rgb[0];
+    out_rgb[1] = s->albedo[1] * k * e_rgb[1];
+    out_rgb[2] = s->albedo[2] * k * e_rgb[2];
+}
+
+#endif

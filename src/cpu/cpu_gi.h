@@ -1,0 +1,45 @@
+/* Global illumination in the CPU event pipeline: one photon pass per segment through the
+ * backend's motion-blurred Embree scene (src/cpu/photon_pass.c, src/core/photon.h), the gather
+ * per traced sample, and which buffer cells changed since the previous segment (a pixel whose
+ * gather window saw no change may keep its intensity: change-driven sampling stays exact). */
+#ifndef EVR_CPU_GI_H
+#define EVR_CPU_GI_H
+
+#include <embree3/rtcore.h>
+#include "backend.h"
+#include "cpu/photon_pass.h"
+
+typedef struct {
+    RTCScene top;                  /* the backend's top-level scene */
+    const int *members, *group_first;   /* (instance, geometry) of a hit -> scene instance */
+} evr_cpu_trace_ctx;
+
+typedef struct {
+    evr_cpu_trace_ctx tc;
+    evr_tracer tr;
+    evr_photon_buffer buf, prev;   /* this segment's buffer and the previous segment's */
+    evr_photon_emitters em;
+    evr_gather_params gp;
+    evr_photon_params pp;
+    uint32_t photons;
+    uint32_t *sat;                 /* summed-area table of the cells that changed, (w + 1) x (h + 1) */
+    int have_prev;
+    int window;                    /* cells around a pixel a gather may read */
+} evr_cpu_gi;
+
+evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,
+                           evr_error *err);
+/* The photon pass of a segment (rs holds its keys). still: nothing moved in this segment or
+ * since the previous one (camera, lights and instances), so the photons are those of the
+ * previous segment: the pass is not run and no cell changed. */
+evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int still, int threads, evr_backend *stats,
+                              evr_error *err);
+/* 1 when a cell the gather of pixel (x, y) may read changed in this segment. */
+int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y);
+/* Luminance of the indirect light leaving surface s of scene instance inst, seen from cam_org
+ * through pixel (x, y). */
+float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
+                          int x, int y);
+void evr_cpu_gi_free(evr_cpu_gi *g);
+
+#endif

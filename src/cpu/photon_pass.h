@@ -1,0 +1,85 @@
+/* The photon pass on the CPU (issue 5): emitters of a segment, the image-space photon buffer,
+ * and the loop that traces every photon through a ray-tracing interface given as function
+ * pointers, so any backend (the still renderer's Embree scene, the event pipeline's motion-
+ * blurred Embree scene) can run it. Per-photon decisions are src/core/photon.h. */
+#ifndef EVR_CPU_PHOTON_PASS_H
+#define EVR_CPU_PHOTON_PASS_H
+
+#include <stdint.h>
+#include "evray.h"
+#include "core/photon.h"
+
+/* What a closest-hit query returns: the scene instance, its triangle, barycentrics, distance. */
+typedef struct {
+    int inst;
+    unsigned prim;
+    float u, v, t;
+} evr_trace_hit;
+
+/* The ray tracer the pass uses. Both calls must be safe to make from several threads at once.
+ * f is the normalized segment time of the ray (motion blur); directions are unit vectors. */
+typedef struct {
+    void *user;
+    /* closest hit along ray with distance in [tnear, tfar); returns 0 when nothing is hit */
+    int (*closest)(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit);
+    /* 1 when anything lies along ray with distance in [tnear, tfar) */
+    int (*occluded)(void *user, evr_ray ray, float tnear, float tfar, float f);
+} evr_tracer;
+
+/* The emitters of one pass and how the photons are split among them (by power). */
+typedef struct {
+    evr_photon_emitter *e;
+    int n, cap;
+    float *cdf;                    /* cumulative triangle areas of the emissive instances */
+    int cdf_n, cdf_cap;
+    float total_power;             /* luminance flux of all emitters */
+    uint32_t photons;              /* sum of the emitters' counts (== the photons asked for, give or take rounding) */
+} evr_photon_emitters;
+
+/* Emitters at normalized segment time f (light positions and emissive areas; bb: a sphere
+ * holding the scene at every time of the segment): every light with non-zero power, every instance whose
+ * material is emissive (its triangles' world areas at f); photons split by luminance power,
+ * each emitter's count fixed by (powers, photons) alone, so a static scene gets the same photons
+ * every segment. Reuses em's arrays (zero-initialize em before the first call). */
+evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_photon_bounds bb, uint32_t photons,
+                                     evr_photon_emitters *em, evr_error *err);
+void evr_photon_emitters_free(evr_photon_emitters *em);
+
+/* A buffer for a width x height image with a guard band of margin pixels. */
+evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers, int margin, evr_error *err);
+void evr_photon_buffer_clear(evr_photon_buffer *b);
+void evr_photon_buffer_free(evr_photon_buffer *b);
+
+/* Fills buf->gbuf (allocated here when NULL; freed by evr_photon_buffer_free): the surface the
+ * camera (pose at time f) sees through every cell's centre, guard band included, and the area
+ * the cell covers there (pixel area at unit distance * depth^2 * cos(off-axis angle) / |cos of
+ * the incidence|, the cosine at least 0.1). */
+evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f, evr_photon_buffer *buf,
+                              int threads, evr_error *err);
+
+typedef struct {
+    int max_bounces;               /* indirect bounces: a light photon has at most max_bounces + 1 hits */
+    float f0, f1;                  /* photon j is traced at time evr_photon_time(j, f0, f1) */
+    uint64_t seed;
+    int threads;                   /* <= 0: all cores */
+    evr_photon_bounds bounds;      /* the scene's bounding sphere (directional lights) */
+    float ray_eps;                 /* secondary-ray offset (rs->ray_eps) */
+} evr_photon_params;
+
+/* Energy bookkeeping (RGB flux) and counts of one pass. Absorbed is the estimate
+ * sum(first hits of light photons: F (1 - albedo)) + sum(stays: F / t_diffuse * (1 - albedo));
+ * on a closed scene with enough bounces emitted = absorbed + capped within Monte Carlo error. */
+typedef struct {
+    double emitted[3], stored[3], absorbed[3], escaped[3], capped[3];
+    uint64_t paths, stored_photons, visible, inserted, collisions;
+    double seconds;
+} evr_photon_stats;
+
+/* Traces every photon of the emitters (threads over chunks of photons), keeps each photon that
+ * stays where the camera (pose at the photon's time) sees it, and inserts it into buf (cleared
+ * first) in photon order: the buffer is identical for any thread count. */
+evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
+                           const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
+                           evr_error *err);
+
+#endif

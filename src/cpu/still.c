@@ -1,0 +1,466 @@
+/* evray still: one image at one time. Its own Embree scene (every instance baked into world
+ * space at that time, geometry id = scene instance), the event pipeline's direct shading through
+ * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
+#include "still.h"
+#include "backend.h"
+#include "core/photon.h"
+#include "core/rng.h"
+#include "core/shading.h"
+#include "scene/scene.h"
+
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#if defined(__SSE__)
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+#endif
+
+void evr_still_defaults(evr_still_params *p)
+{
+    memset(p, 0, sizeof *p);
+    p->width = 256;
+    p->height = 256;
+    p->gi = EVR_GI_NONE;
+    p->spp = 64;
+    p->gather_max = 256;
+    p->gather_window = 48;
+    p->gather_normal_cos = 0.7f;
+    p->photon_layers = 16;
+    p->auto_layers = 1;
+    p->gather_area = 1;
+    p->max_bounces = 8;
+    p->ambient = 0.02f;
+    p->seed = 1;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- Embree as an evr_tracer ---- */
+
+static int em_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
+{
+    RTCScene sc = (RTCScene)user;
+    struct RTCIntersectContext ctx;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&ctx);
+    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(sc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    hit->inst = (int)rh.hit.geomID;
+    hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->t = rh.ray.tfar;
+    return 1;
+}
+
+static int em_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
+{
+    RTCScene sc = (RTCScene)user;
+    struct RTCIntersectContext ctx;
+    struct RTCRay r;
+    rtcInitIntersectContext(&ctx);
+    r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
+    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+    r.tnear = tnear;
+    r.tfar = tfar;
+    r.time = f;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(sc, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+/* ---- shading ---- */
+
+typedef struct {
+    const evr_still_params *p;
+    const evr_render_scene *rs;
+    evr_tracer tr;
+    evr_m34 pose;
+    const evr_photon_buffer *buf;
+    evr_gather_params gp;
+    evr_still_result *out;
+    atomic_int next_row;
+    double *row_used;              /* photons used per row (summed in row order) */
+    int *row_hits;
+} shade_ctx;
+
+/* Unshadowed-light sum acc (irradiance times cosine) at surface s, shadow rays included: the
+ * event pipeline's direct term (sample_intensity8) one ray at a time. */
+static void direct_lights(const shade_ctx *c, const evr_surface *s, float acc[3])
+{
+    const evr_render_scene *rs = c->rs;
+    int l;
+    acc[0] = acc[1] = acc[2] = 0.0f;
+    for (l = 0; l < rs->num_lights; l++) {
+        evr_v3 wi;
+        float dist, e[3];
+        if (!evr_light_incident(rs, &rs->lights[l], 0.0f, s->p, &wi, &dist, e) || evr_v3_dot(wi, s->n) <= 0.0f) continue;
+        evr_ray r;
+        r.org = s->p;
+        r.dir = wi;
+        if (c->tr.occluded(c->tr.user, r, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), 0.0f)) continue;
+        evr_accumulate_lambert(s, wi, e, acc);
+    }
+}
+
+static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_view **mat, int *inst)
+{
+    const evr_render_scene *rs = c->rs;
+    evr_trace_hit h;
+    if (!c->tr.closest(c->tr.user, ray, tnear, INFINITY, 0.0f, &h)) return 0;
+    evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), 0.0f);
+    evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, ray, h.t, s);
+    *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
+    if (inst) *inst = h.inst;
+    return 1;
+}
+
+/* One path from surface s0 (reached along dir_in): the radiance it reflects towards dir_in's
+ * origin, excluding the direct term: paths of 1 .. max_bounces bounces ending on a light (next-
+ * event estimation with the direct term's lights, diffuse share) or on an emissive surface. */
+static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_view *m0, evr_v3 dir_in,
+                        uint64_t pix, uint64_t sample, float out[3])
+{
+    const evr_render_scene *rs = c->rs;
+    const uint64_t seed = c->p->seed ^ 0x70617468ull;   /* "path" */
+    evr_surface s = *s0;
+    const evr_material_view *m = m0;
+    float beta[3] = {1.0f, 1.0f, 1.0f};
+    int depth, dim = 0;
+    out[0] = out[1] = out[2] = 0.0f;
+    for (depth = 0; depth < c->p->max_bounces; depth++) {
+        float ms = evr_photon_mirror_share(m->t_diffuse, m->t_specular);
+        float xi = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        float u1 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        float u2 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        evr_v3 wo = xi < ms ? evr_v3_norm(evr_mirror_dir(dir_in, s.n)) : evr_cosine_dir(s.n, u1, u2);
+        beta[0] *= s.albedo[0];
+        beta[1] *= s.albedo[1];
+        beta[2] *= s.albedo[2];
+        if (depth >= 3) {   /* Russian roulette */
+            float q = fminf(fmaxf(beta[0], fmaxf(beta[1], beta[2])), 0.95f);
+            if (evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++)) >= q) return;
+            beta[0] /= q; beta[1] /= q; beta[2] /= q;
+        }
+        if (!(beta[0] > 0.0f || beta[1] > 0.0f || beta[2] > 0.0f)) return;
+        evr_ray r;
+        evr_surface y;
+        const evr_material_view *my;
+        r.org = s.p;
+        r.dir = wo;
+        if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), &y, &my, NULL)) return;
+        float acc[3], kd = (1.0f - evr_photon_mirror_share(my->t_diffuse, my->t_specular)) / EVR_PI;
+        direct_lights(c, &y, acc);
+        out[0] += beta[0] * (y.emissive[0] + y.albedo[0] * kd * acc[0]);
+        out[1] += beta[1] * (y.emissive[1] + y.albedo[1] * kd * acc[1]);
+        out[2] += beta[2] * (y.emissive[2] + y.albedo[2] * kd * acc[2]);
+        s = y;
+        m = my;
+        dir_in = wo;
+    }
+}
+
+static void shade_row(shade_ctx *c, int y)
+{
+    const evr_render_scene *rs = c->rs;
+    const evr_still_params *p = c->p;
+    evr_still_result *o = c->out;
+    int x, k;
+    double used = 0.0;
+    int hits = 0;
+    for (x = 0; x < p->width; x++) {
+        size_t i = (size_t)y * (size_t)p->width + (size_t)x;
+        float *rgb = o->rgb + 3 * i, *dir = o->direct + 3 * i, acc[3];
+        evr_ray ray = evr_camera_ray(&rs->camera, &c->pose, (float)x + 0.5f, (float)y + 0.5f);
+        evr_surface s;
+        const evr_material_view *mat;
+        int inst;
+        rgb[0] = rgb[1] = rgb[2] = dir[0] = dir[1] = dir[2] = 0.0f;
+        o->instance[i] = -1;
+        if (!surface_of(c, ray, 0.0f, &s, &mat, &inst)) continue;
+        o->instance[i] = inst;
+        direct_lights(c, &s, acc);
+        for (k = 0; k < 3; k++) {
+            dir[k] = s.albedo[k] * (rs->ambient + acc[k] / EVR_PI) + s.emissive[k];
+            rgb[k] = dir[k];
+        }
+        if (p->gi == EVR_GI_PHOTON) {
+            float e[3], ind[3];
+            float dist = evr_v3_len(evr_v3_sub(s.p, ray.org));
+            used += evr_photon_gather(c->buf, &rs->camera, x, y, s.p, s.n, dist, &c->gp, e);
+            hits++;
+            evr_photon_indirect(&s, mat, e, ind);
+            for (k = 0; k < 3; k++) rgb[k] += ind[k];
+        } else if (p->gi == EVR_GI_PATH) {
+            double sum[3] = {0, 0, 0};
+            int n;
+            for (n = 0; n < p->spp; n++) {
+                float l[3];
+                path_sample(c, &s, mat, ray.dir, (uint64_t)i, (uint64_t)n, l);
+                for (k = 0; k < 3; k++) sum[k] += (double)l[k];
+            }
+            for (k = 0; k < 3; k++) rgb[k] += (float)(sum[k] / (double)p->spp);
+        }
+    }
+    c->row_used[y] = used;
+    c->row_hits[y] = hits;
+}
+
+static void *shade_worker(void *arg)
+{
+    shade_ctx *c = (shade_ctx *)arg;
+    int y;
+#if defined(__SSE__)
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#endif
+    while ((y = atomic_fetch_add(&c->next_row, 1)) < c->p->height) shade_row(c, y);
+    return NULL;
+}
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    char *msg = (char *)user;
+    if (!msg[0]) snprintf(msg, 256, "Embree error %d: %s", (int)code, str ? str : "");
+}
+
+void evr_still_result_free(evr_still_result *r)
+{
+    free(r->rgb);
+    free(r->direct);
+    free(r->instance);
+    memset(r, 0, sizeof *r);
+}
+
+evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_still_result *out, evr_error *err)
+{
+    evr_render_host host;
+    evr_motion_key *keys = NULL;
+    int *toff = NULL, *tcnt = NULL;
+    RTCDevice dev = NULL;
+    RTCScene sc = NULL;
+    evr_photon_buffer buf;
+    evr_photon_emitters em;
+    shade_ctx c;
+    char emsg[256] = "";
+    int cam, i, nthreads = p->threads, started = 0;
+    evr_status st;
+    double t0 = now();
+    size_t npix;
+    memset(out, 0, sizeof *out);
+    memset(&buf, 0, sizeof buf);
+    memset(&em, 0, sizeof em);
+    memset(&c, 0, sizeof c);
+    memset(&host, 0, sizeof host);
+    if (p->width <= 0 || p->height <= 0 || p->width > 16384 || p->height > 16384) {
+        snprintf(err->msg, sizeof err->msg, "resolution must be between 1x1 and 16384x16384 (got %dx%d)", p->width, p->height);
+        return EVR_ERR_ARG;
+    }
+    if (p->gi == EVR_GI_PATH && p->spp <= 0) {
+        snprintf(err->msg, sizeof err->msg, "--spp must be at least 1 (got %d)", p->spp);
+        return EVR_ERR_ARG;
+    }
+    if (p->max_bounces < 1 || p->max_bounces > 15) {
+        snprintf(err->msg, sizeof err->msg, "--max-bounces must be between 1 and 15 (got %d)", p->max_bounces);
+        return EVR_ERR_ARG;
+    }
+    if (p->gi == EVR_GI_PHOTON && (p->gather_max < 1 || p->photon_layers < 1 || p->photon_layers > 64 || p->gather_window < 0)) {
+        snprintf(err->msg, sizeof err->msg, "--gather-max must be >= 1 and --photon-layers between 1 and 64");
+        return EVR_ERR_ARG;
+    }
+    if (!(p->ambient >= 0.0f) || !isfinite(p->ambient)) {
+        snprintf(err->msg, sizeof err->msg, "--ambient must be >= 0");
+        return EVR_ERR_ARG;
+    }
+    if ((cam = evr_scene_find_camera(s, p->camera)) < 0) {
+        snprintf(err->msg, sizeof err->msg, "the scene has no camera named '%s'", p->camera);
+        return EVR_ERR_ARG;
+    }
+    if (nthreads <= 0) {
+        long nc = sysconf(_SC_NPROCESSORS_ONLN);
+        nthreads = nc > 0 ? (int)nc : 1;
+    }
+    if ((st = evr_render_host_init(&host, s, cam, p->width, p->height, p->ambient, err)) != EVR_OK) return st;
+    npix = (size_t)p->width * (size_t)p->height;
+    out->width = p->width;
+    out->height = p->height;
+    out->threads = nthreads;
+    out->rgb = malloc(npix * 3 * sizeof(float));
+    out->direct = malloc(npix * 3 * sizeof(float));
+    out->instance = malloc(npix * sizeof(int));
+    keys = malloc(((size_t)s->num_nodes + 1) * sizeof *keys);
+    toff = malloc(((size_t)s->num_nodes + 1) * sizeof *toff);
+    tcnt = malloc(((size_t)s->num_nodes + 1) * sizeof *tcnt);
+    c.row_used = calloc((size_t)p->height, sizeof *c.row_used);
+    c.row_hits = calloc((size_t)p->height, sizeof *c.row_hits);
+    if (!out->rgb || !out->direct || !out->instance || !keys || !toff || !tcnt || !c.row_used || !c.row_hits) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d image", p->width, p->height);
+        st = EVR_ERR_NOMEM;
+        goto done;
+    }
+    /* one key per track: every node's world transform at the time; the last track is the world */
+    for (i = 0; i <= s->num_nodes; i++) {
+        evr_m34 w = i < s->num_nodes ? evr_node_world_at(s, i, p->time) : evr_m34_identity();
+        keys[i] = evr_motion_key_from_matrix(&w);
+        toff[i] = i;
+        tcnt[i] = 1;
+    }
+    host.rs.keys = keys;
+    host.rs.track_offset = toff;
+    host.rs.track_count = tcnt;
+
+    dev = rtcNewDevice(NULL);
+    if (!dev) {
+        snprintf(err->msg, sizeof err->msg, "cannot create the Embree device");
+        st = EVR_ERR_BACKEND;
+        goto done;
+    }
+    rtcSetDeviceErrorFunction(dev, embree_error, emsg);
+    sc = rtcNewScene(dev);
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+    evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY), hi = evr_v3_make(-INFINITY, -INFINITY, -INFINITY);
+    for (i = 0; i < s->num_instances; i++) {
+        const evr_mesh *m = &s->meshes[s->instances[i].mesh];
+        evr_m34 xf = evr_motion_eval(evr_rs_track(&host.rs, host.rs.instances[i].track), 0.0f);
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
+        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+        uint32_t v;
+        if (!vb || !ib) {
+            rtcReleaseGeometry(g);
+            break;
+        }
+        for (v = 0; v < m->num_vertices; v++) {
+            evr_v3 q = evr_m34_point(&xf, evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]));
+            vb[3 * v] = q.x;
+            vb[3 * v + 1] = q.y;
+            vb[3 * v + 2] = q.z;
+            lo = evr_v3_make(fminf(lo.x, q.x), fminf(lo.y, q.y), fminf(lo.z, q.z));
+            hi = evr_v3_make(fmaxf(hi.x, q.x), fmaxf(hi.y, q.y), fmaxf(hi.z, q.z));
+        }
+        memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(sc, g, (unsigned)i);
+        rtcReleaseGeometry(g);
+    }
+    rtcCommitScene(sc);
+    if (emsg[0]) {
+        snprintf(err->msg, sizeof err->msg, "%s", emsg);
+        st = EVR_ERR_BACKEND;
+        goto done;
+    }
+    c.p = p;
+    c.rs = &host.rs;
+    c.tr.user = sc;
+    c.tr.closest = em_closest;
+    c.tr.occluded = em_occluded;
+    c.pose = evr_rs_camera_pose(&host.rs, 0.0f);
+    c.out = out;
+    out->seconds_setup = now() - t0;
+
+    if (p->gi == EVR_GI_PHOTON) {
+        evr_photon_params pp;
+        evr_photon_bounds bb;
+        double t1 = now();
+        uint32_t nph = p->photons ? p->photons : (npix > (1u << 25) ? (1u << 28) : (uint32_t)(8 * npix));
+        /* the scene at the time, baked: a sphere round its bounds (a little larger) */
+        if (!(lo.x <= hi.x)) lo = hi = evr_v3_make(0.0f, 0.0f, 0.0f);
+        bb.center = evr_v3_scale(evr_v3_add(lo, hi), 0.5f);
+        bb.radius = 0.5f * evr_v3_len(evr_v3_sub(hi, lo)) * 1.001f + host.rs.ray_eps;
+        if ((st = evr_photon_emitters_build(&host.rs, 0.0f, bb, nph, &em, err)) != EVR_OK) goto done;
+        if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, p->photon_layers, p->gather_window < 16 ? p->gather_window : 16, err)) != EVR_OK) goto done;
+        memset(&pp, 0, sizeof pp);
+        pp.max_bounces = p->max_bounces;
+        pp.f0 = pp.f1 = 0.0f;
+        pp.seed = p->seed;
+        pp.threads = nthreads;
+        pp.bounds = bb;
+        pp.ray_eps = host.rs.ray_eps;
+        if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, err)) != EVR_OK) goto done;
+        /* more than 3% of the photons found their pixel full: twice the layers (up to 64), again */
+        while (p->auto_layers && buf.layers < 64 && out->photon.visible > 0 &&
+               (double)out->photon.collisions > 0.03 * (double)out->photon.visible) {
+            int layers = 2 * buf.layers, margin = buf.margin;
+            evr_photon_buffer_free(&buf);
+            if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, layers > 64 ? 64 : layers, margin, err)) != EVR_OK) goto done;
+            if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, err)) != EVR_OK) goto done;
+        }
+        out->photon_layers = buf.layers;
+        if (p->gather_area && (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, nthreads, err)) != EVR_OK) goto done;
+        c.buf = &buf;
+        c.gp.radius = p->gather_radius > 0.0f ? p->gather_radius : 0.02f * host.scene_size;
+        c.gp.max_photons = p->gather_max;
+        c.gp.max_window = p->gather_window;
+        c.gp.normal_cos = p->gather_normal_cos;
+        out->gather_radius = c.gp.radius;
+        out->seconds_photons = now() - t1;
+    }
+    {
+        double t2 = now();
+        pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
+        if (!th) {
+            snprintf(err->msg, sizeof err->msg, "out of memory");
+            st = EVR_ERR_NOMEM;
+            goto done;
+        }
+        atomic_store(&c.next_row, 0);
+        for (i = 1; i < nthreads; i++) {
+            if (pthread_create(&th[i], NULL, shade_worker, &c) != 0) break;
+            started++;
+        }
+        shade_worker(&c);
+        for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
+        free(th);
+        out->seconds_shading = now() - t2;
+    }
+    {
+        double used = 0.0;
+        long hits = 0;
+        for (i = 0; i < p->height; i++) {
+            used += c.row_used[i];
+            hits += c.row_hits[i];
+        }
+        out->photons_per_estimate = hits ? used / (double)hits : 0.0;
+    }
+    if (emsg[0]) {
+        snprintf(err->msg, sizeof err->msg, "%s", emsg);
+        st = EVR_ERR_BACKEND;
+    }
+done:
+    if (sc) rtcReleaseScene(sc);
+    if (dev) rtcReleaseDevice(dev);
+    evr_photon_buffer_free(&buf);
+    evr_photon_emitters_free(&em);
+    free(keys);
+    free(toff);
+    free(tcnt);
+    free(c.row_used);
+    free(c.row_hits);
+    evr_render_host_free(&host);
+    if (st != EVR_OK) evr_still_result_free(out);
+    return st;
+}

@@ -1,0 +1,49 @@
+"""Global illumination in the event pipeline (--gi photon, CPU backend): a still Cornell box makes
+no events with GI on (the same photons every segment), with and without change-driven sampling;
+the moving box's events are identical with and without skipping; GI changes the intensities;
+run.json accounts for the photon passes; bad options and the CUDA backend give one-line errors."""
+import os
+
+import evrtest as T
+
+tmp = T.tmpdir()
+
+
+def render(name, scene, *extra):
+    d = os.path.join(tmp, name)
+    T.run("demo", "--scene", scene, "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
+          "--res", "64x48", *extra)
+    return open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d)
+
+
+for mode in ([], ["--no-skip"]):
+    ev, js = render("still" + "".join(mode), "cornell-still", "--gi", "photon", "--duration", "1", *mode)
+    st = js["stats"]
+    T.check(st["events"] == 0, f"still Cornell box, GI on {mode}: no events ({st['events']})")
+    T.check(js["config"]["gi"] == "photon" and st["photons_traced"] > 0, "GI in run.json")
+    if mode:
+        T.check(st["photon_passes"] == st["segments"], "brute force: a photon pass every segment")
+    else:
+        T.check(st["photon_passes"] == 1, f"nothing moves: one photon pass ({st['photon_passes']})")
+
+ev_s, js = render("moving", "cornell", "--gi", "photon", "--duration", "0.5")
+ev_b, jb = render("moving-brute", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip")
+ev_d, jd = render("direct", "cornell", "--duration", "0.5")
+print(f"cornell 0.5 s: {js['stats']['events']} events with GI, {jd['stats']['events']} without; traced "
+      f"{js['stats']['samples_traced']} of {js['stats']['samples']} samples; {js['stats']['photon_passes']} photon passes")
+T.check(js["stats"]["events"] > 0 and ev_s == ev_b, "moving box, GI on: identical events with and without skipping")
+T.check(js["stats"]["samples_traced"] < jb["stats"]["samples_traced"], "moving box, GI on: pixels are still skipped")
+T.check(ev_s != ev_d, "GI changes the events")
+
+bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
+       ["--gi", "photon", "--gather-max", "0"], ["--gi", "photon", "--gather-radius", "-1"],
+       ["--gi", "photon", "--photons", "x"]]
+for args in bad:
+    p = T.run("demo", "--scene", "cornell", "-o", os.path.join(tmp, "bad"), "--duration", "0.1", "--quiet", *args,
+              expect=None)
+    T.check(p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, f"{args}: one-line error, exit 2 ({p.stderr})")
+    T.check(not os.path.exists(os.path.join(tmp, "bad")), f"{args}: nothing left behind")
+p = T.run("demo", "--scene", "cornell", "-o", os.path.join(tmp, "gpu"), "--duration", "0.1", "--quiet", "--gi", "photon",
+          "--backend", "cuda", expect=None)
+T.check(p.returncode != 0 and len(p.stderr.strip().splitlines()) == 1, f"--gi photon --backend cuda: one-line error ({p.stderr})")
+T.finish("test_gi")

@@ -1,0 +1,563 @@
+/* Image-space photon mapping (src/core/photon.h, src/cpu/photon_pass.c): projection, ring
+ * search, kernel, gather units, flux conservation of the pass in a closed box, determinism. */
+#include "check.h"
+#include "core/photon.h"
+#include "cpu/photon_pass.h"
+
+#include <embree3/rtcore.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void test_projection(void)
+{
+    evr_camera_intr c = evr_camera_intr_make(320, 240, 0.9f);
+    evr_quat q = evr_quat_normalize(evr_quat_make(0.9f, 0.1f, -0.3f, 0.2f));
+    evr_m34 pose;
+    float r[3][3];
+    int i, j;
+    evr_quat_to_m33(q, r);
+    for (i = 0; i < 3; i++)
+        for (j = 0; j < 3; j++) pose.m[i][j] = r[i][j];
+    pose.m[0][3] = 1.0f; pose.m[1][3] = -2.0f; pose.m[2][3] = 0.5f;
+    evr_m34 inv = evr_m34_inverse(&pose);
+    for (i = 0; i < 50; i++) {
+        float px = 320.0f * (float)((i * 37) % 50) / 50.0f + 0.3f, py = 240.0f * (float)((i * 13) % 50) / 50.0f + 0.5f;
+        float t = 0.5f + (float)i * 0.3f, qx = -1.0f, qy = -1.0f;
+        int x = -1, y = -1;
+        evr_ray ray = evr_camera_ray(&c, &pose, px, py);
+        evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t));
+        CHECK(evr_camera_project(&c, &inv, p, &qx, &qy));
+        CHECK_NEAR(qx, px, 2e-3);
+        CHECK_NEAR(qy, py, 2e-3);
+        CHECK(evr_photon_pixel(&c, &inv, p, 0, &x, &y));
+        CHECK(x == (int)px && y == (int)py);
+        /* behind the camera: nothing */
+        evr_v3 b = evr_v3_sub(ray.org, evr_v3_scale(ray.dir, t));
+        CHECK(!evr_photon_pixel(&c, &inv, b, 0, &x, &y));
+    }
+}
+
+static void test_rings(void)
+{
+    int R;
+    for (R = 0; R <= 8; R++) {
+        int n = 2 * R + 1, k, last = 0;
+        char *seen = calloc((size_t)(n * n), 1);
+        for (k = 0; k < n * n; k++) {
+            int dx, dy, r = evr_ring_cell(k, &dx, &dy);
+            int cheb = abs(dx) > abs(dy) ? abs(dx) : abs(dy);
+            CHECK(r == cheb);
+            CHECK(r >= last);          /* rings in order */
+            CHECK(r <= R);
+            last = r;
+            if (abs(dx) <= R && abs(dy) <= R) {
+                CHECK(!seen[(dy + R) * n + dx + R]);   /* each cell once */
+                seen[(dy + R) * n + dx + R] = 1;
+            }
+        }
+        for (k = 0; k < n * n; k++) CHECK(seen[k]);
+        free(seen);
+    }
+}
+
+static void test_kernel(void)
+{
+    const float radii[3] = {0.01f, 1.0f, 5.0f};
+    int i, x, y;
+    for (i = 0; i < 3; i++) {
+        float r = radii[i], h = r / 200.0f;
+        double sum = 0.0;
+        for (y = -200; y < 200; y++)
+            for (x = -200; x < 200; x++) {
+                float px = ((float)x + 0.5f) * h, py = ((float)y + 0.5f) * h;
+                sum += (double)evr_gauss_kernel(px * px + py * py, r) * (double)h * (double)h;
+            }
+        CHECK_NEAR(sum, 1.0, 2e-3);
+        CHECK(evr_gauss_kernel(r * r * 1.01f, r) == 0.0f);
+        CHECK(evr_gauss_kernel(0.0f, r) > evr_gauss_kernel(0.25f * r * r, r));
+    }
+}
+
+/* A plane of photons facing the camera, one per pixel with flux phi: the gather estimates the
+ * irradiance phi / (pixel area on the plane). */
+static void test_gather_units(void)
+{
+    const int w = 64, h = 64, layers = 2;
+    evr_camera_intr c = evr_camera_intr_make(w, h, 0.8f);
+    evr_m34 pose = evr_m34_identity(), inv = evr_m34_identity();
+    evr_photon_buffer b;
+    evr_error err;
+    int x, y;
+    const float depth = 2.0f, phi = 0.01f;
+    CHECK_OK(evr_photon_buffer_alloc(&b, w, h, layers, 0, &err));
+    evr_photon_buffer_clear(&b);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            evr_ray r = evr_camera_ray(&c, &pose, (float)x + 0.5f, (float)y + 0.5f);
+            evr_v3 p = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
+            evr_photon ph;
+            int px = -1, py = -1;
+            memset(&ph, 0, sizeof ph);
+            ph.p[0] = p.x; ph.p[1] = p.y; ph.p[2] = p.z;
+            ph.n[2] = 1.0f;
+            ph.flux[0] = ph.flux[1] = ph.flux[2] = phi;
+            ph.key = (uint32_t)(y * w + x);
+            CHECK(evr_photon_pixel(&c, &inv, p, 0, &px, &py));
+            CHECK(px == x && py == y);
+            CHECK(evr_photon_buffer_insert(&b, px, py, &ph));
+        }
+    CHECK(*b.collisions == 0);
+    float pix = 2.0f * c.tan_half_y * depth / (float)h;   /* photon spacing on the plane (near the centre) */
+    evr_gather_params gp;
+    gp.radius = 6.0f * pix;
+    gp.max_photons = 1000;
+    gp.max_window = 64;
+    gp.normal_cos = 0.5f;
+    float e[3];
+    int used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth), evr_v3_make(0, 0, 1),
+                                 depth, &gp, e);
+    CHECK(used > 100);
+    CHECK_NEAR(e[0] / (phi / (pix * pix)), 1.0, 0.03);
+    /* at most max_photons: the radius shrinks, the estimate stays */
+    gp.max_photons = 40;
+    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth), evr_v3_make(0, 0, 1),
+                             depth, &gp, e);
+    CHECK(used >= 10 && used <= 80);
+    CHECK_NEAR(e[0] / (phi / (pix * pix)), 1.0, 0.25);
+    /* a photon facing away is skipped */
+    gp.max_photons = 1000;
+    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0, 0, -depth), evr_v3_make(0, 0, -1), depth, &gp, e);
+    CHECK(used == 0 && e[0] == 0.0f);
+    /* half the plane (x < w / 2): at its edge the disk is half empty; the camera's view of the
+     * cells (gbuf) tells the gather which half lies on the surface */
+    {
+        evr_photon_buffer hb;
+        float e_disk[3], e_view[3];
+        const float a = pix * pix;   /* the area a cell covers on the plane */
+        CHECK_OK(evr_photon_buffer_alloc(&hb, w, h, layers, 0, &err));
+        evr_photon_buffer_clear(&hb);
+        hb.gbuf = calloc((size_t)w * (size_t)h * 8, sizeof(float));
+        for (y = 0; y < h; y++)
+            for (x = 0; x < w / 2; x++) {
+                evr_ray r = evr_camera_ray(&c, &pose, (float)x + 0.5f, (float)y + 0.5f);
+                evr_v3 p = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
+                evr_photon ph;
+                float *g = hb.gbuf + 8 * ((size_t)y * (size_t)w + (size_t)x);
+                memset(&ph, 0, sizeof ph);
+                ph.p[0] = g[0] = p.x; ph.p[1] = g[1] = p.y; ph.p[2] = g[2] = p.z;
+                ph.n[2] = g[5] = 1.0f;
+                g[6] = a;   /* (2 tan / H)^2 depth^2 cos(off axis) / cos(incidence), both cosines -r.dir.z */
+                ph.flux[0] = ph.flux[1] = ph.flux[2] = phi;
+                evr_photon_buffer_insert(&hb, x, y, &ph);
+            }
+        gp.max_photons = 1000;
+        evr_v3 q = evr_v3_make(-0.5f * pix, -0.5f * pix, -depth);   /* the centre of pixel (31, 32) */
+        float *gb = hb.gbuf;
+        evr_photon_gather(&hb, &c, w / 2 - 1, h / 2, q, evr_v3_make(0, 0, 1), depth, &gp, e_view);
+        hb.gbuf = NULL;
+        evr_photon_gather(&hb, &c, w / 2 - 1, h / 2, q, evr_v3_make(0, 0, 1), depth, &gp, e_disk);
+        CHECK_NEAR(e_view[0] / (phi / (pix * pix)), 1.0, 0.08);
+        CHECK(e_disk[0] / (phi / (pix * pix)) < 0.75);
+        printf("half plane edge: %.3f with the view, %.3f over the whole disk\n", e_view[0] / (phi / (pix * pix)),
+               e_disk[0] / (phi / (pix * pix)));
+        hb.gbuf = gb;
+        evr_photon_buffer_free(&hb);   /* frees gbuf too */
+    }
+    /* one layer: the second photon of a pixel is a collision */
+    evr_photon_buffer b1;
+    evr_photon ph;
+    memset(&ph, 0, sizeof ph);
+    CHECK_OK(evr_photon_buffer_alloc(&b1, 4, 4, 1, 0, &err));
+    evr_photon_buffer_clear(&b1);
+    CHECK(evr_photon_buffer_insert(&b1, 1, 2, &ph));
+    CHECK(!evr_photon_buffer_insert(&b1, 1, 2, &ph));
+    CHECK(*b1.collisions == 1 && b1.count[2 * 4 + 1] == 2);
+    evr_photon_buffer_free(&b1);
+    evr_photon_buffer_free(&b);
+}
+
+static void test_material(void)
+{
+    const float white[3] = {0.725f, 0.71f, 0.68f}, black[3] = {0, 0, 0};
+    float td, ts, w;
+    evr_photon_material_map(white, 0.0f, 1.0f, &td, &ts);
+    CHECK_NEAR(td, 0.275, 1e-6);
+    CHECK_NEAR(ts, 1.0, 1e-6);
+    CHECK_NEAR(evr_photon_mirror_share(td, ts), 0.0, 1e-6);
+    evr_photon_material_map(white, 1.0f, 0.0f, &td, &ts);   /* a polished metal: a mirror */
+    CHECK_NEAR(ts, td, 1e-6);
+    CHECK_NEAR(evr_photon_mirror_share(td, ts), 1.0, 1e-6);
+    evr_photon_material_map(black, 0.0f, 1.0f, &td, &ts);
+    CHECK_NEAR(td, 0.95, 1e-6);
+    /* decisions and weights */
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 1, &w) == EVR_PHOTON_STAY);
+    CHECK_NEAR(w, 1.0 / 0.3, 1e-5);
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.5f, 1, &w) == EVR_PHOTON_DIFFUSE);
+    CHECK_NEAR(w, 1.0 / 0.7, 1e-5);
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.9f, 1, &w) == EVR_PHOTON_MIRROR);
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 0, &w) == EVR_PHOTON_DIFFUSE);   /* no stay at a light's first hit */
+    CHECK_NEAR(w, 1.0, 1e-6);
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.95f, 0, &w) == EVR_PHOTON_MIRROR);
+    CHECK(evr_photon_scatter(1.0f, 1.0f, 0.5f, 0, &w) == EVR_PHOTON_ABSORB);
+    /* cosine directions stay in the hemisphere and have mean cosine 2/3 */
+    {
+        evr_v3 n = evr_v3_norm(evr_v3_make(0.3f, -0.8f, 0.5f));
+        double mc = 0.0;
+        int i;
+        for (i = 0; i < 4096; i++) {
+            evr_v3 d = evr_cosine_dir(n, evr_radical_inverse((uint32_t)i + 1, 2), evr_radical_inverse((uint32_t)i + 1, 3));
+            CHECK(evr_v3_dot(d, n) >= -1e-6f);
+            CHECK_NEAR(evr_v3_len(d), 1.0, 1e-5);
+            mc += evr_v3_dot(d, n);
+        }
+        CHECK_NEAR(mc / 4096.0, 2.0 / 3.0, 5e-3);
+        evr_v3 m = evr_mirror_dir(evr_v3_make(1, -1, 0), evr_v3_make(0, 1, 0));
+        CHECK(m.x == 1.0f && m.y == 1.0f && m.z == 0.0f);
+    }
+    CHECK_NEAR(evr_radical_inverse(1, 2), 0.5, 1e-7);
+    CHECK_NEAR(evr_radical_inverse(5, 3), 7.0 / 9.0, 1e-6);
+    CHECK(evr_photon_rand(1, 0, 17, 3) == evr_photon_rand(1, 0, 17, 3));
+    CHECK(evr_photon_rand(1, 0, 17, 9) == evr_photon_rand(1, 0, 17, 9));
+}
+
+/* Emission: directions inside a spot's cone, total flux = the light's (integral of the falloff
+ * for a spot, E pi R^2 for a directional light, 2 pi Le A for an emissive triangle). */
+static void test_emission(void)
+{
+    evr_render_scene rs;
+    evr_light_view l;
+    evr_photon_bounds bb;
+    const uint32_t n = 20000;
+    uint32_t j;
+    int k;
+    memset(&rs, 0, sizeof rs);
+    memset(&l, 0, sizeof l);
+    bb.center = evr_v3_make(1, 2, 3);
+    bb.radius = 2.0f;
+    /* spot along -y, 0.3 / 0.5 rad */
+    l.type = 1;
+    l.track = -1;
+    l.color[0] = l.color[1] = l.color[2] = 2.0f;
+    l.pos = evr_v3_make(0, 5, 0);
+    l.dir = evr_v3_make(0, -1, 0);
+    l.cos_inner = cosf(0.3f);
+    l.cos_outer = cosf(0.5f);
+    double total = 0.0, want = 0.0;
+    for (j = 0; j < n; j++) {
+        float u[4];
+        evr_photon_ray pr;
+        for (k = 0; k < 4; k++) u[k] = evr_photon_rand(3, 0, j, k);
+        evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr);   /* 0 at the cone's rim (zero flux) */
+        CHECK(evr_v3_dot(pr.ray.dir, l.dir) >= l.cos_outer - 1e-5f);
+        CHECK_NEAR(evr_v3_len(pr.ray.dir), 1.0, 1e-5);
+        CHECK(pr.from_light == 1);
+        total += pr.flux[0];
+    }
+    for (k = 0; k < 100000; k++) {   /* integral of I * falloff over the cone, midpoint rule in cos */
+        double cz = 1.0 - (k + 0.5) / 100000.0 * (1.0 - l.cos_outer);
+        double a = (cz - l.cos_outer) / (l.cos_inner - l.cos_outer);
+        a = a < 0 ? 0 : a > 1 ? 1 : a;
+        want += 2.0 * 3.14159265358979 * (1.0 - l.cos_outer) / 100000.0 * a * a * l.color[0];
+    }
+    CHECK_NEAR(total / want, 1.0, 0.01);
+    /* a point light outside the scene's sphere: only towards it, flux I * the cone's solid angle */
+    l.type = 0;
+    l.pos = evr_v3_make(1, 2, 13);   /* 10 from the centre, radius 2 */
+    total = 0.0;
+    {
+        float cmax = sqrtf(1.0f - 4.0f / 100.0f), fl[3];
+        for (j = 0; j < n; j++) {
+            float u[4];
+            evr_photon_ray pr;
+            for (k = 0; k < 4; k++) u[k] = evr_photon_rand(3, 4, j, k);
+            CHECK(evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr));
+            CHECK(evr_v3_dot(pr.ray.dir, evr_v3_make(0, 0, -1)) >= cmax - 1e-5f);
+            total += pr.flux[0];
+        }
+        CHECK_NEAR(total / (2.0 * 3.14159265358979 * (1.0 - cmax) * 2.0), 1.0, 1e-4);
+        evr_photon_light_flux(&rs, &l, 0.0f, bb, fl);
+        CHECK_NEAR(fl[0] / total, 1.0, 1e-4);
+        l.pos = evr_v3_make(1, 2.5f, 3);   /* inside: every direction */
+        evr_photon_light_flux(&rs, &l, 0.0f, bb, fl);
+        CHECK_NEAR(fl[0], 4.0 * 3.14159265358979 * 2.0, 1e-4);
+    }
+    /* directional: a disk of the bounding radius upstream, flux E pi R^2 */
+    l.type = 2;
+    l.dir = evr_v3_norm(evr_v3_make(1, -2, 0.5f));
+    total = 0.0;
+    for (j = 0; j < n; j++) {
+        float u[4];
+        evr_photon_ray pr;
+        for (k = 0; k < 4; k++) u[k] = evr_photon_rand(3, 1, j, k);
+        evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr);
+        evr_v3 rel = evr_v3_sub(pr.ray.org, bb.center);
+        CHECK_NEAR(evr_v3_dot(rel, l.dir), -1.01 * bb.radius, 1e-4);   /* upstream of the sphere */
+        evr_v3 perp = evr_v3_sub(rel, evr_v3_scale(l.dir, evr_v3_dot(rel, l.dir)));
+        CHECK(evr_v3_len(perp) <= bb.radius * 1.0001f);
+        CHECK(pr.ray.dir.x == l.dir.x && pr.ray.dir.y == l.dir.y);
+        total += pr.flux[1];
+    }
+    CHECK_NEAR(total / (2.0 * 3.14159265358979 * 4.0), 1.0, 1e-4);
+    /* an emissive triangle, both sides: flux 2 pi Le A, points on the triangle */
+    {
+        static const float pos[9] = {0, 0, 0, 2, 0, 0, 0, 1, 0}, nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+        static const uint32_t idx[3] = {0, 1, 2};
+        evr_mesh_view m;
+        evr_material_view mat;
+        evr_instance_view in;
+        evr_photon_emitter em;
+        const float cdf[1] = {1.0f};
+        evr_m34 xf = evr_m34_identity();
+        int up = 0;
+        memset(&m, 0, sizeof m);
+        memset(&mat, 0, sizeof mat);
+        m.positions = pos;
+        m.normals = nrm;
+        m.indices = idx;
+        m.num_triangles = 1;
+        mat.emissive[0] = 0.5f;
+        in.mesh = 0;
+        in.track = 0;
+        rs.meshes = &m;
+        rs.materials = &mat;
+        rs.instances = &in;
+        memset(&em, 0, sizeof em);
+        em.kind = 1;
+        em.count = n;
+        em.ntri = 1;
+        em.area = 1.0f;
+        total = 0.0;
+        for (j = 0; j < n; j++) {
+            float u[5];
+            evr_photon_ray pr;
+            for (k = 0; k < 5; k++) u[k] = evr_photon_rand(3, 2, j, k);
+            CHECK(evr_photon_emit_surface(&rs, &em, cdf, &xf, u, &pr));
+            CHECK(pr.from_light == 0);
+            CHECK(pr.ray.org.z == 0.0f && pr.ray.org.x >= 0.0f && pr.ray.org.y >= 0.0f &&
+                  pr.ray.org.x / 2.0f + pr.ray.org.y <= 1.0001f);
+            up += pr.ray.dir.z > 0.0f;
+            total += pr.flux[0];
+        }
+        CHECK_NEAR(total / (2.0 * 3.14159265358979 * 0.5 * 1.0), 1.0, 1e-4);
+        CHECK(up > (int)n / 2 - 200 && up < (int)n / 2 + 200);   /* both sides */
+    }
+}
+
+/* ---- a closed grey box [-1, 1]^3 with a point light inside, through Embree ---- */
+
+static float box_pos[24 * 3], box_nrm[24 * 3];
+static uint32_t box_idx[36];
+
+static void make_box(void)
+{
+    int f, k, v = 0, t = 0;
+    for (f = 0; f < 6; f++) {
+        int axis = f / 2, u = (axis + 1) % 3, w = (axis + 2) % 3;
+        float s = (f % 2) ? 1.0f : -1.0f;
+        for (k = 0; k < 4; k++) {
+            float c[3];
+            c[axis] = s;
+            c[u] = (k & 1) ? 1.0f : -1.0f;
+            c[w] = (k & 2) ? 1.0f : -1.0f;
+            memcpy(&box_pos[3 * (v + k)], c, sizeof c);
+            box_nrm[3 * (v + k)] = box_nrm[3 * (v + k) + 1] = box_nrm[3 * (v + k) + 2] = 0.0f;
+            box_nrm[3 * (v + k) + axis] = -s;   /* inward */
+        }
+        box_idx[t++] = (uint32_t)v; box_idx[t++] = (uint32_t)v + 1; box_idx[t++] = (uint32_t)v + 2;
+        box_idx[t++] = (uint32_t)v + 1; box_idx[t++] = (uint32_t)v + 3; box_idx[t++] = (uint32_t)v + 2;
+        v += 4;
+    }
+}
+
+static int tr_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
+{
+    struct RTCIntersectContext ctx;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&ctx);
+    memset(&rh, 0, sizeof rh);
+    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = f;
+    rh.ray.mask = 0xffffffffu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1((RTCScene)user, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    hit->inst = (int)rh.hit.geomID;
+    hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->t = rh.ray.tfar;
+    return 1;
+}
+
+static int tr_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
+{
+    struct RTCIntersectContext ctx;
+    struct RTCRay r;
+    rtcInitIntersectContext(&ctx);
+    memset(&r, 0, sizeof r);
+    r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
+    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+    r.tnear = tnear;
+    r.tfar = tfar;
+    r.time = f;
+    r.mask = 0xffffffffu;
+    rtcOccluded1((RTCScene)user, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+static int same_buffer(const evr_photon_buffer *a, const evr_photon_buffer *b)
+{
+    size_t npix = (size_t)a->width * (size_t)a->height, i;
+    int l;
+    if (memcmp(a->count, b->count, npix * sizeof *a->count) || *a->collisions != *b->collisions) return 0;
+    for (i = 0; i < npix; i++)
+        for (l = 0; l < a->layers && (uint32_t)l < a->count[i]; l++)
+            if (memcmp(&a->slots[(size_t)l * npix + i], &b->slots[(size_t)l * npix + i], sizeof(evr_photon))) return 0;
+    return 1;
+}
+
+static void test_pass(void)
+{
+    const float rho = 0.5f;
+    evr_mesh_view mesh;
+    evr_material_view mat;
+    evr_instance_view inst;
+    evr_light_view light;
+    evr_motion_key keys[2];
+    int toff[2] = {0, 1}, tcnt[2] = {1, 1};
+    evr_render_scene rs;
+    evr_m34 id = evr_m34_identity();
+    evr_error err;
+    int k;
+    make_box();
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = box_pos;
+    mesh.normals = box_nrm;
+    mesh.indices = box_idx;
+    mesh.num_triangles = 12;
+    memset(&mat, 0, sizeof mat);
+    mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = rho;
+    mat.base_color[3] = 1.0f;
+    mat.base_texture = -1;
+    {
+        float c3[3] = {rho, rho, rho};
+        evr_photon_material_map(c3, 0.0f, 1.0f, &mat.t_diffuse, &mat.t_specular);
+    }
+    inst.mesh = 0;
+    inst.track = 0;
+    memset(&light, 0, sizeof light);
+    light.type = 0;
+    light.track = -1;
+    light.color[0] = 1.0f; light.color[1] = 0.5f; light.color[2] = 0.25f;
+    light.pos = evr_v3_make(0.2f, 0.3f, -0.1f);
+    keys[0] = evr_motion_key_from_matrix(&id);
+    keys[1] = keys[0];
+    memset(&rs, 0, sizeof rs);
+    rs.meshes = &mesh;
+    rs.materials = &mat;
+    rs.instances = &inst;
+    rs.lights = &light;
+    rs.num_instances = 1;
+    rs.num_lights = 1;
+    rs.keys = keys;
+    rs.track_offset = toff;
+    rs.track_count = tcnt;
+    rs.camera_track = 1;
+    rs.camera_local = evr_m34_identity();
+    rs.camera_local.m[2][3] = 0.9f;   /* inside the box, looking at the back wall */
+    rs.camera = evr_camera_intr_make(48, 40, 1.2f);
+    rs.ray_eps = 1e-5f;
+
+    RTCDevice dev = rtcNewDevice(NULL);
+    RTCScene sc = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, 24);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, 12);
+    memcpy(vb, box_pos, sizeof box_pos);
+    memcpy(ib, box_idx, sizeof box_idx);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc, g, 0);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(sc);
+
+    evr_tracer tr;
+    tr.user = sc;
+    tr.closest = tr_closest;
+    tr.occluded = tr_occluded;
+    evr_photon_bounds bb;
+    bb.center = evr_v3_make(0, 0, 0);
+    bb.radius = 1.8f;
+    evr_photon_emitters em;
+    memset(&em, 0, sizeof em);
+    const uint32_t N = 40000;
+    CHECK_OK(evr_photon_emitters_build(&rs, 0.0f, bb, N, &em, &err));
+    CHECK(em.n == 1 && em.photons == N);
+    evr_photon_params pp;
+    memset(&pp, 0, sizeof pp);
+    pp.max_bounces = 15;
+    pp.seed = 7;
+    pp.threads = 1;
+    pp.bounds = bb;
+    pp.ray_eps = rs.ray_eps;
+    evr_photon_buffer b1, b2, b3;
+    evr_photon_stats s1, s2, s3;
+    CHECK_OK(evr_photon_buffer_alloc(&b1, 48, 40, 4, 8, &err));
+    CHECK_OK(evr_photon_buffer_alloc(&b2, 48, 40, 4, 8, &err));
+    CHECK_OK(evr_photon_buffer_alloc(&b3, 48, 40, 4, 8, &err));
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b1, &s1, &err));
+    /* flux conservation: all emitted flux is absorbed (closed box), within Monte Carlo error */
+    for (k = 0; k < 3; k++) {
+        double want = 4.0 * 3.14159265358979 * light.color[k];
+        CHECK_NEAR(s1.emitted[k] / want, 1.0, 1e-4);
+        CHECK(s1.escaped[k] == 0.0);
+        CHECK_NEAR((s1.absorbed[k] + s1.capped[k]) / s1.emitted[k], 1.0, 0.02);
+        /* stored photons stand for the incident flux after the first hit: rho + rho^2 + ... */
+        CHECK_NEAR(s1.stored[k] / (s1.emitted[k] * rho / (1.0 - rho)), 1.0, 0.03);
+    }
+    printf("pass: %llu paths, %llu stayed, %llu visible, %llu inserted, %llu collisions; absorbed/emitted %.4f\n",
+           (unsigned long long)s1.paths, (unsigned long long)s1.stored_photons, (unsigned long long)s1.visible,
+           (unsigned long long)s1.inserted, (unsigned long long)s1.collisions, (s1.absorbed[0] + s1.capped[0]) / s1.emitted[0]);
+    CHECK(s1.paths == N);
+    CHECK(s1.visible > 1000 && s1.inserted + s1.collisions == s1.visible);
+    /* determinism: the same photons give the same buffer, whatever the thread count */
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b2, &s2, &err));
+    pp.threads = 3;
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b3, &s3, &err));
+    CHECK(same_buffer(&b1, &b2));
+    CHECK(same_buffer(&b1, &b3));
+    CHECK(memcmp(s1.absorbed, s3.absorbed, sizeof s1.absorbed) == 0);
+    /* a stored photon's flux: the light's power per photon, over t_diffuse, times albedo (one bounce at least) */
+    {
+        size_t i, npix = (size_t)b1.width * (size_t)b1.height;
+        int found = 0;
+        for (i = 0; i < npix && !found; i++)
+            if (b1.count[i]) {
+                const evr_photon *ph = &b1.slots[i];
+                CHECK(ph->flux[0] > 0.0f && ph->flux[1] > 0.0f);
+                CHECK_NEAR(ph->flux[1] / ph->flux[0], 0.5, 1e-4);   /* grey box keeps the light's colour */
+                found = 1;
+            }
+        CHECK(found);
+    }
+    evr_photon_buffer_free(&b1);
+    evr_photon_buffer_free(&b2);
+    evr_photon_buffer_free(&b3);
+    evr_photon_emitters_free(&em);
+    rtcReleaseScene(sc);
+    rtcReleaseDevice(dev);
+}
+
+int main(void)
+{
+    test_projection();
+    test_rings();
+    test_kernel();
+    test_gather_units();
+    test_material();
+    test_emission();
+    test_pass();
+    return check_report("test_photon");
+}
