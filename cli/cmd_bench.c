@@ -37,7 +37,15 @@ typedef struct {
     double render_s;              /* device kernels on the GPU, else the render wait */
     double peak_mb;
     int skip;                     /* change-driven sampling was on */
+    int adaptive;                 /* adaptive sampling (samples: those taken) */
 } bench_figures;
+
+/* Samples taken per pixel per simulated second. */
+static double samples_per_pixel_s(const bench_figures *f)
+{
+    double d = (double)f->width * (double)f->height * f->s.sim_time;
+    return d > 0.0 ? (double)f->s.samples / d : 0.0;
+}
 
 /* Reads the run's events (its first event file) into *ev. */
 static int read_run_events(const char *dir, evr_event **ev, size_t *n)
@@ -92,11 +100,13 @@ static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, in
         f->width = cfg.width;
         f->height = cfg.height;
         f->samples_per_frame = cfg.samples_per_frame;
-        f->skip = !cfg.no_skip;
+        f->skip = !cfg.no_skip && cfg.sampling != EVR_SAMPLING_ADAPTIVE;
+        f->adaptive = cfg.sampling == EVR_SAMPLING_ADAPTIVE;
         /* the set frame rate; else the scene's, as segments per simulated second (the last segment
          * may be partial, so this is approximate for short runs) */
         f->fps = cfg.fps > 0 ? cfg.fps : s->segments_total > 0 && s->sim_time > 0 ? s->segments_total / s->sim_time : 0.0;
         f->temporal_us = f->fps > 0 ? 1e6 / (f->fps * cfg.samples_per_frame) : 0.0;
+        if (f->adaptive) f->temporal_us = samples_per_pixel_s(f) > 0.0 ? 1e6 / samples_per_pixel_s(f) : 0.0;
         f->render_s = s->time_device > 0 ? s->time_device : s->time_render;
         f->peak_mb = (double)ru.ru_maxrss / 1024.0;
     }
@@ -124,7 +134,7 @@ static void print_row(const char *name, const bench_figures *f, int json)
                "\"sort_seconds\": %.4f, \"copy_seconds\": %.4f, \"write_seconds\": %.4f, "
                "\"skip\": %s, \"samples_traced\": %llu, \"traced_samples_per_second\": %.6g, "
                "\"equivalent_samples_per_second\": %.6g, \"rays\": %llu, \"pixels_skipped\": %llu, "
-               "\"pixels_skipped_per_segment\": %.1f}\n",
+               "\"pixels_skipped_per_segment\": %.1f, \"sampling\": \"%s\", \"samples_per_pixel_per_second\": %.6g}\n",
                name, s->backend, s->device, f->width, f->height, f->samples_per_frame, s->sim_time,
                (unsigned long long)(s->events_on + s->events_off), s->wall_time, s->realtime_factor,
                (double)s->samples / w, (double)s->rays / w, f->temporal_us, (unsigned long long)s->unique_timestamps,
@@ -132,7 +142,8 @@ static void print_row(const char *name, const bench_figures *f, int json)
                s->time_write, f->skip ? "true" : "false", (unsigned long long)s->samples_traced,
                (double)s->samples_traced / w, (double)s->samples / w, (unsigned long long)s->rays,
                (unsigned long long)s->pixels_skipped,
-               s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0);
+               s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0,
+               f->adaptive ? "adaptive" : "uniform", samples_per_pixel_s(f));
     } else {
         char res[32];
         printf("%-8s %-5s %9s %4s %12s %9s %9s %12s %12s %9s %12s %9s %8s  %s\n", "scene", "bknd", "res", "spf",
@@ -145,7 +156,11 @@ static void print_row(const char *name, const bench_figures *f, int json)
                (unsigned long long)s->unique_timestamps, f->peak_mb, (double)s->device_memory / 1048576.0,
                f->render_s / w, s->time_sort / w, s->time_copy / w, s->time_write / w);
         printf("(%s; %.3f s simulated; setup %.2f s not in wall_s)\n", s->device, s->sim_time, s->time_setup);
-        if (f->skip) {
+        if (f->adaptive) {
+            printf("adaptive sampling: %.4g samples taken (all traced), %.1f per pixel per simulated second "
+                   "(mean %.1f us apart; samples/s counts samples taken)\n",
+                   (double)s->samples, samples_per_pixel_s(f), f->temporal_us);
+        } else if (f->skip) {
             double npix = (double)f->width * f->height * (s->segments_done > 0 ? s->segments_done : 1);
             printf("change-driven sampling: %.1f%% of pixel-segments skipped (%.0f pixels per segment), "
                    "%.4g samples traced (%.4g/s), %llu rays; equivalent samples/s %.4g (samples brute force "
@@ -204,11 +219,13 @@ static int run_vs_brute(const evr_scene *scene, const evr_config *base, const ch
 
 static int run_suite(const evr_scene *scene, const evr_config *base, int json)
 {
-    static const struct { const char *name; double fps; int spf; const char *meaning; } rows[] = {
-        {"Standard", 30.0, 10, "10 samples per frame, 30 frames per simulated second"},
-        {"Slow", 300.0, 10, "animation at 0.1x speed: 10x the frames per simulated second, 10 samples each"},
-        {"Extra", 30.0, 100, "100 samples per frame"},
+    static const struct { const char *name; double fps; int spf; int gi; const char *meaning; } rows[] = {
+        {"Standard", 30.0, 10, 0, "10 samples per frame, 30 frames per simulated second"},
+        {"Slow", 300.0, 10, 0, "animation at 0.1x speed: 10x the frames per simulated second, 10 samples each"},
+        {"Extra", 30.0, 100, 0, "100 samples per frame"},
+        {"Photon", 30.0, 10, 1, "Standard with global illumination (image-space photon mapping, CPU backend)"},
     };
+    const int gi_here = base->backend == EVR_BACKEND_CPU;   /* GI runs on the CPU backend only */
     int i, rc;
     if (!json) {
         printf("suite seed: eye scene, %dx%d, backend %s; every row simulates the whole 30 s animation (as the\n"
@@ -225,6 +242,12 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
         bench_figures f;
         cfg.fps = rows[i].fps;
         cfg.samples_per_frame = rows[i].spf;
+        cfg.gi = rows[i].gi;
+        if (rows[i].gi && !gi_here) {
+            if (json) printf("  {\"row\": \"%s\", \"available\": false, \"reason\": \"--gi photon runs on the CPU backend only\"},\n", rows[i].name);
+            else printf("%-8s not available on this backend (--gi photon runs on the CPU backend only: --backend cpu)\n", rows[i].name);
+            continue;
+        }
         if ((rc = bench_run(scene, &cfg, 0, &f)) != 0) return rc;
         if (json) {
             printf("  {\"row\": \"%s\", \"fps\": %g, \"samples_per_frame\": %d, \"width\": %d, \"height\": %d, "
@@ -243,9 +266,8 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
         fflush(stdout);
     }
     if (json) {
-        printf("  {\"row\": \"Photon\", \"available\": false, \"reason\": \"--gi photon not implemented\"}\n]\n");
+        printf("  {\"row\": \"end\"}\n]\n");
     } else {
-        printf("%-8s not available (--gi photon not implemented)\n", "Photon");
         printf("rows: Standard = 10 samples per frame at 30 fps; Slow = the reference's animation at 0.1x speed,\n"
                "i.e. 10x the frames (300 fps) of 10 samples each, timestamps kept in animation time (divide the\n"
                "reference's by 10 to compare); Extra = 100 samples per frame at 30 fps. Slow and Extra sample each\n"
@@ -419,6 +441,8 @@ static int bench_usage(void)
          "--backend, --format, --no-skip, ...). With change-driven sampling (the default) the row\n"
          "also gives the share of pixel-segments skipped, the samples actually traced and the\n"
          "equivalent samples/s (samples brute force takes / wall time; samples/s is that figure).\n"
+         "With --sampling adaptive, samples are those taken (every one traced): the row adds\n"
+         "the samples taken per pixel per simulated second, and dt_us is their mean spacing.\n"
          "--vs-brute     runs the row twice, with change-driven sampling and with --no-skip, prints\n"
          "               both, the speedup, and whether the events are identical (exit 3 if not)\n\n"
          "--suite seed   the rows of the reference design's Table 4.2 on the eye scene, default 1280x720\n"
@@ -434,7 +458,8 @@ static int bench_usage(void)
          "                 Extra     100 samples per frame at 30 fps (0.33 ms): the same sampling\n"
          "                           density as Slow (samples are per pixel, spread over each frame)\n"
          "                           but 10x fewer segments, i.e. fewer host round trips\n"
-         "                 Photon    global illumination: not available (--gi photon not implemented)\n"
+         "                 Photon    Standard with --gi photon (CPU backend only: with --backend cpu;\n"
+         "                           on other backends the row says it is not available)\n"
          "--sweep KIND   a series of short runs (default 0.2 s each) growing one quantity; prints the\n"
          "               rows and writes DIR/sweep_KIND.csv (quantity, size, samples per frame, samples,\n"
          "               wall s, ns per sample, samples/s, events) and DIR/sweep_KIND.png (time per\n"

@@ -70,6 +70,12 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
         return EVR_ERR_NOMEM;
     }
+    g->image_width = setup->width;
+    g->memo = calloc((size_t)setup->width * (size_t)setup->height, sizeof *g->memo);
+    if (!g->memo) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
+        return EVR_ERR_NOMEM;
+    }
     g->photons = setup->photons ? setup->photons : (uint32_t)((size_t)setup->width * (size_t)setup->height);
     g->gp.radius = setup->gather_radius;
     g->gp.max_photons = setup->gather_max;
@@ -158,15 +164,28 @@ int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y)
     return n != 0;
 }
 
-float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
-                          int x, int y)
+void evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y)
+{
+    if (evr_cpu_gi_window_changed(g, x, y)) g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].valid = 0;
+}
+
+float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
+                          int y)
 {
     const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
+    struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
     float e[3], ind[3];
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
+    const float key[7] = {s->p.x, s->p.y, s->p.z, s->n.x, s->n.y, s->n.z, dist};
+    /* the albedo is the surface's at p (same point, same triangle side: same albedo) */
+    if (m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) return m->lum;
     evr_photon_gather(&g->buf, &rs->camera, x, y, s->p, s->n, dist, &g->gp, e);
     evr_photon_indirect(s, mat, e, ind);
-    return evr_luminance(ind[0], ind[1], ind[2]);
+    memcpy(m->key, key, sizeof key);
+    m->inst = inst;
+    m->lum = evr_luminance(ind[0], ind[1], ind[2]);
+    m->valid = 1;
+    return m->lum;
 }
 
 void evr_cpu_gi_free(evr_cpu_gi *g)
@@ -175,5 +194,6 @@ void evr_cpu_gi_free(evr_cpu_gi *g)
     evr_photon_buffer_free(&g->prev);
     evr_photon_emitters_free(&g->em);
     free(g->sat);
+    free(g->memo);
     memset(g, 0, sizeof *g);
 }

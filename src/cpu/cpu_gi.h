@@ -25,6 +25,10 @@ typedef struct {
     uint32_t *sat;                 /* summed-area table of the cells that changed, (w + 1) x (h + 1) */
     int have_prev;
     int window;                    /* cells around a pixel a gather may read */
+    /* per pixel, the last gather: the same point, normal and distance with no change in the
+     * window since give the same estimate bit for bit (most samples of a still surface) */
+    struct evr_gi_memo { float key[7]; int inst, valid; float lum; } *memo;   /* key: point, normal, distance */
+    int image_width;
 } evr_cpu_gi;
 
 evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,
@@ -36,10 +40,13 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
                               evr_error *err);
 /* 1 when a cell the gather of pixel (x, y) may read changed in this segment. */
 int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y);
+/* Forgets pixel (x, y)'s last gather when a cell its window reads changed in this segment; the
+ * thread that renders the pixel calls it before the pixel's samples. */
+void evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y);
 /* Luminance of the indirect light leaving surface s of scene instance inst, seen from cam_org
- * through pixel (x, y). */
-float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
-                          int x, int y);
+ * through pixel (x, y) (one thread per pixel at a time: it updates the pixel's memo). */
+float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
+                          int y);
 void evr_cpu_gi_free(evr_cpu_gi *g);
 
 #endif
