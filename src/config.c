@@ -227,7 +227,7 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
         evr_json_key(&j, "sampling"); evr_json_string(&j, "adaptive");
         evr_json_key(&j, "adapt_frac"); evr_json_float(&j, c->adapt_frac);
         evr_json_key(&j, "min_dt"); evr_json_number(&j, c->min_dt);
-        evr_json_key(&j, "max_dt"); evr_json_number(&j, c->max_dt > 0.0 ? c->max_dt : 1.0 / fps);
+        evr_json_key(&j, "max_dt"); evr_json_number(&j, fmax(c->max_dt > 0.0 ? c->max_dt : 1.0 / fps, c->min_dt));
     } else {
         evr_json_key(&j, "sampling"); evr_json_string(&j, "uniform, per-pixel phase");
     }

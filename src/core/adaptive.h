@@ -11,6 +11,9 @@
  *    2 frac pixels (half a pixel at the default frac 0.25) between samples;
  *  - max_dt,
  * and at least min_dt. While the camera or a light moves every pixel samples every min_dt.
+ * A sample that changed by more than frac of a threshold since the previous one is held back
+ * while the interval is bisected (evr_adapt_refine), and a pixel something moving can reach
+ * takes a sample just before its segment's end (evr_adapt_next_time).
  *
  * Samples stay inside segments: a pixel's next scheduled time is carried across segments in
  * segment-relative seconds (as t_prev). At a segment's start a pixel whose last sample's rays meet
@@ -29,6 +32,7 @@
 #include "core/skip.h"
 
 #define EVR_ADAPT_PX_PER_FRAC 2.0f   /* image motion allowed between samples, pixels per unit of frac */
+#define EVR_ADAPT_DEPTH 16           /* samples a pixel holds back while it refines an interval */
 
 typedef struct {
     float frac;                      /* fraction of a threshold (and 2 frac pixels) between samples */
@@ -107,31 +111,62 @@ EVR_HD static inline float evr_adapt_next_dt(const evr_adapt_params *ap, const e
 /* The first sample of a segment (segment-relative seconds): next_t as carried from the previous
  * segment, brought forward as the segment's motion asks (speed and jump: evr_adapt_rays_speed of
  * the last sample's rays), never before the segment's start. A pixel's very first sample comes at
- * phase * min_dt (phase in [0, 1), the pixel's own). */
+ * phase * min(min_dt, seg) (phase in [0, 1), the pixel's own; seg the segment's length). */
 EVR_HD static inline float evr_adapt_first(const evr_adapt_params *ap, const evr_adapt_plan *pl, int started,
-                                           float next_t, float t_prev, float phase, float speed, int jump)
+                                           float next_t, float t_prev, float phase, float speed, int jump, float seg)
 {
-    if (!started) return phase * ap->min_dt;
+    if (!started) return phase * fminf(ap->min_dt, seg);
     if (pl->all_min) next_t = fminf(next_t, t_prev + ap->min_dt);
     if (jump) next_t = 0.0f;
     else if (speed > 0.0f) next_t = fminf(next_t, t_prev + evr_adapt_clamp(ap, evr_adapt_motion_dt(ap, speed)));
     return fmaxf(next_t, 0.0f);
 }
 
+/* Refinement: a sample at t whose log intensity differs from the pixel's previous sample's (the
+ * state s) by more than frac of a threshold is held back, and a sample is first taken halfway
+ * (returned in *t_mid), as long as the interval is at least 2 min_dt long and inside the segment
+ * (from max(t_prev, 0)). An edge found between two samples so gets its time to about min_dt
+ * in log2(interval / min_dt) samples, and the pixel model sees the samples in time order. */
+EVR_HD static inline int evr_adapt_refine(const evr_adapt_params *ap, const evr_pixel_state *s,
+                                          const evr_pixel_params *p, float t, float intensity, float *t_mid)
+{
+    if (!s->started) return 0;
+    const float lo = fmaxf(s->t_prev, 0.0f);
+    if (!(t - lo >= 2.0f * ap->min_dt)) return 0;
+    const float dl = fabsf(evr_log_response(intensity, p->log_floor) - evr_log_response(s->intensity, p->log_floor));
+    if (!(dl > ap->frac * fminf(p->pos_thres, p->neg_thres))) return 0;
+    *t_mid = 0.5f * (lo + t);
+    return 1;
+}
+
 /* Everything a backend does after tracing a sample at segment time t (intensity, primary ray
  * ray0 with hit distance t_hit) and before running it through the pixel model (s: the state
- * before the sample): returns the time to the next sample. */
+ * before the sample): returns the time to the next sample; *moving is set when something moving
+ * can reach the pixel in this segment (evr_adapt_next_time). */
 EVR_HD static inline float evr_adapt_after_sample(const evr_render_scene *rs, const evr_adapt_params *ap,
                                                   const evr_adapt_plan *pl, const evr_pixel_state *s,
                                                   const evr_pixel_params *p, evr_ray ray0, float t_hit, float t,
-                                                  float intensity)
+                                                  float intensity, int *moving)
 {
+    *moving = 1;
     if (pl->all_min) return ap->min_dt;
     int jump;
     const float speed = evr_adapt_rays_speed(rs, pl, ray0, t_hit, &jump);
+    *moving = speed > 0.0f;
     const float l = evr_log_response(intensity, p->log_floor);
     const float l_prev = evr_log_response(s->intensity, p->log_floor);
     return evr_adapt_next_dt(ap, pl, s->started, s->t_prev, l_prev, t, l, fminf(p->pos_thres, p->neg_thres), speed);
+}
+
+/* The time of the next sample after one at t, step later (evr_adapt_after_sample). A pixel that
+ * something moving can reach and whose next sample would fall past the segment's end (seg, its
+ * length) takes one at the segment's end (min_dt / 2 before it) first: the next segment cannot
+ * refine the part of an interval before its start (its motion keys are another segment's), so
+ * that part stays short. At or past seg: no more samples in this segment. */
+EVR_HD static inline float evr_adapt_next_time(const evr_adapt_params *ap, float t, float step, float seg, int moving)
+{
+    const float next = t + step, last = seg - 0.5f * ap->min_dt;
+    return moving && next >= seg && t < last ? last : next;
 }
 
 #endif

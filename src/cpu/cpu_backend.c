@@ -308,8 +308,15 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
 }
 
 /* Adaptive sampling (core/adaptive.h): every pixel of the tile takes its samples at its own
- * scheduled times; each round, the pixels that still have a sample due in the segment take their
- * next one, eight at a time in packets (any pixels of the tile, each at its own time). */
+ * scheduled times; each round, the pixels that still have a sample to trace in the segment trace
+ * it, eight at a time in packets (any pixels of the tile, each at its own time), then run what
+ * they can through the pixel model: a sample that changed too much is held back on the pixel's
+ * stack while the interval before it is refined (evr_adapt_refine). */
+typedef struct {
+    float t[EVR_ADAPT_DEPTH], intensity[EVR_ADAPT_DEPTH], hit[EVR_ADAPT_DEPTH];
+    int n;
+} adapt_stack;
+
 static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
@@ -325,6 +332,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
     const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
     evr_pixel_params pp[TILE * TILE];
+    adapt_stack stack[TILE * TILE];
     float tnext[TILE * TILE];
     int act[TILE * TILE], nact = 0, j;
     out->n = 0;
@@ -336,11 +344,12 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         int jump = 0;
         if (ideal) pp[j] = b->setup.pixel;
         else evr_pixel_params_at(&b->setup.pixel, x, y, &pp[j]);
+        stack[j].n = 0;
         if (st->started && !plan->all_min) {   /* what the last sample's rays meet in this segment */
             evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
             speed = evr_adapt_rays_speed(rs, plan, ray, st->cache_dist, &jump);
         }
-        tnext[j] = evr_adapt_first(ap, plan, st->started, b->next_t[pix], st->t_prev, b->phase[pix], speed, jump);
+        tnext[j] = evr_adapt_first(ap, plan, st->started, b->next_t[pix], st->t_prev, b->phase[pix], speed, jump, dt);
         if (tnext[j] < dt) act[nact++] = j;
     }
     while (nact > 0) {
@@ -360,26 +369,46 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 if (!valid[i]) continue;
                 const int jj = js[i];
                 evr_pixel_state *st = &b->pixels[(size_t)ys[i] * (size_t)w + (size_t)xs[i]];
-                const float t = fs[i] * dt;
-                evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
-                const float step = evr_adapt_after_sample(rs, ap, plan, st, &pp[jj], ray, t_hit[i], t, intensity[i]);
-                evr_pixel_span sp;
-                float te;
-                int pol;
+                const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
+                adapt_stack *sk = &stack[jj];
+                float t = tnext[jj], in = intensity[i], hit = t_hit[i], mid;
                 (*samples)++;
-                st->cache_dist = t_hit[i];
-                if (evr_pixel_begin_s(st, &pp[jj], t, intensity[i], &sp, !ideal)) {
-                    while (evr_pixel_next_s(st, &pp[jj], &sp, &te, &pol, !ideal)) {
-                        evr_event e;
-                        e.t = evr_event_time_us_s(&pp[jj], seg->t0 + (double)te, xs[i], ys[i], !ideal);
-                        e.x = (uint16_t)xs[i];
-                        e.y = (uint16_t)ys[i];
-                        e.p = (int8_t)pol;
-                        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+                for (;;) {   /* the pixel's candidate sample (t, in, hit) */
+                    if (sk->n < EVR_ADAPT_DEPTH && evr_adapt_refine(ap, st, &pp[jj], t, in, &mid)) {
+                        sk->t[sk->n] = t;
+                        sk->intensity[sk->n] = in;
+                        sk->hit[sk->n] = hit;
+                        sk->n++;
+                        tnext[jj] = mid;   /* trace halfway first */
+                        break;
                     }
-                    evr_pixel_end_s(st, &sp, !ideal);
+                    int moving;
+                    const float step = evr_adapt_after_sample(rs, ap, plan, st, &pp[jj], ray, hit, t, in, &moving);
+                    evr_pixel_span sp;
+                    float te;
+                    int pol;
+                    st->cache_dist = hit;
+                    if (evr_pixel_begin_s(st, &pp[jj], t, in, &sp, !ideal)) {
+                        while (evr_pixel_next_s(st, &pp[jj], &sp, &te, &pol, !ideal)) {
+                            evr_event e;
+                            e.t = evr_event_time_us_s(&pp[jj], seg->t0 + (double)te, xs[i], ys[i], !ideal);
+                            e.x = (uint16_t)xs[i];
+                            e.y = (uint16_t)ys[i];
+                            e.p = (int8_t)pol;
+                            if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+                        }
+                        evr_pixel_end_s(st, &sp, !ideal);
+                    }
+                    if (sk->n > 0) {   /* the sample held back next */
+                        sk->n--;
+                        t = sk->t[sk->n];
+                        in = sk->intensity[sk->n];
+                        hit = sk->hit[sk->n];
+                        continue;
+                    }
+                    tnext[jj] = evr_adapt_next_time(ap, t, step, dt, moving);
+                    break;
                 }
-                tnext[jj] = t + step;
                 if (tnext[jj] < dt) act[kept++] = jj;   /* kept <= base + i: in place */
             }
         }

@@ -23,6 +23,7 @@ extern "C" {
 #include "core/rng.h"
 #include "core/shading.h"
 #include "core/skip.h"
+#include "core/adaptive.h"
 #include "cuda/gpu_traverse.h"
 
 #include <math.h>
@@ -305,6 +306,141 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
     if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
 }
 
+/* Adaptive sampling's own arguments: a second kernel parameter, so that kernel_args (and the
+ * uniform kernels) keep their layout. */
+struct adapt_args {
+    const float *next_in;          /* each pixel's next sample time, segment-relative (a ring as the states) */
+    float *next_out;
+    const evr_adapt_plan *plan;    /* the segment's motion bounds (device memory) */
+    evr_adapt_params p;
+};
+
+/* pixel_sample with the sample's time in seconds from the segment's start (adaptive sampling
+ * keeps times, not fractions of the segment, as the CPU backend does). */
+template <int SENSOR>
+__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
+                                                bool live, float t, float intensity, int x, int y, unsigned lane)
+{
+    evr_pixel_span sp;
+    int more = 0;
+    if (live)
+        more = SENSOR ? evr_pixel_begin_s(&st, &own, t, intensity, &sp, 1)
+                      : evr_pixel_begin_ideal(&st, a.log_floor, t, intensity, &sp);
+    const int began = more;
+    for (;;) {
+        float te = 0.0f;
+        int pol = 0, has = 0;
+        if (more) {
+            has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
+                         : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
+            more = has;
+        }
+        unsigned mask = __ballot_sync(0xffffffffu, has);
+        if (!mask) break;
+        unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
+        if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
+        base = __shfl_sync(0xffffffffu, base, leader);
+        if (has) {
+            unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+            long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
+                                    : llround((a.t0 + (double)te) * 1e6);
+            if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
+        }
+    }
+    if (began) evr_pixel_end_s(&st, &sp, SENSOR);
+}
+
+/* Adaptive sampling (core/adaptive.h), one thread per pixel, the same steps as the CPU backend's
+ * render_tile_adaptive: the pixel traces at its scheduled times; a sample that changed too much
+ * is held back on the pixel's stack while the interval before it is refined; every sample goes
+ * through the pixel model in time order. Lanes run their own schedules; the event appends stay
+ * warp-synchronous (every lane calls pixel_sample_at each round). */
+template <int LAYOUT, int SENSOR>
+__global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args d)
+{
+    const int npix = a.width * a.height;
+    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    if ((int)(blockIdx.x * blockDim.x) >= npix) return;   /* the whole block */
+    const bool active = pix < npix;
+    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    const unsigned lane = threadIdx.x & 31u;
+    evr_pixel_state st;
+    evr_pixel_reset(&st);
+    evr_pixel_params own = *a.sensor;   /* the run's parameters; per pixel for the sensor kernel */
+    const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    float t = 0.0f;
+    bool need = false;
+    if (active) {
+        load_state<SENSOR>(a, pix, st);
+        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
+        float speed = 0.0f;
+        int jump = 0;
+        if (st.started && !d.plan->all_min) speed = evr_adapt_rays_speed(&a.rs, d.plan, ray0, st.cache_dist, &jump);
+        t = evr_adapt_first(&d.p, d.plan, st.started, d.next_in[pix], st.t_prev, a.phase[pix], speed, jump, a.dt);
+        need = t < a.dt;
+    }
+    float sk_t[EVR_ADAPT_DEPTH], sk_i[EVR_ADAPT_DEPTH], sk_h[EVR_ADAPT_DEPTH];
+    int n = 0;
+    float ct = 0.0f, ci = 0.0f, ch = INFINITY;   /* the candidate sample: time, intensity, hit distance */
+    bool cand = false;
+    unsigned rays = 0, taken = 0;
+    while (__any_sync(0xffffffffu, need || cand)) {
+        if (need) {
+            const float f = t / a.dt;
+            evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
+            ci = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &ch);
+            ct = t;
+            cand = true;
+            need = false;
+            taken++;
+        }
+        bool consume = false;
+        float step = 0.0f, mid = 0.0f;
+        int moving = 0;
+        if (cand) {
+            if (n < EVR_ADAPT_DEPTH && evr_adapt_refine(&d.p, &st, &own, ct, ci, &mid)) {
+                sk_t[n] = ct;
+                sk_i[n] = ci;
+                sk_h[n] = ch;
+                n++;
+                t = mid;   /* trace halfway first */
+                need = true;
+                cand = false;
+            } else {
+                consume = true;
+                step = evr_adapt_after_sample(&a.rs, &d.p, d.plan, &st, &own, ray0, ch, ct, ci, &moving);
+                st.cache_dist = ch;
+            }
+        }
+        pixel_sample_at<SENSOR>(a, st, own, consume, ct, ci, x, y, lane);
+        if (consume) {
+            if (n > 0) {   /* the sample held back next */
+                n--;
+                ct = sk_t[n];
+                ci = sk_i[n];
+                ch = sk_h[n];
+            } else {
+                cand = false;
+                t = evr_adapt_next_time(&d.p, ct, step, a.dt, moving);
+                need = t < a.dt;
+            }
+        }
+    }
+    if (active) {
+        d.next_out[pix] = t - a.dt;
+        evr_pixel_end_segment(&st, a.dt);
+        store_state<SENSOR>(a, pix, st);
+    }
+    unsigned long long r = rays, ts = taken;
+    for (int o = 16; o > 0; o >>= 1) {
+        r += __shfl_down_sync(0xffffffffu, r, o);
+        ts += __shfl_down_sync(0xffffffffu, ts, o);
+    }
+    if (lane == 0 && r) atomicAdd(a.rays, r);
+    if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
+}
+
 /* Intensity frames: frame k is every pixel's intensity at normalized segment time frame_f[k], one
  * sample through the pixel centre (the same gpu_sample as the segment's samples), written to
  * frames[k * npix + pix]. A kernel of its own so that the render kernel and the pixel states are
@@ -385,6 +521,8 @@ struct slot {
     dbuf<evr_skip_plan> d_plan;
     hbuf<evr_skip_plan> h_plan;
     dbuf<int> d_list;                  /* pixels that trace (change-driven sampling) */
+    dbuf<evr_adapt_plan> d_adapt;      /* adaptive sampling's plan */
+    hbuf<evr_adapt_plan> h_adapt;
     int reuse;                         /* the plan lets pixels reuse their intensity */
     dbuf<float> d_intensity;
     hbuf<unsigned int> h_count;
@@ -422,6 +560,7 @@ struct cuda_backend {
     dbuf<evr_gpu_node8> d_nodes8;
     dbuf<evr_gpu_tri> d_tris;
     dbuf<evr_pixel_state> d_state[3];
+    dbuf<float> d_next[3];                 /* adaptive sampling: next sample times, a ring as d_state */
     dbuf<float> d_phase;
     dbuf<evr_pixel_params> d_sensor;       /* the run's pixel parameters, for the sensor kernel */
     cudaStream_t render = nullptr;
@@ -569,12 +708,27 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     CK(cudaEventRecord(sl->started, b->render));
     const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
     const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
-    if (sl->reuse) {
+    if (b->setup.adaptive) {
+        adapt_args d;
+        d.next_in = b->d_next[sl->index % 3].p;
+        d.next_out = b->d_next[(sl->index + 1) % 3].p;
+        d.plan = sl->d_adapt.p;
+        d.p = b->setup.adapt;
+        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
+            if (ideal) adapt_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a, d);
+            else adapt_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a, d);
+        } else {
+            if (ideal) adapt_kernel<EVR_GPU_LAYOUT_BVH4, 0><<<grid, BLOCK, 0, b->render>>>(a, d);
+            else adapt_kernel<EVR_GPU_LAYOUT_BVH4, 1><<<grid, BLOCK, 0, b->render>>>(a, d);
+        }
+    } else if (sl->reuse) {
         if (ideal) skip_kernel<0><<<grid, BLOCK, 0, b->render>>>(a);
         else skip_kernel<1><<<grid, BLOCK, 0, b->render>>>(a);
         CK(cudaGetLastError());
     }
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
+    if (b->setup.adaptive) {
+        /* launched above */
+    } else if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
         if (ideal) render_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a);
         else render_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a);
     } else {
@@ -616,6 +770,10 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     sl->reuse = seg->skip->reuse;
     *sl->h_plan.p = *seg->skip;
     CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice, b->render));
+    if (b->setup.adaptive) {
+        *sl->h_adapt.p = *seg->adapt;
+        CK(cudaMemcpyAsync(sl->d_adapt.p, sl->h_adapt.p, sizeof(evr_adapt_plan), cudaMemcpyHostToDevice, b->render));
+    }
     sl->num_frames = seg->num_frames > 0 ? seg->num_frames : 0;
     if (sl->num_frames) {
         size_t nf = (size_t)sl->num_frames, npix = (size_t)b->setup.width * b->setup.height;
@@ -633,6 +791,7 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     const evr_pixel_params *px = &b->setup.pixel;
     double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter + (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
     double dt = seg->t1 - seg->t0, back = 2.0 * dt + 1.0 + slack;
+    if (b->setup.adaptive) back += (double)b->setup.adapt.max_dt;   /* a pixel's last sample: up to max_dt back */
     sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
     double span_us = (back + dt + slack) * 1e6 + 2.0;
     int tbits = 1;
@@ -680,7 +839,7 @@ static uint64_t device_bytes(const cuda_backend *b)
                  bytes(b->d_textures) + bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
                  bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) +
                  bytes(b->d_sensor);
-    for (int i = 0; i < 3; i++) n += bytes(b->d_state[i]);
+    for (int i = 0; i < 3; i++) n += bytes(b->d_state[i]) + bytes(b->d_next[i]);
     for (int i = 0; i < 2; i++) {
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
@@ -717,7 +876,8 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
-    base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
+    if (b->setup.adaptive) base->samples += sl->h_rays.p[2];   /* the samples taken, all traced */
+    else base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
     CK(cudaEventRecord(sl->counted, sl->copy));   /* start of sort and copy */
     if (n) {
         size_t temp = 0;
@@ -789,6 +949,7 @@ static void cuda_release(evr_backend *base)
         sl->d_keys_ev.release(); sl->d_keys_sorted.release(); sl->d_sort_temp.release();
         sl->d_count.release(); sl->d_rays.release(); sl->d_intensity.release();
         sl->d_plan.release(); sl->h_plan.release(); sl->d_list.release();
+        sl->d_adapt.release(); sl->h_adapt.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
         if (sl->framed) cudaEventDestroy(sl->framed);
@@ -803,7 +964,10 @@ static void cuda_release(evr_backend *base)
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
     b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release();
     b->d_sensor.release();
-    for (int i = 0; i < 3; i++) b->d_state[i].release();
+    for (int i = 0; i < 3; i++) {
+        b->d_state[i].release();
+        b->d_next[i].release();
+    }
     if (b->render) cudaStreamDestroy(b->render);
     evr_gpu_bvh_free(&b->bvh);
     evr_event_vec_free(&b->decoded);
@@ -840,6 +1004,12 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if ((st = upload_scene(b, err)) != EVR_OK) return st;
     size_t npix = (size_t)b->setup.width * b->setup.height;
     for (int i = 0; i < 3; i++) CK(b->d_state[i].reserve(npix));
+    if (b->setup.adaptive) {
+        for (int i = 0; i < 3; i++) {
+            CK(b->d_next[i].reserve(npix));
+            CK(cudaMemset(b->d_next[i].p, 0, npix * sizeof(float)));
+        }
+    }
     CK(b->d_phase.reserve(npix));
     CK(b->d_sensor.reserve(1));
     CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params), cudaMemcpyHostToDevice));
@@ -869,6 +1039,10 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(sl->d_rays.reserve(3));
         CK(sl->d_plan.reserve(1));
         CK(sl->h_plan.reserve(1));
+        if (b->setup.adaptive) {
+            CK(sl->d_adapt.reserve(1));
+            CK(sl->h_adapt.reserve(1));
+        }
         CK(sl->d_list.reserve((size_t)b->setup.width * (size_t)b->setup.height));
         CK(sl->d_intensity.reserve(npix));
         CK(sl->h_count.reserve(1));
