@@ -145,13 +145,16 @@ static void print_row(const char *name, const bench_figures *f, int json)
                s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0,
                f->adaptive ? "adaptive" : "uniform", samples_per_pixel_s(f));
     } else {
-        char res[32];
+        char res[32], spf[16];
+        /* adaptive sampling has no samples per frame: each pixel picks its own times */
+        if (f->adaptive) snprintf(spf, sizeof spf, "ad");
+        else snprintf(spf, sizeof spf, "%d", f->samples_per_frame);
         printf("%-8s %-5s %9s %4s %12s %9s %9s %12s %12s %9s %12s %9s %8s  %s\n", "scene", "bknd", "res", "spf",
                "events", "wall_s", "rt_factor", "samples/s", "rays/s", "dt_us", "unique_ts", "host_MB", "gpu_MB",
                "share render/sort/copy/write");
         snprintf(res, sizeof res, "%dx%d", f->width, f->height);
-        printf("%-8.8s %-5s %9s %4d %12llu %9.3f %9.4f %12.4g %12.4g %9.1f %12llu %9.1f %8.1f  %.2f/%.2f/%.2f/%.2f\n",
-               name, s->backend, res, f->samples_per_frame, (unsigned long long)(s->events_on + s->events_off),
+        printf("%-8.8s %-5s %9s %4s %12llu %9.3f %9.4f %12.4g %12.4g %9.1f %12llu %9.1f %8.1f  %.2f/%.2f/%.2f/%.2f\n",
+               name, s->backend, res, spf, (unsigned long long)(s->events_on + s->events_off),
                s->wall_time, s->realtime_factor, (double)s->samples / w, (double)s->rays / w, f->temporal_us,
                (unsigned long long)s->unique_timestamps, f->peak_mb, (double)s->device_memory / 1048576.0,
                f->render_s / w, s->time_sort / w, s->time_copy / w, s->time_write / w);
