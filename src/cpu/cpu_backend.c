@@ -5,6 +5,7 @@
 #include "core/shading.h"
 #include "core/skip.h"
 #include "cpu/cpu_gi.h"
+#include "cuda/gpu_bvh.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -31,7 +32,7 @@ typedef struct {
     /* Instances are grouped: every instance whose node never moves goes, baked into world space,
      * into one static group; the instances of each moving node share one group. One Embree
      * instance per group keeps overlapping instances (lids over an eyeball) out of each other's
-     * way in the top-level BVH. Past a size (evr_static_bake_limit, build_groups) the static
+     * way in the top-level BVH. Past a size (evr_static_bake_limit in cuda/gpu_bvh.h, build_groups) the static
      * instances are not baked: each is a group of its own, an Embree instance with its node's
      * fixed transform of one scene per mesh that all its instances share. */
     int num_groups;
@@ -666,22 +667,6 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
-/* Baking copies every static instance's triangles into one world-space tree. Past
- * EVR_STATIC_BAKE_LIMIT_DEFAULT triangles so copied (counted per instance), the static instances
- * are instanced instead (the same rule as the GPU BVH, gpu_bvh_build.c). The environment
- * variable EVR_STATIC_BAKE_LIMIT (a triangle count; 0: always instance, for tests and
- * comparisons) overrides the limit. */
-#define EVR_STATIC_BAKE_LIMIT_DEFAULT 1000000ull
-static unsigned long long static_bake_limit(void)
-{
-    const char *v = getenv("EVR_STATIC_BAKE_LIMIT");
-    char *end;
-    unsigned long long x;
-    if (!v || !*v) return EVR_STATIC_BAKE_LIMIT_DEFAULT;
-    x = strtoull(v, &end, 10);
-    return *end ? EVR_STATIC_BAKE_LIMIT_DEFAULT : x;
-}
-
 /* Groups the instances (see cpu_backend), numbered in the order of their first member, and
  * builds one Embree scene per group (per mesh for instanced static groups). */
 static int build_groups(cpu_backend *b, const evr_scene *s)
@@ -706,7 +691,7 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
     }
     for (i = 0; i < n; i++)
         if (node_never_moves(s, s->instances[i].node)) static_tris += s->meshes[s->instances[i].mesh].num_triangles;
-    instance_static = static_tris > static_bake_limit();
+    instance_static = static_tris > evr_static_bake_limit();   /* cuda/gpu_bvh.h */
     for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
     b->num_groups = 0;
     for (i = 0; i < n; i++) {

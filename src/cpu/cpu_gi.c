@@ -8,35 +8,26 @@
 #include <string.h>
 #include <time.h>
 
-static int gi_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
+int evr_embree_closest1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f, struct RTCRayHit *rh)
 {
-    const evr_cpu_trace_ctx *c = (const evr_cpu_trace_ctx *)user;
     struct RTCIntersectContext ctx;
-    struct RTCRayHit rh;
     rtcInitIntersectContext(&ctx);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(c->top, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    hit->inst = c->members[c->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    hit->t = rh.ray.tfar;
-    return 1;
+    rh->ray.org_x = ray.org.x; rh->ray.org_y = ray.org.y; rh->ray.org_z = ray.org.z;
+    rh->ray.dir_x = ray.dir.x; rh->ray.dir_y = ray.dir.y; rh->ray.dir_z = ray.dir.z;
+    rh->ray.tnear = tnear;
+    rh->ray.tfar = tfar;
+    rh->ray.time = f;
+    rh->ray.mask = 0xffffffffu;
+    rh->ray.id = 0;
+    rh->ray.flags = 0;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(sc, &ctx, rh);
+    return rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
 
-static int gi_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
+int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f)
 {
-    const evr_cpu_trace_ctx *c = (const evr_cpu_trace_ctx *)user;
     struct RTCIntersectContext ctx;
     struct RTCRay r;
     rtcInitIntersectContext(&ctx);
@@ -48,8 +39,26 @@ static int gi_occluded(void *user, evr_ray ray, float tnear, float tfar, float f
     r.mask = 0xffffffffu;
     r.id = 0;
     r.flags = 0;
-    rtcOccluded1(c->top, &ctx, &r);
+    rtcOccluded1(sc, &ctx, &r);
     return r.tfar < 0.0f;
+}
+
+static int gi_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
+{
+    const evr_cpu_trace_ctx *c = (const evr_cpu_trace_ctx *)user;
+    struct RTCRayHit rh;
+    if (!evr_embree_closest1(c->top, ray, tnear, tfar, f, &rh)) return 0;
+    hit->inst = c->members[c->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
+    hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->t = rh.ray.tfar;
+    return 1;
+}
+
+static int gi_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
+{
+    return evr_embree_occluded1(((const evr_cpu_trace_ctx *)user)->top, ray, tnear, tfar, f);
 }
 
 evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,

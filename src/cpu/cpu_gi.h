@@ -31,6 +31,12 @@ typedef struct {
     int image_width;
 } evr_cpu_gi;
 
+/* One ray through an Embree scene at normalized time f (the photon pass's evr_tracer calls, the
+ * still renderer's too): the closest hit (geometry, instance, triangle, barycentrics and distance
+ * in *rh; 0 when nothing is hit), or whether anything lies along it. */
+int evr_embree_closest1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f, struct RTCRayHit *rh);
+int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f);
+
 evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,
                            evr_error *err);
 /* The photon pass of a segment (rs holds its keys). still: nothing moved in this segment or

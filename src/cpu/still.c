@@ -2,6 +2,7 @@
  * space at that time, geometry id = scene instance), the event pipeline's direct shading through
  * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
 #include "still.h"
+#include "cpu/cpu_gi.h"
 #include "backend.h"
 #include "core/photon.h"
 #include "core/rng.h"
@@ -49,24 +50,11 @@ static double now(void)
 
 /* ---- Embree as an evr_tracer ---- */
 
+/* The baked scene: geometry g is scene instance g. */
 static int em_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
 {
-    RTCScene sc = (RTCScene)user;
-    struct RTCIntersectContext ctx;
     struct RTCRayHit rh;
-    rtcInitIntersectContext(&ctx);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(sc, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    if (!evr_embree_closest1((RTCScene)user, ray, tnear, tfar, f, &rh)) return 0;
     hit->inst = (int)rh.hit.geomID;
     hit->prim = rh.hit.primID;
     hit->u = rh.hit.u;
@@ -77,20 +65,7 @@ static int em_closest(void *user, evr_ray ray, float tnear, float tfar, float f,
 
 static int em_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
 {
-    RTCScene sc = (RTCScene)user;
-    struct RTCIntersectContext ctx;
-    struct RTCRay r;
-    rtcInitIntersectContext(&ctx);
-    r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
-    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
-    r.tnear = tnear;
-    r.tfar = tfar;
-    r.time = f;
-    r.mask = 0xffffffffu;
-    r.id = 0;
-    r.flags = 0;
-    rtcOccluded1(sc, &ctx, &r);
-    return r.tfar < 0.0f;
+    return evr_embree_occluded1((RTCScene)user, ray, tnear, tfar, f);
 }
 
 /* ---- shading ---- */

@@ -207,6 +207,12 @@ void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_top *top, evr_g
  * the two samples widened by a bound on how far a point can turn or stretch in between (slerp
  * at its angular speed, scale/skew change); the union over all steps. Samples are spaced so
  * that the widening is about 1% of the object's size (at most 64 per key interval). */
+/* Both backends bake every never-moving instance into one world-space tree, but past this many
+ * triangles so copied (counted per instance) they keep static instances as instances of one tree
+ * per mesh instead: 1,000,000, or the environment variable EVR_STATIC_BAKE_LIMIT (a triangle
+ * count; 0: always instance, for tests and comparisons). */
+unsigned long long evr_static_bake_limit(void);
+
 void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
                             float out_hi[3]);
 

@@ -646,11 +646,8 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
-/* The static group's size limit, as the CPU backend's (cpu_backend.c, static_bake_limit): past
- * EVR_STATIC_BAKE_LIMIT_DEFAULT triangles baked (counted per instance; the environment variable
- * EVR_STATIC_BAKE_LIMIT overrides it, 0: always instance), the static instances are not baked. */
 #define EVR_STATIC_BAKE_LIMIT_DEFAULT 1000000ull
-static unsigned long long static_bake_limit(void)
+unsigned long long evr_static_bake_limit(void)
 {
     const char *v = getenv("EVR_STATIC_BAKE_LIMIT");
     char *end;
@@ -673,7 +670,7 @@ static int make_groups(const evr_scene *s, evr_gpu_bvh *out, int grouped)
         if (m >= 0 && m < s->num_meshes && node_never_moves(s, s->instances[i].node))
             static_tris += s->meshes[m].num_triangles;
     }
-    out->static_instanced = grouped && static_tris > static_bake_limit();
+    out->static_instanced = grouped && static_tris > evr_static_bake_limit();
     out->static_group = -1;
     out->num_groups = 0;
     for (i = 0; i < n; i++) {
