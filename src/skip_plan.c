@@ -84,20 +84,28 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
     }
 }
 
-/* Adds a box; 0 when the plan is full. */
-static int add_box(evr_skip_plan *pl, const float lo[3], const float hi[3])
+/* Merges the plan's boxes of the same track (box_track[b]: box b's track) into one each. */
+static void merge_by_track(evr_skip_plan *pl, int *box_track)
 {
-    if (pl->num_boxes == EVR_SKIP_MAX_BOXES) return 0;
-    memcpy(pl->lo[pl->num_boxes], lo, 3 * sizeof(float));
-    memcpy(pl->hi[pl->num_boxes], hi, 3 * sizeof(float));
-    pl->num_boxes++;
-    return 1;
+    int b, c, n = 0;
+    for (b = 0; b < pl->num_boxes; b++) {
+        for (c = 0; c < n && box_track[c] != box_track[b]; c++) {}
+        if (c == n) {
+            memcpy(pl->lo[n], pl->lo[b], 3 * sizeof(float));
+            memcpy(pl->hi[n], pl->hi[b], 3 * sizeof(float));
+            box_track[n++] = box_track[b];
+        } else {
+            box_union(pl->lo[c], pl->hi[c], pl->lo[b], pl->hi[b]);
+        }
+    }
+    pl->num_boxes = n;
 }
 
 void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
                          evr_skip_plan *pl)
 {
-    int i, tr, ok = 1;
+    int i, tr, per_track = 0;
+    int box_track[EVR_SKIP_MAX_BOXES];
     memset(pl, 0, sizeof *pl);
     pl->pad = rs->ray_eps;
     if (!enabled) return;
@@ -110,30 +118,30 @@ void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const ev
         if (rs->track_count[tr] != 1) cache = 0;
         if (t->moved[tr]) still = 0;
     }
-    /* a box per moving instance; if they are too many, a box per moving track */
-    for (i = 0; i < rs->num_instances && ok; i++) {
+    /* a box per moving instance; once they are too many, a box per moving track */
+    for (i = 0; i < rs->num_instances; i++) {
         float lo[3], hi[3];
-        if (!t->moved[rs->instances[i].track]) continue;
+        int b = pl->num_boxes;
+        tr = rs->instances[i].track;
+        if (!t->moved[tr]) continue;
         instance_box(t, s, rs, i, lo, hi);
-        ok = add_box(pl, lo, hi);
-    }
-    if (!ok) {
-        pl->num_boxes = 0;
-        for (tr = 0; tr < t->num_tracks; tr++) {
-            float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-            int any = 0;
-            if (!t->moved[tr]) continue;
-            for (i = 0; i < rs->num_instances; i++) {
-                float l2[3], h2[3];
-                if (rs->instances[i].track != tr) continue;
-                instance_box(t, s, rs, i, l2, h2);
-                box_union(lo, hi, l2, h2);
-                any = 1;
-            }
-            if (any && !add_box(pl, lo, hi)) {   /* too many moving things to bound: trace all */
-                pl->num_boxes = 0;
-                return;
-            }
+        if (per_track)
+            for (b = 0; b < pl->num_boxes && box_track[b] != tr; b++) {}
+        if (b == EVR_SKIP_MAX_BOXES && !per_track) {
+            per_track = 1;
+            merge_by_track(pl, box_track);
+            for (b = 0; b < pl->num_boxes && box_track[b] != tr; b++) {}
+        }
+        if (b < pl->num_boxes) {
+            box_union(pl->lo[b], pl->hi[b], lo, hi);
+        } else if (b < EVR_SKIP_MAX_BOXES) {
+            memcpy(pl->lo[b], lo, sizeof lo);
+            memcpy(pl->hi[b], hi, sizeof hi);
+            box_track[b] = tr;
+            pl->num_boxes++;
+        } else {   /* too many moving things to bound: trace all */
+            pl->num_boxes = 0;
+            return;
         }
     }
     pl->cache = cache;

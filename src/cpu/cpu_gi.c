@@ -8,22 +8,30 @@
 #include <string.h>
 #include <time.h>
 
-int evr_embree_closest1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f, struct RTCRayHit *rh)
+int evr_embree_closest1(RTCScene sc, const int *members, const int *group_first, evr_ray ray, float tnear, float tfar,
+                        float f, evr_trace_hit *hit)
 {
     struct RTCIntersectContext ctx;
+    struct RTCRayHit rh;
     rtcInitIntersectContext(&ctx);
-    rh->ray.org_x = ray.org.x; rh->ray.org_y = ray.org.y; rh->ray.org_z = ray.org.z;
-    rh->ray.dir_x = ray.dir.x; rh->ray.dir_y = ray.dir.y; rh->ray.dir_z = ray.dir.z;
-    rh->ray.tnear = tnear;
-    rh->ray.tfar = tfar;
-    rh->ray.time = f;
-    rh->ray.mask = 0xffffffffu;
-    rh->ray.id = 0;
-    rh->ray.flags = 0;
-    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(sc, &ctx, rh);
-    return rh->hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.time = f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(sc, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    hit->inst = members ? members[group_first[rh.hit.instID[0]] + (int)rh.hit.geomID] : (int)rh.hit.geomID;
+    hit->prim = rh.hit.primID;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->t = rh.ray.tfar;
+    return 1;
 }
 
 int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f)
@@ -46,14 +54,7 @@ int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, floa
 static int gi_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
 {
     const evr_cpu_trace_ctx *c = (const evr_cpu_trace_ctx *)user;
-    struct RTCRayHit rh;
-    if (!evr_embree_closest1(c->top, ray, tnear, tfar, f, &rh)) return 0;
-    hit->inst = c->members[c->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    hit->t = rh.ray.tfar;
-    return 1;
+    return evr_embree_closest1(c->top, c->members, c->group_first, ray, tnear, tfar, f, hit);
 }
 
 static int gi_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)

@@ -32,9 +32,11 @@ typedef struct {
 } evr_cpu_gi;
 
 /* One ray through an Embree scene at normalized time f (the photon pass's evr_tracer calls, the
- * still renderer's too): the closest hit (geometry, instance, triangle, barycentrics and distance
- * in *rh; 0 when nothing is hit), or whether anything lies along it. */
-int evr_embree_closest1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f, struct RTCRayHit *rh);
+ * still renderer's too): the closest hit (0 when nothing is hit), or whether anything lies along
+ * it. The hit's scene instance: members[group_first[instance] + geometry] with a mapping (the
+ * backend's grouped scene), else the geometry itself (a scene of one geometry per instance). */
+int evr_embree_closest1(RTCScene sc, const int *members, const int *group_first, evr_ray ray, float tnear, float tfar,
+                        float f, evr_trace_hit *hit);
 int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, float f);
 
 evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,

@@ -53,14 +53,7 @@ static double now(void)
 /* The baked scene: geometry g is scene instance g. */
 static int em_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
 {
-    struct RTCRayHit rh;
-    if (!evr_embree_closest1((RTCScene)user, ray, tnear, tfar, f, &rh)) return 0;
-    hit->inst = (int)rh.hit.geomID;
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    hit->t = rh.ray.tfar;
-    return 1;
+    return evr_embree_closest1((RTCScene)user, NULL, NULL, ray, tnear, tfar, f, hit);
 }
 
 static int em_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)

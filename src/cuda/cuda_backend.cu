@@ -163,18 +163,18 @@ __device__ __forceinline__ void store_state(const kernel_args &a, int pix, const
     if (a.intensity) a.intensity[pix] = st.intensity;
 }
 
-/* One sample (intensity at normalized time f) through the pixel model; its events are appended
- * with warp-aggregated atomics. Every lane of the warp calls it together; live: this lane has a
- * sample. */
+/* One sample (intensity at t seconds from the segment's start) through the pixel model; its
+ * events are appended with warp-aggregated atomics. Every lane of the warp calls it together;
+ * live: this lane has a sample. */
 template <int SENSOR>
-__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
-                                             bool live, float f, float intensity, int x, int y, unsigned lane)
+__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
+                                                bool live, float t, float intensity, int x, int y, unsigned lane)
 {
     evr_pixel_span sp;
     int more = 0;
     if (live)
-        more = SENSOR ? evr_pixel_begin_s(&st, &own, f * a.dt, intensity, &sp, 1)
-                      : evr_pixel_begin_ideal(&st, a.log_floor, f * a.dt, intensity, &sp);
+        more = SENSOR ? evr_pixel_begin_s(&st, &own, t, intensity, &sp, 1)
+                      : evr_pixel_begin_ideal(&st, a.log_floor, t, intensity, &sp);
     const int began = more;
     for (;;) {
         float te = 0.0f;
@@ -197,6 +197,26 @@ __device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_sta
         }
     }
     if (began) evr_pixel_end_s(&st, &sp, SENSOR);
+}
+
+/* The same at normalized segment time f (uniform sampling). */
+template <int SENSOR>
+__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
+                                             bool live, float f, float intensity, int x, int y, unsigned lane)
+{
+    pixel_sample_at<SENSOR>(a, st, own, live, f * a.dt, intensity, x, y, lane);
+}
+
+/* Adds the warp's rays and traced samples to the segment's counters (a.rays[0] and a.rays[2]). */
+__device__ __forceinline__ void add_counts(const kernel_args &a, unsigned lane, unsigned rays, unsigned traced)
+{
+    unsigned long long r = rays, ts = traced;
+    for (int o = 16; o > 0; o >>= 1) {
+        r += __shfl_down_sync(0xffffffffu, r, o);
+        ts += __shfl_down_sync(0xffffffffu, ts, o);
+    }
+    if (lane == 0 && r) atomicAdd(a.rays, r);
+    if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
 }
 
 /* Change-driven sampling, first pass: a pixel that keeps its cached intensity runs its samples
@@ -297,13 +317,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
     }
-    unsigned long long r = rays, ts = traced;
-    for (int o = 16; o > 0; o >>= 1) {
-        r += __shfl_down_sync(0xffffffffu, r, o);
-        ts += __shfl_down_sync(0xffffffffu, ts, o);
-    }
-    if (lane == 0 && r) atomicAdd(a.rays, r);
-    if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
+    add_counts(a, lane, rays, traced);
 }
 
 /* Adaptive sampling's own arguments: a second kernel parameter, so that kernel_args (and the
@@ -314,41 +328,6 @@ struct adapt_args {
     const evr_adapt_plan *plan;    /* the segment's motion bounds (device memory) */
     evr_adapt_params p;
 };
-
-/* pixel_sample with the sample's time in seconds from the segment's start (adaptive sampling
- * keeps times, not fractions of the segment, as the CPU backend does). */
-template <int SENSOR>
-__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
-                                                bool live, float t, float intensity, int x, int y, unsigned lane)
-{
-    evr_pixel_span sp;
-    int more = 0;
-    if (live)
-        more = SENSOR ? evr_pixel_begin_s(&st, &own, t, intensity, &sp, 1)
-                      : evr_pixel_begin_ideal(&st, a.log_floor, t, intensity, &sp);
-    const int began = more;
-    for (;;) {
-        float te = 0.0f;
-        int pol = 0, has = 0;
-        if (more) {
-            has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
-                         : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
-            more = has;
-        }
-        unsigned mask = __ballot_sync(0xffffffffu, has);
-        if (!mask) break;
-        unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
-        if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
-        base = __shfl_sync(0xffffffffu, base, leader);
-        if (has) {
-            unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
-            long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
-                                    : llround((a.t0 + (double)te) * 1e6);
-            if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
-        }
-    }
-    if (began) evr_pixel_end_s(&st, &sp, SENSOR);
-}
 
 /* Adaptive sampling (core/adaptive.h), one thread per pixel, the same steps as the CPU backend's
  * render_tile_adaptive: the pixel traces at its scheduled times; a sample that changed too much
@@ -432,13 +411,7 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
     }
-    unsigned long long r = rays, ts = taken;
-    for (int o = 16; o > 0; o >>= 1) {
-        r += __shfl_down_sync(0xffffffffu, r, o);
-        ts += __shfl_down_sync(0xffffffffu, ts, o);
-    }
-    if (lane == 0 && r) atomicAdd(a.rays, r);
-    if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
+    add_counts(a, lane, rays, taken);
 }
 
 /* Intensity frames: frame k is every pixel's intensity at normalized segment time frame_f[k], one
