@@ -47,4 +47,16 @@ for backend in backends:
         if scene in ("square", "cornell"):   # a small mover on a still background
             T.check(ss["samples_traced"] < 0.5 * ss["samples"], f"{backend} {scene}: most samples skipped")
             T.check(ss["rays"] < sb["rays"], f"{backend} {scene}: fewer rays")
+# inside one of the eye's fixations (3.5-3.8 s) nothing moves: after the first segment, whose pixels
+# settle after one sample each, every pixel skips every segment (still nodes must be bitwise still:
+# one key per segment, held curve values exact, the same key from segment to segment)
+for backend in backends:
+    d = os.path.join(tmp, f"{backend}-fixation")
+    T.run("demo", "--scene", "eye", "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
+          "--res", "64x48", "--start", "3.5", "--duration", "0.3")
+    st = T.load_run_json(d)["stats"]
+    npix = 64 * 48
+    T.check(st["events"] == 0 and st["pixels_skipped"] == (st["segments"] - 1) * npix and st["samples_traced"] == npix,
+            f"{backend} eye fixation: one sample per pixel, then nothing traced ({st['samples_traced']} traced, "
+            f"{st['pixels_skipped']} skipped, {st['segments']} segments)")
 T.finish("test_skip")
