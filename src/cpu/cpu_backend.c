@@ -214,11 +214,11 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
                 phi[i] = b->phase[(size_t)y * (size_t)w + (size_t)xs[i]];
                 if (ideal) pp[i] = b->setup.pixel;
                 else evr_pixel_params_at(&b->setup.pixel, xs[i], y, &pp[i]);
-                if (b->gi && valid[i]) evr_cpu_gi_pixel_begin(&b->gi_state, xs[i], y);
+                /* global illumination: whether the photons this pixel's gather reads changed */
+                const int gi_changed = b->gi && valid[i] && evr_cpu_gi_pixel_begin(&b->gi_state, xs[i], y);
                 /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
                 ray[i] = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)y + 0.5f);
-                trace[i] = valid[i] && !(evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]) &&
-                                         !(b->gi && evr_cpu_gi_window_changed(&b->gi_state, xs[i], y)));
+                trace[i] = valid[i] && !(evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]) && !gi_changed);
                 any_trace |= trace[i];
                 if (valid[i] && !trace[i]) (*skipped)++;
             }

@@ -159,7 +159,8 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
     return EVR_OK;
 }
 
-int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y)
+/* 1 when a cell the gather of pixel (x, y) may read changed in this segment. */
+static int window_changed(const evr_cpu_gi *g, int x, int y)
 {
     const int w = g->buf.width, h = g->buf.height, m = g->buf.margin;
     int x0 = x + m - g->window, x1 = x + m + g->window + 1, y0 = y + m - g->window, y1 = y + m + g->window + 1;
@@ -174,9 +175,11 @@ int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y)
     return n != 0;
 }
 
-void evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y)
+int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y)
 {
-    if (evr_cpu_gi_window_changed(g, x, y)) g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].valid = 0;
+    if (!window_changed(g, x, y)) return 0;
+    g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].valid = 0;
+    return 1;
 }
 
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,

@@ -46,11 +46,9 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
  * previous segment: the pass is not run and no cell changed. */
 evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int still, int threads, evr_backend *stats,
                               evr_error *err);
-/* 1 when a cell the gather of pixel (x, y) may read changed in this segment. */
-int evr_cpu_gi_window_changed(const evr_cpu_gi *g, int x, int y);
-/* Forgets pixel (x, y)'s last gather when a cell its window reads changed in this segment; the
- * thread that renders the pixel calls it before the pixel's samples. */
-void evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y);
+/* Whether a cell pixel (x, y)'s gather window reads changed in this segment; if so, forgets the
+ * pixel's last gather. The thread that renders the pixel calls it before the pixel's samples. */
+int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y);
 /* Luminance of the indirect light leaving surface s of scene instance inst, seen from cam_org
  * through pixel (x, y) (one thread per pixel at a time: it updates the pixel's memo). */
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
