@@ -67,6 +67,8 @@ vs = T.run("bench", "--scene", "square", "--res", "32x32", "--duration", "0.5", 
 rows = [json.loads(l) for l in vs]
 T.check(len(rows) == 3 and rows[0]["skip"] and not rows[1]["skip"] and rows[2]["identical"]
         and rows[2]["events"] == rows[0]["events"], f"bench --vs-brute: two rows and an identity check ({vs})")
+expect_error(["bench", "--vs-brute", "--no-skip"], "bench --vs-brute with --no-skip")
+expect_error(["bench", "--vs-brute", "--suite", "seed"], "bench --vs-brute with --suite")
 T.check(abs(b["temporal_resolution_us"] - 1e6 / 300) < 0.1, "bench: 30 fps x 10 samples = 3333 us between a pixel's samples")
 
 # bad input
