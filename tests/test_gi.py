@@ -34,6 +34,12 @@ print(f"cornell 0.5 s: {js['stats']['events']} events with GI, {jd['stats']['eve
 T.check(js["stats"]["events"] > 0 and ev_s == ev_b, "moving box, GI on: identical events with and without skipping")
 T.check(js["stats"]["samples_traced"] < jb["stats"]["samples_traced"], "moving box, GI on: pixels are still skipped")
 T.check(ev_s != ev_d, "GI changes the events")
+# a pixel reuses its last gather while its hit and its window are unchanged: gathering at every
+# sample instead (EVR_GI_NO_MEMO) gives the same events
+os.environ["EVR_GI_NO_MEMO"] = "1"
+ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip")
+del os.environ["EVR_GI_NO_MEMO"]
+T.check(ev_m == ev_b, "GI: the same events without the gather memo")
 
 bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
        ["--gi", "photon", "--gather-max", "0"], ["--gi", "photon", "--gather-radius", "-1"],

@@ -81,6 +81,8 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
         return EVR_ERR_NOMEM;
     }
     g->image_width = setup->width;
+    /* EVR_GI_NO_MEMO (hidden, for tests): gather at every sample, to show the memo changes nothing */
+    g->memo_off = getenv("EVR_GI_NO_MEMO") != NULL;
     g->memo = calloc((size_t)setup->width * (size_t)setup->height, sizeof *g->memo);
     if (!g->memo) {
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
@@ -191,7 +193,7 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
     const float key[7] = {s->p.x, s->p.y, s->p.z, s->n.x, s->n.y, s->n.z, dist};
     /* the albedo is the surface's at p (same point, same triangle side: same albedo) */
-    if (m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) return m->lum;
+    if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) return m->lum;
     evr_photon_gather(&g->buf, &rs->camera, x, y, s->p, s->n, dist, &g->gp, e);
     evr_photon_indirect(s, mat, e, ind);
     memcpy(m->key, key, sizeof key);

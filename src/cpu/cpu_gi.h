@@ -29,6 +29,7 @@ typedef struct {
      * window since give the same estimate bit for bit (most samples of a still surface) */
     struct evr_gi_memo { float key[7]; int inst, valid; float lum; } *memo;   /* key: point, normal, distance */
     int image_width;
+    int memo_off;                  /* EVR_GI_NO_MEMO set: no memo (tests) */
 } evr_cpu_gi;
 
 /* One ray through an Embree scene at normalized time f (the photon pass's evr_tracer calls, the
