@@ -134,7 +134,8 @@ static void print_row(const char *name, const bench_figures *f, int json)
                "\"sort_seconds\": %.4f, \"copy_seconds\": %.4f, \"write_seconds\": %.4f, "
                "\"skip\": %s, \"samples_traced\": %llu, \"traced_samples_per_second\": %.6g, "
                "\"equivalent_samples_per_second\": %.6g, \"rays\": %llu, \"pixels_skipped\": %llu, "
-               "\"pixels_skipped_per_segment\": %.1f, \"sampling\": \"%s\", \"samples_per_pixel_per_second\": %.6g}\n",
+               "\"pixels_skipped_per_segment\": %.1f, \"sampling\": \"%s\", \"samples_per_pixel_per_second\": %.6g, "
+               "\"photon_seconds\": %.4f, \"photons_stored\": %llu, \"photon_collisions\": %llu, \"photon_cells_changed\": %llu}\n",
                name, s->backend, s->device, f->width, f->height, f->samples_per_frame, s->sim_time,
                (unsigned long long)(s->events_on + s->events_off), s->wall_time, s->realtime_factor,
                (double)s->samples / w, (double)s->rays / w, f->temporal_us, (unsigned long long)s->unique_timestamps,
@@ -143,7 +144,9 @@ static void print_row(const char *name, const bench_figures *f, int json)
                (double)s->samples_traced / w, (double)s->samples / w, (unsigned long long)s->rays,
                (unsigned long long)s->pixels_skipped,
                s->segments_done > 0 ? (double)s->pixels_skipped / s->segments_done : 0.0,
-               f->adaptive ? "adaptive" : "uniform", samples_per_pixel_s(f));
+               f->adaptive ? "adaptive" : "uniform", samples_per_pixel_s(f), s->time_photons,
+               (unsigned long long)s->photons_stored, (unsigned long long)s->photon_collisions,
+               (unsigned long long)s->photon_cells_changed);
     } else {
         char res[32], spf[16];
         /* adaptive sampling has no samples per frame: each pixel picks its own times */
@@ -226,9 +229,8 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
         {"Standard", 30.0, 10, 0, "10 samples per frame, 30 frames per simulated second"},
         {"Slow", 300.0, 10, 0, "animation at 0.1x speed: 10x the frames per simulated second, 10 samples each"},
         {"Extra", 30.0, 100, 0, "100 samples per frame"},
-        {"Photon", 30.0, 10, 1, "Standard with global illumination (image-space photon mapping, CPU backend)"},
+        {"Photon", 30.0, 10, 1, "Standard with global illumination (image-space photon mapping)"},
     };
-    const int gi_here = base->backend == EVR_BACKEND_CPU;   /* GI runs on the CPU backend only */
     int i, rc;
     if (!json) {
         printf("suite seed: eye scene, %dx%d, backend %s; every row simulates the whole 30 s animation (as the\n"
@@ -246,11 +248,6 @@ static int run_suite(const evr_scene *scene, const evr_config *base, int json)
         cfg.fps = rows[i].fps;
         cfg.samples_per_frame = rows[i].spf;
         cfg.gi = rows[i].gi;
-        if (rows[i].gi && !gi_here) {
-            if (json) printf("  {\"row\": \"%s\", \"available\": false, \"reason\": \"--gi photon runs on the CPU backend only\"},\n", rows[i].name);
-            else printf("%-8s not available on this backend (--gi photon runs on the CPU backend only: --backend cpu)\n", rows[i].name);
-            continue;
-        }
         if ((rc = bench_run(scene, &cfg, 0, &f)) != 0) return rc;
         if (json) {
             printf("  {\"row\": \"%s\", \"fps\": %g, \"samples_per_frame\": %d, \"width\": %d, \"height\": %d, "
@@ -461,8 +458,7 @@ static int bench_usage(void)
          "                 Extra     100 samples per frame at 30 fps (0.33 ms): the same sampling\n"
          "                           density as Slow (samples are per pixel, spread over each frame)\n"
          "                           but 10x fewer segments, i.e. fewer host round trips\n"
-         "                 Photon    Standard with --gi photon (CPU backend only: with --backend cpu;\n"
-         "                           on other backends the row says it is not available)\n"
+         "                 Photon    Standard with --gi photon (image-space photon mapping)\n"
          "--sweep KIND   a series of short runs (default 0.2 s each) growing one quantity; prints the\n"
          "               rows and writes DIR/sweep_KIND.csv (quantity, size, samples per frame, samples,\n"
          "               wall s, ns per sample, samples/s, events) and DIR/sweep_KIND.png (time per\n"

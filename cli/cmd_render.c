@@ -114,7 +114,7 @@ static void help(void)
          "  --photons N                photons per segment (default: one per pixel)\n"
          "  --gather-radius R          distance filter, world units (default 2% of the scene's diagonal)\n"
          "  --gather-max N             photons per estimate at most (default 64)\n"
-         "  --gather-window N          gather window half size at most, pixels (default 16)\n"
+         "  --gather-window N          gather window half size at most, pixels (default 8)\n"
          "  --photon-layers N          photons each pixel of the buffer holds (default 8)\n"
          "  --gi-bounces N             indirect bounces of a photon (default 4)\n"
          "sensor (laws, presets and their sources: docs/sensors.md; the default is the ideal sensor):\n"

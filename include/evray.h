@@ -121,7 +121,7 @@ typedef struct {
     double frames_fps;            /* frames per second; <= 0: the segment rate (fps) */
     float frames_exposure;        /* 8-bit frames: intensity that maps to white is 1 / this */
     float frames_max;             /* 16-bit frames: intensity that maps to 65535 */
-    /* global illumination: image-space photon mapping (src/core/photon.h), CPU backend */
+    /* global illumination: image-space photon mapping (src/core/photon.h) */
     int gi;                       /* 0: direct light only, 1: photon mapping */
     uint32_t photons;             /* photons per segment (0: one per pixel) */
     float gather_radius;          /* distance filter r, world units (<= 0: 2% of the scene's diagonal) */
@@ -157,6 +157,8 @@ typedef struct {
     double time_device;           /* GPU kernels (0 on the CPU) */
     double time_sort, time_copy;  /* event sort and device-to-host copy inside the backend */
     double time_write;            /* the writer thread's busy time (overlaps rendering) */
+    double time_photons;          /* global illumination: the photon passes (GPU: device time) */
+    uint64_t photons_stored, photon_collisions, photon_cells_changed;
     uint64_t device_memory;       /* bytes the backend holds on the GPU (0 on the CPU) */
     char backend[16];             /* the backend that ran: "cpu" or "cuda" */
     char device[128];             /* CPU threads or the GPU's name */

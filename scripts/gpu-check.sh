@@ -3,6 +3,7 @@
 # benchmark of the eye demo at 1280x720. Logs go to $OUT (or ./gpu-out).
 set -u
 cd "$(dirname "$0")/.."
+scripts/gpu-unpack.sh
 OUT="${OUT:-gpu-out}"
 mkdir -p "$OUT"
 export LD_LIBRARY_PATH="$PWD/gpu-carry/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"

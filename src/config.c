@@ -52,7 +52,7 @@ void evr_config_defaults(evr_config *c)
     c->photons = 0;
     c->gather_radius = 0.0f;
     c->gather_max = 64;
-    c->gather_window = 16;
+    c->gather_window = 8;
     c->photon_layers = 8;
     c->gi_bounces = 4;
 }

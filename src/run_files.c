@@ -234,6 +234,7 @@ static char *run_json(const evr_sim *sim)
         evr_json_key(&j, "photons_traced"); evr_json_unsigned(&j, sim->backend->photons_traced);
         evr_json_key(&j, "photons_stored"); evr_json_unsigned(&j, sim->backend->photons_stored);
         evr_json_key(&j, "photon_collisions"); evr_json_unsigned(&j, sim->backend->photon_collisions);
+        evr_json_key(&j, "photon_cells_changed"); evr_json_unsigned(&j, sim->backend->photon_cells_changed);
         evr_json_key(&j, "time_photons_seconds"); evr_json_number(&j, sim->backend->photon_seconds);
     }
     evr_json_key(&j, "segments"); evr_json_integer(&j, s->segments_done);

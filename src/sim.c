@@ -46,15 +46,6 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
     const evr_scene *s = sim->scene;
     evr_backend_kind kind = sim->cfg.backend;
     evr_status st;
-    if (sim->cfg.gi && kind == EVR_BACKEND_CUDA) {
-        snprintf(err->msg, sizeof err->msg, "--gi photon runs on the CPU backend only (the GPU photon pass is not written yet); "
-                 "use --backend cpu or auto");
-        return EVR_ERR_ARG;
-    }
-    if (sim->cfg.gi && kind == EVR_BACKEND_AUTO) {
-        snprintf(sim->st.notice, sizeof sim->st.notice, "--gi photon runs on the CPU backend only; running on the CPU");
-        kind = EVR_BACKEND_CPU;
-    }
 #ifdef EVR_HAVE_CUDA
     if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
         evr_error cerr;
@@ -334,6 +325,10 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     sim->st.samples_traced = sim->backend->samples_traced;
     sim->skipped_per_segment[i] = (uint32_t)(sim->backend->pixels_skipped - sim->st.pixels_skipped);
     sim->st.pixels_skipped = sim->backend->pixels_skipped;
+    sim->st.time_photons = sim->backend->photon_seconds;
+    sim->st.photons_stored = sim->backend->photons_stored;
+    sim->st.photon_collisions = sim->backend->photon_collisions;
+    sim->st.photon_cells_changed = sim->backend->photon_cells_changed;
     sim->st.sim_time = t1 - sim->cfg.start;
     sim->st.wall_time = now_seconds() - wall0;
     sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;

@@ -70,8 +70,10 @@ T.check(all(r["wall_seconds"] > 0 and r["samples_per_second"] > 0 for r in suite
 T.check(photon["events"] > 0 and photon["backend"] == "cpu" and photon["samples_per_second"] > 0,
         "suite Photon: GI on the CPU backend")
 p = T.run("bench", "--suite", "seed", "--res", "48x32", "--duration", "0.05", "--backend", "cuda", expect=None)
-if p.returncode == 0:   # a GPU: the Photon row says why it is missing
-    T.check("not available on this backend" in p.stdout, "suite table on CUDA: the Photon row says why it is missing")
+if p.returncode == 0:   # a GPU: every row, Photon included (the GPU photon pass)
+    rows = [line.split()[0] for line in p.stdout.splitlines()[2:] if line.strip()]
+    T.check(rows[:4] == ["Standard", "Slow", "Extra", "Photon"] and "not available" not in p.stdout,
+            f"suite table on CUDA: every row ({rows})")
 expect_error(["bench", "--suite", "seed", "--samples-per-frame", "5"], "suite with --samples-per-frame")
 expect_error(["bench", "--suite", "other"], "unknown suite")
 

@@ -63,4 +63,32 @@ T.check(len(runs["auto"]) > 100000 and runs["auto"] == runs["tiny"],
         "overflowing event buffers are re-rendered: identical events with a 1000-event initial buffer")
 T.check(len(runs["adaptive-auto"]) > 100000 and runs["adaptive-auto"] == runs["adaptive-tiny"],
         "adaptive sampling: overflowing event buffers are re-rendered, identical events")
+
+# global illumination on the GPU (cuda/gpu_gi.cuh): the same photons as the CPU's up to float
+# differences of the traversals; the buffer is filled in photon order (deterministic: two runs give
+# the same events); a segment re-rendered after an overflow finds its own photons; a still Cornell
+# box makes no events
+gi = ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--format", "npy,h5", "--seed", "5"]
+gi_runs = {}
+for label, extra in (("cpu", ["--backend", "cpu"]), ("cuda", ["--backend", "cuda"]), ("cuda2", ["--backend", "cuda"]),
+                     ("cuda-tiny", ["--backend", "cuda", "--gpu-event-capacity", "1000"])):
+    d = os.path.join(tmp, f"gi-{label}")
+    T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", *gi, *extra)
+    gi_runs[label] = (d, open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d)["stats"])
+st_cpu, st_gpu = gi_runs["cpu"][2], gi_runs["cuda"][2]
+r = json.loads(T.run("compare", os.path.join(gi_runs["cpu"][0], "events.h5"), os.path.join(gi_runs["cuda"][0], "events.h5"),
+                     "--tol-us", "100", "--json").stdout)
+print(f"cornell GI: cpu {st_cpu['events']} events, cuda {st_gpu['events']}, F1 {r['f1']:.5f}; photons stored cpu "
+      f"{st_cpu.get('photons_stored')} cuda {st_gpu.get('photons_stored')}; photon passes cpu {st_cpu.get('photon_passes')} "
+      f"cuda {st_gpu.get('photon_passes')}")
+T.check(st_gpu["events"] > 0 and abs(st_gpu["events"] - st_cpu["events"]) <= 0.02 * st_cpu["events"],
+        "cornell GI: CUDA event count within 2% of the CPU's")
+T.check(r["f1"] >= 0.95, f"cornell GI: CPU vs CUDA F1 {r['f1']} >= 0.95")
+T.check(st_gpu.get("photon_passes") == st_cpu.get("photon_passes"), "cornell GI: the same photon passes (still segments reuse)")
+T.check(gi_runs["cuda"][1] == gi_runs["cuda2"][1], "cornell GI on CUDA: two runs give identical events")
+T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: overflowing segments re-rendered, identical events")
+d = os.path.join(tmp, "gi-still")
+T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
+      "--res", "96x72", "--duration", "1.0")
+T.check(T.load_run_json(d)["stats"]["events"] == 0, "cornell-still with GI on CUDA: no events over 1 s")
 T.finish("test_cuda")

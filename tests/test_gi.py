@@ -49,7 +49,4 @@ for args in bad:
               expect=None)
     T.check(p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1, f"{args}: one-line error, exit 2 ({p.stderr})")
     T.check(not os.path.exists(os.path.join(tmp, "bad")), f"{args}: nothing left behind")
-p = T.run("demo", "--scene", "cornell", "-o", os.path.join(tmp, "gpu"), "--duration", "0.1", "--quiet", "--gi", "photon",
-          "--backend", "cuda", expect=None)
-T.check(p.returncode != 0 and len(p.stderr.strip().splitlines()) == 1, f"--gi photon --backend cuda: one-line error ({p.stderr})")
 T.finish("test_gi")

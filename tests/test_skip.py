@@ -17,6 +17,8 @@ cases = [(n, ["--res", "64x48", "--duration", "0.4"]) for n in names]
 cases.append(("square", ["--res", "96x96", "--duration", "1.0", "--pos-thres", "0.3", "--neg-thres", "0.25"]))
 cases.append(("square", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
 cases.append(("cornell", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
+# global illumination: a pixel whose gather window saw no photon change keeps its intensity
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}

@@ -305,6 +305,104 @@ EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs, con
     return k > 0.0f;
 }
 
+/* ---- a photon's path (the loop that traces it is the backend's) ---- */
+
+/* What a pass traces with (the CPU's and the GPU's). */
+typedef struct {
+    int max_bounces;               /* indirect bounces: a light photon has at most max_bounces + 1 hits */
+    float f0, f1;                  /* photon j is traced at time evr_photon_time(j, f0, f1) */
+    uint64_t seed;
+    int threads;                   /* CPU: <= 0 all cores */
+    evr_photon_bounds bounds;      /* the scene's bounding sphere (directional lights) */
+    float ray_eps;                 /* secondary-ray offset (rs->ray_eps) */
+} evr_photon_params;
+
+/* Index of the emitter of photon i of a pass: the last emitter whose first <= i. */
+EVR_HD static inline int evr_photon_emitter_of(const evr_photon_emitter *e, int n, uint32_t i)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (e[mid].first <= i) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+typedef struct {
+    evr_photon_ray pr;             /* the ray to trace next and the flux it carries */
+    float tnear;                   /* where the next ray starts */
+    float f;                       /* normalized segment time of the photon */
+    uint32_t i, j;                 /* photon number in the pass, in its emitter */
+    int ei;                        /* emitter */
+    int bounce, max_hits;          /* hits so far; the path ends at max_hits ("capped") */
+} evr_photon_path;
+
+/* Starts photon i of a pass over emitters e[0..n) (cdf: the emissive instances' cumulative
+ * areas): its time, its first ray and flux. 0 when there is no such photon or it carries nothing. */
+EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs, const evr_photon_emitter *e, int n,
+                                               const float *cdf, const evr_photon_params *pp, uint32_t i,
+                                               evr_photon_path *p)
+{
+    float u[5];
+    int k;
+    if (n <= 0) return 0;
+    p->ei = evr_photon_emitter_of(e, n, i);
+    const evr_photon_emitter *em = &e[p->ei];
+    p->i = i;
+    p->j = i - em->first;
+    if (p->j >= em->count) return 0;
+    p->f = evr_photon_time(p->j, pp->f0, pp->f1);
+    for (k = 0; k < 5; k++) u[k] = evr_photon_rand(pp->seed, p->ei, p->j, k);
+    if (em->kind == 0) {
+        if (!evr_photon_emit_light(rs, &rs->lights[em->index], p->f, pp->bounds, u, em->count, &p->pr)) return 0;
+    } else {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[em->index].track), p->f);
+        if (!evr_photon_emit_surface(rs, em, cdf, &xf, u, &p->pr)) return 0;
+    }
+    p->bounce = 0;
+    p->max_hits = p->pr.from_light ? pp->max_bounces + 1 : pp->max_bounces;
+    p->tnear = p->pr.from_light ? 0.0f : pp->ray_eps;
+    return 1;
+}
+
+/* The path meets surface s (material mat). Returns EVR_PHOTON_STAY (stored[] gets the flux the
+ * photon stands for, *key its canonical order), EVR_PHOTON_DIFFUSE or EVR_PHOTON_MIRROR (the
+ * path's ray is the next one to trace while bounce < max_hits; past that the path is capped) or
+ * EVR_PHOTON_ABSORB (the path ends). absorbed[] gets the flux this hit absorbs (bookkeeping). */
+EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photon_params *pp, const evr_surface *s,
+                                             const evr_material_view *mat, float stored[3], float absorbed[3],
+                                             uint32_t *key)
+{
+    float w;
+    const int first_light = p->pr.from_light && p->bounce == 0;
+    const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
+    const int ev = evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, !first_light, &w);
+    int c;
+    for (c = 0; c < 3; c++) absorbed[c] = stored[c] = 0.0f;
+    if (ev == EVR_PHOTON_STAY) {
+        for (c = 0; c < 3; c++) {
+            stored[c] = p->pr.flux[c] * w;
+            absorbed[c] = stored[c] * (1.0f - s->albedo[c]);
+        }
+        *key = p->i * 16u + (uint32_t)(p->bounce < 15 ? p->bounce : 15);
+        return ev;
+    }
+    if (first_light)   /* the direct term's light: the part the surface absorbs */
+        for (c = 0; c < 3; c++) absorbed[c] = p->pr.flux[c] * (1.0f - s->albedo[c]);
+    if (ev == EVR_PHOTON_ABSORB) return ev;
+    for (c = 0; c < 3; c++) p->pr.flux[c] *= s->albedo[c] * w;
+    if (ev == EVR_PHOTON_DIFFUSE)
+        p->pr.ray.dir = evr_cosine_dir(s->n, evr_photon_rand(pp->seed, p->ei, p->j, 6 + 3 * p->bounce),
+                                       evr_photon_rand(pp->seed, p->ei, p->j, 7 + 3 * p->bounce));
+    else
+        p->pr.ray.dir = evr_v3_norm(evr_mirror_dir(p->pr.ray.dir, s->n));
+    p->pr.ray.org = s->p;
+    p->tnear = evr_shadow_tnear(s, p->pr.ray.dir, pp->ray_eps);
+    p->bounce++;
+    return ev;
+}
+
 /* ---- the image-space buffer ---- */
 
 typedef struct {
@@ -345,6 +443,95 @@ EVR_HD static inline int evr_photon_pixel(const evr_camera_intr *c, const evr_m3
     if (*x >= c->width + margin) *x = c->width + margin - 1;
     if (*y >= c->height + margin) *y = c->height + margin - 1;
     return 1;
+}
+
+/* A photon that stays at s at time f is kept where the camera sees it: the cell (x, y) it
+ * lands in, and the ray r from s towards the camera that must be free over [*tnear, *tfar).
+ * 0 when the camera is behind the surface or the point projects outside the image and its band. */
+EVR_HD static inline int evr_photon_view_ray(const evr_render_scene *rs, const evr_surface *s, float f, int margin,
+                                             float eps, int *x, int *y, evr_ray *r, float *tnear, float *tfar)
+{
+    evr_m34 pose = evr_rs_camera_pose(rs, f), inv = evr_m34_inverse(&pose);
+    evr_v3 cam = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
+    evr_v3 d = evr_v3_sub(cam, s->p);
+    float dist = evr_v3_len(d);
+    if (!(dist > 0.0f) || evr_v3_dot(d, s->n) <= 0.0f) return 0;
+    if (!evr_photon_pixel(&rs->camera, &inv, s->p, margin, x, y)) return 0;
+    r->org = s->p;
+    r->dir = evr_v3_scale(d, 1.0f / dist);
+    *tnear = evr_shadow_tnear(s, r->dir, eps);
+    *tfar = dist * (1.0f - 1e-4f);
+    return 1;
+}
+
+/* The buffer's record of a photon stored at s. */
+EVR_HD static inline evr_photon evr_photon_make(const evr_surface *s, const float flux[3], uint32_t key)
+{
+    evr_photon ph;
+    ph.p[0] = s->p.x; ph.p[1] = s->p.y; ph.p[2] = s->p.z;
+    ph.n[0] = s->n.x; ph.n[1] = s->n.y; ph.n[2] = s->n.z;
+    ph.flux[0] = flux[0]; ph.flux[1] = flux[1]; ph.flux[2] = flux[2];
+    ph.key = key;
+    return ph;
+}
+
+/* The camera's ray (pose) through the centre of buffer cell (cx, cy), guard band included. */
+EVR_HD static inline evr_ray evr_photon_cell_ray(const evr_render_scene *rs, const evr_m34 *pose, const evr_photon_buffer *b,
+                                                 int cx, int cy)
+{
+    return evr_camera_ray(&rs->camera, pose, (float)(cx - b->margin) + 0.5f, (float)(cy - b->margin) + 0.5f);
+}
+
+/* A cell's view (gbuf, 8 floats) from the surface s met at distance t along its ray; fwd: the
+ * camera's forward axis. The area is the pixel's at unit distance * depth^2 * cos(off-axis
+ * angle) / |cos of the incidence| (the cosine at least 0.1). */
+EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v3 fwd, const evr_surface *s, evr_ray ray,
+                                               float t, float g[8])
+{
+    const float a = 4.0f * rs->camera.tan_half_y * rs->camera.tan_half_y / ((float)rs->camera.height * (float)rs->camera.height);
+    float ca = evr_v3_dot(ray.dir, fwd), z = t * ca;
+    float ct = fmaxf(fabsf(evr_v3_dot(s->n, ray.dir)), 0.1f);
+    g[0] = s->p.x; g[1] = s->p.y; g[2] = s->p.z;
+    g[3] = s->n.x; g[4] = s->n.y; g[5] = s->n.z;
+    g[6] = a * z * z * ca / ct;
+    g[7] = 0.0f;
+}
+
+/* Whether cell i holds the same photons and the same view in buffers a and b (bit for bit). */
+EVR_HD static inline int evr_photon_cell_same(const evr_photon_buffer *a, const evr_photon_buffer *b, size_t i)
+{
+    size_t npix = (size_t)a->width * (size_t)a->height;
+    uint32_t n = a->count[i] < (uint32_t)a->layers ? a->count[i] : (uint32_t)a->layers, l;
+    int k;
+    if (a->count[i] != b->count[i]) return 0;
+    for (l = 0; l < n; l++) {
+        const uint32_t *pa = (const uint32_t *)&a->slots[(size_t)l * npix + i], *pb = (const uint32_t *)&b->slots[(size_t)l * npix + i];
+        for (k = 0; k < (int)(sizeof(evr_photon) / 4); k++)
+            if (pa[k] != pb[k]) return 0;
+    }
+    if (a->gbuf && b->gbuf) {
+        const uint32_t *ga = (const uint32_t *)(a->gbuf + 8 * i), *gb = (const uint32_t *)(b->gbuf + 8 * i);
+        for (k = 0; k < 8; k++)
+            if (ga[k] != gb[k]) return 0;
+    }
+    return 1;
+}
+
+/* Whether any cell the gather of image pixel (x, y) may read (window cells around it) changed:
+ * sat is the summed-area table, (w + 1) x (h + 1), of the changed cells of a w x h buffer with
+ * the given guard band. */
+EVR_HD static inline int evr_photon_window_changed(const uint32_t *sat, int w, int h, int margin, int window, int x, int y)
+{
+    int x0 = x + margin - window, x1 = x + margin + window + 1, y0 = y + margin - window, y1 = y + margin + window + 1;
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > w) x1 = w;
+    if (y1 > h) y1 = h;
+    if (x0 >= x1 || y0 >= y1) return 0;
+    const size_t W = (size_t)w + 1;
+    uint32_t c = sat[(size_t)y1 * W + (size_t)x1] - sat[(size_t)y0 * W + (size_t)x1] - sat[(size_t)y1 * W + (size_t)x0] +
+                 sat[(size_t)y0 * W + (size_t)x0];
+    return c != 0;
 }
 
 /* Lock-free insertion: an atomic increment claims a layer; a photon arriving at a full cell is
@@ -414,85 +601,144 @@ typedef struct {
     float normal_cos;   /* photons whose normal differs more (cosine below) are skipped */
 } evr_gather_params;
 
+/* One cell's share of a gather: the photons of buffer cell (x, y) (anywhere: a cell outside the
+ * buffer has none) within sqrt(lim2) of p whose normal is within normal_cos of n add their
+ * Gaussian-weighted flux to acc (in layer order); with the camera's view of the cells, the
+ * kernel's weight over the surface the cell shows (if it is like the query's) adds to *area_w.
+ * Returns the photons taken. */
+EVR_HD static inline int evr_photon_gather_cell(const evr_photon_buffer *b, int x, int y, evr_v3 p, evr_v3 n, float lim2,
+                                                float normal_cos, float s2, float acc[3], float *area_w)
+{
+    const size_t npix = (size_t)b->width * (size_t)b->height;
+    int l, nl, used = 0;
+    if (x < 0 || y < 0 || x >= b->width || y >= b->height) return 0;
+    size_t i = (size_t)y * (size_t)b->width + (size_t)x;
+    if (b->gbuf) {   /* the kernel's integral over the surfaces the camera sees here */
+        const float *g = b->gbuf + 8 * i;
+        evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
+        float d2 = evr_v3_dot(d, d);
+        if (g[6] > 0.0f && d2 <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos)
+            *area_w += expf(-d2 / (2.0f * s2)) * g[6];
+    }
+    nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
+    for (l = 0; l < nl; l++) {
+        const evr_photon *ph = &b->slots[(size_t)l * npix + i];
+        evr_v3 d = evr_v3_make(ph->p[0] - p.x, ph->p[1] - p.y, ph->p[2] - p.z);
+        float d2 = evr_v3_dot(d, d);
+        if (d2 > lim2) continue;
+        if (ph->n[0] * n.x + ph->n[1] * n.y + ph->n[2] * n.z < normal_cos) continue;
+        float w = expf(-d2 / (2.0f * s2));
+        acc[0] += w * ph->flux[0];
+        acc[1] += w * ph->flux[1];
+        acc[2] += w * ph->flux[2];
+        used++;
+    }
+    return used;
+}
+
+/* The window of a gather at a hit seen at distance cam_dist through image pixel (px, py): its
+ * centre cell, its half size h in cells (ceil(r / pixel size at the hit) + 1, at most
+ * max_window: nearer points project farther out), the pixel size at the hit, r, r^2, sigma^2. */
+typedef struct {
+    int cx, cy, h;
+    float pix, r, r2, s2;
+} evr_gather_window;
+
+EVR_HD static inline evr_gather_window evr_photon_gather_window(const evr_photon_buffer *b, const evr_camera_intr *cam, int px,
+                                                                int py, float cam_dist, const evr_gather_params *gp)
+{
+    evr_gather_window w;
+    const float r = gp->radius;
+    w.r = r;
+    w.r2 = r * r;
+    w.s2 = 0.25f * w.r2;
+    w.pix = 2.0f * cam->tan_half_y * fmaxf(cam_dist, 1e-6f) / (float)cam->height;
+    float hf = ceilf(r / w.pix) + 1.0f;
+    w.h = hf > (float)gp->max_window ? gp->max_window : (int)hf;
+    w.cx = px + b->margin;
+    w.cy = py + b->margin;
+    return w;
+}
+
+/* After the search stopped at ring stop (max photons reached): the disk the rings searched surely
+ * cover (radius stop pixel sizes, at least half a pixel, at most r), returned as its radius^2,
+ * and the rings that hold all of it (*rings: p lies anywhere in its pixel, one ring further). */
+EVR_HD static inline float evr_photon_gather_shrink(const evr_gather_window *w, int stop, int *rings)
+{
+    float rho = fminf(w->r, fmaxf((float)stop, 0.5f) * w->pix);
+    *rings = stop + 1 < w->h ? stop + 1 : w->h;
+    return rho * rho;
+}
+
+/* The irradiance from the sums over the disk of radius^2 lim2: the Gaussian's integral over the
+ * disk, scaled by the share of the disk on surfaces like the query's where the disk spans enough
+ * cells to measure it (the camera's view of the cells). */
+EVR_HD static inline void evr_photon_gather_finish(const evr_photon_buffer *b, const evr_gather_window *w, float lim2,
+                                                   const float acc[3], float area_w, float e_rgb[3])
+{
+    float z = 2.0f * EVR_PI * w->s2 * (1.0f - expf(-lim2 / (2.0f * w->s2)));
+    if (b->gbuf && lim2 >= 9.0f * w->pix * w->pix) z *= fminf(fmaxf(area_w / z, 0.25f), 1.25f);
+    float inv = z > 0.0f ? 1.0f / z : 0.0f;
+    e_rgb[0] = acc[0] * inv;
+    e_rgb[1] = acc[1] * inv;
+    e_rgb[2] = acc[2] * inv;
+}
+
 /* Sums the photons of rings 0 .. rings of the window around cell (cx, cy) that lie within
- * sqrt(lim2) of p with a normal within the cosine; stops once max photons are counted (returns
- * the ring where it stopped in *stop_ring, or -1 when it did not stop). */
+ * sqrt(lim2) of p with a normal within the cosine; stops in the cell where max photons are
+ * reached (returns the ring where it stopped in *stop_ring, or -1 when it did not stop). */
 EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int cx, int cy, int rings, evr_v3 p,
                                                  evr_v3 n, float lim2, float normal_cos, float s2, int max,
                                                  float acc[3], int *stop_ring, float *area_w)
 {
-    const size_t npix = (size_t)b->width * (size_t)b->height;
     int ncell = (2 * rings + 1) * (2 * rings + 1), k, used = 0;
     acc[0] = acc[1] = acc[2] = 0.0f;
     *stop_ring = -1;
     *area_w = 0.0f;
     for (k = 0; k < ncell; k++) {
-        int dx, dy, l, nl, ring = evr_ring_cell(k, &dx, &dy);
-        int x = cx + dx, y = cy + dy;
-        if (x < 0 || y < 0 || x >= b->width || y >= b->height) continue;
-        size_t i = (size_t)y * (size_t)b->width + (size_t)x;
-        if (b->gbuf) {   /* the kernel's integral over the surfaces the camera sees here */
-            const float *g = b->gbuf + 8 * i;
-            evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
-            float d2 = evr_v3_dot(d, d);
-            if (g[6] > 0.0f && d2 <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos)
-                *area_w += expf(-d2 / (2.0f * s2)) * g[6];
-        }
-        nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
-        for (l = 0; l < nl; l++) {
-            const evr_photon *ph = &b->slots[(size_t)l * npix + i];
-            evr_v3 d = evr_v3_make(ph->p[0] - p.x, ph->p[1] - p.y, ph->p[2] - p.z);
-            float d2 = evr_v3_dot(d, d);
-            if (d2 > lim2) continue;
-            if (ph->n[0] * n.x + ph->n[1] * n.y + ph->n[2] * n.z < normal_cos) continue;
-            float w = expf(-d2 / (2.0f * s2));
-            acc[0] += w * ph->flux[0];
-            acc[1] += w * ph->flux[1];
-            acc[2] += w * ph->flux[2];
-            if (++used >= max) {
-                *stop_ring = ring;
-                return used;
-            }
+        int dx, dy, ring = evr_ring_cell(k, &dx, &dy);
+        used += evr_photon_gather_cell(b, cx + dx, cy + dy, p, n, lim2, normal_cos, s2, acc, area_w);
+        if (used >= max) {
+            *stop_ring = ring;
+            return used;
         }
     }
     return used;
 }
 
 /* Irradiance at surface point p (normal n, seen at distance cam_dist from the camera through
- * image pixel (px, py)) from the buffer. The window is the square of half size ceil(r / pixel
- * size at the hit's distance) + 1 (at most max_window), searched ring by ring from the centre;
- * photons farther than r or whose normal differs more than normal_cos are skipped; weights are
- * the Gaussian kernel (sigma = r / 2) normalized over the disk searched. When max_photons is
- * reached in ring k, the disk shrinks to the one that rings 0 .. k surely cover (radius k pixel
- * sizes, at least half a pixel) and the estimate is every photon in that disk (rings 0 .. k + 1):
- * on a surface seen at a grazing angle the window reaches far along the surface but not across,
- * and the farthest photon taken would overstate the disk. Returns the photons used. */
+ * image pixel (px, py)) from the buffer. The window (evr_photon_gather_window) is searched ring
+ * by ring from the centre; photons farther than r or whose normal differs more than normal_cos
+ * are skipped; weights are the Gaussian kernel (sigma = r / 2) normalized over the disk searched.
+ * When max_photons is reached in ring k, the disk shrinks to the one that rings 0 .. k surely
+ * cover (evr_photon_gather_shrink) and the estimate is every photon in that disk: on a surface
+ * seen at a grazing angle the window reaches far along the surface but not across, and the
+ * farthest photon taken would overstate the disk. Returns the photons used. */
 EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr_camera_intr *cam, int px, int py,
                                            evr_v3 p, evr_v3 n, float cam_dist, const evr_gather_params *gp,
                                            float e_rgb[3])
 {
-    const float r = gp->radius, r2 = r * r, s2 = 0.25f * r2;
-    float pix = 2.0f * cam->tan_half_y * fmaxf(cam_dist, 1e-6f) / (float)cam->height;   /* pixel size at the hit */
-    float hf = ceilf(r / pix) + 1.0f, acc[3], lim2 = r2;   /* + 1: nearer points project farther out */
-    int h = hf > (float)gp->max_window ? gp->max_window : (int)hf, stop, used;
-    int cx = px + b->margin, cy = py + b->margin;
-    float area_w;
-    used = evr_photon_gather_rings(b, cx, cy, h, p, n, r2, gp->normal_cos, s2, gp->max_photons, acc, &stop, &area_w);
+    const evr_gather_window w = evr_photon_gather_window(b, cam, px, py, cam_dist, gp);
+    float acc[3], lim2 = w.r2, area_w;
+    int stop, used;
+    used = evr_photon_gather_rings(b, w.cx, w.cy, w.h, p, n, lim2, gp->normal_cos, w.s2, gp->max_photons, acc, &stop, &area_w);
     if (stop >= 0) {   /* the limit: the disk the rings searched cover, all of its photons */
-        float rho = fminf(r, fmaxf((float)stop, 0.5f) * pix);
-        int rings = stop + 1;   /* p lies anywhere in its pixel: the disk may reach one ring further */
-        lim2 = rho * rho;
-        used = evr_photon_gather_rings(b, cx, cy, rings < h ? rings : h, p, n, lim2, gp->normal_cos, s2, 0x7fffffff, acc,
-                                       &stop, &area_w);
+        int rings;
+        lim2 = evr_photon_gather_shrink(&w, stop, &rings);
+        used = evr_photon_gather_rings(b, w.cx, w.cy, rings, p, n, lim2, gp->normal_cos, w.s2, 0x7fffffff, acc, &stop, &area_w);
     }
-    float z = 2.0f * EVR_PI * s2 * (1.0f - expf(-lim2 / (2.0f * s2)));
-    /* the share of the disk on such surfaces, where the disk spans enough cells to measure it */
-    if (b->gbuf && lim2 >= 9.0f * pix * pix) z *= fminf(fmaxf(area_w / z, 0.25f), 1.25f);
-    float inv = z > 0.0f ? 1.0f / z : 0.0f;
-    e_rgb[0] = acc[0] * inv;
-    e_rgb[1] = acc[1] * inv;
-    e_rgb[2] = acc[2] * inv;
+    evr_photon_gather_finish(b, &w, lim2, acc, area_w, e_rgb);
     return used;
+}
+
+/* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s of material
+ * mat: the diffuse share of the albedo over pi. */
+EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_view *mat, float k_rgb[3])
+{
+    float k = (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
+    k_rgb[0] = s->albedo[0] * k;
+    k_rgb[1] = s->albedo[1] * k;
+    k_rgb[2] = s->albedo[2] * k;
 }
 
 /* Indirect radiance leaving surface s (material mat) from an irradiance estimate: the diffuse
@@ -500,10 +746,23 @@ EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr
 EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_view *mat, const float e_rgb[3],
                                               float out_rgb[3])
 {
-    float k = (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
-    out_rgb[0] = s->albedo[0] * k * e_rgb[0];
-    out_rgb[1] = s->albedo[1] * k * e_rgb[1];
-    out_rgb[2] = s->albedo[2] * k * e_rgb[2];
+    float k[3];
+    evr_photon_indirect_k(s, mat, k);
+    out_rgb[0] = k[0] * e_rgb[0];
+    out_rgb[1] = k[1] * e_rgb[1];
+    out_rgb[2] = k[2] * e_rgb[2];
+}
+
+/* Luminance of the indirect light leaving surface s (material mat) seen from cam_org through
+ * image pixel (x, y): the gather and the diffuse share. */
+EVR_HD static inline float evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
+                                                   const evr_gather_params *gp, const evr_material_view *mat,
+                                                   const evr_surface *s, evr_v3 cam_org, int x, int y)
+{
+    float e[3], ind[3];
+    evr_photon_gather(b, cam, x, y, s->p, s->n, evr_v3_len(evr_v3_sub(s->p, cam_org)), gp, e);
+    evr_photon_indirect(s, mat, e, ind);
+    return evr_luminance(ind[0], ind[1], ind[2]);
 }
 
 #endif

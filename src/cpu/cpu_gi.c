@@ -66,8 +66,9 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
                            evr_error *err)
 {
     evr_status st;
-    int margin = setup->gather_window < 16 ? setup->gather_window : 16;
+    int margin = 0;
     memset(g, 0, sizeof *g);
+    evr_gi_run_params(setup, s, &g->photons, &g->gp, &g->pp, &margin, &g->window);
     g->tc = *tc;
     g->tr.user = &g->tc;
     g->tr.closest = gi_closest;
@@ -88,35 +89,7 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
         return EVR_ERR_NOMEM;
     }
-    g->photons = setup->photons ? setup->photons : (uint32_t)((size_t)setup->width * (size_t)setup->height);
-    g->gp.radius = setup->gather_radius;
-    g->gp.max_photons = setup->gather_max;
-    g->gp.max_window = setup->gather_window;
-    g->gp.normal_cos = 0.7f;
-    g->window = setup->gather_window + 1;
-    g->pp.max_bounces = setup->gi_bounces;
-    g->pp.f0 = 0.0f;   /* photons spread over the segment (motion blur), the same times every segment */
-    g->pp.f1 = 1.0f;
-    g->pp.seed = setup->seed;
-    {   /* directional lights emit over a disk round the scene (its rest bounds, a little larger) */
-        evr_v3 lo = s->bounds_min, hi = s->bounds_max;
-        if (!(lo.x <= hi.x)) lo = hi = evr_v3_make(0.0f, 0.0f, 0.0f);
-        g->pp.bounds.center = evr_v3_scale(evr_v3_add(lo, hi), 0.5f);
-        g->pp.bounds.radius = 0.55f * evr_v3_len(evr_v3_sub(hi, lo)) + 1e-6f;
-    }
     return EVR_OK;
-}
-
-/* Whether cell i holds the same photons and the same surface in both buffers. */
-static int cell_same(const evr_photon_buffer *a, const evr_photon_buffer *b, size_t i)
-{
-    size_t npix = (size_t)a->width * (size_t)a->height;
-    uint32_t n = a->count[i] < (uint32_t)a->layers ? a->count[i] : (uint32_t)a->layers, l;
-    if (a->count[i] != b->count[i]) return 0;
-    for (l = 0; l < n; l++)
-        if (memcmp(&a->slots[(size_t)l * npix + i], &b->slots[(size_t)l * npix + i], sizeof(evr_photon))) return 0;
-    if (a->gbuf && b->gbuf && memcmp(a->gbuf + 8 * i, b->gbuf + 8 * i, 8 * sizeof(float))) return 0;
-    return 1;
 }
 
 evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int still, int threads, evr_backend *stats,
@@ -147,7 +120,7 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
         uint32_t row = 0;
         for (x = 0; x < w; x++) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
-            row += !g->have_prev || !cell_same(&g->buf, &g->prev, i);
+            row += !g->have_prev || !evr_photon_cell_same(&g->buf, &g->prev, i);
             g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
         }
     }
@@ -156,30 +129,15 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
     stats->photons_traced += ps.paths;
     stats->photons_stored += ps.inserted;
     stats->photon_collisions += ps.collisions;
+    stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
     stats->photon_passes++;
     stats->photon_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     return EVR_OK;
 }
 
-/* 1 when a cell the gather of pixel (x, y) may read changed in this segment. */
-static int window_changed(const evr_cpu_gi *g, int x, int y)
-{
-    const int w = g->buf.width, h = g->buf.height, m = g->buf.margin;
-    int x0 = x + m - g->window, x1 = x + m + g->window + 1, y0 = y + m - g->window, y1 = y + m + g->window + 1;
-    if (x0 < 0) x0 = 0;
-    if (y0 < 0) y0 = 0;
-    if (x1 > w) x1 = w;
-    if (y1 > h) y1 = h;
-    if (x0 >= x1 || y0 >= y1) return 0;
-    const size_t W = (size_t)w + 1;
-    uint32_t n = g->sat[(size_t)y1 * W + (size_t)x1] - g->sat[(size_t)y0 * W + (size_t)x1] - g->sat[(size_t)y1 * W + (size_t)x0] +
-                 g->sat[(size_t)y0 * W + (size_t)x0];
-    return n != 0;
-}
-
 int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y)
 {
-    if (!window_changed(g, x, y)) return 0;
+    if (!evr_photon_window_changed(g->sat, g->buf.width, g->buf.height, g->buf.margin, g->window, x, y)) return 0;
     g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].valid = 0;
     return 1;
 }
@@ -189,16 +147,13 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
 {
     const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
-    float e[3], ind[3];
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
     const float key[7] = {s->p.x, s->p.y, s->p.z, s->n.x, s->n.y, s->n.z, dist};
     /* the albedo is the surface's at p (same point, same triangle side: same albedo) */
     if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) return m->lum;
-    evr_photon_gather(&g->buf, &rs->camera, x, y, s->p, s->n, dist, &g->gp, e);
-    evr_photon_indirect(s, mat, e, ind);
     memcpy(m->key, key, sizeof key);
     m->inst = inst;
-    m->lum = evr_luminance(ind[0], ind[1], ind[2]);
+    m->lum = evr_photon_indirect_lum(&g->buf, &rs->camera, &g->gp, mat, s, cam_org, x, y);
     m->valid = 1;
     return m->lum;
 }

@@ -160,7 +160,6 @@ static void *gbuf_worker(void *arg)
 {
     gbuf_ctx *c = (gbuf_ctx *)arg;
     const evr_render_scene *rs = c->rs;
-    const float a = 4.0f * rs->camera.tan_half_y * rs->camera.tan_half_y / ((float)rs->camera.height * (float)rs->camera.height);
     int y, x;
 #if defined(__SSE__)
     _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
@@ -169,18 +168,14 @@ static void *gbuf_worker(void *arg)
     while ((y = atomic_fetch_add(&c->next, 1)) < c->buf->height) {
         for (x = 0; x < c->buf->width; x++) {
             float *g = c->buf->gbuf + 8 * ((size_t)y * (size_t)c->buf->width + (size_t)x);
-            evr_ray ray = evr_camera_ray(&rs->camera, &c->pose, (float)(x - c->buf->margin) + 0.5f, (float)(y - c->buf->margin) + 0.5f);
+            evr_ray ray = evr_photon_cell_ray(rs, &c->pose, c->buf, x, y);
             evr_trace_hit h;
             evr_surface s;
             memset(g, 0, 8 * sizeof *g);
             if (!c->tr->closest(c->tr->user, ray, 0.0f, INFINITY, c->f, &h)) continue;
             evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), c->f);
             evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, ray, h.t, &s);
-            float ca = evr_v3_dot(ray.dir, c->fwd), z = h.t * ca;
-            float ct = fmaxf(fabsf(evr_v3_dot(s.n, ray.dir)), 0.1f);
-            g[0] = s.p.x; g[1] = s.p.y; g[2] = s.p.z;
-            g[3] = s.n.x; g[4] = s.n.y; g[5] = s.n.z;
-            g[6] = a * z * z * ca / ct;
+            evr_photon_cell_view(rs, c->fwd, &s, ray, h.t, g);
         }
     }
     return NULL;
@@ -263,18 +258,11 @@ static void add3(double a[3], const float b[3], float k)
 /* Keeps a photon that stays where the camera sees it. */
 static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float flux[3], uint32_t key, float f)
 {
-    const evr_render_scene *rs = c->rs;
-    evr_m34 pose = evr_rs_camera_pose(rs, f), inv = evr_m34_inverse(&pose);
-    evr_v3 cam = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
-    evr_v3 d = evr_v3_sub(cam, s->p);
-    float dist = evr_v3_len(d);
-    int x, y;
-    if (!(dist > 0.0f) || evr_v3_dot(d, s->n) <= 0.0f) return;   /* the camera is behind the surface */
-    if (!evr_photon_pixel(&rs->camera, &inv, s->p, c->margin, &x, &y)) return;
     evr_ray r;
-    r.org = s->p;
-    r.dir = evr_v3_scale(d, 1.0f / dist);
-    if (c->tr->occluded(c->tr->user, r, evr_shadow_tnear(s, r.dir, c->pp->ray_eps), dist * (1.0f - 1e-4f), f)) return;
+    float tnear, tfar;
+    int x, y;
+    if (!evr_photon_view_ray(c->rs, s, f, c->margin, c->pp->ray_eps, &x, &y, &r, &tnear, &tfar)) return;
+    if (c->tr->occluded(c->tr->user, r, tnear, tfar, f)) return;
     if (co->n == co->cap) {
         size_t nc = co->cap ? 2 * co->cap : 256;
         pending *p = realloc(co->v, nc * sizeof *p);
@@ -283,88 +271,41 @@ static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float f
         co->cap = nc;
     }
     pending *p = &co->v[co->n++];
-    p->ph.p[0] = s->p.x; p->ph.p[1] = s->p.y; p->ph.p[2] = s->p.z;
-    p->ph.n[0] = s->n.x; p->ph.n[1] = s->n.y; p->ph.n[2] = s->n.z;
-    p->ph.flux[0] = flux[0]; p->ph.flux[1] = flux[1]; p->ph.flux[2] = flux[2];
-    p->ph.key = key;
+    p->ph = evr_photon_make(s, flux, key);
     p->x = x;
     p->y = y;
-}
-
-static int emitter_of(const evr_photon_emitters *em, uint32_t i)
-{
-    int lo = 0, hi = em->n - 1;
-    while (lo < hi) {   /* last emitter whose first <= i */
-        int mid = (lo + hi + 1) / 2;
-        if (em->e[mid].first <= i) lo = mid;
-        else hi = mid - 1;
-    }
-    return lo;
 }
 
 static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
 {
     const evr_render_scene *rs = c->rs;
-    const evr_photon_params *pp = c->pp;
-    int ei = emitter_of(c->em, i);
-    const evr_photon_emitter *e = &c->em->e[ei];
-    uint32_t j = i - e->first;
-    float f = evr_photon_time(j, pp->f0, pp->f1), u[5];
-    evr_photon_ray pr;
-    int k, bounce, max_hits;
-    if (j >= e->count) return;
-    for (k = 0; k < 5; k++) u[k] = evr_photon_rand(pp->seed, ei, j, k);
-    if (e->kind == 0) {
-        if (!evr_photon_emit_light(rs, &rs->lights[e->index], f, pp->bounds, u, e->count, &pr)) return;
-    } else {
-        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[e->index].track), f);
-        if (!evr_photon_emit_surface(rs, e, c->em->cdf, &xf, u, &pr)) return;
-    }
+    evr_photon_path path;
+    if (!evr_photon_path_start(rs, c->em->e, c->em->n, c->em->cdf, c->pp, i, &path)) return;
     co->paths++;
-    add3(co->emitted, pr.flux, 1.0f);
-    max_hits = pr.from_light ? pp->max_bounces + 1 : pp->max_bounces;
-    float tnear = pr.from_light ? 0.0f : pp->ray_eps;
-    for (bounce = 0; bounce < max_hits; bounce++) {
+    add3(co->emitted, path.pr.flux, 1.0f);
+    while (path.bounce < path.max_hits) {
         evr_trace_hit h;
         evr_surface s;
-        float w, xi;
-        int ev;
-        if (!c->tr->closest(c->tr->user, pr.ray, tnear, INFINITY, f, &h)) {
-            add3(co->escaped, pr.flux, 1.0f);
+        float stored[3], absorbed[3];
+        uint32_t key = 0;
+        if (!c->tr->closest(c->tr->user, path.pr.ray, path.tnear, INFINITY, path.f, &h)) {
+            add3(co->escaped, path.pr.flux, 1.0f);
             return;
         }
-        const evr_mesh_view *m = &rs->meshes[rs->instances[h.inst].mesh];
-        const evr_material_view *mat = &rs->materials[m->material];
-        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), f);
-        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, pr.ray, h.t, &s);
-        xi = evr_photon_rand(pp->seed, ei, j, 5 + 3 * bounce);
-        ev = evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, !(pr.from_light && bounce == 0), &w);
+        const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), path.f);
+        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
+        int ev = evr_photon_path_hit(&path, c->pp, &s, mat, stored, absorbed, &key);
+        add3(co->absorbed, absorbed, 1.0f);
         if (ev == EVR_PHOTON_STAY) {
-            float fl[3] = {pr.flux[0] * w, pr.flux[1] * w, pr.flux[2] * w};
-            float ab[3] = {fl[0] * (1.0f - s.albedo[0]), fl[1] * (1.0f - s.albedo[1]), fl[2] * (1.0f - s.albedo[2])};
-            add3(co->stored, fl, 1.0f);
-            add3(co->absorbed, ab, 1.0f);
+            add3(co->stored, stored, 1.0f);
             co->stored_photons++;
-            keep(c, co, &s, fl, i * 16u + (uint32_t)(bounce < 15 ? bounce : 15), f);
+            keep(c, co, &s, stored, key, path.f);
             return;
-        }
-        if (pr.from_light && bounce == 0) {   /* the direct term's light: absorbed part counted here */
-            float ab[3] = {pr.flux[0] * (1.0f - s.albedo[0]), pr.flux[1] * (1.0f - s.albedo[1]), pr.flux[2] * (1.0f - s.albedo[2])};
-            add3(co->absorbed, ab, 1.0f);
         }
         if (ev == EVR_PHOTON_ABSORB) return;
-        pr.flux[0] *= s.albedo[0] * w;
-        pr.flux[1] *= s.albedo[1] * w;
-        pr.flux[2] *= s.albedo[2] * w;
-        if (ev == EVR_PHOTON_DIFFUSE)
-            pr.ray.dir = evr_cosine_dir(s.n, evr_photon_rand(pp->seed, ei, j, 6 + 3 * bounce),
-                                        evr_photon_rand(pp->seed, ei, j, 7 + 3 * bounce));
-        else
-            pr.ray.dir = evr_v3_norm(evr_mirror_dir(pr.ray.dir, s.n));
-        pr.ray.org = s.p;
-        tnear = evr_shadow_tnear(&s, pr.ray.dir, pp->ray_eps);
     }
-    add3(co->capped, pr.flux, 1.0f);
+    add3(co->capped, path.pr.flux, 1.0f);
 }
 
 static void *pass_worker(void *arg)
@@ -450,4 +391,26 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     st->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     if (rc != EVR_OK) snprintf(err->msg, sizeof err->msg, "out of memory for the photon pass");
     return rc;
+}
+
+void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons, evr_gather_params *gp,
+                       evr_photon_params *pp, int *margin, int *window)
+{
+    evr_v3 lo = s->bounds_min, hi = s->bounds_max;
+    *photons = setup->photons ? setup->photons : (uint32_t)((size_t)setup->width * (size_t)setup->height);
+    memset(gp, 0, sizeof *gp);
+    gp->radius = setup->gather_radius;
+    gp->max_photons = setup->gather_max;
+    gp->max_window = setup->gather_window;
+    gp->normal_cos = 0.7f;
+    memset(pp, 0, sizeof *pp);
+    pp->max_bounces = setup->gi_bounces;
+    pp->f0 = 0.0f;
+    pp->f1 = 1.0f;
+    pp->seed = setup->seed;
+    if (!(lo.x <= hi.x)) lo = hi = evr_v3_make(0.0f, 0.0f, 0.0f);
+    pp->bounds.center = evr_v3_scale(evr_v3_add(lo, hi), 0.5f);
+    pp->bounds.radius = 0.55f * evr_v3_len(evr_v3_sub(hi, lo)) + 1e-6f;
+    *margin = setup->gather_window < 16 ? setup->gather_window : 16;
+    *window = setup->gather_window + 1;
 }

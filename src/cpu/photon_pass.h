@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "evray.h"
 #include "core/photon.h"
+#include "backend.h"
 
 /* What a closest-hit query returns: the scene instance, its triangle, barycentrics, distance. */
 typedef struct {
@@ -57,14 +58,6 @@ void evr_photon_buffer_free(evr_photon_buffer *b);
 evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f, evr_photon_buffer *buf,
                               int threads, evr_error *err);
 
-typedef struct {
-    int max_bounces;               /* indirect bounces: a light photon has at most max_bounces + 1 hits */
-    float f0, f1;                  /* photon j is traced at time evr_photon_time(j, f0, f1) */
-    uint64_t seed;
-    int threads;                   /* <= 0: all cores */
-    evr_photon_bounds bounds;      /* the scene's bounding sphere (directional lights) */
-    float ray_eps;                 /* secondary-ray offset (rs->ray_eps) */
-} evr_photon_params;
 
 /* Energy bookkeeping (RGB flux) and counts of one pass. Absorbed is the estimate
  * sum(first hits of light photons: F (1 - albedo)) + sum(stays: F / t_diffuse * (1 - albedo));
@@ -81,5 +74,12 @@ typedef struct {
 evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
                            const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
                            evr_error *err);
+
+/* The run's GI settings, the same for the CPU and CUDA backends: photons per pass (0 asked: one
+ * per pixel), gather parameters, pass parameters (photons spread over the segment, the same
+ * times every segment; directional lights emit over a disk round the scene's rest bounds, a
+ * little larger), the buffer's guard band and the cells around a pixel a gather may read. */
+void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons, evr_gather_params *gp,
+                       evr_photon_params *pp, int *margin, int *window);
 
 #endif

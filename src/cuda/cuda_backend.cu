@@ -19,6 +19,7 @@ extern "C" {
 #include "backend.h"
 #include "cuda/cuda_backend.h"
 #include "cuda/gpu_bvh.h"
+#include "cpu/photon_pass.h"   /* the host side of the photon pass: emitters, run parameters */
 }
 #include "core/rng.h"
 #include "core/shading.h"
@@ -43,6 +44,9 @@ extern "C" {
 #define BLOCK 128
 #ifndef MIN_BLOCKS
 #define MIN_BLOCKS 6   /* 80 registers: measured faster than 128 (occupancy) on the H100 */
+#endif
+#ifndef MIN_BLOCKS_GI
+#define MIN_BLOCKS_GI 4   /* with global illumination: 128 registers (the gather's state) */
 #endif
 
 /* Everything one launch reads, by value. */
@@ -72,6 +76,7 @@ struct kernel_args {
      * thread (the traversal takes its address), so it is kept small, and this comes last so
      * that the ideal kernel sees the same layout as before the sensor model */
     const evr_pixel_params *sensor;
+    const struct gpu_gi_view *gi;  /* global illumination (gpu_gi.cuh), NULL when off */
 };
 
 /* One traversal body for primary and shadow rays, not inlined: a kernel with four inlined copies
@@ -85,10 +90,13 @@ __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_
     return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit);
 }
 
-/* Intensity of one sample: as sample_intensity in cpu/cpu_backend.c, with our traversal. */
-template <int LAYOUT>
+#include "cuda/gpu_gi.cuh"
+
+/* Intensity of one sample: as sample_intensity in cpu/cpu_backend.c, with our traversal; GI: plus
+ * the indirect light gathered from the segment's photons (memo: the pixel's last gather). */
+template <int LAYOUT, int GI>
 __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
-                                  float *t_hit)
+                                  float *t_hit, gi_memo *memo)
 {
     const evr_render_scene *rs = &a.rs;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
@@ -114,7 +122,9 @@ __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, in
             continue;
         evr_accumulate_lambert(&s, wi, e, acc);
     }
-    return evr_surface_intensity(&s, acc, rs->ambient);
+    float out = evr_surface_intensity(&s, acc, rs->ambient);
+    if (GI) out += gi_indirect(a.gi, rs, hit.instance, &s, ray.org, x, y, memo);
+    return out;
 }
 
 __device__ static unsigned long long pack_event(const kernel_args &a, long long t_abs_us, int x, int y, int p)
@@ -242,6 +252,9 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
         evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
         evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
         skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
+        /* global illumination: a pixel whose gather window saw photons change traces */
+        if (skip && a.gi)
+            skip = !evr_photon_window_changed(a.gi->sat, a.gi->buf.width, a.gi->buf.height, a.gi->buf.margin, a.gi->window, x, y);
     }
     const unsigned traced = __ballot_sync(0xffffffffu, active && !skip);
     if (traced) {
@@ -268,8 +281,8 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
  * size and layout: measured on an H100, the same time on the eye and square demos; an earlier
  * version a few instructions longer was 40% slower on the square through instruction fetch).
  * With a list (change-driven sampling), thread i renders pixel list[i]. */
-template <int LAYOUT, int SENSOR>
-__global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a)
+template <int LAYOUT, int SENSOR, int GI>
+__global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render_kernel(kernel_args a)
 {
     const int npix = a.width * a.height;
     const int n = a.list ? (int)*a.list_count : npix;
@@ -292,13 +305,15 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) render_kernel(kernel_args a
     unsigned rays = 0, traced = 0;
     float t_hit = INFINITY;
     bool tracing = active;
+    gi_memo memo;
+    memo.valid = false;
     evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     for (int k = 0; k < a.samples; k++) {
         float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled */
         if (tracing) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            intensity = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit);
+            intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo);
             traced++;
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
@@ -334,7 +349,7 @@ struct adapt_args {
  * is held back on the pixel's stack while the interval before it is refined; every sample goes
  * through the pixel model in time order. Lanes run their own schedules; the event appends stay
  * warp-synchronous (every lane calls pixel_sample_at each round). */
-template <int LAYOUT, int SENSOR>
+template <int LAYOUT, int SENSOR, int GI>
 __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args d)
 {
     const int npix = a.width * a.height;
@@ -364,11 +379,13 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
     float ct = 0.0f, ci = 0.0f, ch = INFINITY;   /* the candidate sample: time, intensity, hit distance */
     bool cand = false;
     unsigned rays = 0, taken = 0;
+    gi_memo memo;
+    memo.valid = false;
     while (__any_sync(0xffffffffu, need || cand)) {
         if (need) {
             const float f = t / a.dt;
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            ci = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &ch);
+            ci = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &ch, &memo);
             ct = t;
             cand = true;
             need = false;
@@ -418,7 +435,7 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
  * sample through the pixel centre (the same gpu_sample as the segment's samples), written to
  * frames[k * npix + pix]. A kernel of its own so that the render kernel and the pixel states are
  * untouched: events are the same with or without frames. Its rays are not counted. */
-template <int LAYOUT>
+template <int LAYOUT, int GI>
 __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float *frame_f, int num_frames, float *frames)
 {
     const int npix = a.width * a.height;
@@ -426,11 +443,13 @@ __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float
     if (pix >= npix) return;
     const int x = pix % a.width, y = pix / a.width;
     unsigned rays = 0;
+    gi_memo memo;
+    memo.valid = false;
     for (int k = 0; k < num_frames; k++) {
         const float f = frame_f[k];
         evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
         float t_hit;
-        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit);
+        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo);
     }
 }
 
@@ -510,6 +529,19 @@ struct slot {
     cudaEvent_t framed = nullptr;      /* the frame kernel is done */
     cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr, copied = nullptr;
     int num_tracks, num_keys;
+    /* global illumination: this segment's photon buffer, its view, the changed cells */
+    dbuf<evr_photon> d_ph_slots;
+    dbuf<uint32_t> d_ph_count;
+    dbuf<float> d_ph_gbuf;
+    dbuf<uint32_t> d_sat;
+    dbuf<gpu_gi_view> d_gi_view;
+    hbuf<evr_photon_emitter> h_em;
+    dbuf<evr_photon_emitter> d_em;
+    hbuf<float> h_cdf;
+    dbuf<float> d_cdf;
+    cudaEvent_t gi_started = nullptr, gi_done = nullptr;
+    int gi_pass;                       /* the pass ran for this segment (not a still copy) */
+    evr_photon_buffer ph;              /* the buffer's shape and device pointers */
 };
 
 struct cuda_backend {
@@ -541,6 +573,17 @@ struct cuda_backend {
     int head, queued;
     size_t capacity;                       /* event keys per segment */
     evr_event_vec decoded, scratch;
+    /* global illumination (gpu_gi.cuh): the pass's photons and their sort, shared by the slots
+     * (one pass at a time on the render stream) */
+    int gi, gi_have_prev;
+    uint32_t photons;
+    evr_photon_params pp;
+    evr_gather_params gp;
+    evr_photon_emitters em;                /* host: rebuilt per segment */
+    dbuf<evr_photon> d_pending;
+    dbuf<unsigned long long> d_pkeys, d_pkeys_sorted;
+    dbuf<unsigned> d_pvals, d_pvals_sorted, d_pcount;
+    dbuf<unsigned char> d_ptemp;
 };
 
 static evr_status upload_scene(cuda_backend *b, evr_error *err)
@@ -668,7 +711,29 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.plan = sl->d_plan.p;
     a.list = sl->reuse ? sl->d_list.p : NULL;
     a.list_count = sl->d_count.p + 1;
+    a.gi = b->gi ? sl->d_gi_view.p : nullptr;
     return a;
+}
+
+/* Calls f with the kernel variant of the run as compile-time constants: f(variant<LAYOUT, SENSOR, GI>{}). */
+template <int L, int S, int G> struct variant {
+    static constexpr int layout = L, sensor = S, gi = G;
+};
+template <int L, typename F> static void with_variant_of(bool sensor, bool gi, F f)
+{
+    if (sensor) {
+        if (gi) f(variant<L, 1, 1>{});
+        else f(variant<L, 1, 0>{});
+    } else {
+        if (gi) f(variant<L, 0, 1>{});
+        else f(variant<L, 0, 0>{});
+    }
+}
+template <typename F> static void with_variant(const cuda_backend *b, F f)
+{
+    const bool sensor = !evr_pixel_params_ideal(&b->setup.pixel), gi = b->gi != 0;
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) with_variant_of<EVR_GPU_LAYOUT_CW8>(sensor, gi, f);
+    else with_variant_of<EVR_GPU_LAYOUT_BVH4>(sensor, gi, f);
 }
 
 /* Renders a slot's segment on the render stream and queues the read-back of its event count. */
@@ -681,47 +746,155 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     CK(cudaEventRecord(sl->started, b->render));
     const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
     const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
+    cudaStream_t rs = b->render;
     if (b->setup.adaptive) {
         adapt_args d;
         d.next_in = b->d_next[sl->index % 3].p;
         d.next_out = b->d_next[(sl->index + 1) % 3].p;
         d.plan = sl->d_adapt.p;
         d.p = b->setup.adapt;
-        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
-            if (ideal) adapt_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a, d);
-            else adapt_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a, d);
-        } else {
-            if (ideal) adapt_kernel<EVR_GPU_LAYOUT_BVH4, 0><<<grid, BLOCK, 0, b->render>>>(a, d);
-            else adapt_kernel<EVR_GPU_LAYOUT_BVH4, 1><<<grid, BLOCK, 0, b->render>>>(a, d);
-        }
-    } else if (sl->reuse) {
-        if (ideal) skip_kernel<0><<<grid, BLOCK, 0, b->render>>>(a);
-        else skip_kernel<1><<<grid, BLOCK, 0, b->render>>>(a);
-        CK(cudaGetLastError());
-    }
-    if (b->setup.adaptive) {
-        /* launched above */
-    } else if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) {
-        if (ideal) render_kernel<EVR_GPU_LAYOUT_CW8, 0><<<grid, BLOCK, 0, b->render>>>(a);
-        else render_kernel<EVR_GPU_LAYOUT_CW8, 1><<<grid, BLOCK, 0, b->render>>>(a);
+        with_variant(b, [&](auto v) { adapt_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a, d); });
     } else {
-        if (ideal) render_kernel<EVR_GPU_LAYOUT_BVH4, 0><<<grid, BLOCK, 0, b->render>>>(a);
-        else render_kernel<EVR_GPU_LAYOUT_BVH4, 1><<<grid, BLOCK, 0, b->render>>>(a);
+        if (sl->reuse) {
+            if (ideal) skip_kernel<0><<<grid, BLOCK, 0, rs>>>(a);
+            else skip_kernel<1><<<grid, BLOCK, 0, rs>>>(a);
+            CK(cudaGetLastError());
+        }
+        with_variant(b, [&](auto v) { render_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a); });
     }
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
     if (sl->num_frames > 0) {   /* after the timed render: device time stays the events' */
-        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
-            frame_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, b->render>>>(a, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p);
-        else
-            frame_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, b->render>>>(a, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p);
+        with_variant(b, [&](auto v) {
+            frame_kernel<decltype(v)::layout, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p);
+        });
         CK(cudaGetLastError());
         CK(cudaEventRecord(sl->framed, b->render));
     }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
-    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, 3 * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, GI_COUNTERS * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaEventRecord(sl->counted, sl->copy));
+    return EVR_OK;
+}
+
+/* The segment's photons (gpu_gi.cuh) on the render stream, before its render: the pass, the
+ * buffer's view, the changed cells. A still segment (nothing moved in it or since the previous
+ * one) copies the previous segment's buffer (in the other slot) and changes no cell. hrs: the
+ * segment's scene with host pointers (the emitters are built on the host). */
+static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
+{
+    const slot *prev = &b->slots[sl == &b->slots[0] ? 1 : 0];
+    const evr_photon_buffer *buf = &sl->ph;
+    const size_t cells = (size_t)buf->width * (size_t)buf->height, npix_layers = cells * (size_t)buf->layers;
+    const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
+    cudaStream_t rs = b->render;
+    evr_status st;
+    sl->gi_pass = 0;
+    CK(cudaMemsetAsync(sl->d_rays.p + GI_PATHS, 0, (GI_COUNTERS - GI_PATHS) * sizeof(unsigned long long), rs));
+    if (seg->skip->reuse && seg->skip->num_boxes == 0 && b->gi_have_prev) {
+        CK(cudaMemcpyAsync(sl->d_ph_count.p, prev->d_ph_count.p, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(sl->d_ph_slots.p, prev->d_ph_slots.p, npix_layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(sl->d_ph_gbuf.p, prev->d_ph_gbuf.p, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemsetAsync(sl->d_sat.p, 0, (size_t)(buf->width + 1) * (size_t)(buf->height + 1) * sizeof(uint32_t), rs));
+        return EVR_OK;
+    }
+    if ((st = evr_photon_emitters_build(hrs, 0.0f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
+    if (b->em.photons > (1u << 28)) {
+        snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", b->em.photons);
+        return EVR_ERR_ARG;
+    }
+    const unsigned n = b->em.n > 0 ? b->em.photons : 0u;
+    CK(sl->h_em.reserve((size_t)b->em.n + 1));
+    CK(sl->d_em.reserve((size_t)b->em.n + 1));
+    CK(sl->h_cdf.reserve((size_t)b->em.cdf_n + 1));
+    CK(sl->d_cdf.reserve((size_t)b->em.cdf_n + 1));
+    if (b->em.n) memcpy(sl->h_em.p, b->em.e, (size_t)b->em.n * sizeof(evr_photon_emitter));
+    if (b->em.cdf_n) memcpy(sl->h_cdf.p, b->em.cdf, (size_t)b->em.cdf_n * sizeof(float));
+    CK(cudaMemcpyAsync(sl->d_em.p, sl->h_em.p, ((size_t)b->em.n + 1) * sizeof(evr_photon_emitter), cudaMemcpyHostToDevice, rs));
+    CK(cudaMemcpyAsync(sl->d_cdf.p, sl->h_cdf.p, ((size_t)b->em.cdf_n + 1) * sizeof(float), cudaMemcpyHostToDevice, rs));
+    CK(b->d_pending.reserve((size_t)n + 1));
+    CK(b->d_pkeys.reserve((size_t)n + 1));
+    CK(b->d_pkeys_sorted.reserve((size_t)n + 1));
+    CK(b->d_pvals.reserve((size_t)n + 1));
+    CK(b->d_pvals_sorted.reserve((size_t)n + 1));
+    CK(cudaEventRecord(sl->gi_started, rs));
+    CK(cudaMemsetAsync(sl->d_ph_count.p, 0, cells * sizeof(uint32_t), rs));
+    CK(cudaMemsetAsync(b->d_pcount.p, 0, sizeof(unsigned), rs));
+    kernel_args a = make_args(b, sl);
+    if (n) {
+        photon_args p;
+        p.em = sl->d_em.p;
+        p.n_em = b->em.n;
+        p.cdf = sl->d_cdf.p;
+        p.pp = b->pp;
+        p.pp.ray_eps = hrs->ray_eps;
+        p.photons = n;
+        p.margin = buf->margin;
+        p.cells_w = buf->width;
+        p.sort_keys = b->d_pkeys.p;
+        p.sort_vals = b->d_pvals.p;
+        p.pending = b->d_pending.p;
+        p.pending_count = b->d_pcount.p;
+        CK(cudaMemsetAsync(b->d_pkeys.p, 0xff, (size_t)n * sizeof(unsigned long long), rs));
+        const unsigned pgrid = (n + BLOCK - 1) / BLOCK;
+        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        else photon_kernel<EVR_GPU_LAYOUT_BVH4><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        CK(cudaGetLastError());
+        /* the cell in the high bits (up to 2^end - 1), the photon key in the low 32 */
+        int end_bit = 33;
+        while (end_bit < 64 && (1ull << (end_bit - 32)) <= cells) end_bit++;
+        size_t temp = 0;
+        CK(cub::DeviceRadixSort::SortPairs(nullptr, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
+                                           (int)n, 0, end_bit, rs));
+        CK(b->d_ptemp.reserve(temp));
+        CK(cub::DeviceRadixSort::SortPairs(b->d_ptemp.p, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
+                                           (int)n, 0, end_bit, rs));
+        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n, b->d_pending.p, *buf, sl->d_rays.p);
+        CK(cudaGetLastError());
+    }
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *buf);
+    else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *buf);
+    CK(cudaGetLastError());
+    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*buf, prev->ph, b->gi_have_prev, sl->d_sat.p);
+    sat_rows_kernel<<<(unsigned)((buf->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height);
+    sat_cols_kernel<<<(unsigned)((buf->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height, sl->d_rays.p);
+    CK(cudaGetLastError());
+    CK(cudaEventRecord(sl->gi_done, rs));
+    sl->gi_pass = 1;
+    b->gi_have_prev = 1;
+    return EVR_OK;
+}
+
+/* Device memory of a slot's photon buffer and the view the kernels read. */
+static evr_status gi_alloc(cuda_backend *b, slot *sl, int margin, int window, evr_error *err)
+{
+    evr_photon_buffer *buf = &sl->ph;
+    memset(buf, 0, sizeof *buf);
+    buf->width = b->setup.width + 2 * margin;
+    buf->height = b->setup.height + 2 * margin;
+    buf->layers = b->setup.photon_layers;
+    buf->margin = margin;
+    const size_t cells = (size_t)buf->width * (size_t)buf->height;
+    CK(sl->d_ph_slots.reserve(cells * (size_t)buf->layers));
+    CK(sl->d_ph_count.reserve(cells));
+    CK(sl->d_ph_gbuf.reserve(cells * 8));
+    CK(sl->d_sat.reserve((size_t)(buf->width + 1) * (size_t)(buf->height + 1)));
+    CK(cudaMemset(sl->d_sat.p, 0, (size_t)(buf->width + 1) * (size_t)(buf->height + 1) * sizeof(uint32_t)));
+    CK(cudaMemset(sl->d_ph_count.p, 0, cells * sizeof(uint32_t)));
+    buf->slots = sl->d_ph_slots.p;
+    buf->count = sl->d_ph_count.p;
+    buf->gbuf = sl->d_ph_gbuf.p;
+    buf->collisions = nullptr;   /* the place kernel counts them (GI_COLLISIONS) */
+    gpu_gi_view v;
+    v.buf = *buf;
+    v.sat = sl->d_sat.p;
+    v.gp = b->gp;
+    v.window = window;
+    CK(sl->d_gi_view.reserve(1));
+    CK(cudaMemcpy(sl->d_gi_view.p, &v, sizeof v, cudaMemcpyHostToDevice));
+    CK(cudaEventCreate(&sl->gi_started));
+    CK(cudaEventCreate(&sl->gi_done));
     return EVR_OK;
 }
 
@@ -799,6 +972,7 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst), cudaMemcpyHostToDevice, b->render));
     /* the host top-level arrays are reused by the next build of this slot only after collect,
      * by which time these copies are done (collect synchronizes) */
+    if (b->gi && (st = gi_segment(b, sl, seg, &hrs, err)) != EVR_OK) return st;
     if ((st = launch(b, sl, err)) != EVR_OK) return st;
     b->queued++;
     return EVR_OK;
@@ -817,8 +991,11 @@ static uint64_t device_bytes(const cuda_backend *b)
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
-             bytes(sl->d_rays) + bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames);
+             bytes(sl->d_rays) + bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames) +
+             bytes(sl->d_ph_slots) + bytes(sl->d_ph_count) + bytes(sl->d_ph_gbuf) + bytes(sl->d_sat) + bytes(sl->d_em) + bytes(sl->d_cdf);
     }
+    n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
+         bytes(b->d_pcount) + bytes(b->d_ptemp);
     return n;
 }
 
@@ -846,6 +1023,17 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     base->rays += sl->h_rays.p[0];
     base->pixels_skipped += sl->h_rays.p[1];
     base->samples_traced += sl->h_rays.p[2];
+    if (b->gi && sl->gi_pass) {
+        float gi_ms = 0.0f;
+        CK(cudaEventElapsedTime(&gi_ms, sl->gi_started, sl->gi_done));
+        base->photon_seconds += 1e-3 * (double)gi_ms;
+        base->photons_traced += sl->h_rays.p[GI_PATHS];
+        base->photons_stored += sl->h_rays.p[GI_INSERTED];
+        base->photon_collisions += sl->h_rays.p[GI_COLLISIONS];
+        base->photon_cells_changed += sl->h_rays.p[GI_CHANGED];
+        base->photon_passes++;
+        sl->gi_pass = 0;   /* a re-render at overflow does not run the pass again */
+    }
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
@@ -925,6 +1113,10 @@ static void cuda_release(evr_backend *base)
         sl->d_adapt.release(); sl->h_adapt.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
+        sl->d_ph_slots.release(); sl->d_ph_count.release(); sl->d_ph_gbuf.release(); sl->d_sat.release();
+        sl->d_gi_view.release(); sl->h_em.release(); sl->d_em.release(); sl->h_cdf.release(); sl->d_cdf.release();
+        if (sl->gi_started) cudaEventDestroy(sl->gi_started);
+        if (sl->gi_done) cudaEventDestroy(sl->gi_done);
         if (sl->framed) cudaEventDestroy(sl->framed);
         if (sl->copy) cudaStreamDestroy(sl->copy);
         if (sl->started) cudaEventDestroy(sl->started);
@@ -941,6 +1133,9 @@ static void cuda_release(evr_backend *base)
         b->d_state[i].release();
         b->d_next[i].release();
     }
+    b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
+    b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
+    evr_photon_emitters_free(&b->em);
     if (b->render) cudaStreamDestroy(b->render);
     evr_gpu_bvh_free(&b->bvh);
     evr_event_vec_free(&b->decoded);
@@ -991,6 +1186,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaGetLastError());
     CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
     b->capacity = npix * 2 > (1u << 20) ? npix * 2 : (1u << 20);
+    int gi_margin = 0, gi_window = 0;
+    b->gi = b->setup.gi;
+    if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     for (int i = 0; i < 2; i++) {
         slot *sl = &b->slots[i];
@@ -1009,7 +1207,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaEventCreate(&sl->framed));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(2));
-        CK(sl->d_rays.reserve(3));
+        CK(sl->d_rays.reserve(GI_COUNTERS));
         CK(sl->d_plan.reserve(1));
         CK(sl->h_plan.reserve(1));
         if (b->setup.adaptive) {
@@ -1019,8 +1217,11 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(sl->d_list.reserve((size_t)b->setup.width * (size_t)b->setup.height));
         CK(sl->d_intensity.reserve(npix));
         CK(sl->h_count.reserve(1));
-        CK(sl->h_rays.reserve(3));
+        CK(sl->h_rays.reserve(GI_COUNTERS));
+        CK(cudaMemset(sl->d_rays.p, 0, GI_COUNTERS * sizeof(unsigned long long)));
+        if (b->gi && (st = gi_alloc(b, sl, gi_margin, gi_window, err)) != EVR_OK) return st;
     }
+    if (b->gi) CK(b->d_pcount.reserve(1));
     CK(cudaDeviceSynchronize());
     return EVR_OK;
 }

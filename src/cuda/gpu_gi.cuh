@@ -1,0 +1,190 @@
+/* Global illumination on the GPU (issue 5): the photon pass of a segment, the camera's view of
+ * the buffer's cells, which cells changed since the previous segment, and the gather of a
+ * sample. Every per-photon and per-pixel decision is src/core/photon.h, the very functions the
+ * CPU pass (src/cpu/photon_pass.c, src/cpu/cpu_gi.c) runs; this file only schedules them.
+ *
+ * Included by cuda_backend.cu after gpu_trace (one translation unit: the kernels here trace
+ * with the same traversal and take the same kernel_args).
+ *
+ * Deterministic insertion. The CPU inserts the visible photons in photon order, so a cell keeps
+ * its first `layers` photons by key. Here every visible photon is appended (atomic counter) with
+ * the sort key (cell << 32 | photon key); CUB sorts the keys, and each sorted photon's rank in
+ * its cell (a binary search for the cell's first entry) picks its layer: the same buffer as the
+ * CPU's for the same photons, whatever order the threads ran in.
+ *
+ * Buffers live per slot: a segment that overflows its event buffer is rendered again at collect,
+ * after the next segment's pass may have run, and must find its own photons. A still segment
+ * (nothing moved since the previous one) copies the previous slot's buffer on the device. */
+#ifndef EVR_CUDA_GPU_GI_CUH
+#define EVR_CUDA_GPU_GI_CUH
+
+#include "core/photon.h"
+
+/* What the render kernels read (device memory, one per slot). */
+struct gpu_gi_view {
+    evr_photon_buffer buf;         /* device pointers */
+    const uint32_t *sat;           /* summed-area table of the changed cells, (w + 1) x (h + 1) */
+    evr_gather_params gp;
+    int window;                    /* cells around a pixel a gather may read */
+};
+
+/* A pixel's last gather in this launch: the same point, normal, distance and instance in the
+ * same buffer give the same estimate bit for bit (a traced pixel on a still surface). */
+struct gi_memo {
+    uint32_t key[7];
+    int inst;
+    float lum;
+    bool valid;
+};
+
+/* The indirect light of a sample at surface s of instance inst: the pixel's memo, or a gather
+ * (the pixel's own thread walks its window; a version spreading each window's cells over the
+ * warp's lanes was slower, measured on an H200: 2.07 s against 1.80 s of render kernels for the
+ * Cornell box at 1280x720, 2 s: most windows are searched to the same size, so the lanes of a
+ * warp were already busy in step). */
+__device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs, int inst, const evr_surface *s,
+                                             evr_v3 cam_org, int x, int y, gi_memo *m)
+{
+    const float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
+    const uint32_t key[7] = {__float_as_uint(s->p.x), __float_as_uint(s->p.y), __float_as_uint(s->p.z), __float_as_uint(s->n.x),
+                             __float_as_uint(s->n.y), __float_as_uint(s->n.z), __float_as_uint(dist)};
+    bool same = m->valid && m->inst == inst;
+    for (int k = 0; k < 7 && same; k++) same = m->key[k] == key[k];
+    if (same) return m->lum;
+    const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
+    for (int k = 0; k < 7; k++) m->key[k] = key[k];
+    m->inst = inst;
+    m->lum = evr_photon_indirect_lum(&g->buf, &rs->camera, &g->gp, mat, s, cam_org, x, y);
+    m->valid = true;
+    return m->lum;
+}
+
+/* Counters of a pass in the slot's counter array (after the render kernels' three). */
+enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_COUNTERS = 7 };
+
+struct photon_args {
+    const evr_photon_emitter *em;
+    int n_em;
+    const float *cdf;
+    evr_photon_params pp;
+    unsigned photons;
+    int margin, cells_w;
+    unsigned long long *sort_keys; /* (cell << 32) | photon key; all ones where no photon */
+    unsigned *sort_vals;           /* index into pending */
+    evr_photon *pending;
+    unsigned *pending_count;
+};
+
+/* One thread per photon: its path (core/photon.h), and where it stays, the camera's check. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK) photon_kernel(kernel_args a, photon_args p)
+{
+    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    const evr_render_scene *rs = &a.rs;
+    evr_photon_path path;
+    if (i >= p.photons || !evr_photon_path_start(rs, p.em, p.n_em, p.cdf, &p.pp, i, &path)) return;
+    atomicAdd(&a.rays[GI_PATHS], 1ull);
+    while (path.bounce < path.max_hits) {
+        evr_gpu_hit h;
+        evr_surface s;
+        float stored[3], absorbed[3];
+        uint32_t key = 0;
+        if (!gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h)) return;
+        const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), path.f);
+        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
+        const int ev = evr_photon_path_hit(&path, &p.pp, &s, mat, stored, absorbed, &key);
+        if (ev == EVR_PHOTON_STAY) {
+            evr_ray r;
+            float tn, tf;
+            int x, y;
+            if (!evr_photon_view_ray(rs, &s, path.f, p.margin, p.pp.ray_eps, &x, &y, &r, &tn, &tf)) return;
+            if (gpu_trace<LAYOUT>(&a.view, rs, r, tn, tf, path.f, 1, &h)) return;
+            const unsigned idx = atomicAdd(p.pending_count, 1u);   /* < photons: one stay per photon */
+            const unsigned cell = (unsigned)(y + p.margin) * (unsigned)p.cells_w + (unsigned)(x + p.margin);
+            p.pending[idx] = evr_photon_make(&s, stored, key);
+            p.sort_keys[idx] = ((unsigned long long)cell << 32) | key;
+            p.sort_vals[idx] = idx;
+            return;
+        }
+        if (ev == EVR_PHOTON_ABSORB) return;
+    }
+}
+
+/* One thread per sorted photon: its layer is its rank among its cell's photons. */
+__global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long long *keys, const unsigned *vals, unsigned n,
+                                                             const evr_photon *pending, evr_photon_buffer buf,
+                                                             unsigned long long *counters)
+{
+    const unsigned j = blockIdx.x * blockDim.x + threadIdx.x;
+    if (j >= n) return;
+    const unsigned long long k = keys[j];
+    if (k == ~0ull) return;
+    const unsigned cell = (unsigned)(k >> 32);
+    const unsigned long long first_key = (unsigned long long)cell << 32;
+    unsigned lo = 0, hi = j;
+    while (lo < hi) {   /* the cell's first entry */
+        unsigned mid = (lo + hi) / 2;
+        if (keys[mid] < first_key) lo = mid + 1;
+        else hi = mid;
+    }
+    const unsigned rank = j - lo;
+    if (rank < (unsigned)buf.layers) {
+        buf.slots[(size_t)rank * (size_t)buf.width * (size_t)buf.height + cell] = pending[vals[j]];
+        atomicAdd(&counters[GI_INSERTED], 1ull);
+    } else {
+        atomicAdd(&counters[GI_COLLISIONS], 1ull);
+    }
+    if (j + 1 == n || (unsigned)(keys[j + 1] >> 32) != cell) buf.count[cell] = rank + 1;   /* arrivals, as the CPU counts */
+}
+
+/* One thread per cell: what the camera sees through the cell's centre at the segment's start. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_photon_buffer buf)
+{
+    const int cell = blockIdx.x * blockDim.x + threadIdx.x;
+    if (cell >= buf.width * buf.height) return;
+    const evr_render_scene *rs = &a.rs;
+    const evr_m34 pose = evr_rs_camera_pose(rs, 0.0f);
+    const evr_v3 fwd = evr_v3_norm(evr_m34_vector(&pose, evr_v3_make(0.0f, 0.0f, -1.0f)));
+    const evr_ray ray = evr_photon_cell_ray(rs, &pose, &buf, cell % buf.width, cell / buf.width);
+    float g[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+    evr_gpu_hit h;
+    if (gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, 0.0f, 0, &h)) {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), 0.0f);
+        evr_surface s;
+        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, ray, h.t, &s);
+        evr_photon_cell_view(rs, fwd, &s, ray, h.t, g);
+    }
+    for (int k = 0; k < 8; k++) buf.gbuf[8 * (size_t)cell + k] = g[k];
+}
+
+/* Changed cells (1 where the photons or the view differ from the previous segment's; all when
+ * there is none) into the summed-area table's interior; row 0 and column 0 stay zero. */
+__global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer cur, evr_photon_buffer prev, int have_prev,
+                                                               uint32_t *sat)
+{
+    const int cell = blockIdx.x * blockDim.x + threadIdx.x;
+    if (cell >= cur.width * cur.height) return;
+    const int x = cell % cur.width, y = cell / cur.width;
+    sat[(size_t)(y + 1) * (size_t)(cur.width + 1) + (size_t)(x + 1)] = !have_prev || !evr_photon_cell_same(&cur, &prev, (size_t)cell);
+}
+
+/* The summed-area table: prefix sums along rows (one thread per row), then columns. */
+__global__ void __launch_bounds__(BLOCK) sat_rows_kernel(uint32_t *sat, int w, int h)
+{
+    const int y = blockIdx.x * blockDim.x + threadIdx.x;
+    if (y >= h) return;
+    uint32_t *row = sat + (size_t)(y + 1) * (size_t)(w + 1);
+    for (int x = 1; x <= w; x++) row[x] += row[x - 1];
+}
+
+__global__ void __launch_bounds__(BLOCK) sat_cols_kernel(uint32_t *sat, int w, int h, unsigned long long *counters)
+{
+    const int x = blockIdx.x * blockDim.x + threadIdx.x + 1;
+    if (x > w) return;
+    for (int y = 1; y <= h; y++) sat[(size_t)y * (size_t)(w + 1) + x] += sat[(size_t)(y - 1) * (size_t)(w + 1) + x];
+    if (x == w) counters[GI_CHANGED] = sat[(size_t)h * (size_t)(w + 1) + (size_t)w];   /* the cells that changed */
+}
+
+#endif
