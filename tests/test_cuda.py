@@ -64,6 +64,21 @@ T.check(len(runs["auto"]) > 100000 and runs["auto"] == runs["tiny"],
 T.check(len(runs["adaptive-auto"]) > 100000 and runs["adaptive-auto"] == runs["adaptive-tiny"],
         "adaptive sampling: overflowing event buffers are re-rendered, identical events")
 
+# temporal coherence (a primary ray first bounded by its pixel's last hit, traced again unbounded
+# when that finds nothing) changes no event: EVR_NO_COHERENCE turns it off
+for scene, extra in (("eye", ["--res", "200x150", "--duration", "1.0", "--start", "0.9"]),
+                     ("city", ["--res", "160x90", "--duration", "0.3"]),
+                     ("square", ["--res", "96x96", "--duration", "1.0"])):
+    evs = []
+    for off in (False, True):
+        if off:
+            os.environ["EVR_NO_COHERENCE"] = "1"
+        d = os.path.join(tmp, f"coh-{scene}-{int(off)}")
+        T.run("demo", "--scene", scene, "-o", d, "--backend", "cuda", "--format", "npy", "--no-preview", "--quiet", *extra)
+        os.environ.pop("EVR_NO_COHERENCE", None)
+        evs.append(open(os.path.join(d, "events.npy"), "rb").read())
+    T.check(len(evs[0]) > 1000 and evs[0] == evs[1], f"{scene}: identical events with and without temporal coherence")
+
 # global illumination on the GPU (cuda/gpu_gi.cuh): the same photons as the CPU's up to float
 # differences of the traversals; the buffer is filled in photon order (deterministic: two runs give
 # the same events); a segment re-rendered after an overflow finds its own photons; a still Cornell
