@@ -426,6 +426,27 @@ EVR_HD static inline void evr_pixel_end_s(evr_pixel_state *s, const evr_pixel_sp
 
 EVR_HD static inline void evr_pixel_end(evr_pixel_state *s, const evr_pixel_span *sp) { evr_pixel_end_s(s, sp, 1); }
 
+/* The ideal pixel given the same intensity at each of its remaining samples in the segment, the
+ * last at time t_last: 1 when none of them can change anything but the previous sample, i.e. the
+ * pixel is awake and its log intensity lies within both thresholds of the reference, or it stays
+ * blind past t_last. Then evr_pixel_quiet_finish leaves it exactly as those samples through
+ * evr_pixel_begin_ideal / next / end would (a pixel that keeps its intensity skips them). */
+EVR_HD static inline int evr_pixel_quiet_ideal(const evr_pixel_state *s, float log_floor, float pos_thres, float neg_thres,
+                                               float intensity, float t_last)
+{
+    if (!s->started) return 0;
+    if (s->blind) return s->refr_end > t_last;
+    float l = evr_log_response(intensity, log_floor);
+    return l - s->ref < pos_thres && s->ref - l < neg_thres;
+}
+
+EVR_HD static inline void evr_pixel_quiet_finish(evr_pixel_state *s, float log_floor, float intensity, float t_last)
+{
+    s->l_prev = evr_log_response(intensity, log_floor);
+    s->t_prev = t_last;
+    s->intensity = intensity;
+}
+
 /* Rebases the pixel's times when the simulation moves to the next segment. */
 EVR_HD static inline void evr_pixel_end_segment(evr_pixel_state *s, float segment_length)
 {

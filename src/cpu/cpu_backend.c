@@ -185,6 +185,99 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
 
 static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
 
+/* One sample of pixel (x, y) (intensity at t seconds from the segment's start) through its pixel
+ * model; its events go to out. */
+static void pixel_sample(cpu_backend *b, evr_pixel_state *st, const evr_pixel_params *pp, int ideal, float t, float intensity,
+                         int x, int y, evr_event_vec *out)
+{
+    evr_pixel_span sp;
+    float te;
+    int pol;
+    if (!evr_pixel_begin_s(st, pp, t, intensity, &sp, !ideal)) return;
+    while (evr_pixel_next_s(st, pp, &sp, &te, &pol, !ideal)) {
+        evr_event e;
+        e.t = evr_event_time_us_s(pp, b->seg->t0 + (double)te, x, y, !ideal);
+        e.x = (uint16_t)x;
+        e.y = (uint16_t)y;
+        e.p = (int8_t)pol;
+        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
+    }
+    evr_pixel_end_s(st, &sp, !ideal);
+}
+
+/* A pixel of the tile in the segment's work. */
+typedef struct {
+    evr_pixel_state *st;
+    evr_pixel_params pp;           /* its thresholds, leak and noise (a fixed pattern) */
+    evr_ray ray;                   /* its centre ray (the camera at the segment's start) */
+    float phi, t_last, t_hit;      /* sample phase; time of its last sample; last hit distance */
+    int x, y;
+} tile_pixel;
+
+/* The samples k0 .. n - 1 of a pixel that keeps its intensity: none when they cannot change it
+ * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. */
+static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n, float dt, evr_event_vec *out)
+{
+    const float in = q->st->intensity;
+    int k;
+    if (ideal && evr_pixel_quiet_ideal(q->st, q->pp.log_floor, q->pp.pos_thres, q->pp.neg_thres, in, q->t_last)) {
+        evr_pixel_quiet_finish(q->st, q->pp.log_floor, in, q->t_last);
+        return;
+    }
+    for (k = k0; k < n; k++) pixel_sample(b, q->st, &q->pp, ideal, (((float)k + q->phi) / (float)n) * dt, in, q->x, q->y, out);
+}
+
+/* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
+ * tile: the packets stay full however few pixels trace). With settle (k0 == 0, k1 == 1): a pixel
+ * whose first sample's rays meet nothing that moves in the segment keeps that intensity for the
+ * rest of the segment (its later samples run here); the others are listed in *more. */
+static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int count, int k0, int k1, int settle, int *more,
+                          int *num_more, const evr_m34 *pose_static, int ideal, float dt, evr_event_vec *out,
+                          unsigned long long *rays, unsigned long long *traced)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    const evr_segment *seg = b->seg;
+    const int n = b->setup.samples_per_frame;
+    int c, i, k;
+    for (c = 0; c < count; c += PACKET) {
+        int xs[PACKET], ys[PACKET], valid[PACKET];
+        float fs[PACKET], intensity[PACKET], t_hit[PACKET];
+        tile_pixel *q[PACKET];
+        for (i = 0; i < PACKET; i++) {
+            valid[i] = c + i < count;
+            q[i] = &px[list[valid[i] ? c + i : c]];
+            xs[i] = q[i]->x;
+            ys[i] = q[i]->y;
+        }
+        for (k = k0; k < k1; k++) {
+            for (i = 0; i < PACKET; i++) fs[i] = ((float)k + q[i]->phi) / (float)n;
+            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, rays);
+            for (i = 0; i < PACKET; i++) {
+                if (!valid[i]) continue;
+                (*traced)++;
+                q[i]->t_hit = t_hit[i];
+                pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
+            }
+        }
+        if (!settle) continue;
+        for (i = 0; i < PACKET; i++) {
+            if (!valid[i]) continue;
+            float cd = evr_skip_cache_after_trace(rs, seg->skip, q[i]->ray, q[i]->t_hit);
+            if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
+                q[i]->st->cache_dist = cd;
+                q[i]->t_hit = -1.0f;   /* its cache is set */
+                keep_samples(b, q[i], ideal, k1, n, dt, out);
+            } else {
+                more[(*num_more)++] = list[c + i];
+            }
+        }
+    }
+}
+
+/* A tile's pixels through the segment. A pixel that nothing moving can reach keeps its intensity
+ * (change-driven sampling) and runs its samples without rays; the others trace, compacted into
+ * full packets: first every such pixel's first sample, then the samples of those that did not
+ * settle. A pixel's samples always reach its pixel model in time order. */
 static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays,
                         unsigned long long *traced, unsigned long long *skipped)
 {
@@ -198,82 +291,39 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
     evr_event_vec *out = &b->tile_events[tile];
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
     const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
-    int x, y, k;
+    tile_pixel px[TILE * TILE];
+    int list[TILE * TILE], more[TILE * TILE], count = 0, num_more = 0, np = 0, x, y, i;
     out->n = 0;
     for (y = y0; y < y1; y++) {
-        for (x = x0; x < x1; x += PACKET) {
-            evr_pixel_state *st[PACKET];
-            evr_pixel_params pp[PACKET];   /* each pixel's thresholds, leak and noise (a fixed pattern) */
-            float phi[PACKET], fs[PACKET], intensity[PACKET], t_hit[PACKET];
-            int xs[PACKET], valid[PACKET], trace[PACKET], any_trace = 0, i;
-            evr_ray ray[PACKET];
-            for (i = 0; i < PACKET; i++) {
-                xs[i] = x + i < x1 ? x + i : x1 - 1;
-                valid[i] = x + i < x1;
-                st[i] = &b->pixels[(size_t)y * (size_t)w + (size_t)xs[i]];
-                phi[i] = b->phase[(size_t)y * (size_t)w + (size_t)xs[i]];
-                if (ideal) pp[i] = b->setup.pixel;
-                else evr_pixel_params_at(&b->setup.pixel, xs[i], y, &pp[i]);
-                /* global illumination: whether the photons this pixel's gather reads changed */
-                const int gi_changed = b->gi && valid[i] && evr_cpu_gi_pixel_begin(&b->gi_state, xs[i], y);
-                /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
-                ray[i] = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)y + 0.5f);
-                trace[i] = valid[i] && !(evr_skip_pixel(rs, plan, st[i]->started, st[i]->cache_dist, ray[i]) && !gi_changed);
-                any_trace |= trace[i];
-                if (valid[i] && !trace[i]) (*skipped)++;
-            }
-            for (k = 0; k < n; k++) {
-                for (i = 0; i < PACKET; i++) {
-                    fs[i] = ((float)k + phi[i]) / (float)n;
-                    intensity[i] = st[i]->intensity;   /* what a skipped or settled pixel keeps */
-                }
-                if (any_trace) {
-                    float traced_intensity[PACKET];
-                    sample_intensity8(b, seg->camera_static ? &pose_static : NULL, xs, y, fs, trace, traced_intensity,
-                                      t_hit, rays);
-                    for (i = 0; i < PACKET; i++)
-                        if (trace[i]) {
-                            intensity[i] = traced_intensity[i];
-                            (*traced)++;
-                        }
-                }
-                for (i = 0; i < PACKET; i++) {
-                    evr_pixel_span sp;
-                    float te;
-                    int pol;
-                    if (!valid[i]) continue;
-                    if (!evr_pixel_begin_s(st[i], &pp[i], fs[i] * dt, intensity[i], &sp, !ideal)) continue;
-                    while (evr_pixel_next_s(st[i], &pp[i], &sp, &te, &pol, !ideal)) {
-                        evr_event e;
-                        e.t = evr_event_time_us_s(&pp[i], seg->t0 + (double)te, xs[i], y, !ideal);
-                        e.x = (uint16_t)xs[i];
-                        e.y = (uint16_t)y;
-                        e.p = (int8_t)pol;
-                        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
-                    }
-                    evr_pixel_end_s(st[i], &sp, !ideal);
-                }
-                if (k == 0 && any_trace) {
-                    /* settle: a pixel whose first sample's rays meet nothing that moves in the
-                     * segment sees the same triangles at every sample: it keeps that intensity */
-                    any_trace = 0;
-                    for (i = 0; i < PACKET; i++) {
-                        if (!trace[i]) continue;
-                        float c = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
-                        if (c >= 0.0f) {
-                            trace[i] = 0;
-                            st[i]->cache_dist = c;
-                        }
-                        any_trace |= trace[i];
-                    }
-                }
-            }
-            for (i = 0; i < PACKET; i++) {
-                if (!valid[i]) continue;
-                if (trace[i]) st[i]->cache_dist = evr_skip_cache_after_trace(rs, plan, ray[i], t_hit[i]);
-                evr_pixel_end_segment(st[i], dt);
+        for (x = x0; x < x1; x++, np++) {
+            tile_pixel *q = &px[np];
+            q->x = x;
+            q->y = y;
+            q->st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
+            q->phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
+            q->t_last = (((float)(n - 1) + q->phi) / (float)n) * dt;
+            q->t_hit = INFINITY;
+            if (ideal) q->pp = b->setup.pixel;
+            else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
+            /* global illumination: whether the photons this pixel's gather reads changed */
+            const int gi_changed = b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, x, y);
+            /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
+            q->ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+            if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) && !gi_changed) {
+                (*skipped)++;
+                keep_samples(b, q, ideal, 0, n, dt, out);
+                evr_pixel_end_segment(q->st, dt);
+            } else {
+                list[count++] = np;
             }
         }
+    }
+    trace_samples(b, px, list, count, 0, n < 1 ? n : 1, 1, more, &num_more, &pose_static, ideal, dt, out, rays, traced);
+    trace_samples(b, px, more, num_more, 1, n, 0, NULL, NULL, &pose_static, ideal, dt, out, rays, traced);
+    for (i = 0; i < count; i++) {
+        tile_pixel *q = &px[list[i]];
+        if (q->t_hit >= 0.0f) q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit);
+        evr_pixel_end_segment(q->st, dt);
     }
     render_frames(b, x0, y0, x1, y1);
     *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
