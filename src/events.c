@@ -87,21 +87,14 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     return 1;
 }
 
-static int key_less(const evr_event *a, const evr_event *b)
-{
-    if (a->t != b->t) return a->t < b->t;
-    if (a->y != b->y) return a->y < b->y;
-    return a->x < b->x;
-}
-
 int evr_events_merge(evr_event_vec *v, const evr_event *ev, size_t n, evr_event_vec *scratch)
 {
     if (!n) return 1;
-    if (!v->n || !key_less(ev, &v->data[v->n - 1])) return evr_event_vec_append(v, ev, n);   /* common: no overlap */
+    if (!v->n || !evr_event_key_less(ev, &v->data[v->n - 1])) return evr_event_vec_append(v, ev, n);   /* common: no overlap */
     scratch->n = 0;
     if (!evr_event_vec_reserve(scratch, v->n + n)) return 0;
     size_t i = 0, j = 0, k = 0;
-    while (i < v->n && j < n) scratch->data[k++] = key_less(&ev[j], &v->data[i]) ? ev[j++] : v->data[i++];
+    while (i < v->n && j < n) scratch->data[k++] = evr_event_key_less(&ev[j], &v->data[i]) ? ev[j++] : v->data[i++];
     while (i < v->n) scratch->data[k++] = v->data[i++];
     while (j < n) scratch->data[k++] = ev[j++];
     scratch->n = k;

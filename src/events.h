@@ -21,6 +21,14 @@ static inline int evr_event_vec_push(evr_event_vec *v, evr_event e)
 int evr_event_vec_append(evr_event_vec *v, const evr_event *e, size_t n);
 void evr_event_vec_free(evr_event_vec *v);
 
+/* The file order: by t, then y, then x. */
+static inline int evr_event_key_less(const evr_event *a, const evr_event *b)
+{
+    if (a->t != b->t) return a->t < b->t;
+    if (a->y != b->y) return a->y < b->y;
+    return a->x < b->x;
+}
+
 /* Sorts by (t, y, x), stable, so equal keys keep their input order (deterministic when the input
  * order is). scratch is grown as needed and may be reused between calls. */
 int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch);

@@ -247,13 +247,14 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
         if (e->t != sim->last_t) sim->st.unique_timestamps++;
         sim->last_t = e->t;
     }
-    if ((st = evr_write_queue_push(sim->wq, v->data, n, err)) != EVR_OK) return st;
     sim->time_write += now_seconds() - t;
     t = now_seconds();
     if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
     sim->time_preview += now_seconds() - t;
-    memmove(v->data, v->data + n, (v->n - n) * sizeof *v->data);
-    v->n -= n;
+    t = now_seconds();
+    /* the writers take the buffer; the events held back move to one of the queue's */
+    if ((st = evr_write_queue_push_take(sim->wq, v, n, err)) != EVR_OK) return st;
+    sim->time_write += now_seconds() - t;
     return EVR_OK;
 }
 

@@ -91,7 +91,7 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     return EVR_OK;
 }
 
-evr_status evr_write_queue_push(evr_write_queue *q, const evr_event *ev, size_t n, evr_error *err)
+evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n, evr_error *err)
 {
     double t = now_s();
     pthread_mutex_lock(&q->mu);
@@ -103,14 +103,20 @@ evr_status evr_write_queue_push(evr_write_queue *q, const evr_event *ev, size_t 
         pthread_mutex_unlock(&q->mu);
         return st;
     }
-    evr_event_vec *v = &q->slots[(q->head + q->count) % QUEUE_SLOTS];
+    evr_event_vec *slot = &q->slots[(q->head + q->count) % QUEUE_SLOTS];
     pthread_mutex_unlock(&q->mu);
-    /* this slot is not pending, so the thread does not touch it */
-    v->n = 0;
-    if (!evr_event_vec_append(v, ev, n)) {
+    /* this slot is not pending, so the thread does not touch it: its buffer takes v's rest */
+    evr_event_vec rest = *slot;
+    rest.n = 0;
+    if (!evr_event_vec_append(&rest, v->data + n, v->n - n)) {
+        *slot = rest;
         snprintf(err->msg, sizeof err->msg, "out of memory queueing events for writing");
         return EVR_ERR_NOMEM;
     }
+    slot->data = v->data;
+    slot->cap = v->cap;
+    slot->n = n;
+    *v = rest;
     pthread_mutex_lock(&q->mu);
     q->count++;
     pthread_cond_broadcast(&q->cv);

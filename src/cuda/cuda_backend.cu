@@ -1092,23 +1092,28 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         base->sort_seconds += 1e-3 * (double)sort_ms;
         base->copy_seconds += 1e-3 * (double)copy_ms;
     }
-    b->decoded.n = 0;
-    if (!evr_event_vec_reserve(&b->decoded, n)) {
-        snprintf(err->msg, sizeof err->msg, "out of memory for events");
-        return EVR_ERR_NOMEM;
-    }
+    /* decoded straight into out when they all follow its last event (the common case), else
+     * into a buffer of their own and merged */
     const int xb = event_key_bits(b->setup.width), yb = event_key_bits(b->setup.height);
-    for (size_t i = 0; i < n; i++) {
-        unsigned long long k = sl->h_sorted.p[i];
+    auto decode = [&](unsigned long long k) {
         evr_event e;
         e.t = sl->base_us + (long long)(k >> (1 + xb + yb));
         e.y = (uint16_t)((k >> (1 + xb)) & ((1u << yb) - 1u));
         e.x = (uint16_t)((k >> 1) & ((1u << xb) - 1u));
         e.p = (int8_t)(k & 1u);
-        b->decoded.data[i] = e;
+        return e;
+    };
+    const evr_event first = decode(n ? sl->h_sorted.p[0] : 0ull);
+    const bool direct = n && (!out->n || !evr_event_key_less(&first, &out->data[out->n - 1]));
+    evr_event_vec *dst = direct ? out : &b->decoded;
+    if (!direct) b->decoded.n = 0;
+    if (!evr_event_vec_reserve(dst, n)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
     }
-    b->decoded.n = n;
-    if (!evr_events_merge(out, b->decoded.data, n, &b->scratch)) {
+    for (size_t i = 0; i < n; i++) dst->data[dst->n + i] = decode(sl->h_sorted.p[i]);
+    dst->n += n;
+    if (!direct && !evr_events_merge(out, b->decoded.data, n, &b->scratch)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
     }
