@@ -23,10 +23,20 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --bac
     --sensor davis346 --start 0.9 -o "$OUT/cs-eye2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck davis346 exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x64 --duration 0.1 \
     -o "$OUT/cs-sq" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck exit $?" >> "$OUT/sanitizer.log"
+# global illumination on the GPU (photon pass, sort, gathers)
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --backend cuda --res 96x72 \
+    --duration 0.3 -o "$OUT/cs-gi" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck gi exit $?" >> "$OUT/sanitizer.log"
+compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --backend cuda --res 64x48 \
+    --duration 0.2 -o "$OUT/cs-gi2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck gi exit $?" >> "$OUT/sanitizer.log"
 # issue 7's figure: the eye at 1280x720, 10 samples per frame, 30 fps, the whole 30 s, ideal
 # sensor, change-driven sampling against brute force in the same run, with the identity check
 "$E" bench --scene eye --backend cuda --res 1280x720 --samples-per-frame 10 --vs-brute > "$OUT/bench.log" 2>&1
 echo "bench exit $?" >> "$OUT/bench.log"
 "$E" bench --scene eye-drift --backend cuda --res 1280x720 --samples-per-frame 10 --duration 3 --vs-brute >> "$OUT/bench.log" 2>&1
 echo "bench exit $?" >> "$OUT/bench.log"
+# issue 5's cost: the Cornell box with and without GI
+for gi in none photon; do
+    "$E" bench --scene cornell --backend cuda --res 1280x720 --samples-per-frame 10 --duration 2 --gi "$gi" >> "$OUT/bench.log" 2>&1
+    echo "bench gi $gi exit $?" >> "$OUT/bench.log"
+done
 cat "$OUT"/*.log
