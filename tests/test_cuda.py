@@ -24,7 +24,9 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
          # adaptive sampling (core/adaptive.h): a pixel's sample times follow its intensities, so
          # float differences between the traversals can move them: looser bounds (2%, F1 0.97)
          ("eye", ["--res", "160x120", "--start", "0.2", "--duration", "1.0", "--sampling", "adaptive"]),
-         ("eye", ["--sensor", "davis346", "--res", "160x120", "--duration", "0.5", "--sampling", "adaptive"])]
+         ("eye", ["--sensor", "davis346", "--res", "160x120", "--duration", "0.5", "--sampling", "adaptive"]),
+         # adaptive sampling with global illumination (the adaptive kernel's GI variant)
+         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"])]
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     for backend in ("cpu", "cuda"):

@@ -1,7 +1,8 @@
 """Global illumination in the event pipeline (--gi photon, CPU backend): a still Cornell box makes
 no events with GI on (the same photons every segment), with and without change-driven sampling;
 the moving box's events are identical with and without skipping; GI changes the intensities;
-run.json accounts for the photon passes; bad options and the CUDA backend give one-line errors."""
+run.json accounts for the photon passes; the per-pixel gather memo changes no event (uniform and
+adaptive sampling); bad options give one-line errors."""
 import os
 
 import evrtest as T
@@ -40,6 +41,12 @@ os.environ["EVR_GI_NO_MEMO"] = "1"
 ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip")
 del os.environ["EVR_GI_NO_MEMO"]
 T.check(ev_m == ev_b, "GI: the same events without the gather memo")
+# the same with adaptive sampling (its tiles must forget a pixel's gather when its window changed)
+ev_a, ja = render("adaptive", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
+os.environ["EVR_GI_NO_MEMO"] = "1"
+ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
+del os.environ["EVR_GI_NO_MEMO"]
+T.check(ja["stats"]["events"] > 0 and ev_a == ev_am, "GI with adaptive sampling: the same events without the gather memo")
 
 bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
        ["--gi", "photon", "--gather-max", "0"], ["--gi", "photon", "--gather-radius", "-1"],

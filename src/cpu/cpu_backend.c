@@ -395,6 +395,9 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         int jump = 0;
         if (ideal) pp[j] = b->setup.pixel;
         else evr_pixel_params_at(&b->setup.pixel, x, y, &pp[j]);
+        /* global illumination: a gather window whose photons changed forgets the pixel's last
+         * gather (else its memo would keep the previous segment's indirect light) */
+        if (b->gi) evr_cpu_gi_pixel_begin(&b->gi_state, x, y);
         stack[j].n = 0;
         if (st->started && !plan->all_min) {   /* what the last sample's rays meet in this segment */
             evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
