@@ -26,7 +26,9 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
          ("eye", ["--res", "160x120", "--start", "0.2", "--duration", "1.0", "--sampling", "adaptive"]),
          ("eye", ["--sensor", "davis346", "--res", "160x120", "--duration", "0.5", "--sampling", "adaptive"]),
          # adaptive sampling with global illumination (the adaptive kernel's GI variant)
-         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"])]
+         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"]),
+         # the sensor model with global illumination (the sensor kernel's GI variant)
+         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"])]
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     for backend in ("cpu", "cuda"):
