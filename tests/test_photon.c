@@ -60,6 +60,47 @@ static void test_rings(void)
     }
 }
 
+/* The gather walks the cells in evr_ring_cell's order: the same sums bit for bit as a loop over
+ * evr_ring_cell, and it stops in the ring of the cell where the count reaches the maximum. */
+static void test_gather_walk(void)
+{
+    const int R = 5, n = 2 * R + 1;
+    evr_photon_buffer b;
+    evr_error err;
+    int x, y, k;
+    CHECK_OK(evr_photon_buffer_alloc(&b, n, n, 1, 0, &err));
+    for (y = 0; y < n; y++)
+        for (x = 0; x < n; x++) {   /* one photon per cell, every one within reach, distinct fluxes */
+            evr_photon ph;
+            memset(&ph, 0, sizeof ph);
+            ph.p[0] = 0.01f * (float)(x - R) + 0.001f * (float)(y % 3);
+            ph.p[1] = 0.01f * (float)(y - R);
+            ph.n[2] = 1.0f;
+            ph.flux[0] = 1.0f + 0.137f * (float)(x * n + y);
+            ph.flux[1] = 3.0f / (1.0f + (float)(x + 2 * y));
+            ph.flux[2] = 0.5f;
+            CHECK(evr_photon_buffer_insert(&b, x, y, &ph));
+        }
+    const evr_v3 p = evr_v3_make(0.0013f, -0.0021f, 0.0f), nrm = evr_v3_make(0.0f, 0.0f, 1.0f);
+    const float lim2 = 1.0f, s2 = 0.0025f;
+    float ref[3] = {0.0f, 0.0f, 0.0f}, ref_area = 0.0f, acc[3], area;
+    int stop, used;
+    for (k = 0; k < n * n; k++) {
+        int dx, dy;
+        evr_ring_cell(k, &dx, &dy);
+        evr_photon_gather_cell(&b, R + dx, R + dy, p, nrm, lim2, 0.5f, s2, ref, &ref_area);
+    }
+    used = evr_photon_gather_rings(&b, R, R, R, p, nrm, lim2, 0.5f, s2, 1 << 30, acc, &stop, &area);
+    CHECK(used == n * n && stop == -1);
+    CHECK(memcmp(acc, ref, sizeof acc) == 0);   /* the same order: the same bits */
+    for (k = 0; k < n * n; k++) {
+        int dx, dy, ring = evr_ring_cell(k, &dx, &dy);
+        used = evr_photon_gather_rings(&b, R, R, R, p, nrm, lim2, 0.5f, s2, k + 1, acc, &stop, &area);
+        CHECK(used == k + 1 && stop == ring);
+    }
+    evr_photon_buffer_free(&b);
+}
+
 static void test_kernel(void)
 {
     const float radii[3] = {0.01f, 1.0f, 5.0f};
@@ -554,6 +595,7 @@ int main(void)
 {
     test_projection();
     test_rings();
+    test_gather_walk();
     test_kernel();
     test_gather_units();
     test_material();
