@@ -4,18 +4,17 @@
 #include "core/rng.h"
 #include "core/shading.h"
 #include "core/skip.h"
+#include "cpu/workers.h"
 #include "cpu/cpu_gi.h"
 #include "cuda/gpu_bvh.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 #if defined(__SSE__)
 #include <pmmintrin.h>
 #include <xmmintrin.h>
@@ -576,19 +575,10 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     atomic_store(&b->samples_traced, 0);
     atomic_store(&b->pixels_skipped, 0);
     atomic_store(&b->failed, 0);
-    pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
-    if (!th) {
+    if (!evr_run_workers(worker, b, nthreads)) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;
     }
-    int started = 0;
-    for (i = 1; i < nthreads; i++) {
-        if (pthread_create(&th[i], NULL, worker, b) != 0) break;
-        started++;
-    }
-    worker(b);   /* the calling thread works too */
-    for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
-    free(th);
     /* counted when collected, so that the totals after a collect are those of the segments
      * collected so far */
     b->done_counts[slot][0] = atomic_load(&b->samples);
@@ -827,10 +817,7 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     b->scene = s;
     b->host = *h;
     b->setup = *setup;
-    if (b->setup.threads <= 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        b->setup.threads = nc > 0 ? (int)nc : 1;
-    }
+    b->setup.threads = evr_cpu_threads(b->setup.threads);
     b->tiles_x = (setup->width + TILE - 1) / TILE;
     b->tiles_y = (setup->height + TILE - 1) / TILE;
     b->pixels = malloc(npix * sizeof *b->pixels);

@@ -1,14 +1,13 @@
 /* The CPU photon pass: emitters, buffer, and the tracing loop over all cores. */
 #include "cpu/photon_pass.h"
+#include "cpu/workers.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 #if defined(__SSE__)
 #include <pmmintrin.h>
 #include <xmmintrin.h>
@@ -185,17 +184,12 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
                               int threads, evr_error *err)
 {
     gbuf_ctx c;
-    int i, started = 0;
     if (!buf->gbuf) {
         buf->gbuf = malloc((size_t)buf->width * (size_t)buf->height * 8 * sizeof(float));
         if (!buf->gbuf) {
             snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer's view");
             return EVR_ERR_NOMEM;
         }
-    }
-    if (threads <= 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = nc > 0 ? (int)nc : 1;
     }
     memset(&c, 0, sizeof c);
     c.rs = rs;
@@ -205,18 +199,10 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
     c.pose = evr_rs_camera_pose(rs, f);
     c.fwd = evr_v3_norm(evr_m34_vector(&c.pose, evr_v3_make(0.0f, 0.0f, -1.0f)));
     atomic_store(&c.next, 0);
-    pthread_t *th = malloc(sizeof *th * (size_t)threads);
-    if (!th) {
+    if (!evr_run_workers(gbuf_worker, &c, evr_cpu_threads(threads))) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;
     }
-    for (i = 1; i < threads; i++) {
-        if (pthread_create(&th[i], NULL, gbuf_worker, &c) != 0) break;
-        started++;
-    }
-    gbuf_worker(&c);
-    for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
-    free(th);
     return EVR_OK;
 }
 
@@ -330,7 +316,7 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
 {
     pass_ctx c;
     struct timespec t0, t1;
-    int nthreads = pp->threads, i, k, started = 0;
+    int i, k;
     evr_status rc = EVR_OK;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     memset(st, 0, sizeof *st);
@@ -340,10 +326,6 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
         snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", em->photons);
         return EVR_ERR_ARG;
     }
-    if (nthreads <= 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        nthreads = nc > 0 ? (int)nc : 1;
-    }
     memset(&c, 0, sizeof c);
     c.rs = rs;
     c.tr = tr;
@@ -352,21 +334,12 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     c.margin = buf->margin;
     c.nchunks = (int)((em->photons + CHUNK - 1) / CHUNK);
     c.chunks = calloc((size_t)c.nchunks, sizeof *c.chunks);
-    pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
-    if (!c.chunks || !th) {
+    atomic_store(&c.next, 0);
+    if (!c.chunks || !evr_run_workers(pass_worker, &c, evr_cpu_threads(pp->threads))) {
         free(c.chunks);
-        free(th);
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon pass");
         return EVR_ERR_NOMEM;
     }
-    atomic_store(&c.next, 0);
-    for (i = 1; i < nthreads; i++) {
-        if (pthread_create(&th[i], NULL, pass_worker, &c) != 0) break;
-        started++;
-    }
-    pass_worker(&c);
-    for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
-    free(th);
     /* in photon order: the same buffer for any thread count */
     for (k = 0; k < c.nchunks; k++) {
         chunk_out *co = &c.chunks[k];

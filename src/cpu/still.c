@@ -3,6 +3,7 @@
  * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
 #include "still.h"
 #include "cpu/cpu_gi.h"
+#include "cpu/workers.h"
 #include "backend.h"
 #include "core/photon.h"
 #include "core/rng.h"
@@ -11,13 +12,11 @@
 
 #include <embree3/rtcore.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 #if defined(__SSE__)
 #include <pmmintrin.h>
 #include <xmmintrin.h>
@@ -235,7 +234,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     evr_photon_emitters em;
     shade_ctx c;
     char emsg[256] = "";
-    int cam, i, nthreads = p->threads, started = 0;
+    int cam, i, nthreads = p->threads;
     evr_status st;
     double t0 = now();
     size_t npix;
@@ -268,10 +267,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         snprintf(err->msg, sizeof err->msg, "the scene has no camera named '%s'", p->camera);
         return EVR_ERR_ARG;
     }
-    if (nthreads <= 0) {
-        long nc = sysconf(_SC_NPROCESSORS_ONLN);
-        nthreads = nc > 0 ? (int)nc : 1;
-    }
+    nthreads = evr_cpu_threads(nthreads);
     if ((st = evr_render_host_init(&host, s, cam, p->width, p->height, p->ambient, err)) != EVR_OK) return st;
     npix = (size_t)p->width * (size_t)p->height;
     out->width = p->width;
@@ -389,20 +385,12 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     }
     {
         double t2 = now();
-        pthread_t *th = malloc(sizeof *th * (size_t)nthreads);
-        if (!th) {
+        atomic_store(&c.next_row, 0);
+        if (!evr_run_workers(shade_worker, &c, nthreads)) {
             snprintf(err->msg, sizeof err->msg, "out of memory");
             st = EVR_ERR_NOMEM;
             goto done;
         }
-        atomic_store(&c.next_row, 0);
-        for (i = 1; i < nthreads; i++) {
-            if (pthread_create(&th[i], NULL, shade_worker, &c) != 0) break;
-            started++;
-        }
-        shade_worker(&c);
-        for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
-        free(th);
         out->seconds_shading = now() - t2;
     }
     {
