@@ -16,6 +16,7 @@
  * Prints traversal speed next to Embree's, for information. */
 #include "check.h"
 #include "backend.h"
+#include "cpu/cpu_gi.h"
 #include "core/rng.h"
 #include "cuda/gpu_bvh.h"
 #include "cuda/gpu_traverse.h"
@@ -234,46 +235,22 @@ static int same_groups(const evr_scene *s, const evr_gpu_bvh *b, const reference
     return 1;
 }
 
+/* Embree's answers over the reference's grouped scene (cpu/cpu_gi.h's queries). */
 static int reference_closest(const reference *r, evr_ray ray, float tmax, float f, evr_gpu_hit *hit)
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRayHit rh;
-    rtcInitIntersectContext(&ctx);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = tmax;
-    rh.ray.time = f;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(r->top, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    hit->instance = r->members[r->group_first[rh.hit.instID[0]] + (int)rh.hit.geomID];
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    hit->t = rh.ray.tfar;
+    evr_trace_hit h;
+    if (!evr_embree_closest1(r->top, r->members, r->group_first, ray, 0.0f, tmax, f, &h)) return 0;
+    hit->instance = h.inst;
+    hit->prim = h.prim;
+    hit->u = h.u;
+    hit->v = h.v;
+    hit->t = h.t;
     return 1;
 }
 
 static int reference_occluded(const reference *r, evr_ray ray, float tnear, float tfar, float f)
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRay q;
-    rtcInitIntersectContext(&ctx);
-    q.org_x = ray.org.x; q.org_y = ray.org.y; q.org_z = ray.org.z;
-    q.dir_x = ray.dir.x; q.dir_y = ray.dir.y; q.dir_z = ray.dir.z;
-    q.tnear = tnear;
-    q.tfar = tfar;
-    q.time = f;
-    q.mask = 0xffffffffu;
-    q.id = 0;
-    q.flags = 0;
-    rtcOccluded1(r->top, &ctx, &q);
-    return q.tfar < 0.0f;
+    return evr_embree_occluded1(r->top, ray, tnear, tfar, f);
 }
 
 /* ---- rays ---- */

@@ -2,6 +2,7 @@
  * search, kernel, gather units, flux conservation of the pass in a closed box, determinism. */
 #include "check.h"
 #include "core/photon.h"
+#include "cpu/cpu_gi.h"
 #include "cpu/photon_pass.h"
 
 #include <embree3/rtcore.h>
@@ -410,43 +411,15 @@ static void make_box(void)
     }
 }
 
+/* The pass's tracer over a scene of one geometry per instance (cpu/cpu_gi.h's Embree queries). */
 static int tr_closest(void *user, evr_ray ray, float tnear, float tfar, float f, evr_trace_hit *hit)
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRayHit rh;
-    rtcInitIntersectContext(&ctx);
-    memset(&rh, 0, sizeof rh);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
-    rh.ray.tnear = tnear;
-    rh.ray.tfar = tfar;
-    rh.ray.time = f;
-    rh.ray.mask = 0xffffffffu;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1((RTCScene)user, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    hit->inst = (int)rh.hit.geomID;
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    hit->t = rh.ray.tfar;
-    return 1;
+    return evr_embree_closest1((RTCScene)user, NULL, NULL, ray, tnear, tfar, f, hit);
 }
 
 static int tr_occluded(void *user, evr_ray ray, float tnear, float tfar, float f)
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRay r;
-    rtcInitIntersectContext(&ctx);
-    memset(&r, 0, sizeof r);
-    r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
-    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
-    r.tnear = tnear;
-    r.tfar = tfar;
-    r.time = f;
-    r.mask = 0xffffffffu;
-    rtcOccluded1((RTCScene)user, &ctx, &r);
-    return r.tfar < 0.0f;
+    return evr_embree_occluded1((RTCScene)user, ray, tnear, tfar, f);
 }
 
 static int same_buffer(const evr_photon_buffer *a, const evr_photon_buffer *b)
