@@ -81,6 +81,44 @@ def quad_gltf(path, with_triangles=True, animated=False):
         json.dump(g, f)
 
 
+def square_crossings(ev, w, h, c_on, c_off):
+    """The built-in 'square' scene's events against its analytic crossings (tests/test_square.py
+    derives them): the pixels checked, how many of them have the wrong number of ON or OFF events,
+    the largest |t - analytic| in seconds of each correctly counted pixel, and whether the rows the
+    square never reaches stay silent. A pixel whose centre looks at X on the square's plane sees
+    the leading edge at t = X + 0.75 and the trailing edge at t = X + 1.25; it fires floor(2 / c_on)
+    ON events and floor(that * c_on / c_off) OFF events."""
+    import math
+    half = 3.99 / 4.0   # half-width of the view at the square's plane
+    count_on = int(math.floor(2.0 / c_on))
+    count_off = int(math.floor(count_on * c_on / c_off))
+    by_pixel = {}
+    for e in ev:
+        by_pixel.setdefault((int(e["x"]), int(e["y"])), []).append((int(e["t"]), int(e["p"])))
+    checked = bad = 0
+    errors = []
+    for j in range(h):
+        y = (1 - (j + 0.5) / h * 2) * half
+        if abs(y) > 0.22:
+            continue
+        for i in range(w):
+            x = ((i + 0.5) / w * 2 - 1) * half
+            if x < -0.6 or x > 0.7:
+                continue
+            t_on, t_off = x + 0.75, x + 1.25
+            evs = by_pixel.get((i, j), [])
+            on = [t for t, p in evs if p == 1]
+            off = [t for t, p in evs if p == 0]
+            checked += 1
+            if len(on) != count_on or len(off) != count_off:
+                bad += 1
+                continue
+            errors.append(max(max(abs(t * 1e-6 - t_on) for t in on), max(abs(t * 1e-6 - t_off) for t in off)))
+    quiet_rows = [j for j in range(h) if abs((1 - (j + 0.5) / h * 2) * half) > 0.3]
+    silent = not any(y in quiet_rows for (_, y) in by_pixel)
+    return checked, bad, errors, silent
+
+
 def finish(name):
     if failures:
         print(f"{name}: {len(failures)} check(s) failed")
