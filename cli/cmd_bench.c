@@ -556,13 +556,8 @@ int cmd_bench(int argc, char **argv)
         cfg.out_dir = NULL;
         return run_city_sweep(&cfg, sweep, dir, max_detail, max_buildings);
     }
-    evr_error err = {{0}};
-    evr_scene *scene = NULL;
-    evr_status st = scene_path ? evr_scene_load(scene_path, &scene, &err) : evr_demo_load(demo, &scene, &err);
-    if (st != EVR_OK) {
-        cli_error("%s", err.msg);
-        return 1;
-    }
+    evr_scene *scene = cli_load_scene(scene_path, demo);
+    if (!scene) return 1;
     int rc;
     if (suite) {
         rc = run_suite(scene, &cfg, json);

@@ -171,13 +171,10 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         return 2;
     }
 
+    evr_scene *scene = cli_load_scene(scene_path, default_demo);
+    if (!scene) return 1;
     evr_error err = {{0}};
-    evr_scene *scene = NULL;
-    evr_status st = scene_path ? evr_scene_load(scene_path, &scene, &err) : evr_demo_load(default_demo, &scene, &err);
-    if (st != EVR_OK) {
-        cli_error("%s", err.msg);
-        return 1;
-    }
+    evr_status st;
     evr_sim *sim = NULL;
     if ((st = evr_sim_new(scene, &cfg, &sim, &err)) != EVR_OK) {
         cli_error("%s", err.msg);

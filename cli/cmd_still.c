@@ -263,17 +263,15 @@ int cmd_still(int argc, char **argv)
             return 2;
         }
     }
-    evr_error err = {{0}};
-    evr_scene *scene = NULL;
-    evr_status st = scene_path ? evr_scene_load(scene_path, &scene, &err) : evr_demo_load(demo, &scene, &err);
-    if (st != EVR_OK) {
-        cli_error("%s", err.msg);
+    evr_scene *scene = cli_load_scene(scene_path, demo);
+    if (!scene) {
         free(ref);
         free(cmp);
         return 1;
     }
+    evr_error err = {{0}};
     evr_still_result r;
-    st = evr_still_render(scene, &p, &r, &err);
+    evr_status st = evr_still_render(scene, &p, &r, &err);
     if (st != EVR_OK) {
         cli_error("%s", err.msg);
         free(ref);

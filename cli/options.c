@@ -132,3 +132,15 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
     (*i)++;
     return argv[*i];
 }
+
+evr_scene *cli_load_scene(const char *path, const char *demo)
+{
+    evr_error err = {{0}};
+    evr_scene *scene = NULL;
+    evr_status st = path ? evr_scene_load(path, &scene, &err) : evr_demo_load(demo, &scene, &err);
+    if (st != EVR_OK) {
+        cli_error("%s", err.msg);
+        return NULL;
+    }
+    return scene;
+}

@@ -20,4 +20,8 @@ int opt_is(const char *arg, const char *name);
 
 void cli_error(const char *fmt, ...);
 
+/* The scene file at path, else the built-in scene demo; NULL (after the error message) when it
+ * cannot be loaded. */
+evr_scene *cli_load_scene(const char *path, const char *demo);
+
 #endif
