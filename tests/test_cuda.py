@@ -106,6 +106,20 @@ T.check(r["f1"] >= 0.95, f"cornell GI: CPU vs CUDA F1 {r['f1']} >= 0.95")
 T.check(st_gpu.get("photon_passes") == st_cpu.get("photon_passes"), "cornell GI: the same photon passes (still segments reuse)")
 T.check(gi_runs["cuda"][1] == gi_runs["cuda2"][1], "cornell GI on CUDA: two runs give identical events")
 T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: overflowing segments re-rendered, identical events")
+# the gathers deferred to a kernel of their own (cuda/gpu_gi_deferred.cuh, the default with uniform
+# sampling) give the events of the render kernel that gathers inline (EVR_GI_INLINE=1) bit for
+# bit: with change-driven sampling, brute force and the full sensor model
+for label, extra in (("skip", []), ("brute", ["--no-skip"]), ("davis346", ["--sensor", "davis346"]),
+                     ("720p", ["--res", "1280x720", "--duration", "0.3"])):
+    evs = []
+    for inline in (False, True):
+        if inline:
+            os.environ["EVR_GI_INLINE"] = "1"
+        d = os.path.join(tmp, f"gi-deferred-{label}-{int(inline)}")
+        T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi, *extra)
+        os.environ.pop("EVR_GI_INLINE", None)
+        evs.append(open(os.path.join(d, "events.npy"), "rb").read())
+    T.check(len(evs[0]) > 10000 and evs[0] == evs[1], f"cornell GI ({label}): deferred and inline gathers give identical events")
 d = os.path.join(tmp, "gi-still")
 T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
       "--res", "96x72", "--duration", "1.0")

@@ -764,16 +764,42 @@ EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_ma
     out_rgb[2] = k[2] * e_rgb[2];
 }
 
+/* What a gather needs of a surface point: position, normal, distance from the camera and the
+ * diffuse share of the albedo over pi (evr_photon_indirect_k). Made where the ray meets the
+ * surface; the gather itself may run later (the GPU defers it to a kernel of its own). */
+typedef struct evr_gather_point {
+    evr_v3 p, n;
+    float dist;
+    float k[3];
+} evr_gather_point;
+
+EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_view *mat, evr_v3 cam_org,
+                                              evr_gather_point *g)
+{
+    g->p = s->p;
+    g->n = s->n;
+    g->dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
+    evr_photon_indirect_k(s, mat, g->k);
+}
+
+/* Luminance of the indirect light leaving gather point g seen through image pixel (x, y). */
+EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
+                                                const evr_gather_params *gp, const evr_gather_point *g, int x, int y)
+{
+    float e[3];
+    evr_photon_gather(b, cam, x, y, g->p, g->n, g->dist, gp, e);
+    return evr_luminance(g->k[0] * e[0], g->k[1] * e[1], g->k[2] * e[2]);
+}
+
 /* Luminance of the indirect light leaving surface s (material mat) seen from cam_org through
  * image pixel (x, y): the gather and the diffuse share. */
 EVR_HD static inline float evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
                                                    const evr_gather_params *gp, const evr_material_view *mat,
                                                    const evr_surface *s, evr_v3 cam_org, int x, int y)
 {
-    float e[3], ind[3];
-    evr_photon_gather(b, cam, x, y, s->p, s->n, evr_v3_len(evr_v3_sub(s->p, cam_org)), gp, e);
-    evr_photon_indirect(s, mat, e, ind);
-    return evr_luminance(ind[0], ind[1], ind[2]);
+    evr_gather_point g;
+    evr_gather_point_at(s, mat, cam_org, &g);
+    return evr_gather_point_lum(b, cam, gp, &g, x, y);
 }
 
 #endif

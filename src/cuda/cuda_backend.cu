@@ -94,44 +94,60 @@ __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_
 
 #include "cuda/gpu_gi.cuh"
 
-/* Intensity of one sample: as sample_intensity in cpu/cpu_backend.c, with our traversal; GI: plus
- * the indirect light gathered from the segment's photons (memo: the pixel's last gather). */
-template <int LAYOUT, int GI>
-__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
-                                  float *t_hit, gi_memo *memo, float hint = INFINITY)
+/* Direct light of one sample, as sample_intensity in cpu/cpu_backend.c, with our traversal; 0 on a
+ * miss (returns false), else the surface met, its instance and the ray's origin for the gather. */
+template <int LAYOUT>
+__device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
+                                         float *t_hit, float hint, float *direct, evr_surface *s, int *inst, evr_v3 *cam_org)
 {
     const evr_render_scene *rs = &a.rs;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
     evr_gpu_hit hit;
     (*rays)++;
     *t_hit = INFINITY;
+    *direct = 0.0f;
     /* temporal coherence: the pixel's last hit distance (hint) bounds the search first; the
      * closest hit below that bound is the closest hit, and finding none, the ray is traced again
      * unbounded: the same hit either way */
     const float tf = hint < 1e30f ? hint * 1.0001f + 1e-6f : 1e30f;
     if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, tf, f, 0, &hit) &&
         (tf >= 1e30f || !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &hit)))
-        return 0.0f;
+        return false;
     *t_hit = hit.t;
+    *inst = hit.instance;
+    *cam_org = ray.org;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
-    evr_surface s;
-    evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, ray, hit.t, &s);
+    evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, ray, hit.t, s);
     float acc[3] = {0.0f, 0.0f, 0.0f};
     for (int l = 0; l < rs->num_lights; l++) {
         evr_v3 wi;
         float dist, e[3];
-        if (!evr_light_incident(rs, &rs->lights[l], f, s.p, &wi, &dist, e)) continue;
-        if (evr_v3_dot(wi, s.n) <= 0.0f) continue;
+        if (!evr_light_incident(rs, &rs->lights[l], f, s->p, &wi, &dist, e)) continue;
+        if (evr_v3_dot(wi, s->n) <= 0.0f) continue;
         (*rays)++;
         evr_ray sr;
-        sr.org = s.p;
+        sr.org = s->p;
         sr.dir = wi;
-        if (gpu_trace<LAYOUT>(&a.view, rs, sr, evr_shadow_tnear(&s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f, 1, &hit))
+        if (gpu_trace<LAYOUT>(&a.view, rs, sr, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f, 1, &hit))
             continue;
-        evr_accumulate_lambert(&s, wi, e, acc);
+        evr_accumulate_lambert(s, wi, e, acc);
     }
-    float out = evr_surface_intensity(&s, acc, rs->ambient);
-    if (GI) out += gi_indirect(a.gi, rs, hit.instance, &s, ray.org, x, y, memo);
+    *direct = evr_surface_intensity(s, acc, rs->ambient);
+    return true;
+}
+
+/* Intensity of one sample; GI: plus the indirect light gathered from the segment's photons (memo:
+ * the pixel's last gather). */
+template <int LAYOUT, int GI>
+__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
+                                  float *t_hit, gi_memo *memo, float hint = INFINITY)
+{
+    evr_surface s;
+    int inst = 0;
+    evr_v3 org;
+    float out;
+    if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org)) return 0.0f;
+    if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, memo);
     return out;
 }
 
@@ -461,6 +477,8 @@ __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float
     }
 }
 
+#include "cuda/gpu_gi_deferred.cuh"
+
 /* A buffer that grows (contents not kept), in device memory or in pinned host memory. */
 struct device_memory {
     static cudaError_t alloc(void **p, size_t n) { return cudaMalloc(p, n); }
@@ -474,11 +492,12 @@ struct pinned_memory {
 template <typename T, typename M> struct growing_buffer {
     T *p = nullptr;
     size_t cap = 0;
-    cudaError_t reserve(size_t n)
+    cudaError_t reserve(size_t n, bool exact = false)
     {
         if (n <= cap) return cudaSuccess;
         size_t c = cap ? cap : 1;
         while (c < n) c *= 2;
+        if (exact) c = n;
         release();
         void *q = nullptr;
         cudaError_t e = M::alloc(&q, c * sizeof(T));
@@ -602,6 +621,14 @@ struct cuda_backend {
     dbuf<unsigned long long> d_pkeys, d_pkeys_sorted;
     dbuf<unsigned> d_pvals, d_pvals_sorted, d_pcount;
     dbuf<unsigned char> d_ptemp;
+    /* GI with deferred gathers (gpu_gi_deferred.cuh): off when its buffers do not fit, or with
+     * adaptive sampling (its kernel gathers inline) */
+    int gi_deferred;
+    unsigned gather_grid;
+    dbuf<float> d_gd_direct, d_gd_cache, d_gd_lum;
+    dbuf<unsigned> d_gd_req, d_gd_count;
+    dbuf<int> d_gd_traced;
+    dbuf<gi_request> d_gd_requests;
 };
 
 static evr_status upload_scene(cuda_backend *b, evr_error *err)
@@ -758,6 +785,47 @@ template <typename F> static void with_variant(const cuda_backend *b, F f)
     else with_variant_of<EVR_GPU_LAYOUT_BVH4>(sensor, gi, f);
 }
 
+static gi_deferred deferred_args(const cuda_backend *b)
+{
+    gi_deferred d;
+    d.direct = b->d_gd_direct.p;
+    d.req = b->d_gd_req.p;
+    d.traced = b->d_gd_traced.p;
+    d.cache_dist = b->d_gd_cache.p;
+    d.requests = b->d_gd_requests.p;
+    d.lum = b->d_gd_lum.p;
+    d.count = b->d_gd_count.p;
+    d.stride = b->setup.width * b->setup.height;
+    return d;
+}
+
+/* The deferred gathers' buffers: every sample of every pixel may make a request (the moving
+ * object's pixels do). Where they do not fit in device memory the render kernel gathers inline,
+ * with a notice. EVR_GI_INLINE=1 (hidden, for tests and measurement) chooses that too. */
+static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
+{
+    b->gi_deferred = 0;
+    if (!b->gi || b->setup.adaptive || getenv("EVR_GI_INLINE")) return;
+    const size_t npix = (size_t)b->setup.width * b->setup.height, n = npix * (size_t)b->setup.samples_per_frame;
+    if (b->d_gd_direct.reserve(n, true) == cudaSuccess && b->d_gd_req.reserve(n, true) == cudaSuccess &&
+        b->d_gd_lum.reserve(n, true) == cudaSuccess && b->d_gd_requests.reserve(n, true) == cudaSuccess &&
+        b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_count.reserve(1) == cudaSuccess) {
+        b->gi_deferred = 1;
+        b->gather_grid = (unsigned)prop->multiProcessorCount * 16u;
+        return;
+    }
+    (void)cudaGetLastError();   /* the failed allocation: not sticky, cleared */
+    b->d_gd_direct.release();
+    b->d_gd_req.release();
+    b->d_gd_lum.release();
+    b->d_gd_requests.release();
+    b->d_gd_traced.release();
+    b->d_gd_cache.release();
+    fprintf(stderr, "evray: notice: not enough GPU memory to defer the gathers of %zu samples a segment; "
+                    "gathering inside the render kernel (slower)\n", n);
+}
+
 /* Renders a slot's segment on the render stream and queues the read-back of its event count. */
 static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 {
@@ -782,7 +850,19 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
             else skip_kernel<1><<<grid, BLOCK, 0, rs>>>(a);
             CK(cudaGetLastError());
         }
-        with_variant(b, [&](auto v) { render_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a); });
+        if (b->gi_deferred) {
+            gi_deferred d = deferred_args(b);
+            CK(cudaMemsetAsync(d.count, 0, sizeof(unsigned), rs));
+            if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
+            else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
+            CK(cudaGetLastError());
+            gi_gather_kernel<<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+            CK(cudaGetLastError());
+            if (ideal) gi_pixel_kernel<0><<<grid, BLOCK, 0, rs>>>(a, d);
+            else gi_pixel_kernel<1><<<grid, BLOCK, 0, rs>>>(a, d);
+        } else {
+            with_variant(b, [&](auto v) { render_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a); });
+        }
     }
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
@@ -1163,6 +1243,8 @@ static void cuda_release(evr_backend *base)
     }
     b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
     b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
+    b->d_gd_direct.release(); b->d_gd_req.release(); b->d_gd_lum.release(); b->d_gd_requests.release();
+    b->d_gd_traced.release(); b->d_gd_cache.release(); b->d_gd_count.release();
     evr_photon_emitters_free(&b->em);
     if (b->render) cudaStreamDestroy(b->render);
     evr_gpu_bvh_free(&b->bvh);
@@ -1250,6 +1332,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         if (b->gi && (st = gi_alloc(b, sl, gi_margin, gi_window, err)) != EVR_OK) return st;
     }
     if (b->gi) CK(b->d_pcount.reserve(1));
+    gi_deferred_alloc(b, &prop);
     CK(cudaDeviceSynchronize());
     return EVR_OK;
 }

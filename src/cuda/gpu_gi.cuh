@@ -29,13 +29,47 @@ struct gpu_gi_view {
 };
 
 /* A pixel's last gather in this launch: the same point, normal, distance and instance in the
- * same buffer give the same estimate bit for bit (a traced pixel on a still surface). */
+ * same buffer give the same estimate bit for bit (a traced pixel on a still surface). lum: the
+ * estimate (gathers inside the render kernel); req: the deferred gather's request (gi_trace_kernel). */
 struct gi_memo {
     uint32_t key[7];
     int inst;
     float lum;
+    unsigned req;
     bool valid;
 };
+
+/* The gather point of surface s (instance inst) seen from cam_org, and a gather's luminance at
+ * one: not inlined, so that the render kernel (gathers inline) and the deferred kernels
+ * (gpu_gi_deferred.cuh) run the very same instructions: inlined into different kernels the
+ * compiler may fuse a multiply and an add in one and not the other, and the events would differ
+ * in the last bit of a few samples (13 of 6.5 M events at 1280x720 when both were inlined). */
+__device__ __noinline__ void gpu_gather_point(const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
+                                              evr_gather_point *g)
+{
+    evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org, g);
+}
+
+__device__ __noinline__ float gpu_gather_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
+                                             int y)
+{
+    return evr_gather_point_lum(&v->buf, cam, &v->gp, g, x, y);
+}
+
+/* Whether the memo holds gather point g of instance inst; if not, it takes it (the caller fills
+ * lum or req). The albedo is the surface's at the point: same point, same triangle side. */
+__device__ __forceinline__ bool gi_memo_take(gi_memo *m, int inst, const evr_gather_point *g)
+{
+    const uint32_t key[7] = {__float_as_uint(g->p.x), __float_as_uint(g->p.y), __float_as_uint(g->p.z), __float_as_uint(g->n.x),
+                             __float_as_uint(g->n.y), __float_as_uint(g->n.z), __float_as_uint(g->dist)};
+    bool same = m->valid && m->inst == inst;
+    for (int k = 0; k < 7 && same; k++) same = m->key[k] == key[k];
+    if (same) return true;
+    for (int k = 0; k < 7; k++) m->key[k] = key[k];
+    m->inst = inst;
+    m->valid = true;
+    return false;
+}
 
 /* The indirect light of a sample at surface s of instance inst: the pixel's memo, or a gather
  * (the pixel's own thread walks its window; a version spreading each window's cells over the
@@ -45,17 +79,10 @@ struct gi_memo {
 __device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs, int inst, const evr_surface *s,
                                              evr_v3 cam_org, int x, int y, gi_memo *m)
 {
-    const float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
-    const uint32_t key[7] = {__float_as_uint(s->p.x), __float_as_uint(s->p.y), __float_as_uint(s->p.z), __float_as_uint(s->n.x),
-                             __float_as_uint(s->n.y), __float_as_uint(s->n.z), __float_as_uint(dist)};
-    bool same = m->valid && m->inst == inst;
-    for (int k = 0; k < 7 && same; k++) same = m->key[k] == key[k];
-    if (same) return m->lum;
-    const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
-    for (int k = 0; k < 7; k++) m->key[k] = key[k];
-    m->inst = inst;
-    m->lum = evr_photon_indirect_lum(&g->buf, &rs->camera, &g->gp, mat, s, cam_org, x, y);
-    m->valid = true;
+    evr_gather_point gp;
+    gpu_gather_point(rs, inst, s, cam_org, &gp);
+    if (gi_memo_take(m, inst, &gp)) return m->lum;
+    m->lum = gpu_gather_lum(g, &rs->camera, &gp, x, y);
     return m->lum;
 }
 

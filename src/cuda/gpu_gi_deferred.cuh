@@ -1,0 +1,167 @@
+/* Global illumination with the gathers deferred (uniform sampling): the render of a segment in
+ * three kernels instead of one.
+ *
+ *   gi_trace_kernel   the pixels' samples: rays and direct light; a sample that needs a gather
+ *                     (its pixel's memo does not hold its surface point) appends a request
+ *   gi_gather_kernel  one thread per request: the gather (core/photon.h)
+ *   gi_pixel_kernel   the pixels' samples through the pixel model: direct + gathered light
+ *
+ * Why: a gather inside the render kernel cost 31 ns against 3.8 ns in a kernel of its own
+ * (H100, Cornell box at 1280x720; docs/benchmarks.md): there it ran at the render kernel's
+ * occupancy, its lanes beside lanes that trace. The samples, their intensities (direct + gathered,
+ * the same float addition as gpu_sample) and the events are those of render_kernel<GI> bit for
+ * bit; tests/test_cuda.py compares the two (EVR_GI_INLINE=1 selects the single kernel).
+ *
+ * Included by cuda_backend.cu after render_kernel (it uses its helpers). */
+#ifndef EVR_CUDA_GPU_GI_DEFERRED_CUH
+#define EVR_CUDA_GPU_GI_DEFERRED_CUH
+
+#define GI_NO_REQUEST 0xffffffffu
+
+/* A deferred gather: the surface point and its pixel. */
+struct gi_request {
+    evr_gather_point g;
+    int pix;
+};
+
+/* The three kernels' shared buffers (device memory, reused by every launch: the kernels of a
+ * segment run in order on the render stream). Per-sample arrays are [sample][thread]. */
+struct gi_deferred {
+    float *direct;        /* a traced sample's direct light */
+    unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
+    int *traced;          /* per thread: samples traced; later samples keep the last intensity */
+    float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
+    gi_request *requests;
+    float *lum;           /* per request: the gather's luminance */
+    unsigned *count;      /* requests made */
+    int stride;           /* threads of a launch at most: the pixel count */
+};
+
+/* First kernel: render_kernel's rays and settling, without the pixel model. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args a, gi_deferred d)
+{
+    const int npix = a.width * a.height;
+    const int n = a.list ? (int)*a.list_count : npix;
+    const int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if ((int)(blockIdx.x * blockDim.x) >= n) return;   /* the whole block */
+    const bool active = i < n;                           /* inactive threads still take part in warp votes */
+    const int pix = active ? (a.list ? a.list[i] : i) : 0;
+    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    const unsigned lane = threadIdx.x & 31u;
+    const float phi = active ? a.phase[pix] : 0.0f;
+    unsigned rays = 0, traced = 0;
+    float t_hit = INFINITY, cache = -1.0f;
+    bool tracing = active;
+    gi_memo memo;
+    memo.valid = false;
+    const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    for (int k = 0; k < a.samples; k++) {
+        const bool now = tracing;
+        bool want = false;
+        unsigned r = GI_NO_REQUEST;
+        float direct = 0.0f;
+        evr_gather_point g;
+        if (now) {
+            const float f = ((float)k + phi) / (float)a.samples;
+            evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
+            evr_surface s;
+            int inst = 0;
+            evr_v3 org;
+            if (gpu_sample_direct<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit, a.coherence ? t_hit : INFINITY, &direct, &s, &inst,
+                                          &org)) {
+                gpu_gather_point(&a.rs, inst, &s, org, &g);
+                if (gi_memo_take(&memo, inst, &g)) r = memo.req;
+                else want = true;
+            }
+            traced++;
+        }
+        const unsigned mask = __ballot_sync(0xffffffffu, want);
+        if (mask) {   /* the warp's requests in one atomic */
+            const unsigned leader = (unsigned)__ffs(mask) - 1u;
+            unsigned base = 0;
+            if (lane == leader) base = atomicAdd(d.count, (unsigned)__popc(mask));
+            base = __shfl_sync(0xffffffffu, base, leader);
+            if (want) {
+                r = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+                d.requests[r].g = g;
+                d.requests[r].pix = pix;
+                memo.req = r;
+            }
+        }
+        if (now) {
+            const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
+            d.direct[at] = direct;
+            d.req[at] = r;
+        }
+        if (k == 0 && tracing) {
+            /* settle, as render_kernel: the first sample's rays meet nothing that moves */
+            const float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
+            if (c >= 0.0f) {
+                tracing = false;
+                cache = c;
+            }
+        }
+    }
+    if (active) {
+        if (tracing) cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
+        d.cache_dist[i] = cache;
+        d.traced[i] = (int)traced;
+    }
+    add_counts(a, lane, rays, traced);
+}
+
+/* Second kernel: the requests' gathers, a grid-stride loop over however many were made. */
+__global__ void __launch_bounds__(BLOCK) gi_gather_kernel(kernel_args a, gi_deferred d)
+{
+    const unsigned n = *d.count;
+    for (unsigned r = blockIdx.x * blockDim.x + threadIdx.x; r < n; r += gridDim.x * blockDim.x) {
+        const gi_request q = d.requests[r];
+        d.lum[r] = gpu_gather_lum(a.gi, &a.rs.camera, &q.g, q.pix % a.width, q.pix / a.width);
+    }
+}
+
+/* Third kernel: render_kernel's pixel model over the intensities of the first two. */
+template <int SENSOR>
+__global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args a, gi_deferred d)
+{
+    const int npix = a.width * a.height;
+    const int n = a.list ? (int)*a.list_count : npix;
+    const int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if ((int)(blockIdx.x * blockDim.x) >= n) return;
+    const bool active = i < n;
+    const int pix = active ? (a.list ? a.list[i] : i) : 0;
+    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    const unsigned lane = threadIdx.x & 31u;
+    evr_pixel_state st;
+    evr_pixel_reset(&st);
+    float phi = 0.0f;
+    int traced = 0;
+    evr_pixel_params own;
+    if (SENSOR) own = *a.sensor;
+    if (active) {
+        load_state<SENSOR>(a, pix, st);
+        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
+        phi = a.phase[pix];
+        traced = d.traced[i];
+    }
+    for (int k = 0; k < a.samples; k++) {
+        const float f = ((float)k + phi) / (float)a.samples;
+        float intensity = st.intensity;   /* kept when settled */
+        if (k < traced) {
+            const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
+            intensity = d.direct[at];
+            const unsigned r = d.req[at];
+            if (r != GI_NO_REQUEST) intensity += d.lum[r];
+        }
+        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
+    }
+    if (active) {
+        st.cache_dist = d.cache_dist[i];
+        evr_pixel_end_segment(&st, a.dt);
+        store_state<SENSOR>(a, pix, st);
+    }
+}
+
+#endif
