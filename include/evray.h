@@ -159,6 +159,7 @@ typedef struct {
     double time_write;            /* the writer thread's busy time (overlaps rendering) */
     double time_photons;          /* global illumination: the photon passes (GPU: device time) */
     uint64_t photons_stored, photon_collisions, photon_cells_changed;
+    uint64_t photons_traced, photons_reused;   /* photon paths traced, and those that reused their trail */
     uint64_t device_memory;       /* bytes the backend holds on the GPU (0 on the CPU) */
     char backend[16];             /* the backend that ran: "cpu" or "cuda" */
     char device[128];             /* CPU threads or the GPU's name */

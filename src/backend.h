@@ -74,6 +74,7 @@ struct evr_backend {
     uint64_t samples_traced;      /* samples that traced rays (the others reused a cached intensity) */
     uint64_t pixels_skipped;      /* pixel-segments that reused their cached intensity */
     uint64_t photons_traced, photons_stored, photon_collisions, photon_passes;   /* GI */
+    uint64_t photons_reused;         /* GI: photons whose path was not traced again (their trail's outcome) */
     uint64_t photon_cells_changed;   /* GI: buffer cells whose photons or view changed, all passes */
     double photon_seconds;
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */

@@ -232,6 +232,7 @@ static char *run_json(const evr_sim *sim)
     if (sim->cfg.gi) {   /* the photon passes (a still segment reuses the previous segment's photons) */
         evr_json_key(&j, "photon_passes"); evr_json_unsigned(&j, sim->backend->photon_passes);
         evr_json_key(&j, "photons_traced"); evr_json_unsigned(&j, sim->backend->photons_traced);
+        evr_json_key(&j, "photons_reused"); evr_json_unsigned(&j, sim->backend->photons_reused);
         evr_json_key(&j, "photons_stored"); evr_json_unsigned(&j, sim->backend->photons_stored);
         evr_json_key(&j, "photon_collisions"); evr_json_unsigned(&j, sim->backend->photon_collisions);
         evr_json_key(&j, "photon_cells_changed"); evr_json_unsigned(&j, sim->backend->photon_cells_changed);

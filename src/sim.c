@@ -329,6 +329,8 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     sim->st.time_photons = sim->backend->photon_seconds;
     sim->st.photons_stored = sim->backend->photons_stored;
     sim->st.photon_collisions = sim->backend->photon_collisions;
+    sim->st.photons_traced = sim->backend->photons_traced;
+    sim->st.photons_reused = sim->backend->photons_reused;
     sim->st.photon_cells_changed = sim->backend->photon_cells_changed;
     sim->st.sim_time = t1 - sim->cfg.start;
     sim->st.wall_time = now_seconds() - wall0;

@@ -120,6 +120,21 @@ for label, extra in (("skip", []), ("brute", ["--no-skip"]), ("davis346", ["--se
         os.environ.pop("EVR_GI_INLINE", None)
         evs.append(open(os.path.join(d, "events.npy"), "rb").read())
     T.check(len(evs[0]) > 10000 and evs[0] == evs[1], f"cornell GI ({label}): deferred and inline gathers give identical events")
+# photons whose trails meet nothing that moves keep their outcome (core/photon.h): the same events
+# as tracing every photon (EVR_NO_PHOTON_REUSE), and about as many photons reused as on the CPU
+os.environ["EVR_NO_PHOTON_REUSE"] = "1"
+d = os.path.join(tmp, "gi-no-reuse")
+T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi)
+os.environ.pop("EVR_NO_PHOTON_REUSE", None)
+st_nr = T.load_run_json(d)["stats"]
+print(f"photon trails: cuda {st_gpu['photons_reused']} reused / {st_gpu['photons_traced']} traced, cpu "
+      f"{st_cpu['photons_reused']} / {st_cpu['photons_traced']}; without reuse {st_nr['photons_traced']} traced")
+T.check(open(os.path.join(d, "events.npy"), "rb").read() == gi_runs["cuda"][1],
+        "cornell GI on CUDA: the same events with and without reusing photon trails")
+T.check(st_gpu["photons_reused"] > st_gpu["photons_traced"] and st_nr["photons_reused"] == 0,
+        "cornell GI on CUDA: most photons reuse their trails")
+T.check(abs(st_gpu["photons_reused"] - st_cpu["photons_reused"]) <= 0.02 * st_cpu["photons_reused"],
+        "cornell GI: CUDA reuses as many photon trails as the CPU (within 2%)")
 d = os.path.join(tmp, "gi-still")
 T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
       "--res", "96x72", "--duration", "1.0")

@@ -1,8 +1,8 @@
 """Global illumination in the event pipeline (--gi photon, CPU backend): a still Cornell box makes
 no events with GI on (the same photons every segment), with and without change-driven sampling;
 the moving box's events are identical with and without skipping; GI changes the intensities;
-run.json accounts for the photon passes; the per-pixel gather memo changes no event (uniform and
-adaptive sampling); bad options give one-line errors."""
+run.json accounts for the photon passes; the per-pixel gather memo and the reuse of photon
+trails change no event (uniform and adaptive sampling); bad options give one-line errors."""
 import os
 
 import evrtest as T
@@ -47,6 +47,21 @@ os.environ["EVR_GI_NO_MEMO"] = "1"
 ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
 del os.environ["EVR_GI_NO_MEMO"]
 T.check(ja["stats"]["events"] > 0 and ev_a == ev_am, "GI with adaptive sampling: the same events without the gather memo")
+# a photon whose last path met nothing that moves keeps its outcome instead of being traced again
+# (its trail, core/photon.h): the same events as tracing every photon (EVR_NO_PHOTON_REUSE), most
+# photons of the moving box's passes reused, none under brute force
+st = js["stats"]
+os.environ["EVR_NO_PHOTON_REUSE"] = "1"
+ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--duration", "0.5")
+del os.environ["EVR_NO_PHOTON_REUSE"]
+print(f"photon trails: {st['photons_reused']} reused, {st['photons_traced']} traced in {st['photon_passes']} passes; "
+      f"without reuse {jt['stats']['photons_traced']} traced")
+T.check(ev_t == ev_s, "GI: the same events with and without reusing photon trails")
+T.check(jt["stats"]["photons_reused"] == 0 and st["photons_reused"] > st["photons_traced"],
+        "GI: most photons reuse their trails while the box moves")
+T.check(st["photons_reused"] + st["photons_traced"] == jt["stats"]["photons_traced"],
+        "GI: every photon is either traced or reused")
+T.check(jb["stats"]["photons_reused"] == 0, "GI brute force (--no-skip): no photon reuses its trail")
 
 bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
        ["--gi", "photon", "--gather-max", "0"], ["--gi", "photon", "--gather-radius", "-1"],

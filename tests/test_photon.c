@@ -1,5 +1,6 @@
 /* Image-space photon mapping (src/core/photon.h, src/cpu/photon_pass.c): projection, ring
- * search, kernel, gather units, flux conservation of the pass in a closed box, determinism. */
+ * search, kernel, gather units, flux conservation of the pass in a closed box, determinism, the
+ * photons' trails. */
 #include "check.h"
 #include "core/photon.h"
 #include "cpu/cpu_gi.h"
@@ -521,7 +522,7 @@ static void test_pass(void)
     CHECK_OK(evr_photon_buffer_alloc(&b1, 48, 40, 4, 8, &err));
     CHECK_OK(evr_photon_buffer_alloc(&b2, 48, 40, 4, 8, &err));
     CHECK_OK(evr_photon_buffer_alloc(&b3, 48, 40, 4, 8, &err));
-    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b1, &s1, &err));
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b1, &s1, NULL, &err));
     /* flux conservation: all emitted flux is absorbed (closed box), within Monte Carlo error */
     for (k = 0; k < 3; k++) {
         double want = 4.0 * 3.14159265358979 * light.color[k];
@@ -537,9 +538,9 @@ static void test_pass(void)
     CHECK(s1.paths == N);
     CHECK(s1.visible > 1000 && s1.inserted + s1.collisions == s1.visible);
     /* determinism: the same photons give the same buffer, whatever the thread count */
-    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b2, &s2, &err));
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b2, &s2, NULL, &err));
     pp.threads = 3;
-    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b3, &s3, &err));
+    CHECK_OK(evr_photon_pass(&rs, &tr, &pp, &em, &b3, &s3, NULL, &err));
     CHECK(same_buffer(&b1, &b2));
     CHECK(same_buffer(&b1, &b3));
     CHECK(memcmp(s1.absorbed, s3.absorbed, sizeof s1.absorbed) == 0);
@@ -564,6 +565,52 @@ static void test_pass(void)
     rtcReleaseDevice(dev);
 }
 
+/* A photon's trail (core/photon.h): recorded clean only while its rays miss what moves; reused
+ * only when clean, when the plan allows reuse, and when no ray meets the new segment's bounds. */
+static void test_trail(void)
+{
+    evr_skip_plan pl;
+    memset(&pl, 0, sizeof pl);
+    pl.cache = pl.reuse = 1;
+    pl.num_boxes = 1;
+    pl.lo[0][0] = 1.0f; pl.lo[0][1] = -1.0f; pl.lo[0][2] = -1.0f;   /* a box at x in [1, 2] */
+    pl.hi[0][0] = 2.0f; pl.hi[0][1] = 1.0f; pl.hi[0][2] = 1.0f;
+    evr_photon_params pp;
+    memset(&pp, 0, sizeof pp);
+    pp.max_bounces = 1;
+    const int len = evr_photon_trail_len(&pp);
+    CHECK(len == 3);
+    evr_trail_ray rays[3];
+    evr_photon_trail t;
+    evr_ray up = {evr_v3_make(0.0f, 0.0f, 0.0f), evr_v3_make(0.0f, 1.0f, 0.0f)};
+    evr_ray toward = {evr_v3_make(0.0f, 0.0f, 0.0f), evr_v3_make(1.0f, 0.0f, 0.0f)};
+    evr_photon_trail_begin(&t, &pl);
+    CHECK(t.clean && t.n == 0 && t.cell == EVR_TRAIL_NONE);
+    evr_photon_trail_ray(&t, rays, len, &pl, up, 5.0f);
+    evr_photon_trail_ray(&t, rays, len, &pl, toward, 0.5f);   /* stops short of the box */
+    CHECK(t.clean && t.n == 2);
+    CHECK(evr_photon_trail_reusable(&t, rays, &pl));
+    /* the next segment's box covers x in [0.25, 2]: the second ray meets it */
+    evr_skip_plan next = pl;
+    next.lo[0][0] = 0.25f;
+    CHECK(!evr_photon_trail_reusable(&t, rays, &next));
+    next.lo[0][0] = 1.0f;
+    next.reuse = 0;   /* the camera or a light moved */
+    CHECK(!evr_photon_trail_reusable(&t, rays, &next));
+    /* a ray into the box (or to infinity toward it) leaves the trail unclean for good */
+    evr_photon_trail_ray(&t, rays, len, &pl, toward, 1e30f);
+    CHECK(!t.clean && !evr_photon_trail_reusable(&t, rays, &pl));
+    /* more rays than the trail holds: unclean */
+    evr_photon_trail_begin(&t, &pl);
+    for (int k = 0; k < 4; k++) evr_photon_trail_ray(&t, rays, len, &pl, up, 1.0f);
+    CHECK(!t.clean);
+    /* a plan that may not cache (the camera moves in the segment) records no clean trail */
+    evr_skip_plan moving = pl;
+    moving.cache = 0;
+    evr_photon_trail_begin(&t, &moving);
+    CHECK(!t.clean && !evr_photon_trail_reusable(&t, rays, &pl));
+}
+
 int main(void)
 {
     test_projection();
@@ -574,5 +621,6 @@ int main(void)
     test_material();
     test_emission();
     test_pass();
+    test_trail();
     return check_report("test_photon");
 }

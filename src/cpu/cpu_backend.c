@@ -538,8 +538,7 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->host.rs.track_count = seg->track_count;
     if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
     if (b->gi) {   /* the segment's photons: still when nothing moved since the previous segment */
-        int still = seg->skip->reuse && seg->skip->num_boxes == 0;
-        if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, still, b->setup.threads, base, err)) != EVR_OK) return st;
+        if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, seg->skip, b->setup.threads, base, err)) != EVR_OK) return st;
     }
     if (seg->num_frames > 0) {
         size_t npix = (size_t)b->setup.width * (size_t)b->setup.height, nf = (size_t)seg->num_frames;

@@ -84,6 +84,7 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     g->image_width = setup->width;
     /* EVR_GI_NO_MEMO (hidden, for tests): gather at every sample, to show the memo changes nothing */
     g->memo_off = getenv("EVR_GI_NO_MEMO") != NULL;
+    g->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;
     g->memo = calloc((size_t)setup->width * (size_t)setup->height, sizeof *g->memo);
     if (!g->memo) {
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
@@ -92,9 +93,10 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     return EVR_OK;
 }
 
-evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int still, int threads, evr_backend *stats,
-                              evr_error *err)
+evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
+                              evr_backend *stats, evr_error *err)
 {
+    const int still = plan->reuse && plan->num_boxes == 0;
     const int w = g->buf.width, h = g->buf.height;
     evr_status st;
     evr_photon_stats ps;
@@ -114,7 +116,9 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
     g->pp.ray_eps = rs->ray_eps;
     if ((st = evr_photon_emitters_build(rs, 0.0f, g->pp.bounds, g->photons, &g->em, err)) != EVR_OK) return st;
     memset(&ps, 0, sizeof ps);
-    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, &g->buf, &ps, err)) != EVR_OK) return st;
+    g->trails.plan = plan;
+    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, &g->buf, &ps, g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
+        return st;
     if ((st = evr_photon_gbuffer(rs, &g->tr, 0.0f, &g->buf, threads, err)) != EVR_OK) return st;
     for (y = 0; y < h; y++) {
         uint32_t row = 0;
@@ -127,6 +131,7 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int sti
     g->have_prev = 1;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     stats->photons_traced += ps.paths;
+    stats->photons_reused += ps.reused;
     stats->photons_stored += ps.inserted;
     stats->photon_collisions += ps.collisions;
     stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
@@ -163,6 +168,7 @@ void evr_cpu_gi_free(evr_cpu_gi *g)
     evr_photon_buffer_free(&g->buf);
     evr_photon_buffer_free(&g->prev);
     evr_photon_emitters_free(&g->em);
+    evr_photon_trails_free(&g->trails);
     free(g->sat);
     free(g->memo);
     memset(g, 0, sizeof *g);

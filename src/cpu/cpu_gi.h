@@ -19,6 +19,8 @@ typedef struct {
     evr_tracer tr;
     evr_photon_buffer buf, prev;   /* this segment's buffer and the previous segment's */
     evr_photon_emitters em;
+    evr_photon_trails trails;      /* the photons' paths, reused where nothing moving meets them */
+    int trails_off;                /* EVR_NO_PHOTON_REUSE set: none (tests, measurement) */
     evr_gather_params gp;
     evr_photon_params pp;
     uint32_t photons;
@@ -42,11 +44,12 @@ int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, floa
 
 evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,
                            evr_error *err);
-/* The photon pass of a segment (rs holds its keys). still: nothing moved in this segment or
- * since the previous one (camera, lights and instances), so the photons are those of the
- * previous segment: the pass is not run and no cell changed. */
-evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, int still, int threads, evr_backend *stats,
-                              evr_error *err);
+/* The photon pass of a segment (rs holds its keys, plan its change-driven sampling plan). When
+ * nothing moved in this segment or since the previous one (camera, lights and instances) the
+ * photons are those of the previous segment: the pass is not run and no cell changed. Else the
+ * photons whose trails meet nothing that moves keep their outcome (evr_photon_pass). */
+evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
+                              evr_backend *stats, evr_error *err);
 /* Whether a cell pixel (x, y)'s gather window reads changed in this segment; if so, forgets the
  * pixel's last gather. The thread that renders the pixel calls it before the pixel's samples. */
 int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y);

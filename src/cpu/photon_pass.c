@@ -97,6 +97,36 @@ nomem:
     return EVR_ERR_NOMEM;
 }
 
+int evr_photon_emitters_copy(evr_photon_emitters *dst, const evr_photon_emitters *src)
+{
+    if (dst->cap < src->n) {
+        evr_photon_emitter *p = realloc(dst->e, (size_t)src->n * sizeof *p);
+        if (!p) return 0;
+        dst->e = p;
+        dst->cap = src->n;
+    }
+    if (dst->cdf_cap < src->cdf_n) {
+        float *c = realloc(dst->cdf, (size_t)src->cdf_n * sizeof *c);
+        if (!c) return 0;
+        dst->cdf = c;
+        dst->cdf_cap = src->cdf_n;
+    }
+    if (src->n) memcpy(dst->e, src->e, (size_t)src->n * sizeof *src->e);
+    if (src->cdf_n) memcpy(dst->cdf, src->cdf, (size_t)src->cdf_n * sizeof *src->cdf);
+    dst->n = src->n;
+    dst->cdf_n = src->cdf_n;
+    dst->total_power = src->total_power;
+    dst->photons = src->photons;
+    return 1;
+}
+
+int evr_photon_emitters_same(const evr_photon_emitters *a, const evr_photon_emitters *b)
+{
+    return a->n == b->n && a->cdf_n == b->cdf_n && a->photons == b->photons &&
+           (a->n == 0 || !memcmp(a->e, b->e, (size_t)a->n * sizeof *a->e)) &&
+           (a->cdf_n == 0 || !memcmp(a->cdf, b->cdf, (size_t)a->cdf_n * sizeof *a->cdf));
+}
+
 void evr_photon_emitters_free(evr_photon_emitters *em)
 {
     free(em->e);
@@ -219,7 +249,7 @@ typedef struct {
     pending *v;
     size_t n, cap;
     double emitted[3], stored[3], absorbed[3], escaped[3], capped[3];
-    uint64_t paths, stored_photons;
+    uint64_t paths, stored_photons, reused;
     int failed;
 } chunk_out;
 
@@ -228,7 +258,9 @@ typedef struct {
     const evr_tracer *tr;
     const evr_photon_params *pp;
     const evr_photon_emitters *em;
-    int margin;
+    int margin, cells_w;
+    evr_photon_trails *trails;     /* NULL: none */
+    int reuse;                     /* the trails are the previous pass's, with the same emitters */
     chunk_out *chunks;
     int nchunks;
     atomic_int next;
@@ -241,14 +273,9 @@ static void add3(double a[3], const float b[3], float k)
     a[2] += (double)(b[2] * k);
 }
 
-/* Keeps a photon that stays where the camera sees it. */
-static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float flux[3], uint32_t key, float f)
+/* Appends a visible photon of image pixel (x, y) to the chunk's list. */
+static void push(chunk_out *co, const evr_photon *ph, int x, int y)
 {
-    evr_ray r;
-    float tnear, tfar;
-    int x, y;
-    if (!evr_photon_view_ray(c->rs, s, f, c->margin, c->pp->ray_eps, &x, &y, &r, &tnear, &tfar)) return;
-    if (c->tr->occluded(c->tr->user, r, tnear, tfar, f)) return;
     if (co->n == co->cap) {
         size_t nc = co->cap ? 2 * co->cap : 256;
         pending *p = realloc(co->v, nc * sizeof *p);
@@ -257,16 +284,58 @@ static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float f
         co->cap = nc;
     }
     pending *p = &co->v[co->n++];
-    p->ph = evr_photon_make(s, flux, key);
+    p->ph = *ph;
     p->x = x;
     p->y = y;
 }
 
+/* Keeps a photon that stays where the camera sees it (its view ray goes to the trail t). */
+static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float flux[3], uint32_t key, float f,
+                 evr_photon_trail *t, evr_trail_ray *rays)
+{
+    evr_ray r;
+    float tnear, tfar;
+    int x, y;
+    if (!evr_photon_view_ray(c->rs, s, f, c->margin, c->pp->ray_eps, &x, &y, &r, &tnear, &tfar)) return;
+    const int occluded = c->tr->occluded(c->tr->user, r, tnear, tfar, f);
+    if (t) evr_photon_trail_ray(t, rays, c->trails->len, c->trails->plan, r, tfar);
+    if (occluded) return;
+    evr_photon ph = evr_photon_make(s, flux, key);
+    if (t) {
+        t->ph = ph;
+        t->cell = (uint32_t)(y + c->margin) * (uint32_t)c->cells_w + (uint32_t)(x + c->margin);
+    }
+    push(co, &ph, x, y);
+}
+
+static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t, evr_trail_ray *rays);
+
+/* Photon i: its trail's outcome where the pass may reuse it, else its path (recorded). */
 static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
+{
+    evr_photon_trails *tt = c->trails;
+    if (!tt) {
+        trace_path(c, co, i, NULL, NULL);
+        return;
+    }
+    evr_photon_trail *t = &tt->t[i];
+    evr_trail_ray *rays = tt->rays + (size_t)i * (size_t)tt->len;
+    if (c->reuse && evr_photon_trail_reusable(t, rays, tt->plan)) {
+        co->reused++;
+        if (t->cell != EVR_TRAIL_NONE)
+            push(co, &t->ph, (int)(t->cell % (uint32_t)c->cells_w) - c->margin, (int)(t->cell / (uint32_t)c->cells_w) - c->margin);
+        return;
+    }
+    evr_photon_trail_begin(t, tt->plan);
+    trace_path(c, co, i, t, rays);
+}
+
+static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t, evr_trail_ray *rays)
 {
     const evr_render_scene *rs = c->rs;
     evr_photon_path path;
     if (!evr_photon_path_start(rs, c->em->e, c->em->n, c->em->cdf, c->pp, i, &path)) return;
+    if (t) t->started = 1;
     co->paths++;
     add3(co->emitted, path.pr.flux, 1.0f);
     while (path.bounce < path.max_hits) {
@@ -274,7 +343,9 @@ static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
         evr_surface s;
         float stored[3], absorbed[3];
         uint32_t key = 0;
-        if (!c->tr->closest(c->tr->user, path.pr.ray, path.tnear, INFINITY, path.f, &h)) {
+        const int hit = c->tr->closest(c->tr->user, path.pr.ray, path.tnear, INFINITY, path.f, &h);
+        if (t) evr_photon_trail_ray(t, rays, c->trails->len, c->trails->plan, path.pr.ray, hit ? h.t : 1e30f);
+        if (!hit) {
             add3(co->escaped, path.pr.flux, 1.0f);
             return;
         }
@@ -286,7 +357,7 @@ static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
         if (ev == EVR_PHOTON_STAY) {
             add3(co->stored, stored, 1.0f);
             co->stored_photons++;
-            keep(c, co, &s, stored, key, path.f);
+            keep(c, co, &s, stored, key, path.f, t, rays);
             return;
         }
         if (ev == EVR_PHOTON_ABSORB) return;
@@ -310,9 +381,37 @@ static void *pass_worker(void *arg)
     return NULL;
 }
 
+/* Room for the pass's trails and whether the previous pass's may be reused (see the header). */
+static int trails_prepare(evr_photon_trails *tt, const evr_photon_params *pp, const evr_photon_emitters *em)
+{
+    const int len = evr_photon_trail_len(pp);
+    if (em->photons > tt->cap || len != tt->len) {
+        free(tt->t);
+        free(tt->rays);
+        tt->t = calloc(em->photons, sizeof *tt->t);
+        tt->rays = calloc((size_t)em->photons * (size_t)len, sizeof *tt->rays);
+        tt->cap = tt->t && tt->rays ? em->photons : 0;
+        tt->len = len;
+        tt->valid = 0;
+        if (!tt->cap) return -1;
+    }
+    const int reuse = tt->valid && evr_photon_emitters_same(&tt->em, em);
+    /* this pass records every photon's trail: valid for the next, with these emitters */
+    tt->valid = evr_photon_emitters_copy(&tt->em, em);
+    return reuse;
+}
+
+void evr_photon_trails_free(evr_photon_trails *tt)
+{
+    free(tt->t);
+    free(tt->rays);
+    evr_photon_emitters_free(&tt->em);
+    memset(tt, 0, sizeof *tt);
+}
+
 evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
                            const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
-                           evr_error *err)
+                           evr_photon_trails *trails, evr_error *err)
 {
     pass_ctx c;
     struct timespec t0, t1;
@@ -332,6 +431,15 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     c.pp = pp;
     c.em = em;
     c.margin = buf->margin;
+    c.cells_w = buf->width;
+    if (trails) {
+        c.reuse = trails_prepare(trails, pp, em);
+        if (c.reuse < 0) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for the photon trails");
+            return EVR_ERR_NOMEM;
+        }
+        c.trails = trails;
+    }
     c.nchunks = (int)((em->photons + CHUNK - 1) / CHUNK);
     c.chunks = calloc((size_t)c.nchunks, sizeof *c.chunks);
     atomic_store(&c.next, 0);
@@ -353,6 +461,7 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
             st->capped[i] += co->capped[i];
         }
         st->paths += co->paths;
+        st->reused += co->reused;
         st->stored_photons += co->stored_photons;
         st->visible += co->n;
         for (n = 0; n < co->n; n++) st->inserted += (uint64_t)evr_photon_buffer_insert(buf, co->v[n].x, co->v[n].y, &co->v[n].ph);

@@ -45,6 +45,10 @@ typedef struct {
 evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_photon_bounds bb, uint32_t photons,
                                      evr_photon_emitters *em, evr_error *err);
 void evr_photon_emitters_free(evr_photon_emitters *em);
+/* dst becomes a copy of src (dst's arrays reused); 0: out of memory (dst unchanged in size). */
+int evr_photon_emitters_copy(evr_photon_emitters *dst, const evr_photon_emitters *src);
+/* Whether two tables send the same photons: the same emitters, counts and areas. */
+int evr_photon_emitters_same(const evr_photon_emitters *a, const evr_photon_emitters *b);
 
 /* A buffer for a width x height image with a guard band of margin pixels. */
 evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers, int margin, evr_error *err);
@@ -65,15 +69,31 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
 typedef struct {
     double emitted[3], stored[3], absorbed[3], escaped[3], capped[3];
     uint64_t paths, stored_photons, visible, inserted, collisions;
+    uint64_t reused;               /* photons that took their trail's outcome (not in the flux sums) */
     double seconds;
 } evr_photon_stats;
 
+/* The photons' trails between the passes of a run (core/photon.h): zero-initialize; plan: the
+ * segment's change-driven sampling plan, set before each pass. */
+typedef struct {
+    evr_photon_trail *t;
+    evr_trail_ray *rays;
+    uint32_t cap;                  /* photons */
+    int len;                       /* rays per trail */
+    int valid;                     /* they hold the previous pass's, whose emitters were em */
+    evr_photon_emitters em;
+    const evr_skip_plan *plan;
+} evr_photon_trails;
+void evr_photon_trails_free(evr_photon_trails *tt);
+
 /* Traces every photon of the emitters (threads over chunks of photons), keeps each photon that
  * stays where the camera (pose at the photon's time) sees it, and inserts it into buf (cleared
- * first) in photon order: the buffer is identical for any thread count. */
+ * first) in photon order: the buffer is identical for any thread count. trails (NULL: none): a
+ * photon whose trail the plan lets it reuse takes its outcome instead of being traced; every
+ * other photon's trail is recorded. The flux sums of st count traced photons only. */
 evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
                            const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
-                           evr_error *err);
+                           evr_photon_trails *trails, evr_error *err);
 
 /* The run's GI settings, the same for the CPU and CUDA backends: photons per pass (0 asked: one
  * per pixel), gather parameters, pass parameters (photons spread over the segment, the same

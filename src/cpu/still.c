@@ -364,14 +364,14 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         pp.threads = nthreads;
         pp.bounds = bb;
         pp.ray_eps = host.rs.ray_eps;
-        if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, err)) != EVR_OK) goto done;
+        if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) != EVR_OK) goto done;
         /* more than 3% of the photons found their pixel full: twice the layers (up to 64), again */
         while (p->auto_layers && buf.layers < 64 && out->photon.visible > 0 &&
                (double)out->photon.collisions > 0.03 * (double)out->photon.visible) {
             int layers = 2 * buf.layers, margin = buf.margin;
             evr_photon_buffer_free(&buf);
             if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, layers > 64 ? 64 : layers, margin, err)) != EVR_OK) goto done;
-            if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, err)) != EVR_OK) goto done;
+            if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) != EVR_OK) goto done;
         }
         out->photon_layers = buf.layers;
         if (p->gather_area && (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, nthreads, err)) != EVR_OK) goto done;

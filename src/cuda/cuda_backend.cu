@@ -621,6 +621,11 @@ struct cuda_backend {
     dbuf<unsigned long long> d_pkeys, d_pkeys_sorted;
     dbuf<unsigned> d_pvals, d_pvals_sorted, d_pcount;
     dbuf<unsigned char> d_ptemp;
+    /* the photons' trails (core/photon.h) and the emitter table of the pass that recorded them */
+    dbuf<evr_photon_trail> d_trails;
+    dbuf<evr_trail_ray> d_trail_rays;
+    int trails_valid, trails_off;
+    evr_photon_emitters trail_em;
     /* GI with deferred gathers (gpu_gi_deferred.cuh): off when its buffers do not fit, or with
      * adaptive sampling (its kernel gathers inline) */
     int gi_deferred;
@@ -880,6 +885,34 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     return EVR_OK;
 }
 
+/* The pass's trails: reused where the previous pass recorded them with the same emitters; room
+ * for n photons (a pass that needs more starts them afresh). Without the memory, no trails (every
+ * photon traced, as before them). EVR_NO_PHOTON_REUSE=1 (hidden, for tests and measurement): none. */
+static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
+{
+    p->trails = nullptr;
+    p->trail_rays = nullptr;
+    p->trail_len = evr_photon_trail_len(&b->pp);
+    p->reuse = 0;
+    if (b->trails_off || getenv("EVR_NO_PHOTON_REUSE")) return;
+    const size_t len = (size_t)p->trail_len;
+    if (n > b->d_trails.cap || (size_t)n * len > b->d_trail_rays.cap) {
+        b->trails_valid = 0;
+        if (b->d_trails.reserve(n, true) != cudaSuccess || b->d_trail_rays.reserve((size_t)n * len, true) != cudaSuccess) {
+            (void)cudaGetLastError();   /* not sticky: cleared */
+            b->d_trails.release();
+            b->d_trail_rays.release();
+            b->trails_off = 1;
+            return;
+        }
+    }
+    p->trails = b->d_trails.p;
+    p->trail_rays = b->d_trail_rays.p;
+    p->reuse = b->trails_valid && evr_photon_emitters_same(&b->em, &b->trail_em);
+    /* this pass records every photon's trail: they are valid for the next, with these emitters */
+    b->trails_valid = evr_photon_emitters_copy(&b->trail_em, &b->em);
+}
+
 /* The segment's photons (gpu_gi.cuh) on the render stream, before its render: the pass, the
  * buffer's view, the changed cells. A still segment (nothing moved in it or since the previous
  * one) copies the previous segment's buffer (in the other slot) and changes no cell. hrs: the
@@ -938,6 +971,7 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
         p.sort_vals = b->d_pvals.p;
         p.pending = b->d_pending.p;
         p.pending_count = b->d_pcount.p;
+        trail_args(b, n, &p);
         CK(cudaMemsetAsync(b->d_pkeys.p, 0xff, (size_t)n * sizeof(unsigned long long), rs));
         const unsigned pgrid = (n + BLOCK - 1) / BLOCK;
         if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
@@ -959,7 +993,7 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *buf);
     CK(cudaGetLastError());
     photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*buf, prev->ph, b->gi_have_prev, sl->d_sat.p);
-    sat_rows_kernel<<<(unsigned)((buf->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height);
+    sat_rows_kernel<<<(unsigned)((32 * (size_t)buf->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height);
     sat_cols_kernel<<<(unsigned)((buf->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height, sl->d_rays.p);
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->gi_done, rs));
@@ -1130,6 +1164,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(cudaEventElapsedTime(&gi_ms, sl->gi_started, sl->gi_done));
         base->photon_seconds += 1e-3 * (double)gi_ms;
         base->photons_traced += sl->h_rays.p[GI_PATHS];
+        base->photons_reused += sl->h_rays.p[GI_REUSED];
         base->photons_stored += sl->h_rays.p[GI_INSERTED];
         base->photon_collisions += sl->h_rays.p[GI_COLLISIONS];
         base->photon_cells_changed += sl->h_rays.p[GI_CHANGED];
@@ -1243,6 +1278,8 @@ static void cuda_release(evr_backend *base)
     }
     b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
     b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
+    b->d_trails.release(); b->d_trail_rays.release();
+    evr_photon_emitters_free(&b->trail_em);
     b->d_gd_direct.release(); b->d_gd_req.release(); b->d_gd_lum.release(); b->d_gd_requests.release();
     b->d_gd_traced.release(); b->d_gd_cache.release(); b->d_gd_count.release();
     evr_photon_emitters_free(&b->em);

@@ -87,7 +87,7 @@ __device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_ren
 }
 
 /* Counters of a pass in the slot's counter array (after the render kernels' three). */
-enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_COUNTERS = 7 };
+enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_REUSED = 7, GI_COUNTERS = 8 };
 
 struct photon_args {
     const evr_photon_emitter *em;
@@ -100,23 +100,46 @@ struct photon_args {
     unsigned *sort_vals;           /* index into pending */
     evr_photon *pending;
     unsigned *pending_count;
+    /* trails (core/photon.h): NULL when they did not fit in memory */
+    evr_photon_trail *trails;
+    evr_trail_ray *trail_rays;
+    int trail_len;
+    int reuse;                     /* the trails are the previous pass's, with the same emitters */
 };
 
-/* One thread per photon: its path (core/photon.h), and where it stays, the camera's check. */
-template <int LAYOUT>
-__global__ void __launch_bounds__(BLOCK) photon_kernel(kernel_args a, photon_args p)
+/* Adds 1 per calling lane to counter c, one atomic per warp. */
+__device__ __forceinline__ void count_lanes(unsigned long long *counters, int c)
 {
-    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    const unsigned m = __activemask(), lane = threadIdx.x & 31u;
+    if (lane == (unsigned)__ffs(m) - 1u) atomicAdd(&counters[c], (unsigned long long)__popc(m));
+}
+
+/* Appends a visible photon in cell `cell` for the sort (its rank in the cell is its layer). */
+__device__ __forceinline__ void photon_append(const photon_args &p, const evr_photon &ph, unsigned cell)
+{
+    const unsigned idx = atomicAdd(p.pending_count, 1u);   /* < photons: one stay per photon */
+    p.pending[idx] = ph;
+    p.sort_keys[idx] = ((unsigned long long)cell << 32) | ph.key;
+    p.sort_vals[idx] = idx;
+}
+
+/* Photon i's path (core/photon.h) and, where it stays, the camera's check; its rays go to trail t. */
+template <int LAYOUT>
+__device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned i, evr_photon_trail *t, evr_trail_ray *rays)
+{
     const evr_render_scene *rs = &a.rs;
     evr_photon_path path;
-    if (i >= p.photons || !evr_photon_path_start(rs, p.em, p.n_em, p.cdf, &p.pp, i, &path)) return;
-    atomicAdd(&a.rays[GI_PATHS], 1ull);
+    if (!evr_photon_path_start(rs, p.em, p.n_em, p.cdf, &p.pp, i, &path)) return;
+    t->started = 1;
+    count_lanes(a.rays, GI_PATHS);
     while (path.bounce < path.max_hits) {
         evr_gpu_hit h;
         evr_surface s;
         float stored[3], absorbed[3];
         uint32_t key = 0;
-        if (!gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h)) return;
+        const int hit = gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h);
+        if (rays) evr_photon_trail_ray(t, rays, p.trail_len, a.plan, path.pr.ray, hit ? h.t : 1e30f);
+        if (!hit) return;
         const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), path.f);
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
@@ -126,16 +149,35 @@ __global__ void __launch_bounds__(BLOCK) photon_kernel(kernel_args a, photon_arg
             float tn, tf;
             int x, y;
             if (!evr_photon_view_ray(rs, &s, path.f, p.margin, p.pp.ray_eps, &x, &y, &r, &tn, &tf)) return;
-            if (gpu_trace<LAYOUT>(&a.view, rs, r, tn, tf, path.f, 1, &h)) return;
-            const unsigned idx = atomicAdd(p.pending_count, 1u);   /* < photons: one stay per photon */
-            const unsigned cell = (unsigned)(y + p.margin) * (unsigned)p.cells_w + (unsigned)(x + p.margin);
-            p.pending[idx] = evr_photon_make(&s, stored, key);
-            p.sort_keys[idx] = ((unsigned long long)cell << 32) | key;
-            p.sort_vals[idx] = idx;
+            const int occluded = gpu_trace<LAYOUT>(&a.view, rs, r, tn, tf, path.f, 1, &h);
+            if (rays) evr_photon_trail_ray(t, rays, p.trail_len, a.plan, r, tf);
+            if (occluded) return;
+            t->ph = evr_photon_make(&s, stored, key);
+            t->cell = (unsigned)(y + p.margin) * (unsigned)p.cells_w + (unsigned)(x + p.margin);
+            photon_append(p, t->ph, t->cell);
             return;
         }
         if (ev == EVR_PHOTON_ABSORB) return;
     }
+}
+
+/* One thread per photon: its trail's outcome where the pass may reuse it, else its path. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK) photon_kernel(kernel_args a, photon_args p)
+{
+    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= p.photons) return;
+    evr_trail_ray *rays = p.trails ? p.trail_rays + (size_t)i * (size_t)p.trail_len : nullptr;
+    if (rays && p.reuse && evr_photon_trail_reusable(&p.trails[i], rays, a.plan)) {
+        count_lanes(a.rays, GI_REUSED);
+        const evr_photon_trail t = p.trails[i];
+        if (t.cell != EVR_TRAIL_NONE) photon_append(p, t.ph, t.cell);
+        return;
+    }
+    evr_photon_trail t;
+    evr_photon_trail_begin(&t, a.plan);
+    photon_path<LAYOUT>(a, p, i, &t, rays);
+    if (rays) p.trails[i] = t;
 }
 
 /* One thread per sorted photon: its layer is its rank among its cell's photons. */
@@ -197,13 +239,27 @@ __global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer
     sat[(size_t)(y + 1) * (size_t)(cur.width + 1) + (size_t)(x + 1)] = !have_prev || !evr_photon_cell_same(&cur, &prev, (size_t)cell);
 }
 
-/* The summed-area table: prefix sums along rows (one thread per row), then columns. */
+/* The summed-area table: prefix sums along rows, then columns. Rows: one warp per row, 32 cells
+ * at a time (a shuffle scan plus the carry of the cells before): one thread per row walking its
+ * row read memory 1,300 cells apart per lane, 0.24 ms a segment at 1280x720 on the H100. */
 __global__ void __launch_bounds__(BLOCK) sat_rows_kernel(uint32_t *sat, int w, int h)
 {
-    const int y = blockIdx.x * blockDim.x + threadIdx.x;
-    if (y >= h) return;
-    uint32_t *row = sat + (size_t)(y + 1) * (size_t)(w + 1);
-    for (int x = 1; x <= w; x++) row[x] += row[x - 1];
+    const int y = (int)((blockIdx.x * blockDim.x + threadIdx.x) / 32u);
+    const unsigned lane = threadIdx.x & 31u;
+    if (y >= h) return;   /* the whole warp */
+    uint32_t *row = sat + (size_t)(y + 1) * (size_t)(w + 1) + 1;
+    uint32_t carry = 0;
+    for (int x0 = 0; x0 < w; x0 += 32) {
+        const int x = x0 + (int)lane;
+        uint32_t v = x < w ? row[x] : 0u;
+        for (int o = 1; o < 32; o <<= 1) {
+            const uint32_t u = __shfl_up_sync(0xffffffffu, v, (unsigned)o);
+            if (lane >= (unsigned)o) v += u;
+        }
+        v += carry;
+        if (x < w) row[x] = v;
+        carry = __shfl_sync(0xffffffffu, v, 31);
+    }
 }
 
 __global__ void __launch_bounds__(BLOCK) sat_cols_kernel(uint32_t *sat, int w, int h, unsigned long long *counters)
