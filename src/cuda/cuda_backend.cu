@@ -624,6 +624,7 @@ struct cuda_backend {
     /* the photons' trails (core/photon.h) and the emitter table of the pass that recorded them */
     dbuf<evr_photon_trail> d_trails;
     dbuf<evr_trail_ray> d_trail_rays;
+    dbuf<unsigned> d_todo, d_todo_count;   /* the photons a pass traces when others reuse their trails */
     int trails_valid, trails_off;
     evr_photon_emitters trail_em;
     /* GI with deferred gathers (gpu_gi_deferred.cuh): off when its buffers do not fit, or with
@@ -894,6 +895,8 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     p->trail_rays = nullptr;
     p->trail_len = evr_photon_trail_len(&b->pp);
     p->reuse = 0;
+    p->todo = nullptr;
+    p->todo_count = nullptr;
     if (b->trails_off || getenv("EVR_NO_PHOTON_REUSE")) return;
     const size_t len = (size_t)p->trail_len;
     if (n > b->d_trails.cap || (size_t)n * len > b->d_trail_rays.cap) {
@@ -906,8 +909,15 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
             return;
         }
     }
+    if (b->d_todo.reserve(n) != cudaSuccess || b->d_todo_count.reserve(1) != cudaSuccess) {
+        (void)cudaGetLastError();
+        b->trails_valid = 0;
+        return;   /* no reuse this pass, no trails recorded */
+    }
     p->trails = b->d_trails.p;
     p->trail_rays = b->d_trail_rays.p;
+    p->todo = b->d_todo.p;
+    p->todo_count = b->d_todo_count.p;
     p->reuse = b->trails_valid && evr_photon_emitters_same(&b->em, &b->trail_em);
     /* this pass records every photon's trail: they are valid for the next, with these emitters */
     b->trails_valid = evr_photon_emitters_copy(&b->trail_em, &b->em);
@@ -974,6 +984,11 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
         trail_args(b, n, &p);
         CK(cudaMemsetAsync(b->d_pkeys.p, 0xff, (size_t)n * sizeof(unsigned long long), rs));
         const unsigned pgrid = (n + BLOCK - 1) / BLOCK;
+        if (p.reuse) {
+            CK(cudaMemsetAsync(p.todo_count, 0, sizeof(unsigned), rs));
+            photon_reuse_kernel<<<pgrid, BLOCK, 0, rs>>>(a, p);
+            CK(cudaGetLastError());
+        }
         if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
         else photon_kernel<EVR_GPU_LAYOUT_BVH4><<<pgrid, BLOCK, 0, rs>>>(a, p);
         CK(cudaGetLastError());
@@ -1278,7 +1293,7 @@ static void cuda_release(evr_backend *base)
     }
     b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
     b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
-    b->d_trails.release(); b->d_trail_rays.release();
+    b->d_trails.release(); b->d_trail_rays.release(); b->d_todo.release(); b->d_todo_count.release();
     evr_photon_emitters_free(&b->trail_em);
     b->d_gd_direct.release(); b->d_gd_req.release(); b->d_gd_lum.release(); b->d_gd_requests.release();
     b->d_gd_traced.release(); b->d_gd_cache.release(); b->d_gd_count.release();
