@@ -611,6 +611,59 @@ static void test_trail(void)
     CHECK(!t.clean && !evr_photon_trail_reusable(&t, rays, &pl));
 }
 
+/* The summed-area table of the cells that differ between two buffers (as the CPU pass builds it). */
+static void changed_sat(const evr_photon_buffer *cur, const evr_photon_buffer *prev, uint32_t *sat)
+{
+    const int w = cur->width, h = cur->height;
+    memset(sat, 0, (size_t)(w + 1) * (size_t)(h + 1) * sizeof *sat);
+    for (int y = 0; y < h; y++) {
+        uint32_t row = 0;
+        for (int x = 0; x < w; x++) {
+            row += !evr_photon_cell_same(cur, prev, (size_t)y * (size_t)w + (size_t)x);
+            sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
+        }
+    }
+}
+
+/* A gather moves only when a changed cell of its window holds, before or after, a photon it could
+ * take: a change far away in space, facing away, or outside the window leaves it as it was. */
+static void test_gather_moved(void)
+{
+    enum { N = 21 };
+    const evr_camera_intr cam = evr_camera_intr_make(N, N, 0.5f * EVR_PI);   /* tan(yfov / 2) = 1 */
+    evr_gather_params gp = {0.2f, 64, 8, 0.5f};   /* r, max, window, normal cosine */
+    const evr_v3 p = evr_v3_make(0.0f, 0.0f, 0.0f), nrm = evr_v3_make(0.0f, 0.0f, 1.0f);
+    const float dist = 1.0f;   /* pixel size 2/21 at the point: window half size ceil(0.2 / 0.095) + 1 = 4 */
+    static uint32_t sat[(N + 1) * (N + 1)];
+    struct { float x, nz; int cx, in_cur; int moved; const char *what; } cases[] = {
+        {5.0f, 1.0f, 12, 1, 0, "a photon 5 m away"},
+        {0.05f, 1.0f, 12, 1, 1, "a photon within r"},
+        {0.05f, -1.0f, 12, 1, 0, "a photon within r facing away"},
+        {0.05f, 1.0f, 18, 1, 0, "a photon within r in a cell outside the window"},
+        {0.05f, 1.0f, 12, 0, 1, "a photon within r that left"},
+    };
+    evr_error err;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        evr_photon_buffer cur, prev;
+        CHECK_OK(evr_photon_buffer_alloc(&cur, N, N, 1, 0, &err));
+        CHECK_OK(evr_photon_buffer_alloc(&prev, N, N, 1, 0, &err));
+        changed_sat(&cur, &prev, sat);
+        CHECK(!evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, dist));   /* nothing changed */
+        evr_photon ph;
+        memset(&ph, 0, sizeof ph);
+        ph.p[0] = cases[c].x;
+        ph.n[2] = cases[c].nz;
+        ph.flux[0] = 1.0f;
+        CHECK(evr_photon_buffer_insert(cases[c].in_cur ? &cur : &prev, cases[c].cx, 10, &ph));
+        changed_sat(&cur, &prev, sat);
+        const int moved = evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, dist);
+        if (moved != cases[c].moved) fprintf(stderr, "gather moved by %s: %d, expected %d\n", cases[c].what, moved, cases[c].moved);
+        CHECK(moved == cases[c].moved);
+        evr_photon_buffer_free(&cur);
+        evr_photon_buffer_free(&prev);
+    }
+}
+
 int main(void)
 {
     test_projection();
@@ -622,5 +675,6 @@ int main(void)
     test_emission();
     test_pass();
     test_trail();
+    test_gather_moved();
     return check_report("test_photon");
 }

@@ -814,6 +814,63 @@ EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr
     return used;
 }
 
+/* Whether buffer cell i (of b, or of a buffer of its shape) holds anything a gather at point p
+ * (normal n) could take within sqrt(lim2): a photon close enough with a normal within the
+ * cosine, or the camera's view of the cell (its weight in the normalization), tested as
+ * evr_photon_gather_cell tests them. */
+EVR_HD static inline int evr_photon_cell_reaches(const evr_photon_buffer *b, size_t i, evr_v3 p, evr_v3 n, float lim2,
+                                                 float normal_cos)
+{
+    const size_t npix = (size_t)b->width * (size_t)b->height;
+    int l, nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
+    if (b->gbuf) {
+        const float *g = b->gbuf + 8 * i;
+        evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
+        if (g[6] > 0.0f && evr_v3_dot(d, d) <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos) return 1;
+    }
+    for (l = 0; l < nl; l++) {
+        const evr_photon *ph = &b->slots[(size_t)l * npix + i];
+        evr_v3 d = evr_v3_make(ph->p[0] - p.x, ph->p[1] - p.y, ph->p[2] - p.z);
+        if (evr_v3_dot(d, d) <= lim2 && ph->n[0] * n.x + ph->n[1] * n.y + ph->n[2] * n.z >= normal_cos) return 1;
+    }
+    return 0;
+}
+
+/* Whether the change from buffer prev to cur can move the gather at point p (normal n, seen at
+ * distance cam_dist through image pixel (px, py)); sat: the summed-area table of the cells that
+ * changed. It cannot when no changed cell of the gather's window holds, before or after, anything
+ * the gather could take at its full radius r (evr_photon_cell_reaches): every cell it reads
+ * then adds the same, the search stops in the same ring, and the estimate is the same bit for
+ * bit. (Photons the moving box sends elsewhere change cells all over the image; most windows
+ * see such a change and few are reached by it.) */
+EVR_HD static inline int evr_photon_gather_moved(const evr_photon_buffer *cur, const evr_photon_buffer *prev, const uint32_t *sat,
+                                                 const evr_camera_intr *cam, const evr_gather_params *gp, int px, int py,
+                                                 evr_v3 p, evr_v3 n, float cam_dist)
+{
+    const evr_gather_window w = evr_photon_gather_window(cur, cam, px, py, cam_dist, gp);
+    const size_t W = (size_t)cur->width + 1;
+    int x0 = w.cx - w.h, x1 = w.cx + w.h + 1, y0 = w.cy - w.h, y1 = w.cy + w.h + 1, x, y;
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > cur->width) x1 = cur->width;
+    if (y1 > cur->height) y1 = cur->height;
+    for (y = y0; y < y1; y++) {
+        /* the row's changed cells, from the table: none, and the row is passed over */
+        if (sat[(size_t)(y + 1) * W + (size_t)x1] - sat[(size_t)y * W + (size_t)x1] - sat[(size_t)(y + 1) * W + (size_t)x0] +
+                sat[(size_t)y * W + (size_t)x0] == 0)
+            continue;
+        for (x = x0; x < x1; x++) {
+            if (sat[(size_t)(y + 1) * W + (size_t)(x + 1)] - sat[(size_t)y * W + (size_t)(x + 1)] - sat[(size_t)(y + 1) * W + (size_t)x] +
+                    sat[(size_t)y * W + (size_t)x] == 0)
+                continue;
+            const size_t i = (size_t)y * (size_t)cur->width + (size_t)x;
+            if (evr_photon_cell_reaches(cur, i, p, n, w.r2, gp->normal_cos) || evr_photon_cell_reaches(prev, i, p, n, w.r2, gp->normal_cos))
+                return 1;
+        }
+    }
+    return 0;
+}
+
 /* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s of material
  * mat: the diffuse share of the albedo over pi. */
 EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_view *mat, float k_rgb[3])

@@ -305,7 +305,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             if (ideal) q->pp = b->setup.pixel;
             else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
             /* global illumination: whether the photons this pixel's gather reads changed */
-            const int gi_changed = b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, x, y);
+            const int gi_changed = b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
             /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
             q->ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
             if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) && !gi_changed) {
@@ -396,7 +396,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         else evr_pixel_params_at(&b->setup.pixel, x, y, &pp[j]);
         /* global illumination: a gather window whose photons changed forgets the pixel's last
          * gather (else its memo would keep the previous segment's indirect light) */
-        if (b->gi) evr_cpu_gi_pixel_begin(&b->gi_state, x, y);
+        if (b->gi) evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
         stack[j].n = 0;
         if (st->started && !plan->all_min) {   /* what the last sample's rays meet in this segment */
             evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);

@@ -140,10 +140,16 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
     return EVR_OK;
 }
 
-int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y)
+int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int y)
 {
     if (!evr_photon_window_changed(g->sat, g->buf.width, g->buf.height, g->buf.margin, g->window, x, y)) return 0;
-    g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].valid = 0;
+    struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
+    /* the window changed: the pixel's last gather still holds if nothing that changed reaches it */
+    if (m->valid && !g->memo_off &&
+        !evr_photon_gather_moved(&g->buf, &g->prev, g->sat, cam, &g->gp, x, y, evr_v3_make(m->key[0], m->key[1], m->key[2]),
+                                 evr_v3_make(m->key[3], m->key[4], m->key[5]), m->key[6]))
+        return 0;
+    m->valid = 0;
     return 1;
 }
 

@@ -50,9 +50,10 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
  * photons whose trails meet nothing that moves keep their outcome (evr_photon_pass). */
 evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
                               evr_backend *stats, evr_error *err);
-/* Whether a cell pixel (x, y)'s gather window reads changed in this segment; if so, forgets the
- * pixel's last gather. The thread that renders the pixel calls it before the pixel's samples. */
-int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, int x, int y);
+/* Whether pixel (x, y)'s gather may change in this segment: a cell of its window changed and the
+ * change reaches its last gather's point (evr_photon_gather_moved); if so, forgets that gather.
+ * The thread that renders the pixel calls it before the pixel's samples. */
+int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int y);
 /* Luminance of the indirect light leaving surface s of scene instance inst, seen from cam_org
  * through pixel (x, y) (one thread per pixel at a time: it updates the pixel's memo). */
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
