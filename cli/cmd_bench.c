@@ -136,7 +136,7 @@ static void print_row(const char *name, const bench_figures *f, int json)
                "\"equivalent_samples_per_second\": %.6g, \"rays\": %llu, \"pixels_skipped\": %llu, "
                "\"pixels_skipped_per_segment\": %.1f, \"sampling\": \"%s\", \"samples_per_pixel_per_second\": %.6g, "
                "\"photon_seconds\": %.4f, \"photons_stored\": %llu, \"photon_collisions\": %llu, \"photon_cells_changed\": %llu, "
-               "\"photons_traced\": %llu, \"photons_reused\": %llu}\n",
+               "\"photons_traced\": %llu, \"photons_reused\": %llu, \"device_seconds\": %.4f}\n",
                name, s->backend, s->device, f->width, f->height, f->samples_per_frame, s->sim_time,
                (unsigned long long)(s->events_on + s->events_off), s->wall_time, s->realtime_factor,
                (double)s->samples / w, (double)s->rays / w, f->temporal_us, (unsigned long long)s->unique_timestamps,
@@ -148,7 +148,7 @@ static void print_row(const char *name, const bench_figures *f, int json)
                f->adaptive ? "adaptive" : "uniform", samples_per_pixel_s(f), s->time_photons,
                (unsigned long long)s->photons_stored, (unsigned long long)s->photon_collisions,
                (unsigned long long)s->photon_cells_changed, (unsigned long long)s->photons_traced,
-               (unsigned long long)s->photons_reused);
+               (unsigned long long)s->photons_reused, s->time_device);
     } else {
         char res[32], spf[16];
         /* adaptive sampling has no samples per frame: each pixel picks its own times */

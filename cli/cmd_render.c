@@ -1,4 +1,5 @@
 #include "commands.h"
+#include "host_clock.h"
 #include "evray.h"
 #include "options.h"
 
@@ -23,13 +24,6 @@ typedef struct {
     double started;
 } progress_state;
 
-static double wall(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static int on_progress(void *user, const evr_stats *st)
 {
     progress_state *p = (progress_state *)user;
@@ -37,7 +31,7 @@ static int on_progress(void *user, const evr_stats *st)
         p->duration = st->sim_time * st->segments_total / st->segments_done;
     if (p->show) {
         double frac = st->segments_total ? (double)st->segments_done / st->segments_total : 1.0;
-        double el = wall() - p->started;
+        double el = evr_host_seconds() - p->started;
         double eta = frac > 0 ? el * (1.0 - frac) / frac : 0.0;
         char bar[31];
         int filled = (int)(frac * 30.0), i;
@@ -191,7 +185,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
 
     progress_state ps;
     ps.show = !quiet && isatty(2);
-    ps.started = wall();
+    ps.started = evr_host_seconds();
     ps.duration = 0;
     ps.duration = cfg.duration;
     st = evr_sim_run(sim, on_progress, &ps, &err);

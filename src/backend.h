@@ -78,6 +78,7 @@ struct evr_backend {
     uint64_t photon_cells_changed;   /* GI: buffer cells whose photons or view changed, all passes */
     double photon_seconds;
     double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
+    double wait_seconds;          /* the calling thread blocked on the device in submit and collect (GPU) */
     double sort_seconds, copy_seconds;
     uint64_t device_bytes;        /* memory held on the device */
 };

@@ -257,6 +257,7 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
     evr_json_key(&j, "time_motion_seconds"); evr_json_number(&j, sim->time_motion);
     evr_json_key(&j, "time_device_seconds"); evr_json_number(&j, sim->backend->device_seconds);
+    evr_json_key(&j, "time_device_wait_seconds"); evr_json_number(&j, sim->backend->wait_seconds);
     evr_json_key(&j, "device_samples_per_second"); evr_json_number(&j, sim->backend->device_seconds > 0 ? (double)s->samples / sim->backend->device_seconds : 0.0);
     evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, s->time_sort);
     evr_json_key(&j, "time_copy_seconds"); evr_json_number(&j, s->time_copy);

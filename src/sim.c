@@ -1,6 +1,7 @@
 /* The segment loop: scene motion per segment -> backend -> time-ordered events -> writers,
  * previews and run statistics. */
 #include "sim_internal.h"
+#include "host_clock.h"
 #include "config_json.h"
 #include "io/json.h"
 #include "io/preview.h"
@@ -17,13 +18,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 const char *evr_version(void) { return EVR_VERSION; }
 
@@ -158,9 +152,9 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
     mark_used(sim, s->cameras[sim->camera].node);
 
-    double t_setup = now_seconds();
+    double t_setup = evr_host_seconds();
     st = make_backend(sim, err);
-    sim->time_setup = now_seconds() - t_setup;
+    sim->time_setup = evr_host_seconds() - t_setup;
     if (st != EVR_OK) {
         evr_sim_release(sim);
         return st;
@@ -239,7 +233,7 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     evr_status st;
     while (n < v->n && v->data[n].t < limit_us) n++;
     if (n == 0) return EVR_OK;
-    double t = now_seconds();
+    double t = evr_host_seconds();
     for (i = 0; i < n; i++) {
         const evr_event *e = &v->data[i];
         if (e->p) sim->st.events_on++;
@@ -247,14 +241,14 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
         if (e->t != sim->last_t) sim->st.unique_timestamps++;
         sim->last_t = e->t;
     }
-    sim->time_write += now_seconds() - t;
-    t = now_seconds();
+    sim->time_write += evr_host_seconds() - t;
+    t = evr_host_seconds();
     if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
-    sim->time_preview += now_seconds() - t;
-    t = now_seconds();
+    sim->time_preview += evr_host_seconds() - t;
+    t = evr_host_seconds();
     /* the writers take the buffer; the events held back move to one of the queue's */
     if ((st = evr_write_queue_push_take(sim->wq, v, n, err)) != EVR_OK) return st;
-    sim->time_write += now_seconds() - t;
+    sim->time_write += evr_host_seconds() - t;
     return EVR_OK;
 }
 
@@ -270,16 +264,16 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.index = i;
     seg.t0 = segment_start(sim, i);
     seg.t1 = segment_end(sim, i);
-    double tm = now_seconds();
+    double tm = evr_host_seconds();
     compute_motion(sim, seg.t0, seg.t1, &seg);
-    sim->time_motion += now_seconds() - tm;
+    sim->time_motion += evr_host_seconds() - tm;
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
     seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
-    double t = now_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
+    double t = evr_host_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
-    sim->time_render += now_seconds() - t;
+    sim->time_render += evr_host_seconds() - t;
     return st;
 }
 
@@ -291,9 +285,9 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     const float *intensity = NULL, *frames = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
     evr_status st;
-    double t = now_seconds();
+    double t = evr_host_seconds();
     if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, &frames, err)) != EVR_OK) return st;
-    sim->time_render += now_seconds() - t;
+    sim->time_render += evr_host_seconds() - t;
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
     int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
@@ -304,9 +298,9 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
         safe -= (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
     if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;   /* written and flushed on the writer thread */
     if (intensity) {
-        t = now_seconds();
+        t = evr_host_seconds();
         if ((st = evr_run_preview_intensity(sim, intensity, t1, last, err)) != EVR_OK) return st;
-        sim->time_preview += now_seconds() - t;
+        sim->time_preview += evr_host_seconds() - t;
     }
     int first, count, k;
     evr_frames_of_segment(sim, i, &first, &count);
@@ -314,12 +308,12 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
         snprintf(err->msg, sizeof err->msg, "internal error: the backend returned no intensity frames");
         return EVR_ERR_BACKEND;
     }
-    t = now_seconds();
+    t = evr_host_seconds();
     for (k = 0; k < count; k++) {
         size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
         if ((st = evr_frames_write(sim, first + k, frames + (size_t)k * npix, err)) != EVR_OK) return st;
     }
-    sim->time_preview += now_seconds() - t;
+    sim->time_preview += evr_host_seconds() - t;
     sim->st.segments_done = i + 1;
     sim->st.samples = sim->backend->samples;
     sim->st.rays = sim->backend->rays;
@@ -333,7 +327,7 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     sim->st.photons_reused = sim->backend->photons_reused;
     sim->st.photon_cells_changed = sim->backend->photon_cells_changed;
     sim->st.sim_time = t1 - sim->cfg.start;
-    sim->st.wall_time = now_seconds() - wall0;
+    sim->st.wall_time = evr_host_seconds() - wall0;
     sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
     sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
     sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
@@ -343,7 +337,7 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err)
 {
     evr_status st = EVR_OK;
-    double wall0 = now_seconds();
+    double wall0 = evr_host_seconds();
     int submitted = 0, i, stop = 0;
     /* keep one segment in flight while the previous one is written */
     if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
@@ -367,7 +361,7 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         }
     }
     sim->st.interrupted = sim->st.segments_done < sim->num_segments;
-    sim->st.wall_time = now_seconds() - wall0;
+    sim->st.wall_time = evr_host_seconds() - wall0;
     if ((st = evr_run_finish(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
 }

@@ -1,4 +1,5 @@
 #include "write_queue.h"
+#include "host_clock.h"
 #include "events.h"
 
 #include <pthread.h>
@@ -24,13 +25,6 @@ struct evr_write_queue {
     double busy_seconds, wait_seconds;
 };
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void *writer_main(void *arg)
 {
     evr_write_queue *q = (evr_write_queue *)arg;
@@ -45,11 +39,11 @@ static void *writer_main(void *arg)
         evr_status st = EVR_OK;
         evr_error err;
         err.msg[0] = 0;
-        double t = now_s();
+        double t = evr_host_seconds();
         int w;
         for (w = 0; !failed && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->write(q->writers[w], v->data, v->n, &err);
         for (w = 0; !failed && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->flush(q->writers[w], &err);
-        double dt = now_s() - t;
+        double dt = evr_host_seconds() - t;
         pthread_mutex_lock(&q->mu);
         q->busy_seconds += dt;
         if (st != EVR_OK && q->status == EVR_OK) {
@@ -93,10 +87,10 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
 
 evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n, evr_error *err)
 {
-    double t = now_s();
+    double t = evr_host_seconds();
     pthread_mutex_lock(&q->mu);
     while (q->count == QUEUE_SLOTS && q->status == EVR_OK) pthread_cond_wait(&q->cv, &q->mu);
-    q->wait_seconds += now_s() - t;
+    q->wait_seconds += evr_host_seconds() - t;
     if (q->status != EVR_OK) {
         *err = q->err;
         evr_status st = q->status;
@@ -126,10 +120,10 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
 
 evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err)
 {
-    double t = now_s();
+    double t = evr_host_seconds();
     pthread_mutex_lock(&q->mu);
     while (q->count > 0) pthread_cond_wait(&q->cv, &q->mu);
-    q->wait_seconds += now_s() - t;
+    q->wait_seconds += evr_host_seconds() - t;
     evr_status st = q->status;
     if (st != EVR_OK) *err = q->err;
     pthread_mutex_unlock(&q->mu);

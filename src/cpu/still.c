@@ -2,6 +2,7 @@
  * space at that time, geometry id = scene instance), the event pipeline's direct shading through
  * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
 #include "still.h"
+#include "host_clock.h"
 #include "cpu/cpu_gi.h"
 #include "cpu/workers.h"
 #include "backend.h"
@@ -38,13 +39,6 @@ void evr_still_defaults(evr_still_params *p)
     p->max_bounces = 8;
     p->ambient = 0.02f;
     p->seed = 1;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- Embree as an evr_tracer ---- */
@@ -236,7 +230,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     char emsg[256] = "";
     int cam, i, nthreads = p->threads;
     evr_status st;
-    double t0 = now();
+    double t0 = evr_host_seconds();
     size_t npix;
     memset(out, 0, sizeof *out);
     memset(&buf, 0, sizeof buf);
@@ -344,12 +338,12 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     c.tr.occluded = em_occluded;
     c.pose = evr_rs_camera_pose(&host.rs, 0.0f);
     c.out = out;
-    out->seconds_setup = now() - t0;
+    out->seconds_setup = evr_host_seconds() - t0;
 
     if (p->gi == EVR_GI_PHOTON) {
         evr_photon_params pp;
         evr_photon_bounds bb;
-        double t1 = now();
+        double t1 = evr_host_seconds();
         uint32_t nph = p->photons ? p->photons : (npix > (1u << 25) ? (1u << 28) : (uint32_t)(8 * npix));
         /* the scene at the time, baked: a sphere round its bounds (a little larger) */
         if (!(lo.x <= hi.x)) lo = hi = evr_v3_make(0.0f, 0.0f, 0.0f);
@@ -381,17 +375,17 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         c.gp.max_window = p->gather_window;
         c.gp.normal_cos = p->gather_normal_cos;
         out->gather_radius = c.gp.radius;
-        out->seconds_photons = now() - t1;
+        out->seconds_photons = evr_host_seconds() - t1;
     }
     {
-        double t2 = now();
+        double t2 = evr_host_seconds();
         atomic_store(&c.next_row, 0);
         if (!evr_run_workers(shade_worker, &c, nthreads)) {
             snprintf(err->msg, sizeof err->msg, "out of memory");
             st = EVR_ERR_NOMEM;
             goto done;
         }
-        out->seconds_shading = now() - t2;
+        out->seconds_shading = evr_host_seconds() - t2;
     }
     {
         double used = 0.0;

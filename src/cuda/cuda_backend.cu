@@ -26,6 +26,7 @@ extern "C" {
 #include "core/skip.h"
 #include "core/adaptive.h"
 #include "cuda/gpu_traverse.h"
+#include "host_clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -1160,7 +1161,9 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         return EVR_ERR_BACKEND;
     }
     slot *sl = &b->slots[b->head];
+    double tw = evr_host_seconds();
     CK(cudaEventSynchronize(sl->counted));
+    base->wait_seconds += evr_host_seconds() - tw;
     size_t n = *sl->h_count.p;
     while (n > sl->d_keys_ev.cap) {
         /* overflow: grow and render this segment again from its unchanged input states (the
@@ -1214,7 +1217,9 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
     }
     CK(cudaEventRecord(sl->copied, sl->copy));
+    tw = evr_host_seconds();
     CK(cudaStreamSynchronize(sl->copy));
+    base->wait_seconds += evr_host_seconds() - tw;
     if (n) {
         float sort_ms = 0.0f, copy_ms = 0.0f;
         CK(cudaEventElapsedTime(&sort_ms, sl->counted, sl->sorted));
