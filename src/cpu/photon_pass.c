@@ -432,13 +432,10 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     c.em = em;
     c.margin = buf->margin;
     c.cells_w = buf->width;
-    if (trails) {
+    if (trails) {   /* without the memory for them, every photon is traced (as without trails) */
         c.reuse = trails_prepare(trails, pp, em);
-        if (c.reuse < 0) {
-            snprintf(err->msg, sizeof err->msg, "out of memory for the photon trails");
-            return EVR_ERR_NOMEM;
-        }
-        c.trails = trails;
+        c.trails = c.reuse < 0 ? NULL : trails;
+        if (c.reuse < 0) c.reuse = 0;
     }
     c.nchunks = (int)((em->photons + CHUNK - 1) / CHUNK);
     c.chunks = calloc((size_t)c.nchunks, sizeof *c.chunks);
