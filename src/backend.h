@@ -58,8 +58,8 @@ typedef struct {
 typedef struct evr_backend evr_backend;
 struct evr_backend {
     const char *name;
-    /* Starts rendering a segment; segments are submitted in order, at most two ahead of collect(),
-     * so a backend can render one while the host writes the previous one. */
+    /* Starts rendering a segment; segments are submitted in order, at most `depth` of them ahead
+     * of collect(), so a backend can render while the host takes in and writes earlier ones. */
     evr_status (*submit)(evr_backend *b, const evr_segment *seg, evr_error *err);
     /* Waits for the oldest submitted segment and appends its events, sorted by (t, y, x), to out.
      * *intensity is set to every pixel's last linear intensity (row-major, top row first) when the
@@ -69,6 +69,7 @@ struct evr_backend {
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, const float **frames,
                           evr_error *err);
     void (*release)(evr_backend *b);
+    int depth;                    /* segments the backend holds submitted and not yet collected, at most */
     uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not;
                                      adaptive sampling: every sample taken) */
     uint64_t samples_traced;      /* samples that traced rays (the others reused a cached intensity) */

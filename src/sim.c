@@ -339,13 +339,16 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
     evr_status st = EVR_OK;
     double wall0 = evr_host_seconds();
     int submitted = 0, i, stop = 0;
-    /* keep one segment in flight while the previous one is written */
+    /* keep the backend's depth of segments in flight (at least two: one renders while the previous
+     * one is taken in and written) */
+    const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;
     if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
     for (i = 0; st == EVR_OK && i < submitted; i++) {
-        if (!stop && submitted < sim->num_segments) {
+        while (!stop && st == EVR_OK && submitted < sim->num_segments && submitted < i + depth) {
             if ((st = submit_segment(sim, submitted, err)) != EVR_OK) break;
             submitted++;
         }
+        if (st != EVR_OK) break;
         if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, wall0, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }

@@ -810,6 +810,7 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     int m, x, y;
     if (!b) goto nomem;
     b->base.name = "cpu";
+    b->base.depth = 2;
     b->base.submit = cpu_submit;
     b->base.collect = cpu_collect;
     b->base.release = cpu_release;

@@ -6,12 +6,14 @@
  * motion transforms (cuda/gpu_traverse.h), shading and the pixel model from src/core, the very
  * functions the CPU backend runs. Events are appended with warp-aggregated atomics as 64-bit
  * keys (time, y, x, polarity), sorted on the GPU with CUB's radix sort and copied to pinned host
- * memory on a second stream while the next segment renders.
+ * memory on a second stream while the next segments render: NSLOT segments are in flight, so that
+ * the GPU has work queued while the host takes in and writes earlier ones (render times vary
+ * widely from segment to segment).
  *
- * Pixel states live in a ring of three device arrays: segment i reads ring[i % 3] and writes
- * ring[(i + 1) % 3], so when segment i's event buffer overflows (found at collect, when segment
- * i + 1 may already be rendering) segment i can be rendered again from its unchanged input with
- * a larger buffer: events are never dropped. */
+ * Pixel states live in a ring of NRING device arrays: segment i reads ring[i % NRING] and writes
+ * ring[(i + 1) % NRING], so when segment i's event buffer overflows (found at collect, when the
+ * segments after it may already have rendered) segment i can be rendered again from its
+ * unchanged input with a larger buffer: events are never dropped. */
 #include <cuda_runtime.h>
 #include <cub/device/device_radix_sort.cuh>
 
@@ -43,6 +45,8 @@ extern "C" {
     } while (0)
 
 #define BLOCK 128
+#define NSLOT 3                 /* segments in flight */
+#define NRING (NSLOT + 1)       /* pixel-state arrays: the in-flight segments' inputs and the last output */
 #ifndef MIN_BLOCKS
 #define MIN_BLOCKS 6   /* 80 registers: measured faster than 128 (occupancy) on the H100 */
 #endif
@@ -602,12 +606,12 @@ struct cuda_backend {
     dbuf<evr_gpu_node4> d_nodes4;
     dbuf<evr_gpu_node8> d_nodes8;
     dbuf<evr_gpu_tri> d_tris;
-    dbuf<evr_pixel_state> d_state[3];
-    dbuf<float> d_next[3];                 /* adaptive sampling: next sample times, a ring as d_state */
+    dbuf<evr_pixel_state> d_state[NRING];
+    dbuf<float> d_next[NRING];             /* adaptive sampling: next sample times, a ring as d_state */
     dbuf<float> d_phase;
     dbuf<evr_pixel_params> d_sensor;       /* the run's pixel parameters, for the sensor kernel */
     cudaStream_t render = nullptr;
-    slot slots[2];
+    slot slots[NSLOT];
     int head, queued;
     size_t capacity;                       /* event keys per segment */
     evr_event_vec decoded, scratch;
@@ -740,8 +744,8 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.view.num_tris = b->bvh.num_tris;
     a.view.num_top_nodes = sl->top.num_nodes;
     a.view.num_insts = sl->top.num_insts;
-    a.state_in = b->d_state[sl->index % 3].p;
-    a.state_out = b->d_state[(sl->index + 1) % 3].p;
+    a.state_in = b->d_state[sl->index % NRING].p;
+    a.state_out = b->d_state[(sl->index + 1) % NRING].p;
     a.phase = b->d_phase.p;
     a.intensity = sl->want_intensity ? sl->d_intensity.p : NULL;
     a.pos_thres = b->setup.pixel.pos_thres;
@@ -846,8 +850,8 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     cudaStream_t rs = b->render;
     if (b->setup.adaptive) {
         adapt_args d;
-        d.next_in = b->d_next[sl->index % 3].p;
-        d.next_out = b->d_next[(sl->index + 1) % 3].p;
+        d.next_in = b->d_next[sl->index % NRING].p;
+        d.next_out = b->d_next[(sl->index + 1) % NRING].p;
         d.plan = sl->d_adapt.p;
         d.p = b->setup.adapt;
         with_variant(b, [&](auto v) { adapt_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a, d); });
@@ -930,7 +934,7 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
  * segment's scene with host pointers (the emitters are built on the host). */
 static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
 {
-    const slot *prev = &b->slots[sl == &b->slots[0] ? 1 : 0];
+    const slot *prev = &b->slots[(sl - b->slots + NSLOT - 1) % NSLOT];   /* the previous segment's */
     const evr_photon_buffer *buf = &sl->ph;
     const size_t cells = (size_t)buf->width * (size_t)buf->height, npix_layers = cells * (size_t)buf->layers;
     const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
@@ -1054,11 +1058,11 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
 {
     cuda_backend *b = (cuda_backend *)base;
     evr_status st;
-    if (b->queued == 2) {
-        snprintf(err->msg, sizeof err->msg, "internal error: more than two segments submitted");
+    if (b->queued == NSLOT) {
+        snprintf(err->msg, sizeof err->msg, "internal error: more than %d segments submitted", NSLOT);
         return EVR_ERR_BACKEND;
     }
-    slot *sl = &b->slots[(b->head + b->queued) % 2];
+    slot *sl = &b->slots[(b->head + b->queued) % NSLOT];
     /* the slot's previous segment was collected, so its copy stream is idle */
     sl->index = seg->index;
     sl->t0 = seg->t0;
@@ -1138,8 +1142,8 @@ static uint64_t device_bytes(const cuda_backend *b)
                  bytes(b->d_textures) + bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
                  bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) +
                  bytes(b->d_sensor);
-    for (int i = 0; i < 3; i++) n += bytes(b->d_state[i]) + bytes(b->d_next[i]);
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < NRING; i++) n += bytes(b->d_state[i]) + bytes(b->d_next[i]);
+    for (int i = 0; i < NSLOT; i++) {
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
@@ -1255,7 +1259,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
     *frames = sl->num_frames ? sl->h_frames.p : NULL;
     base->device_bytes = device_bytes(b);
-    b->head = (b->head + 1) % 2;
+    b->head = (b->head + 1) % NSLOT;
     b->queued--;
     return EVR_OK;
 }
@@ -1265,7 +1269,7 @@ static void cuda_release(evr_backend *base)
     cuda_backend *b = (cuda_backend *)base;
     if (!b) return;
     cudaDeviceSynchronize();
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];
         sl->h_keys.release(); sl->h_tracks.release(); sl->d_keys.release(); sl->d_tracks.release();
         evr_gpu_top_free(&sl->top);
@@ -1292,7 +1296,7 @@ static void cuda_release(evr_backend *base)
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
     b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release();
     b->d_sensor.release();
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < NRING; i++) {
         b->d_state[i].release();
         b->d_next[i].release();
     }
@@ -1338,9 +1342,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if ((st = evr_gpu_bvh_build(b->scene, b->setup.gpu_bvh, &b->bvh, err)) != EVR_OK) return st;
     if ((st = upload_scene(b, err)) != EVR_OK) return st;
     size_t npix = (size_t)b->setup.width * b->setup.height;
-    for (int i = 0; i < 3; i++) CK(b->d_state[i].reserve(npix));
+    for (int i = 0; i < NRING; i++) CK(b->d_state[i].reserve(npix));
     if (b->setup.adaptive) {
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < NRING; i++) {
             CK(b->d_next[i].reserve(npix));
             CK(cudaMemset(b->d_next[i].p, 0, npix * sizeof(float)));
         }
@@ -1357,7 +1361,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     b->gi = b->setup.gi;
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
-    for (int i = 0; i < 2; i++) {
+    for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];
         /* the sort and copy of segment i run while segment i + 1 renders: at the highest
          * priority, so that their few blocks go first and the host can take in segment i's
@@ -1403,6 +1407,7 @@ extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_
         return EVR_ERR_NOMEM;
     }
     b->base.name = "cuda";
+    b->base.depth = NSLOT;
     b->base.submit = cuda_submit;
     b->base.collect = cuda_collect;
     b->base.release = cuda_release;
