@@ -25,6 +25,18 @@ def run(*args, expect=0):
     return p
 
 
+def run_env(env, *args, expect=0):
+    """run() with environment variable env set to 1 (None: as it is), for hidden switches that a
+    test compares against (e.g. EVR_NO_COHERENCE)."""
+    if env is None:
+        return run(*args, expect=expect)
+    os.environ[env] = "1"
+    try:
+        return run(*args, expect=expect)
+    finally:
+        os.environ.pop(env, None)
+
+
 def tmpdir():
     return tempfile.mkdtemp(prefix="evray-test-")
 

@@ -74,12 +74,9 @@ for scene, extra in (("eye", ["--res", "200x150", "--duration", "1.0", "--start"
                      ("city", ["--res", "160x90", "--duration", "0.3"]),
                      ("square", ["--res", "96x96", "--duration", "1.0"])):
     evs = []
-    for off in (False, True):
-        if off:
-            os.environ["EVR_NO_COHERENCE"] = "1"
-        d = os.path.join(tmp, f"coh-{scene}-{int(off)}")
-        T.run("demo", "--scene", scene, "-o", d, "--backend", "cuda", "--format", "npy", "--no-preview", "--quiet", *extra)
-        os.environ.pop("EVR_NO_COHERENCE", None)
+    for env in (None, "EVR_NO_COHERENCE"):
+        d = os.path.join(tmp, f"coh-{scene}-{env}")
+        T.run_env(env, "demo", "--scene", scene, "-o", d, "--backend", "cuda", "--format", "npy", "--no-preview", "--quiet", *extra)
         evs.append(open(os.path.join(d, "events.npy"), "rb").read())
     T.check(len(evs[0]) > 1000 and evs[0] == evs[1], f"{scene}: identical events with and without temporal coherence")
 
@@ -112,20 +109,15 @@ T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: over
 for label, extra in (("skip", []), ("brute", ["--no-skip"]), ("davis346", ["--sensor", "davis346"]),
                      ("720p", ["--res", "1280x720", "--duration", "0.3"])):
     evs = []
-    for inline in (False, True):
-        if inline:
-            os.environ["EVR_GI_INLINE"] = "1"
-        d = os.path.join(tmp, f"gi-deferred-{label}-{int(inline)}")
-        T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi, *extra)
-        os.environ.pop("EVR_GI_INLINE", None)
+    for env in (None, "EVR_GI_INLINE"):
+        d = os.path.join(tmp, f"gi-deferred-{label}-{env}")
+        T.run_env(env, "demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi, *extra)
         evs.append(open(os.path.join(d, "events.npy"), "rb").read())
     T.check(len(evs[0]) > 10000 and evs[0] == evs[1], f"cornell GI ({label}): deferred and inline gathers give identical events")
 # photons whose trails meet nothing that moves keep their outcome (core/photon.h): the same events
 # as tracing every photon (EVR_NO_PHOTON_REUSE), and about as many photons reused as on the CPU
-os.environ["EVR_NO_PHOTON_REUSE"] = "1"
 d = os.path.join(tmp, "gi-no-reuse")
-T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi)
-os.environ.pop("EVR_NO_PHOTON_REUSE", None)
+T.run_env("EVR_NO_PHOTON_REUSE", "demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", *gi)
 st_nr = T.load_run_json(d)["stats"]
 print(f"photon trails: cuda {st_gpu['photons_reused']} reused / {st_gpu['photons_traced']} traced, cpu "
       f"{st_cpu['photons_reused']} / {st_cpu['photons_traced']}; without reuse {st_nr['photons_traced']} traced")

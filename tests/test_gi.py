@@ -51,7 +51,7 @@ T.check(ja["stats"]["events"] > 0 and ev_a == ev_am, "GI with adaptive sampling:
 # (its trail, core/photon.h): the same events as tracing every photon (EVR_NO_PHOTON_REUSE), most
 # photons of the moving box's passes reused, none under brute force
 st = js["stats"]
-os.environ["EVR_NO_PHOTON_REUSE"] = "1"
+os.environ["EVR_NO_PHOTON_REUSE"] = "1"   # as the EVR_GI_NO_MEMO runs above
 ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--duration", "0.5")
 del os.environ["EVR_NO_PHOTON_REUSE"]
 print(f"photon trails: {st['photons_reused']} reused, {st['photons_traced']} traced in {st['photon_passes']} passes; "

@@ -304,6 +304,27 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
     }
 }
 
+/* Thread threadIdx of a launch over every pixel, or over the skip kernel's list of pixels that
+ * trace: its pixel, or none (active false; such threads still take part in warp votes). Returns
+ * false when the whole block is past the pixels (the block returns). */
+struct launch_pixel {
+    int i, pix, x, y;
+    bool active;
+    unsigned lane;
+};
+__device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pixel *p)
+{
+    const int n = a.list ? (int)*a.list_count : a.width * a.height;
+    p->i = blockIdx.x * blockDim.x + threadIdx.x;
+    if ((int)(blockIdx.x * blockDim.x) >= n) return false;
+    p->active = p->i < n;
+    p->pix = p->active ? (a.list ? a.list[p->i] : p->i) : 0;
+    p->x = p->active ? p->pix % a.width : 0;
+    p->y = p->active ? p->pix / a.width : 0;
+    p->lane = threadIdx.x & 31u;
+    return true;
+}
+
 /* SENSOR: 1 for the full sensor model of core/pixel.h (mismatch, bandwidth, leak, noise,
  * timestamps), 0 for the ideal sensor: then the kernel runs the ideal model's own functions on the
  * ideal part of the state and compiles to the same code as before the sensor model existed (same
@@ -313,14 +334,11 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
 template <int LAYOUT, int SENSOR, int GI>
 __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render_kernel(kernel_args a)
 {
-    const int npix = a.width * a.height;
-    const int n = a.list ? (int)*a.list_count : npix;
-    const int i = blockIdx.x * blockDim.x + threadIdx.x;
-    if ((int)(blockIdx.x * blockDim.x) >= n) return;   /* the whole block */
-    const bool active = i < n;           /* inactive threads still take part in warp votes */
-    const int pix = active ? (a.list ? a.list[i] : i) : 0;
-    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
-    const unsigned lane = threadIdx.x & 31u;
+    launch_pixel lp;
+    if (!launch_pixel_of(a, &lp)) return;
+    const bool active = lp.active;
+    const int pix = lp.pix, x = lp.x, y = lp.y;
+    const unsigned lane = lp.lane;
     evr_pixel_state st;
     evr_pixel_reset(&st);
     float phi = 0.0f;

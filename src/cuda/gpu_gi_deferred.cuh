@@ -41,14 +41,11 @@ struct gi_deferred {
 template <int LAYOUT>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args a, gi_deferred d)
 {
-    const int npix = a.width * a.height;
-    const int n = a.list ? (int)*a.list_count : npix;
-    const int i = blockIdx.x * blockDim.x + threadIdx.x;
-    if ((int)(blockIdx.x * blockDim.x) >= n) return;   /* the whole block */
-    const bool active = i < n;                           /* inactive threads still take part in warp votes */
-    const int pix = active ? (a.list ? a.list[i] : i) : 0;
-    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
-    const unsigned lane = threadIdx.x & 31u;
+    launch_pixel lp;
+    if (!launch_pixel_of(a, &lp)) return;
+    const bool active = lp.active;
+    const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
+    const unsigned lane = lp.lane;
     const float phi = active ? a.phase[pix] : 0.0f;
     unsigned rays = 0, traced = 0;
     float t_hit = INFINITY, cache = -1.0f;
@@ -126,14 +123,11 @@ __global__ void __launch_bounds__(BLOCK) gi_gather_kernel(kernel_args a, gi_defe
 template <int SENSOR>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args a, gi_deferred d)
 {
-    const int npix = a.width * a.height;
-    const int n = a.list ? (int)*a.list_count : npix;
-    const int i = blockIdx.x * blockDim.x + threadIdx.x;
-    if ((int)(blockIdx.x * blockDim.x) >= n) return;
-    const bool active = i < n;
-    const int pix = active ? (a.list ? a.list[i] : i) : 0;
-    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
-    const unsigned lane = threadIdx.x & 31u;
+    launch_pixel lp;
+    if (!launch_pixel_of(a, &lp)) return;
+    const bool active = lp.active;
+    const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
+    const unsigned lane = lp.lane;
     evr_pixel_state st;
     evr_pixel_reset(&st);
     float phi = 0.0f;
