@@ -16,6 +16,7 @@ export PATH="$PATH:/usr/local/cuda/bin"
 } > "$OUT/env.log" 2>&1
 python3 tests/test_cuda.py "$E" > "$OUT/test_cuda.log" 2>&1; echo "test_cuda exit $?" >> "$OUT/test_cuda.log"
 python3 tests/test_skip.py "$E" > "$OUT/test_skip.log" 2>&1; echo "test_skip exit $?" >> "$OUT/test_skip.log"
+python3 tests/test_bench.py "$E" > "$OUT/test_bench.log" 2>&1; echo "test_bench exit $?" >> "$OUT/test_bench.log"
 # memcheck over segments that skip (the eye in a fixation) and that trace (a saccade), ideal and davis346
 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.5 \
     --start 0.9 -o "$OUT/cs-eye" --no-preview -q > "$OUT/sanitizer.log" 2>&1; echo "memcheck exit $?" >> "$OUT/sanitizer.log"

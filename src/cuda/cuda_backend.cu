@@ -601,6 +601,9 @@ struct slot {
     dbuf<float> d_cdf;
     cudaEvent_t gi_started = nullptr, gi_done = nullptr;
     int gi_pass;                       /* the pass ran for this segment (not a still copy) */
+    int copying;                       /* the sort and copy of this render's events are queued */
+    size_t copy_n;                     /* their count */
+    cudaEvent_t sort_from = nullptr;   /* start of the sort (copy stream) */
     evr_photon_buffer ph;              /* the buffer's shape and device pointers */
 };
 
@@ -906,6 +909,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaMemcpyAsync(sl->h_rays.p, sl->d_rays.p, GI_COUNTERS * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaEventRecord(sl->counted, sl->copy));
+    sl->copying = 0;
     return EVR_OK;
 }
 
@@ -1072,6 +1076,57 @@ static evr_status gi_alloc(cuda_backend *b, slot *sl, int margin, int window, ev
     return EVR_OK;
 }
 
+/* Queues the sort and copy to the host of a rendered segment's n events (and of its intensity
+ * and frames) on the slot's copy stream. */
+static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err)
+{
+    CK(cudaEventRecord(sl->sort_from, sl->copy));
+    if (n) {
+        size_t temp = 0;
+        CK(sl->d_keys_sorted.reserve(n));
+        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->d_sort_temp.reserve(temp));
+        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->h_sorted.reserve(n));
+        CK(cudaEventRecord(sl->sorted, sl->copy));
+        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->want_intensity) {
+        size_t npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_intensity.reserve(npix));
+        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->num_frames) {
+        size_t nf = (size_t)sl->num_frames * (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_frames.reserve(nf));
+        CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
+        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    CK(cudaEventRecord(sl->copied, sl->copy));
+    sl->copying = 1;
+    sl->copy_n = n;
+    return EVR_OK;
+}
+
+/* Queues the sort and copy of every submitted segment, in order, whose render is done (its count
+ * is on the host) and whose events fit its buffer (else collect renders it again): they run on
+ * the GPU while the host is busy elsewhere, instead of after the host asks for them. */
+static evr_status start_ready_copies(cuda_backend *b, evr_error *err)
+{
+    for (int q = 0; q < b->queued; q++) {
+        slot *sl = &b->slots[(b->head + q) % NSLOT];
+        if (sl->copying) continue;
+        const cudaError_t e = cudaEventQuery(sl->counted);
+        if (e == cudaErrorNotReady) return EVR_OK;   /* the later ones render after it */
+        CK(e);
+        const size_t n = *sl->h_count.p;
+        if (n > sl->d_keys_ev.cap) return EVR_OK;
+        evr_status st = start_copy(b, sl, n, err);
+        if (st != EVR_OK) return st;
+    }
+    return EVR_OK;
+}
+
 static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err)
 {
     cuda_backend *b = (cuda_backend *)base;
@@ -1080,6 +1135,8 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
         snprintf(err->msg, sizeof err->msg, "internal error: more than %d segments submitted", NSLOT);
         return EVR_ERR_BACKEND;
     }
+    /* the segments rendered since the last call: their sorts start now, before the host work below */
+    if ((st = start_ready_copies(b, err)) != EVR_OK) return st;
     slot *sl = &b->slots[(b->head + b->queued) % NSLOT];
     /* the slot's previous segment was collected, so its copy stream is idle */
     sl->index = seg->index;
@@ -1216,35 +1273,13 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     base->device_seconds += 1e-3 * (double)ms;
     if (b->setup.adaptive) base->samples += sl->h_rays.p[2];   /* the samples taken, all traced */
     else base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
-    CK(cudaEventRecord(sl->counted, sl->copy));   /* start of sort and copy */
-    if (n) {
-        size_t temp = 0;
-        CK(sl->d_keys_sorted.reserve(n));
-        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
-        CK(sl->d_sort_temp.reserve(temp));
-        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
-        CK(sl->h_sorted.reserve(n));
-        CK(cudaEventRecord(sl->sorted, sl->copy));
-        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
-    }
-    if (sl->want_intensity) {
-        size_t npix = (size_t)b->setup.width * b->setup.height;
-        CK(sl->h_intensity.reserve(npix));
-        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
-    }
-    if (sl->num_frames) {
-        size_t nf = (size_t)sl->num_frames * (size_t)b->setup.width * b->setup.height;
-        CK(sl->h_frames.reserve(nf));
-        CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
-        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
-    }
-    CK(cudaEventRecord(sl->copied, sl->copy));
+    if (!sl->copying && (st = start_copy(b, sl, n, err)) != EVR_OK) return st;
     tw = evr_host_seconds();
     CK(cudaStreamSynchronize(sl->copy));
     base->wait_seconds += evr_host_seconds() - tw;
     if (n) {
         float sort_ms = 0.0f, copy_ms = 0.0f;
-        CK(cudaEventElapsedTime(&sort_ms, sl->counted, sl->sorted));
+        CK(cudaEventElapsedTime(&sort_ms, sl->sort_from, sl->sorted));
         CK(cudaEventElapsedTime(&copy_ms, sl->sorted, sl->copied));
         base->sort_seconds += 1e-3 * (double)sort_ms;
         base->copy_seconds += 1e-3 * (double)copy_ms;
@@ -1279,7 +1314,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     base->device_bytes = device_bytes(b);
     b->head = (b->head + 1) % NSLOT;
     b->queued--;
-    return EVR_OK;
+    return start_ready_copies(b, err);
 }
 
 static void cuda_release(evr_backend *base)
@@ -1309,6 +1344,7 @@ static void cuda_release(evr_backend *base)
         if (sl->counted) cudaEventDestroy(sl->counted);
         if (sl->sorted) cudaEventDestroy(sl->sorted);
         if (sl->copied) cudaEventDestroy(sl->copied);
+        if (sl->sort_from) cudaEventDestroy(sl->sort_from);
     }
     b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
@@ -1393,6 +1429,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaEventCreate(&sl->counted));
         CK(cudaEventCreate(&sl->sorted));
         CK(cudaEventCreate(&sl->copied));
+        CK(cudaEventCreate(&sl->sort_from));
         CK(cudaEventCreate(&sl->framed));
         CK(sl->d_keys_ev.reserve(b->capacity));
         CK(sl->d_count.reserve(2));
