@@ -4,7 +4,7 @@
  *
  *   shuffle  the chunk's element bytes transposed: every element's first byte, then every
  *            element's second byte, ... (HDF5 leaves 1-byte elements as they are)
- *   deflate  zlib's compress2 at the given level (zlib format, header and Adler-32 included)
+ *   deflate  a zlib stream (header and Adler-32 included), made by libdeflate at the given level
  *
  * A chunk always holds the dataset's full chunk size; elements past the data (the last chunk of a
  * dataset whose length is not a multiple of it) are zero, HDF5's default fill value, which is
@@ -24,20 +24,27 @@ typedef struct {
     size_t elem_size;       /* bytes per element */
     size_t count;           /* elements taken from src (at most chunk_elems) */
     size_t chunk_elems;     /* elements in a chunk: the rest is zero */
-    int level;              /* deflate level, 0 .. 9 */
+    int level;              /* libdeflate's compression level, 0 .. 12 */
     unsigned char *dst;     /* room for evr_chunk_bound(chunk_elems * elem_size) bytes */
     /* out */
     size_t dst_size;        /* compressed bytes */
-    int ok;                 /* 0: zlib failed (out of memory) */
+    int ok;                 /* 0: the compressor failed (out of memory) */
 } evr_chunk_job;
 
 typedef struct evr_chunk_pool evr_chunk_pool;
 
+/* What one thread compresses with: room for a shuffled chunk of at most max_chunk_bytes, and a
+ * compressor. NULL when out of memory. */
+typedef struct evr_chunk_worker evr_chunk_worker;
+evr_chunk_worker *evr_chunk_worker_new(size_t max_chunk_bytes);
+void evr_chunk_worker_free(evr_chunk_worker *w);   /* NULL is fine */
+
 /* Bytes that the compressed form of a chunk of raw_bytes bytes can take at most. */
 size_t evr_chunk_bound(size_t raw_bytes);
 
-/* Compresses one chunk; scratch holds chunk_elems * elem_size bytes. Returns job->ok. */
-int evr_chunk_compress(evr_chunk_job *job, unsigned char *scratch);
+/* Compresses one chunk with worker w (made for at least chunk_elems * elem_size bytes). Returns
+ * job->ok. */
+int evr_chunk_compress(evr_chunk_job *job, evr_chunk_worker *w);
 
 /* The number of threads a pool should have here: the processors this process may run on, at
  * most max. */
