@@ -1226,7 +1226,9 @@ static uint64_t device_bytes(const cuda_backend *b)
              bytes(sl->d_ph_slots) + bytes(sl->d_ph_count) + bytes(sl->d_ph_gbuf) + bytes(sl->d_sat) + bytes(sl->d_em) + bytes(sl->d_cdf);
     }
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
-         bytes(b->d_pcount) + bytes(b->d_ptemp);
+         bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) + bytes(b->d_trail_rays) + bytes(b->d_todo) +
+         bytes(b->d_gd_direct) + bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +
+         bytes(b->d_gd_requests);
     return n;
 }
 
