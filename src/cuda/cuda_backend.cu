@@ -258,15 +258,36 @@ __device__ __forceinline__ void add_counts(const kernel_args &a, unsigned lane, 
     if (lane == 0 && ts) atomicAdd(&a.rays[2], ts);
 }
 
+/* Launches over every pixel give each warp a tile of TILE_W x TILE_H pixels (8 x 4) rather than a
+ * run of 32 along a row: the warp's rays, and the cells its pixels' gathers read, then lie close
+ * together in both directions. Edge tiles have lanes outside the image (inactive). The skip
+ * kernel lists the pixels that trace in this order too. */
+#ifndef TILE_W
+#define TILE_W 8
+#endif
+#define TILE_H (32 / TILE_W)
+static unsigned tiled_threads(int w, int h)
+{
+    return (unsigned)((w + TILE_W - 1) / TILE_W) * (unsigned)((h + TILE_H - 1) / TILE_H) * 32u;
+}
+__device__ __forceinline__ bool tiled_pixel(int i, int w, int h, int *pix, int *x, int *y)
+{
+    const int warp = i >> 5, lane = i & 31, tiles_x = (w + TILE_W - 1) / TILE_W;
+    *x = (warp % tiles_x) * TILE_W + lane % TILE_W;
+    *y = (warp / tiles_x) * TILE_H + lane / TILE_W;
+    const bool in = *x < w && *y < h;
+    *pix = in ? *y * w + *x : 0;
+    if (!in) *x = *y = 0;
+    return in;
+}
+
 /* Change-driven sampling, first pass: a pixel that keeps its cached intensity runs its samples
  * through the pixel model here (no rays); the others are listed for the render kernel. */
 template <int SENSOR>
 __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
 {
-    const int npix = a.width * a.height;
-    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
-    const bool active = pix < npix;
-    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    int pix, x, y;
+    const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
     evr_pixel_reset(&st);
@@ -314,14 +335,18 @@ struct launch_pixel {
 };
 __device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pixel *p)
 {
-    const int n = a.list ? (int)*a.list_count : a.width * a.height;
     p->i = blockIdx.x * blockDim.x + threadIdx.x;
+    p->lane = threadIdx.x & 31u;
+    if (!a.list) {   /* every pixel, in warp tiles */
+        p->active = tiled_pixel(p->i, a.width, a.height, &p->pix, &p->x, &p->y);
+        return true;
+    }
+    const int n = (int)*a.list_count;
     if ((int)(blockIdx.x * blockDim.x) >= n) return false;
     p->active = p->i < n;
-    p->pix = p->active ? (a.list ? a.list[p->i] : p->i) : 0;
+    p->pix = p->active ? a.list[p->i] : 0;
     p->x = p->active ? p->pix % a.width : 0;
     p->y = p->active ? p->pix / a.width : 0;
-    p->lane = threadIdx.x & 31u;
     return true;
 }
 
@@ -399,11 +424,8 @@ struct adapt_args {
 template <int LAYOUT, int SENSOR, int GI>
 __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args d)
 {
-    const int npix = a.width * a.height;
-    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
-    if ((int)(blockIdx.x * blockDim.x) >= npix) return;   /* the whole block */
-    const bool active = pix < npix;
-    const int x = active ? pix % a.width : 0, y = active ? pix / a.width : 0;
+    int pix, x, y;
+    const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
     evr_pixel_reset(&st);
@@ -864,9 +886,8 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     CK(cudaMemsetAsync(sl->d_count.p, 0, 2 * sizeof(unsigned int), b->render));
     CK(cudaMemsetAsync(sl->d_rays.p, 0, 3 * sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
-    int npix = b->setup.width * b->setup.height;
     CK(cudaEventRecord(sl->started, b->render));
-    const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
+    const unsigned grid = (tiled_threads(b->setup.width, b->setup.height) + BLOCK - 1) / BLOCK;   /* >= npix threads */
     const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
     cudaStream_t rs = b->render;
     if (b->setup.adaptive) {
