@@ -179,6 +179,11 @@ static void print_row(const char *name, const bench_figures *f, int json)
         } else {
             printf("brute force (--no-skip): every sample traced\n");
         }
+        if (s->photons_traced + s->photons_reused > 0)
+            printf("global illumination: photon passes %.3f s, %llu photon paths traced, %llu reused (their last paths met "
+                   "nothing that moved), %llu photons stored, %llu collisions\n",
+                   s->time_photons, (unsigned long long)s->photons_traced, (unsigned long long)s->photons_reused,
+                   (unsigned long long)s->photons_stored, (unsigned long long)s->photon_collisions);
     }
 }
 

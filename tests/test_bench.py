@@ -1,5 +1,5 @@
-"""evray bench --sweep (CSV and PNG), --suite seed (shortened), and evray plot (rate and heat map
-PNGs; bad input gives one error line)."""
+"""evray bench --sweep (CSV and PNG), --suite seed (shortened), the GI line of the report, and
+evray plot (rate and heat map PNGs; bad input gives one error line)."""
 import csv
 import json
 import os
@@ -39,6 +39,17 @@ def expect_error(args, what):
     T.check(p.returncode > 0, f"{what}: non-zero exit without a crash (got {p.returncode})")
     T.check(len(lines) == 1 and lines[0].startswith("evray: error: "), f"{what}: one error line (got {lines!r})")
 
+
+# one row with GI: the text report says how many photon paths were traced and how many reused their
+# trail, and those numbers are the JSON's; a row without GI has no such line
+p = T.run("bench", "--scene", "cornell", "--backend", "cpu", "--res", "48x36", "--duration", "0.3", "--gi", "photon")
+gi_line = [l for l in p.stdout.splitlines() if l.startswith("global illumination:")]
+js = json.loads(T.run("bench", "--scene", "cornell", "--backend", "cpu", "--res", "48x36", "--duration", "0.3", "--gi",
+                      "photon", "--json").stdout)
+T.check(len(gi_line) == 1 and f"{js['photons_traced']} photon paths traced, {js['photons_reused']} reused" in gi_line[0]
+        and js["photons_reused"] > 0, f"bench GI: photon paths traced and reused reported ({gi_line})")
+p = T.run("bench", "--scene", "cornell", "--backend", "cpu", "--res", "48x36", "--duration", "0.1")
+T.check("global illumination:" not in p.stdout, "bench without GI: no photon line")
 
 # --sweep res, tiny: 80x60 and 160x120 over 0.05 s
 out = os.path.join(tmp, "sweep")
