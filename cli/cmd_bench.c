@@ -1,6 +1,7 @@
 /* evray bench: one simulation and one row of figures; the reference design's table (--suite
  * seed); how the cost per sample grows (--sweep, CSV and PNG plot). */
 #include "commands.h"
+#include "host_clock.h"
 #include "evray.h"
 #include "io/event_reader.h"
 #include "io/plot.h"
@@ -395,18 +396,16 @@ static int run_city_sweep(const evr_config *base, const char *kind, const char *
         evr_config cfg = *base;
         evr_scene *scene = NULL;
         evr_error err = {{0}};
-        struct timespec t0, t1;
         unsigned long long mesh_tris = 0, scene_tris = 0;
         double load_s;
         int ninst, detail = is_tri ? details[i] : EVR_CITY_DETAIL, buildings = is_tri ? EVR_CITY_BUILDINGS : counts[i], k;
         if (is_tri ? detail > max_detail : buildings > max_buildings) continue;
-        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const double t0 = evr_host_seconds();
         if (evr_demo_city_load(detail, buildings, &scene, &err) != EVR_OK) {
             cli_error("%s", err.msg);
             return 1;
         }
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        load_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        load_s = evr_host_seconds() - t0;
         for (k = 0; k < scene->num_meshes; k++) mesh_tris += scene->meshes[k].num_triangles;
         for (k = 0; k < scene->num_instances; k++) scene_tris += scene->meshes[scene->instances[k].mesh].num_triangles;
         ninst = scene->num_instances;

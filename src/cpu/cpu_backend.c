@@ -1,6 +1,7 @@
 /* CPU backend: Embree finds the triangles; motion-blurred instances carry each node's segment
  * keys as quaternion-decomposition time steps; tiles of pixels are spread over threads. */
 #include "backend.h"
+#include "host_clock.h"
 #include "core/rng.h"
 #include "core/shading.h"
 #include "core/skip.h"
@@ -602,11 +603,9 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
             return EVR_ERR_NOMEM;
         }
     }
-    struct timespec ts0, ts1;
-    clock_gettime(CLOCK_MONOTONIC, &ts0);
+    const double ts0 = evr_host_seconds();
     int sorted = evr_events_sort(out, &b->scratch);
-    clock_gettime(CLOCK_MONOTONIC, &ts1);
-    base->sort_seconds += (double)(ts1.tv_sec - ts0.tv_sec) + 1e-9 * (double)(ts1.tv_nsec - ts0.tv_nsec);
+    base->sort_seconds += evr_host_seconds() - ts0;
     if (!sorted) {
         snprintf(err->msg, sizeof err->msg, "out of memory sorting events");
         return EVR_ERR_NOMEM;

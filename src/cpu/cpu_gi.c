@@ -1,5 +1,6 @@
 /* Global illumination in the CPU event pipeline: see cpu_gi.h. */
 #include "cpu/cpu_gi.h"
+#include "host_clock.h"
 #include "core/shading.h"
 
 #include <math.h>
@@ -100,13 +101,12 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
     const int w = g->buf.width, h = g->buf.height;
     evr_status st;
     evr_photon_stats ps;
-    struct timespec t0, t1;
     int x, y;
     if (still && g->have_prev) {   /* the same photons as last time: nothing changed */
         memset(g->sat, 0, (size_t)(w + 1) * (size_t)(h + 1) * sizeof *g->sat);
         return EVR_OK;
     }
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    const double t0 = evr_host_seconds();
     {   /* the previous segment's buffer becomes prev */
         evr_photon_buffer tmp = g->prev;
         g->prev = g->buf;
@@ -129,14 +129,13 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
         }
     }
     g->have_prev = 1;
-    clock_gettime(CLOCK_MONOTONIC, &t1);
     stats->photons_traced += ps.paths;
     stats->photons_reused += ps.reused;
     stats->photons_stored += ps.inserted;
     stats->photon_collisions += ps.collisions;
     stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
     stats->photon_passes++;
-    stats->photon_seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    stats->photon_seconds += evr_host_seconds() - t0;
     return EVR_OK;
 }
 

@@ -1,5 +1,6 @@
 /* The CPU photon pass: emitters, buffer, and the tracing loop over all cores. */
 #include "cpu/photon_pass.h"
+#include "host_clock.h"
 #include "cpu/workers.h"
 
 #include <math.h>
@@ -414,10 +415,9 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
                            evr_photon_trails *trails, evr_error *err)
 {
     pass_ctx c;
-    struct timespec t0, t1;
     int i, k;
     evr_status rc = EVR_OK;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    const double t0 = evr_host_seconds();
     memset(st, 0, sizeof *st);
     evr_photon_buffer_clear(buf);
     if (em->n == 0 || em->photons == 0) return EVR_OK;
@@ -466,8 +466,7 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     }
     free(c.chunks);
     st->collisions = *buf->collisions;
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    st->seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    st->seconds = evr_host_seconds() - t0;
     if (rc != EVR_OK) snprintf(err->msg, sizeof err->msg, "out of memory for the photon pass");
     return rc;
 }
