@@ -396,9 +396,14 @@ static int trails_prepare(evr_photon_trails *tt, const evr_photon_params *pp, co
         tt->valid = 0;
         if (!tt->cap) return -1;
     }
-    const int reuse = tt->valid && evr_photon_emitters_same(&tt->em, em);
+    return evr_photon_trails_pass(&tt->em, &tt->valid, em);
+}
+
+int evr_photon_trails_pass(evr_photon_emitters *recorded, int *valid, const evr_photon_emitters *em)
+{
+    const int reuse = *valid && evr_photon_emitters_same(recorded, em);
     /* this pass records every photon's trail: valid for the next, with these emitters */
-    tt->valid = evr_photon_emitters_copy(&tt->em, em);
+    *valid = evr_photon_emitters_copy(recorded, em);
     return reuse;
 }
 

@@ -85,6 +85,10 @@ typedef struct {
     const evr_skip_plan *plan;
 } evr_photon_trails;
 void evr_photon_trails_free(evr_photon_trails *tt);
+/* The bookkeeping of a pass that records every photon's trail, for the CPU's trails and the GPU's:
+ * whether the recorded trails (*valid, made with emitter table *recorded) may be reused by a pass
+ * with emitters em; then *recorded and *valid describe this pass's trails. */
+int evr_photon_trails_pass(evr_photon_emitters *recorded, int *valid, const evr_photon_emitters *em);
 
 /* Traces every photon of the emitters (threads over chunks of photons), keeps each photon that
  * stays where the camera (pose at the photon's time) sees it, and inserts it into buf (cleared

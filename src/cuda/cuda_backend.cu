@@ -97,6 +97,20 @@ __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_
     return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit);
 }
 
+/* A warp-aggregated append: every lane of the warp calls it; the lanes with `want` get
+ * consecutive slots after *count, claimed with one atomic for the warp. Returns this lane's slot
+ * (meaningless without want). */
+__device__ __forceinline__ unsigned warp_append(unsigned *count, bool want)
+{
+    const unsigned mask = __ballot_sync(0xffffffffu, want), lane = threadIdx.x & 31u;
+    if (!mask) return 0;
+    const unsigned leader = (unsigned)__ffs(mask) - 1u;
+    unsigned base = 0;
+    if (lane == leader) base = atomicAdd(count, (unsigned)__popc(mask));
+    base = __shfl_sync(0xffffffffu, base, leader);
+    return base + (unsigned)__popc(mask & ((1u << lane) - 1u));
+}
+
 #include "cuda/gpu_gi.cuh"
 
 /* Direct light of one sample, as sample_intensity in cpu/cpu_backend.c, with our traversal; 0 on a
@@ -202,6 +216,20 @@ __device__ __forceinline__ void store_state(const kernel_args &a, int pix, const
     if (a.intensity) a.intensity[pix] = st.intensity;
 }
 
+/* A launch's pixel before its samples: its state and (sensor kernel) its own parameters. Returns
+ * its sample phase; an inactive lane (which still takes part in warp votes) gets a reset state. */
+template <int SENSOR>
+__device__ __forceinline__ float pixel_begin(const kernel_args &a, bool active, int pix, int x, int y, evr_pixel_state &st,
+                                             evr_pixel_params &own)
+{
+    evr_pixel_reset(&st);
+    if (SENSOR) own = *a.sensor;
+    if (!active) return 0.0f;
+    load_state<SENSOR>(a, pix, st);
+    if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
+    return a.phase[pix];
+}
+
 /* One sample (intensity at t seconds from the segment's start) through the pixel model; its
  * events are appended with warp-aggregated atomics. Every lane of the warp calls it together;
  * live: this lane has a sample. */
@@ -290,15 +318,10 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
     const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
-    evr_pixel_reset(&st);
     evr_pixel_params own;
-    if (SENSOR) own = *a.sensor;
+    const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     bool skip = false;
-    float phi = 0.0f;
     if (active) {
-        load_state<SENSOR>(a, pix, st);
-        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
-        phi = a.phase[pix];
         evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
         evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
         skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
@@ -306,13 +329,8 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
         if (skip && a.gi)
             skip = !evr_photon_window_changed(a.gi->sat, a.gi->buf.width, a.gi->buf.height, a.gi->buf.margin, a.gi->window, x, y);
     }
-    const unsigned traced = __ballot_sync(0xffffffffu, active && !skip);
-    if (traced) {
-        unsigned leader = (unsigned)__ffs(traced) - 1u, base = 0;
-        if (lane == leader) base = atomicAdd(a.list_count, (unsigned)__popc(traced));
-        base = __shfl_sync(0xffffffffu, base, leader);
-        if (active && !skip) a.list[base + (unsigned)__popc(traced & ((1u << lane) - 1u))] = pix;
-    }
+    const unsigned at = warp_append(a.list_count, active && !skip);
+    if (active && !skip) a.list[at] = pix;
     const unsigned skipped = __ballot_sync(0xffffffffu, skip);
     if (!skipped) return;   /* the whole warp */
     if (lane == 0) atomicAdd(&a.rays[1], (unsigned long long)__popc(skipped));
@@ -365,15 +383,8 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
     const int pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     evr_pixel_state st;
-    evr_pixel_reset(&st);
-    float phi = 0.0f;
     evr_pixel_params own;                /* the sensor kernel's parameters of this pixel */
-    if (SENSOR) own = *a.sensor;
-    if (active) {
-        load_state<SENSOR>(a, pix, st);
-        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
-        phi = a.phase[pix];
-    }
+    const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     unsigned rays = 0, traced = 0;
     float t_hit = INFINITY;
     bool tracing = active;
@@ -624,7 +635,6 @@ struct slot {
     cudaEvent_t gi_started = nullptr, gi_done = nullptr;
     int gi_pass;                       /* the pass ran for this segment (not a still copy) */
     int copying;                       /* the sort and copy of this render's events are queued */
-    size_t copy_n;                     /* their count */
     cudaEvent_t sort_from = nullptr;   /* start of the sort (copy stream) */
     evr_photon_buffer ph;              /* the buffer's shape and device pointers */
 };
@@ -853,6 +863,17 @@ static gi_deferred deferred_args(const cuda_backend *b)
     return d;
 }
 
+static void gi_deferred_release(cuda_backend *b)
+{
+    b->d_gd_direct.release();
+    b->d_gd_req.release();
+    b->d_gd_lum.release();
+    b->d_gd_requests.release();
+    b->d_gd_traced.release();
+    b->d_gd_cache.release();
+    b->d_gd_count.release();
+}
+
 /* The deferred gathers' buffers: every sample of every pixel may make a request (the moving
  * object's pixels do). Where they do not fit in device memory the render kernel gathers inline,
  * with a notice. EVR_GI_INLINE=1 (hidden, for tests and measurement) chooses that too. */
@@ -870,12 +891,7 @@ static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
         return;
     }
     (void)cudaGetLastError();   /* the failed allocation: not sticky, cleared */
-    b->d_gd_direct.release();
-    b->d_gd_req.release();
-    b->d_gd_lum.release();
-    b->d_gd_requests.release();
-    b->d_gd_traced.release();
-    b->d_gd_cache.release();
+    gi_deferred_release(b);
     fprintf(stderr, "evray: notice: not enough GPU memory to defer the gathers of %zu samples a segment; "
                     "gathering inside the render kernel (slower)\n", n);
 }
@@ -966,14 +982,12 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     p->trail_rays = b->d_trail_rays.p;
     p->todo = b->d_todo.p;
     p->todo_count = b->d_todo_count.p;
-    p->reuse = b->trails_valid && evr_photon_emitters_same(&b->em, &b->trail_em);
-    /* this pass records every photon's trail: they are valid for the next, with these emitters */
-    b->trails_valid = evr_photon_emitters_copy(&b->trail_em, &b->em);
+    p->reuse = evr_photon_trails_pass(&b->trail_em, &b->trails_valid, &b->em);
 }
 
 /* The segment's photons (gpu_gi.cuh) on the render stream, before its render: the pass, the
  * buffer's view, the changed cells. A still segment (nothing moved in it or since the previous
- * one) copies the previous segment's buffer (in the other slot) and changes no cell. hrs: the
+ * one) copies the previous segment's buffer (in the slot before) and changes no cell. hrs: the
  * segment's scene with host pointers (the emitters are built on the host). */
 static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
 {
@@ -1125,7 +1139,6 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
     }
     CK(cudaEventRecord(sl->copied, sl->copy));
     sl->copying = 1;
-    sl->copy_n = n;
     return EVR_OK;
 }
 
@@ -1381,8 +1394,7 @@ static void cuda_release(evr_backend *base)
     b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
     b->d_trails.release(); b->d_trail_rays.release(); b->d_todo.release(); b->d_todo_count.release();
     evr_photon_emitters_free(&b->trail_em);
-    b->d_gd_direct.release(); b->d_gd_req.release(); b->d_gd_lum.release(); b->d_gd_requests.release();
-    b->d_gd_traced.release(); b->d_gd_cache.release(); b->d_gd_count.release();
+    gi_deferred_release(b);
     evr_photon_emitters_free(&b->em);
     if (b->render) cudaStreamDestroy(b->render);
     evr_gpu_bvh_free(&b->bvh);

@@ -169,7 +169,6 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
 __global__ void __launch_bounds__(BLOCK) photon_reuse_kernel(kernel_args a, photon_args p)
 {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    const unsigned lane = threadIdx.x & 31u;
     bool trace = false;
     if (i < p.photons) {
         const evr_trail_ray *rays = p.trail_rays + (size_t)i * (size_t)p.trail_len;
@@ -181,13 +180,8 @@ __global__ void __launch_bounds__(BLOCK) photon_reuse_kernel(kernel_args a, phot
             trace = true;
         }
     }
-    const unsigned mask = __ballot_sync(0xffffffffu, trace);
-    if (!mask) return;
-    const unsigned leader = (unsigned)__ffs(mask) - 1u;
-    unsigned base = 0;
-    if (lane == leader) base = atomicAdd(p.todo_count, (unsigned)__popc(mask));
-    base = __shfl_sync(0xffffffffu, base, leader);
-    if (trace) p.todo[base + (unsigned)__popc(mask & ((1u << lane) - 1u))] = i;
+    const unsigned at = warp_append(p.todo_count, trace);
+    if (trace) p.todo[at] = i;
 }
 
 /* One thread per photon to trace (every photon, or the reuse kernel's list): its path, its

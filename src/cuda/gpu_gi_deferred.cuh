@@ -74,18 +74,12 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             }
             traced++;
         }
-        const unsigned mask = __ballot_sync(0xffffffffu, want);
-        if (mask) {   /* the warp's requests in one atomic */
-            const unsigned leader = (unsigned)__ffs(mask) - 1u;
-            unsigned base = 0;
-            if (lane == leader) base = atomicAdd(d.count, (unsigned)__popc(mask));
-            base = __shfl_sync(0xffffffffu, base, leader);
-            if (want) {
-                r = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
-                d.requests[r].g = g;
-                d.requests[r].pix = pix;
-                memo.req = r;
-            }
+        const unsigned at = warp_append(d.count, want);   /* the warp's requests in one atomic */
+        if (want) {
+            r = at;
+            d.requests[r].g = g;
+            d.requests[r].pix = pix;
+            memo.req = r;
         }
         if (now) {
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
@@ -129,17 +123,9 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     evr_pixel_state st;
-    evr_pixel_reset(&st);
-    float phi = 0.0f;
-    int traced = 0;
     evr_pixel_params own;
-    if (SENSOR) own = *a.sensor;
-    if (active) {
-        load_state<SENSOR>(a, pix, st);
-        if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
-        phi = a.phase[pix];
-        traced = d.traced[i];
-    }
+    const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
+    const int traced = active ? d.traced[i] : 0;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
         float intensity = st.intensity;   /* kept when settled */
