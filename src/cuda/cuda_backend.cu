@@ -952,7 +952,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 
 /* The pass's trails: reused where the previous pass recorded them with the same emitters; room
  * for n photons (a pass that needs more starts them afresh). Without the memory, no trails (every
- * photon traced, as before them). EVR_NO_PHOTON_REUSE=1 (hidden, for tests and measurement): none. */
+ * photon traced, as before them), nor with EVR_NO_PHOTON_REUSE set (trails_off). */
 static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
 {
     p->trails = nullptr;
@@ -961,7 +961,7 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     p->reuse = 0;
     p->todo = nullptr;
     p->todo_count = nullptr;
-    if (b->trails_off || getenv("EVR_NO_PHOTON_REUSE")) return;
+    if (b->trails_off) return;
     const size_t len = (size_t)p->trail_len;
     if (n > b->d_trails.cap || (size_t)n * len > b->d_trail_rays.cap) {
         b->trails_valid = 0;
@@ -1449,6 +1449,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     int gi_margin = 0, gi_window = 0;
     b->gi = b->setup.gi;
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
+    b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];

@@ -74,9 +74,9 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             }
             traced++;
         }
-        const unsigned at = warp_append(d.count, want);   /* the warp's requests in one atomic */
+        const unsigned slot = warp_append(d.count, want);   /* the warp's requests in one atomic */
         if (want) {
-            r = at;
+            r = slot;
             d.requests[r].g = g;
             d.requests[r].pix = pix;
             memo.req = r;
