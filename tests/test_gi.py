@@ -10,9 +10,9 @@ import evrtest as T
 tmp = T.tmpdir()
 
 
-def render(name, scene, *extra):
+def render(name, scene, *extra, env=None):
     d = os.path.join(tmp, name)
-    T.run("demo", "--scene", scene, "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
+    T.run_env(env, "demo", "--scene", scene, "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
           "--res", "64x48", *extra)
     return open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d)
 
@@ -37,23 +37,18 @@ T.check(js["stats"]["samples_traced"] < jb["stats"]["samples_traced"], "moving b
 T.check(ev_s != ev_d, "GI changes the events")
 # a pixel reuses its last gather while its hit and its window are unchanged: gathering at every
 # sample instead (EVR_GI_NO_MEMO) gives the same events
-os.environ["EVR_GI_NO_MEMO"] = "1"
-ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip")
-del os.environ["EVR_GI_NO_MEMO"]
+ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip", env="EVR_GI_NO_MEMO")
 T.check(ev_m == ev_b, "GI: the same events without the gather memo")
 # the same with adaptive sampling (its tiles must forget a pixel's gather when its window changed)
 ev_a, ja = render("adaptive", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
-os.environ["EVR_GI_NO_MEMO"] = "1"
-ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
-del os.environ["EVR_GI_NO_MEMO"]
+ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive",
+                    env="EVR_GI_NO_MEMO")
 T.check(ja["stats"]["events"] > 0 and ev_a == ev_am, "GI with adaptive sampling: the same events without the gather memo")
 # a photon whose last path met nothing that moves keeps its outcome instead of being traced again
 # (its trail, core/photon.h): the same events as tracing every photon (EVR_NO_PHOTON_REUSE), most
 # photons of the moving box's passes reused, none under brute force
 st = js["stats"]
-os.environ["EVR_NO_PHOTON_REUSE"] = "1"   # as the EVR_GI_NO_MEMO runs above
-ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--duration", "0.5")
-del os.environ["EVR_NO_PHOTON_REUSE"]
+ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--duration", "0.5", env="EVR_NO_PHOTON_REUSE")
 print(f"photon trails: {st['photons_reused']} reused, {st['photons_traced']} traced in {st['photon_passes']} passes; "
       f"without reuse {jt['stats']['photons_traced']} traced")
 T.check(ev_t == ev_s, "GI: the same events with and without reusing photon trails")
