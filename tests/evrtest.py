@@ -55,6 +55,35 @@ def load_h5(path):
     return ev, ms, attrs
 
 
+def npy_event_times(data):
+    """The t column (microseconds) of an events.npy file's bytes, without numpy (the GPU machine
+    has none): the header's dtype gives the record layout."""
+    import ast
+    import struct
+    major = data[6]
+    hlen = struct.unpack_from("<H" if major == 1 else "<I", data, 8)[0]
+    start = 10 + hlen if major == 1 else 12 + hlen
+    header = ast.literal_eval(data[10 if major == 1 else 12:start].decode("latin1"))
+    sizes = {"i8": 8, "u8": 8, "u2": 2, "i2": 2, "i1": 1, "u1": 1, "f8": 8, "i4": 4, "u4": 4, "f4": 4}
+    offset, t_at = 0, None
+    for name, typ in header["descr"]:
+        if name == "t":
+            t_at = offset
+        offset += sizes[typ.lstrip("<>|=")]
+    n = (len(data) - start) // offset
+    return [struct.unpack_from("<q", data, start + i * offset + t_at)[0] for i in range(n)]
+
+
+def boundary_share(npy, segments, duration):
+    """The share of an events.npy's events within a tenth of a segment of a segment boundary."""
+    t = npy_event_times(npy)
+    near = 0
+    for us in t:
+        phase = (us * 1e-6 * segments / duration) % 1.0
+        near += phase < 0.1 or phase > 0.9
+    return near / max(len(t), 1)
+
+
 def quad_gltf(path, with_triangles=True, animated=False):
     """A lit grey quad facing +Z seen by a camera at z = 3; optionally moving."""
     pos = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)

@@ -102,6 +102,11 @@ T.check(st_gpu["events"] > 0 and abs(st_gpu["events"] - st_cpu["events"]) <= 0.0
 T.check(r["f1"] >= 0.95, f"cornell GI: CPU vs CUDA F1 {r['f1']} >= 0.95")
 T.check(st_gpu.get("photon_passes") == st_cpu.get("photon_passes"), "cornell GI: the same photon passes (still segments reuse)")
 T.check(gi_runs["cuda"][1] == gi_runs["cuda2"][1], "cornell GI on CUDA: two runs give identical events")
+# the indirect light is linear in time between the photon passes at segment boundaries: GI's
+# events do not cluster there (tests/test_gi.py on the CPU)
+share = T.boundary_share(gi_runs["cuda"][1], st_gpu["segments"], 0.5)
+print(f"cornell GI on CUDA: {share:.3f} of the events within a tenth of a segment of a boundary")
+T.check(share < 0.3, "cornell GI on CUDA: events do not cluster at segment boundaries")
 T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: overflowing segments re-rendered, identical events")
 # the gathers deferred to a kernel of their own (cuda/gpu_gi_deferred.cuh, the default with uniform
 # sampling) give the events of the render kernel that gathers inline (EVR_GI_INLINE=1) bit for

@@ -95,11 +95,13 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
 
 /* Intensity of eight samples at once (neighbouring pixels of a row, each at its own time):
  * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
- * shared shading of src/core lane by lane. Counts the rays it traces; t_hit (may be NULL) gets
- * each primary ray's hit distance (INFINITY: none). */
+ * shared shading of src/core lane by lane. Counts the rays it traces; t_hit gets each primary
+ * ray's hit distance (INFINITY: none); NULL for a frame's samples, which are not the pixel
+ * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. */
 #define PACKET 8
 static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, const int *ys,
-                                   const float *fs, const int *valid, float *out, float *t_hit, unsigned long long *rays)
+                                   const float *fs, const int *valid, float *out, float *t_hit, float *direct,
+                                   unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -131,6 +133,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     rtcIntersect8(vmask, b->top, &ctx, &rh);
     for (i = 0; i < PACKET; i++) {
         out[i] = 0.0f;   /* nothing: black */
+        if (direct) direct[i] = 0.0f;
         acc[i][0] = acc[i][1] = acc[i][2] = 0.0f;
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
@@ -168,9 +171,13 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
     }
     for (i = 0; i < PACKET; i++) {
-        if (!hit[i]) continue;
+        if (!hit[i]) {   /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
+            if (b->gi && valid[i] && t_hit) evr_cpu_gi_missed(&b->gi_state, xs[i], ys[i]);
+            continue;
+        }
         out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
-        if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i]);
+        if (direct) direct[i] = out[i];
+        if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i], fs[i], t_hit != NULL);
     }
 }
 
@@ -180,7 +187,7 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
 {
     int ys[PACKET], i;
     for (i = 0; i < PACKET; i++) ys[i] = y;
-    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, rays);
+    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, NULL, rays);
 }
 
 static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
@@ -211,15 +218,25 @@ typedef struct {
     evr_pixel_params pp;           /* its thresholds, leak and noise (a fixed pattern) */
     evr_ray ray;                   /* its centre ray (the camera at the segment's start) */
     float phi, t_last, t_hit;      /* sample phase; time of its last sample; last hit distance */
+    float direct;                  /* GI: its last traced sample's direct light */
     int x, y;
 } tile_pixel;
 
 /* The samples k0 .. n - 1 of a pixel that keeps its intensity: none when they cannot change it
- * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. */
-static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n, float dt, evr_event_vec *out)
+ * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. With GI, a pixel
+ * that settled on a surface (lit: its last sample met one) keeps the direct light of that sample
+ * and its gather, whose indirect light still moves in time (evr_cpu_gi_last). */
+static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int lit, int k0, int n, float dt, evr_event_vec *out)
 {
     const float in = q->st->intensity;
     int k;
+    if (lit && !evr_cpu_gi_flat(&b->gi_state, q->x, q->y)) {
+        for (k = k0; k < n; k++) {
+            const float f = ((float)k + q->phi) / (float)n;
+            pixel_sample(b, q->st, &q->pp, ideal, f * dt, q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f), q->x, q->y, out);
+        }
+        return;
+    }
     if (ideal && evr_pixel_quiet_ideal(q->st, q->pp.log_floor, q->pp.pos_thres, q->pp.neg_thres, in, q->t_last)) {
         evr_pixel_quiet_finish(q->st, q->pp.log_floor, in, q->t_last);
         return;
@@ -241,7 +258,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     int c, i, k;
     for (c = 0; c < count; c += PACKET) {
         int xs[PACKET], ys[PACKET], valid[PACKET];
-        float fs[PACKET], intensity[PACKET], t_hit[PACKET];
+        float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
         tile_pixel *q[PACKET];
         for (i = 0; i < PACKET; i++) {
             valid[i] = c + i < count;
@@ -251,11 +268,12 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
         }
         for (k = k0; k < k1; k++) {
             for (i = 0; i < PACKET; i++) fs[i] = ((float)k + q[i]->phi) / (float)n;
-            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, rays);
+            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, direct, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 (*traced)++;
                 q[i]->t_hit = t_hit[i];
+                q[i]->direct = direct[i];
                 pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
             }
         }
@@ -264,9 +282,10 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             if (!valid[i]) continue;
             float cd = evr_skip_cache_after_trace(rs, seg->skip, q[i]->ray, q[i]->t_hit);
             if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
+                const int lit = b->gi && q[i]->t_hit < INFINITY;
                 q[i]->st->cache_dist = cd;
                 q[i]->t_hit = -1.0f;   /* its cache is set */
-                keep_samples(b, q[i], ideal, k1, n, dt, out);
+                keep_samples(b, q[i], ideal, lit, k1, n, dt, out);
             } else {
                 more[(*num_more)++] = list[c + i];
             }
@@ -309,13 +328,13 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             q->t_hit = INFINITY;
             if (ideal) q->pp = b->setup.pixel;
             else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
-            /* global illumination: whether the photons this pixel's gather reads changed */
+            /* global illumination: whether the pixel's indirect light may differ from its last sample's */
             const int gi_changed = b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
             /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
             q->ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
             if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) && !gi_changed) {
                 (*skipped)++;
-                keep_samples(b, q, ideal, 0, n, dt, out);
+                keep_samples(b, q, ideal, 0, 0, n, dt, out);
                 evr_pixel_end_segment(q->st, dt);
             } else {
                 list[count++] = np;
@@ -422,7 +441,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 ys[i] = y0 + js[i] / tw;
                 fs[i] = tnext[js[i]] / dt;
             }
-            sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, rays);
+            sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, NULL, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 const int jj = js[i];

@@ -74,10 +74,10 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     g->tr.user = &g->tc;
     g->tr.closest = gi_closest;
     g->tr.occluded = gi_occluded;
-    if ((st = evr_photon_buffer_alloc(&g->buf, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK ||
-        (st = evr_photon_buffer_alloc(&g->prev, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK)
+    if ((st = evr_photon_buffer_alloc(&g->end, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK ||
+        (st = evr_photon_buffer_alloc(&g->start, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK)
         return st;
-    g->sat = calloc((size_t)(g->buf.width + 1) * (size_t)(g->buf.height + 1), sizeof *g->sat);
+    g->sat = calloc((size_t)(g->end.width + 1) * (size_t)(g->end.height + 1), sizeof *g->sat);
     if (!g->sat) {
         snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
         return EVR_ERR_NOMEM;
@@ -94,84 +94,163 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     return EVR_OK;
 }
 
-evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
-                              evr_backend *stats, evr_error *err)
+/* One photon pass at normalized segment time f into buffer out: the photons are a sample in time
+ * (every one traced at f), the view of the cells too. */
+static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, float f, int threads,
+                          evr_photon_buffer *out, evr_backend *stats, evr_error *err)
 {
-    const int still = plan->reuse && plan->num_boxes == 0;
-    const int w = g->buf.width, h = g->buf.height;
     evr_status st;
     evr_photon_stats ps;
-    int x, y;
-    if (still && g->have_prev) {   /* the same photons as last time: nothing changed */
-        memset(g->sat, 0, (size_t)(w + 1) * (size_t)(h + 1) * sizeof *g->sat);
-        return EVR_OK;
-    }
-    const double t0 = evr_host_seconds();
-    {   /* the previous segment's buffer becomes prev */
-        evr_photon_buffer tmp = g->prev;
-        g->prev = g->buf;
-        g->buf = tmp;
-    }
     g->pp.threads = threads;
     g->pp.ray_eps = rs->ray_eps;
-    if ((st = evr_photon_emitters_build(rs, 0.0f, g->pp.bounds, g->photons, &g->em, err)) != EVR_OK) return st;
+    g->pp.f0 = g->pp.f1 = f;
+    if ((st = evr_photon_emitters_build(rs, f, g->pp.bounds, g->photons, &g->em, err)) != EVR_OK) return st;
     memset(&ps, 0, sizeof ps);
     g->trails.plan = plan;
-    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, &g->buf, &ps, g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
+    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, out, &ps, g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
         return st;
-    if ((st = evr_photon_gbuffer(rs, &g->tr, 0.0f, &g->buf, threads, err)) != EVR_OK) return st;
-    for (y = 0; y < h; y++) {
-        uint32_t row = 0;
-        for (x = 0; x < w; x++) {
-            size_t i = (size_t)y * (size_t)w + (size_t)x;
-            row += !g->have_prev || !evr_photon_cell_same(&g->buf, &g->prev, i);
-            g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
-        }
-    }
-    g->have_prev = 1;
+    if ((st = evr_photon_gbuffer(rs, &g->tr, f, out, threads, err)) != EVR_OK) return st;
     stats->photons_traced += ps.paths;
     stats->photons_reused += ps.reused;
     stats->photons_stored += ps.inserted;
     stats->photon_collisions += ps.collisions;
-    stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
     stats->photon_passes++;
+    return EVR_OK;
+}
+
+evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
+                              evr_backend *stats, evr_error *err)
+{
+    const int still = plan->reuse && plan->num_boxes == 0;
+    const int w = g->end.width, h = g->end.height;
+    evr_status st;
+    int x, y;
+    if (still && g->have_prev) {   /* the photons of the last segment's end, here at both ends */
+        g->start_same = 1;
+        memset(g->sat, 0, (size_t)(w + 1) * (size_t)(h + 1) * sizeof *g->sat);
+        return EVR_OK;
+    }
+    const double t0 = evr_host_seconds();
+    if (g->have_prev) {   /* the previous segment's end (the last pass's) is this one's start */
+        evr_photon_buffer tmp = g->start;
+        g->start = g->end;
+        g->end = tmp;
+    } else if ((st = gi_pass(g, rs, plan, 0.0f, threads, &g->start, stats, err)) != EVR_OK) {
+        return st;
+    }
+    g->start_same = 0;
+    if ((st = gi_pass(g, rs, plan, 1.0f, threads, &g->end, stats, err)) != EVR_OK) return st;
+    for (y = 0; y < h; y++) {
+        uint32_t row = 0;
+        for (x = 0; x < w; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            row += !evr_photon_cell_same(&g->end, &g->start, i);
+            g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
+        }
+    }
+    g->have_prev = 1;
+    stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
     stats->photon_seconds += evr_host_seconds() - t0;
     return EVR_OK;
 }
 
+static const evr_photon_buffer *start_of(const evr_cpu_gi *g)
+{
+    return g->start_same ? &g->end : &g->start;
+}
+
 int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int y)
 {
-    if (!evr_photon_window_changed(g->sat, g->buf.width, g->buf.height, g->buf.margin, g->window, x, y)) return 0;
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
+    if (m->valid && !m->end_valid) m->valid = 0;   /* its end was never gathered: forgotten */
+    if (m->valid) m->ls = m->le;                   /* the last segment's end is this one's start */
+    if (!m->valid && !m->missed) return 1;         /* nothing known of the last sample */
+    const int was_flat = m->missed || m->flat;
+    int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin, g->window, x, y);
     /* the window changed: the pixel's last gather still holds if nothing that changed reaches it */
-    if (m->valid && !g->memo_off &&
-        !evr_photon_gather_moved(&g->buf, &g->prev, g->sat, cam, &g->gp, x, y, evr_v3_make(m->key[0], m->key[1], m->key[2]),
-                                 evr_v3_make(m->key[3], m->key[4], m->key[5]), m->key[6]))
-        return 0;
-    m->valid = 0;
-    return 1;
+    if (changed && m->valid && !g->memo_off)
+        changed = evr_photon_gather_moved(&g->end, &g->start, g->sat, cam, &g->gp, x, y, evr_v3_make(m->key[0], m->key[1], m->key[2]),
+                                          evr_v3_make(m->key[3], m->key[4], m->key[5]), m->key[6]);
+    if (changed) {
+        m->end_valid = 0;
+        return !m->missed;
+    }
+    m->flat = 1;   /* its end is its start */
+    return !was_flat;
+}
+
+/* The luminance of the indirect light leaving surface s seen through pixel (x, y), from the
+ * photons at the segment's start (ls) and end (le): walked together (evr_gather_point_lum_n:
+ * 4-6% faster than two walks, machine A, Cornell box at 346x260), one walk where the window saw
+ * no change over the segment (the same cells, the same estimate); end_only: le alone. */
+static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_material_view *mat, const evr_surface *s,
+                        evr_v3 cam_org, int x, int y, int end_only, float *ls, float *le)
+{
+    const evr_photon_buffer *b[2] = {start_of(g), &g->end};
+    const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin, g->window, x, y);
+    evr_gather_point gp;
+    float lum[2];
+    evr_gather_point_at(s, mat, cam_org, &gp);
+    if (end_only) {
+        if (changed) evr_gather_point_lum_n(&b[1], 1, &rs->camera, &g->gp, &gp, x, y, le);
+        else *le = *ls;
+        return;
+    }
+    evr_gather_point_lum_n(b, changed ? 2 : 1, &rs->camera, &g->gp, &gp, x, y, lum);
+    *ls = lum[0];
+    *le = changed ? lum[1] : lum[0];
 }
 
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
-                          int y)
+                          int y, float f, int memo)
 {
     const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
+    if (!memo) {
+        float ls, le;
+        gather_ends(g, rs, mat, s, cam_org, x, y, 0, &ls, &le);
+        return evr_gi_lerp(ls, le, f);
+    }
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
     const float key[7] = {s->p.x, s->p.y, s->p.z, s->n.x, s->n.y, s->n.z, dist};
+    m->missed = 0;
     /* the albedo is the surface's at p (same point, same triangle side: same albedo) */
-    if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) return m->lum;
+    if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) {
+        if (!m->end_valid) {
+            gather_ends(g, rs, mat, s, cam_org, x, y, 1, &m->ls, &m->le);
+            m->end_valid = 1;
+            m->flat = m->le == m->ls;
+        }
+        return evr_gi_lerp(m->ls, m->le, f);
+    }
     memcpy(m->key, key, sizeof key);
     m->inst = inst;
-    m->lum = evr_photon_indirect_lum(&g->buf, &rs->camera, &g->gp, mat, s, cam_org, x, y);
-    m->valid = 1;
-    return m->lum;
+    gather_ends(g, rs, mat, s, cam_org, x, y, 0, &m->ls, &m->le);
+    m->valid = m->end_valid = 1;
+    m->flat = m->le == m->ls;
+    return evr_gi_lerp(m->ls, m->le, f);
+}
+
+int evr_cpu_gi_flat(const evr_cpu_gi *g, int x, int y)
+{
+    return g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].flat;
+}
+
+float evr_cpu_gi_last(const evr_cpu_gi *g, int x, int y, float f)
+{
+    const struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
+    return evr_gi_lerp(m->ls, m->le, f);
+}
+
+void evr_cpu_gi_missed(const evr_cpu_gi *g, int x, int y)
+{
+    g->memo[(size_t)y * (size_t)g->image_width + (size_t)x].missed = 1;
 }
 
 void evr_cpu_gi_free(evr_cpu_gi *g)
 {
-    evr_photon_buffer_free(&g->buf);
-    evr_photon_buffer_free(&g->prev);
+    evr_photon_buffer_free(&g->end);
+    evr_photon_buffer_free(&g->start);
     evr_photon_emitters_free(&g->em);
     evr_photon_trails_free(&g->trails);
     free(g->sat);

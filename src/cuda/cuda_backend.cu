@@ -156,17 +156,18 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
 }
 
 /* Intensity of one sample; GI: plus the indirect light gathered from the segment's photons (memo:
- * the pixel's last gather). */
+ * the pixel's last gather). direct (may be NULL): the direct light alone. */
 template <int LAYOUT, int GI>
 __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
-                                  float *t_hit, gi_memo *memo, float hint = INFINITY)
+                                  float *t_hit, gi_memo *memo, float hint = INFINITY, float *direct = nullptr)
 {
     evr_surface s;
     int inst = 0;
     evr_v3 org;
     float out;
     if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org)) return 0.0f;
-    if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, memo);
+    if (direct) *direct = out;
+    if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, f, memo);
     return out;
 }
 
@@ -325,9 +326,10 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
         evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
         evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
         skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
-        /* global illumination: a pixel whose gather window saw photons change traces */
+        /* global illumination: a pixel whose gather window saw photons change over this segment
+         * or the last traces (its indirect light moves, or moved after its last sample) */
         if (skip && a.gi)
-            skip = !evr_photon_window_changed(a.gi->sat, a.gi->buf.width, a.gi->buf.height, a.gi->buf.margin, a.gi->window, x, y);
+            skip = !evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height, a.gi->end.margin, a.gi->window, x, y);
     }
     const unsigned at = warp_append(a.list_count, active && !skip);
     if (active && !skip) a.list[at] = pix;
@@ -386,7 +388,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
     evr_pixel_params own;                /* the sensor kernel's parameters of this pixel */
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     unsigned rays = 0, traced = 0;
-    float t_hit = INFINITY;
+    float t_hit = INFINITY, direct = 0.0f;
     bool tracing = active;
     gi_memo memo;
     memo.valid = false;
@@ -396,13 +398,15 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
         float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled */
         if (tracing) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo, a.coherence ? t_hit : INFINITY);
+            intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo, a.coherence ? t_hit : INFINITY, &direct);
             traced++;
+        } else if (GI && t_hit < INFINITY) {   /* settled on a surface: its direct light, its gathers at f */
+            intensity = direct + evr_gi_lerp(memo.ls, memo.le, f);
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
         if (k == 0 && tracing) {
             /* settle: the first sample's rays meet nothing that moves in the segment, so every
-             * sample sees the same triangles: keep its intensity */
+             * sample sees the same triangles: keep its intensity (GI: its direct light) */
             float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
             if (c >= 0.0f) {
                 tracing = false;
@@ -622,21 +626,26 @@ struct slot {
     cudaEvent_t framed = nullptr;      /* the frame kernel is done */
     cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr, copied = nullptr;
     int num_tracks, num_keys;
-    /* global illumination: this segment's photon buffer, its view, the changed cells */
-    dbuf<evr_photon> d_ph_slots;
-    dbuf<uint32_t> d_ph_count;
-    dbuf<float> d_ph_gbuf;
+    /* global illumination: the changed cells, the view the kernels read (which ring buffers) */
     dbuf<uint32_t> d_sat;
     dbuf<gpu_gi_view> d_gi_view;
+    hbuf<gpu_gi_view> h_gi_view;
     hbuf<evr_photon_emitter> h_em;
     dbuf<evr_photon_emitter> d_em;
     hbuf<float> h_cdf;
     dbuf<float> d_cdf;
     cudaEvent_t gi_started = nullptr, gi_done = nullptr;
-    int gi_pass;                       /* the pass ran for this segment (not a still copy) */
+    int gi_passes;                     /* photon passes run for this segment (0: a still copy) */
     int copying;                       /* the sort and copy of this render's events are queued */
     cudaEvent_t sort_from = nullptr;   /* start of the sort (copy stream) */
-    evr_photon_buffer ph;              /* the buffer's shape and device pointers */
+};
+
+/* A photon buffer in device memory (gpu_gi.cuh): a ring of them, indexed by segment. */
+struct gi_buffer {
+    dbuf<evr_photon> slots;
+    dbuf<uint32_t> count;
+    dbuf<float> gbuf;
+    evr_photon_buffer ph;              /* the shape and the device pointers */
 };
 
 struct cuda_backend {
@@ -671,6 +680,8 @@ struct cuda_backend {
     /* global illumination (gpu_gi.cuh): the pass's photons and their sort, shared by the slots
      * (one pass at a time on the render stream) */
     int gi, gi_have_prev;
+    gi_buffer gi_ring[NRING];              /* segment i ends in gi_ring[i % NRING], starts in the one before */
+    dbuf<uint8_t> d_gi_last;               /* per cell: changed over the last segment */
     uint32_t photons;
     evr_photon_params pp;
     evr_gather_params gp;
@@ -689,7 +700,8 @@ struct cuda_backend {
      * adaptive sampling (its kernel gathers inline) */
     int gi_deferred;
     unsigned gather_grid;
-    dbuf<float> d_gd_direct, d_gd_cache, d_gd_lum;
+    dbuf<float> d_gd_direct, d_gd_cache;
+    dbuf<float2> d_gd_lum;
     dbuf<unsigned> d_gd_req, d_gd_count;
     dbuf<int> d_gd_traced;
     dbuf<gi_request> d_gd_requests;
@@ -985,28 +997,17 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     p->reuse = evr_photon_trails_pass(&b->trail_em, &b->trails_valid, &b->em);
 }
 
-/* The segment's photons (gpu_gi.cuh) on the render stream, before its render: the pass, the
- * buffer's view, the changed cells. A still segment (nothing moved in it or since the previous
- * one) copies the previous segment's buffer (in the slot before) and changes no cell. hrs: the
- * segment's scene with host pointers (the emitters are built on the host). */
-static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
+/* One photon pass (gpu_gi.cuh) at normalized segment time f into buffer out, on the render stream:
+ * the photons, traced at f, and the camera's view of the cells at f. hrs: the segment's scene
+ * with host pointers (the emitters are built on the host). */
+static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs, float f, const evr_photon_buffer *out,
+                          evr_error *err)
 {
-    const slot *prev = &b->slots[(sl - b->slots + NSLOT - 1) % NSLOT];   /* the previous segment's */
-    const evr_photon_buffer *buf = &sl->ph;
-    const size_t cells = (size_t)buf->width * (size_t)buf->height, npix_layers = cells * (size_t)buf->layers;
+    const size_t cells = (size_t)out->width * (size_t)out->height;
     const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
     cudaStream_t rs = b->render;
     evr_status st;
-    sl->gi_pass = 0;
-    CK(cudaMemsetAsync(sl->d_rays.p + GI_PATHS, 0, (GI_COUNTERS - GI_PATHS) * sizeof(unsigned long long), rs));
-    if (seg->skip->reuse && seg->skip->num_boxes == 0 && b->gi_have_prev) {
-        CK(cudaMemcpyAsync(sl->d_ph_count.p, prev->d_ph_count.p, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
-        CK(cudaMemcpyAsync(sl->d_ph_slots.p, prev->d_ph_slots.p, npix_layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
-        CK(cudaMemcpyAsync(sl->d_ph_gbuf.p, prev->d_ph_gbuf.p, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
-        CK(cudaMemsetAsync(sl->d_sat.p, 0, (size_t)(buf->width + 1) * (size_t)(buf->height + 1) * sizeof(uint32_t), rs));
-        return EVR_OK;
-    }
-    if ((st = evr_photon_emitters_build(hrs, 0.0f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
+    if ((st = evr_photon_emitters_build(hrs, f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
     if (b->em.photons > (1u << 28)) {
         snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", b->em.photons);
         return EVR_ERR_ARG;
@@ -1025,8 +1026,7 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     CK(b->d_pkeys_sorted.reserve((size_t)n + 1));
     CK(b->d_pvals.reserve((size_t)n + 1));
     CK(b->d_pvals_sorted.reserve((size_t)n + 1));
-    CK(cudaEventRecord(sl->gi_started, rs));
-    CK(cudaMemsetAsync(sl->d_ph_count.p, 0, cells * sizeof(uint32_t), rs));
+    CK(cudaMemsetAsync(out->count, 0, cells * sizeof(uint32_t), rs));
     CK(cudaMemsetAsync(b->d_pcount.p, 0, sizeof(unsigned), rs));
     kernel_args a = make_args(b, sl);
     if (n) {
@@ -1036,9 +1036,10 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
         p.cdf = sl->d_cdf.p;
         p.pp = b->pp;
         p.pp.ray_eps = hrs->ray_eps;
+        p.pp.f0 = p.pp.f1 = f;
         p.photons = n;
-        p.margin = buf->margin;
-        p.cells_w = buf->width;
+        p.margin = out->margin;
+        p.cells_w = out->width;
         p.sort_keys = b->d_pkeys.p;
         p.sort_vals = b->d_pvals.p;
         p.pending = b->d_pending.p;
@@ -1063,49 +1064,99 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
         CK(b->d_ptemp.reserve(temp));
         CK(cub::DeviceRadixSort::SortPairs(b->d_ptemp.p, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
                                            (int)n, 0, end_bit, rs));
-        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n, b->d_pending.p, *buf, sl->d_rays.p);
+        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n, b->d_pending.p, *out, sl->d_rays.p);
         CK(cudaGetLastError());
     }
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *buf);
-    else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *buf);
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
     CK(cudaGetLastError());
-    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*buf, prev->ph, b->gi_have_prev, sl->d_sat.p);
-    sat_rows_kernel<<<(unsigned)((32 * (size_t)buf->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height);
-    sat_cols_kernel<<<(unsigned)((buf->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, buf->width, buf->height, sl->d_rays.p);
+    sl->gi_passes++;
+    return EVR_OK;
+}
+
+/* The segment's photons on the render stream, before its render: the pass at its end (the first
+ * segment's at its start too), the cells that changed, the view its kernels read. A still segment
+ * (nothing moved in it or since the previous one) copies the previous segment's buffer. */
+static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
+{
+    const gi_buffer *end = &b->gi_ring[sl->index % NRING], *start = &b->gi_ring[(sl->index + NRING - 1) % NRING];
+    const evr_photon_buffer *eb = &end->ph, *sb = &start->ph;
+    const size_t cells = (size_t)eb->width * (size_t)eb->height;
+    const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
+    cudaStream_t rs = b->render;
+    evr_status st;
+    sl->gi_passes = 0;
+    CK(cudaMemsetAsync(sl->d_rays.p + GI_PATHS, 0, (GI_COUNTERS - GI_PATHS) * sizeof(unsigned long long), rs));
+    if (seg->skip->reuse && seg->skip->num_boxes == 0 && b->gi_have_prev) {
+        CK(cudaMemcpyAsync(eb->count, sb->count, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->slots, sb->slots, cells * (size_t)eb->layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
+    } else {
+        CK(cudaEventRecord(sl->gi_started, rs));
+        if (!b->gi_have_prev) {
+            if ((st = gi_pass(b, sl, hrs, 0.0f, sb, err)) != EVR_OK) return st;
+            CK(cudaStreamSynchronize(rs));   /* the emitters' staging is the slot's: its copy done */
+        }
+        if ((st = gi_pass(b, sl, hrs, 1.0f, eb, err)) != EVR_OK) return st;
+    }
+    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p, sl->d_rays.p);
+    sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    sat_cols_kernel<<<(unsigned)((eb->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
     CK(cudaGetLastError());
-    CK(cudaEventRecord(sl->gi_done, rs));
-    sl->gi_pass = 1;
+    if (sl->gi_passes) CK(cudaEventRecord(sl->gi_done, rs));
+    /* the slot's last copy from its staging finished before its previous segment was collected */
+    gpu_gi_view *v = sl->h_gi_view.p;
+    v->end = *eb;
+    v->start = *sb;
+    CK(cudaMemcpyAsync(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice, rs));
     b->gi_have_prev = 1;
     return EVR_OK;
 }
 
-/* Device memory of a slot's photon buffer and the view the kernels read. */
-static evr_status gi_alloc(cuda_backend *b, slot *sl, int margin, int window, evr_error *err)
+/* Device memory of the ring's photon buffers and the per-cell changes (shared by the slots). */
+static evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
 {
-    evr_photon_buffer *buf = &sl->ph;
-    memset(buf, 0, sizeof *buf);
-    buf->width = b->setup.width + 2 * margin;
-    buf->height = b->setup.height + 2 * margin;
-    buf->layers = b->setup.photon_layers;
-    buf->margin = margin;
-    const size_t cells = (size_t)buf->width * (size_t)buf->height;
-    CK(sl->d_ph_slots.reserve(cells * (size_t)buf->layers));
-    CK(sl->d_ph_count.reserve(cells));
-    CK(sl->d_ph_gbuf.reserve(cells * 8));
-    CK(sl->d_sat.reserve((size_t)(buf->width + 1) * (size_t)(buf->height + 1)));
-    CK(cudaMemset(sl->d_sat.p, 0, (size_t)(buf->width + 1) * (size_t)(buf->height + 1) * sizeof(uint32_t)));
-    CK(cudaMemset(sl->d_ph_count.p, 0, cells * sizeof(uint32_t)));
-    buf->slots = sl->d_ph_slots.p;
-    buf->count = sl->d_ph_count.p;
-    buf->gbuf = sl->d_ph_gbuf.p;
-    buf->collisions = nullptr;   /* the place kernel counts them (GI_COLLISIONS) */
-    gpu_gi_view v;
-    v.buf = *buf;
-    v.sat = sl->d_sat.p;
-    v.gp = b->gp;
-    v.window = window;
+    for (int i = 0; i < NRING; i++) {
+        gi_buffer *g = &b->gi_ring[i];
+        evr_photon_buffer *buf = &g->ph;
+        memset(buf, 0, sizeof *buf);
+        buf->width = b->setup.width + 2 * margin;
+        buf->height = b->setup.height + 2 * margin;
+        buf->layers = b->setup.photon_layers;
+        buf->margin = margin;
+        const size_t cells = (size_t)buf->width * (size_t)buf->height;
+        CK(g->slots.reserve(cells * (size_t)buf->layers));
+        CK(g->count.reserve(cells));
+        CK(g->gbuf.reserve(cells * 8));
+        CK(cudaMemset(g->count.p, 0, cells * sizeof(uint32_t)));
+        CK(cudaMemset(g->gbuf.p, 0, cells * 8 * sizeof(float)));
+        buf->slots = g->slots.p;
+        buf->count = g->count.p;
+        buf->gbuf = g->gbuf.p;
+        buf->collisions = nullptr;   /* the place kernel counts them (GI_COLLISIONS) */
+        if (i == 0) {
+            CK(b->d_gi_last.reserve(cells));
+            CK(cudaMemset(b->d_gi_last.p, 0, cells));
+        }
+    }
+    return EVR_OK;
+}
+
+/* A slot's changed-cell table and the view its kernels read. */
+static evr_status gi_alloc(cuda_backend *b, slot *sl, int window, evr_error *err)
+{
+    const evr_photon_buffer *shape = &b->gi_ring[0].ph;
+    const size_t sat_n = (size_t)(shape->width + 1) * (size_t)(shape->height + 1);
+    CK(sl->d_sat.reserve(sat_n));
+    CK(cudaMemset(sl->d_sat.p, 0, sat_n * sizeof(uint32_t)));
+    CK(sl->h_gi_view.reserve(1));
+    gpu_gi_view *v = sl->h_gi_view.p;
+    v->end = v->start = *shape;
+    v->sat = sl->d_sat.p;
+    v->gp = b->gp;
+    v->window = window;
     CK(sl->d_gi_view.reserve(1));
-    CK(cudaMemcpy(sl->d_gi_view.p, &v, sizeof v, cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice));
     CK(cudaEventCreate(&sl->gi_started));
     CK(cudaEventCreate(&sl->gi_done));
     return EVR_OK;
@@ -1257,8 +1308,10 @@ static uint64_t device_bytes(const cuda_backend *b)
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
              bytes(sl->d_rays) + bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames) +
-             bytes(sl->d_ph_slots) + bytes(sl->d_ph_count) + bytes(sl->d_ph_gbuf) + bytes(sl->d_sat) + bytes(sl->d_em) + bytes(sl->d_cdf);
+             bytes(sl->d_sat) + bytes(sl->d_em) + bytes(sl->d_cdf);
     }
+    for (int i = 0; i < NRING; i++) n += bytes(b->gi_ring[i].slots) + bytes(b->gi_ring[i].count) + bytes(b->gi_ring[i].gbuf);
+    n += bytes(b->d_gi_last);
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
          bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) + bytes(b->d_trail_rays) + bytes(b->d_todo) +
          bytes(b->d_gd_direct) + bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +
@@ -1292,7 +1345,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     base->rays += sl->h_rays.p[0];
     base->pixels_skipped += sl->h_rays.p[1];
     base->samples_traced += sl->h_rays.p[2];
-    if (b->gi && sl->gi_pass) {
+    if (b->gi && sl->gi_passes) {
         float gi_ms = 0.0f;
         CK(cudaEventElapsedTime(&gi_ms, sl->gi_started, sl->gi_done));
         base->photon_seconds += 1e-3 * (double)gi_ms;
@@ -1301,8 +1354,8 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         base->photons_stored += sl->h_rays.p[GI_INSERTED];
         base->photon_collisions += sl->h_rays.p[GI_COLLISIONS];
         base->photon_cells_changed += sl->h_rays.p[GI_CHANGED];
-        base->photon_passes++;
-        sl->gi_pass = 0;   /* a re-render at overflow does not run the pass again */
+        base->photon_passes += (uint64_t)sl->gi_passes;
+        sl->gi_passes = 0;   /* a re-render at overflow does not run the passes again */
     }
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
@@ -1369,7 +1422,7 @@ static void cuda_release(evr_backend *base)
         sl->d_adapt.release(); sl->h_adapt.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
-        sl->d_ph_slots.release(); sl->d_ph_count.release(); sl->d_ph_gbuf.release(); sl->d_sat.release();
+        sl->d_sat.release(); sl->h_gi_view.release();
         sl->d_gi_view.release(); sl->h_em.release(); sl->d_em.release(); sl->h_cdf.release(); sl->d_cdf.release();
         if (sl->gi_started) cudaEventDestroy(sl->gi_started);
         if (sl->gi_done) cudaEventDestroy(sl->gi_done);
@@ -1389,7 +1442,11 @@ static void cuda_release(evr_backend *base)
     for (int i = 0; i < NRING; i++) {
         b->d_state[i].release();
         b->d_next[i].release();
+        b->gi_ring[i].slots.release();
+        b->gi_ring[i].count.release();
+        b->gi_ring[i].gbuf.release();
     }
+    b->d_gi_last.release();
     b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
     b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
     b->d_trails.release(); b->d_trail_rays.release(); b->d_todo.release(); b->d_todo_count.release();
@@ -1451,6 +1508,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
+    if (b->gi && (st = gi_ring_alloc(b, gi_margin, err)) != EVR_OK) return st;
     for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];
         /* the sort and copy of segment i run while segment i + 1 renders: at the highest
@@ -1481,7 +1539,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(sl->h_count.reserve(1));
         CK(sl->h_rays.reserve(GI_COUNTERS));
         CK(cudaMemset(sl->d_rays.p, 0, GI_COUNTERS * sizeof(unsigned long long)));
-        if (b->gi && (st = gi_alloc(b, sl, gi_margin, gi_window, err)) != EVR_OK) return st;
+        if (b->gi && (st = gi_alloc(b, sl, gi_window, err)) != EVR_OK) return st;
     }
     if (b->gi) CK(b->d_pcount.reserve(1));
     gi_deferred_alloc(b, &prop);

@@ -1,7 +1,8 @@
-/* Global illumination on the GPU (issue 5): the photon pass of a segment, the camera's view of
- * the buffer's cells, which cells changed since the previous segment, and the gather of a
- * sample. Every per-photon and per-pixel decision is src/core/photon.h, the very functions the
- * CPU pass (src/cpu/photon_pass.c, src/cpu/cpu_gi.c) runs; this file only schedules them.
+/* Global illumination on the GPU (issue 5): the photon pass at a segment's end, the camera's
+ * view of the buffer's cells, which cells changed over the segment, and the gathers of a sample
+ * in the buffers of its segment's start and end, interpolated in time (evr_gi_lerp). Every
+ * per-photon and per-pixel decision is src/core/photon.h, the very functions the CPU pass
+ * (src/cpu/photon_pass.c, src/cpu/cpu_gi.c) runs; this file only schedules them.
  *
  * Included by cuda_backend.cu after gpu_trace (one translation unit: the kernels here trace
  * with the same traversal and take the same kernel_args).
@@ -12,9 +13,10 @@
  * its cell (a binary search for the cell's first entry) picks its layer: the same buffer as the
  * CPU's for the same photons, whatever order the threads ran in.
  *
- * Buffers live per slot: a segment that overflows its event buffer is rendered again at collect,
- * after the next segment's pass may have run, and must find its own photons. A still segment
- * (nothing moved since the previous one) copies the previous slot's buffer on the device. */
+ * Buffers live in a ring indexed by segment, one more than the segments in flight: a segment
+ * reads its own (its end) and the one before (its start), and one that overflows its event
+ * buffer is rendered again at collect, after later segments' passes may have run, and must find
+ * both. A still segment (nothing moved since the previous one) copies the previous buffer. */
 #ifndef EVR_CUDA_GPU_GI_CUH
 #define EVR_CUDA_GPU_GI_CUH
 
@@ -22,19 +24,23 @@
 
 /* What the render kernels read (device memory, one per slot). */
 struct gpu_gi_view {
-    evr_photon_buffer buf;         /* device pointers */
-    const uint32_t *sat;           /* summed-area table of the changed cells, (w + 1) x (h + 1) */
+    evr_photon_buffer end, start;  /* the photons at the segment's end and start (device pointers) */
+    /* summed-area table, (w + 1) x (h + 1), of the cells that changed over this segment or the
+     * one before: a pixel with no such cell in its window had the same indirect light all through
+     * both (its intensity may be kept) */
+    const uint32_t *sat;
     evr_gather_params gp;
     int window;                    /* cells around a pixel a gather may read */
 };
 
 /* A pixel's last gather in this launch: the same point, normal, distance and instance in the
- * same buffer give the same estimate bit for bit (a traced pixel on a still surface). lum: the
- * estimate (gathers inside the render kernel); req: the deferred gather's request (gi_trace_kernel). */
+ * same buffers give the same estimates bit for bit (a traced pixel on a still surface). ls, le:
+ * the estimates at the segment's start and end (gathers inside the render kernel); req: the
+ * deferred gathers' request (gi_trace_kernel). */
 struct gi_memo {
     uint32_t key[7];
     int inst;
-    float lum;
+    float ls, le;
     unsigned req;
     bool valid;
 };
@@ -50,10 +56,23 @@ __device__ __noinline__ void gpu_gather_point(const evr_render_scene *rs, int in
     evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org, g);
 }
 
-__device__ __noinline__ float gpu_gather_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                             int y)
+__device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
+                                             const evr_gather_point *g, int x, int y)
 {
-    return evr_gather_point_lum(&v->buf, cam, &v->gp, g, x, y);
+    return evr_gather_point_lum(b, cam, &v->gp, g, x, y);
+}
+
+/* The gathers of point g (pixel (x, y)) at the segment's start and end; one where the window saw
+ * no change (the same cells give the same estimate). Two walks: the CPU's walk of both buffers
+ * together (evr_gather_point_lum_n) made the gather kernel 12% slower here (H200, Cornell box at
+ * 1280x720, 0.5 s: 0.237 s against 0.210 s). */
+__device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
+                                                int y, float *ls, float *le)
+{
+    *ls = gpu_gather_lum(&v->start, v, cam, g, x, y);
+    *le = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y)
+              ? gpu_gather_lum(&v->end, v, cam, g, x, y)
+              : *ls;
 }
 
 /* Whether the memo holds gather point g of instance inst; if not, it takes it (the caller fills
@@ -71,19 +90,18 @@ __device__ __forceinline__ bool gi_memo_take(gi_memo *m, int inst, const evr_gat
     return false;
 }
 
-/* The indirect light of a sample at surface s of instance inst: the pixel's memo, or a gather
- * (the pixel's own thread walks its window; a version spreading each window's cells over the
- * warp's lanes was slower, measured on an H200: 2.07 s against 1.80 s of render kernels for the
- * Cornell box at 1280x720, 2 s: most windows are searched to the same size, so the lanes of a
- * warp were already busy in step). */
+/* The indirect light of a sample at surface s of instance inst at normalized segment time f: the
+ * pixel's memo, or gathers (the pixel's own thread walks its window; a version spreading each
+ * window's cells over the warp's lanes was slower, measured on an H200: 2.07 s against 1.80 s of
+ * render kernels for the Cornell box at 1280x720, 2 s: most windows are searched to the same
+ * size, so the lanes of a warp were already busy in step). */
 __device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs, int inst, const evr_surface *s,
-                                             evr_v3 cam_org, int x, int y, gi_memo *m)
+                                             evr_v3 cam_org, int x, int y, float f, gi_memo *m)
 {
     evr_gather_point gp;
     gpu_gather_point(rs, inst, s, cam_org, &gp);
-    if (gi_memo_take(m, inst, &gp)) return m->lum;
-    m->lum = gpu_gather_lum(g, &rs->camera, &gp, x, y);
-    return m->lum;
+    if (!gi_memo_take(m, inst, &gp)) gpu_gather_ends(g, &rs->camera, &gp, x, y, &m->ls, &m->le);
+    return evr_gi_lerp(m->ls, m->le, f);
 }
 
 /* Counters of a pass in the slot's counter array (after the render kernels' three). */
@@ -227,20 +245,20 @@ __global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long
     if (j + 1 == n || (unsigned)(keys[j + 1] >> 32) != cell) buf.count[cell] = rank + 1;   /* arrivals, as the CPU counts */
 }
 
-/* One thread per cell: what the camera sees through the cell's centre at the segment's start. */
+/* One thread per cell: what the camera sees through the cell's centre at normalized segment time f. */
 template <int LAYOUT>
-__global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_photon_buffer buf)
+__global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_photon_buffer buf, float f)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= buf.width * buf.height) return;
     const evr_render_scene *rs = &a.rs;
-    const evr_m34 pose = evr_rs_camera_pose(rs, 0.0f);
+    const evr_m34 pose = evr_rs_camera_pose(rs, f);
     const evr_v3 fwd = evr_v3_norm(evr_m34_vector(&pose, evr_v3_make(0.0f, 0.0f, -1.0f)));
     const evr_ray ray = evr_photon_cell_ray(rs, &pose, &buf, cell % buf.width, cell / buf.width);
     float g[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     evr_gpu_hit h;
-    if (gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, 0.0f, 0, &h)) {
-        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), 0.0f);
+    if (gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &h)) {
+        evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), f);
         evr_surface s;
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, ray, h.t, &s);
         evr_photon_cell_view(rs, fwd, &s, ray, h.t, g);
@@ -248,15 +266,19 @@ __global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_p
     for (int k = 0; k < 8; k++) buf.gbuf[8 * (size_t)cell + k] = g[k];
 }
 
-/* Changed cells (1 where the photons or the view differ from the previous segment's; all when
- * there is none) into the summed-area table's interior; row 0 and column 0 stay zero. */
-__global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer cur, evr_photon_buffer prev, int have_prev,
-                                                               uint32_t *sat)
+/* Changed cells into the summed-area table's interior (row 0 and column 0 stay zero): 1 where
+ * the photons or the view at the segment's end differ from its start's, or did over the segment
+ * before (last, per cell: updated to this segment's). */
+__global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer end, evr_photon_buffer start, uint8_t *last,
+                                                               uint32_t *sat, unsigned long long *counters)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
-    if (cell >= cur.width * cur.height) return;
-    const int x = cell % cur.width, y = cell / cur.width;
-    sat[(size_t)(y + 1) * (size_t)(cur.width + 1) + (size_t)(x + 1)] = !have_prev || !evr_photon_cell_same(&cur, &prev, (size_t)cell);
+    if (cell >= end.width * end.height) return;
+    const int x = cell % end.width, y = cell / end.width;
+    const uint8_t now = !evr_photon_cell_same(&end, &start, (size_t)cell);
+    sat[(size_t)(y + 1) * (size_t)(end.width + 1) + (size_t)(x + 1)] = now | last[cell];
+    last[cell] = now;
+    if (now) count_lanes(counters, GI_CHANGED);   /* this segment's changes, as the CPU counts them */
 }
 
 /* The summed-area table: prefix sums along rows, then columns. Rows: one warp per row, 32 cells
@@ -282,12 +304,11 @@ __global__ void __launch_bounds__(BLOCK) sat_rows_kernel(uint32_t *sat, int w, i
     }
 }
 
-__global__ void __launch_bounds__(BLOCK) sat_cols_kernel(uint32_t *sat, int w, int h, unsigned long long *counters)
+__global__ void __launch_bounds__(BLOCK) sat_cols_kernel(uint32_t *sat, int w, int h)
 {
     const int x = blockIdx.x * blockDim.x + threadIdx.x + 1;
     if (x > w) return;
     for (int y = 1; y <= h; y++) sat[(size_t)y * (size_t)(w + 1) + x] += sat[(size_t)(y - 1) * (size_t)(w + 1) + x];
-    if (x == w) counters[GI_CHANGED] = sat[(size_t)h * (size_t)(w + 1) + (size_t)w];   /* the cells that changed */
 }
 
 #endif

@@ -3,8 +3,9 @@
  *
  *   gi_trace_kernel   the pixels' samples: rays and direct light; a sample that needs a gather
  *                     (its pixel's memo does not hold its surface point) appends a request
- *   gi_gather_kernel  one thread per request: the gather (core/photon.h)
- *   gi_pixel_kernel   the pixels' samples through the pixel model: direct + gathered light
+ *   gi_gather_kernel  one thread per request: the gathers at the segment's start and end (core/photon.h)
+ *   gi_pixel_kernel   the pixels' samples through the pixel model: direct + gathered light at the
+ *                     sample's time (a settled pixel: its last direct light, its gathers)
  *
  * Why: a gather inside the render kernel cost 31 ns against 3.8 ns in a kernel of its own
  * (H100, Cornell box at 1280x720; docs/benchmarks.md): there it ran at the render kernel's
@@ -32,7 +33,7 @@ struct gi_deferred {
     int *traced;          /* per thread: samples traced; later samples keep the last intensity */
     float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
     gi_request *requests;
-    float *lum;           /* per request: the gather's luminance */
+    float2 *lum;          /* per request: the gathers' luminance at the segment's start and end */
     unsigned *count;      /* requests made */
     int stride;           /* threads of a launch at most: the pixel count */
 };
@@ -109,7 +110,9 @@ __global__ void __launch_bounds__(BLOCK) gi_gather_kernel(kernel_args a, gi_defe
     const unsigned n = *d.count;
     for (unsigned r = blockIdx.x * blockDim.x + threadIdx.x; r < n; r += gridDim.x * blockDim.x) {
         const gi_request q = d.requests[r];
-        d.lum[r] = gpu_gather_lum(a.gi, &a.rs.camera, &q.g, q.pix % a.width, q.pix / a.width);
+        float2 l;
+        gpu_gather_ends(a.gi, &a.rs.camera, &q.g, q.pix % a.width, q.pix / a.width, &l.x, &l.y);
+        d.lum[r] = l;
     }
 }
 
@@ -126,14 +129,22 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     evr_pixel_params own;
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     const int traced = active ? d.traced[i] : 0;
+    float direct = 0.0f;
+    unsigned r = GI_NO_REQUEST;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
-        float intensity = st.intensity;   /* kept when settled */
+        float intensity = st.intensity;   /* kept when settled on nothing */
         if (k < traced) {
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
-            intensity = d.direct[at];
-            const unsigned r = d.req[at];
-            if (r != GI_NO_REQUEST) intensity += d.lum[r];
+            direct = d.direct[at];
+            r = d.req[at];
+        }
+        if (k < traced || r != GI_NO_REQUEST) {   /* settled on a surface: its last direct light, its gathers at f */
+            intensity = direct;
+            if (r != GI_NO_REQUEST) {
+                const float2 l = d.lum[r];
+                intensity += evr_gi_lerp(l.x, l.y, f);
+            }
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
     }
