@@ -756,107 +756,61 @@ EVR_HD static inline void evr_photon_gather_finish(const evr_photon_buffer *b, c
     e_rgb[2] = acc[2] * inv;
 }
 
-/* What a ring walk takes from one buffer: the Gaussian-weighted flux, the kernel's weight over the
- * surfaces seen (evr_photon_gather_cell), the photons taken, and the ring where it stopped (-1:
- * it did not). */
-typedef struct {
-    float acc[3], area_w;
-    int used, stop;
-} evr_gather_sums;
-
 /* Sums the photons of rings 0 .. rings of the window around cell (cx, cy) that lie within
- * sqrt(lim2) of p with a normal within the cosine, in each of nb buffers of one shape (out[k]
- * from b[k]); a buffer's walk stops in the cell where max photons are reached. The buffers are
- * walked together, cell by cell: each one's sums are those of a walk of its own, operation for
- * operation, while the cells' addresses are computed once and the loads of the buffers overlap
- * (the CPU's gathers at a segment's start and end: 4-6% faster than two walks there; on the GPU
- * the walk of two buffers was slower, see gpu_gather_ends). */
-EVR_HD static inline void evr_photon_gather_rings_n(const evr_photon_buffer *const *b, int nb, int cx, int cy, int rings,
-                                                    evr_v3 p, evr_v3 n, float lim2, float normal_cos, float s2, int max,
-                                                    evr_gather_sums *out)
-{
-    int r, side, o, k, live = nb;
-    for (k = 0; k < nb; k++) {
-        out[k].acc[0] = out[k].acc[1] = out[k].acc[2] = 0.0f;
-        out[k].area_w = 0.0f;
-        out[k].used = 0;
-        out[k].stop = -1;
-    }
-    /* the cells in evr_ring_cell's order, walked directly (no square root and division per cell) */
-    for (r = 0; r <= rings; r++) {   /* ring 0: the centre, one "side" of one cell */
-        for (side = 0; side < (r ? 4 : 1); side++) {
-            for (o = 0; o < (r ? 2 * r : 1); o++) {
-                const int dx = side == 0 ? -r + o : side == 1 ? r : side == 2 ? r - o : -r;
-                const int dy = side == 0 ? -r : side == 1 ? -r + o : side == 2 ? r : r - o;
-                for (k = 0; k < nb; k++) {
-                    if (out[k].stop >= 0) continue;
-                    out[k].used += evr_photon_gather_cell(b[k], cx + dx, cy + dy, p, n, lim2, normal_cos, s2, out[k].acc,
-                                                          &out[k].area_w);
-                    if (out[k].used >= max) {
-                        out[k].stop = r;
-                        live--;
-                    }
-                }
-                if (!live) return;
-            }
-        }
-    }
-}
-
-/* The walk of one buffer (evr_photon_gather_rings_n): returns the photons taken. */
+ * sqrt(lim2) of p with a normal within the cosine; stops in the cell where max photons are
+ * reached (returns the ring where it stopped in *stop_ring, or -1 when it did not stop). */
 EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int cx, int cy, int rings, evr_v3 p,
                                                  evr_v3 n, float lim2, float normal_cos, float s2, int max,
                                                  float acc[3], int *stop_ring, float *area_w)
 {
-    evr_gather_sums g;
-    evr_photon_gather_rings_n(&b, 1, cx, cy, rings, p, n, lim2, normal_cos, s2, max, &g);
-    acc[0] = g.acc[0];
-    acc[1] = g.acc[1];
-    acc[2] = g.acc[2];
-    *area_w = g.area_w;
-    *stop_ring = g.stop;
-    return g.used;
+    int r, side, o, used = 0;
+    acc[0] = acc[1] = acc[2] = 0.0f;
+    *stop_ring = -1;
+    *area_w = 0.0f;
+    /* the cells in evr_ring_cell's order, walked directly (no square root and division per cell) */
+    used += evr_photon_gather_cell(b, cx, cy, p, n, lim2, normal_cos, s2, acc, area_w);
+    if (used >= max) {
+        *stop_ring = 0;
+        return used;
+    }
+    for (r = 1; r <= rings; r++) {
+        for (side = 0; side < 4; side++) {
+            for (o = 0; o < 2 * r; o++) {
+                int dx = side == 0 ? -r + o : side == 1 ? r : side == 2 ? r - o : -r;
+                int dy = side == 0 ? -r : side == 1 ? -r + o : side == 2 ? r : r - o;
+                used += evr_photon_gather_cell(b, cx + dx, cy + dy, p, n, lim2, normal_cos, s2, acc, area_w);
+                if (used >= max) {
+                    *stop_ring = r;
+                    return used;
+                }
+            }
+        }
+    }
+    return used;
 }
 
 /* Irradiance at surface point p (normal n, seen at distance cam_dist from the camera through
- * image pixel (px, py)) from each of nb buffers of one shape (e_rgb[k] from b[k]). The window
- * (evr_photon_gather_window) is searched ring by ring from the centre; photons farther than r or
- * whose normal differs more than normal_cos are skipped; weights are the Gaussian kernel (sigma =
- * r / 2) normalized over the disk searched. When max_photons is reached in ring k, the disk
- * shrinks to the one that rings 0 .. k surely cover (evr_photon_gather_shrink) and the estimate
- * is every photon in that disk: on a surface seen at a grazing angle the window reaches far
- * along the surface but not across, and the farthest photon taken would overstate the disk.
- * Each buffer's estimate is the one it gets alone. nb: 1 or 2. Returns the photons the first used. */
-EVR_HD static inline int evr_photon_gather_n(const evr_photon_buffer *const *b, int nb, const evr_camera_intr *cam, int px,
-                                             int py, evr_v3 p, evr_v3 n, float cam_dist, const evr_gather_params *gp,
-                                             float (*e_rgb)[3])
-{
-    const evr_gather_window w = evr_photon_gather_window(b[0], cam, px, py, cam_dist, gp);
-    evr_gather_sums g[2];
-    int k;
-    evr_photon_gather_rings_n(b, nb, w.cx, w.cy, w.h, p, n, w.r2, gp->normal_cos, w.s2, gp->max_photons, g);
-    for (k = 0; k < nb; k++) {
-        float lim2 = w.r2;
-        if (g[k].stop >= 0) {   /* the limit: the disk the rings searched cover, all of its photons */
-            int rings;
-            lim2 = evr_photon_gather_shrink(&w, g[k].stop, &rings);
-            evr_photon_gather_rings_n(&b[k], 1, w.cx, w.cy, rings, p, n, lim2, gp->normal_cos, w.s2, 0x7fffffff, &g[k]);
-        }
-        evr_photon_gather_finish(b[k], &w, lim2, g[k].acc, g[k].area_w, e_rgb[k]);
-    }
-    return g[0].used;
-}
-
-/* The irradiance from one buffer (evr_photon_gather_n). */
+ * image pixel (px, py)) from the buffer. The window (evr_photon_gather_window) is searched ring
+ * by ring from the centre; photons farther than r or whose normal differs more than normal_cos
+ * are skipped; weights are the Gaussian kernel (sigma = r / 2) normalized over the disk searched.
+ * When max_photons is reached in ring k, the disk shrinks to the one that rings 0 .. k surely
+ * cover (evr_photon_gather_shrink) and the estimate is every photon in that disk: on a surface
+ * seen at a grazing angle the window reaches far along the surface but not across, and the
+ * farthest photon taken would overstate the disk. Returns the photons used. */
 EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr_camera_intr *cam, int px, int py,
                                            evr_v3 p, evr_v3 n, float cam_dist, const evr_gather_params *gp,
                                            float e_rgb[3])
 {
-    float e[1][3];
-    const int used = evr_photon_gather_n(&b, 1, cam, px, py, p, n, cam_dist, gp, e);
-    e_rgb[0] = e[0][0];
-    e_rgb[1] = e[0][1];
-    e_rgb[2] = e[0][2];
+    const evr_gather_window w = evr_photon_gather_window(b, cam, px, py, cam_dist, gp);
+    float acc[3], lim2 = w.r2, area_w;
+    int stop, used;
+    used = evr_photon_gather_rings(b, w.cx, w.cy, w.h, p, n, lim2, gp->normal_cos, w.s2, gp->max_photons, acc, &stop, &area_w);
+    if (stop >= 0) {   /* the limit: the disk the rings searched cover, all of its photons */
+        int rings;
+        lim2 = evr_photon_gather_shrink(&w, stop, &rings);
+        used = evr_photon_gather_rings(b, w.cx, w.cy, rings, p, n, lim2, gp->normal_cos, w.s2, 0x7fffffff, acc, &stop, &area_w);
+    }
+    evr_photon_gather_finish(b, &w, lim2, acc, area_w, e_rgb);
     return used;
 }
 
@@ -957,23 +911,13 @@ EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_ma
     evr_photon_indirect_k(s, mat, g->k);
 }
 
-/* Luminance of the indirect light leaving gather point g seen through image pixel (x, y), from
- * each of nb (1 or 2) buffers of one shape: lum[k] from b[k]. */
-EVR_HD static inline void evr_gather_point_lum_n(const evr_photon_buffer *const *b, int nb, const evr_camera_intr *cam,
-                                                 const evr_gather_params *gp, const evr_gather_point *g, int x, int y,
-                                                 float *lum)
-{
-    float e[2][3];
-    evr_photon_gather_n(b, nb, cam, x, y, g->p, g->n, g->dist, gp, e);
-    for (int k = 0; k < nb; k++) lum[k] = evr_luminance(g->k[0] * e[k][0], g->k[1] * e[k][1], g->k[2] * e[k][2]);
-}
-
+/* Luminance of the indirect light leaving gather point g seen through image pixel (x, y). */
 EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
                                                 const evr_gather_params *gp, const evr_gather_point *g, int x, int y)
 {
-    float lum;
-    evr_gather_point_lum_n(&b, 1, cam, gp, g, x, y, &lum);
-    return lum;
+    float e[3];
+    evr_photon_gather(b, cam, x, y, g->p, g->n, g->dist, gp, e);
+    return evr_luminance(g->k[0] * e[0], g->k[1] * e[1], g->k[2] * e[2]);
 }
 
 /* The indirect light of a sample at normalized segment time f, from the gathers in the photon
