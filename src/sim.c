@@ -175,7 +175,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         return st;
     }
     if ((st = evr_run_writers_open(sim, err)) != EVR_OK ||
-        (st = evr_write_queue_start(sim->writers, sim->num_writers, &sim->wq, err)) != EVR_OK) {
+        (st = evr_write_queue_start(sim->writers, sim->num_writers, EVR_WRITE_FLUSH_SECONDS, &sim->wq, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
