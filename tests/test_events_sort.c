@@ -3,6 +3,7 @@
 #include "events.h"
 #include "core/rng.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 
 static int cmp(const void *a, const void *b)
@@ -40,6 +41,19 @@ int main(void)
         if (v.data[i].t != ref[i].t || v.data[i].x != ref[i].x || v.data[i].y != ref[i].y) same_keys = 0;
     CHECK(same_keys);
     free(ref);
+
+    /* the events before a time: what a linear scan counts, ties and both ends included */
+    {
+        int64_t limits[] = {INT64_MIN, base - 1, base, base + 1, base + 12345, v.data[n / 2].t, base + 69999,
+                            base + 70000, INT64_MAX};
+        int before_ok = evr_events_before(v.data, 0, base) == 0;
+        for (size_t k = 0; k < sizeof limits / sizeof limits[0]; k++) {
+            size_t m = 0;
+            while (m < n && v.data[m].t < limits[k]) m++;
+            if (evr_events_before(v.data, n, limits[k]) != m) before_ok = 0;
+        }
+        CHECK(before_ok);
+    }
 
     /* stability: equal keys keep input order */
     v.n = 0;
