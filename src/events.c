@@ -55,7 +55,7 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     }
     uint64_t span = (uint64_t)(tmax - tmin);
     int tdigits = 0;
-    while (span >> (16 * tdigits)) tdigits++;
+    while (tdigits < 4 && span >> (16 * tdigits)) tdigits++;   /* a shift by 64 is undefined */
     scratch->n = 0;
     if (!evr_event_vec_reserve(scratch, n)) return 0;
     size_t *count = malloc(65536 * sizeof *count);
