@@ -31,6 +31,17 @@ void evr_event_vec_free(evr_event_vec *v)
     v->n = v->cap = 0;
 }
 
+size_t evr_events_before(const evr_event *ev, size_t n, int64_t limit)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (ev[mid].t < limit) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 /* LSD radix sort on 16-bit digits of the key (t - t_min, y, x); passes whose digit is the same for
  * every event are skipped, so a segment typically needs four or five passes. */
 int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
@@ -44,7 +55,7 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     }
     uint64_t span = (uint64_t)(tmax - tmin);
     int tdigits = 0;
-    while (span >> (16 * tdigits)) tdigits++;
+    while (tdigits < 4 && span >> (16 * tdigits)) tdigits++;   /* a shift by 64 is undefined */
     scratch->n = 0;
     if (!evr_event_vec_reserve(scratch, n)) return 0;
     size_t *count = malloc(65536 * sizeof *count);

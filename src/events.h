@@ -29,6 +29,9 @@ static inline int evr_event_key_less(const evr_event *a, const evr_event *b)
     return a->x < b->x;
 }
 
+/* The number of leading events of ev[0 .. n) (sorted by t) with t < limit: a binary search. */
+size_t evr_events_before(const evr_event *ev, size_t n, int64_t limit);
+
 /* Sorts by (t, y, x), stable, so equal keys keep their input order (deterministic when the input
  * order is). scratch is grown as needed and may be reused between calls. */
 int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch);

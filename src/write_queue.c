@@ -13,57 +13,102 @@
 struct evr_write_queue {
     evr_event_writer *writers[8];
     int num_writers;
+    double flush_seconds;
     pthread_t thread;
     pthread_mutex_t mu;
-    pthread_cond_t cv;
+    pthread_cond_t cv;     /* on CLOCK_MONOTONIC, the host clock, for the timed flush */
     evr_event_vec slots[QUEUE_SLOTS];
     int head, count;       /* pending batches: slots[head], slots[head + 1], ... */
-    int busy;              /* the thread is writing the batch at head */
+    int busy;              /* the thread is writing the batch at head, or flushing */
+    int dirty;             /* batches written since the last flush */
+    double last_flush;     /* host seconds */
     int stop;
     evr_status status;     /* first error of the writer thread */
     evr_error err;
     double busy_seconds, wait_seconds;
 };
 
+/* Writes batch v (NULL: none) to every writer, then flushes them all when flush is set; on the
+ * writer thread, without the lock. */
+static evr_status write_batch(evr_write_queue *q, const evr_event_vec *v, int flush, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    int w;
+    for (w = 0; v && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->write(q->writers[w], v->data, v->n, err);
+    for (w = 0; flush && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->flush(q->writers[w], err);
+    return st;
+}
+
+/* Runs write_batch with the lock released (held on entry and on return) and accounts for it. */
+static void run_batch(evr_write_queue *q, const evr_event_vec *v, int flush)
+{
+    int failed = q->status != EVR_OK;
+    evr_status st = EVR_OK;
+    evr_error err;
+    q->busy = 1;
+    pthread_mutex_unlock(&q->mu);
+    err.msg[0] = 0;
+    double t = evr_host_seconds();
+    if (!failed) st = write_batch(q, v, flush, &err);
+    double t1 = evr_host_seconds();
+    pthread_mutex_lock(&q->mu);
+    q->busy_seconds += t1 - t;
+    if (flush) {
+        q->dirty = 0;
+        q->last_flush = t1;
+    }
+    if (st != EVR_OK && q->status == EVR_OK) {
+        q->status = st;
+        q->err = err;
+    }
+    q->busy = 0;
+}
+
+static struct timespec host_deadline(double seconds)
+{
+    struct timespec ts;
+    ts.tv_sec = (time_t)seconds;
+    ts.tv_nsec = (long)((seconds - (double)ts.tv_sec) * 1e9);
+    if (ts.tv_nsec > 999999999L) ts.tv_nsec = 999999999L;
+    return ts;
+}
+
 static void *writer_main(void *arg)
 {
     evr_write_queue *q = (evr_write_queue *)arg;
     pthread_mutex_lock(&q->mu);
     for (;;) {
-        while (!q->count && !q->stop) pthread_cond_wait(&q->cv, &q->mu);
+        while (!q->count && !q->stop) {
+            double due = q->last_flush + q->flush_seconds;
+            if (!q->dirty) {
+                pthread_cond_wait(&q->cv, &q->mu);
+            } else if (evr_host_seconds() >= due) {
+                run_batch(q, NULL, 1);   /* idle since a batch: make it durable now */
+                pthread_cond_broadcast(&q->cv);
+            } else {
+                struct timespec ts = host_deadline(due);
+                pthread_cond_timedwait(&q->cv, &q->mu, &ts);
+            }
+        }
         if (!q->count) break;   /* stop requested and nothing pending */
         evr_event_vec *v = &q->slots[q->head];
-        q->busy = 1;
-        int failed = q->status != EVR_OK;
-        pthread_mutex_unlock(&q->mu);
-        evr_status st = EVR_OK;
-        evr_error err;
-        err.msg[0] = 0;
-        double t = evr_host_seconds();
-        int w;
-        for (w = 0; !failed && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->write(q->writers[w], v->data, v->n, &err);
-        for (w = 0; !failed && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->flush(q->writers[w], &err);
-        double dt = evr_host_seconds() - t;
-        pthread_mutex_lock(&q->mu);
-        q->busy_seconds += dt;
-        if (st != EVR_OK && q->status == EVR_OK) {
-            q->status = st;
-            q->err = err;
-        }
+        q->dirty = 1;
+        run_batch(q, v, evr_host_seconds() >= q->last_flush + q->flush_seconds);
         v->n = 0;
         q->head = (q->head + 1) % QUEUE_SLOTS;
         q->count--;
-        q->busy = 0;
         pthread_cond_broadcast(&q->cv);
     }
     pthread_mutex_unlock(&q->mu);
     return NULL;
 }
 
-evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, evr_write_queue **out, evr_error *err)
+evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, double flush_seconds,
+                                 evr_write_queue **out, evr_error *err)
 {
     evr_write_queue *q = calloc(1, sizeof *q);
-    int i;
+    pthread_condattr_t ca;
+    int i, ok;
     if (!q || num_writers > 8) {
         free(q);
         snprintf(err->msg, sizeof err->msg, "out of memory");
@@ -71,12 +116,21 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     }
     for (i = 0; i < num_writers; i++) q->writers[i] = writers[i];
     q->num_writers = num_writers;
+    q->flush_seconds = flush_seconds;
+    q->last_flush = evr_host_seconds();   /* the writers' files are valid when opened */
     q->status = EVR_OK;
     pthread_mutex_init(&q->mu, NULL);
-    pthread_cond_init(&q->cv, NULL);
-    if (pthread_create(&q->thread, NULL, writer_main, q) != 0) {
-        pthread_mutex_destroy(&q->mu);
+    ok = pthread_condattr_init(&ca) == 0;
+    if (ok) {
+        ok = pthread_condattr_setclock(&ca, CLOCK_MONOTONIC) == 0 && pthread_cond_init(&q->cv, &ca) == 0;
+        pthread_condattr_destroy(&ca);
+    }
+    if (ok && pthread_create(&q->thread, NULL, writer_main, q) != 0) {
         pthread_cond_destroy(&q->cv);
+        ok = 0;
+    }
+    if (!ok) {
+        pthread_mutex_destroy(&q->mu);
         free(q);
         snprintf(err->msg, sizeof err->msg, "cannot start the writer thread");
         return EVR_ERR_IO;
@@ -122,7 +176,7 @@ evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err)
 {
     double t = evr_host_seconds();
     pthread_mutex_lock(&q->mu);
-    while (q->count > 0) pthread_cond_wait(&q->cv, &q->mu);
+    while (q->count > 0 || q->busy) pthread_cond_wait(&q->cv, &q->mu);
     q->wait_seconds += evr_host_seconds() - t;
     evr_status st = q->status;
     if (st != EVR_OK) *err = q->err;

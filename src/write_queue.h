@@ -1,6 +1,10 @@
 /* Writes event batches on a thread of its own, so that the host writes segment i while the
- * backend renders segment i + 1. Batches are written in the order pushed; each batch is followed
- * by a flush of every writer (a valid file after every segment). At most two batches wait. */
+ * backend renders segment i + 1. Batches are written in the order pushed. Every writer is
+ * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
+ * flush, and otherwise once the thread has been idle until then: an interrupted run's files lag
+ * at most about flush_seconds (plus the batch being written) behind the batches pushed, and a
+ * fast run does not store and flush per segment (the HDF5 writer recompresses its partial last
+ * chunk at each flush). At most two batches wait. */
 #ifndef EVR_WRITE_QUEUE_H
 #define EVR_WRITE_QUEUE_H
 
@@ -8,20 +12,26 @@
 #include "events.h"
 #include "io/event_writer.h"
 
+/* The simulation's flush interval: a second of work at most is lost when a run is killed. */
+#define EVR_WRITE_FLUSH_SECONDS 1.0
+
 typedef struct evr_write_queue evr_write_queue;
 
-evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, evr_write_queue **out, evr_error *err);
+evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, double flush_seconds,
+                                 evr_write_queue **out, evr_error *err);
 /* Queues the first n events of v for writing and returns (waits only while two batches are
  * pending) without copying them: the queue takes v's buffer and gives v one of its own holding
  * the rest of v (v->data[n .. v->n)), which is usually short. Fails with the writer thread's
  * first error, if any. */
 evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n, evr_error *err);
-/* Waits until everything pushed is written and flushed; returns the first error, if any. */
+/* Waits until everything pushed is written (not necessarily flushed: the writers' finish()
+ * completes the files); returns the first error, if any. */
 evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err);
-/* Seconds the writer thread spent writing, and the caller spent waiting in push/drain. */
+/* Seconds the writer thread spent writing and flushing, and the caller spent waiting in
+ * push/drain. */
 double evr_write_queue_busy_seconds(evr_write_queue *q);
 double evr_write_queue_wait_seconds(evr_write_queue *q);
-/* Stops the thread (after the pending batches) and frees the queue. */
+/* Stops the thread (after the pending batches, without a last flush) and frees the queue. */
 void evr_write_queue_stop(evr_write_queue *q);
 
 #endif

@@ -3,6 +3,7 @@
 #include "events.h"
 #include "core/rng.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 
 static int cmp(const void *a, const void *b)
@@ -40,6 +41,45 @@ int main(void)
         if (v.data[i].t != ref[i].t || v.data[i].x != ref[i].x || v.data[i].y != ref[i].y) same_keys = 0;
     CHECK(same_keys);
     free(ref);
+
+    /* the events before a time: what a linear scan counts, ties and both ends included */
+    {
+        int64_t limits[] = {INT64_MIN, base - 1, base, base + 1, base + 12345, v.data[n / 2].t, base + 69999,
+                            base + 70000, INT64_MAX};
+        int before_ok = evr_events_before(v.data, 0, base) == 0;
+        for (size_t k = 0; k < sizeof limits / sizeof limits[0]; k++) {
+            size_t m = 0;
+            while (m < n && v.data[m].t < limits[k]) m++;
+            if (evr_events_before(v.data, n, limits[k]) != m) before_ok = 0;
+        }
+        CHECK(before_ok);
+    }
+
+    /* keys wider than 64 bits: full-range x and y, times spanning most of int64 */
+    {
+        size_t m = 20000, k;
+        v.n = 0;
+        for (k = 0; k < m; k++) {
+            uint64_t h = evr_hash4(9, k, 0, 0), g = evr_hash4(9, k, 1, 0);
+            evr_event e;
+            e.t = (int64_t)(h >> 2) - (INT64_C(1) << 61) + (int64_t)(k % 5);
+            if (k % 7 == 0) e.t = INT64_C(-4000000000000000000) + (int64_t)(k % 3);   /* ties */
+            e.x = (uint16_t)g;
+            e.y = (uint16_t)(g >> 16);
+            if (k % 11 == 0) e.x = 65535;
+            e.p = (int8_t)(k & 1);
+            CHECK(evr_event_vec_push(&v, e));
+        }
+        evr_event *wide = malloc(m * sizeof *wide);
+        for (k = 0; k < m; k++) wide[k] = v.data[k];
+        qsort(wide, m, sizeof *wide, cmp);
+        CHECK(evr_events_sort(&v, &scratch));
+        int wide_ok = v.n == m;
+        for (k = 0; wide_ok && k < m; k++)
+            if (v.data[k].t != wide[k].t || v.data[k].x != wide[k].x || v.data[k].y != wide[k].y) wide_ok = 0;
+        CHECK(wide_ok);
+        free(wide);
+    }
 
     /* stability: equal keys keep input order */
     v.n = 0;

@@ -833,8 +833,9 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Write speed of the HDF5 writer, as the simulation drives it: 10 M events per simulated second
- * in segments of 1/30 s, each written and flushed. 10 M events in optimized builds, 1 M
+/* Write speed of the HDF5 writer: 10 M events per simulated second in segments of 1/30 s, each
+ * written and flushed (the worst case: the simulation flushes about once a second, write_queue.h;
+ * kept so that the figures compare with earlier ones). 10 M events in optimized builds, 1 M
  * otherwise; EVR_H5_BENCH_EVENTS sets another count (0 skips). */
 static void bench_h5(const char *root)
 {
