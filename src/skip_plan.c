@@ -43,12 +43,16 @@ static int keys_close(const evr_motion_key *a, const evr_motion_key *b, float si
 void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const int *track_offset,
                              const int *track_count, float scene_size)
 {
-    int i;
+    int i, j;
     for (i = 0; i < t->num_tracks; i++) {
         evr_motion_key *k = keys + track_offset[i];
         int n = track_count[i];
         if (n == 1 && t->have_prev && t->prev_count[i] == 1 && keys_close(&k[0], &t->prev_last[i], scene_size))
             k[0] = t->prev_last[i];
+        /* the same inside the segment: a key as close to the one before is that key, so that a
+         * part of the segment where the track holds still is still bit for bit */
+        for (j = 1; j < n; j++)
+            if (keys_close(&k[j], &k[j - 1], scene_size)) k[j] = k[j - 1];
         t->moved[i] = n > 1 || (t->have_prev && memcmp(&k[0], &t->prev_last[i], sizeof k[0]) != 0);
         t->prev_last[i] = k[n - 1];
         t->prev_count[i] = n;
@@ -101,6 +105,26 @@ static void merge_by_track(evr_skip_plan *pl, int *box_track)
     pl->num_boxes = n;
 }
 
+/* The plan's still span: before the first and after the last change between consecutive keys of
+ * any moving instance's track (with a hundredth of a key interval to spare, so that a time's
+ * float key position never lands in the interval of a change). */
+static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t, evr_skip_plan *pl)
+{
+    int i, j;
+    pl->still_before = 2.0f;
+    pl->still_after = -1.0f;
+    for (i = 0; i < rs->num_instances; i++) {
+        const int tr = rs->instances[i].track;
+        if (!t->moved[tr]) continue;
+        const evr_motion_track tk = evr_rs_track(rs, tr);
+        for (j = 0; j + 1 < tk.n; j++) {
+            if (evr_motion_key_same(&tk.keys[j], &tk.keys[j + 1])) continue;
+            pl->still_before = fminf(pl->still_before, ((float)j - 0.01f) / (float)(tk.n - 1));
+            pl->still_after = fmaxf(pl->still_after, ((float)j + 1.01f) / (float)(tk.n - 1));
+        }
+    }
+}
+
 void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
                          evr_skip_plan *pl)
 {
@@ -108,7 +132,6 @@ void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const ev
     int box_track[EVR_SKIP_MAX_BOXES];
     memset(pl, 0, sizeof *pl);
     pl->pad = rs->ray_eps;
-    if (!enabled) return;
     /* the camera and the lights must hold still: inside the segment to cache, and since the
      * previous segment too to reuse */
     int cam = rs->camera_track, cache = rs->track_count[cam] == 1, still = !t->moved[cam];
@@ -118,6 +141,10 @@ void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const ev
         if (rs->track_count[tr] != 1) cache = 0;
         if (t->moved[tr]) still = 0;
     }
+    /* still spans with and without skipping: brute force traces their samples at the same times */
+    pl->spans = cache;
+    still_span(rs, t, pl);
+    if (!enabled) return;
     /* a box per moving instance; once they are too many, a box per moving track */
     for (i = 0; i < rs->num_instances; i++) {
         float lo[3], hi[3];

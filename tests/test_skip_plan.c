@@ -1,7 +1,7 @@
 /* The per-segment plan of change-driven sampling (src/skip_plan.c): which tracks moved, a box per
  * moving instance, a box per moving track once there are more than EVR_SKIP_MAX_BOXES instances,
- * tracing everything once there are more moving tracks than that; and the ray tests of
- * core/skip.h against those boxes. */
+ * tracing everything once there are more moving tracks than that; the ray tests of core/skip.h
+ * against those boxes; the still spans of a segment (before and after its motion). */
 #include "check.h"
 #include "skip_plan.h"
 
@@ -98,6 +98,42 @@ int main(void)
         CHECK(!evr_skip_ray_meets_any(&pl, o, d, 8.0f));                        /* ends before the box */
         CHECK(!evr_skip_ray_meets_any(&pl, evr_v3_make(5.0f, 0.0f, 10.0f), d, INFINITY));   /* beside it */
         CHECK(evr_skip_ray_meets_any(&pl, evr_v3_make(1.9f, 0.0f, 10.0f), d, INFINITY));    /* the swept end */
+    }
+    /* still spans: one track of six keys, still, still (but for a billionth), still, moving,
+     * moving, still: nothing moves before key 2 nor after key 4 */
+    make_world(&w, 1, 1);
+    {
+        evr_m34 m = evr_m34_identity();
+        const float x[6] = {0.0f, 1e-12f, 0.0f, 0.5f, 1.0f, 1.0f};
+        evr_skip_tracker t;
+        int k;
+        for (k = 0; k < 6; k++) {
+            m.m[0][3] = x[k];
+            w.keys[k] = evr_motion_key_from_matrix(&m);
+        }
+        w.keys[6] = evr_motion_key_from_matrix(&m);   /* the camera's */
+        w.offset[0] = 0;
+        w.count[0] = 6;
+        w.offset[1] = 6;
+        w.count[1] = 1;
+        CHECK(evr_skip_tracker_init(&t, 2));
+        evr_skip_tracker_update(&t, w.keys, w.offset, w.count, 1.0f);
+        CHECK(evr_motion_key_same(&w.keys[1], &w.keys[0]));   /* the billionth: snapped to the key before */
+        evr_skip_plan_build(&t, &w.s, &w.rs, 1, &pl);
+        CHECK(pl.spans && pl.cache);
+        CHECK(fabsf(pl.still_before - 1.99f / 5.0f) < 1e-6f && fabsf(pl.still_after - 4.01f / 5.0f) < 1e-6f);
+        CHECK(evr_skip_still_span(&pl, 0.1f) == 1 && evr_skip_still_span(&pl, 0.5f) == 0 && evr_skip_still_span(&pl, 0.9f) == 2);
+        CHECK(evr_skip_held(&pl, 1, 1) && !evr_skip_held(&pl, 2, 1) && !evr_skip_held(&pl, 0, 0) && !evr_skip_held(&pl, 1, -1));
+        CHECK(evr_skip_trace_time(&pl, 0.1f) == 0.0f && evr_skip_trace_time(&pl, 0.9f) == 1.0f && evr_skip_trace_time(&pl, 0.5f) == 0.5f);
+        /* the transform is the same bits anywhere in a span, and moves in between */
+        evr_motion_track tr = evr_rs_track(&w.rs, 0);
+        evr_m34 a = evr_motion_eval(tr, 0.01f), b2 = evr_motion_eval(tr, 0.37f), c = evr_motion_eval(tr, 0.81f),
+                d = evr_motion_eval(tr, 0.999f), e = evr_motion_eval(tr, 0.5f);
+        CHECK(memcmp(&a, &b2, sizeof a) == 0 && memcmp(&c, &d, sizeof c) == 0 && e.m[0][3] > 0.0f && e.m[0][3] < 1.0f);
+        /* brute force: the same spans (its samples traced at the same times), nothing held */
+        evr_skip_plan_build(&t, &w.s, &w.rs, 0, &pl);
+        CHECK(pl.spans && !pl.cache && evr_skip_still_span(&pl, 0.1f) == 1 && !evr_skip_held(&pl, 1, 1));
+        evr_skip_tracker_free(&t);
     }
     return check_report("test_skip_plan");
 }

@@ -6,6 +6,8 @@
 #ifndef EVR_CORE_MOTION_H
 #define EVR_CORE_MOTION_H
 
+#include <stdint.h>
+
 #include "core/vec.h"
 
 typedef struct {
@@ -50,7 +52,29 @@ EVR_HD static inline evr_motion_key evr_motion_key_lerp(const evr_motion_key *a,
     return k;
 }
 
-/* Transform at normalized segment time f in [0,1]. */
+EVR_HD static inline uint32_t evr_motion_bits_diff(float a, float b)
+{
+    union { float f; uint32_t u; } x, y;
+    x.f = a;
+    y.f = b;
+    return x.u ^ y.u;
+}
+
+/* Whether two keys are the same bit for bit. */
+EVR_HD static inline int evr_motion_key_same(const evr_motion_key *a, const evr_motion_key *b)
+{
+    uint32_t d = evr_motion_bits_diff(a->rot.w, b->rot.w) | evr_motion_bits_diff(a->rot.x, b->rot.x) |
+                 evr_motion_bits_diff(a->rot.y, b->rot.y) | evr_motion_bits_diff(a->rot.z, b->rot.z) |
+                 evr_motion_bits_diff(a->trans.x, b->trans.x) | evr_motion_bits_diff(a->trans.y, b->trans.y) |
+                 evr_motion_bits_diff(a->trans.z, b->trans.z);
+    for (int i = 0; i < 3; i++) d |= evr_motion_bits_diff(a->scale[i], b->scale[i]) | evr_motion_bits_diff(a->skew[i], b->skew[i]);
+    return d == 0;
+}
+
+/* Transform at normalized segment time f in [0,1]. Between two keys that are the same, the key
+ * itself: the same bits at every time of the interval (an interpolation of equal ends rounds
+ * differently at different times), so that a sample there may take another's intensity
+ * (evr_skip_still_span). */
 EVR_HD static inline evr_m34 evr_motion_eval(evr_motion_track tr, float f)
 {
     if (tr.n <= 1) return evr_motion_key_matrix(&tr.keys[0]);
@@ -58,6 +82,7 @@ EVR_HD static inline evr_m34 evr_motion_eval(evr_motion_track tr, float f)
     int i = (int)floorf(x);
     if (i < 0) i = 0;
     if (i > tr.n - 2) i = tr.n - 2;
+    if (evr_motion_key_same(&tr.keys[i], &tr.keys[i + 1])) return evr_motion_key_matrix(&tr.keys[i]);
     evr_motion_key k = evr_motion_key_lerp(&tr.keys[i], &tr.keys[i + 1], x - (float)i);
     return evr_motion_key_matrix(&k);
 }

@@ -28,7 +28,39 @@ typedef struct {
     int num_boxes;
     float pad;            /* added to every box on every side (float error of the tests) */
     float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+    /* spans (with or without skipping): the camera and the lights hold still in the segment, and
+     * nothing moves (every instance's transform the same bits) at normalized times
+     * f < still_before, nor at f > still_after (evr_skip_still_span) */
+    int spans;
+    float still_before, still_after;
 } evr_skip_plan;
+
+/* The still span of normalized segment time f: 1 before anything of the segment moves, 2 after
+ * all of it has, 0 while things move or where the plan does not tell (the camera or a light
+ * moves). Two samples of a pixel in the same nonzero span see the same scene bit for bit
+ * (evr_motion_eval; Embree at evr_skip_trace_time), so with skipping (cache) the later takes the
+ * earlier's intensity without rays (evr_skip_held); brute force traces both, to the same bits. */
+EVR_HD static inline int evr_skip_still_span(const evr_skip_plan *pl, float f)
+{
+    if (!pl->spans) return 0;
+    return f < pl->still_before ? 1 : f > pl->still_after ? 2 : 0;
+}
+
+/* Whether a sample in span `span` takes the intensity of its pixel's last traced sample, traced
+ * in span last_span (-1: none yet). */
+EVR_HD static inline int evr_skip_held(const evr_skip_plan *pl, int span, int last_span)
+{
+    return pl->cache && span != 0 && span == last_span;
+}
+
+/* The time a ray of a sample at f is traced at where the tracer interpolates motion its own way
+ * (Embree: equal keys give slightly different transforms at different times): the start of a
+ * still span before all motion, the end after it, else f. */
+EVR_HD static inline float evr_skip_trace_time(const evr_skip_plan *pl, float f)
+{
+    const int span = evr_skip_still_span(pl, f);
+    return span == 1 ? 0.0f : span == 2 ? 1.0f : f;
+}
 
 /* Whether the part [0, tmax] of the ray o + t d meets the box (padded): the slab test. Any NaN
  * makes it answer yes, so that a doubtful case is traced. */

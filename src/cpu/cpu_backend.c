@@ -122,7 +122,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         rh.ray.dir_x[i] = ray[i].dir.x; rh.ray.dir_y[i] = ray[i].dir.y; rh.ray.dir_z[i] = ray[i].dir.z;
         rh.ray.tnear[i] = 0.0f;
         rh.ray.tfar[i] = INFINITY;
-        rh.ray.time[i] = fs[i];
+        rh.ray.time[i] = evr_skip_trace_time(b->seg->skip, fs[i]);   /* a still span: one time for Embree */
         rh.ray.mask[i] = 0xffffffffu;
         rh.ray.id[i] = (unsigned)i;
         rh.ray.flags[i] = 0;
@@ -160,7 +160,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             sr.dir_x[i] = wi[i].x; sr.dir_y[i] = wi[i].y; sr.dir_z[i] = wi[i].z;
             sr.tnear[i] = evr_shadow_tnear(&s[i], wi[i], rs->ray_eps);
             sr.tfar[i] = dist * (1.0f - 1e-4f);
-            sr.time[i] = fs[i];
+            sr.time[i] = rh.ray.time[i];
             sr.mask[i] = 0xffffffffu;
             sr.id[i] = (unsigned)i;
             sr.flags[i] = 0;
@@ -219,8 +219,17 @@ typedef struct {
     evr_ray ray;                   /* its centre ray (the camera at the segment's start) */
     float phi, t_last, t_hit;      /* sample phase; time of its last sample; last hit distance */
     float direct;                  /* GI: its last traced sample's direct light */
+    int last_span;                 /* the still span (evr_skip_still_span) of its last traced sample */
     int x, y;
 } tile_pixel;
+
+/* The intensity of a sample at normalized time f that takes its pixel's last traced sample's
+ * (settled, or held in a still span): that intensity, or with GI on a surface, that sample's
+ * direct light and its gathers' indirect light at f (evr_cpu_gi_last). */
+static float kept_intensity(const cpu_backend *b, const tile_pixel *q, int lit, float f)
+{
+    return lit ? q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f) : q->st->intensity;
+}
 
 /* The samples k0 .. n - 1 of a pixel that keeps its intensity: none when they cannot change it
  * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. With GI, a pixel
@@ -233,7 +242,7 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int lit, int 
     if (lit && !evr_cpu_gi_flat(&b->gi_state, q->x, q->y)) {
         for (k = k0; k < n; k++) {
             const float f = ((float)k + q->phi) / (float)n;
-            pixel_sample(b, q->st, &q->pp, ideal, f * dt, q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f), q->x, q->y, out);
+            pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, 1, f), q->x, q->y, out);
         }
         return;
     }
@@ -247,7 +256,8 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int lit, int 
 /* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
  * tile: the packets stay full however few pixels trace). With settle (k0 == 0, k1 == 1): a pixel
  * whose first sample's rays meet nothing that moves in the segment keeps that intensity for the
- * rest of the segment (its later samples run here); the others are listed in *more. */
+ * rest of the segment (its later samples run here); the others are listed in *more. A sample in
+ * the still span of its pixel's last traced sample takes that sample's intensity (no rays). */
 static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int count, int k0, int k1, int settle, int *more,
                           int *num_more, const evr_m34 *pose_static, int ideal, float dt, evr_event_vec *out,
                           unsigned long long *rays, unsigned long long *traced)
@@ -267,13 +277,25 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             ys[i] = q[i]->y;
         }
         for (k = k0; k < k1; k++) {
-            for (i = 0; i < PACKET; i++) fs[i] = ((float)k + q[i]->phi) / (float)n;
-            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, direct, rays);
+            int lane[PACKET], any = 0;
+            for (i = 0; i < PACKET; i++) {
+                fs[i] = ((float)k + q[i]->phi) / (float)n;
+                /* held: in the still span of its last traced sample, the same scene bit for bit */
+                const int span = evr_skip_still_span(seg->skip, fs[i]);
+                lane[i] = valid[i] && !evr_skip_held(seg->skip, span, q[i]->last_span);
+                if (lane[i]) q[i]->last_span = span;
+                any |= lane[i];
+            }
+            if (any) sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, lane, intensity, t_hit, direct, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
-                (*traced)++;
-                q[i]->t_hit = t_hit[i];
-                q[i]->direct = direct[i];
+                if (lane[i]) {
+                    (*traced)++;
+                    q[i]->t_hit = t_hit[i];
+                    q[i]->direct = direct[i];
+                } else {
+                    intensity[i] = kept_intensity(b, q[i], b->gi && q[i]->t_hit < INFINITY, fs[i]);
+                }
                 pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
             }
         }
@@ -311,7 +333,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
     const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
     tile_pixel px[TILE * TILE];
-    int list[TILE * TILE], more[TILE * TILE], count = 0, num_more = 0, np = 0, x, y, i;
+    int list[TILE * TILE] = {0}, more[TILE * TILE], count = 0, num_more = 0, np = 0, x, y, i;   /* zeroed: GCC cannot see the listed entries set */
     out->n = 0;
     /* pixels in blocks of 4 x 2 (a packet's worth): rays of a packet then start close together in
      * both directions, which Embree's packet traversal rewards */
@@ -326,6 +348,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             q->phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
             q->t_last = (((float)(n - 1) + q->phi) / (float)n) * dt;
             q->t_hit = INFINITY;
+            q->last_span = -1;
             if (ideal) q->pp = b->setup.pixel;
             else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
             /* global illumination: whether the pixel's indirect light may differ from its last sample's */

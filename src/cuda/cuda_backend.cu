@@ -394,13 +394,16 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
     memo.valid = false;
     evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    int last_span = -1;   /* the still span of the last traced sample */
     for (int k = 0; k < a.samples; k++) {
-        float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled */
-        if (tracing) {
+        float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled or held */
+        const int span = evr_skip_still_span(a.plan, f);
+        if (tracing && !evr_skip_held(a.plan, span, last_span)) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo, a.coherence ? t_hit : INFINITY, &direct);
             traced++;
-        } else if (GI && t_hit < INFINITY) {   /* settled on a surface: its direct light, its gathers at f */
+            last_span = span;
+        } else if (GI && t_hit < INFINITY) {   /* settled or held on a surface: its direct light, its gathers at f */
             intensity = direct + evr_gi_lerp(memo.ls, memo.le, f);
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);

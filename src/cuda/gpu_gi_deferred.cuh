@@ -30,7 +30,7 @@ struct gi_request {
 struct gi_deferred {
     float *direct;        /* a traced sample's direct light */
     unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
-    int *traced;          /* per thread: samples traced; later samples keep the last intensity */
+    int *traced;          /* per thread: samples with an entry (traced or held); later samples keep the last */
     float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
     gi_request *requests;
     float2 *lum;          /* per request: the gathers' luminance at the segment's start and end */
@@ -49,20 +49,25 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     const unsigned lane = lp.lane;
     const float phi = active ? a.phase[pix] : 0.0f;
     unsigned rays = 0, traced = 0;
+    int entries = 0, last_span = -1;   /* samples with an entry; the still span of the last traced */
     float t_hit = INFINITY, cache = -1.0f;
     bool tracing = active;
     gi_memo memo;
     memo.valid = false;
     const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    float direct = 0.0f;               /* the last traced sample's, and its request */
+    unsigned r = GI_NO_REQUEST;
     for (int k = 0; k < a.samples; k++) {
-        const bool now = tracing;
+        const float f = ((float)k + phi) / (float)a.samples;
+        const int span = evr_skip_still_span(a.plan, f);
+        /* held: in the still span of the last traced sample, the same direct light and gathers */
+        const bool now = tracing && !evr_skip_held(a.plan, span, last_span);
         bool want = false;
-        unsigned r = GI_NO_REQUEST;
-        float direct = 0.0f;
         evr_gather_point g;
         if (now) {
-            const float f = ((float)k + phi) / (float)a.samples;
+            r = GI_NO_REQUEST;
+            direct = 0.0f;
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             evr_surface s;
             int inst = 0;
@@ -74,6 +79,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
                 else want = true;
             }
             traced++;
+            last_span = span;
         }
         const unsigned slot = warp_append(d.count, want);   /* the warp's requests in one atomic */
         if (want) {
@@ -82,10 +88,11 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             d.requests[r].pix = pix;
             memo.req = r;
         }
-        if (now) {
+        if (tracing) {
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
             d.direct[at] = direct;
             d.req[at] = r;
+            entries = k + 1;
         }
         if (k == 0 && tracing) {
             /* settle, as render_kernel: the first sample's rays meet nothing that moves */
@@ -99,7 +106,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     if (active) {
         if (tracing) cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
         d.cache_dist[i] = cache;
-        d.traced[i] = (int)traced;
+        d.traced[i] = entries;
     }
     add_counts(a, lane, rays, traced);
 }
