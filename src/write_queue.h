@@ -4,7 +4,7 @@
  * flush, and otherwise once the thread has been idle until then: an interrupted run's files lag
  * at most about flush_seconds (plus the batch being written) behind the batches pushed, and a
  * fast run does not store and flush per segment (the HDF5 writer recompresses its partial last
- * chunk at each flush). At most two batches wait. */
+ * chunk at each flush). At most eight batches wait (write_queue.c). */
 #ifndef EVR_WRITE_QUEUE_H
 #define EVR_WRITE_QUEUE_H
 
@@ -19,7 +19,7 @@ typedef struct evr_write_queue evr_write_queue;
 
 evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, double flush_seconds,
                                  evr_write_queue **out, evr_error *err);
-/* Queues the first n events of v for writing and returns (waits only while two batches are
+/* Queues the first n events of v for writing and returns (waits only while eight batches are
  * pending) without copying them: the queue takes v's buffer and gives v one of its own holding
  * the rest of v (v->data[n .. v->n)), which is usually short. Fails with the writer thread's
  * first error, if any. */

@@ -34,6 +34,7 @@ extern "C" {
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <thread>
 
 #define CK(call)                                                                                          \
     do {                                                                                                  \
@@ -1322,6 +1323,47 @@ static uint64_t device_bytes(const cuda_backend *b)
     return n;
 }
 
+/* The event of a sorted key (pack_event's layout). */
+static inline evr_event decode_key(unsigned long long k, long long base_us, int xb, int yb)
+{
+    evr_event e;
+    e.t = base_us + (long long)(k >> (1 + xb + yb));
+    e.y = (uint16_t)((k >> (1 + xb)) & ((1u << yb) - 1u));
+    e.x = (uint16_t)((k >> 1) & ((1u << xb) - 1u));
+    e.p = (int8_t)(k & 1u);
+    return e;
+}
+
+/* Decodes n sorted keys into dst, a segment of many events on several threads: on one it was
+ * most of the main thread's own time (the eye's 218.7 M events in 30 s at 1280x720). */
+static void decode_keys(const unsigned long long *keys, size_t n, long long base_us, int xb, int yb, evr_event *dst)
+{
+    const size_t chunk = (size_t)1 << 19;
+    auto run = [=](size_t i0, size_t i1) {
+        for (size_t i = i0; i < i1; i++) dst[i] = decode_key(keys[i], base_us, xb, yb);
+    };
+    size_t threads = std::thread::hardware_concurrency();
+    if (threads > 8) threads = 8;
+    if (threads > (n + chunk - 1) / chunk) threads = (n + chunk - 1) / chunk;
+    if (threads <= 1) {
+        run(0, n);
+        return;
+    }
+    std::thread pool[8];
+    size_t started = 0;
+    for (size_t t = 1; t < threads; t++) {
+        try {
+            pool[t] = std::thread(run, n * t / threads, n * (t + 1) / threads);
+            started = t;
+        } catch (...) {   /* no thread: this one decodes the rest */
+            break;
+        }
+    }
+    run(0, n * 1 / threads);
+    if (started + 1 < threads) run(n * (started + 1) / threads, n);
+    for (size_t t = 1; t <= started; t++) pool[t].join();
+}
+
 static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, const float **frames,
                                evr_error *err)
 {
@@ -1379,15 +1421,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
     /* decoded straight into out when they all follow its last event (the common case), else
      * into a buffer of their own and merged */
     const int xb = event_key_bits(b->setup.width), yb = event_key_bits(b->setup.height);
-    auto decode = [&](unsigned long long k) {
-        evr_event e;
-        e.t = sl->base_us + (long long)(k >> (1 + xb + yb));
-        e.y = (uint16_t)((k >> (1 + xb)) & ((1u << yb) - 1u));
-        e.x = (uint16_t)((k >> 1) & ((1u << xb) - 1u));
-        e.p = (int8_t)(k & 1u);
-        return e;
-    };
-    const evr_event first = decode(n ? sl->h_sorted.p[0] : 0ull);
+    const evr_event first = decode_key(n ? sl->h_sorted.p[0] : 0ull, sl->base_us, xb, yb);
     const bool direct = n && (!out->n || !evr_event_key_less(&first, &out->data[out->n - 1]));
     evr_event_vec *dst = direct ? out : &b->decoded;
     if (!direct) b->decoded.n = 0;
@@ -1395,7 +1429,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
     }
-    for (size_t i = 0; i < n; i++) dst->data[dst->n + i] = decode(sl->h_sorted.p[i]);
+    decode_keys(sl->h_sorted.p, n, sl->base_us, xb, yb, dst->data + dst->n);
     dst->n += n;
     if (!direct && !evr_events_merge(out, b->decoded.data, n, &b->scratch)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
