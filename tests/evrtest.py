@@ -5,6 +5,7 @@ import os
 import struct
 import subprocess
 import sys
+import shutil
 import tempfile
 
 EVRAY = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("EVRAY", "build/evray")
@@ -37,8 +38,15 @@ def run_env(env, *args, expect=0):
         os.environ.pop(env, None)
 
 
+_tmpdirs = []
+
+
 def tmpdir():
-    return tempfile.mkdtemp(prefix="evray-test-")
+    """A fresh folder for a test's files: removed by finish() when every check passed, kept (and
+    named) for inspection when one failed."""
+    d = tempfile.mkdtemp(prefix="evray-test-")
+    _tmpdirs.append(d)
+    return d
 
 
 def load_run_json(d):
@@ -160,8 +168,18 @@ def square_crossings(ev, w, h, c_on, c_off):
     return checked, bad, errors, silent
 
 
+def skip(name, why):
+    """Ends a test that cannot run here (ctest's SKIP_RETURN_CODE 77), its folders removed."""
+    for d in _tmpdirs:
+        shutil.rmtree(d, ignore_errors=True)
+    print(f"{name}: skipped: {why}")
+    raise SystemExit(77)
+
+
 def finish(name):
     if failures:
-        print(f"{name}: {len(failures)} check(s) failed")
+        print(f"{name}: {len(failures)} check(s) failed (files kept in {', '.join(_tmpdirs)})")
         raise SystemExit(1)
+    for d in _tmpdirs:
+        shutil.rmtree(d, ignore_errors=True)
     print(f"{name}: all checks passed")

@@ -13,8 +13,7 @@ tmp = T.tmpdir()
 probe = T.run("demo", "--scene", "square", "-o", os.path.join(tmp, "probe"), "--res", "16x16", "--duration", "0.1",
               "--backend", "cuda", "--quiet", "--no-preview", expect=None)
 if probe.returncode != 0:
-    print("test_cuda: skipped:", probe.stderr.strip())
-    sys.exit(77)
+    T.skip("test_cuda", probe.stderr.strip())
 
 cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0.25"]),
          ("eye", ["--res", "346x260", "--duration", "1.5"]),
