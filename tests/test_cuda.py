@@ -5,7 +5,6 @@ Skipped (exit 77)
 where this build has no CUDA backend or no GPU is usable."""
 import json
 import os
-import sys
 
 import evrtest as T
 
