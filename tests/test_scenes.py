@@ -1,6 +1,5 @@
 """Every built-in scene renders on the CPU at a small size, makes events, and exports as a glTF
 file that renders the same events as the built-in scene."""
-import json
 import os
 
 import evrtest as T
