@@ -343,6 +343,7 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
     if (skip) {
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
+        if (a.gi && a.gi->ends_out) a.gi->ends_out[pix] = a.gi->ends_in[pix];   /* its last gather holds */
     }
 }
 
@@ -686,6 +687,7 @@ struct cuda_backend {
     int gi, gi_have_prev;
     gi_buffer gi_ring[NRING];              /* segment i ends in gi_ring[i % NRING], starts in the one before */
     dbuf<uint8_t> d_gi_last;               /* per cell: changed over the last segment */
+    dbuf<gi_end> d_gi_ends[NRING];         /* deferred gathers: each pixel's last gather, a ring as d_state */
     uint32_t photons;
     evr_photon_params pp;
     evr_gather_params gp;
@@ -888,6 +890,21 @@ static void gi_deferred_release(cuda_backend *b)
     b->d_gd_traced.release();
     b->d_gd_cache.release();
     b->d_gd_count.release();
+    for (int i = 0; i < NRING; i++) b->d_gi_ends[i].release();
+}
+
+/* The pixels' last gathers (gi_end), none known yet; without the memory, none are kept (every
+ * start gathered again). */
+static void gi_ends_alloc(cuda_backend *b, size_t npix)
+{
+    for (int i = 0; i < NRING; i++) {
+        if (b->d_gi_ends[i].reserve(npix, true) != cudaSuccess ||
+            cudaMemset(b->d_gi_ends[i].p, 0xff, npix * sizeof(gi_end)) != cudaSuccess) {   /* dist NaN: none */
+            (void)cudaGetLastError();
+            for (int j = 0; j < NRING; j++) b->d_gi_ends[j].release();
+            return;
+        }
+    }
 }
 
 /* The deferred gathers' buffers: every sample of every pixel may make a request (the moving
@@ -903,6 +920,7 @@ static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
         b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
         b->d_gd_count.reserve(1) == cudaSuccess) {
         b->gi_deferred = 1;
+        gi_ends_alloc(b, npix);
         b->gather_grid = (unsigned)prop->multiProcessorCount * 16u;
         return;
     }
@@ -1112,6 +1130,8 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     gpu_gi_view *v = sl->h_gi_view.p;
     v->end = *eb;
     v->start = *sb;
+    v->ends_in = b->d_gi_ends[0].p ? b->d_gi_ends[sl->index % NRING].p : nullptr;
+    v->ends_out = b->d_gi_ends[0].p ? b->d_gi_ends[(sl->index + 1) % NRING].p : nullptr;
     CK(cudaMemcpyAsync(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice, rs));
     b->gi_have_prev = 1;
     return EVR_OK;
@@ -1159,6 +1179,8 @@ static evr_status gi_alloc(cuda_backend *b, slot *sl, int window, evr_error *err
     v->sat = sl->d_sat.p;
     v->gp = b->gp;
     v->window = window;
+    v->ends_in = nullptr;
+    v->ends_out = nullptr;
     CK(sl->d_gi_view.reserve(1));
     CK(cudaMemcpy(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice));
     CK(cudaEventCreate(&sl->gi_started));
@@ -1316,6 +1338,7 @@ static uint64_t device_bytes(const cuda_backend *b)
     }
     for (int i = 0; i < NRING; i++) n += bytes(b->gi_ring[i].slots) + bytes(b->gi_ring[i].count) + bytes(b->gi_ring[i].gbuf);
     n += bytes(b->d_gi_last);
+    for (int i = 0; i < NRING; i++) n += bytes(b->d_gi_ends[i]);
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
          bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) + bytes(b->d_trail_rays) + bytes(b->d_todo) +
          bytes(b->d_gd_direct) + bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +

@@ -22,6 +22,14 @@
 
 #include "core/photon.h"
 
+/* A pixel's last gather of a segment, kept for the next (the deferred kernels): its gather point
+ * (dist NaN or negative: none) and its luminance at the segment's end, which is the next
+ * segment's start bit for bit (the same buffer, the same point, the same pixel). */
+struct gi_end {
+    evr_gather_point g;
+    float le;
+};
+
 /* What the render kernels read (device memory, one per slot). */
 struct gpu_gi_view {
     evr_photon_buffer end, start;  /* the photons at the segment's end and start (device pointers) */
@@ -31,6 +39,10 @@ struct gpu_gi_view {
     const uint32_t *sat;
     evr_gather_params gp;
     int window;                    /* cells around a pixel a gather may read */
+    /* the deferred kernels' per-pixel last gathers: the previous segment's (read) and this one's
+     * (written), a ring indexed by segment as the pixel states; NULL where they did not fit */
+    const gi_end *ends_in;
+    gi_end *ends_out;
 };
 
 /* A pixel's last gather in this launch: the same point, normal, distance and instance in the
@@ -63,16 +75,27 @@ __device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const g
 }
 
 /* The gathers of point g (pixel (x, y)) at the segment's start and end; one where the window saw
- * no change (the same cells give the same estimate). Two walks: walking both buffers together,
- * cell by cell, made the gather kernel 12% slower (H200, Cornell box at 1280x720, 0.5 s: 0.237 s
- * against 0.210 s). */
+ * no change (the same cells give the same estimate), none at the start where it is known
+ * (known_ls: the previous segment's end gather of the same point). Two walks: walking both
+ * buffers together, cell by cell, made the gather kernel 12% slower (H200, Cornell box at
+ * 1280x720, 0.5 s: 0.237 s against 0.210 s). */
 __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                                int y, float *ls, float *le)
+                                                int y, float *ls, float *le, const float *known_ls = nullptr)
 {
-    *ls = gpu_gather_lum(&v->start, v, cam, g, x, y);
+    *ls = known_ls ? *known_ls : gpu_gather_lum(&v->start, v, cam, g, x, y);
     *le = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y)
               ? gpu_gather_lum(&v->end, v, cam, g, x, y)
               : *ls;
+}
+
+/* Whether two gather points are the same bit for bit (the same estimates). */
+__device__ __forceinline__ bool gather_point_same(const evr_gather_point *a, const evr_gather_point *b)
+{
+    const float fa[10] = {a->p.x, a->p.y, a->p.z, a->n.x, a->n.y, a->n.z, a->dist, a->k[0], a->k[1], a->k[2]};
+    const float fb[10] = {b->p.x, b->p.y, b->p.z, b->n.x, b->n.y, b->n.z, b->dist, b->k[0], b->k[1], b->k[2]};
+    unsigned d = 0;
+    for (int i = 0; i < 10; i++) d |= __float_as_uint(fa[i]) ^ __float_as_uint(fb[i]);
+    return d == 0;
 }
 
 /* Whether the memo holds gather point g of instance inst; if not, it takes it (the caller fills

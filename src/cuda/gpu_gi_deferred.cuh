@@ -3,7 +3,8 @@
  *
  *   gi_trace_kernel   the pixels' samples: rays and direct light; a sample that needs a gather
  *                     (its pixel's memo does not hold its surface point) appends a request
- *   gi_gather_kernel  one thread per request: the gathers at the segment's start and end (core/photon.h)
+ *   gi_gather_kernel  one thread per request: the gathers at the segment's start (unless the
+ *                     pixel's last gather of the previous segment was at the same point) and end
  *   gi_pixel_kernel   the pixels' samples through the pixel model: direct + gathered light at the
  *                     sample's time (a settled pixel: its last direct light, its gathers)
  *
@@ -19,10 +20,13 @@
 
 #define GI_NO_REQUEST 0xffffffffu
 
-/* A deferred gather: the surface point and its pixel. */
+/* A deferred gather: the surface point and its pixel; has_ls: its start gather is known (ls, the
+ * pixel's end gather of the previous segment at the same point). */
 struct gi_request {
     evr_gather_point g;
     int pix;
+    float ls;
+    int has_ls;
 };
 
 /* The three kernels' shared buffers (device memory, reused by every launch: the kernels of a
@@ -54,6 +58,9 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     bool tracing = active;
     gi_memo memo;
     memo.valid = false;
+    gi_end last;                       /* the pixel's last gather of the previous segment */
+    last.g.dist = -1.0f;
+    if (active && a.gi->ends_in) last = a.gi->ends_in[pix];
     const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     float direct = 0.0f;               /* the last traced sample's, and its request */
@@ -84,8 +91,11 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
         const unsigned slot = warp_append(d.count, want);   /* the warp's requests in one atomic */
         if (want) {
             r = slot;
+            const bool known = last.g.dist >= 0.0f && gather_point_same(&last.g, &g);
             d.requests[r].g = g;
             d.requests[r].pix = pix;
+            d.requests[r].ls = known ? last.le : 0.0f;
+            d.requests[r].has_ls = known;
             memo.req = r;
         }
         if (tracing) {
@@ -118,7 +128,7 @@ __global__ void __launch_bounds__(BLOCK) gi_gather_kernel(kernel_args a, gi_defe
     for (unsigned r = blockIdx.x * blockDim.x + threadIdx.x; r < n; r += gridDim.x * blockDim.x) {
         const gi_request q = d.requests[r];
         float2 l;
-        gpu_gather_ends(a.gi, &a.rs.camera, &q.g, q.pix % a.width, q.pix / a.width, &l.x, &l.y);
+        gpu_gather_ends(a.gi, &a.rs.camera, &q.g, q.pix % a.width, q.pix / a.width, &l.x, &l.y, q.has_ls ? &q.ls : nullptr);
         d.lum[r] = l;
     }
 }
@@ -159,6 +169,15 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
         st.cache_dist = d.cache_dist[i];
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
+        if (a.gi->ends_out) {   /* its last gather, for the next segment's start */
+            gi_end e{};
+            e.g.dist = -1.0f;
+            if (r != GI_NO_REQUEST) {
+                e.g = d.requests[r].g;
+                e.le = d.lum[r].y;
+            }
+            a.gi->ends_out[pix] = e;
+        }
     }
 }
 
