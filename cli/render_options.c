@@ -123,7 +123,7 @@ static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *qui
     else if (opt_is(a, "--photons")) { VAL("--photons");
             uint64_t n;
             if (!opt_u64("--photons", v, &n)) return -1;
-            if (n > (1u << 30)) { cli_error("--photons: at most 2^30 photons per segment (got %s)", v); return -1; }
+            if (n > (1u << 30)) { cli_error("--photons: at most 2^30 photons per pass (got %s)", v); return -1; }
             cfg.photons = (uint32_t)n; }
     else if (opt_is(a, "--gather-radius")) { VAL("--gather-radius"); if (!opt_float("--gather-radius", v, &cfg.gather_radius)) return -1; }
     else if (opt_is(a, "--gather-max")) { VAL("--gather-max"); if (!opt_int("--gather-max", v, &cfg.gather_max)) return -1; }
