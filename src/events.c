@@ -98,20 +98,40 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     return 1;
 }
 
-int evr_events_merge(evr_event_vec *v, const evr_event *ev, size_t n, evr_event_vec *scratch)
+int evr_events_merge_runs(evr_event_vec *v, size_t h, evr_event_vec *scratch)
 {
-    if (!n) return 1;
-    if (!v->n || !evr_event_key_less(ev, &v->data[v->n - 1])) return evr_event_vec_append(v, ev, n);   /* common: no overlap */
+    evr_event *d = v->data;
+    const size_t n = v->n;
+    if (h == 0 || h >= n || !evr_event_key_less(&d[h], &d[h - 1])) return 1;   /* already in order */
+    /* lo: the first event of the first run that the second run's first precedes; end: the first
+     * event of the second run that the first run's last does not follow */
+    size_t lo = 0, hi = h;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (evr_event_key_less(&d[h], &d[mid])) hi = mid;
+        else lo = mid + 1;
+    }
+    size_t a = h, b = n;
+    while (a < b) {
+        size_t mid = a + (b - a) / 2;
+        if (evr_event_key_less(&d[mid], &d[h - 1])) a = mid + 1;
+        else b = mid;
+    }
+    const size_t end = a, m = h - lo;
     scratch->n = 0;
-    if (!evr_event_vec_reserve(scratch, v->n + n)) return 0;
-    size_t i = 0, j = 0, k = 0;
-    while (i < v->n && j < n) scratch->data[k++] = evr_event_key_less(&ev[j], &v->data[i]) ? ev[j++] : v->data[i++];
-    while (i < v->n) scratch->data[k++] = v->data[i++];
-    while (j < n) scratch->data[k++] = ev[j++];
-    scratch->n = k;
-    evr_event_vec tmp = *v;
-    *v = *scratch;
-    *scratch = tmp;
+    if (!evr_event_vec_append(scratch, d + lo, m)) return 0;
+    /* forward merge into d[lo ..): the write index never passes the second run's read index */
+    size_t i = 0, j = h, k = lo;
+    while (i < m && j < end) d[k++] = evr_event_key_less(&d[j], &scratch->data[i]) ? d[j++] : scratch->data[i++];
+    while (i < m) d[k++] = scratch->data[i++];
     scratch->n = 0;
     return 1;
+}
+
+int evr_events_merge(evr_event_vec *v, const evr_event *ev, size_t n, evr_event_vec *scratch)
+{
+    const size_t h = v->n;
+    if (!n) return 1;
+    if (!evr_event_vec_append(v, ev, n)) return 0;
+    return evr_events_merge_runs(v, h, scratch);
 }

@@ -40,4 +40,10 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch);
  * keys. */
 int evr_events_merge(evr_event_vec *v, const evr_event *ev, size_t n, evr_event_vec *scratch);
 
+/* The same for events already appended to v: merges its sorted runs v[0 .. h) and v[h .. n) in
+ * place, the first run's first among equal keys. Only the overlap moves: the first run's events
+ * that the second run's first precedes go through scratch (a segment's events overlap the few
+ * held back from the one before, not the many before those). */
+int evr_events_merge_runs(evr_event_vec *v, size_t h, evr_event_vec *scratch);
+
 #endif

@@ -92,6 +92,53 @@ int main(void)
     for (i = 1; i < v.n; i++)
         if (v.data[i].t == v.data[i - 1].t && v.data[i].p == v.data[i - 1].p) stable = 0;   /* alternates */
     CHECK(stable);
+    /* merging sorted runs in place (evr_events_merge_runs, evr_events_merge): the order of a
+     * plain two-way merge that takes the first run's event on equal keys, for runs that overlap
+     * a little, a lot, not at all, and with ties across them (p tells the run apart) */
+    {
+        const size_t lens[][2] = {{0, 5}, {5, 0}, {300, 2000}, {2000, 300}, {1000, 1000}, {1, 700}, {700, 1}};
+        const int64_t shifts[] = {0, 40, 200, 1000};
+        evr_event_vec runs = {0}, ref2 = {0};
+        int merge_ok = 1;
+        for (size_t c = 0; c < sizeof lens / sizeof lens[0]; c++) {
+            for (size_t sh = 0; sh < sizeof shifts / sizeof shifts[0]; sh++) {
+                runs.n = 0;
+                for (int r = 0; r < 2; r++)
+                    for (size_t k = 0; k < lens[c][r]; k++) {   /* run r: sorted keys, t from a small range */
+                        evr_event e;
+                        e.t = base + (int64_t)(k / 3) + (r ? shifts[sh] : 0);
+                        e.y = (uint16_t)(k % 3 == 2 ? 1 : 0);
+                        e.x = (uint16_t)(k % 3 == 1 ? 7 : 3);
+                        if (e.y) e.x = 0;
+                        e.p = (int8_t)r;
+                        CHECK(evr_event_vec_push(&runs, e));
+                    }
+                const size_t h = lens[c][0], total = runs.n;
+                ref2.n = 0;   /* the reference: a plain merge */
+                size_t a = 0, b = h;
+                while (a < h || b < total) {
+                    int take_b = a == h || (b < total && evr_event_key_less(&runs.data[b], &runs.data[a]));
+                    CHECK(evr_event_vec_push(&ref2, runs.data[take_b ? b++ : a++]));
+                }
+                /* evr_events_merge: the first run, the second merged into it */
+                evr_event_vec first = {0};
+                CHECK(evr_event_vec_append(&first, runs.data, h));
+                CHECK(evr_events_merge(&first, runs.data + h, total - h, &scratch));
+                CHECK(evr_events_merge_runs(&runs, h, &scratch));
+                for (size_t k = 0; k < total; k++) {
+                    const evr_event *x = &runs.data[k], *y = &ref2.data[k], *z = &first.data[k];
+                    if (x->t != y->t || x->x != y->x || x->y != y->y || x->p != y->p) merge_ok = 0;
+                    if (z->t != y->t || z->x != y->x || z->y != y->y || z->p != y->p) merge_ok = 0;
+                }
+                if (first.n != total) merge_ok = 0;
+                evr_event_vec_free(&first);
+                if (runs.n != total) merge_ok = 0;
+            }
+        }
+        CHECK(merge_ok);
+        evr_event_vec_free(&runs);
+        evr_event_vec_free(&ref2);
+    }
     evr_event_vec_free(&v);
     evr_event_vec_free(&scratch);
     return check_report("test_events_sort");
