@@ -592,6 +592,15 @@ EVR_HD static inline int evr_photon_cell_same(const evr_photon_buffer *a, const 
 /* Whether any cell the gather of image pixel (x, y) may read (window cells around it) changed:
  * sat is the summed-area table, (w + 1) x (h + 1), of the changed cells of a w x h buffer with
  * the given guard band. */
+/* The changed cells in columns x0 .. x1 - 1 of rows y0 .. y1 - 1 of a w-wide buffer, from its
+ * summed-area table (w + 1 entries a row, row 0 and column 0 zero). */
+EVR_HD static inline uint32_t evr_sat_count(const uint32_t *sat, int w, int x0, int y0, int x1, int y1)
+{
+    const size_t W = (size_t)w + 1;
+    return sat[(size_t)y1 * W + (size_t)x1] - sat[(size_t)y0 * W + (size_t)x1] - sat[(size_t)y1 * W + (size_t)x0] +
+           sat[(size_t)y0 * W + (size_t)x0];
+}
+
 EVR_HD static inline int evr_photon_window_changed(const uint32_t *sat, int w, int h, int margin, int window, int x, int y)
 {
     int x0 = x + margin - window, x1 = x + margin + window + 1, y0 = y + margin - window, y1 = y + margin + window + 1;
@@ -600,10 +609,7 @@ EVR_HD static inline int evr_photon_window_changed(const uint32_t *sat, int w, i
     if (x1 > w) x1 = w;
     if (y1 > h) y1 = h;
     if (x0 >= x1 || y0 >= y1) return 0;
-    const size_t W = (size_t)w + 1;
-    uint32_t c = sat[(size_t)y1 * W + (size_t)x1] - sat[(size_t)y0 * W + (size_t)x1] - sat[(size_t)y1 * W + (size_t)x0] +
-                 sat[(size_t)y0 * W + (size_t)x0];
-    return c != 0;
+    return evr_sat_count(sat, w, x0, y0, x1, y1) != 0;
 }
 
 /* Lock-free insertion: an atomic increment claims a layer; a photon arriving at a full cell is
@@ -848,7 +854,6 @@ EVR_HD static inline int evr_photon_gather_moved(const evr_photon_buffer *cur, c
                                                  evr_v3 p, evr_v3 n, float cam_dist)
 {
     const evr_gather_window w = evr_photon_gather_window(cur, cam, px, py, cam_dist, gp);
-    const size_t W = (size_t)cur->width + 1;
     int x0 = w.cx - w.h, x1 = w.cx + w.h + 1, y0 = w.cy - w.h, y1 = w.cy + w.h + 1, x, y;
     if (x0 < 0) x0 = 0;
     if (y0 < 0) y0 = 0;
@@ -856,13 +861,9 @@ EVR_HD static inline int evr_photon_gather_moved(const evr_photon_buffer *cur, c
     if (y1 > cur->height) y1 = cur->height;
     for (y = y0; y < y1; y++) {
         /* the row's changed cells, from the table: none, and the row is passed over */
-        if (sat[(size_t)(y + 1) * W + (size_t)x1] - sat[(size_t)y * W + (size_t)x1] - sat[(size_t)(y + 1) * W + (size_t)x0] +
-                sat[(size_t)y * W + (size_t)x0] == 0)
-            continue;
+        if (evr_sat_count(sat, cur->width, x0, y, x1, y + 1) == 0) continue;
         for (x = x0; x < x1; x++) {
-            if (sat[(size_t)(y + 1) * W + (size_t)(x + 1)] - sat[(size_t)y * W + (size_t)(x + 1)] - sat[(size_t)(y + 1) * W + (size_t)x] +
-                    sat[(size_t)y * W + (size_t)x] == 0)
-                continue;
+            if (evr_sat_count(sat, cur->width, x, y, x + 1, y + 1) == 0) continue;
             const size_t i = (size_t)y * (size_t)cur->width + (size_t)x;
             if (evr_photon_cell_reaches(cur, i, p, n, w.r2, gp->normal_cos) || evr_photon_cell_reaches(prev, i, p, n, w.r2, gp->normal_cos))
                 return 1;
