@@ -35,6 +35,13 @@ typedef struct {
     float still_before, still_after;
 } evr_skip_plan;
 
+/* Whether nothing moves in the segment nor changed since the previous one (camera, lights and
+ * instances): the photons of the previous segment's end hold for this one too. */
+EVR_HD static inline int evr_skip_plan_still(const evr_skip_plan *pl)
+{
+    return pl->reuse && pl->num_boxes == 0;
+}
+
 /* The still span of normalized segment time f: 1 before anything of the segment moves, 2 after
  * all of it has, 0 while things move or where the plan does not tell (the camera or a light
  * moves). Two samples of a pixel in the same nonzero span see the same scene bit for bit

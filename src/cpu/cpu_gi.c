@@ -121,7 +121,7 @@ static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_s
 evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
                               evr_backend *stats, evr_error *err)
 {
-    const int still = plan->reuse && plan->num_boxes == 0;
+    const int still = evr_skip_plan_still(plan);
     const int w = g->end.width, h = g->end.height;
     evr_status st;
     int x, y;

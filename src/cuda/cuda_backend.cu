@@ -1109,7 +1109,7 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     evr_status st;
     sl->gi_passes = 0;
     CK(cudaMemsetAsync(sl->d_rays.p + GI_PATHS, 0, (GI_COUNTERS - GI_PATHS) * sizeof(unsigned long long), rs));
-    if (seg->skip->reuse && seg->skip->num_boxes == 0 && b->gi_have_prev) {
+    if (evr_skip_plan_still(seg->skip) && b->gi_have_prev) {
         CK(cudaMemcpyAsync(eb->count, sb->count, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
         CK(cudaMemcpyAsync(eb->slots, sb->slots, cells * (size_t)eb->layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
         CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
@@ -1158,11 +1158,10 @@ static evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
         buf->count = g->count.p;
         buf->gbuf = g->gbuf.p;
         buf->collisions = nullptr;   /* the place kernel counts them (GI_COLLISIONS) */
-        if (i == 0) {
-            CK(b->d_gi_last.reserve(cells));
-            CK(cudaMemset(b->d_gi_last.p, 0, cells));
-        }
     }
+    const size_t cells = (size_t)b->gi_ring[0].ph.width * (size_t)b->gi_ring[0].ph.height;
+    CK(b->d_gi_last.reserve(cells));
+    CK(cudaMemset(b->d_gi_last.p, 0, cells));
     return EVR_OK;
 }
 
