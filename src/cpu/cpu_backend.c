@@ -223,26 +223,33 @@ typedef struct {
     int x, y;
 } tile_pixel;
 
+/* Whether, with GI, the pixel's last traced sample met a surface (its indirect light then moves
+ * in time). */
+static int gi_lit(const cpu_backend *b, const tile_pixel *q)
+{
+    return b->gi && q->t_hit >= 0.0f && q->t_hit < INFINITY;
+}
+
 /* The intensity of a sample at normalized time f that takes its pixel's last traced sample's
  * (settled, or held in a still span): that intensity, or with GI on a surface, that sample's
  * direct light and its gathers' indirect light at f (evr_cpu_gi_last). */
-static float kept_intensity(const cpu_backend *b, const tile_pixel *q, int lit, float f)
+static float kept_intensity(const cpu_backend *b, const tile_pixel *q, float f)
 {
-    return lit ? q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f) : q->st->intensity;
+    return gi_lit(b, q) ? q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f) : q->st->intensity;
 }
 
 /* The samples k0 .. n - 1 of a pixel that keeps its intensity: none when they cannot change it
  * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. With GI, a pixel
- * that settled on a surface (lit: its last sample met one) keeps the direct light of that sample
- * and its gather, whose indirect light still moves in time (evr_cpu_gi_last). */
-static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int lit, int k0, int n, float dt, evr_event_vec *out)
+ * that settled on a surface (gi_lit) keeps the direct light of that sample and its gather, whose
+ * indirect light still moves in time (evr_cpu_gi_last). */
+static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n, float dt, evr_event_vec *out)
 {
     const float in = q->st->intensity;
     int k;
-    if (lit && !evr_cpu_gi_flat(&b->gi_state, q->x, q->y)) {
+    if (gi_lit(b, q) && !evr_cpu_gi_flat(&b->gi_state, q->x, q->y)) {
         for (k = k0; k < n; k++) {
             const float f = ((float)k + q->phi) / (float)n;
-            pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, 1, f), q->x, q->y, out);
+            pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y, out);
         }
         return;
     }
@@ -294,7 +301,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
                     q[i]->t_hit = t_hit[i];
                     q[i]->direct = direct[i];
                 } else {
-                    intensity[i] = kept_intensity(b, q[i], b->gi && q[i]->t_hit < INFINITY, fs[i]);
+                    intensity[i] = kept_intensity(b, q[i], fs[i]);
                 }
                 pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
             }
@@ -304,10 +311,9 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             if (!valid[i]) continue;
             float cd = evr_skip_cache_after_trace(rs, seg->skip, q[i]->ray, q[i]->t_hit);
             if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
-                const int lit = b->gi && q[i]->t_hit < INFINITY;
                 q[i]->st->cache_dist = cd;
+                keep_samples(b, q[i], ideal, k1, n, dt, out);
                 q[i]->t_hit = -1.0f;   /* its cache is set */
-                keep_samples(b, q[i], ideal, lit, k1, n, dt, out);
             } else {
                 more[(*num_more)++] = list[c + i];
             }
@@ -357,7 +363,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
             q->ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
             if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) && !gi_changed) {
                 (*skipped)++;
-                keep_samples(b, q, ideal, 0, 0, n, dt, out);
+                keep_samples(b, q, ideal, 0, n, dt, out);
                 evr_pixel_end_segment(q->st, dt);
             } else {
                 list[count++] = np;
