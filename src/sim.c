@@ -139,7 +139,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->track_count = malloc(sizeof(int) * (size_t)ntracks);
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
     if (!sim->keys || !sim->track_offset || !sim->track_count || !sim->node_used ||
-        !evr_skip_tracker_init(&sim->skip, ntracks) ||
+        !evr_skip_tracker_init(&sim->skip, ntracks) || !evr_skip_tracker_parts(&sim->skip, s) ||
         !(sim->skipped_per_segment = calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
         evr_sim_release(sim);
         return nomem(err);

@@ -1,6 +1,7 @@
 /* Per-segment plan of change-driven sampling: see skip_plan.h and core/skip.h. */
 #include "skip_plan.h"
 #include "cuda/gpu_bvh.h"
+#include "sim_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -13,7 +14,9 @@ int evr_skip_tracker_init(evr_skip_tracker *t, int num_tracks)
     t->prev_last = calloc((size_t)num_tracks, sizeof *t->prev_last);
     t->prev_count = calloc((size_t)num_tracks, sizeof *t->prev_count);
     t->moved = calloc((size_t)num_tracks, sizeof *t->moved);
-    return t->prev_last && t->prev_count && t->moved;
+    t->last = calloc((size_t)num_tracks, sizeof *t->last);
+    t->last_count = calloc((size_t)num_tracks, sizeof *t->last_count);
+    return t->prev_last && t->prev_count && t->moved && t->last && t->last_count;
 }
 
 void evr_skip_tracker_free(evr_skip_tracker *t)
@@ -21,7 +24,103 @@ void evr_skip_tracker_free(evr_skip_tracker *t)
     free(t->prev_last);
     free(t->prev_count);
     free(t->moved);
+    free(t->last);
+    free(t->last_count);
+    for (int i = 0; t->mesh_parts && i < t->num_meshes; i++) free(t->mesh_parts[i]);
+    free(t->mesh_parts);
     memset(t, 0, sizeof *t);
+}
+
+int evr_skip_tracker_parts(evr_skip_tracker *t, const evr_scene *s)
+{
+    t->num_meshes = s->num_meshes;
+    t->mesh_parts = calloc((size_t)(s->num_meshes ? s->num_meshes : 1), sizeof *t->mesh_parts);
+    return t->mesh_parts != NULL;
+}
+
+typedef struct {
+    float key;
+    uint32_t tri;
+} keyed_tri;
+
+static int keyed_cmp(const void *a, const void *b)
+{
+    const keyed_tri *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->tri < y->tri ? -1 : x->tri > y->tri;
+}
+
+static void tri_box(const evr_mesh *m, uint32_t tri, float box[6])
+{
+    for (int c = 0; c < 3; c++) {
+        const float *p = &m->positions[3 * m->indices[3 * tri + c]];
+        for (int a = 0; a < 3; a++) {
+            box[a] = fminf(box[a], p[a]);
+            box[a + 3] = fmaxf(box[a + 3], p[a]);
+        }
+    }
+}
+
+static void empty_box(float box[6])
+{
+    box[0] = box[1] = box[2] = INFINITY;
+    box[3] = box[4] = box[5] = -INFINITY;
+}
+
+/* Splits the triangles k[0 .. n) at the median of their centroids along the widest axis of the
+ * centroids, depth times; the leaves' boxes go to out[0 .. 2^depth) in order (empty leaves
+ * empty), so that 2^j consecutive leaves make a leaf of depth - j. */
+static void split_parts(const evr_mesh *m, keyed_tri *k, size_t n, int depth, float (*out)[6])
+{
+    const size_t leaves = (size_t)1 << depth;
+    if (depth == 0 || n <= 1) {
+        for (size_t i = 0; i < leaves; i++) empty_box(out[i]);
+        for (size_t i = 0; i < n; i++) tri_box(m, k[i].tri, out[0]);
+        return;
+    }
+    float c[6];
+    empty_box(c);
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t *ix = &m->indices[3 * k[i].tri];
+        for (int a = 0; a < 3; a++) {
+            const float v = m->positions[3 * ix[0] + a] + m->positions[3 * ix[1] + a] + m->positions[3 * ix[2] + a];
+            c[a] = fminf(c[a], v);
+            c[a + 3] = fmaxf(c[a + 3], v);
+        }
+    }
+    int axis = 0;
+    for (int a = 1; a < 3; a++)
+        if (c[a + 3] - c[a] > c[axis + 3] - c[axis]) axis = a;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t *ix = &m->indices[3 * k[i].tri];
+        k[i].key = m->positions[3 * ix[0] + axis] + m->positions[3 * ix[1] + axis] + m->positions[3 * ix[2] + axis];
+    }
+    qsort(k, n, sizeof *k, keyed_cmp);
+    split_parts(m, k, n / 2, depth - 1, out);
+    split_parts(m, k + n / 2, n - n / 2, depth - 1, out + leaves / 2);
+}
+
+/* The parts of mesh i (made on first use); NULL when the tracker has none or memory ran out. */
+static const float (*mesh_parts(evr_skip_tracker *t, const evr_scene *s, int i))[6]
+{
+    if (!t->mesh_parts || i < 0 || i >= t->num_meshes) return NULL;
+    if (!t->mesh_parts[i]) {
+        const evr_mesh *m = &s->meshes[i];
+        float (*out)[6] = malloc(sizeof *out * EVR_SKIP_MESH_PARTS);
+        keyed_tri *k = malloc(sizeof *k * (m->num_triangles ? m->num_triangles : 1));
+        if (!k || !out) {
+            free(k);
+            free(out);
+            return NULL;
+        }
+        for (uint32_t j = 0; j < m->num_triangles; j++) k[j].tri = j;
+        int depth = 0;
+        while ((1 << depth) < EVR_SKIP_MESH_PARTS) depth++;
+        split_parts(m, k, m->num_triangles, depth, out);
+        free(k);
+        t->mesh_parts[i] = out;
+    }
+    return (const float (*)[6])t->mesh_parts[i];
 }
 
 static int close_to(float a, float b, float tol) { return fabsf(a - b) <= tol; }
@@ -44,6 +143,10 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
                              const int *track_count, float scene_size)
 {
     int i, j;
+    if (t->have_prev) {   /* the segment seen last is now the previous one */
+        memcpy(t->prev_last, t->last, sizeof *t->last * (size_t)t->num_tracks);
+        memcpy(t->prev_count, t->last_count, sizeof *t->last_count * (size_t)t->num_tracks);
+    }
     for (i = 0; i < t->num_tracks; i++) {
         evr_motion_key *k = keys + track_offset[i];
         int n = track_count[i];
@@ -54,8 +157,8 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
         for (j = 1; j < n; j++)
             if (keys_close(&k[j], &k[j - 1], scene_size)) k[j] = k[j - 1];
         t->moved[i] = n > 1 || (t->have_prev && memcmp(&k[0], &t->prev_last[i], sizeof k[0]) != 0);
-        t->prev_last[i] = k[n - 1];
-        t->prev_count[i] = n;
+        t->last[i] = k[n - 1];
+        t->last_count[i] = n;
     }
     t->have_prev = 1;
 }
@@ -69,14 +172,11 @@ static void box_union(float lo[3], float hi[3], const float l2[3], const float h
     }
 }
 
-/* World box of instance i over the segment, and where it was at the previous segment's end. */
-static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, float blo[3],
-                         float bhi[3])
+/* World box of the object-space box [lo, hi] moved by track tr over the segment, and where it
+ * was at the previous segment's end. */
+static void swept_box(const evr_skip_tracker *t, const evr_render_scene *rs, int tr, const float lo[3], const float hi[3],
+                      float blo[3], float bhi[3])
 {
-    int tr = rs->instances[i].track;
-    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
-    float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
-    float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
     evr_gpu_segment_bounds(lo, hi, evr_rs_track(rs, tr), blo, bhi);
     if (t->prev_count[tr] > 0) {
         evr_motion_track prev;
@@ -86,6 +186,161 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
         evr_gpu_segment_bounds(lo, hi, prev, plo, phi);
         box_union(blo, bhi, plo, phi);
     }
+}
+
+/* World box of instance i over the segment, and where it was at the previous segment's end. */
+static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, float blo[3],
+                         float bhi[3])
+{
+    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
+    const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
+    const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
+    swept_box(t, rs, rs->instances[i].track, lo, hi, blo, bhi);
+}
+
+/* Float bounds that hold the double ones. */
+static float float_down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+static float float_up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+static double upper_norm(const evr_motion_key *k)   /* Frobenius norm of U */
+{
+    double n = 0.0;
+    for (int a = 0; a < 3; a++) n += (double)k->scale[a] * k->scale[a] + (double)k->skew[a] * k->skew[a];
+    return sqrt(n);
+}
+
+static double upper_diff_norm(const evr_motion_key *a, const evr_motion_key *b)
+{
+    double n = 0.0;
+    for (int i = 0; i < 3; i++) {
+        const double ds = (double)b->scale[i] - a->scale[i], dk = (double)b->skew[i] - a->skew[i];
+        n += ds * ds + dk * dk;
+    }
+    return sqrt(n);
+}
+
+/* The box of [lo, hi] under m's linear part (Arvo): centre and half extent, in double. */
+static void linear_box(const evr_m34 *m, const float lo[3], const float hi[3], double c[3], double h[3])
+{
+    for (int r = 0; r < 3; r++) {
+        c[r] = h[r] = 0.0;
+        for (int k = 0; k < 3; k++) {
+            const double mc = 0.5 * ((double)lo[k] + hi[k]), mh = 0.5 * ((double)hi[k] - lo[k]);
+            c[r] += (double)m->m[r][k] * mc;
+            h[r] += fabs((double)m->m[r][k]) * mh;
+        }
+    }
+}
+
+/* One track's motion over the segment, for sweeping many boxes: each key's matrix and, per key
+ * interval, the bound on how fast a point at unit distance from the origin moves (the same
+ * bound as evr_gpu_segment_bounds: rotation at the slerp's angular speed times |U c|, plus the
+ * change of U). */
+typedef struct {
+    int n;
+    evr_m34 m[EVR_MAX_KEYS];
+    double speed[EVR_MAX_KEYS];   /* per interval, per unit of |c| */
+} track_sweep;
+
+static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts)
+{
+    const evr_motion_track tk = evr_rs_track(rs, tr);
+    ts->n = tk.n < EVR_MAX_KEYS ? tk.n : EVR_MAX_KEYS;
+    for (int k = 0; k < ts->n; k++) ts->m[k] = evr_motion_key_matrix(&tk.keys[k]);
+    for (int k = 0; k + 1 < ts->n; k++) {
+        const evr_motion_key *a = &tk.keys[k], *b = &tk.keys[k + 1];
+        double d = fabs((double)evr_quat_dot(a->rot, b->rot));
+        const double qa = sqrt((double)evr_quat_dot(a->rot, a->rot)), qb = sqrt((double)evr_quat_dot(b->rot, b->rot));
+        d = qa > 0.0 && qb > 0.0 ? d / (qa * qb) : 1.0;
+        const double w = 2.0 * acos(d > 1.0 ? 1.0 : d) * 1.01 + 1e-6;
+        ts->speed[k] = w * fmax(upper_norm(a), upper_norm(b)) + upper_diff_norm(a, b);
+    }
+}
+
+/* World box of the object-space box [lo, hi] moved by the track over the segment: the boxes at
+ * the keys, each key interval's pair widened by half its
+ * speed times the farthest corner's distance (a point moving at speed L between two keys stays
+ * within L / 2 of one of them), translation taken as its box. */
+static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3], float out_hi[3])
+{
+    double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double pc[3] = {0.0, 0.0, 0.0}, ph[3] = {0.0, 0.0, 0.0}, r = 0.0, mag = 0.0;
+    for (int c = 0; c < 8; c++) {
+        const double x = c & 1 ? hi[0] : lo[0], y = c & 2 ? hi[1] : lo[1], z = c & 4 ? hi[2] : lo[2];
+        r = fmax(r, sqrt(x * x + y * y + z * z));
+    }
+    for (int k = 0; k < ts->n; k++) {
+        const evr_m34 *m = &ts->m[k];
+        double c[3], h[3];
+        linear_box(m, lo, hi, c, h);
+        for (int a = 0; a < 3; a++) {
+            const double t = m->m[a][3];
+            blo[a] = fmin(blo[a], t + c[a] - h[a]);
+            bhi[a] = fmax(bhi[a], t + c[a] + h[a]);
+        }
+        if (k > 0) {   /* the interval from key k - 1 */
+            const double margin = 0.5 * ts->speed[k - 1] * r;
+            for (int a = 0; a < 3; a++) {
+                const double t0 = ts->m[k - 1].m[a][3], t1 = m->m[a][3];
+                blo[a] = fmin(blo[a], fmin(t0, t1) + fmin(pc[a] - ph[a], c[a] - h[a]) - margin);
+                bhi[a] = fmax(bhi[a], fmax(t0, t1) + fmax(pc[a] + ph[a], c[a] + h[a]) + margin);
+            }
+        }
+        for (int a = 0; a < 3; a++) {
+            pc[a] = c[a];
+            ph[a] = h[a];
+        }
+    }
+    for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(blo[a]), fabs(bhi[a])));
+    for (int a = 0; a < 3; a++) {
+        /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
+        const double slack = 1e-6 * mag + 1e-30;
+        out_lo[a] = float_down(blo[a] - slack);
+        out_hi[a] = float_up(bhi[a] + slack);
+    }
+}
+
+/* Box b (instance i's) as a tree of its mesh's parts, `leaves` leaves (merged from the mesh's
+ * EVR_SKIP_MESH_PARTS in order), each swept over the segment; an inner node the union of its
+ * children. Where the part was before the segment does not matter here: a pixel's cache is
+ * clean only if its rays met nothing that moved in its own segment, so it holds the static
+ * scene's answer, and it holds now when its rays meet nothing where things are now. */
+static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, int leaves,
+                      evr_skip_plan *pl, int b, track_sweep *ts)
+{
+    const float (*parts)[6] = mesh_parts(t, s, rs->instances[i].mesh);
+    const int base = pl->part_first[b], per = EVR_SKIP_MESH_PARTS / leaves;
+    if (!parts) {
+        pl->part_first[b + 1] = base;
+        return;
+    }
+    track_sweep_init(rs, rs->instances[i].track, ts);
+    for (int l = 0; l < leaves; l++) {
+        float box[6], *lo = pl->part_lo[base + leaves - 1 + l], *hi = pl->part_hi[base + leaves - 1 + l];
+        empty_box(box);
+        for (int q = l * per; q < (l + 1) * per; q++) box_union(box, box + 3, parts[q], parts[q] + 3);
+        if (box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5]) {
+            sweep_box(ts, box, box + 3, lo, hi);
+        } else {
+            memcpy(lo, box, 3 * sizeof(float));
+            memcpy(hi, box + 3, 3 * sizeof(float));
+        }
+    }
+    for (int n = leaves - 2; n >= 0; n--) {
+        float *lo = pl->part_lo[base + n], *hi = pl->part_hi[base + n];
+        memcpy(lo, pl->part_lo[base + 2 * n + 1], 3 * sizeof(float));
+        memcpy(hi, pl->part_hi[base + 2 * n + 1], 3 * sizeof(float));
+        box_union(lo, hi, pl->part_lo[base + 2 * n + 2], pl->part_hi[base + 2 * n + 2]);
+    }
+    pl->part_first[b + 1] = base + 2 * leaves - 1;
 }
 
 /* Merges the plan's boxes of the same track (box_track[b]: box b's track) into one each. */
@@ -125,7 +380,7 @@ static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t, ev
     }
 }
 
-void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
+void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
                          evr_skip_plan *pl)
 {
     int i, tr, per_track = 0;
@@ -170,6 +425,15 @@ void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const ev
             pl->num_boxes = 0;
             return;
         }
+    }
+    /* a box per instance: each also a tree of parts, as many as fit */
+    if (!per_track && pl->num_boxes > 0 && t->mesh_parts) {
+        int leaves = EVR_SKIP_MESH_PARTS;
+        track_sweep *ts = malloc(sizeof *ts);
+        while (leaves > 1 && (2 * leaves - 1) * pl->num_boxes > EVR_SKIP_MAX_PARTS) leaves /= 2;
+        for (int j = 0, nb = 0; ts && leaves > 1 && j < rs->num_instances; j++)
+            if (t->moved[rs->instances[j].track]) add_parts(t, s, rs, j, leaves, pl, nb++, ts);
+        free(ts);
     }
     pl->cache = cache;
     pl->reuse = cache && still;

@@ -13,10 +13,25 @@ typedef struct {
     evr_motion_key *prev_last;    /* per track: the last key of the previous segment */
     int *prev_count;              /* per track: its key count there */
     int *moved;                   /* per track: moves in this segment or changed since the last */
+    evr_motion_key *last;         /* per track: the last key of the segment seen last */
+    int *last_count;
+    /* mesh parts (evr_skip_tracker_parts; NULL: the plan bounds whole meshes): per mesh NULL or
+     * EVR_SKIP_MESH_PARTS object-space boxes, lo xyz hi xyz (empty: lo > hi), made when the mesh
+     * first moves */
+    int num_meshes;
+    float (**mesh_parts)[6];
 } evr_skip_tracker;
+
+/* Parts a moving mesh is bounded by at most: its triangles split eight times at the median of
+ * their centroids along the widest axis. */
+#define EVR_SKIP_MESH_PARTS 256
 
 int evr_skip_tracker_init(evr_skip_tracker *t, int num_tracks);
 void evr_skip_tracker_free(evr_skip_tracker *t);
+
+/* Lets the plans of tracker t bound each moving instance by the parts of its mesh (swept each on
+ * its own) as well as by its whole box; returns 0 when out of memory. */
+int evr_skip_tracker_parts(evr_skip_tracker *t, const evr_scene *s);
 
 /* Called with every segment's freshly computed keys (in order). A track that holds still in
  * this segment and in the previous one, within a billionth of the scene size, keeps the
@@ -27,7 +42,7 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
 
 /* Fills the plan of the segment whose keys the tracker saw last: enabled 0 (--no-skip) gives a
  * plan that neither reuses nor caches. rs holds the segment's keys. */
-void evr_skip_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
+void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
                          evr_skip_plan *pl);
 
 /* Fills the adaptive-sampling plan (core/adaptive.h) of the same segment: the swept bounds of

@@ -4,6 +4,7 @@
  * against those boxes; the still spans of a segment (before and after its motion). */
 #include "check.h"
 #include "skip_plan.h"
+#include "core/rng.h"
 
 #include <math.h>
 #include <string.h>
@@ -61,6 +62,117 @@ static void plan_of(world *w, int moving_tracks, evr_skip_plan *pl)
     CHECK(evr_skip_tracker_init(&t, moving_tracks + 1));
     evr_skip_tracker_update(&t, w->keys, w->offset, w->count, 1.0f);
     evr_skip_plan_build(&t, &w->s, &w->rs, 1, pl);
+    evr_skip_tracker_free(&t);
+}
+
+/* Mesh parts: an arc of 8 small triangles (a quarter circle of radius 10 in the xy plane)
+ * turning about z (10 degrees between keys) and moving along x. The plan's tree of swept parts
+ * must hold every point of every triangle at every time of the segment (each point met by a ray
+ * aimed at it), the instance's box also where it was at the previous segment's end; and the
+ * parts leave the middle of the circle free, which the instance's box alone cannot. */
+#define RING 8
+static float uni(uint64_t *st)
+{
+    *st += 0x9E3779B97F4A7C15ull;
+    return evr_uniform(evr_mix64(*st));
+}
+
+/* Five keys turning about z from deg0 by step degrees each, moving 0.1 along x each. */
+static void ring_keys(evr_motion_key *keys, float deg0, float step)
+{
+    for (int k = 0; k < 5; k++) {
+        const float a = (deg0 + step * (float)k) * 3.14159265f / 180.0f;
+        evr_m34 m = evr_m34_identity();
+        m.m[0][0] = cosf(a); m.m[0][1] = -sinf(a);
+        m.m[1][0] = sinf(a); m.m[1][1] = cosf(a);
+        m.m[0][3] = 0.1f * (float)k;
+        keys[k] = evr_motion_key_from_matrix(&m);
+    }
+}
+
+static void test_parts(void)
+{
+    static float pos[RING * 9];
+    static uint32_t idx[RING * 3];
+    evr_scene s;
+    evr_mesh mesh;
+    evr_instance_view inst;
+    evr_motion_key keys[8];
+    int offset[2] = {0, 5}, count[2] = {5, 1};
+    evr_render_scene rs;
+    evr_skip_tracker t;
+    static evr_skip_plan pl;
+    memset(&s, 0, sizeof s);
+    memset(&mesh, 0, sizeof mesh);
+    memset(&rs, 0, sizeof rs);
+    for (int i = 0; i < RING; i++) {
+        const float a = 1.5707963f * (float)i / RING, c = cosf(a), sn = sinf(a);
+        const float v[9] = {10.0f * c, 10.0f * sn, -0.2f, 10.5f * c, 10.5f * sn, 0.2f, 10.0f * c - 0.4f * sn, 10.0f * sn + 0.4f * c, 0.0f};
+        memcpy(&pos[9 * i], v, sizeof v);
+        for (int k = 0; k < 3; k++) idx[3 * i + k] = (uint32_t)(3 * i + k);
+    }
+    mesh.positions = pos;
+    mesh.indices = idx;
+    mesh.num_vertices = 3 * RING;
+    mesh.num_triangles = RING;
+    mesh.bounds_min = evr_v3_make(-0.5f, -0.5f, -0.2f);
+    mesh.bounds_max = evr_v3_make(10.5f, 10.5f, 0.2f);
+    s.meshes = &mesh;
+    s.num_meshes = 1;
+    inst.mesh = 0;
+    inst.track = 0;
+    rs.instances = &inst;
+    rs.num_instances = 1;
+    rs.keys = keys;
+    rs.track_offset = offset;
+    rs.track_count = count;
+    rs.camera_track = 1;
+    rs.ray_eps = 1e-5f;
+    CHECK(evr_skip_tracker_init(&t, 2));
+    CHECK(evr_skip_tracker_parts(&t, &s));
+    uint64_t rng = 12345u;
+    evr_m34 prev_end = evr_m34_identity();
+    for (int seg = 0; seg < 2; seg++) {
+        /* segment 0 turns 0 -> 40 degrees; segment 1 jumps to 160 and turns to 320 in steps of
+         * 40 degrees, so that the triangles pass the circle's extremes between keys (there the
+         * boxes at the keys do not hold them) */
+        ring_keys(keys, seg == 0 ? 0.0f : 160.0f, seg == 0 ? 10.0f : 40.0f);
+        if (seg == 1) {   /* where segment 0 ended */
+            evr_motion_key k0[5];
+            ring_keys(k0, 0.0f, 10.0f);
+            prev_end = evr_motion_eval((evr_motion_track){k0, 5}, 1.0f);
+        }
+        keys[5] = evr_motion_key_from_matrix(&(evr_m34){{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}});   /* the camera's */
+        evr_skip_tracker_update(&t, keys, offset, count, 1.0f);
+        evr_skip_plan_build(&t, &s, &rs, 1, &pl);
+        CHECK(pl.num_boxes == 1 && pl.part_first[1] - pl.part_first[0] > 1);
+        int missed = 0;
+        for (int n = 0; n < 20000; n++) {
+            /* a point of a triangle at a time of the segment (or, one in ten, the previous end) */
+            float r1 = uni(&rng), r2 = uni(&rng), f = uni(&rng);
+            if (r1 + r2 > 1.0f) { r1 = 1.0f - r1; r2 = 1.0f - r2; }
+            const int tri = (int)(uni(&rng) * RING) % RING;
+            const float *v = &pos[9 * tri];
+            evr_v3 p = evr_v3_make(v[0] + r1 * (v[3] - v[0]) + r2 * (v[6] - v[0]), v[1] + r1 * (v[4] - v[1]) + r2 * (v[7] - v[1]),
+                                   v[2] + r1 * (v[5] - v[2]) + r2 * (v[8] - v[2]));
+            const int before = seg == 1 && n % 10 == 0;
+            evr_m34 m = before ? prev_end : evr_motion_eval(evr_rs_track(&rs, 0), f);
+            p = evr_m34_point(&m, p);
+            evr_v3 o = evr_v3_make(40.0f * uni(&rng) - 20.0f, 40.0f * uni(&rng) - 20.0f, 30.0f);
+            evr_v3 d = evr_v3_sub(p, o);
+            const float len = sqrtf(evr_v3_dot(d, d));
+            d = evr_v3_scale(d, 1.0f / len);
+            /* where it was at the previous segment's end: in the instance's box (adaptive sampling
+             * needs that), not in the parts (a clean cache needs only where things are now) */
+            if (before ? !evr_skip_segment_meets(o, d, len, pl.lo[0], pl.hi[0], pl.pad) : !evr_skip_ray_meets_any(&pl, o, d, len))
+                missed++;
+        }
+        CHECK(missed == 0);
+        /* the middle of the circle: inside the instance's box, outside every part */
+        evr_v3 o = evr_v3_make(0.2f, 0.0f, 30.0f), d = evr_v3_make(0.0f, 0.0f, -1.0f);
+        CHECK(evr_skip_segment_meets(o, d, INFINITY, pl.lo[0], pl.hi[0], pl.pad));
+        if (seg == 0) CHECK(!evr_skip_ray_meets_any(&pl, o, d, INFINITY));
+    }
     evr_skip_tracker_free(&t);
 }
 
@@ -135,5 +247,6 @@ int main(void)
         CHECK(pl.spans && !pl.cache && evr_skip_still_span(&pl, 0.1f) == 1 && !evr_skip_held(&pl, 1, 1));
         evr_skip_tracker_free(&t);
     }
+    test_parts();
     return check_report("test_skip_plan");
 }

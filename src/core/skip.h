@@ -19,6 +19,7 @@
 #include "core/shading.h"
 
 #define EVR_SKIP_MAX_BOXES 64
+#define EVR_SKIP_MAX_PARTS 2048
 
 typedef struct {
     int reuse;            /* clean caches may be reused this segment (camera and lights still, and
@@ -28,6 +29,13 @@ typedef struct {
     int num_boxes;
     float pad;            /* added to every box on every side (float error of the tests) */
     float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+    /* tighter: box b's mesh split into parts, each part's triangles swept on their own (a ray
+     * that meets box b can still pass between them: the eye's lids are thin sheets in a large
+     * box), as a binary tree of boxes: box b's nodes are part_lo/hi[part_first[b] + n] for
+     * n < part_first[b + 1] - part_first[b] (none: the box alone decides), node n's children
+     * 2n + 1 and 2n + 2, a node without children a leaf; an empty node (lo > hi) holds nothing */
+    int part_first[EVR_SKIP_MAX_BOXES + 1];
+    float part_lo[EVR_SKIP_MAX_PARTS][3], part_hi[EVR_SKIP_MAX_PARTS][3];
     /* spans (with or without skipping): the camera and the lights hold still in the segment, and
      * nothing moves (every instance's transform the same bits) at normalized times
      * f < still_before, nor at f > still_after (evr_skip_still_span) */
@@ -96,10 +104,33 @@ EVR_HD static inline int evr_skip_segment_meets(evr_v3 o, evr_v3 d, float tmax, 
     return 1;
 }
 
+/* Whether the ray meets a leaf of box b's tree of parts (evr_skip_plan.part_first). */
+EVR_HD static inline int evr_skip_parts_meet(const evr_skip_plan *pl, int b, evr_v3 o, evr_v3 d, float tmax)
+{
+    const int base = pl->part_first[b], n = pl->part_first[b + 1] - base;
+    int stack[24], sp = 0, node = 0;
+    for (;;) {
+        const float *lo = pl->part_lo[base + node], *hi = pl->part_hi[base + node];
+        if (!(lo[0] > hi[0]) && evr_skip_segment_meets(o, d, tmax, lo, hi, pl->pad)) {
+            if (2 * node + 1 >= n) return 1;   /* a leaf */
+            if (sp < 24) {
+                stack[sp++] = 2 * node + 2;
+                node = 2 * node + 1;
+                continue;
+            }
+            return 1;   /* deeper than planned for: say yes */
+        }
+        if (sp == 0) return 0;
+        node = stack[--sp];
+    }
+}
+
 EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 o, evr_v3 d, float tmax)
 {
-    for (int b = 0; b < pl->num_boxes; b++)
-        if (evr_skip_segment_meets(o, d, tmax, pl->lo[b], pl->hi[b], pl->pad)) return 1;
+    for (int b = 0; b < pl->num_boxes; b++) {
+        if (!evr_skip_segment_meets(o, d, tmax, pl->lo[b], pl->hi[b], pl->pad)) continue;
+        if (pl->part_first[b] >= pl->part_first[b + 1] || evr_skip_parts_meet(pl, b, o, d, tmax)) return 1;
+    }
     return 0;
 }
 
