@@ -198,6 +198,10 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
     swept_box(t, rs, rs->instances[i].track, lo, hi, blo, bhi);
 }
 
+/* min and max without libm's NaN rules (no call): the sweep's inputs are finite */
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
 /* Float bounds that hold the double ones. */
 static float float_down(double x)
 {
@@ -227,26 +231,14 @@ static double upper_diff_norm(const evr_motion_key *a, const evr_motion_key *b)
     return sqrt(n);
 }
 
-/* The box of [lo, hi] under m's linear part (Arvo): centre and half extent, in double. */
-static void linear_box(const evr_m34 *m, const float lo[3], const float hi[3], double c[3], double h[3])
-{
-    for (int r = 0; r < 3; r++) {
-        c[r] = h[r] = 0.0;
-        for (int k = 0; k < 3; k++) {
-            const double mc = 0.5 * ((double)lo[k] + hi[k]), mh = 0.5 * ((double)hi[k] - lo[k]);
-            c[r] += (double)m->m[r][k] * mc;
-            h[r] += fabs((double)m->m[r][k]) * mh;
-        }
-    }
-}
-
 /* One track's motion over the segment, for sweeping many boxes: each key's matrix and, per key
  * interval, the bound on how fast a point at unit distance from the origin moves (the same
  * bound as evr_gpu_segment_bounds: rotation at the slerp's angular speed times |U c|, plus the
  * change of U). */
 typedef struct {
     int n;
-    evr_m34 m[EVR_MAX_KEYS];
+    double m[EVR_MAX_KEYS][3][4]; /* each key's matrix */
+    double am[EVR_MAX_KEYS][3][3];/* |linear part|, for the box of a box (Arvo) */
     double speed[EVR_MAX_KEYS];   /* per interval, per unit of |c| */
 } track_sweep;
 
@@ -254,7 +246,14 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
 {
     const evr_motion_track tk = evr_rs_track(rs, tr);
     ts->n = tk.n < EVR_MAX_KEYS ? tk.n : EVR_MAX_KEYS;
-    for (int k = 0; k < ts->n; k++) ts->m[k] = evr_motion_key_matrix(&tk.keys[k]);
+    for (int k = 0; k < ts->n; k++) {
+        const evr_m34 m = evr_motion_key_matrix(&tk.keys[k]);
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++) {
+                ts->m[k][r][c] = m.m[r][c];
+                if (c < 3) ts->am[k][r][c] = fabs((double)m.m[r][c]);
+            }
+    }
     for (int k = 0; k + 1 < ts->n; k++) {
         const evr_motion_key *a = &tk.keys[k], *b = &tk.keys[k + 1];
         double d = fabs((double)evr_quat_dot(a->rot, b->rot));
@@ -272,26 +271,30 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
 static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3], float out_hi[3])
 {
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double pc[3] = {0.0, 0.0, 0.0}, ph[3] = {0.0, 0.0, 0.0}, r = 0.0, mag = 0.0;
+    double pc[3] = {0.0, 0.0, 0.0}, ph[3] = {0.0, 0.0, 0.0}, r = 0.0, mag = 0.0, mc[3], mh[3];
     for (int c = 0; c < 8; c++) {
         const double x = c & 1 ? hi[0] : lo[0], y = c & 2 ? hi[1] : lo[1], z = c & 4 ? hi[2] : lo[2];
-        r = fmax(r, sqrt(x * x + y * y + z * z));
+        r = dmax(r, sqrt(x * x + y * y + z * z));
+    }
+    for (int a = 0; a < 3; a++) {
+        mc[a] = 0.5 * ((double)lo[a] + hi[a]);
+        mh[a] = 0.5 * ((double)hi[a] - lo[a]);
     }
     for (int k = 0; k < ts->n; k++) {
-        const evr_m34 *m = &ts->m[k];
         double c[3], h[3];
-        linear_box(m, lo, hi, c, h);
-        for (int a = 0; a < 3; a++) {
-            const double t = m->m[a][3];
-            blo[a] = fmin(blo[a], t + c[a] - h[a]);
-            bhi[a] = fmax(bhi[a], t + c[a] + h[a]);
+        for (int a = 0; a < 3; a++) {   /* the box at key k, about its translation (Arvo) */
+            c[a] = ts->m[k][a][0] * mc[0] + ts->m[k][a][1] * mc[1] + ts->m[k][a][2] * mc[2];
+            h[a] = ts->am[k][a][0] * mh[0] + ts->am[k][a][1] * mh[1] + ts->am[k][a][2] * mh[2];
+            const double t = ts->m[k][a][3];
+            blo[a] = dmin(blo[a], t + c[a] - h[a]);
+            bhi[a] = dmax(bhi[a], t + c[a] + h[a]);
         }
         if (k > 0) {   /* the interval from key k - 1 */
             const double margin = 0.5 * ts->speed[k - 1] * r;
             for (int a = 0; a < 3; a++) {
-                const double t0 = ts->m[k - 1].m[a][3], t1 = m->m[a][3];
-                blo[a] = fmin(blo[a], fmin(t0, t1) + fmin(pc[a] - ph[a], c[a] - h[a]) - margin);
-                bhi[a] = fmax(bhi[a], fmax(t0, t1) + fmax(pc[a] + ph[a], c[a] + h[a]) + margin);
+                const double t0 = ts->m[k - 1][a][3], t1 = ts->m[k][a][3];
+                blo[a] = dmin(blo[a], dmin(t0, t1) + dmin(pc[a] - ph[a], c[a] - h[a]) - margin);
+                bhi[a] = dmax(bhi[a], dmax(t0, t1) + dmax(pc[a] + ph[a], c[a] + h[a]) + margin);
             }
         }
         for (int a = 0; a < 3; a++) {
@@ -299,7 +302,7 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
             ph[a] = h[a];
         }
     }
-    for (int a = 0; a < 3; a++) mag = fmax(mag, fmax(fabs(blo[a]), fabs(bhi[a])));
+    for (int a = 0; a < 3; a++) mag = dmax(mag, dmax(fabs(blo[a]), fabs(bhi[a])));
     for (int a = 0; a < 3; a++) {
         /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
         const double slack = 1e-6 * mag + 1e-30;
