@@ -134,11 +134,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.gi_bounces = c->gi_bounces;
 
     int ntracks = s->num_nodes + 1;
-    sim->keys = malloc(sizeof *sim->keys * (size_t)ntracks * EVR_MAX_KEYS);
-    sim->track_offset = malloc(sizeof(int) * (size_t)ntracks);
-    sim->track_count = malloc(sizeof(int) * (size_t)ntracks);
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
-    if (!sim->keys || !sim->track_offset || !sim->track_count || !sim->node_used ||
+    if (!sim->node_used ||
         !evr_skip_tracker_init(&sim->skip, ntracks) || !evr_skip_tracker_parts(&sim->skip, s) ||
         !(sim->skipped_per_segment = calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
         evr_sim_release(sim);
@@ -186,43 +183,42 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     return EVR_OK;
 }
 
-/* Motion keys of every used node over [t0, t1]; the extra last track is the fixed world frame. */
-static void compute_motion(evr_sim *sim, double t0, double t1, evr_segment *seg)
+static double segment_start(const evr_sim *sim, int i) { return sim->cfg.start + (double)i / sim->fps; }
+static double segment_end(const evr_sim *sim, int i)
 {
+    return i + 1 == sim->num_segments ? sim->cfg.start + sim->duration : segment_start(sim, i + 1);
+}
+
+/* Plans segment i (on the planner's thread, in order): motion keys of every used node over the
+ * segment (the extra last track is the fixed world frame), the tracker, and the plans. */
+static void plan_segment(void *user, int i, evr_planned_segment *out)
+{
+    evr_sim *sim = user;
     const evr_scene *s = sim->scene;
-    int i, off = 0;
+    const double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
+    int off = 0;
     float tol = 1e-5f;
-    for (i = 0; i <= s->num_nodes; i++) {
-        evr_motion_key *k = sim->keys + off;
-        int n = 1;
-        if (i < s->num_nodes && sim->node_used[i]) {
-            n = evr_node_motion_keys(s, i, t0, t1, tol, k, EVR_MAX_KEYS);
+    for (int n = 0; n <= s->num_nodes; n++) {
+        evr_motion_key *k = out->keys + off;
+        int c = 1;
+        if (n < s->num_nodes && sim->node_used[n]) {
+            c = evr_node_motion_keys(s, n, t0, t1, tol, k, EVR_MAX_KEYS);
         } else {
             evr_m34 id = evr_m34_identity();
             *k = evr_motion_key_from_matrix(&id);
         }
-        sim->track_offset[i] = off;
-        sim->track_count[i] = n;
-        off += n;
+        out->track_offset[n] = off;
+        out->track_count[n] = c;
+        off += c;
     }
-    seg->keys = sim->keys;
-    seg->track_offset = sim->track_offset;
-    seg->track_count = sim->track_count;
-    seg->num_tracks = s->num_nodes + 1;
-    seg->num_keys = off;
-    seg->camera_static = sim->track_count[sim->host.rs.camera_track] == 1;
-    evr_skip_tracker_update(&sim->skip, sim->keys, sim->track_offset, sim->track_count, sim->host.scene_size);
-    {
-        evr_render_scene rs = sim->host.rs;
-        rs.keys = sim->keys;
-        rs.track_offset = sim->track_offset;
-        rs.track_count = sim->track_count;
-        evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip && !sim->setup.adaptive, &sim->plan);
-        if (sim->setup.adaptive)
-            evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &sim->adapt_plan);
-    }
-    seg->skip = &sim->plan;
-    seg->adapt = sim->setup.adaptive ? &sim->adapt_plan : NULL;
+    out->num_keys = off;
+    evr_skip_tracker_update(&sim->skip, out->keys, out->track_offset, out->track_count, sim->host.scene_size);
+    evr_render_scene rs = sim->host.rs;
+    rs.keys = out->keys;
+    rs.track_offset = out->track_offset;
+    rs.track_count = out->track_count;
+    evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip && !sim->setup.adaptive, &out->plan);
+    if (sim->setup.adaptive) evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &out->adapt);
 }
 
 /* Adds ev[0 .. n) to the run's ON/OFF and unique timestamp counts: branch-free sums in locals
@@ -263,11 +259,6 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     return EVR_OK;
 }
 
-static double segment_start(const evr_sim *sim, int i) { return sim->cfg.start + (double)i / sim->fps; }
-static double segment_end(const evr_sim *sim, int i)
-{
-    return i + 1 == sim->num_segments ? sim->cfg.start + sim->duration : segment_start(sim, i + 1);
-}
 
 static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 {
@@ -275,9 +266,15 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.index = i;
     seg.t0 = segment_start(sim, i);
     seg.t1 = segment_end(sim, i);
-    double tm = evr_host_seconds();
-    compute_motion(sim, seg.t0, seg.t1, &seg);
-    sim->time_motion += evr_host_seconds() - tm;
+    const evr_planned_segment *pl = evr_planner_take(sim->planner, i);
+    seg.keys = pl->keys;
+    seg.track_offset = pl->track_offset;
+    seg.track_count = pl->track_count;
+    seg.num_tracks = sim->scene->num_nodes + 1;
+    seg.num_keys = pl->num_keys;
+    seg.camera_static = pl->track_count[sim->host.rs.camera_track] == 1;
+    seg.skip = &pl->plan;
+    seg.adapt = sim->setup.adaptive ? &pl->adapt : NULL;
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
@@ -285,6 +282,7 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     double t = evr_host_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
     sim->time_render += evr_host_seconds() - t;
+    evr_planner_release(sim->planner, i);   /* the backend has what it needs of the plan */
     return st;
 }
 
@@ -353,6 +351,11 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
     /* keep the backend's depth of segments in flight (at least two: one renders while the previous
      * one is taken in and written) */
     const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;
+    if (!sim->planner) {
+        sim->planner = evr_planner_start(sim->num_segments, (size_t)(sim->scene->num_nodes + 1) * EVR_MAX_KEYS,
+                                         sim->scene->num_nodes + 1, plan_segment, sim);
+        if (!sim->planner) return nomem(err);
+    }
     if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
     for (i = 0; st == EVR_OK && i < submitted; i++) {
         while (!stop && st == EVR_OK && submitted < sim->num_segments && submitted < i + depth) {
@@ -363,6 +366,9 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, wall0, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
+    sim->time_motion = evr_planner_busy_seconds(sim->planner);
+    evr_planner_stop(sim->planner);   /* stops early when the run did */
+    sim->planner = NULL;
     if (st != EVR_OK) {
         /* a failed run leaves nothing behind that looks complete */
         evr_run_dir_discard(sim);
@@ -393,9 +399,7 @@ void evr_sim_release(evr_sim *sim)
     evr_render_host_free(&sim->host);
     evr_event_vec_free(&sim->pending);
     evr_event_vec_free(&sim->scratch);
-    free(sim->keys);
-    free(sim->track_offset);
-    free(sim->track_count);
+    evr_planner_stop(sim->planner);
     free(sim->node_used);
     evr_skip_tracker_free(&sim->skip);
     free(sim->skipped_per_segment);

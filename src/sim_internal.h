@@ -3,6 +3,7 @@
 #define EVR_SIM_INTERNAL_H
 
 #include "backend.h"
+#include "segment_planner.h"
 #include "skip_plan.h"
 #include "io/event_writer.h"
 #include "io/preview.h"
@@ -27,14 +28,10 @@ struct evr_sim {
     int num_writers;
     evr_write_queue *wq;         /* writes on its own thread */
     char *config_json;
-    /* per-segment motion */
-    evr_motion_key *keys;
-    int *track_offset, *track_count;
+    /* per-segment motion and plans (segment_planner.h: the tracker is the planner thread's) */
+    evr_planner *planner;
     int *node_used;
-    /* change-driven sampling */
     evr_skip_tracker skip;
-    evr_skip_plan plan;
-    evr_adapt_plan adapt_plan;       /* adaptive sampling's plan of the segment being submitted */
     uint32_t *skipped_per_segment;   /* pixels that traced nothing, per segment */
     /* events */
     evr_event_vec pending, scratch;
@@ -57,7 +54,7 @@ struct evr_sim {
     uint16_t *frame16;
     /* statistics */
     evr_stats st;
-    double time_motion;          /* motion keys and the skip plan, per segment on the host */
+    double time_motion;          /* motion keys and the skip plan, per segment on the planner's thread */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 

@@ -184,24 +184,36 @@ fail_alloc:
     return NULL;
 }
 
-int evr_chunk_pool_run(evr_chunk_pool *p, evr_chunk_job *jobs, size_t n)
+void evr_chunk_pool_start(evr_chunk_pool *p, evr_chunk_job *jobs, size_t n)
 {
-    int failed;
-    if (n == 0) return 1;
     pthread_mutex_lock(&p->mu);
     p->jobs = jobs;
     p->njobs = n;
     p->next = 0;
     p->finished = 0;
     p->failed = 0;
-    if (p->started) pthread_cond_broadcast(&p->work);
-    take_jobs(p, p->workers[0]);
+    if (p->started && n) pthread_cond_broadcast(&p->work);
+    pthread_mutex_unlock(&p->mu);
+}
+
+int evr_chunk_pool_wait(evr_chunk_pool *p)
+{
+    int failed;
+    pthread_mutex_lock(&p->mu);
+    take_jobs(p, p->workers[0]);   /* what the workers have not taken yet */
     while (p->finished < p->njobs) pthread_cond_wait(&p->done, &p->mu);
     failed = p->failed;
     p->jobs = NULL;
     p->njobs = p->next = p->finished = 0;
     pthread_mutex_unlock(&p->mu);
     return !failed;
+}
+
+int evr_chunk_pool_run(evr_chunk_pool *p, evr_chunk_job *jobs, size_t n)
+{
+    if (n == 0) return 1;
+    evr_chunk_pool_start(p, jobs, n);
+    return evr_chunk_pool_wait(p);
 }
 
 int evr_chunk_pool_threads(const evr_chunk_pool *p)

@@ -58,6 +58,13 @@ evr_chunk_pool *evr_chunk_pool_new(int threads, size_t max_chunk_bytes);
  * taken in order, so list the largest first. */
 int evr_chunk_pool_run(evr_chunk_pool *pool, evr_chunk_job *jobs, size_t n);
 
+/* The same in two steps: start hands the jobs to the pool's threads and returns at once (the
+ * caller may do other work; jobs and their buffers must stay as they are); wait takes the jobs
+ * not taken yet (all of them in a pool of one thread) and returns when all are done, 1 when
+ * every job succeeded. One list at a time: start, then wait, before the next start. */
+void evr_chunk_pool_start(evr_chunk_pool *pool, evr_chunk_job *jobs, size_t n);
+int evr_chunk_pool_wait(evr_chunk_pool *pool);
+
 int evr_chunk_pool_threads(const evr_chunk_pool *pool);
 
 /* Stops the threads and frees the pool (NULL is fine). */

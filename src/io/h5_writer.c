@@ -37,16 +37,26 @@ typedef struct {
     char *path, *tmp;
     hid_t file, group;
     hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
-    /* staged events, from dataset index written on (p already 0 or 1) */
+    /* staged events, from dataset index written on (p already 0 or 1): set fill's stage */
     evr_event *stage;
     size_t nstage, cap_stage;    /* cap_stage: a whole number of chunks */
     uint64_t written;            /* events in full chunks stored (a multiple of H5W_CHUNK) */
     uint64_t tail_stored;        /* events of the partial chunk at written stored by a flush */
     uint64_t extent;             /* length of the event datasets */
     uint64_t total;              /* events received (written + staged) */
-    /* compression: one job per column and chunk, each with its output room in zbuf */
+    /* compression: one job per column and chunk, each with its output room in zbuf; two sets,
+     * set[fill] staging, the other compressing (inflight) the batch of inflight_chunks chunks
+     * from dataset index inflight_at */
     evr_chunk_pool *pool;
-    evr_chunk_job *jobs;
+    struct {
+        evr_event *stage;
+        evr_chunk_job *jobs;
+        unsigned char *zbuf;
+    } set[2];
+    int fill, inflight;
+    uint64_t inflight_at;
+    size_t inflight_chunks;
+    evr_chunk_job *jobs;         /* set[fill]'s */
     unsigned char *zbuf;
     size_t batch;                /* chunks in a full stage */
     int64_t last_t;
@@ -167,9 +177,11 @@ static void free_writer(h5_writer *w)
     evr_chunk_pool_free(w->pool);
     free(w->path);
     free(w->tmp);
-    free(w->stage);
-    free(w->jobs);
-    free(w->zbuf);
+    for (int i = 0; i < 2; i++) {
+        free(w->set[i].stage);
+        free(w->set[i].jobs);
+        free(w->set[i].zbuf);
+    }
     free(w->ms);
     free(w);
 }
@@ -213,42 +225,36 @@ static size_t column_room(const h5_writer *w, int c)
     return w->batch * evr_chunk_bound(H5W_CHUNK * column_size(c));
 }
 
-/* Stores the full chunks of the stage and, with tail set, the partial chunk after them (when it
- * holds events not stored yet), then keeps only that partial chunk's events in the stage. */
-static evr_status store(h5_writer *w, int tail, evr_error *err)
+/* Jobs compressing chunks 0 .. nchunks of stage into zbuf (chunk k holds count(k) events: the
+ * full chunk size but for a last partial one of rest events when nchunks > nfull). */
+static size_t make_jobs(const h5_writer *w, const evr_event *stage, evr_chunk_job *jobs, unsigned char *zbuf,
+                        size_t nchunks, size_t nfull, size_t rest)
 {
-    size_t nfull = w->nstage / H5W_CHUNK, rest = w->nstage % H5W_CHUNK;
-    size_t nchunks, njobs = 0;
-    uint64_t done = nfull ? 0 : w->tail_stored;   /* events of the partial chunk on file */
-    uint64_t extent;
-    herr_t r = 0;
-    if (!(tail && rest > done)) tail = 0;
-    nchunks = nfull + (tail ? 1 : 0);
-    if (nchunks == 0) return EVR_OK;
-    /* nchunks <= batch: a full stage has no partial chunk, and flush() finds the stage less
-     * than full (write() stores a full one at once) */
-    {
-        unsigned char *room = w->zbuf;
-        for (int c = 0; c < H5W_COLUMNS; c++) {
-            size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(c));
-            for (size_t k = 0; k < nchunks; k++) {
-                evr_chunk_job *j = &w->jobs[njobs++];
-                j->src = (const unsigned char *)(w->stage + k * H5W_CHUNK) + column_offset(c);
-                j->stride = sizeof(evr_event);
-                j->elem_size = column_size(c);
-                j->count = k < nfull ? H5W_CHUNK : rest;
-                j->chunk_elems = H5W_CHUNK;
-                j->level = H5W_DEFLATE;
-                j->dst = room + k * bound;
-            }
-            room += column_room(w, c);
+    unsigned char *room = zbuf;
+    size_t njobs = 0;
+    for (int c = 0; c < H5W_COLUMNS; c++) {
+        size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(c));
+        for (size_t k = 0; k < nchunks; k++) {
+            evr_chunk_job *j = &jobs[njobs++];
+            j->src = (const unsigned char *)(stage + k * H5W_CHUNK) + column_offset(c);
+            j->stride = sizeof(evr_event);
+            j->elem_size = column_size(c);
+            j->count = k < nfull ? H5W_CHUNK : rest;
+            j->chunk_elems = H5W_CHUNK;
+            j->level = H5W_DEFLATE;
+            j->dst = room + k * bound;
         }
+        room += column_room(w, c);
     }
-    if (!evr_chunk_pool_run(w->pool, w->jobs, njobs)) {
-        snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory compressing events");
-        return EVR_ERR_NOMEM;
-    }
-    extent = w->written + nfull * H5W_CHUNK + (tail ? rest : 0);
+    return njobs;
+}
+
+/* Stores the compressed chunks of jobs (nchunks per column) from dataset index at on, the
+ * datasets first extended to `extent` events when shorter. */
+static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nchunks, uint64_t at, uint64_t extent,
+                             evr_error *err)
+{
+    herr_t r = 0;
     if (extent < w->extent) extent = w->extent;
     H5E_BEGIN_TRY {
         hsize_t size[1] = {(hsize_t)extent};
@@ -256,13 +262,76 @@ static evr_status store(h5_writer *w, int tail, evr_error *err)
             if (extent != w->extent && H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
         for (size_t k = 0; k < nchunks && r >= 0; k++)
             for (int c = 0; c < H5W_COLUMNS && r >= 0; c++) {
-                const evr_chunk_job *j = &w->jobs[(size_t)c * nchunks + k];
-                hsize_t offset[1] = {(hsize_t)(w->written + k * H5W_CHUNK)};
+                const evr_chunk_job *j = &jobs[(size_t)c * nchunks + k];
+                hsize_t offset[1] = {(hsize_t)(at + k * H5W_CHUNK)};
                 r = H5Dwrite_chunk(column_dataset(w, c), H5P_DEFAULT, 0, offset, j->dst_size, j->dst);
             }
     } H5E_END_TRY;
     if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
     w->extent = extent;
+    return EVR_OK;
+}
+
+static evr_status compress_failed(evr_error *err)
+{
+    snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory compressing events");
+    return EVR_ERR_NOMEM;
+}
+
+/* Waits for the batch in flight, if any, and stores it. */
+static evr_status land_inflight(h5_writer *w, evr_error *err)
+{
+    if (!w->inflight) return EVR_OK;
+    w->inflight = 0;
+    if (!evr_chunk_pool_wait(w->pool)) return compress_failed(err);
+    const int b = 1 - w->fill;
+    const uint64_t end = w->inflight_at + w->inflight_chunks * H5W_CHUNK;
+    return put_chunks(w, w->set[b].jobs, w->inflight_chunks, w->inflight_at, end, err);
+}
+
+/* A full stage (batch chunks): compressed by the pool while the writer goes on; the batch in
+ * flight before it lands meanwhile. */
+static evr_status store_full(h5_writer *w, evr_error *err)
+{
+    const int was_inflight = w->inflight;
+    const uint64_t prev_at = w->inflight_at;
+    const size_t prev_chunks = w->inflight_chunks;
+    if (was_inflight && !evr_chunk_pool_wait(w->pool)) return compress_failed(err);
+    const size_t njobs = make_jobs(w, w->stage, w->jobs, w->zbuf, w->batch, w->batch, 0);
+    evr_chunk_pool_start(w->pool, w->jobs, njobs);
+    w->inflight = 1;
+    w->inflight_at = w->written;
+    w->inflight_chunks = w->batch;
+    w->written += w->batch * H5W_CHUNK;
+    w->nstage = 0;
+    w->tail_stored = 0;
+    w->fill = 1 - w->fill;   /* the landed batch's set stages next */
+    w->stage = w->set[w->fill].stage;
+    w->jobs = w->set[w->fill].jobs;
+    w->zbuf = w->set[w->fill].zbuf;
+    if (was_inflight)
+        return put_chunks(w, w->jobs, prev_chunks, prev_at, prev_at + prev_chunks * H5W_CHUNK, err);
+    return EVR_OK;
+}
+
+/* Stores the full chunks of the stage and, with tail set, the partial chunk after them (when it
+ * holds events not stored yet), then keeps only that partial chunk's events in the stage; the
+ * batch in flight lands first. */
+static evr_status store(h5_writer *w, int tail, evr_error *err)
+{
+    size_t nfull = w->nstage / H5W_CHUNK, rest = w->nstage % H5W_CHUNK;
+    size_t nchunks, njobs;
+    uint64_t done = nfull ? 0 : w->tail_stored;   /* events of the partial chunk on file */
+    evr_status st = land_inflight(w, err);
+    if (st != EVR_OK) return st;
+    if (!(tail && rest > done)) tail = 0;
+    nchunks = nfull + (tail ? 1 : 0);
+    if (nchunks == 0) return EVR_OK;
+    /* nchunks <= batch: flush() finds the stage less than full (write() stores a full one at once) */
+    njobs = make_jobs(w, w->stage, w->jobs, w->zbuf, nchunks, nfull, rest);
+    if (!evr_chunk_pool_run(w->pool, w->jobs, njobs)) return compress_failed(err);
+    st = put_chunks(w, w->jobs, nchunks, w->written, w->written + nfull * H5W_CHUNK + (tail ? rest : 0), err);
+    if (st != EVR_OK) return st;
     if (nfull) {
         w->written += nfull * H5W_CHUNK;
         memmove(w->stage, w->stage + nfull * H5W_CHUNK, rest * sizeof *w->stage);
@@ -336,7 +405,7 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
         ev += m;
         n -= m;
         if (w->nstage == w->cap_stage) {
-            evr_status st = store(w, 0, err);
+            evr_status st = store_full(w, err);
             if (st != EVR_OK) return st;
         }
     }
@@ -435,12 +504,18 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         for (int c = 0; c < H5W_COLUMNS; c++) room += column_room(w, c);
         w->path = malloc(len + 1);
         w->tmp = malloc(len + 5);
-        w->stage = malloc(w->cap_stage * sizeof *w->stage);
-        w->jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->jobs);
-        w->zbuf = malloc(room);
+        for (int i = 0; i < 2; i++) {
+            w->set[i].stage = malloc(w->cap_stage * sizeof *w->stage);
+            w->set[i].jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->jobs);
+            w->set[i].zbuf = malloc(room);
+        }
+        w->stage = w->set[0].stage;
+        w->jobs = w->set[0].jobs;
+        w->zbuf = w->set[0].zbuf;
         w->pool = evr_chunk_pool_new(threads, H5W_CHUNK * sizeof(int64_t));
     }
-    if (!w || !w->path || !w->tmp || !w->stage || !w->jobs || !w->zbuf || !w->pool) {
+    if (!w || !w->path || !w->tmp || !w->set[0].stage || !w->set[0].jobs || !w->set[0].zbuf || !w->set[1].stage ||
+        !w->set[1].jobs || !w->set[1].zbuf || !w->pool) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
         return EVR_ERR_NOMEM;
