@@ -1,8 +1,9 @@
 /* The motion keys and change-driven sampling plans of the coming segments, made on a thread of
- * their own, a few segments ahead of the segment loop (they cost the loop's thread 0.4-0.5 s of
- * the eye's 30 s on the GPU machine). Segments are planned in order, each into one slot of a
- * small ring; the loop takes segment i's slot (waiting until it is planned) and releases it once
- * the backend has copied what it needs. */
+ * their own ahead of the segment loop (on the loop's thread they took 0.4-0.5 s of the eye's
+ * 30 s on the GPU machine). Segments are planned in order, each into a slot of a ring of
+ * EVR_PLANNER_SLOTS: the planner runs ahead through still segments, which cost it little, to make
+ * up for moving ones. The loop takes segment i's slot (waiting until it is planned) and releases
+ * it once the backend has copied what it needs. */
 #ifndef EVR_SEGMENT_PLANNER_H
 #define EVR_SEGMENT_PLANNER_H
 
@@ -12,7 +13,7 @@
 #include "core/motion.h"
 #include "core/skip.h"
 
-#define EVR_PLANNER_SLOTS 3
+#define EVR_PLANNER_SLOTS 8
 
 typedef struct {
     evr_motion_key *keys;              /* room for keys_cap keys */

@@ -13,6 +13,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -221,22 +222,63 @@ static void plan_segment(void *user, int i, evr_planned_segment *out)
     if (sim->setup.adaptive) evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &out->adapt);
 }
 
-/* Adds ev[0 .. n) to the run's ON/OFF and unique timestamp counts: branch-free sums in locals
- * (ON and OFF alternate at random, and counters in sim->st would be stored per event, since
- * an event's int64_t t may alias them), about 10x faster than counting per branch. */
+/* ON events and timestamp changes (t differing from the one before, prev for the first) of
+ * ev[0 .. n): branch-free sums in locals (ON and OFF alternate at random), about 10x faster than
+ * counting per branch. */
+typedef struct {
+    const evr_event *ev;
+    size_t n;
+    int64_t prev;
+    uint64_t on, changes;
+} event_counts;
+
+static void *count_part(void *arg)
+{
+    event_counts *c = arg;
+    uint64_t on = 0, changes = 0;
+    int64_t last = c->prev;
+    for (size_t i = 0; i < c->n; i++) {
+        on += c->ev[i].p != 0;
+        changes += c->ev[i].t != last;
+        last = c->ev[i].t;
+    }
+    c->on = on;
+    c->changes = changes;
+    return NULL;
+}
+
+/* Adds ev[0 .. n) to the run's ON/OFF and unique timestamp counts; many events on several
+ * threads (one pass over them took 0.57 s of the main thread for the eye's 218.7 M events). */
 static void count_events(evr_sim *sim, const evr_event *ev, size_t n)
 {
+    enum { MAX_PARTS = 8 };
+    event_counts part[MAX_PARTS];
+    pthread_t tid[MAX_PARTS];
+    int started[MAX_PARTS] = {0};
+    size_t parts = n >> 16;   /* 65,536 events a part at least */
+    if (parts < 1) parts = 1;
+    if (parts > MAX_PARTS) parts = MAX_PARTS;
+    for (size_t k = 0; k < parts; k++) {
+        const size_t i0 = n * k / parts, i1 = n * (k + 1) / parts;
+        part[k].ev = ev + i0;
+        part[k].n = i1 - i0;
+        part[k].prev = i0 ? ev[i0 - 1].t : sim->last_t;
+        if (k > 0) started[k] = pthread_create(&tid[k], NULL, count_part, &part[k]) == 0;
+    }
+    count_part(&part[0]);
+    for (size_t k = 1; k < parts; k++) {
+        if (started[k]) pthread_join(tid[k], NULL);
+        else count_part(&part[k]);   /* no thread: counted here */
+    }
     uint64_t on = 0, unique = 0;
-    int64_t last = sim->last_t;
-    for (size_t i = 0; i < n; i++) {
-        on += ev[i].p != 0;
-        unique += ev[i].t != last;
-        last = ev[i].t;
+    for (size_t k = 0; k < parts; k++) {
+        on += part[k].on;
+        unique += part[k].changes;
     }
     sim->st.events_on += on;
     sim->st.events_off += n - on;
     sim->st.unique_timestamps += unique;
-    sim->last_t = last;
+    if (n) sim->last_t = ev[n - 1].t;
 }
 
 /* Hands events up to (not including) limit_us to the writers and statistics. */

@@ -33,6 +33,17 @@ expect = np.searchsorted(ev["t"], np.arange(len(ms)) * 1000, side="left")
 T.check(bool(np.array_equal(ms, expect)), "ms_to_idx indexes the first event of every millisecond")
 T.check(len(ms) >= 600, "ms_to_idx covers the simulated time")
 
+# a segment of more than 131,072 events is counted on several threads: the counts still match
+d2 = os.path.join(T.tmpdir(), "big")
+T.run("demo", "--scene", "eye", "-o", d2, "--res", "640x360", "--start", "0.9", "--duration", "0.034",
+      "--quiet", "--no-preview")
+s2 = T.load_run_json(d2)["stats"]
+ev2, _, _ = T.load_h5(os.path.join(d2, "events.h5"))
+T.check(len(ev2["t"]) > 131072, f"one segment of {len(ev2['t'])} events, enough for several counting threads")
+T.check(int(np.sum(ev2["p"] == 1)) == s2["events_on"] and int(np.sum(ev2["p"] == 0)) == s2["events_off"],
+        "ON/OFF counts of a large segment match run.json")
+T.check(len(np.unique(ev2["t"])) == s2["unique_timestamps"], "unique timestamps of a large segment match run.json")
+
 npy = np.load(os.path.join(d, "events.npy"))
 T.check(len(npy) == n, "npy count matches")
 for k in ("x", "y", "t", "p"):
