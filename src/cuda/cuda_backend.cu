@@ -56,6 +56,13 @@ extern "C" {
 #endif
 
 /* Everything one launch reads, by value. */
+/* A camera ray's nearest hit among the static group's triangles (instance -1: none). */
+struct gpu_static_hit {
+    float t, u, v;
+    uint32_t prim;
+    int32_t instance;
+};
+
 struct kernel_args {
     evr_render_scene rs;           /* device pointers */
     evr_gpu_scene_view view;       /* device pointers */
@@ -85,17 +92,21 @@ struct kernel_args {
     const struct gpu_gi_view *gi;  /* global illumination (gpu_gi.cuh), NULL when off */
     int coherence;                 /* primary rays start with tfar just past the pixel's last hit */
     int xbits, ybits;              /* event keys: bits of x and of y (event_key_bits) */
+    /* per pixel, its camera ray's hit in the static group while the camera holds still (NULL:
+     * not this segment): primary rays search the other groups only */
+    const gpu_static_hit *static_hits;
 };
+
 
 /* One traversal body for primary and shadow rays, not inlined: a kernel with four inlined copies
  * (two queries, two node layouts) stalled on instruction-cache misses (measured with ncu). */
 template <int LAYOUT>
 __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_render_scene *rs, evr_ray ray, float tnear,
-                                      float tfar, float f, int any, evr_gpu_hit *hit)
+                                      float tfar, float f, int any, evr_gpu_hit *hit, int groups = EVR_GROUPS_ALL)
 {
     if (view->num_top_nodes == 0) return 0;
-    if (LAYOUT == EVR_GPU_LAYOUT_CW8) return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit);
-    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit);
+    if (LAYOUT == EVR_GPU_LAYOUT_CW8) return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit, groups);
+    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit, groups);
 }
 
 /* A warp-aggregated append: every lane of the warp calls it; the lanes with `want` get
@@ -130,9 +141,24 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
      * closest hit below that bound is the closest hit, and finding none, the ray is traced again
      * unbounded: the same hit either way */
     const float tf = hint < 1e30f ? hint * 1.0001f + 1e-6f : 1e30f;
-    if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, tf, f, 0, &hit) &&
-        (tf >= 1e30f || !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &hit)))
+    if (a.static_hits && a.camera_static) {
+        /* the camera ray's hit in the static group is kept per pixel: the other groups are
+         * searched for a nearer one only (evr_trace_closest_groups) */
+        const gpu_static_hit sh = a.static_hits[y * a.width + x];
+        const float ts = sh.instance >= 0 ? sh.t : 1e30f;
+        if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, fminf(tf, ts), f, 0, &hit, EVR_GROUPS_MOVING) &&
+            (tf >= ts || !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, ts, f, 0, &hit, EVR_GROUPS_MOVING))) {
+            if (sh.instance < 0) return false;
+            hit.t = sh.t;
+            hit.u = sh.u;
+            hit.v = sh.v;
+            hit.prim = sh.prim;
+            hit.instance = sh.instance;
+        }
+    } else if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, tf, f, 0, &hit) &&
+               (tf >= 1e30f || !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &hit))) {
         return false;
+    }
     *t_hit = hit.t;
     *inst = hit.instance;
     *cam_org = ray.org;
@@ -309,6 +335,31 @@ __device__ __forceinline__ bool tiled_pixel(int i, int w, int h, int *pix, int *
     *pix = in ? *y * w + *x : 0;
     if (!in) *x = *y = 0;
     return in;
+}
+
+/* Every pixel's camera ray against the static group alone (the camera holds still). */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK) static_hits_kernel(kernel_args a, gpu_static_hit *out)
+{
+    const int i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= a.width * a.height) return;
+    const int x = i % a.width, y = i / a.width;
+    const evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
+    evr_gpu_hit h;
+    gpu_static_hit sh;
+    if (gpu_trace<LAYOUT>(&a.view, &a.rs, ray, 0.0f, 1e30f, 0.0f, 0, &h, EVR_GROUPS_STATIC)) {
+        sh.t = h.t;
+        sh.u = h.u;
+        sh.v = h.v;
+        sh.prim = h.prim;
+        sh.instance = h.instance;
+    } else {
+        sh.t = sh.u = sh.v = 0.0f;
+        sh.prim = 0;
+        sh.instance = -1;
+    }
+    out[i] = sh;
 }
 
 /* Change-driven sampling, first pass: a pixel that keeps its cached intensity runs its samples
@@ -643,6 +694,7 @@ struct slot {
     int gi_passes;                     /* photon passes run for this segment (0: a still copy) */
     int copying;                       /* the sort and copy of this render's events are queued */
     cudaEvent_t sort_from = nullptr;   /* start of the sort (copy stream) */
+    int static_gen = -1;               /* the static hits it renders with (cuda_backend.static_gen), -1: none */
 };
 
 /* A photon buffer in device memory (gpu_gi.cuh): a ring of them, indexed by segment. */
@@ -656,6 +708,12 @@ struct gi_buffer {
 struct cuda_backend {
     evr_backend base;
     const evr_scene *scene;
+    /* every pixel's camera ray in the static group, for a still camera at static_cam (the
+     * camera track's key); static_gen counts the times it was made; static_off: never
+     * (EVR_NO_STATIC_HITS, for measurements) */
+    dbuf<gpu_static_hit> d_static;
+    evr_motion_key static_cam;
+    int static_gen, static_valid, static_off;
     evr_render_host host;
     evr_run_setup setup;
     evr_gpu_bvh bvh;
@@ -843,6 +901,8 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.coherence = getenv("EVR_NO_COHERENCE") == NULL;
     a.xbits = event_key_bits(b->setup.width);
     a.ybits = event_key_bits(b->setup.height);
+    /* a re-render at overflow after the camera moved on renders without them */
+    a.static_hits = sl->static_gen >= 0 && sl->static_gen == b->static_gen ? b->d_static.p : nullptr;
     return a;
 }
 
@@ -1313,6 +1373,25 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst), cudaMemcpyHostToDevice, b->render));
     /* the host top-level arrays are reused by the next build of this slot only after collect,
      * by which time these copies are done (collect synchronizes) */
+    /* a still camera: its rays' hits in the static group, made again when the camera has moved */
+    sl->static_gen = -1;
+    if (seg->camera_static && !b->static_off) {
+        const evr_motion_key *cam = &seg->keys[seg->track_offset[b->host.rs.camera_track]];
+        if (!b->static_valid || memcmp(cam, &b->static_cam, sizeof *cam) != 0) {
+            const int npix = b->setup.width * b->setup.height;
+            CK(b->d_static.reserve((size_t)npix));
+            b->static_gen++;
+            sl->static_gen = b->static_gen;
+            kernel_args a = make_args(b, sl);
+            const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
+            if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) static_hits_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, b->render>>>(a, b->d_static.p);
+            else static_hits_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, b->render>>>(a, b->d_static.p);
+            CK(cudaGetLastError());
+            b->static_cam = *cam;
+            b->static_valid = 1;
+        }
+        sl->static_gen = b->static_gen;
+    }
     if (b->gi && (st = gi_segment(b, sl, seg, &hrs, err)) != EVR_OK) return st;
     if ((st = launch(b, sl, err)) != EVR_OK) return st;
     b->queued++;
@@ -1494,7 +1573,7 @@ static void cuda_release(evr_backend *base)
     }
     b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
-    b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release();
+    b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release(); b->d_static.release();
     b->d_sensor.release();
     for (int i = 0; i < NRING; i++) {
         b->d_state[i].release();
@@ -1563,6 +1642,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     b->gi = b->setup.gi;
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
+    b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;   /* hidden, for tests and measurement: primary rays search every group */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     if (b->gi && (st = gi_ring_alloc(b, gi_margin, err)) != EVR_OK) return st;
     for (int i = 0; i < NSLOT; i++) {

@@ -434,8 +434,17 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
 
 /* ---- top level ---- */
 
+/* Which groups a search visits: all, all but the static group (world space, track -1), or it alone. */
+#define EVR_GROUPS_ALL 0
+#define EVR_GROUPS_MOVING 1
+#define EVR_GROUPS_STATIC 2
+EVR_HD static inline int evr__group_skipped(const evr_gpu_inst *in, int groups)
+{
+    return groups == EVR_GROUPS_MOVING ? in->track < 0 : groups == EVR_GROUPS_STATIC ? in->track >= 0 : 0;
+}
+
 EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
-                                     float tfar, float f, int any, evr_gpu_hit *hit)
+                                     float tfar, float f, int any, evr_gpu_hit *hit, int groups)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -448,6 +457,7 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
         evr__node4(&v->top4[node], &r, tnear, tfar, ci, ct, lf, lc);
         for (i = 0; i < 4; i++) {
             for (k = 0; k < lc[i]; k++) {
+                if (evr__group_skipped(&v->insts[(uint32_t)lf[i] + k], groups)) continue;
                 if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear, &tfar, any,
                                   stack, sp, hit)) {
                     found = 1;
@@ -480,7 +490,7 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
 }
 
 EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
-                                     float tfar, float f, int any, evr_gpu_hit *hit)
+                                     float tfar, float f, int any, evr_gpu_hit *hit, int groups)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -499,6 +509,7 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
         while (tg_hits) {
             int bit = evr__msb(tg_hits);
             tg_hits &= ~(1u << bit);
+            if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
             if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear, &tfar, any, stack,
                               sp, hit)) {
                 found = 1;
@@ -520,8 +531,19 @@ EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const ev
                                            float tmax, float f, evr_gpu_hit *hit)
 {
     if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit);
-    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit);
+    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, EVR_GROUPS_ALL);
+    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, EVR_GROUPS_ALL);
+}
+
+/* The same among some groups only (EVR_GROUPS_*): a hit nearer than tmax only, ties go to tmax.
+ * The nearest hit of all groups is the static group's unless the others have one nearer (what
+ * a camera ray's static hit, kept per pixel while the camera holds still, saves). */
+EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
+                                                  float tmax, float f, int groups, evr_gpu_hit *hit)
+{
+    if (v->num_top_nodes == 0) return 0;
+    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
+    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
 }
 
 /* Whether anything lies along the world ray in (tnear, tfar] at time f (stops at the first hit). */
@@ -529,8 +551,8 @@ EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_re
                                        float tnear, float tfar, float f)
 {
     if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0);
-    return evr__trace4(v, rs, ray, tnear, tfar, f, 1, 0);
+    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
+    return evr__trace4(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
 }
 
 #endif
