@@ -92,6 +92,7 @@ struct kernel_args {
     const struct gpu_gi_view *gi;  /* global illumination (gpu_gi.cuh), NULL when off */
     int coherence;                 /* primary rays start with tfar just past the pixel's last hit */
     int xbits, ybits;              /* event keys: bits of x and of y (event_key_bits) */
+    long long span_us;             /* event keys hold t_us - base_us in [0, span_us) */
     /* per pixel, its camera ray's hit in the static group while the camera holds still (NULL:
      * not this segment): primary rays search the other groups only */
     const gpu_static_hit *static_hits;
@@ -288,7 +289,8 @@ __device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_
             unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
             long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
                                     : llround((a.t0 + (double)te) * 1e6);
-            if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
+            if (t_us < a.base_us || t_us - a.base_us >= a.span_us) atomicAdd(&a.rays[KEY_RANGE], 1ull);   /* collect fails */
+            else if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
         }
     }
     if (began) evr_pixel_end_s(&st, &sp, SENSOR);
@@ -901,6 +903,7 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.coherence = getenv("EVR_NO_COHERENCE") == NULL;
     a.xbits = event_key_bits(b->setup.width);
     a.ybits = event_key_bits(b->setup.height);
+    a.span_us = 1ll << (sl->end_bit - 1 - a.xbits - a.ybits);
     /* a re-render at overflow after the camera moved on renders without them */
     a.static_hits = sl->static_gen >= 0 && sl->static_gen == b->static_gen ? b->d_static.p : nullptr;
     return a;
@@ -995,6 +998,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 {
     CK(cudaMemsetAsync(sl->d_count.p, 0, 2 * sizeof(unsigned int), b->render));
     CK(cudaMemsetAsync(sl->d_rays.p, 0, 3 * sizeof(unsigned long long), b->render));
+    CK(cudaMemsetAsync(sl->d_rays.p + KEY_RANGE, 0, sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
     CK(cudaEventRecord(sl->started, b->render));
     const unsigned grid = (tiled_threads(b->setup.width, b->setup.height) + BLOCK - 1) / BLOCK;   /* >= npix threads */
@@ -1333,11 +1337,13 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
         }
         CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float), cudaMemcpyHostToDevice, b->render));
     }
-    /* events reach back to the previous segment, and timestamp jitter and rounding move them by
-     * up to EVR_JITTER_CLIP sigma plus one resolution step either way */
+    /* events reach back to the previous segment (a pixel's last sample there; with adaptive
+     * sampling up to max_dt back), and timestamp jitter and rounding move them by up to
+     * EVR_JITTER_CLIP sigma plus one resolution step either way; one more segment to spare. An
+     * event outside the window is counted (KEY_RANGE) and fails the run, never wraps. */
     const evr_pixel_params *px = &b->setup.pixel;
     double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter + (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
-    double dt = seg->t1 - seg->t0, back = 2.0 * dt + 1.0 + slack;
+    double dt = seg->t1 - seg->t0, back = 2.0 * dt + slack;
     if (b->setup.adaptive) back += (double)b->setup.adapt.max_dt;   /* a pixel's last sample: up to max_dt back */
     sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
     double span_us = (back + dt + slack) * 1e6 + 2.0;
@@ -1487,6 +1493,11 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         if ((st = launch(b, sl, err)) != EVR_OK) return st;
         CK(cudaEventSynchronize(sl->counted));
         n = *sl->h_count.p;
+    }
+    if (sl->h_rays.p[KEY_RANGE]) {
+        snprintf(err->msg, sizeof err->msg, "internal error: %llu events of the segment at %.6f s fell outside its time window",
+                 (unsigned long long)sl->h_rays.p[KEY_RANGE], sl->t0);
+        return EVR_ERR_BACKEND;
     }
     base->rays += sl->h_rays.p[0];
     base->pixels_skipped += sl->h_rays.p[1];

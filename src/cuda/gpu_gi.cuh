@@ -128,7 +128,9 @@ __device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_ren
 }
 
 /* Counters of a pass in the slot's counter array (after the render kernels' three). */
-enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_REUSED = 7, GI_COUNTERS = 8 };
+/* the segment's counters (kernel_args.rays): 0 .. 2 rays, pixels skipped, samples traced (cuda_backend.cu);
+ * then the photon pass's; KEY_RANGE: events outside the keys' time window (an internal error) */
+enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_REUSED = 7, KEY_RANGE = 8, GI_COUNTERS = 9 };
 
 struct photon_args {
     const evr_photon_emitter *em;
