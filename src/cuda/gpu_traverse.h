@@ -309,23 +309,55 @@ EVR_HD static inline float evr__exp2_biased(uint8_t e)   /* 2^(e - 127), e in 1.
     return evr__u2f((uint32_t)e << 23);
 }
 
+/* Eight bytes of a node (8-byte aligned within it) as one word, byte i in bits 8i .. 8i + 7. */
+EVR_HD static inline uint64_t evr__node_word(const uint8_t *bytes)
+{
+#ifdef __CUDA_ARCH__
+    return __ldg((const unsigned long long *)bytes);
+#else
+    uint64_t w;
+    memcpy(&w, bytes, sizeof w);
+    return w;
+#endif
+}
+
+/* Byte i of a word as a float: 2^23 + q exactly, less 2^23 (cheaper than a conversion). */
+EVR_HD static inline float evr__byte_float(uint64_t w, int i)
+{
+    return evr__u2f(0x4b000000u | (uint32_t)((w >> (8 * i)) & 0xffu)) - 8388608.0f;
+}
+
 /* Hit mask of a CW8 node: bits 24 + (slot ^ oct_inv) for inner children, the item bits of leaf
- * children below 24. */
+ * children below 24. Each axis's near and far planes are chosen once for the node (by the sign of
+ * the ray's direction) and its eight quantized bytes read as one word; a child's box is then
+ * p + q 2^e (one rounding: q 2^e is exact), as the build checked it, and the slab test is
+ * evr__box's to the bit. */
 EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear, float tfar)
 {
-    float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]), sz = evr__exp2_biased(n->e[2]);
-    float px = n->p[0], py = n->p[1], pz = n->p[2];
+    const float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]), sz = evr__exp2_biased(n->e[2]);
+    const float px = n->p[0], py = n->p[1], pz = n->p[2];
+    const uint64_t meta = evr__node_word(n->meta);
+    const uint64_t lx = evr__node_word(n->qlo[0]), ly = evr__node_word(n->qlo[1]), lz = evr__node_word(n->qlo[2]);
+    const uint64_t hx = evr__node_word(n->qhi[0]), hy = evr__node_word(n->qhi[1]), hz = evr__node_word(n->qhi[2]);
+    const uint64_t nx = r->ix >= 0.0f ? lx : hx, fx = r->ix >= 0.0f ? hx : lx;
+    const uint64_t ny = r->iy >= 0.0f ? ly : hy, fy = r->iy >= 0.0f ? hy : ly;
+    const uint64_t nz = r->iz >= 0.0f ? lz : hz, fz = r->iz >= 0.0f ? hz : lz;
     uint32_t hits = 0;
     int i;
     EVR__UNROLL
     for (i = 0; i < 8; i++) {
-        uint32_t m = n->meta[i], idx;
-        float tn;
+        const uint32_t m = (uint32_t)(meta >> (8 * i)) & 0xffu;
+        uint32_t idx;
         if (!m) continue;
-        if (!evr__box(r, px + (float)n->qlo[0][i] * sx, py + (float)n->qlo[1][i] * sy, pz + (float)n->qlo[2][i] * sz,
-                      px + (float)n->qhi[0][i] * sx, py + (float)n->qhi[1][i] * sy, pz + (float)n->qhi[2][i] * sz,
-                      tnear, tfar, &tn))
-            continue;
+        const float tnx = (px + evr__byte_float(nx, i) * sx - r->ox) * r->ix;
+        const float tny = (py + evr__byte_float(ny, i) * sy - r->oy) * r->iy;
+        const float tnz = (pz + evr__byte_float(nz, i) * sz - r->oz) * r->iz;
+        const float tfx = (px + evr__byte_float(fx, i) * sx - r->ox) * r->ix;
+        const float tfy = (py + evr__byte_float(fy, i) * sy - r->oy) * r->iy;
+        const float tfz = (pz + evr__byte_float(fz, i) * sz - r->oz) * r->iz;
+        const float a = evr__maxf(evr__maxf(tnx, tny), evr__maxf(tnz, tnear));
+        const float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN), evr__minf(tfz * EVR__BOX_WIDEN, tfar));
+        if (!(a <= b)) continue;
         idx = m & 31u;
         if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
         hits |= (m >> 5) << idx;
