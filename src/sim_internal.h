@@ -30,6 +30,7 @@ struct evr_sim {
     char *config_json;
     /* per-segment motion and plans (segment_planner.h: the tracker is the planner thread's) */
     evr_planner *planner;
+    struct evr_par_pool *par;    /* threads for the passes over a segment's events (par_pool.h) */
     int *node_used;
     evr_skip_tracker skip;
     uint32_t *skipped_per_segment;   /* pixels that traced nothing, per segment */

@@ -29,12 +29,14 @@ extern "C" {
 #include "core/adaptive.h"
 #include "cuda/gpu_traverse.h"
 #include "host_clock.h"
+#include "io/chunk_compress.h"
+#include "par_pool.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <thread>
+
 
 #define CK(call)                                                                                          \
     do {                                                                                                  \
@@ -716,6 +718,7 @@ struct cuda_backend {
     dbuf<gpu_static_hit> d_static;
     evr_motion_key static_cam;
     int static_gen, static_valid, static_off;
+    evr_par_pool *par;                 /* decodes the sorted keys (NULL: on the main thread) */
     evr_render_host host;
     evr_run_setup setup;
     evr_gpu_bvh bvh;
@@ -1441,34 +1444,31 @@ static inline evr_event decode_key(unsigned long long k, long long base_us, int 
     return e;
 }
 
-/* Decodes n sorted keys into dst, a segment of many events on several threads: on one it was
- * most of the main thread's own time (the eye's 218.7 M events in 30 s at 1280x720). */
-static void decode_keys(const unsigned long long *keys, size_t n, long long base_us, int xb, int yb, evr_event *dst)
+/* Decodes n sorted keys into dst, a segment of many events in parts on the pool: on one thread it
+ * was most of the main thread's own time (the eye's 218.7 M events in 30 s at 1280x720), and
+ * threads started per segment cost about as much as the work. */
+struct decode_job {
+    const unsigned long long *keys;
+    size_t n, parts;
+    long long base_us;
+    int xb, yb;
+    evr_event *dst;
+};
+static void decode_part(void *ctx, int k)
 {
-    const size_t chunk = (size_t)1 << 19;
-    auto run = [=](size_t i0, size_t i1) {
-        for (size_t i = i0; i < i1; i++) dst[i] = decode_key(keys[i], base_us, xb, yb);
-    };
-    size_t threads = std::thread::hardware_concurrency();
-    if (threads > 8) threads = 8;
-    if (threads > (n + chunk - 1) / chunk) threads = (n + chunk - 1) / chunk;
-    if (threads <= 1) {
-        run(0, n);
-        return;
-    }
-    std::thread pool[8];
-    size_t started = 0;
-    for (size_t t = 1; t < threads; t++) {
-        try {
-            pool[t] = std::thread(run, n * t / threads, n * (t + 1) / threads);
-            started = t;
-        } catch (...) {   /* no thread: this one decodes the rest */
-            break;
-        }
-    }
-    run(0, n * 1 / threads);
-    if (started + 1 < threads) run(n * (started + 1) / threads, n);
-    for (size_t t = 1; t <= started; t++) pool[t].join();
+    const decode_job *j = (const decode_job *)ctx;
+    const size_t i0 = j->n * (size_t)k / j->parts, i1 = j->n * (size_t)(k + 1) / j->parts;
+    for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
+}
+static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n, long long base_us, int xb, int yb,
+                        evr_event *dst)
+{
+    const size_t chunk = (size_t)1 << 17;
+    size_t parts = (n + chunk - 1) / chunk, most = (size_t)evr_par_pool_threads(pool);
+    if (parts > most) parts = most;
+    if (parts < 1) parts = 1;
+    decode_job j = {keys, n, parts, base_us, xb, yb, dst};
+    evr_par_pool_run(pool, (int)parts, decode_part, &j);
 }
 
 static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const float **intensity, const float **frames,
@@ -1539,7 +1539,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, const floa
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
     }
-    decode_keys(sl->h_sorted.p, n, sl->base_us, xb, yb, out->data + held);
+    decode_keys(b->par, sl->h_sorted.p, n, sl->base_us, xb, yb, out->data + held);
     out->n += n;
     if (!evr_events_merge_runs(out, held, &b->scratch)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
@@ -1585,6 +1585,8 @@ static void cuda_release(evr_backend *base)
     b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
     b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
     b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release(); b->d_static.release();
+    evr_par_pool_free(b->par);
+    b->par = nullptr;
     b->d_sensor.release();
     for (int i = 0; i < NRING; i++) {
         b->d_state[i].release();
@@ -1653,7 +1655,8 @@ static evr_status init(cuda_backend *b, evr_error *err)
     b->gi = b->setup.gi;
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
-    b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;   /* hidden, for tests and measurement: primary rays search every group */
+    b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;
+    b->par = evr_par_pool_new(evr_chunk_threads(8));   /* hidden, for tests and measurement: primary rays search every group */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     if (b->gi && (st = gi_ring_alloc(b, gi_margin, err)) != EVR_OK) return st;
     for (int i = 0; i < NSLOT; i++) {

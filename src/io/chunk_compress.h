@@ -17,6 +17,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
     /* in */
     const void *src;        /* first element's bytes */
@@ -70,4 +74,7 @@ int evr_chunk_pool_threads(const evr_chunk_pool *pool);
 /* Stops the threads and frees the pool (NULL is fine). */
 void evr_chunk_pool_free(evr_chunk_pool *pool);
 
+#ifdef __cplusplus
+}
+#endif
 #endif
