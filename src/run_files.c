@@ -256,6 +256,7 @@ static char *run_json(const evr_sim *sim)
     evr_json_key(&j, "time_setup_seconds"); evr_json_number(&j, sim->time_setup);
     evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
     evr_json_key(&j, "time_motion_seconds"); evr_json_number(&j, sim->time_motion);
+    evr_json_key(&j, "time_plan_wait_seconds"); evr_json_number(&j, sim->time_plan_wait);
     evr_json_key(&j, "time_device_seconds"); evr_json_number(&j, sim->backend->device_seconds);
     evr_json_key(&j, "time_device_wait_seconds"); evr_json_number(&j, sim->backend->wait_seconds);
     evr_json_key(&j, "device_samples_per_second"); evr_json_number(&j, sim->backend->device_seconds > 0 ? (double)s->samples / sim->backend->device_seconds : 0.0);

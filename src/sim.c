@@ -302,7 +302,9 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.index = i;
     seg.t0 = segment_start(sim, i);
     seg.t1 = segment_end(sim, i);
+    const double tw = evr_host_seconds();
     const evr_planned_segment *pl = evr_planner_take(sim->planner, i);
+    sim->time_plan_wait += evr_host_seconds() - tw;
     seg.keys = pl->keys;
     seg.track_offset = pl->track_offset;
     seg.track_count = pl->track_count;

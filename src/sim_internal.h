@@ -56,6 +56,7 @@ struct evr_sim {
     /* statistics */
     evr_stats st;
     double time_motion;          /* motion keys and the skip plan, per segment on the planner's thread */
+    double time_plan_wait;       /* the segment loop waiting for the planner */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 

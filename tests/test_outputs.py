@@ -58,7 +58,8 @@ if txt.shape == (n, 4):
 T.check(stats["samples"] == W * H * 4 * 18, f"samples = pixels x samples x segments ({stats['samples']})")
 T.check(stats["rays"] >= stats["samples_traced"] > 0, "at least one ray per traced sample")
 T.check(stats["samples_traced"] <= stats["samples"], "no more samples traced than taken")
-T.check(stats["time_motion_seconds"] >= 0 and stats["time_render_seconds"] >= 0, "run.json: host time in motion keys and rendering")
+T.check(stats["time_motion_seconds"] >= 0 and stats["time_render_seconds"] >= 0 and stats["time_plan_wait_seconds"] >= 0,
+        "run.json: host time in motion keys (planner thread), waiting for the planner, and rendering")
 T.check(stats["samples_per_second"] > 0 and stats["wall_seconds"] > 0, "speed reported")
 T.check(meta["config"]["width"] == W and meta["config"]["pos_thres"] == 0.2, "config in run.json")
 prev = sorted(os.listdir(os.path.join(d, "preview")))
