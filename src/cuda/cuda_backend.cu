@@ -48,7 +48,9 @@ extern "C" {
     } while (0)
 
 #define BLOCK 128
+#ifndef NSLOT
 #define NSLOT 3                 /* segments in flight */
+#endif
 #define NRING (NSLOT + 1)       /* pixel-state arrays: the in-flight segments' inputs and the last output */
 #ifndef MIN_BLOCKS
 #define MIN_BLOCKS 6   /* 80 registers: measured faster than 128 (occupancy) on the H100 */
