@@ -202,17 +202,6 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
-/* Float bounds that hold the double ones. */
-static float float_down(double x)
-{
-    float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
-}
-static float float_up(double x)
-{
-    float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
-}
 
 static double upper_norm(const evr_motion_key *k)   /* Frobenius norm of U */
 {
@@ -265,9 +254,11 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
 }
 
 /* World box of the object-space box [lo, hi] moved by the track over the segment: the boxes at
- * the keys, each key interval's pair widened by half its
- * speed times the farthest corner's distance (a point moving at speed L between two keys stays
- * within L / 2 of one of them), translation taken as its box. */
+ * the keys, each key interval's pair widened by half its speed times the farthest corner's
+ * distance (a point moving at speed L between two keys stays within L / 2 of one of them),
+ * translation taken as its box. evr_gpu_segment_bounds bounds the same motion more tightly, with
+ * samples between the keys; this one is for many boxes of one track (a moving mesh's parts, 1,024
+ * per segment on the eye), its per-track work done once in track_sweep_init. */
 static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3], float out_hi[3])
 {
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -306,8 +297,8 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
     for (int a = 0; a < 3; a++) {
         /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
         const double slack = 1e-6 * mag + 1e-30;
-        out_lo[a] = float_down(blo[a] - slack);
-        out_hi[a] = float_up(bhi[a] + slack);
+        out_lo[a] = evr_round_down(blo[a] - slack);
+        out_hi[a] = evr_round_up(bhi[a] + slack);
     }
 }
 

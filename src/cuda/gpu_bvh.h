@@ -216,6 +216,10 @@ unsigned long long evr_static_bake_limit(void);
 void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
                             float out_hi[3]);
 
+/* Float bounds that hold a double value: the float at or below it, at or above it. */
+float evr_round_down(double x);
+float evr_round_up(double x);
+
 #ifdef __cplusplus
 }
 #endif

@@ -80,13 +80,12 @@ static void *cb_create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuild
     return l;
 }
 
-/* Float bounds that hold a double value: lo rounded down, hi rounded up. */
-static float round_down(double x)
+float evr_round_down(double x)
 {
     float f = (float)x;
     return (double)f > x ? nextafterf(f, -INFINITY) : f;
 }
-static float round_up(double x)
+float evr_round_up(double x)
 {
     float f = (float)x;
     return (double)f < x ? nextafterf(f, INFINITY) : f;
@@ -1064,8 +1063,8 @@ void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_tra
     for (k = 0; k < 3; k++) {
         /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
         double slack = 1e-6 * mag + 1e-30;
-        out_lo[k] = round_down(blo[k] - slack);
-        out_hi[k] = round_up(bhi[k] + slack);
+        out_lo[k] = evr_round_down(blo[k] - slack);
+        out_hi[k] = evr_round_up(bhi[k] + slack);
     }
 }
 
