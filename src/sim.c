@@ -2,7 +2,6 @@
  * previews and run statistics. */
 #include "sim_internal.h"
 #include "par_pool.h"
-#include "io/chunk_compress.h"
 #include "host_clock.h"
 #include "config_json.h"
 #include "io/json.h"
@@ -137,7 +136,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
 
     int ntracks = s->num_nodes + 1;
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
-    sim->par = evr_par_pool_new(evr_chunk_threads(8));   /* NULL: counted on this thread */
+    sim->par = evr_par_pool_new(evr_par_threads(8));   /* NULL: counted on this thread */
     if (!sim->node_used ||
         !evr_skip_tracker_init(&sim->skip, ntracks) || !evr_skip_tracker_parts(&sim->skip, s) ||
         !(sim->skipped_per_segment = calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
@@ -234,9 +233,10 @@ typedef struct {
     uint64_t on, changes;
 } event_counts;
 
-static void count_part(void *ctx, int k)
+static void count_part(void *ctx, int k, int thread)
 {
     event_counts *c = (event_counts *)ctx + k;
+    (void)thread;
     uint64_t on = 0, changes = 0;
     int64_t last = c->prev;
     for (size_t i = 0; i < c->n; i++) {

@@ -15,6 +15,7 @@
 #include "check.h"
 #include "evray.h"
 #include "io/chunk_compress.h"
+#include "par_pool.h"
 #include "io/event_reader.h"
 #include "io/event_writer.h"
 #include "io/json.h"
@@ -374,8 +375,8 @@ static void test_chunk_compress(void)
         evr_chunk_pool_free(pool);
     }
     evr_chunk_pool_free(NULL);
-    CHECK(evr_chunk_threads(16) >= 1 && evr_chunk_threads(16) <= 16);
-    CHECK(evr_chunk_threads(1) == 1);
+    CHECK(evr_par_threads(16) >= 1 && evr_par_threads(16) <= 16);
+    CHECK(evr_par_threads(1) == 1);
 done:
     free(ev);
     free(raw);

@@ -29,7 +29,6 @@ extern "C" {
 #include "core/adaptive.h"
 #include "cuda/gpu_traverse.h"
 #include "host_clock.h"
-#include "io/chunk_compress.h"
 #include "par_pool.h"
 
 #include <math.h>
@@ -715,11 +714,11 @@ struct cuda_backend {
     evr_backend base;
     const evr_scene *scene;
     /* every pixel's camera ray in the static group, for a still camera at static_cam (the
-     * camera track's key); static_gen counts the times it was made; static_off: never
-     * (EVR_NO_STATIC_HITS, for measurements) */
+     * camera track's key); static_gen counts the times it was made (0: not yet); static_off:
+     * never (EVR_NO_STATIC_HITS, for measurements) */
     dbuf<gpu_static_hit> d_static;
     evr_motion_key static_cam;
-    int static_gen, static_valid, static_off;
+    int static_gen, static_off;
     evr_par_pool *par;                 /* decodes the sorted keys (NULL: on the main thread) */
     evr_render_host host;
     evr_run_setup setup;
@@ -1388,18 +1387,16 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     sl->static_gen = -1;
     if (seg->camera_static && !b->static_off) {
         const evr_motion_key *cam = &seg->keys[seg->track_offset[b->host.rs.camera_track]];
-        if (!b->static_valid || memcmp(cam, &b->static_cam, sizeof *cam) != 0) {
+        if (b->static_gen == 0 || memcmp(cam, &b->static_cam, sizeof *cam) != 0) {
             const int npix = b->setup.width * b->setup.height;
             CK(b->d_static.reserve((size_t)npix));
             b->static_gen++;
-            sl->static_gen = b->static_gen;
             kernel_args a = make_args(b, sl);
             const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
             if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) static_hits_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, b->render>>>(a, b->d_static.p);
             else static_hits_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, b->render>>>(a, b->d_static.p);
             CK(cudaGetLastError());
             b->static_cam = *cam;
-            b->static_valid = 1;
         }
         sl->static_gen = b->static_gen;
     }
@@ -1456,7 +1453,7 @@ struct decode_job {
     int xb, yb;
     evr_event *dst;
 };
-static void decode_part(void *ctx, int k)
+static void decode_part(void *ctx, int k, int)
 {
     const decode_job *j = (const decode_job *)ctx;
     const size_t i0 = j->n * (size_t)k / j->parts, i1 = j->n * (size_t)(k + 1) / j->parts;
@@ -1658,7 +1655,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
     b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
     b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;
-    b->par = evr_par_pool_new(evr_chunk_threads(8));   /* hidden, for tests and measurement: primary rays search every group */
+    b->par = evr_par_pool_new(evr_par_threads(8));   /* NULL: keys decoded on this thread */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     if (b->gi && (st = gi_ring_alloc(b, gi_margin, err)) != EVR_OK) return st;
     for (int i = 0; i < NSLOT; i++) {

@@ -10,8 +10,10 @@
  * dataset whose length is not a multiple of it) are zero, HDF5's default fill value, which is
  * what HDF5 itself puts there.
  *
- * A pool of threads compresses a list of chunks in parallel; the calling thread works too, so a
- * pool of one thread starts no thread at all. The pool is owned by one writer at a time. */
+ * A pool of threads (a par_pool.h pool, each thread with a compressor of its own) compresses a
+ * list of chunks in parallel; the calling thread works too, so a pool of one thread starts no
+ * thread at all; evr_par_threads tells how many to ask for. The pool is owned by one writer at a
+ * time. */
 #ifndef EVR_IO_CHUNK_COMPRESS_H
 #define EVR_IO_CHUNK_COMPRESS_H
 
@@ -49,10 +51,6 @@ size_t evr_chunk_bound(size_t raw_bytes);
 /* Compresses one chunk with worker w (made for at least chunk_elems * elem_size bytes). Returns
  * job->ok. */
 int evr_chunk_compress(evr_chunk_job *job, evr_chunk_worker *w);
-
-/* The number of threads a pool should have here: the processors this process may run on, at
- * most max. */
-int evr_chunk_threads(int max);
 
 /* A pool of threads (the caller counted) for chunks of at most max_chunk_bytes raw bytes.
  * NULL when out of memory or when no thread can be started. */

@@ -17,6 +17,7 @@
  * error stack is turned into the message instead. */
 #include "io/event_writer.h"
 #include "io/chunk_compress.h"
+#include "par_pool.h"
 
 #include <hdf5.h>
 #include <inttypes.h>
@@ -32,32 +33,31 @@
 #define H5W_MIN_BATCH 4          /* chunks staged before they are stored, at least */
 #define H5W_COLUMNS 4            /* t, x, y, p: the largest elements first */
 
+/* A stage of events with the compression jobs of its chunks and their output room. */
+typedef struct {
+    evr_event *stage;
+    evr_chunk_job *jobs;
+    unsigned char *zbuf;
+} h5_set;
+
 typedef struct {
     evr_event_writer base;       /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     hid_t file, group;
     hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
-    /* staged events, from dataset index written on (p already 0 or 1): set fill's stage */
-    evr_event *stage;
+    /* staged events, from dataset index written on (p already 0 or 1), in set[fill].stage */
     size_t nstage, cap_stage;    /* cap_stage: a whole number of chunks */
     uint64_t written;            /* events in full chunks stored (a multiple of H5W_CHUNK) */
     uint64_t tail_stored;        /* events of the partial chunk at written stored by a flush */
     uint64_t extent;             /* length of the event datasets */
     uint64_t total;              /* events received (written + staged) */
     /* compression: one job per column and chunk, each with its output room in zbuf; two sets,
-     * set[fill] staging, the other compressing (inflight) the batch of inflight_chunks chunks
-     * from dataset index inflight_at */
+     * set[fill] staging, the other compressing (inflight) a full batch from dataset index
+     * inflight_at */
     evr_chunk_pool *pool;
-    struct {
-        evr_event *stage;
-        evr_chunk_job *jobs;
-        unsigned char *zbuf;
-    } set[2];
+    h5_set set[2];
     int fill, inflight;
     uint64_t inflight_at;
-    size_t inflight_chunks;
-    evr_chunk_job *jobs;         /* set[fill]'s */
-    unsigned char *zbuf;
     size_t batch;                /* chunks in a full stage */
     int64_t last_t;
     int have_last;
@@ -225,12 +225,13 @@ static size_t column_room(const h5_writer *w, int c)
     return w->batch * evr_chunk_bound(H5W_CHUNK * column_size(c));
 }
 
-/* Jobs compressing chunks 0 .. nchunks of stage into zbuf (chunk k holds count(k) events: the
- * full chunk size but for a last partial one of rest events when nchunks > nfull). */
-static size_t make_jobs(const h5_writer *w, const evr_event *stage, evr_chunk_job *jobs, unsigned char *zbuf,
-                        size_t nchunks, size_t nfull, size_t rest)
+/* The jobs of set's chunks 0 .. nchunks, into its zbuf (chunk k holds count(k) events: the full
+ * chunk size but for a last partial one of rest events when nchunks > nfull). */
+static size_t make_jobs(const h5_writer *w, h5_set *set, size_t nchunks, size_t nfull, size_t rest)
 {
-    unsigned char *room = zbuf;
+    const evr_event *stage = set->stage;
+    evr_chunk_job *jobs = set->jobs;
+    unsigned char *room = set->zbuf;
     size_t njobs = 0;
     for (int c = 0; c < H5W_COLUMNS; c++) {
         size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(c));
@@ -284,9 +285,8 @@ static evr_status land_inflight(h5_writer *w, evr_error *err)
     if (!w->inflight) return EVR_OK;
     w->inflight = 0;
     if (!evr_chunk_pool_wait(w->pool)) return compress_failed(err);
-    const int b = 1 - w->fill;
-    const uint64_t end = w->inflight_at + w->inflight_chunks * H5W_CHUNK;
-    return put_chunks(w, w->set[b].jobs, w->inflight_chunks, w->inflight_at, end, err);
+    const uint64_t end = w->inflight_at + w->batch * H5W_CHUNK;
+    return put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at, end, err);
 }
 
 /* A full stage (batch chunks): compressed by the pool while the writer goes on; the batch in
@@ -295,22 +295,17 @@ static evr_status store_full(h5_writer *w, evr_error *err)
 {
     const int was_inflight = w->inflight;
     const uint64_t prev_at = w->inflight_at;
-    const size_t prev_chunks = w->inflight_chunks;
     if (was_inflight && !evr_chunk_pool_wait(w->pool)) return compress_failed(err);
-    const size_t njobs = make_jobs(w, w->stage, w->jobs, w->zbuf, w->batch, w->batch, 0);
-    evr_chunk_pool_start(w->pool, w->jobs, njobs);
+    h5_set *full = &w->set[w->fill];
+    evr_chunk_pool_start(w->pool, full->jobs, make_jobs(w, full, w->batch, w->batch, 0));
     w->inflight = 1;
     w->inflight_at = w->written;
-    w->inflight_chunks = w->batch;
     w->written += w->batch * H5W_CHUNK;
     w->nstage = 0;
     w->tail_stored = 0;
     w->fill = 1 - w->fill;   /* the landed batch's set stages next */
-    w->stage = w->set[w->fill].stage;
-    w->jobs = w->set[w->fill].jobs;
-    w->zbuf = w->set[w->fill].zbuf;
     if (was_inflight)
-        return put_chunks(w, w->jobs, prev_chunks, prev_at, prev_at + prev_chunks * H5W_CHUNK, err);
+        return put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at, prev_at + w->batch * H5W_CHUNK, err);
     return EVR_OK;
 }
 
@@ -328,13 +323,14 @@ static evr_status store(h5_writer *w, int tail, evr_error *err)
     nchunks = nfull + (tail ? 1 : 0);
     if (nchunks == 0) return EVR_OK;
     /* nchunks <= batch: flush() finds the stage less than full (write() stores a full one at once) */
-    njobs = make_jobs(w, w->stage, w->jobs, w->zbuf, nchunks, nfull, rest);
-    if (!evr_chunk_pool_run(w->pool, w->jobs, njobs)) return compress_failed(err);
-    st = put_chunks(w, w->jobs, nchunks, w->written, w->written + nfull * H5W_CHUNK + (tail ? rest : 0), err);
+    h5_set *set = &w->set[w->fill];
+    njobs = make_jobs(w, set, nchunks, nfull, rest);
+    if (!evr_chunk_pool_run(w->pool, set->jobs, njobs)) return compress_failed(err);
+    st = put_chunks(w, set->jobs, nchunks, w->written, w->written + nfull * H5W_CHUNK + (tail ? rest : 0), err);
     if (st != EVR_OK) return st;
     if (nfull) {
         w->written += nfull * H5W_CHUNK;
-        memmove(w->stage, w->stage + nfull * H5W_CHUNK, rest * sizeof *w->stage);
+        memmove(set->stage, set->stage + nfull * H5W_CHUNK, rest * sizeof *set->stage);
         w->nstage = rest;
         w->tail_stored = 0;
     }
@@ -362,7 +358,7 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
     h5_writer *w = (h5_writer *)base;
     while (n > 0) {
         size_t m = w->cap_stage - w->nstage, k;
-        evr_event *dst = w->stage + w->nstage;
+        evr_event *dst = w->set[w->fill].stage + w->nstage;
         int64_t last_t = w->last_t;
         /* the first millisecond boundary not passed yet (ms entries stay below 2^63 / 1000 as
          * long as timestamps are int64) */
@@ -496,7 +492,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     len = strlen(path);
     if (w) {
         /* a batch gives every thread a chunk of each column; about 40 MB with 16 threads */
-        int threads = evr_chunk_threads(H5W_MAX_THREADS);
+        int threads = evr_par_threads(H5W_MAX_THREADS);
         size_t room = 0;
         w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_ms = -1;
         w->batch = threads < H5W_MIN_BATCH ? H5W_MIN_BATCH : (size_t)threads;
@@ -505,13 +501,10 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         w->path = malloc(len + 1);
         w->tmp = malloc(len + 5);
         for (int i = 0; i < 2; i++) {
-            w->set[i].stage = malloc(w->cap_stage * sizeof *w->stage);
-            w->set[i].jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->jobs);
+            w->set[i].stage = malloc(w->cap_stage * sizeof *w->set[i].stage);
+            w->set[i].jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->set[i].jobs);
             w->set[i].zbuf = malloc(room);
         }
-        w->stage = w->set[0].stage;
-        w->jobs = w->set[0].jobs;
-        w->zbuf = w->set[0].zbuf;
         w->pool = evr_chunk_pool_new(threads, H5W_CHUNK * sizeof(int64_t));
     }
     if (!w || !w->path || !w->tmp || !w->set[0].stage || !w->set[0].jobs || !w->set[0].zbuf || !w->set[1].stage ||
