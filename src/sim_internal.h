@@ -10,7 +10,6 @@
 #include "write_queue.h"
 
 #define EVR_MAX_WRITERS 3
-#define EVR_MAX_KEYS 65
 
 struct evr_sim {
     const evr_scene *scene;

@@ -1,7 +1,6 @@
 /* Per-segment plan of change-driven sampling: see skip_plan.h and core/skip.h. */
 #include "skip_plan.h"
 #include "cuda/gpu_bvh.h"
-#include "sim_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -172,11 +171,14 @@ static void box_union(float lo[3], float hi[3], const float l2[3], const float h
     }
 }
 
-/* World box of the object-space box [lo, hi] moved by track tr over the segment, and where it
- * was at the previous segment's end. */
-static void swept_box(const evr_skip_tracker *t, const evr_render_scene *rs, int tr, const float lo[3], const float hi[3],
-                      float blo[3], float bhi[3])
+/* World box of instance i over the segment, and where it was at the previous segment's end. */
+static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, float blo[3],
+                         float bhi[3])
 {
+    const int tr = rs->instances[i].track;
+    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
+    const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
+    const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
     evr_gpu_segment_bounds(lo, hi, evr_rs_track(rs, tr), blo, bhi);
     if (t->prev_count[tr] > 0) {
         evr_motion_track prev;
@@ -186,16 +188,6 @@ static void swept_box(const evr_skip_tracker *t, const evr_render_scene *rs, int
         evr_gpu_segment_bounds(lo, hi, prev, plo, phi);
         box_union(blo, bhi, plo, phi);
     }
-}
-
-/* World box of instance i over the segment, and where it was at the previous segment's end. */
-static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, float blo[3],
-                         float bhi[3])
-{
-    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
-    const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
-    const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
-    swept_box(t, rs, rs->instances[i].track, lo, hi, blo, bhi);
 }
 
 /* min and max without libm's NaN rules (no call): the sweep's inputs are finite */

@@ -17,7 +17,9 @@ typedef struct {
     evr_v3 trans;
 } evr_motion_key;
 
-/* Keys of one moving thing over one segment: n >= 1 keys at uniform times 0, 1/(n-1), ..., 1. */
+/* Keys of one moving thing over one segment: n >= 1 keys at uniform times 0, 1/(n-1), ..., 1,
+ * n at most EVR_MAX_KEYS (the cap the segment loop gives the key fitting, src/sim.c). */
+#define EVR_MAX_KEYS 65
 typedef struct {
     const evr_motion_key *keys;
     int n;
