@@ -166,20 +166,25 @@ EVR_HD static inline void evr__tray_init(evr__tray *r, evr_v3 o, evr_v3 d)
     r->oct_inv = 7 - ((d.x < 0.0f ? 1 : 0) | (d.y < 0.0f ? 2 : 0) | (d.z < 0.0f ? 4 : 0));
 }
 
+/* Slab test of a box given by its planes nearest to the ray's origin (n) and farthest from it (f)
+ * on each axis: entry distance in *tn when the ray's [tnear, tfar] meets it. */
+EVR_HD static inline int evr__slab(const evr__tray *r, float nx, float ny, float nz, float fx, float fy, float fz,
+                                   float tnear, float tfar, float *tn)
+{
+    const float tnx = (nx - r->ox) * r->ix, tny = (ny - r->oy) * r->iy, tnz = (nz - r->oz) * r->iz;
+    const float tfx = (fx - r->ox) * r->ix, tfy = (fy - r->oy) * r->iy, tfz = (fz - r->oz) * r->iz;
+    float a = evr__maxf(evr__maxf(tnx, tny), evr__maxf(tnz, tnear));
+    float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN), evr__minf(tfz * EVR__BOX_WIDEN, tfar));
+    *tn = a;
+    return a <= b;
+}
+
 /* Slab test of the box [lo, hi]: entry distance in *tn when the ray's [tnear, tfar] meets it. */
 EVR_HD static inline int evr__box(const evr__tray *r, float lox, float loy, float loz, float hix, float hiy,
                                   float hiz, float tnear, float tfar, float *tn)
 {
-    float nx = ((r->ix >= 0.0f ? lox : hix) - r->ox) * r->ix;
-    float ny = ((r->iy >= 0.0f ? loy : hiy) - r->oy) * r->iy;
-    float nz = ((r->iz >= 0.0f ? loz : hiz) - r->oz) * r->iz;
-    float fx = ((r->ix >= 0.0f ? hix : lox) - r->ox) * r->ix;
-    float fy = ((r->iy >= 0.0f ? hiy : loy) - r->oy) * r->iy;
-    float fz = ((r->iz >= 0.0f ? hiz : loz) - r->oz) * r->iz;
-    float a = evr__maxf(evr__maxf(nx, ny), evr__maxf(nz, tnear));
-    float b = evr__minf(evr__minf(fx * EVR__BOX_WIDEN, fy * EVR__BOX_WIDEN), evr__minf(fz * EVR__BOX_WIDEN, tfar));
-    *tn = a;
-    return a <= b;
+    return evr__slab(r, r->ix >= 0.0f ? lox : hix, r->iy >= 0.0f ? loy : hiy, r->iz >= 0.0f ? loz : hiz,
+                     r->ix >= 0.0f ? hix : lox, r->iy >= 0.0f ? hiy : loy, r->iz >= 0.0f ? hiz : loz, tnear, tfar, tn);
 }
 
 /* Watertight ray/triangle test (two-sided): t in (tnear, tfar], barycentrics as Embree's. */
@@ -344,7 +349,7 @@ EVR_HD static inline float evr__byte_float(uint64_t w, int i)
  * children below 24. Each axis's near and far planes are chosen once for the node (by the sign of
  * the ray's direction) and its eight quantized bytes read as one word; a child's box is then
  * p + q 2^e (one rounding: q 2^e is exact), as the build checked it, and the slab test is
- * evr__box's to the bit. */
+ * evr__box's (evr__slab). */
 EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear, float tfar)
 {
     const float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]), sz = evr__exp2_biased(n->e[2]);
@@ -362,15 +367,11 @@ EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray
         const uint32_t m = (uint32_t)(meta >> (8 * i)) & 0xffu;
         uint32_t idx;
         if (!m) continue;
-        const float tnx = (px + evr__byte_float(nx, i) * sx - r->ox) * r->ix;
-        const float tny = (py + evr__byte_float(ny, i) * sy - r->oy) * r->iy;
-        const float tnz = (pz + evr__byte_float(nz, i) * sz - r->oz) * r->iz;
-        const float tfx = (px + evr__byte_float(fx, i) * sx - r->ox) * r->ix;
-        const float tfy = (py + evr__byte_float(fy, i) * sy - r->oy) * r->iy;
-        const float tfz = (pz + evr__byte_float(fz, i) * sz - r->oz) * r->iz;
-        const float a = evr__maxf(evr__maxf(tnx, tny), evr__maxf(tnz, tnear));
-        const float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN), evr__minf(tfz * EVR__BOX_WIDEN, tfar));
-        if (!(a <= b)) continue;
+        float tn;
+        if (!evr__slab(r, px + evr__byte_float(nx, i) * sx, py + evr__byte_float(ny, i) * sy,
+                       pz + evr__byte_float(nz, i) * sz, px + evr__byte_float(fx, i) * sx,
+                       py + evr__byte_float(fy, i) * sy, pz + evr__byte_float(fz, i) * sz, tnear, tfar, &tn))
+            continue;
         idx = m & 31u;
         if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
         hits |= (m >> 5) << idx;
@@ -571,16 +572,7 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
     return found;
 }
 
-/* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
-EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
-                                           float tmax, float f, evr_gpu_hit *hit)
-{
-    if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, EVR_GROUPS_ALL);
-    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, EVR_GROUPS_ALL);
-}
-
-/* The same among some groups only (EVR_GROUPS_*): a hit nearer than tmax only, ties go to tmax.
+/* The nearest hit among some groups only (EVR_GROUPS_*), nearer than tmax (ties go to tmax).
  * The nearest hit of all groups is the static group's unless the others have one nearer (what
  * a camera ray's static hit, kept per pixel while the camera holds still, saves). */
 EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
@@ -589,6 +581,13 @@ EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v, c
     if (v->num_top_nodes == 0) return 0;
     if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
     return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
+}
+
+/* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
+EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
+                                           float tmax, float f, evr_gpu_hit *hit)
+{
+    return evr_trace_closest_groups(v, rs, ray, tmax, f, EVR_GROUPS_ALL, hit);
 }
 
 /* Whether anything lies along the world ray in (tnear, tfar] at time f (stops at the first hit). */
