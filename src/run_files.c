@@ -321,6 +321,7 @@ evr_status evr_run_finish(evr_sim *sim, evr_error *err)
             else sim->preview_frame++;
     }
     if ((st = evr_frames_finish(sim, err)) != EVR_OK) return st;
+    evr_sim_set_wall(sim);   /* the run's wall time includes draining and closing every output */
     char *text = run_json(sim);
     char p[4200], tmp[4300];
     if (!text) {

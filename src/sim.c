@@ -326,7 +326,7 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 
 /* Segment i's events: merged into the pending (time-ordered) events, of which those that no
  * later segment can precede go to the writers. */
-static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, evr_error *err)
+static evr_status finish_segment(evr_sim *sim, int i, int last, evr_error *err)
 {
     const int n = sim->cfg.samples_per_frame;
     const float *intensity = NULL, *frames = NULL;
@@ -374,18 +374,23 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, double wall0, ev
     sim->st.photons_reused = sim->backend->photons_reused;
     sim->st.photon_cells_changed = sim->backend->photon_cells_changed;
     sim->st.sim_time = t1 - sim->cfg.start;
-    sim->st.wall_time = evr_host_seconds() - wall0;
+    evr_sim_set_wall(sim);
+    return EVR_OK;
+}
+
+void evr_sim_set_wall(evr_sim *sim)
+{
+    sim->st.wall_time = evr_host_seconds() - sim->wall0;
     sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
     sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
     sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
-    return EVR_OK;
 }
 
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err)
 {
     evr_status st = EVR_OK;
-    double wall0 = evr_host_seconds();
     int submitted = 0, i, stop = 0;
+    sim->wall0 = evr_host_seconds();
     /* keep the backend's depth of segments in flight (at least two: one renders while the previous
      * one is taken in and written) */
     const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;
@@ -401,7 +406,7 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
             submitted++;
         }
         if (st != EVR_OK) break;
-        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, wall0, err)) != EVR_OK) break;
+        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
     sim->time_motion = evr_planner_busy_seconds(sim->planner);
@@ -419,7 +424,7 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         }
     }
     sim->st.interrupted = sim->st.segments_done < sim->num_segments;
-    sim->st.wall_time = evr_host_seconds() - wall0;
+    /* evr_run_finish sets the wall time once the writers have finished their files */
     if ((st = evr_run_finish(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
 }

@@ -54,9 +54,13 @@ struct evr_sim {
     uint16_t *frame16;
     /* statistics */
     evr_stats st;
+    double wall0;                /* the run's start: its wall time ends when every output is complete */
     double time_motion;          /* motion keys and the skip plan, per segment on the planner's thread */
     double time_plan_wait;       /* the segment loop waiting for the planner */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
+
+/* The run's wall time so far, and the rates that follow from it, into sim->st. */
+void evr_sim_set_wall(evr_sim *sim);
 
 #endif
