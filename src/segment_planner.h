@@ -13,7 +13,9 @@
 #include "core/motion.h"
 #include "core/skip.h"
 
+#ifndef EVR_PLANNER_SLOTS
 #define EVR_PLANNER_SLOTS 8
+#endif
 
 typedef struct {
     evr_motion_key *keys;              /* room for keys_cap keys */

@@ -11,6 +11,17 @@
 
 #define EVR_MAX_WRITERS 3
 
+/* ON events and timestamp changes (t differing from the one before, prev for the first) of a
+ * part of a batch of emitted events. */
+typedef struct {
+    const evr_event *ev;
+    size_t n;
+    int64_t prev;
+    uint64_t on, changes;
+} evr_event_counts;
+
+#define EVR_COUNT_PARTS 8
+
 struct evr_sim {
     const evr_scene *scene;
     evr_config cfg;
@@ -36,6 +47,9 @@ struct evr_sim {
     /* events */
     evr_event_vec pending, scratch;
     int64_t last_t;
+    /* the last emitted batch, counted on the pool while the loop goes on (count_parts 0: none) */
+    evr_event_counts counting[EVR_COUNT_PARTS];
+    int count_parts;
     /* previews */
     evr_event_frame preview;     /* event frame being accumulated (width 0: previews off) */
     int64_t preview_window_us;

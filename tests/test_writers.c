@@ -302,6 +302,47 @@ static void test_h5_large(const char *root)
     free(ev);
 }
 
+/* A stored plane larger than one stored block (65,535 bytes) before a compressed one: the
+ * stream inflates to the shuffled chunk. */
+static void test_chunk_stored_blocks(void)
+{
+    enum { CE = 70000 };
+    uint16_t *v = malloc(sizeof(uint16_t) * CE);
+    unsigned char *raw = malloc((size_t)CE * 2);
+    evr_chunk_worker *w = evr_chunk_worker_new((size_t)CE * 2);
+    size_t bound = evr_chunk_bound((size_t)CE * 2);
+    unsigned char *dst = malloc(bound);
+    uint64_t s = 99;
+    CHECK(v && raw && w && dst);
+    if (!v || !raw || !w || !dst) goto done;
+    for (size_t i = 0; i < CE; i++) v[i] = (uint16_t)((rng_next(&s) & 0xff) | (i % 3) << 8);   /* random low, plain high byte */
+    evr_chunk_job j;
+    memset(&j, 0, sizeof j);
+    j.src = v;
+    j.stride = sizeof(uint16_t);
+    j.elem_size = 2;
+    j.count = CE - 5;   /* zero padded */
+    j.chunk_elems = CE;
+    j.level = 1;
+    j.dst = dst;
+    CHECK(evr_chunk_compress(&j, w));
+    CHECK(j.dst_size > CE && j.dst_size < (size_t)CE + CE / 4);   /* low plane stored, high plane compressed */
+    CHECK(dst[2] == 0x00 && dst[3] == 0xff && dst[4] == 0xff && dst[5] == 0x00 && dst[6] == 0x00);   /* 65,535 bytes */
+    uLongf len = (uLongf)CE * 2;
+    CHECK(uncompress(raw, &len, dst, (uLong)j.dst_size) == Z_OK && len == (uLongf)CE * 2);
+    size_t bad = 0;
+    for (size_t i = 0; i < CE; i++) {
+        const uint16_t want = i < j.count ? v[i] : 0;
+        if (raw[i] != (want & 0xff) || raw[CE + i] != (want >> 8)) bad++;
+    }
+    CHECK(bad == 0);
+done:
+    free(v);
+    free(raw);
+    evr_chunk_worker_free(w);
+    free(dst);
+}
+
 /* Chunk compression: the shuffled layout, zero padding, and the pool's output equal to one
  * thread's. */
 static void test_chunk_compress(void)
@@ -349,6 +390,10 @@ static void test_chunk_compress(void)
                 if (raw[b * CE + e] != want) bad++;
             }
         CHECK(bad == 0);
+        /* a full chunk of x: its low bytes are random, stored as the stream's first block (7
+         * bits of entropy per byte or more); p (one plane, the last) is compressed */
+        if (es == 2 && j->count == CE) CHECK(j->dst[2] == 0x00 && j->dst[3] == (CE & 0xff) && j->dst[4] == (CE >> 8));
+        if (es == 1) CHECK(j->dst_size < (size_t)CE / 4);
     }
     /* the pool, with several threads and with the caller alone, makes the same bytes */
     for (int threads = 1; threads <= 3; threads += 2) {
@@ -898,6 +943,7 @@ int main(void)
     }
     test_json();
     test_chunk_compress();
+    test_chunk_stored_blocks();
     test_writers(root, &python_ok);
     test_tonemap(root);
     test_event_frames(root);

@@ -1,14 +1,27 @@
 /* Shuffle + deflate of dataset chunks, in parallel (see chunk_compress.h). HDF5 1.10's H5Z
  * shuffle filter transposes the bytes of the whole chunk (and leaves 1-byte elements untouched);
  * its deflate filter reads any zlib stream, which libdeflate makes faster than zlib's compress2,
- * with smaller output (docs/benchmarks.md: the writer thread 2.3x faster, files 2% smaller).
+ * with smaller output (docs/benchmarks.md: the writer thread 2.3x faster, files 2% smaller);
+ * byte planes of nearly random bytes go into the stream stored, not compressed (zlib_stream).
  * tests/test_writers.c reads the chunks back with zlib and through HDF5. */
 #include "io/chunk_compress.h"
 #include "par_pool.h"
 
+#include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <libdeflate.h>
+
+/* A leading byte plane of the shuffled chunk whose bytes have at least STORE_BITS bits of
+ * entropy (order 0) and repeat the byte before them at most once in STORE_REPEATS is stored as it
+ * is: deflate could save at most an eighth of it, and such planes were the slowest to compress
+ * (the low bytes of x and y: 123 MB/s against 240-390 MB/s for the others, 42% of the writer's
+ * compression time for 0.6% of the file, docs/benchmarks.md). Repeats catch what the histogram
+ * misses: the low byte of sorted timestamps looks random to it, but 90% of its bytes repeat the
+ * one before, and deflate shrinks it six-fold. */
+#define STORE_BITS 7.0
+#define STORE_REPEATS 8
 
 /* A thread's scratch (the shuffled chunk) and its compressor (made for one level at a time). */
 struct evr_chunk_worker {
@@ -28,7 +41,8 @@ struct evr_chunk_pool {
 
 size_t evr_chunk_bound(size_t raw_bytes)
 {
-    return libdeflate_zlib_compress_bound(NULL, raw_bytes);   /* any level */
+    /* any level; stored blocks of the leading planes: 5 bytes each per 65,535 */
+    return libdeflate_zlib_compress_bound(NULL, raw_bytes) + 5 * (raw_bytes / 65535 + 2);
 }
 
 evr_chunk_worker *evr_chunk_worker_new(size_t max_chunk_bytes)
@@ -64,6 +78,71 @@ static inline void shuffle_es(unsigned char *out, const unsigned char *src, size
         for (size_t b = 0; b < es; b++) memset(out + b * chunk_elems + count, 0, chunk_elems - count);
 }
 
+/* Whether p[0 .. n) is random enough to store: its bits per byte (order-0 entropy of its
+ * histogram) and the bytes equal to the one before them (the runs deflate would find). */
+static int plane_random(const unsigned char *p, size_t n)
+{
+    uint32_t h[4][256] = {{0}};   /* four histograms: no store waits on the one before */
+    size_t i = 1, repeats = 0;
+    if (n < 2) return 0;
+    h[0][p[0]]++;
+    for (; i + 4 <= n; i += 4) {
+        h[0][p[i]]++;
+        h[1][p[i + 1]]++;
+        h[2][p[i + 2]]++;
+        h[3][p[i + 3]]++;
+        repeats += (p[i] == p[i - 1]) + (p[i + 1] == p[i]) + (p[i + 2] == p[i + 1]) + (p[i + 3] == p[i + 2]);
+    }
+    for (; i < n; i++) {
+        h[0][p[i]]++;
+        repeats += p[i] == p[i - 1];
+    }
+    if (repeats * STORE_REPEATS > n) return 0;
+    double bits = 0.0;
+    for (int v = 0; v < 256; v++) {
+        const uint32_t c = h[0][v] + h[1][v] + h[2][v] + h[3][v];
+        if (c) bits -= (double)c * log2((double)c / (double)n);
+    }
+    return bits >= STORE_BITS * (double)n;
+}
+
+/* The zlib stream (RFC 1950) of the shuffled chunk raw (es planes of n bytes): the leading planes
+ * that look random (plane_random; all but the last at most) in stored deflate blocks, which end
+ * on a byte, so that libdeflate's raw deflate stream of the rest follows them as the stream's
+ * last blocks; then the Adler-32 of all of raw. Returns its length, 0 when out of room. */
+static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned char *raw, size_t n, size_t es,
+                          unsigned char *dst, size_t room)
+{
+    size_t stored = 0, at = 2, total = n * es;
+    while (stored + 1 < es && plane_random(raw + stored * n, n)) stored++;
+    if (room < 6) return 0;
+    dst[0] = 0x78;   /* deflate, 32 KiB window */
+    dst[1] = 0x01;   /* no dictionary; (0x78 * 256 + 0x01) % 31 == 0 */
+    for (size_t done = 0; done < stored * n;) {
+        size_t len = stored * n - done;
+        if (len > 65535) len = 65535;
+        if (at + 5 + len > room) return 0;
+        dst[at++] = 0x00;   /* BFINAL 0, BTYPE 00 (stored), then padding to the byte */
+        dst[at++] = (unsigned char)(len & 0xff);
+        dst[at++] = (unsigned char)(len >> 8);
+        dst[at++] = (unsigned char)(~len & 0xff);
+        dst[at++] = (unsigned char)((~len >> 8) & 0xff);
+        memcpy(dst + at, raw + done, len);
+        at += len;
+        done += len;
+    }
+    if (room < at + 4) return 0;
+    const size_t z = libdeflate_deflate_compress(comp, raw + stored * n, total - stored * n, dst + at, room - at - 4);
+    if (z == 0) return 0;
+    at += z;
+    const uint32_t a = libdeflate_adler32(1, raw, total);
+    dst[at++] = (unsigned char)(a >> 24);
+    dst[at++] = (unsigned char)(a >> 16);
+    dst[at++] = (unsigned char)(a >> 8);
+    dst[at++] = (unsigned char)a;
+    return at;
+}
+
 int evr_chunk_compress(evr_chunk_job *job, evr_chunk_worker *w)
 {
     const unsigned char *src = (const unsigned char *)job->src;
@@ -87,7 +166,7 @@ int evr_chunk_compress(evr_chunk_job *job, evr_chunk_worker *w)
     case 8: shuffle_es(scratch, src, job->stride, count, job->chunk_elems, 8); break;
     default: shuffle_es(scratch, src, job->stride, count, job->chunk_elems, job->elem_size); break;
     }
-    const size_t len = libdeflate_zlib_compress(w->comp, scratch, raw, job->dst, evr_chunk_bound(raw));
+    const size_t len = zlib_stream(w->comp, scratch, job->chunk_elems, job->elem_size, job->dst, evr_chunk_bound(raw));
     job->ok = len > 0;
     job->dst_size = len;
     return job->ok;

@@ -4,7 +4,9 @@
  *
  *   shuffle  the chunk's element bytes transposed: every element's first byte, then every
  *            element's second byte, ... (HDF5 leaves 1-byte elements as they are)
- *   deflate  a zlib stream (header and Adler-32 included), made by libdeflate at the given level
+ *   deflate  a zlib stream (header and Adler-32 included), made by libdeflate at the given level;
+ *            leading byte planes of nearly random bytes (at least 7 bits of entropy per byte,
+ *            few runs) in stored blocks instead
  *
  * A chunk always holds the dataset's full chunk size; elements past the data (the last chunk of a
  * dataset whose length is not a multiple of it) are zero, HDF5's default fill value, which is
