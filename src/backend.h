@@ -61,13 +61,15 @@ struct evr_backend {
     /* Starts rendering a segment; segments are submitted in order, at most `depth` of them ahead
      * of collect(), so a backend can render while the host takes in and writes earlier ones. */
     evr_status (*submit)(evr_backend *b, const evr_segment *seg, evr_error *err);
-    /* Waits for the oldest submitted segment and appends its events, sorted by (t, y, x), to out.
+    /* Waits for the oldest submitted segment and appends its events, sorted by (t, y, x), to out:
+     * at least those before emit_before_us (the loop writes them; INT64_MAX: all of them), the
+     * rest now or with a later segment's (a backend may carry them into that segment's sort).
      * *intensity is set to every pixel's last linear intensity (row-major, top row first) when the
      * segment asked for it, else NULL; *frames to the segment's num_frames intensity frames, one
      * after the other (each row-major, top row first), or NULL when it asked for none. Both stay
      * valid until the next collect(). */
-    evr_status (*collect)(evr_backend *b, evr_event_vec *out, const float **intensity, const float **frames,
-                          evr_error *err);
+    evr_status (*collect)(evr_backend *b, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
+                          const float **frames, evr_error *err);
     void (*release)(evr_backend *b);
     int depth;                    /* segments the backend holds submitted and not yet collected, at most */
     uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not;

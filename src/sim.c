@@ -327,23 +327,24 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 
 /* Segment i's events: merged into the pending (time-ordered) events, of which those that no
  * later segment can precede go to the writers. */
-static evr_status finish_segment(evr_sim *sim, int i, int last, evr_error *err)
+static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_error *err)
 {
     const int n = sim->cfg.samples_per_frame;
     const float *intensity = NULL, *frames = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
     evr_status st;
-    double t = evr_host_seconds();
-    if ((st = sim->backend->collect(sim->backend, &sim->pending, &intensity, &frames, err)) != EVR_OK) return st;
-    sim->time_render += evr_host_seconds() - t;
     /* Later segments can still produce events back to every pixel's last sample here, which
-     * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order. */
-    int64_t safe = last ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+     * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order (the
+     * last segment the loop finishes holds back none). */
+    int64_t safe = final ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
     /* adaptive sampling: a pixel's last sample here is no earlier than t1 - max_dt */
-    if (!last && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
+    if (!final && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
-    if (!last && (sim->cfg.time_jitter > 0.0 || sim->setup.pixel.time_res_us > 1))
+    if (!final && (sim->cfg.time_jitter > 0.0 || sim->setup.pixel.time_res_us > 1))
         safe -= (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
+    double t = evr_host_seconds();
+    if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) != EVR_OK) return st;
+    sim->time_render += evr_host_seconds() - t;
     if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;   /* written and flushed on the writer thread */
     if (intensity) {
         t = evr_host_seconds();
@@ -407,7 +408,8 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
             submitted++;
         }
         if (st != EVR_OK) break;
-        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, err)) != EVR_OK) break;
+        /* the last to finish: every segment submitted (or the run stopped), this the newest */
+        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, i + 1 == submitted, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
     sim->time_motion = evr_planner_busy_seconds(sim->planner);

@@ -667,10 +667,11 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     return EVR_OK;
 }
 
-static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, const float **intensity, const float **frames,
-                              evr_error *err)
+static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
+                              const float **frames, evr_error *err)
 {
     cpu_backend *b = (cpu_backend *)base;
+    (void)emit_before_us;   /* every event now: merged on the host */
     if (!b->queued) {
         snprintf(err->msg, sizeof err->msg, "internal error: collect without a submitted segment");
         return EVR_ERR_BACKEND;
