@@ -154,6 +154,7 @@ static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n
     meta.width = W;
     meta.height = H;
     meta.config_json = config;
+    meta.max_t_us = duration_us + 1;   /* every event before it: the HDF5 writer's t is uint32 */
     snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     snprintf(partial, sizeof partial, "%s/partial.%s", dir, formats[f].ext);
@@ -250,7 +251,7 @@ static void test_h5_large(const char *root)
     static const struct { size_t len; int flush; } steps[] = {
         {1, 1}, {65535, 1}, {0, 1}, {0, 1}, {3, 0}, {300000, 1}, {7, 0}, {20000, 1}, {14454, 1},
     };
-    evr_writer_meta meta = {W, H, "{}"};
+    evr_writer_meta meta = {W, H, "{}", 0};   /* no bound on the timestamps: t is int64 */
     evr_event_writer *w = NULL;
     evr_event *ev, *got = NULL;
     int64_t last_t;
@@ -300,6 +301,37 @@ static void test_h5_large(const char *root)
     free(got);
     check_ms_to_idx(path, ev, large_n, last_t + 1);
     free(ev);
+}
+
+/* events/t: uint32 when the writer is told every timestamp stays below 2^32 us (an event past
+ * it is an error, not wrapped), int64 otherwise (a timestamp past 2^32 us reads back whole). */
+static void test_h5_t_range(const char *root)
+{
+    char path[600];
+    evr_event ev[3] = {{1000, 1, 2, 1}, {2000, 3, 4, 0}, {(int64_t)UINT32_MAX + 5, 5, 6, 1}};
+    evr_error err;
+    evr_event_writer *w = NULL;
+    evr_writer_meta meta = {W, H, "{}", 3000};
+    snprintf(path, sizeof path, "%s/t32.h5", root);
+    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &err));
+    if (w) {
+        err.msg[0] = 0;
+        CHECK(w->write(w, ev, 3, &err) == EVR_ERR_ARG && strstr(err.msg, "uint32") != NULL);
+        w->abort(w);
+    }
+    meta.max_t_us = (int64_t)UINT32_MAX + 10;
+    snprintf(path, sizeof path, "%s/t64.h5", root);
+    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &err));
+    if (w) {
+        CHECK_OK(w->write(w, ev, 3, &err));
+        CHECK_OK(w->finish(w, ev[2].t + 1, &err));
+        evr_event *got = NULL;
+        size_t n = 0;
+        int gw, gh;
+        CHECK_OK(evr_events_read(path, &got, &n, &gw, &gh, &err));
+        CHECK(n == 3 && got && got[2].t == ev[2].t && got[0].t == 1000 && got[1].x == 3);
+        free(got);
+    }
 }
 
 /* A stored plane larger than one stored block (65,535 bytes) before a compressed one: the
@@ -471,7 +503,7 @@ static void test_writers(const char *root, int *python_ok)
     snprintf(dir, sizeof dir, "%s/aborted", root);
     CHECK(mkdir(dir, 0700) == 0);
     for (size_t f = 0; f < NFORMATS; f++) {
-        evr_writer_meta meta = {W, H, config};
+        evr_writer_meta meta = {W, H, config, 0};
         evr_event_writer *w = NULL;
         snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
         CHECK_OK(formats[f].open(path, &meta, &w, &e_));
@@ -485,7 +517,7 @@ static void test_writers(const char *root, int *python_ok)
 
     /* a folder that does not exist: a clear error, no crash */
     for (size_t f = 0; f < NFORMATS; f++) {
-        evr_writer_meta meta = {W, H, config};
+        evr_writer_meta meta = {W, H, config, 0};
         evr_event_writer *w = NULL;
         evr_error err;
         err.msg[0] = 0;
@@ -532,6 +564,7 @@ static void test_writers(const char *root, int *python_ok)
     }
 
     test_h5_large(root);
+    test_h5_t_range(root);
 
     /* an independent reader */
     if (system("/usr/bin/python3 -c 'import h5py, numpy' >/dev/null 2>&1") == 0) {
@@ -539,12 +572,12 @@ static void test_writers(const char *root, int *python_ok)
             "import json, sys, warnings\n"
             "warnings.simplefilter('ignore', UserWarning)\n"
             "import h5py, numpy as np, zlib\n"
-            "def same_chunks(path, n):\n"
+            "def same_chunks(path, n, t_type):\n"
             "    # the layout DSEC tools expect, and chunks that hold, decompressed, the very bytes HDF5's\n"
             "    # shuffle filter makes (our deflate is libdeflate's, HDF5's zlib's: the streams differ)\n"
             "    ref_path = path + '.ref.h5'\n"
             "    with h5py.File(path, 'r') as f, h5py.File(ref_path, 'w') as r:\n"
-            "        for name, dt in (('x', np.uint16), ('y', np.uint16), ('t', np.int64), ('p', np.int8)):\n"
+            "        for name, dt in (('x', np.uint16), ('y', np.uint16), ('t', t_type), ('p', np.int8)):\n"
             "            d = f['events'][name]\n"
             "            assert d.dtype == dt and d.shape == (n,) and d.maxshape == (None,), (name, d.dtype, d.shape)\n"
             "            assert d.chunks == (65536,), d.chunks\n"
@@ -573,13 +606,13 @@ static void test_writers(const char *root, int *python_ok)
             "        ms = f['ms_to_idx'][:]\n"
             "        assert np.array_equal(ms, np.searchsorted(t, np.arange(len(ms)) * 1000, 'left'))\n"
             "        assert int(f.attrs['complete']) == 1\n"
-            "    same_chunks(d + '/events.h5', n)\n"
+            "    same_chunks(d + '/events.h5', n, np.int64)\n"
             "def check(d, n):\n"
             "    with h5py.File(d + '/events.h5', 'r') as f:\n"
             "        e = f['events']\n"
             "        x, y, t, p = e['x'][:], e['y'][:], e['t'][:], e['p'][:]\n"
             "        assert x.dtype == np.uint16 and y.dtype == np.uint16, (x.dtype, y.dtype)\n"
-            "        assert t.dtype == np.int64 and p.dtype == np.int8, (t.dtype, p.dtype)\n"
+            "        assert t.dtype == np.uint32 and p.dtype == np.int8, (t.dtype, p.dtype)\n"
             "        assert len(x) == len(y) == len(t) == len(p) == n, (len(t), n)\n"
             "        assert np.all(np.diff(t) >= 0)\n"
             "        assert set(np.unique(p)) <= {0, 1}\n"
@@ -592,7 +625,7 @@ static void test_writers(const char *root, int *python_ok)
             "        cfg = f.attrs['config']\n"
             "        cfg = cfg.decode() if isinstance(cfg, bytes) else cfg\n"
             "        json.loads(cfg)\n"
-            "    same_chunks(d + '/events.h5', n)\n"
+            "    same_chunks(d + '/events.h5', n, np.uint32)\n"
             "    a = np.load(d + '/events.npy')\n"
             "    assert a.dtype == np.dtype([('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', 'i1')]), a.dtype\n"
             "    assert a.dtype.itemsize == 13 and a.shape == (n,), a.shape\n"
@@ -892,7 +925,7 @@ static void bench_h5(const char *root)
 #endif
     const size_t seg = 333333;
     const char *env = getenv("EVR_H5_BENCH_EVENTS");
-    evr_writer_meta meta = {W, H, "{}"};
+    evr_writer_meta meta = {W, H, "{}", 0};
     evr_event_writer *w = NULL;
     evr_event *ev;
     int64_t last_t;

@@ -22,10 +22,13 @@ struct evr_event_writer {
     void (*abort)(evr_event_writer *w);
 };
 
-/* Metadata every writer may store: image size and the full configuration as JSON text. */
+/* Metadata every writer may store: image size and the full configuration as JSON text; and
+ * what a writer may size its fields by: max_t_us, no event's timestamp is larger (0: unknown;
+ * timestamps are never negative). */
 typedef struct {
     int width, height;
     const char *config_json;
+    int64_t max_t_us;
 } evr_writer_meta;
 
 /* path is the final name; writers write to path + ".tmp" until finish(). */

@@ -1,10 +1,14 @@
 /* HDF5 event files in the layout of the DSEC data sets:
  *
- *   /events/x  uint16   /events/y  uint16   /events/t  int64 (us)   /events/p  int8 (1 ON, 0 OFF)
+ *   /events/x  uint16   /events/y  uint16   /events/t  uint32 (us)   /events/p  int8 (1 ON, 0 OFF)
  *   /ms_to_idx uint64   index of the first event with t >= i ms, i = 0 .. ceil(duration/1 ms)
  *   /t_offset  int64    0 (our timestamps start at the simulation start)
  *   attributes on /: width, height (int32), config (JSON text), complete (int8, 1 once finished)
  *
+ * t is uint32 as in DSEC ("the storage of timestamp data with fewer bits", t_offset 0) when the
+ * run's timestamps stay below 2^32 us (71.6 minutes: evr_writer_meta.max_t_us), else int64; an
+ * event outside uint32's range is an error, never wrapped. Half the bytes of int64 to compress:
+ * its constant high bytes still cost libdeflate time.
  * The event datasets and ms_to_idx are extendible and chunked (shuffle + deflate). HDF5 runs
  * its filters serially inside H5Dwrite, which cannot keep up with the GPU backend, so the event
  * chunks are filtered here instead, by a pool of threads (chunk_compress.c makes the very bytes
@@ -61,6 +65,7 @@ typedef struct {
     size_t batch;                /* chunks in a full stage */
     int64_t last_t;
     int have_last;
+    int t32;                     /* events/t is uint32 (else int64) */
     /* ms_to_idx entries computed but not yet appended */
     uint64_t *ms;
     size_t nms, cap_ms;
@@ -200,11 +205,12 @@ static int push_ms(h5_writer *w, uint64_t value)
     return 1;
 }
 
-/* Element size, byte offset in evr_event and dataset of column c (largest elements first). */
-static size_t column_size(int c)
+/* Element size, byte offset in evr_event and dataset of column c (largest elements first). A
+ * uint32 t is the low four bytes of evr_event's int64 (little-endian, as the datasets). */
+static size_t column_size(const h5_writer *w, int c)
 {
     static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t), sizeof(int8_t)};
-    return size[c];
+    return c == 0 && w->t32 ? sizeof(uint32_t) : size[c];
 }
 
 static size_t column_offset(int c)
@@ -222,7 +228,7 @@ static hid_t column_dataset(const h5_writer *w, int c)
 /* Bytes of zbuf that the compressed chunks of one column take in a full batch. */
 static size_t column_room(const h5_writer *w, int c)
 {
-    return w->batch * evr_chunk_bound(H5W_CHUNK * column_size(c));
+    return w->batch * evr_chunk_bound(H5W_CHUNK * column_size(w, c));
 }
 
 /* The jobs of set's chunks 0 .. nchunks, into its zbuf (chunk k holds count(k) events: the full
@@ -234,12 +240,12 @@ static size_t make_jobs(const h5_writer *w, h5_set *set, size_t nchunks, size_t 
     unsigned char *room = set->zbuf;
     size_t njobs = 0;
     for (int c = 0; c < H5W_COLUMNS; c++) {
-        size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(c));
+        size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(w, c));
         for (size_t k = 0; k < nchunks; k++) {
             evr_chunk_job *j = &jobs[njobs++];
             j->src = (const unsigned char *)(stage + k * H5W_CHUNK) + column_offset(c);
             j->stride = sizeof(evr_event);
-            j->elem_size = column_size(c);
+            j->elem_size = column_size(w, c);
             j->count = k < nfull ? H5W_CHUNK : rest;
             j->chunk_elems = H5W_CHUNK;
             j->level = H5W_DEFLATE;
@@ -376,6 +382,14 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
                          "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)", e->t, last_t);
                 return EVR_ERR_ARG;
             }
+            if (w->t32 && (uint64_t)e->t > UINT32_MAX) {
+                w->nstage += k;
+                w->total += k;
+                w->last_t = last_t;
+                w->have_last = 1;
+                snprintf(err->msg, sizeof err->msg, "hdf5 writer: timestamp %" PRId64 " us outside events/t's uint32 range", e->t);
+                return EVR_ERR_ARG;
+            }
             last_t = e->t;
             /* every millisecond boundary up to this event starts here */
             while (e->t >= next_ms_t) {
@@ -495,6 +509,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         int threads = evr_par_threads(H5W_MAX_THREADS);
         size_t room = 0;
         w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_ms = -1;
+        w->t32 = meta->max_t_us > 0 && meta->max_t_us <= (int64_t)UINT32_MAX;
         w->batch = threads < H5W_MIN_BATCH ? H5W_MIN_BATCH : (size_t)threads;
         w->cap_stage = w->batch * H5W_CHUNK;
         for (int c = 0; c < H5W_COLUMNS; c++) room += column_room(w, c);
@@ -528,7 +543,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         }
         if (w->group >= 0) w->ds_x = make_extendible(w->group, "x", H5T_STD_U16LE, H5W_CHUNK);
         if (w->ds_x >= 0) w->ds_y = make_extendible(w->group, "y", H5T_STD_U16LE, H5W_CHUNK);
-        if (w->ds_y >= 0) w->ds_t = make_extendible(w->group, "t", H5T_STD_I64LE, H5W_CHUNK);
+        if (w->ds_y >= 0) w->ds_t = make_extendible(w->group, "t", w->t32 ? H5T_STD_U32LE : H5T_STD_I64LE, H5W_CHUNK);
         if (w->ds_t >= 0) w->ds_p = make_extendible(w->group, "p", H5T_STD_I8LE, H5W_CHUNK);
         if (w->ds_p >= 0) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
         if (w->ds_ms >= 0 &&
