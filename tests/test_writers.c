@@ -15,6 +15,7 @@
 #include "check.h"
 #include "evray.h"
 #include "io/chunk_compress.h"
+#include "io/deflate_runs.h"
 #include "par_pool.h"
 #include "io/event_reader.h"
 #include "io/event_writer.h"
@@ -332,6 +333,58 @@ static void test_h5_t_range(const char *root)
         CHECK(n == 3 && got && got[2].t == ev[2].t && got[0].t == 1000 && got[1].x == 3);
         free(got);
     }
+}
+
+/* Raw-inflates src (n bytes) into out (room bytes); returns the length, or (size_t)-1. */
+static size_t raw_inflate(const unsigned char *src, size_t n, unsigned char *out, size_t room)
+{
+    z_stream z;
+    memset(&z, 0, sizeof z);
+    if (inflateInit2(&z, -15) != Z_OK) return (size_t)-1;
+    z.next_in = (unsigned char *)src;
+    z.avail_in = (uInt)n;
+    z.next_out = out;
+    z.avail_out = (uInt)room;
+    const int r = inflate(&z, Z_FINISH);
+    const size_t len = z.total_out;
+    inflateEnd(&z);
+    return r == Z_STREAM_END ? len : (size_t)-1;
+}
+
+/* Blocks of runs inflate to their input: runs of every length around the match limits (3, 258),
+ * bytes of both literal code lengths (8 and 9 bits), random bytes, an empty input; too little
+ * room is refused, not overrun. */
+static void test_deflate_runs(void)
+{
+    static const size_t runs[] = {1, 2, 3, 4, 10, 257, 258, 259, 260, 261, 515, 516, 517, 1000, 65536};
+    enum { N = 200000 };
+    unsigned char *src = malloc(N), *dst = malloc(2 * N), *back = malloc(N);
+    uint64_t s = 7;
+    CHECK(src && dst && back);
+    if (!src || !dst || !back) goto done;
+    for (int kind = 0; kind < 3; kind++) {
+        size_t n = 0, k = 0;
+        while (n < N) {
+            size_t len = kind == 2 ? 1 : runs[k++ % (sizeof runs / sizeof runs[0])];
+            unsigned char b = (unsigned char)(kind == 0 ? (k * 37) : rng_next(&s));   /* both sides of 144 */
+            for (size_t i = 0; i < len && n < N; i++) src[n++] = b;
+        }
+        size_t z = evr_deflate_runs(src, n, dst, 2 * N);
+        CHECK(z > 0);
+        CHECK(raw_inflate(dst, z, back, N) == n && memcmp(back, src, n) == 0);
+        if (kind == 0) CHECK(z < n / 10);   /* runs shrink */
+        CHECK(evr_deflate_runs(src, n, dst, z - 1) == 0);   /* one byte short */
+    }
+    size_t z = evr_deflate_runs(src, 0, dst, 16);
+    CHECK(z > 0 && raw_inflate(dst, z, back, N) == 0);
+    src[0] = 200;
+    z = evr_deflate_runs(src, 1, dst, 16);
+    CHECK(z > 0 && raw_inflate(dst, z, back, N) == 1 && back[0] == 200);
+    CHECK(evr_deflate_repeats((const unsigned char *)"aaab", 4) == 2);
+done:
+    free(src);
+    free(dst);
+    free(back);
 }
 
 /* A stored plane larger than one stored block (65,535 bytes) before a compressed one: the
@@ -977,6 +1030,7 @@ int main(void)
     test_json();
     test_chunk_compress();
     test_chunk_stored_blocks();
+    test_deflate_runs();
     test_writers(root, &python_ok);
     test_tonemap(root);
     test_event_frames(root);
