@@ -38,6 +38,22 @@ def run_env(env, *args, expect=0):
         os.environ.pop(env, None)
 
 
+def interrupt(started_file, after, *args):
+    """Runs evray with args, sends it SIGINT (Ctrl-C) `after` seconds after started_file appears
+    (a writer's temporary file: the run has begun), and returns the finished process's
+    (returncode, stderr)."""
+    import signal
+    import time
+    proc = subprocess.Popen([EVRAY, *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 60
+    while time.time() < deadline and not os.path.exists(started_file):
+        time.sleep(0.05)
+    time.sleep(after)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    return proc.returncode, err
+
+
 _tmpdirs = []
 
 

@@ -140,19 +140,11 @@ T.check(T.load_run_json(d)["stats"]["events"] == 0, "cornell-still with GI on CU
 # Ctrl-C: the CUDA backend keeps each segment's latest events on the device for the next one's
 # sort; the last segment the run finishes must give them up. The interrupted file equals, byte for
 # byte, a run of the simulated length that was not interrupted (brute force, to be slow enough).
-import signal, subprocess, time
 di = os.path.join(tmp, "int-cuda")
-proc = subprocess.Popen([T.EVRAY, "demo", "--scene", "eye", "-o", di, "--backend", "cuda", "--res", "1280x720",
-                         "--no-skip", "--format", "npy", "--no-preview"], stdout=subprocess.PIPE,
-                        stderr=subprocess.PIPE, text=True)
-deadline = time.time() + 60
-while time.time() < deadline and not os.path.exists(os.path.join(di, "events.npy.tmp")):
-    time.sleep(0.05)
-time.sleep(1.5)
-proc.send_signal(signal.SIGINT)
-out, err = proc.communicate(timeout=120)
-T.check(proc.returncode == 130, f"interrupted CUDA run exits 130 (got {proc.returncode}: {err.strip()[-200:]})")
-if proc.returncode == 130:
+rc, err = T.interrupt(os.path.join(di, "events.npy.tmp"), 1.5, "demo", "--scene", "eye", "-o", di, "--backend", "cuda",
+                      "--res", "1280x720", "--no-skip", "--format", "npy", "--no-preview")
+T.check(rc == 130, f"interrupted CUDA run exits 130 (got {rc}: {err.strip()[-200:]})")
+if rc == 130:
     meta = T.load_run_json(di)
     sim = meta["stats"]["simulated_seconds"]
     T.check(meta["stats"]["interrupted"] is True and 0 < sim < 29.9, f"stopped early ({sim} s)")

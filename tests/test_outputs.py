@@ -83,18 +83,11 @@ a, b = (open(os.path.join(x, "events.npy"), "rb").read() for x in (d1, d2))
 T.check(a == b, "identical events for 1 and 2 threads")
 
 # Ctrl-C: stops after the current segment, leaves complete files holding every event so far
-import signal, subprocess, time
 d3 = os.path.join(T.tmpdir(), "int")
-proc = subprocess.Popen([T.EVRAY, "demo", "--scene", "eye", "-o", d3, "--res", "200x150", "--samples-per-frame", "20",
-                         "--format", "h5,npy", "--no-preview", "--threads", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-deadline = time.time() + 60
-while time.time() < deadline and not os.path.exists(os.path.join(d3, "events.h5.tmp")):
-    time.sleep(0.05)
-time.sleep(1.0)
-proc.send_signal(signal.SIGINT)
-out, err = proc.communicate(timeout=120)
-T.check(proc.returncode == 130, f"interrupted run exits 130 (got {proc.returncode}: {err.strip()})")
-if proc.returncode == 130:
+rc, err = T.interrupt(os.path.join(d3, "events.h5.tmp"), 1.0, "demo", "--scene", "eye", "-o", d3, "--res", "200x150",
+                      "--samples-per-frame", "20", "--format", "h5,npy", "--no-preview", "--threads", "1")
+T.check(rc == 130, f"interrupted run exits 130 (got {rc}: {err.strip()})")
+if rc == 130:
     meta = T.load_run_json(d3)
     T.check(meta["stats"]["interrupted"] is True, "run.json says interrupted")
     ev3, ms3, _ = T.load_h5(os.path.join(d3, "events.h5"))
