@@ -85,26 +85,21 @@ static inline void shuffle_es(unsigned char *out, const unsigned char *src, size
         for (size_t b = 0; b < es; b++) memset(out + b * chunk_elems + count, 0, chunk_elems - count);
 }
 
-/* Whether p[0 .. n) is random enough to store: its bits per byte (order-0 entropy of its
- * histogram) and the bytes equal to the one before them (the runs deflate would find). */
-static int plane_random(const unsigned char *p, size_t n)
+/* Whether p[0 .. n), of which `repeats` bytes equal the one before them (the runs deflate would
+ * find; evr_deflate_repeats), is random enough to store: few repeats and many bits per byte
+ * (order-0 entropy of its histogram). */
+static int plane_random(const unsigned char *p, size_t n, size_t repeats)
 {
     uint32_t h[4][256] = {{0}};   /* four histograms: no store waits on the one before */
-    size_t i = 1, repeats = 0;
-    if (n < 2) return 0;
-    h[0][p[0]]++;
+    size_t i = 0;
+    if (n < 2 || repeats * STORE_REPEATS > n) return 0;
     for (; i + 4 <= n; i += 4) {
         h[0][p[i]]++;
         h[1][p[i + 1]]++;
         h[2][p[i + 2]]++;
         h[3][p[i + 3]]++;
-        repeats += (p[i] == p[i - 1]) + (p[i + 1] == p[i]) + (p[i + 2] == p[i + 1]) + (p[i + 3] == p[i + 2]);
     }
-    for (; i < n; i++) {
-        h[0][p[i]]++;
-        repeats += p[i] == p[i - 1];
-    }
-    if (repeats * STORE_REPEATS > n) return 0;
+    for (; i < n; i++) h[0][p[i]]++;
     double bits = 0.0;
     for (int v = 0; v < 256; v++) {
         const uint32_t c = h[0][v] + h[1][v] + h[2][v] + h[3][v];
@@ -121,8 +116,12 @@ static int plane_random(const unsigned char *p, size_t n)
 static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned char *raw, size_t n, size_t es,
                           unsigned char *dst, size_t room)
 {
-    size_t stored = 0, at = 2, total = n * es;
-    while (stored + 1 < es && plane_random(raw + stored * n, n)) stored++;
+    size_t stored = 0, at = 2, total = n * es, rest_repeats = 0;
+    for (size_t j = 0; j < es; j++) {   /* each plane's repeats, counted once */
+        const size_t r = evr_deflate_repeats(raw + j * n, n);
+        if (j == stored && j + 1 < es && plane_random(raw + j * n, n, r)) stored++;
+        else rest_repeats += r + (j > stored && raw[j * n] == raw[j * n - 1]);   /* and across planes */
+    }
     if (room < 6) return 0;
     dst[0] = 0x78;   /* deflate, 32 KiB window */
     dst[1] = 0x01;   /* no dictionary; (0x78 * 256 + 0x01) % 31 == 0 */
@@ -143,7 +142,7 @@ static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned cha
     const unsigned char *rest = raw + stored * n;
     const size_t rest_n = total - stored * n;
     size_t z = 0;
-    if (evr_deflate_repeats(rest, rest_n) * RUNS_REPEATS >= rest_n * (RUNS_REPEATS - 1))
+    if (rest_repeats * RUNS_REPEATS >= rest_n * (RUNS_REPEATS - 1))
         z = evr_deflate_runs(rest, rest_n, dst + at, room - at - 4);
     if (z == 0) z = libdeflate_deflate_compress(comp, rest, rest_n, dst + at, room - at - 4);   /* else, or too long */
     if (z == 0) return 0;
