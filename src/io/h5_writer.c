@@ -359,6 +359,17 @@ static evr_status drain(h5_writer *w, evr_error *err)
     return EVR_OK;
 }
 
+/* Keeps the k events staged before one the writer refuses (their time order ends at last_t) and
+ * returns st. */
+static evr_status stop_staging(h5_writer *w, size_t k, int64_t last_t, evr_status st)
+{
+    w->nstage += k;
+    w->total += k;
+    w->last_t = last_t;
+    w->have_last = 1;
+    return st;
+}
+
 static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     h5_writer *w = (h5_writer *)base;
@@ -374,32 +385,20 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
         for (k = 0; k < m; k++) {
             const evr_event *e = &ev[k];
             if (e->t < last_t) {
-                w->nstage += k;
-                w->total += k;
-                w->last_t = last_t;
-                w->have_last = 1;
                 snprintf(err->msg, sizeof err->msg,
                          "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)", e->t, last_t);
-                return EVR_ERR_ARG;
+                return stop_staging(w, k, last_t, EVR_ERR_ARG);
             }
             if (w->t32 && (uint64_t)e->t > UINT32_MAX) {
-                w->nstage += k;
-                w->total += k;
-                w->last_t = last_t;
-                w->have_last = 1;
                 snprintf(err->msg, sizeof err->msg, "hdf5 writer: timestamp %" PRId64 " us outside events/t's uint32 range", e->t);
-                return EVR_ERR_ARG;
+                return stop_staging(w, k, last_t, EVR_ERR_ARG);
             }
             last_t = e->t;
             /* every millisecond boundary up to this event starts here */
             while (e->t >= next_ms_t) {
                 if (!push_ms(w, w->total + k)) {
-                    w->nstage += k;
-                    w->total += k;
-                    w->last_t = last_t;
-                    w->have_last = 1;
                     snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
-                    return EVR_ERR_NOMEM;
+                    return stop_staging(w, k, last_t, EVR_ERR_NOMEM);
                 }
                 next_ms_t += 1000;
             }
