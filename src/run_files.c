@@ -95,9 +95,8 @@ evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
     meta.width = sim->cfg.width;
     meta.height = sim->cfg.height;
     meta.config_json = sim->config_json;
-    /* timestamps end with the run, moved by jitter (clipped) and rounding to the resolution */
-    meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration + (double)EVR_JITTER_CLIP * sim->cfg.time_jitter) * 1e6) +
-                    sim->setup.pixel.time_res_us + 1;
+    /* timestamps end with the run, moved by jitter and rounding to the resolution */
+    meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + evr_sim_timestamp_slack_us(sim) + 1;
     for (i = 0; i < 3; i++) {
         if (!(sim->cfg.formats & kinds[i].bit)) continue;
         if ((st = path_join(p, sizeof p, sim->out_dir, kinds[i].file, err)) != EVR_OK) return st;

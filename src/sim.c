@@ -340,8 +340,7 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     /* adaptive sampling: a pixel's last sample here is no earlier than t1 - max_dt */
     if (!final && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
-    if (!final && (sim->cfg.time_jitter > 0.0 || sim->setup.pixel.time_res_us > 1))
-        safe -= (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
+    if (!final) safe -= evr_sim_timestamp_slack_us(sim);
     double t = evr_host_seconds();
     if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) != EVR_OK) return st;
     sim->time_render += evr_host_seconds() - t;
@@ -378,6 +377,12 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     sim->st.sim_time = t1 - sim->cfg.start;
     evr_sim_set_wall(sim);
     return EVR_OK;
+}
+
+int64_t evr_sim_timestamp_slack_us(const evr_sim *sim)
+{
+    if (sim->cfg.time_jitter <= 0.0 && sim->setup.pixel.time_res_us <= 1) return 0;
+    return (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
 }
 
 void evr_sim_set_wall(evr_sim *sim)

@@ -74,6 +74,10 @@ struct evr_sim {
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 
+/* How far timestamp jitter (clipped) and rounding to the resolution can move an event's
+ * timestamp from its crossing, in microseconds (0 for exact timestamps). */
+int64_t evr_sim_timestamp_slack_us(const evr_sim *sim);
+
 /* The run's wall time so far, and the rates that follow from it, into sim->st. */
 void evr_sim_set_wall(evr_sim *sim);
 
