@@ -335,6 +335,41 @@ static void test_h5_t_range(const char *root)
     }
 }
 
+/* A batch large enough to be staged on the writer's pool, with one event it must refuse (out of
+ * time order; past events/t's uint32 range): the write says why, the events before it are kept
+ * and the finished file holds exactly those, with their ms_to_idx. */
+static void test_h5_refused_in_bulk(const char *root)
+{
+    const size_t n = 100000, bad_at[2] = {70001, 50003};
+    for (int kind = 0; kind < 2; kind++) {
+        int64_t last_t;
+        evr_event *ev = make_events(n, &last_t), *got = NULL;
+        evr_writer_meta meta = {W, H, "{}", kind == 0 ? 0 : last_t + 10};
+        evr_event_writer *w = NULL;
+        evr_error err;
+        size_t ngot = 0, k = bad_at[kind];
+        char path[600];
+        CHECK(ev != NULL);
+        if (!ev) return;
+        CHECK(ev[k - 1].t > 0);
+        ev[k].t = kind == 0 ? ev[k - 1].t - 1 : (int64_t)UINT32_MAX + 1;
+        snprintf(path, sizeof path, "%s/refused%d.h5", root, kind);
+        CHECK_OK(evr_h5_writer_open(path, &meta, &w, &err));
+        if (w) {
+            err.msg[0] = 0;
+            CHECK(w->write(w, ev, n, &err) == EVR_ERR_ARG);
+            CHECK(strstr(err.msg, kind == 0 ? "out of time order" : "uint32") != NULL);
+            CHECK_OK(w->finish(w, ev[k - 1].t + 1, &err));
+            CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &err));
+            CHECK(ngot == k);
+            if (got && ngot == k) CHECK(same_events(got, ev, k));
+            free(got);
+            check_ms_to_idx(path, ev, k, ev[k - 1].t + 1);
+        }
+        free(ev);
+    }
+}
+
 /* Raw-inflates src (n bytes) into out (room bytes); returns the length, or (size_t)-1. */
 static size_t raw_inflate(const unsigned char *src, size_t n, unsigned char *out, size_t room)
 {
@@ -618,6 +653,7 @@ static void test_writers(const char *root, int *python_ok)
 
     test_h5_large(root);
     test_h5_t_range(root);
+    test_h5_refused_in_bulk(root);
 
     /* an independent reader */
     if (system("/usr/bin/python3 -c 'import h5py, numpy' >/dev/null 2>&1") == 0) {
