@@ -22,12 +22,6 @@
 #endif
 
 #define TILE 16
-/* A moving group's segment keys go to Embree as consecutive instances of at most this many time
- * steps, each valid over its part of the segment (rtcSetGeometryTimeRange), all with the same
- * motion as one instance of every key: Embree's rays slowed 1.8x between 17 and 65 time steps
- * of the same motion (the eye in a blink, machine A) */
-#define SLICE_KEYS 9
-#define MAX_SLICES ((EVR_MAX_KEYS - 1 + SLICE_KEYS - 2) / (SLICE_KEYS - 1))
 
 typedef struct {
     evr_backend base;
@@ -48,14 +42,6 @@ typedef struct {
     int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
     int *members;                  /* scene instance index of each geometry */
     RTCScene top;
-    /* the top level's geometry IDs: group g's instance is g; a moving group's further slices
-     * (SLICE_KEYS) follow the groups, MAX_SLICES - 1 per moving group in order (slice_base[g]:
-     * the first, -1 for a static group); inst_first[id] = group_first of the group of top
-     * geometry id */
-    int *slice_base;
-    int *inst_first;
-    int slices_off;                /* EVR_NO_EMBREE_SLICES (hidden, for tests and measurement): one
-                                      instance of every key */
     int gi;                        /* global illumination on */
     evr_cpu_gi gi_state;
     evr_pixel_state *pixels;
@@ -152,7 +138,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (!hit[i]) continue;
-        int inst = b->members[b->inst_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
+        int inst = b->members[b->group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
@@ -180,20 +166,9 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             sr.flags[i] = 0;
         }
         if (!any) continue;
-        /* Shadow rays take the nearest-hit packet query, any hit blocking, in every segment:
-         * Embree 3.13.5's packet occlusion test ignores an instance's time range (a slice outside
-         * its time blocks the ray; rtcOccluded1 and rtcIntersect8 honour it), and one query for
-         * all segments keeps change-driven sampling exact (a cached answer from a segment that
-         * used the other query differed from brute force once in the eye's 218.7 M events) */
-        struct RTCRayHit8 sh;
-        sh.ray = sr;
-        for (i = 0; i < PACKET; i++) {
-            sh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            sh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcIntersect8(vmask, b->top, &ctx, &sh);
+        rtcOccluded8(vmask, b->top, &ctx, &sr);
         for (i = 0; i < PACKET; i++)
-            if (vmask[i] && sh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
+            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
     }
     for (i = 0; i < PACKET; i++) {
         if (!hit[i]) {   /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
@@ -575,40 +550,21 @@ static void *worker(void *arg)
     return NULL;
 }
 
-/* Top geometry id of slice s of group g. */
-static unsigned slice_id(const cpu_backend *b, int g, int s)
-{
-    return s == 0 ? (unsigned)g : (unsigned)(b->slice_base[g] + s - 1);
-}
-
 static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_error *err)
 {
     int g, k;
     for (g = 0; g < b->num_groups; g++) {
         int track = b->group_track[g];
         if (track < 0) continue;   /* static group: set once */
-        const int n = seg->track_count[track], nseg = n - 1;
-        const int slices = n <= SLICE_KEYS || b->slices_off ? 1 : (nseg + SLICE_KEYS - 2) / (SLICE_KEYS - 1);
-        for (int sl = 0; sl < MAX_SLICES; sl++) {
-            RTCGeometry geom = rtcGetGeometry(b->top, slice_id(b, g, sl));
-            if (sl >= slices) {
-                if (sl > 0) rtcDisableGeometry(geom);
-                continue;
-            }
-            /* keys a .. e over normalized times a / (n - 1) .. e / (n - 1): the same uniform steps */
-            const int a = slices == 1 ? 0 : sl * (SLICE_KEYS - 1);
-            const int e = slices == 1 ? n - 1 : (a + SLICE_KEYS - 1 < n - 1 ? a + SLICE_KEYS - 1 : n - 1);
-            rtcSetGeometryTimeStepCount(geom, (unsigned)(e - a + 1));
-            for (k = a; k <= e; k++) {
-                struct RTCQuaternionDecomposition q;
-                to_embree(&seg->keys[seg->track_offset[track] + k], &q);
-                rtcSetGeometryTransformQuaternion(geom, (unsigned)(k - a), &q);
-            }
-            if (nseg > 0) rtcSetGeometryTimeRange(geom, (float)a / (float)nseg, (float)e / (float)nseg);
-            else rtcSetGeometryTimeRange(geom, 0.0f, 1.0f);
-            if (sl > 0) rtcEnableGeometry(geom);
-            rtcCommitGeometry(geom);
+        int n = seg->track_count[track];
+        RTCGeometry geom = rtcGetGeometry(b->top, (unsigned)g);
+        rtcSetGeometryTimeStepCount(geom, (unsigned)n);
+        for (k = 0; k < n; k++) {
+            struct RTCQuaternionDecomposition q;
+            to_embree(&seg->keys[seg->track_offset[track] + k], &q);
+            rtcSetGeometryTransformQuaternion(geom, (unsigned)k, &q);
         }
+        rtcCommitGeometry(geom);
     }
     rtcCommitScene(b->top);
     if (b->embree_error[0]) {
@@ -743,8 +699,6 @@ static void cpu_release(evr_backend *base)
     if (!b) return;
     if (b->gi) evr_cpu_gi_free(&b->gi_state);
     if (b->top) rtcReleaseScene(b->top);
-    free(b->slice_base);
-    free(b->inst_first);
     if (b->group_scenes) {
         for (i = 0; i < b->num_groups; i++)
             if (b->group_scenes[i]) rtcReleaseScene(b->group_scenes[i]);
@@ -940,25 +894,6 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     if (!build_groups(b, s) || b->embree_error[0]) goto embree_fail;
     b->top = rtcNewScene(b->device);
     if (!b->top) goto embree_fail;
-    b->slices_off = getenv("EVR_NO_EMBREE_SLICES") != NULL;
-    {
-        int moving = 0, next;
-        for (m = 0; m < b->num_groups; m++) moving += b->group_track[m] >= 0;
-        b->slice_base = malloc(sizeof(int) * ((size_t)b->num_groups + 1));
-        b->inst_first = malloc(sizeof(int) * ((size_t)b->num_groups + (size_t)moving * (MAX_SLICES - 1) + 1));
-        if (!b->slice_base || !b->inst_first) {
-            cpu_release(&b->base);
-            snprintf(err->msg, sizeof err->msg, "out of memory");
-            return EVR_ERR_NOMEM;
-        }
-        next = b->num_groups;
-        for (m = 0; m < b->num_groups; m++) {
-            b->inst_first[m] = b->group_first[m];
-            b->slice_base[m] = b->group_track[m] >= 0 ? next : -1;
-            if (b->group_track[m] < 0) continue;
-            for (int sl = 1; sl < MAX_SLICES; sl++) b->inst_first[next++] = b->group_first[m];
-        }
-    }
     /* rebuilt every segment, but over a handful of instances (thousands when static instances are
      * not baked: then nothing in it moves and Embree does not rebuild it): quality costs little */
     rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_HIGH);
@@ -976,14 +911,6 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         }
         rtcAttachGeometryByID(b->top, g, (unsigned)m);
         rtcReleaseGeometry(g);
-        for (int sl = 1; b->group_track[m] >= 0 && sl < MAX_SLICES; sl++) {   /* the further slices, off */
-            RTCGeometry gs = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
-            if (!gs) goto embree_fail;
-            rtcSetGeometryInstancedScene(gs, b->group_scenes[m]);
-            rtcAttachGeometryByID(b->top, gs, slice_id(b, m, sl));
-            rtcDisableGeometry(gs);
-            rtcReleaseGeometry(gs);
-        }
     }
     if (b->embree_error[0]) goto embree_fail;
     if (setup->gi) {
@@ -991,7 +918,7 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         evr_status st;
         tc.top = b->top;
         tc.members = b->members;
-        tc.group_first = b->inst_first;   /* indexed by top geometry id (slices) */
+        tc.group_first = b->group_first;
         b->gi = 1;
         if ((st = evr_cpu_gi_init(&b->gi_state, &tc, &b->setup, s, err)) != EVR_OK) {
             cpu_release(&b->base);
