@@ -335,6 +335,72 @@ static void test_h5_t_range(const char *root)
     }
 }
 
+/* The NPY writer packs and writes large writes in parts on its pool (pwrite at each part's place):
+ * large and small writes and flushes interleaved read back whole, the temporary file after a flush
+ * holds every event so far, and an event out of order inside a large write is refused with the
+ * events before it kept (the finished file holds exactly those). */
+static void test_npy_large(const char *root)
+{
+    static const struct { size_t len; int flush; } steps[] = {
+        {1, 1}, {65535, 0}, {3, 1}, {300000, 1}, {7, 0}, {33000, 0}, {1454, 1},
+    };
+    const size_t n = 400000;
+    int64_t last_t;
+    evr_event *ev = make_events(n, &last_t), *got = NULL;
+    evr_writer_meta meta = {W, H, "{}", 0};
+    evr_event_writer *w = NULL;
+    evr_error err;
+    size_t at = 0, ngot = 0;
+    char path[600], tmp[620], partial[600];
+    CHECK(ev != NULL);
+    if (!ev) return;
+    snprintf(path, sizeof path, "%s/large.npy", root);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    snprintf(partial, sizeof partial, "%s/partial.npy", root);
+    CHECK_OK(evr_npy_writer_open(path, &meta, &w, &err));
+    for (size_t s = 0; w && s < sizeof steps / sizeof steps[0]; s++) {
+        CHECK_OK(w->write(w, ev + at, steps[s].len, &err));
+        at += steps[s].len;
+        if (!steps[s].flush) continue;
+        CHECK_OK(w->flush(w, &err));
+        CHECK(copy_file(tmp, partial));
+        CHECK_OK(evr_events_read(partial, &got, &ngot, NULL, NULL, &err));
+        CHECK(ngot == at);
+        if (got && ngot == at) CHECK(same_events(got, ev, at));
+        free(got);
+        got = NULL;
+        remove(partial);
+    }
+    CHECK(at == n);
+    if (w) {
+        CHECK_OK(w->finish(w, last_t + 1, &err));
+        CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &err));
+        CHECK(ngot == n);
+        if (got && ngot == n) CHECK(same_events(got, ev, n));
+        free(got);
+        got = NULL;
+    }
+    /* refused inside a large write, after a small one */
+    {
+        const size_t k = 70001;
+        CHECK(ev[k - 1].t > 0);
+        ev[k].t = ev[k - 1].t - 1;
+        snprintf(path, sizeof path, "%s/refused.npy", root);
+        CHECK_OK(evr_npy_writer_open(path, &meta, &w, &err));
+        if (w) {
+            CHECK_OK(w->write(w, ev, 5, &err));
+            err.msg[0] = 0;
+            CHECK(w->write(w, ev + 5, 100000, &err) == EVR_ERR_ARG && strstr(err.msg, "out of time order") != NULL);
+            CHECK_OK(w->finish(w, ev[k - 1].t + 1, &err));
+            CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &err));
+            CHECK(ngot == k);
+            if (got && ngot == k) CHECK(same_events(got, ev, k));
+            free(got);
+        }
+    }
+    free(ev);
+}
+
 /* A batch large enough to be staged on the writer's pool, with one event it must refuse (out of
  * time order; past events/t's uint32 range): the write says why, the events before it are kept
  * and the finished file holds exactly those, with their ms_to_idx. */
@@ -654,6 +720,7 @@ static void test_writers(const char *root, int *python_ok)
     test_h5_large(root);
     test_h5_t_range(root);
     test_h5_refused_in_bulk(root);
+    test_npy_large(root);
 
     /* an independent reader */
     if (system("/usr/bin/python3 -c 'import h5py, numpy' >/dev/null 2>&1") == 0) {

@@ -7,16 +7,24 @@
  * every event up to the last flush. */
 #include "io/event_writer.h"
 #include "io/file_commit.h"
+#include "par_pool.h"
 
 #include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define NPY_RECORD 13
 #define NPY_BUFFER_RECORDS (1u << 16)
 #define NPY_DESCR "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1')]"
+/* A write of this many events or more is checked, packed and written (pwrite at its offset) in
+ * parts on a pool of NPY_THREADS: one thread packing and copying 2.84 GB into the page cache
+ * kept the eye's 30 s waiting (H100 machine: writer busy 1.9-2.2 s, the loop waiting 0.7-1.0 s) */
+#define NPY_PAR_MIN (1u << 15)
+#define NPY_THREADS 4
+#define NPY_PARTS 16
 
 typedef struct {
     evr_event_writer base;       /* first: the interface pointer is the writer pointer */
@@ -28,6 +36,9 @@ typedef struct {
     size_t header_len;           /* bytes before the first record */
     int64_t last_t;
     int have_last;
+    evr_par_pool *pool;
+    unsigned char *big;          /* a large write's records */
+    size_t big_cap;              /* records big has room for */
 } npy_writer;
 
 /* Builds the whole header (magic, version, length, dict, padding, newline) for count records.
@@ -74,19 +85,129 @@ static evr_status drain(npy_writer *w, evr_error *err)
 
 static void free_writer(npy_writer *w)
 {
+    evr_par_pool_free(w->pool);
+    free(w->big);
     free(w->path);
     free(w->tmp);
     free(w->buf);
     free(w);
 }
 
+/* One record, little-endian whatever the host. */
+static void pack(unsigned char *r, const evr_event *e)
+{
+    const uint64_t t = (uint64_t)e->t;
+    for (int b = 0; b < 8; b++) r[b] = (unsigned char)(t >> (8 * b));
+    r[8] = (unsigned char)(e->x & 0xff);
+    r[9] = (unsigned char)(e->x >> 8);
+    r[10] = (unsigned char)(e->y & 0xff);
+    r[11] = (unsigned char)(e->y >> 8);
+    r[12] = e->p ? 1 : 0;
+}
+
+/* A large write in parts: pass 0 checks each event against the one before and packs it into big,
+ * pass 1 writes each part's records at their place in the file. */
+typedef struct {
+    const evr_event *ev;
+    size_t n;
+    unsigned char *big;
+    int fd;
+    off_t at;                    /* file offset of ev[0]'s record */
+    int pass;
+    int bad[NPY_PARTS];          /* pass 0: an event out of order; pass 1: a failed write */
+} npy_job;
+
+static void npy_part(void *ctx, int k, int thread)
+{
+    npy_job *j = ctx;
+    const size_t per = (j->n + NPY_PARTS - 1) / NPY_PARTS, a = (size_t)k * per, b = a + per < j->n ? a + per : j->n;
+    (void)thread;
+    if (a >= b) return;
+    if (j->pass == 0) {
+        for (size_t i = a; i < b; i++) {
+            if (i > 0 && j->ev[i].t < j->ev[i - 1].t) {
+                j->bad[k] = 1;
+                return;
+            }
+            pack(j->big + i * NPY_RECORD, &j->ev[i]);
+        }
+        return;
+    }
+    const unsigned char *src = j->big + a * NPY_RECORD;
+    size_t left = (b - a) * NPY_RECORD;
+    off_t at = j->at + (off_t)(a * NPY_RECORD);
+    while (left > 0) {
+        const ssize_t wrote = pwrite(j->fd, src, left, at);
+        if (wrote <= 0) {
+            if (wrote < 0 && errno == EINTR) continue;
+            j->bad[k] = 1;
+            return;
+        }
+        src += wrote;
+        left -= (size_t)wrote;
+        at += wrote;
+    }
+}
+
+/* Writes ev[0 .. n) (n >= NPY_PAR_MIN, ev[0] not before the last event written) on the pool after
+ * the buffered records; returns 0 (nothing written) when an event is out of order, for the serial
+ * path to report. */
+static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err, evr_status *st)
+{
+    npy_job j;
+    *st = EVR_OK;
+    if (n > w->big_cap) {
+        unsigned char *p = realloc(w->big, n * NPY_RECORD);
+        if (!p) return 0;   /* the serial path needs no room */
+        w->big = p;
+        w->big_cap = n;
+    }
+    memset(&j, 0, sizeof j);
+    j.ev = ev;
+    j.n = n;
+    j.big = w->big;
+    evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
+    for (int k = 0; k < NPY_PARTS; k++)
+        if (j.bad[k]) return 0;
+    if ((*st = drain(w, err)) != EVR_OK || fflush(w->f) != 0) {
+        if (*st == EVR_OK) {
+            snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+            *st = EVR_ERR_IO;
+        }
+        return 1;
+    }
+    j.fd = fileno(w->f);
+    j.at = (off_t)w->header_len + (off_t)(w->count * NPY_RECORD);
+    j.pass = 1;
+    evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
+    for (int k = 0; k < NPY_PARTS; k++)
+        if (j.bad[k]) {
+            snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+            *st = EVR_ERR_IO;
+            return 1;
+        }
+    /* the stream goes on after the records written past it */
+    if (fseek(w->f, 0, SEEK_END) != 0) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        *st = EVR_ERR_IO;
+        return 1;
+    }
+    w->count += n;
+    w->last_t = ev[n - 1].t;
+    w->have_last = 1;
+    return 1;
+}
+
 static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     npy_writer *w = (npy_writer *)base;
+    if (n >= NPY_PAR_MIN && !(w->have_last && ev[0].t < w->last_t)) {
+        evr_status st;
+        if (write_parallel(w, ev, n, err, &st)) return st;
+    }
     for (size_t i = 0; i < n; i++) {
         const evr_event *e = &ev[i];
         unsigned char *r;
-        uint64_t t = (uint64_t)e->t;
         if (w->have_last && e->t < w->last_t) {
             snprintf(err->msg, sizeof err->msg, "npy writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
                      e->t, w->last_t);
@@ -98,13 +219,8 @@ static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t 
             evr_status st = drain(w, err);
             if (st != EVR_OK) return st;
         }
-        r = w->buf + w->nbuf * NPY_RECORD;   /* little-endian whatever the host */
-        for (int b = 0; b < 8; b++) r[b] = (unsigned char)(t >> (8 * b));
-        r[8] = (unsigned char)(e->x & 0xff);
-        r[9] = (unsigned char)(e->x >> 8);
-        r[10] = (unsigned char)(e->y & 0xff);
-        r[11] = (unsigned char)(e->y >> 8);
-        r[12] = e->p ? 1 : 0;
+        r = w->buf + w->nbuf * NPY_RECORD;
+        pack(r, e);
         w->nbuf++;
     }
     return EVR_OK;
@@ -159,8 +275,9 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
         w->path = malloc(len + 1);
         w->tmp = malloc(len + 5);
         w->buf = malloc((size_t)NPY_BUFFER_RECORDS * NPY_RECORD);
+        w->pool = evr_par_pool_new(evr_par_threads(NPY_THREADS));
     }
-    if (!w || !w->path || !w->tmp || !w->buf) {
+    if (!w || !w->path || !w->tmp || !w->buf || !w->pool) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "npy writer: out of memory");
         return EVR_ERR_NOMEM;
