@@ -199,15 +199,22 @@ static void free_writer(h5_writer *w)
     free(w);
 }
 
+/* Room for `extra` more ms_to_idx entries; 0 when out of memory (nothing changed). */
+static int reserve_ms(h5_writer *w, size_t extra)
+{
+    if (w->nms + extra <= w->cap_ms) return 1;
+    size_t cap = w->cap_ms ? w->cap_ms : 1024;
+    while (cap < w->nms + extra) cap *= 2;
+    uint64_t *p = realloc(w->ms, cap * sizeof *p);
+    if (!p) return 0;
+    w->ms = p;
+    w->cap_ms = cap;
+    return 1;
+}
+
 static int push_ms(h5_writer *w, uint64_t value)
 {
-    if (w->nms == w->cap_ms) {
-        size_t cap = w->cap_ms ? w->cap_ms * 2 : 1024;
-        uint64_t *p = realloc(w->ms, cap * sizeof *p);
-        if (!p) return 0;
-        w->ms = p;
-        w->cap_ms = cap;
-    }
+    if (!reserve_ms(w, 1)) return 0;
     w->ms[w->nms++] = value;
     w->next_ms++;
     return 1;
@@ -383,6 +390,15 @@ static evr_status stop_staging(h5_writer *w, size_t k, int64_t last_t, evr_statu
  * boundaries that fall between them (ms_to_idx's entries: the index of the first event at or
  * after the boundary). A part that finds an event out of order or out of range says so (bad);
  * the writer then stages the slice alone, which stops at the first such event. */
+/* An event as staged: p 0 or 1. */
+static void stage_event(evr_event *d, const evr_event *e)
+{
+    d->t = e->t;
+    d->x = e->x;
+    d->y = e->y;
+    d->p = e->p ? 1 : 0;
+}
+
 typedef struct {
     const evr_event *ev;
     evr_event *dst;
@@ -426,10 +442,7 @@ static void stage_part(void *ctx, int k, int thread)
             }
             p->ms[p->nms++] = j->base + i;
         }
-        j->dst[i].t = e->t;
-        j->dst[i].x = e->x;
-        j->dst[i].y = e->y;
-        j->dst[i].p = e->p ? 1 : 0;
+        stage_event(&j->dst[i], e);
     }
 }
 
@@ -448,11 +461,18 @@ static int stage_parallel(h5_writer *w, const evr_event *ev, size_t m, evr_event
     j.base = w->total;
     j.t32 = w->t32;
     evr_par_pool_run(w->stage_pool, H5W_STAGE_PARTS, stage_part, &j);
-    for (int k = 0; k < H5W_STAGE_PARTS; k++) ok &= !j.part[k].bad;
+    size_t entries = 0;
+    for (int k = 0; k < H5W_STAGE_PARTS; k++) {
+        ok &= !j.part[k].bad;
+        entries += j.part[k].nms;
+    }
     if (!ok) r = 0;
-    for (int k = 0; ok && k < H5W_STAGE_PARTS; k++)
-        for (size_t i = 0; ok && i < j.part[k].nms; i++)
-            if (!push_ms(w, j.part[k].ms[i])) ok = 0, r = -1;
+    else if (!reserve_ms(w, entries)) r = -1;   /* before any entry: the index stays whole */
+    for (int k = 0; r > 0 && k < H5W_STAGE_PARTS; k++) {
+        if (j.part[k].nms) memcpy(w->ms + w->nms, j.part[k].ms, j.part[k].nms * sizeof *w->ms);   /* ms NULL when none */
+        w->nms += j.part[k].nms;
+        w->next_ms += j.part[k].nms;
+    }
     for (int k = 0; k < H5W_STAGE_PARTS; k++) free(j.part[k].ms);
     return r;
 }
@@ -485,10 +505,7 @@ static evr_status stage_serial(h5_writer *w, const evr_event *ev, evr_event *dst
             }
             next_ms_t += 1000;
         }
-        dst[k].t = e->t;
-        dst[k].x = e->x;
-        dst[k].y = e->y;
-        dst[k].p = e->p ? 1 : 0;
+        stage_event(&dst[k], e);
     }
     return EVR_OK;
 }
