@@ -72,12 +72,16 @@ static evr_status write_header(npy_writer *w, evr_error *err)
     return EVR_OK;
 }
 
+/* The error of a failed write to the temporary file. */
+static evr_status cannot_write(const npy_writer *w, evr_error *err)
+{
+    snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+    return EVR_ERR_IO;
+}
+
 static evr_status drain(npy_writer *w, evr_error *err)
 {
-    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-        return EVR_ERR_IO;
-    }
+    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf) return cannot_write(w, err);
     w->count += w->nbuf;
     w->nbuf = 0;
     return EVR_OK;
@@ -150,8 +154,8 @@ static void npy_part(void *ctx, int k, int thread)
 }
 
 /* Writes ev[0 .. n) (n >= NPY_PAR_MIN, ev[0] not before the last event written) on the pool after
- * the buffered records; returns 0 (nothing written) when an event is out of order, for the serial
- * path to report. */
+ * the buffered records (*st: how it went); returns 0, nothing written, when an event is out of
+ * order or there is no room to pack them: the serial path then writes them or reports it. */
 static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err, evr_status *st)
 {
     npy_job j;
@@ -169,11 +173,9 @@ static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_erro
     evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
     for (int k = 0; k < NPY_PARTS; k++)
         if (j.bad[k]) return 0;
-    if ((*st = drain(w, err)) != EVR_OK || fflush(w->f) != 0) {
-        if (*st == EVR_OK) {
-            snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-            *st = EVR_ERR_IO;
-        }
+    if ((*st = drain(w, err)) != EVR_OK) return 1;
+    if (fflush(w->f) != 0) {
+        *st = cannot_write(w, err);
         return 1;
     }
     j.fd = fileno(w->f);
@@ -182,14 +184,12 @@ static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_erro
     evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
     for (int k = 0; k < NPY_PARTS; k++)
         if (j.bad[k]) {
-            snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-            *st = EVR_ERR_IO;
+            *st = cannot_write(w, err);
             return 1;
         }
     /* the stream goes on after the records written past it */
     if (fseek(w->f, 0, SEEK_END) != 0) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-        *st = EVR_ERR_IO;
+        *st = cannot_write(w, err);
         return 1;
     }
     w->count += n;
@@ -231,10 +231,7 @@ static evr_status npy_flush(evr_event_writer *base, evr_error *err)
     npy_writer *w = (npy_writer *)base;
     evr_status st = drain(w, err);
     if (st == EVR_OK) st = write_header(w, err);
-    if (st == EVR_OK && fflush(w->f) != 0) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
-        st = EVR_ERR_IO;
-    }
+    if (st == EVR_OK && fflush(w->f) != 0) st = cannot_write(w, err);
     return st;
 }
 
@@ -293,7 +290,7 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
         return EVR_ERR_IO;
     }
     if (fwrite(h, 1, w->header_len, w->f) != w->header_len) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+        cannot_write(w, err);
         fclose(w->f);
         remove(w->tmp);
         free_writer(w);
