@@ -648,6 +648,12 @@ static int event_key_bits(int n)
     return b;
 }
 
+/* Bits below an event key's time: polarity, x, y (pack_event). */
+static int key_time_shift(int width, int height)
+{
+    return 1 + event_key_bits(width) + event_key_bits(height);
+}
+
 /* One segment in flight. */
 struct slot {
     int index;
@@ -862,6 +868,12 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
     return EVR_OK;
 }
 
+/* Microseconds after a slot's base_us its event keys can hold. */
+static long long slot_span_us(const cuda_backend *b, const slot *sl)
+{
+    return 1ll << (sl->end_bit - key_time_shift(b->setup.width, b->setup.height));
+}
+
 static kernel_args make_args(cuda_backend *b, slot *sl)
 {
     kernel_args a;
@@ -914,7 +926,7 @@ static kernel_args make_args(cuda_backend *b, slot *sl)
     a.coherence = getenv("EVR_NO_COHERENCE") == NULL;
     a.xbits = event_key_bits(b->setup.width);
     a.ybits = event_key_bits(b->setup.height);
-    a.span_us = 1ll << (sl->end_bit - 1 - a.xbits - a.ybits);
+    a.span_us = slot_span_us(b, sl);
     /* a re-render at overflow after the camera moved on renders without them */
     a.static_hits = sl->static_gen >= 0 && sl->static_gen == b->static_gen ? b->d_static.p : nullptr;
     return a;
@@ -1298,13 +1310,12 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
     const size_t carried = b->carry_slot >= 0 ? b->carry_n : 0;
     CK(cudaEventRecord(sl->sort_from, sl->copy));
     if (carried) {
-        const long long span_us = 1ll << (sl->end_bit - 1 - event_key_bits(b->setup.width) - event_key_bits(b->setup.height));
-        if (b->carry_t_lo < sl->base_us || b->carry_t_hi - sl->base_us >= span_us) {
+        if (b->carry_t_lo < sl->base_us || b->carry_t_hi - sl->base_us >= slot_span_us(b, sl)) {
             snprintf(err->msg, sizeof err->msg, "internal error: events carried to the segment at %.6f s fall outside its time window",
                      sl->t0);
             return EVR_ERR_BACKEND;
         }
-        const int shift = 1 + event_key_bits(b->setup.width) + event_key_bits(b->setup.height);
+        const int shift = key_time_shift(b->setup.width, b->setup.height);
         const unsigned long long delta = (unsigned long long)(sl->base_us - b->carry_base_us) << shift;
         CK(grow_keeping(sl->d_keys_ev, n + carried, n, sl->copy));
         const unsigned blocks = (unsigned)((carried + BLOCK - 1) / BLOCK < 1024 ? (carried + BLOCK - 1) / BLOCK : 1024);
@@ -1405,7 +1416,7 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     double span_us = (back + dt + slack) * 1e6 + 2.0;
     int tbits = 1;
     while (tbits < 31 && (double)(1ull << tbits) < span_us) tbits++;
-    sl->end_bit = 1 + event_key_bits(b->setup.width) + event_key_bits(b->setup.height) + tbits;
+    sl->end_bit = key_time_shift(b->setup.width, b->setup.height) + tbits;
     sl->num_tracks = seg->num_tracks;
     sl->num_keys = seg->num_keys;
     CK(sl->h_keys.reserve((size_t)seg->num_keys));
@@ -1586,14 +1597,14 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t em
      * to its last one here). On the host they had to be merged with the next segment's events:
      * 0.21 s of the main thread for the 30 s eye, and a copy of them at every hand-over. */
     const int xb = event_key_bits(b->setup.width), yb = event_key_bits(b->setup.height);
-    const int shift = 1 + xb + yb;
+    const int shift = key_time_shift(b->setup.width, b->setup.height);
     const size_t total = sl->total;   /* its own n and those carried in */
     size_t split = total;
     if (emit_before_us != INT64_MAX) {
         const long long rel = (long long)emit_before_us - sl->base_us;
         const unsigned long long limit = rel <= 0 ? 0ull : (unsigned long long)rel << shift;   /* the first key at or after it */
         size_t lo = 0, hi = total;
-        if (rel >= (1ll << (sl->end_bit - shift))) lo = total;
+        if (rel >= slot_span_us(b, sl)) lo = total;
         while (lo < hi) {
             const size_t mid = lo + (hi - lo) / 2;
             if (sl->h_sorted.p[mid] < limit) lo = mid + 1;
