@@ -42,6 +42,7 @@ typedef struct {
     int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
     int *members;                  /* scene instance index of each geometry */
     RTCScene top;
+    int time_grid;                 /* the segment's motion keys split it into this many equal intervals (1: none moves) */
     int gi;                        /* global illumination on */
     evr_cpu_gi gi_state;
     evr_pixel_state *pixels;
@@ -261,62 +262,76 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
 }
 
 /* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
- * tile: the packets stay full however few pixels trace). With settle (k0 == 0, k1 == 1): a pixel
- * whose first sample's rays meet nothing that moves in the segment keeps that intensity for the
- * rest of the segment (its later samples run here); the others are listed in *more. A sample in
- * the still span of its pixel's last traced sample takes that sample's intensity (no rays). */
+ * tile: the packets stay full however few pixels trace). Sample by sample, each packet's lanes
+ * are pixels whose ray times fall in the same interval between the segment's motion keys: Embree's
+ * motion-blurred top level splits its nodes at the keys, and a packet whose lanes straddle them
+ * traverses each part again (the eye's blink: 1.75x the time of packets at one time). A sample in
+ * the still span of its pixel's last traced sample takes that sample's intensity (no rays). With
+ * settle (k0 == 0, k1 == 1): a pixel whose first sample's rays meet nothing that moves in the
+ * segment keeps that intensity for the rest of the segment (its later samples run here); the
+ * others are listed in *more. Each pixel's samples reach its pixel model in time order. */
 static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int count, int k0, int k1, int settle, int *more,
                           int *num_more, const evr_m34 *pose_static, int ideal, float dt, evr_event_vec *out,
                           unsigned long long *rays, unsigned long long *traced)
 {
     const evr_render_scene *rs = &b->host.rs;
     const evr_segment *seg = b->seg;
-    const int n = b->setup.samples_per_frame;
-    int c, i, k;
-    for (c = 0; c < count; c += PACKET) {
-        int xs[PACKET], ys[PACKET], valid[PACKET];
-        float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
-        tile_pixel *q[PACKET];
-        for (i = 0; i < PACKET; i++) {
-            valid[i] = c + i < count;
-            q[i] = &px[list[valid[i] ? c + i : c]];
-            xs[i] = q[i]->x;
-            ys[i] = q[i]->y;
-        }
-        for (k = k0; k < k1; k++) {
-            int lane[PACKET], any = 0;
-            for (i = 0; i < PACKET; i++) {
-                fs[i] = ((float)k + q[i]->phi) / (float)n;
-                /* held: in the still span of its last traced sample, the same scene bit for bit */
-                const int span = evr_skip_still_span(seg->skip, fs[i]);
-                lane[i] = valid[i] && !evr_skip_held(seg->skip, span, q[i]->last_span);
-                if (lane[i]) q[i]->last_span = span;
-                any |= lane[i];
+    const int n = b->setup.samples_per_frame, grid = b->time_grid;
+    int order[TILE * TILE], bucket[TILE * TILE], first[EVR_MAX_KEYS + 1];
+    int c, i, j, k, g;
+    for (k = k0; k < k1; k++) {
+        int ntr = 0;
+        for (g = 0; g <= grid; g++) first[g] = 0;
+        for (j = 0; j < count; j++) {
+            tile_pixel *q = &px[list[j]];
+            const float f = ((float)k + q->phi) / (float)n;
+            /* held: in the still span of its last traced sample, the same scene bit for bit */
+            const int span = evr_skip_still_span(seg->skip, f);
+            if (evr_skip_held(seg->skip, span, q->last_span)) {
+                bucket[j] = -1;
+                pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y, out);
+                continue;
             }
-            if (any) sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, lane, intensity, t_hit, direct, rays);
+            q->last_span = span;
+            g = (int)(evr_skip_trace_time(seg->skip, f) * (float)grid);
+            bucket[j] = g < 0 ? 0 : g >= grid ? grid - 1 : g;
+            first[bucket[j] + 1]++;
+            ntr++;
+        }
+        for (g = 0; g < grid; g++) first[g + 1] += first[g];
+        for (j = 0; j < count; j++)
+            if (bucket[j] >= 0) order[first[bucket[j]]++] = j;   /* list order within an interval */
+        for (c = 0; c < ntr; c += PACKET) {
+            int xs[PACKET], ys[PACKET], valid[PACKET];
+            float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
+            tile_pixel *q[PACKET];
+            for (i = 0; i < PACKET; i++) {
+                valid[i] = c + i < ntr;
+                q[i] = &px[list[order[valid[i] ? c + i : c]]];
+                xs[i] = q[i]->x;
+                ys[i] = q[i]->y;
+                fs[i] = ((float)k + q[i]->phi) / (float)n;
+            }
+            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, direct, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
-                if (lane[i]) {
-                    (*traced)++;
-                    q[i]->t_hit = t_hit[i];
-                    q[i]->direct = direct[i];
-                } else {
-                    intensity[i] = kept_intensity(b, q[i], fs[i]);
-                }
+                (*traced)++;
+                q[i]->t_hit = t_hit[i];
+                q[i]->direct = direct[i];
                 pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
             }
         }
-        if (!settle) continue;
-        for (i = 0; i < PACKET; i++) {
-            if (!valid[i]) continue;
-            float cd = evr_skip_cache_after_trace(rs, seg->skip, q[i]->ray, q[i]->t_hit);
-            if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
-                q[i]->st->cache_dist = cd;
-                keep_samples(b, q[i], ideal, k1, n, dt, out);
-                q[i]->t_hit = -1.0f;   /* its cache is set */
-            } else {
-                more[(*num_more)++] = list[c + i];
-            }
+    }
+    if (!settle) return;
+    for (j = 0; j < count; j++) {
+        tile_pixel *q = &px[list[j]];
+        float cd = evr_skip_cache_after_trace(rs, seg->skip, q->ray, q->t_hit);
+        if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
+            q->st->cache_dist = cd;
+            keep_samples(b, q, ideal, k1, n, dt, out);
+            q->t_hit = -1.0f;   /* its cache is set */
+        } else {
+            more[(*num_more)++] = list[j];
         }
     }
 }
@@ -553,10 +568,12 @@ static void *worker(void *arg)
 static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_error *err)
 {
     int g, k;
+    b->time_grid = 1;
     for (g = 0; g < b->num_groups; g++) {
         int track = b->group_track[g];
         if (track < 0) continue;   /* static group: set once */
         int n = seg->track_count[track];
+        if (n - 1 > b->time_grid) b->time_grid = n - 1;   /* 2^k + 1 uniform keys: the finest grid holds the others */
         RTCGeometry geom = rtcGetGeometry(b->top, (unsigned)g);
         rtcSetGeometryTimeStepCount(geom, (unsigned)n);
         for (k = 0; k < n; k++) {
