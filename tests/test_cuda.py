@@ -156,4 +156,28 @@ if rc == 130:
           f"{T.load_run_json(dr)['stats']['events']}")
     T.check(a == b, "the interrupted run's events are those of an uninterrupted run of its length")
 
+# EVR_TIMELINE (a measurement switch): one row per segment, in order, each row's host and GPU
+# times in order, and the segments' own event counts adding up to the run's events
+tl = os.path.join(tmp, "timeline.txt")
+d = os.path.join(tmp, "timeline-run")
+os.environ["EVR_TIMELINE"] = tl
+try:
+    T.run("demo", "--scene", "eye", "-o", d, "--backend", "cuda", "--res", "96x72", "--duration", "0.5", "--start", "0.9",
+          "--format", "npy", "--no-preview", "--quiet")
+    os.environ["EVR_TIMELINE"] = os.path.join(tmp, "no-such-folder", "timeline.txt")
+    bad = T.run("demo", "--scene", "eye", "-o", os.path.join(tmp, "timeline-bad"), "--backend", "cuda", "--res", "32x24",
+                "--duration", "0.1", "--no-preview", "--quiet", expect=None)
+finally:
+    os.environ.pop("EVR_TIMELINE", None)
+lines = open(tl).read().split("\n")
+head, rows = lines[0].split(), [list(map(float, l.split())) for l in lines[1:] if l.strip()]
+col = {name: k for k, name in enumerate(head)}
+T.check([int(r[col["seg"]]) for r in rows] == list(range(15)), f"timeline: one row per segment, in order ({len(rows)} rows)")
+T.check(all(r[col["sub0"]] <= r[col["sub1"]] <= r[col["col1"]] and
+            r[col["col0"]] <= r[col["counted"]] <= r[col["copied"]] <= r[col["col1"]] and
+            r[col["g_start"]] <= r[col["g_rendered"]] <= r[col["g_copied"]] for r in rows), "timeline: each row's times in order")
+T.check(int(sum(r[col["n"]] for r in rows)) == T.load_run_json(d)["stats"]["events"], "timeline: the segments' events add up")
+T.check(bad.returncode != 0 and "cannot write" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1,
+        f"timeline: an unwritable path is a one-line error ({bad.stderr.strip()!r})")
+
 T.finish("test_cuda")
