@@ -793,16 +793,20 @@ struct cuda_backend {
     cudaEvent_t tl_base;
     double tl_h0;
     struct tl_rec { double sub0, sub1, col0, counted, copied, col1, g_start, g_rendered, g_sort, g_copied; size_t n; } *tl_recs;
-    int tl_cap;
+    int tl_cap, tl_lost;
 };
+/* Segment i's timeline record (nullptr: no timeline, or no memory for it, which the file then says). */
 static cuda_backend::tl_rec *tl_at(cuda_backend *b, int i)
 {
-    if (!b->tl) return nullptr;
+    if (!b->tl || b->tl_lost) return nullptr;
     if (i >= b->tl_cap) {
         int cap = b->tl_cap ? 2 * b->tl_cap : 1024;
         while (cap <= i) cap *= 2;
         void *p = realloc(b->tl_recs, (size_t)cap * sizeof *b->tl_recs);
-        if (!p) return nullptr;
+        if (!p) {
+            b->tl_lost = 1;
+            return nullptr;
+        }
         b->tl_recs = (cuda_backend::tl_rec *)p;
         memset(b->tl_recs + b->tl_cap, 0, (size_t)(cap - b->tl_cap) * sizeof *b->tl_recs);
         b->tl_cap = cap;
@@ -1682,7 +1686,7 @@ static void cuda_release(evr_backend *base)
     cuda_backend *b = (cuda_backend *)base;
     if (!b) return;
     cudaDeviceSynchronize();
-    if (b->tl) {
+    if (b->tl) {   /* seconds from the base event; a segment's row once it was submitted */
         fprintf(b->tl, "seg sub0 sub1 col0 counted copied col1 g_start g_rendered g_sort g_copied n\n");
         for (int i = 0; i < b->tl_cap; i++) {
             const cuda_backend::tl_rec *r = &b->tl_recs[i];
@@ -1690,8 +1694,10 @@ static void cuda_release(evr_backend *base)
             fprintf(b->tl, "%d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %zu\n", i, r->sub0, r->sub1, r->col0, r->counted,
                     r->copied, r->col1, r->g_start, r->g_rendered, r->g_sort, r->g_copied, r->n);
         }
-        fclose(b->tl);
+        if (b->tl_lost) fprintf(b->tl, "# incomplete: out of memory for the timeline\n");
+        if (fclose(b->tl) != 0 || b->tl_lost) fprintf(stderr, "evray: warning: the timeline (EVR_TIMELINE) is incomplete\n");
         free(b->tl_recs);
+        if (b->tl_base) cudaEventDestroy(b->tl_base);
     }
     for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];
