@@ -1792,8 +1792,14 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaGetLastError());
     CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
     /* four events a pixel per segment: the eye's busiest segments at 1280x720 take 3.3 (a segment
-     * that needs more grows every slot's buffers, after rendering it again) */
-    b->capacity = npix * 4 > (1u << 20) ? npix * 4 : (1u << 20);
+     * that needs more grows every slot's buffers, after rendering it again); but the slots' key,
+     * sorted-key and sort buffers (24 bytes a key each) take at most an eighth of the free device
+     * memory up front, so that a large image on a small GPU still starts (and grows as needed) */
+    size_t free_bytes = 0, total_bytes = 0;
+    CK(cudaMemGetInfo(&free_bytes, &total_bytes));
+    const size_t fit = free_bytes / 8 / (NSLOT * 24);
+    b->capacity = npix * 4 < fit ? npix * 4 : fit;
+    if (b->capacity < (1u << 20)) b->capacity = 1u << 20;
     b->carry_slot = -1;
     int gi_margin = 0, gi_window = 0;
     b->gi = b->setup.gi;
