@@ -5,11 +5,20 @@
 #ifndef EVR_PAR_POOL_H
 #define EVR_PAR_POOL_H
 
+#include <stddef.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 typedef struct evr_par_pool evr_par_pool;
+
+/* Part k of n items cut into `parts` shares as equal as can be: items [*begin, *end). */
+static inline void evr_par_share(size_t n, int parts, int k, size_t *begin, size_t *end)
+{
+    *begin = n * (size_t)k / (size_t)parts;
+    *end = n * (size_t)(k + 1) / (size_t)parts;
+}
 
 /* Part `part` of a job, run by thread `thread`: 0 the caller's, 1 .. threads - 1 the pool's (for
  * state kept per thread). */

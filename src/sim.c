@@ -264,7 +264,8 @@ static void count_events_start(evr_sim *sim, const evr_event *ev, size_t n)
     if (parts < 1) parts = 1;
     if (parts > EVR_COUNT_PARTS) parts = EVR_COUNT_PARTS;
     for (size_t k = 0; k < parts; k++) {
-        const size_t i0 = n * k / parts, i1 = n * (k + 1) / parts;
+        size_t i0, i1;
+        evr_par_share(n, (int)parts, (int)k, &i0, &i1);
         evr_event_counts *c = &sim->counting[k];
         c->ev = ev + i0;
         c->n = i1 - i0;

@@ -385,11 +385,6 @@ static evr_status stop_staging(h5_writer *w, size_t k, int64_t last_t, evr_statu
     return st;
 }
 
-/* Parallel staging of m events (m >= 2) after a first one staged alone: part k checks and copies
- * its share of events 1 .. m - 1, each against the one before, and lists the millisecond
- * boundaries that fall between them (ms_to_idx's entries: the index of the first event at or
- * after the boundary). A part that finds an event out of order or out of range says so (bad);
- * the writer then stages the slice alone, which stops at the first such event. */
 /* An event as staged: p 0 or 1. */
 static void stage_event(evr_event *d, const evr_event *e)
 {
@@ -399,6 +394,11 @@ static void stage_event(evr_event *d, const evr_event *e)
     d->p = e->p ? 1 : 0;
 }
 
+/* Parallel staging of m events (m >= 2) after a first one staged alone: part k checks and copies
+ * its share of events 1 .. m - 1, each against the one before, and lists the millisecond
+ * boundaries that fall between them (ms_to_idx's entries: the index of the first event at or
+ * after the boundary). A part that finds an event out of order or out of range says so (bad);
+ * the writer then stages the slice alone, which stops at the first such event. */
 typedef struct {
     const evr_event *ev;
     evr_event *dst;
@@ -416,9 +416,11 @@ static void stage_part(void *ctx, int k, int thread)
 {
     stage_job *j = ctx;
     struct stage_part *p = &j->part[k];
-    const size_t per = (j->m - 1 + H5W_STAGE_PARTS - 1) / H5W_STAGE_PARTS;
-    const size_t a = 1 + (size_t)k * per, b = a + per < j->m ? a + per : j->m;
+    size_t a, b;
     (void)thread;
+    evr_par_share(j->m - 1, H5W_STAGE_PARTS, k, &a, &b);   /* of events 1 .. m - 1 */
+    a++;
+    b++;
     p->nms = 0;
     p->bad = 0;
     for (size_t i = a; i < b; i++) {

@@ -124,8 +124,9 @@ typedef struct {
 static void npy_part(void *ctx, int k, int thread)
 {
     npy_job *j = ctx;
-    const size_t per = (j->n + NPY_PARTS - 1) / NPY_PARTS, a = (size_t)k * per, b = a + per < j->n ? a + per : j->n;
+    size_t a, b;
     (void)thread;
+    evr_par_share(j->n, NPY_PARTS, k, &a, &b);
     if (a >= b) return;
     if (j->pass == 0) {
         for (size_t i = a; i < b; i++) {
