@@ -31,6 +31,7 @@ extern "C" {
 #include "host_clock.h"
 #include "par_pool.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -788,7 +789,8 @@ struct cuda_backend {
     dbuf<unsigned> d_gd_req, d_gd_count;
     dbuf<int> d_gd_traced;
     dbuf<gi_request> d_gd_requests;
-    /* EVR_TIMELINE=path (hidden, for measurement): per segment, host and GPU times, written at release */
+    /* EVR_TIMELINE=path (hidden, for measurement): per segment, host times (evr_host_seconds) and
+     * GPU times (seconds after tl_base, recorded at tl_h0 on the host), written at release */
     FILE *tl;
     cudaEvent_t tl_base;
     double tl_h0;
@@ -1492,7 +1494,10 @@ static evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_err
     if (b->gi && (st = gi_segment(b, sl, seg, &hrs, err)) != EVR_OK) return st;
     if ((st = launch(b, sl, err)) != EVR_OK) return st;
     b->queued++;
-    if (cuda_backend::tl_rec *r = tl_at(b, seg->index)) { r->sub0 = tl_sub0 - b->tl_h0; r->sub1 = evr_host_seconds() - b->tl_h0; }
+    if (cuda_backend::tl_rec *r = tl_at(b, seg->index)) {
+        r->sub0 = tl_sub0;
+        r->sub1 = evr_host_seconds();
+    }
     return EVR_OK;
 }
 
@@ -1546,7 +1551,8 @@ struct decode_job {
 static void decode_part(void *ctx, int k, int)
 {
     const decode_job *j = (const decode_job *)ctx;
-    const size_t i0 = j->n * (size_t)k / j->parts, i1 = j->n * (size_t)(k + 1) / j->parts;
+    size_t i0, i1;
+    evr_par_share(j->n, (int)j->parts, k, &i0, &i1);
     for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
 }
 static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n, long long base_us, int xb, int yb,
@@ -1617,12 +1623,16 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t em
     base->wait_seconds += evr_host_seconds() - tw;
     const double tl_copied = evr_host_seconds();
     if (cuda_backend::tl_rec *r = tl_at(b, sl->index)) {
-        float ms = 0.0f;
-        r->col0 = tl_col0 - b->tl_h0; r->counted = tl_counted - b->tl_h0; r->copied = tl_copied - b->tl_h0;
-        CK(cudaEventElapsedTime(&ms, b->tl_base, sl->started)); r->g_start = 1e-3 * ms;
-        CK(cudaEventElapsedTime(&ms, b->tl_base, sl->rendered)); r->g_rendered = 1e-3 * ms;
-        CK(cudaEventElapsedTime(&ms, b->tl_base, sl->sort_from)); r->g_sort = 1e-3 * ms;
-        CK(cudaEventElapsedTime(&ms, b->tl_base, sl->copied)); r->g_copied = 1e-3 * ms;
+        const cudaEvent_t ev[4] = {sl->started, sl->rendered, sl->sort_from, sl->copied};
+        double *g[4] = {&r->g_start, &r->g_rendered, &r->g_sort, &r->g_copied};
+        for (int k = 0; k < 4; k++) {
+            float ms = 0.0f;
+            CK(cudaEventElapsedTime(&ms, b->tl_base, ev[k]));
+            *g[k] = 1e-3 * ms;
+        }
+        r->col0 = tl_col0;
+        r->counted = tl_counted;
+        r->copied = tl_copied;
         r->n = n;
     }
     if (n) {
@@ -1675,7 +1685,7 @@ static evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t em
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
     *frames = sl->num_frames ? sl->h_frames.p : NULL;
     base->device_bytes = device_bytes(b);
-    if (cuda_backend::tl_rec *r = tl_at(b, sl->index)) r->col1 = evr_host_seconds() - b->tl_h0;
+    if (cuda_backend::tl_rec *r = tl_at(b, sl->index)) r->col1 = evr_host_seconds();
     b->head = (b->head + 1) % NSLOT;
     b->queued--;
     return start_ready_copies(b, err);
@@ -1687,12 +1697,14 @@ static void cuda_release(evr_backend *base)
     if (!b) return;
     cudaDeviceSynchronize();
     if (b->tl) {   /* seconds from the base event; a segment's row once it was submitted */
+        const double h0 = b->tl_h0;
         fprintf(b->tl, "seg sub0 sub1 col0 counted copied col1 g_start g_rendered g_sort g_copied n\n");
         for (int i = 0; i < b->tl_cap; i++) {
             const cuda_backend::tl_rec *r = &b->tl_recs[i];
             if (r->sub1 == 0.0) continue;
-            fprintf(b->tl, "%d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %zu\n", i, r->sub0, r->sub1, r->col0, r->counted,
-                    r->copied, r->col1, r->g_start, r->g_rendered, r->g_sort, r->g_copied, r->n);
+            fprintf(b->tl, "%d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %zu\n", i, r->sub0 - h0, r->sub1 - h0,
+                    r->col0 - h0, r->counted - h0, r->copied - h0, r->col1 - h0, r->g_start, r->g_rendered, r->g_sort,
+                    r->g_copied, r->n);
         }
         if (b->tl_lost) fprintf(b->tl, "# incomplete: out of memory for the timeline\n");
         if (fclose(b->tl) != 0 || b->tl_lost) fprintf(stderr, "evray: warning: the timeline (EVR_TIMELINE) is incomplete\n");
@@ -1853,7 +1865,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaDeviceSynchronize());
     if (const char *tl = getenv("EVR_TIMELINE")) {
         if (!(b->tl = fopen(tl, "w"))) {
-            snprintf(err->msg, sizeof err->msg, "cannot write %s", tl);
+            snprintf(err->msg, sizeof err->msg, "cannot write the timeline %s (EVR_TIMELINE): %s", tl, strerror(errno));
             return EVR_ERR_IO;
         }
         CK(cudaEventCreate(&b->tl_base));
