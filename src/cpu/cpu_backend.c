@@ -278,13 +278,14 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     const evr_segment *seg = b->seg;
     const int n = b->setup.samples_per_frame, grid = b->time_grid;
     int order[TILE * TILE], bucket[TILE * TILE], first[EVR_MAX_KEYS + 1];
+    float fk[TILE * TILE];   /* listed pixel j's normalized time at sample k */
     int c, i, j, k, g;
     for (k = k0; k < k1; k++) {
         int ntr = 0;
         for (g = 0; g <= grid; g++) first[g] = 0;
         for (j = 0; j < count; j++) {
             tile_pixel *q = &px[list[j]];
-            const float f = ((float)k + q->phi) / (float)n;
+            const float f = fk[j] = ((float)k + q->phi) / (float)n;
             /* held: in the still span of its last traced sample, the same scene bit for bit */
             const int span = evr_skip_still_span(seg->skip, f);
             if (evr_skip_held(seg->skip, span, q->last_span)) {
@@ -307,10 +308,11 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             tile_pixel *q[PACKET];
             for (i = 0; i < PACKET; i++) {
                 valid[i] = c + i < ntr;
-                q[i] = &px[list[order[valid[i] ? c + i : c]]];
+                j = order[valid[i] ? c + i : c];
+                q[i] = &px[list[j]];
                 xs[i] = q[i]->x;
                 ys[i] = q[i]->y;
-                fs[i] = ((float)k + q[i]->phi) / (float)n;
+                fs[i] = fk[j];
             }
             sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, direct, rays);
             for (i = 0; i < PACKET; i++) {
