@@ -108,7 +108,7 @@ static void help(void)
          "                             gets the same indirect light, so GI makes no events by itself)\n"
          "  --photons N                photons per pass (default: one per pixel)\n"
          "  --gather-radius R          distance filter, world units (default 2% of the scene's diagonal)\n"
-         "  --gather-max N             photons per estimate at most (default 64)\n"
+         "  --gather-max N             photons per estimate at most (default 0: no limit, every photon of the disk)\n"
          "  --gather-window N          gather window half size at most, pixels (default 8)\n"
          "  --photon-layers N          photons each pixel of the buffer holds (default 8)\n"
          "  --gi-bounces N             indirect bounces of a photon (default 4)\n"

@@ -51,7 +51,7 @@ void evr_config_defaults(evr_config *c)
     c->gi = 0;
     c->photons = 0;
     c->gather_radius = 0.0f;
-    c->gather_max = 64;
+    c->gather_max = 0;   /* no limit: every photon of the disk, updated from the changed cells */
     c->gather_window = 8;
     c->photon_layers = 8;
     c->gi_bounces = 4;
@@ -170,7 +170,7 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
     if (c->gpu_bvh != 0 && c->gpu_bvh != 4 && c->gpu_bvh != 8) BAD("unknown GPU BVH layout %d (4 or 8)", c->gpu_bvh);
     if (c->gi != 0 && c->gi != 1) BAD("unknown global illumination mode %d", c->gi);
     if (c->gi) {
-        if (c->gather_max < 1 || c->gather_max > 65536) BAD("--gather-max must be between 1 and 65536 (got %d)", c->gather_max);
+        if (c->gather_max < 0 || c->gather_max > 65536) BAD("--gather-max must be between 0 (no limit) and 65536 (got %d)", c->gather_max);
         if (c->gather_window < 0 || c->gather_window > 256) BAD("--gather-window must be between 0 and 256 pixels (got %d)", c->gather_window);
         if (c->photon_layers < 1 || c->photon_layers > 64) BAD("--photon-layers must be between 1 and 64 (got %d)", c->photon_layers);
         if (c->gi_bounces < 0 || c->gi_bounces > 64) BAD("--gi-bounces must be between 0 and 64 (got %d)", c->gi_bounces);

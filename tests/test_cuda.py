@@ -111,9 +111,10 @@ T.check(share < 0.3, "cornell GI on CUDA: events do not cluster at segment bound
 T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: overflowing segments re-rendered, identical events")
 # the gathers deferred to a kernel of their own (cuda/gpu_gi_deferred.cuh, the default with uniform
 # sampling) give the events of the render kernel that gathers inline (EVR_GI_INLINE=1) bit for
-# bit: with change-driven sampling, brute force and the full sensor model
+# bit: with change-driven sampling, brute force and the full sensor model; and with a limit on the
+# photons per estimate (--gather-max 8: the ring search, not the fixed-point sums)
 for label, extra in (("skip", []), ("brute", ["--no-skip"]), ("davis346", ["--sensor", "davis346"]),
-                     ("720p", ["--res", "1280x720", "--duration", "0.3"])):
+                     ("720p", ["--res", "1280x720", "--duration", "0.3"]), ("gather-max", ["--gather-max", "8"])):
     evs = []
     for env in (None, "EVR_GI_INLINE"):
         d = os.path.join(tmp, f"gi-deferred-{label}-{env}")

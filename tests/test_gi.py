@@ -70,7 +70,7 @@ T.check(st["photons_reused"] + st["photons_traced"] == jt["stats"]["photons_trac
 T.check(jb["stats"]["photons_reused"] == 0, "GI brute force (--no-skip): no photon reuses its trail")
 
 bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
-       ["--gi", "photon", "--gather-max", "0"], ["--gi", "photon", "--gather-radius", "-1"],
+       ["--gi", "photon", "--gather-max", "-1"], ["--gi", "photon", "--gather-radius", "-1"],
        ["--gi", "photon", "--photons", "x"]]
 for args in bad:
     p = T.run("demo", "--scene", "cornell", "-o", os.path.join(tmp, "bad"), "--duration", "0.1", "--quiet", *args,

@@ -161,6 +161,20 @@ static void test_gather_units(void)
                                  depth, &gp, e);
     CHECK(used > 100);
     CHECK_NEAR(e[0] / (phi / (pix * pix)), 1.0, 0.03);
+    {   /* no limit (max_photons 0): the fixed-point sums give the float walk's luminance */
+        evr_gather_params g0 = gp;
+        evr_gather_point g;
+        g.p = evr_v3_make(0.5f * pix, -0.5f * pix, -depth);
+        g.n = evr_v3_make(0, 0, 1);
+        g.dist = depth;
+        g.k[0] = 0.3f; g.k[1] = 0.2f; g.k[2] = 0.1f;
+        const float l_float = evr_gather_point_lum(&b, &c, &gp, &g, w / 2, h / 2);
+        g0.max_photons = 0;
+        g0.flux_scale = evr_gather_flux_scale(phi * (float)(w * h), (uint32_t)(w * h));
+        const float l_fix = evr_gather_point_lum(&b, &c, &g0, &g, w / 2, h / 2);
+        CHECK(l_float > 0.0f);
+        CHECK_NEAR(l_fix / l_float, 1.0, 1e-5);
+    }
     /* at most max_photons: the radius shrinks, the estimate stays */
     gp.max_photons = 40;
     used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth), evr_v3_make(0, 0, 1),
@@ -631,7 +645,7 @@ static void test_gather_moved(void)
 {
     enum { N = 21 };
     const evr_camera_intr cam = evr_camera_intr_make(N, N, 0.5f * EVR_PI);   /* tan(yfov / 2) = 1 */
-    evr_gather_params gp = {0.2f, 64, 8, 0.5f};   /* r, max, window, normal cosine */
+    evr_gather_params gp = {0.2f, 64, 8, 0.5f, 0.0f};   /* r, max, window, normal cosine, (fixed point: unused) */
     const evr_v3 p = evr_v3_make(0.0f, 0.0f, 0.0f), nrm = evr_v3_make(0.0f, 0.0f, 1.0f);
     const float dist = 1.0f;   /* pixel size 2/21 at the point: window half size ceil(0.2 / 0.095) + 1 = 4 */
     static uint32_t sat[(N + 1) * (N + 1)];
@@ -664,6 +678,93 @@ static void test_gather_moved(void)
     }
 }
 
+static uint64_t rng_next(uint64_t *s) { return evr_mix64(++*s); }
+static float rng_uniform(uint64_t *s) { return evr_uniform(rng_next(s)); }
+
+/* The fixed-point sums (max_photons 0): a buffer's sums are another's plus the changed cells'
+ * terms minus their old ones, bit for bit, for gathers all over the image; the luminance from
+ * sums made either way is the same, and is evr_gather_point_lum's. */
+static void test_gather_delta(void)
+{
+    enum { W = 48, H = 40, LAYERS = 3 };
+    const evr_camera_intr cam = evr_camera_intr_make(W, H, 0.8f);
+    const evr_m34 pose = evr_m34_identity();
+    evr_gather_params gp = {0.15f, 0, 6, 0.5f, 0.0f};
+    evr_photon_buffer a, b;
+    evr_error err;
+    static uint32_t sat[(W + 3) * (H + 3)], before[(W + 3) * (H + 2)], base[H + 3], xs[(W + 2) * (H + 2)];
+    uint64_t rng = 12345;
+    int changed = 0;
+    gp.flux_scale = evr_gather_flux_scale(1.0f, 1000u);
+    CHECK_OK(evr_photon_buffer_alloc(&a, W, H, LAYERS, 1, &err));
+    CHECK_OK(evr_photon_buffer_alloc(&b, W, H, LAYERS, 1, &err));
+    evr_photon_buffer_clear(&a);
+    evr_photon_buffer_clear(&b);
+    a.gbuf = calloc((size_t)a.width * (size_t)a.height * 8, sizeof(float));
+    b.gbuf = calloc((size_t)b.width * (size_t)b.height * 8, sizeof(float));
+    /* photons on the plane z = -2 (a wall) and z = -1.5 (a step), one to three a cell; b: a's,
+     * with a tenth of the cells given other photons or another view */
+    for (int y = -1; y <= H; y++)
+        for (int x = -1; x <= W; x++) {
+            const size_t i = (size_t)(y + 1) * (size_t)a.width + (size_t)(x + 1);
+            const int n = 1 + (int)(rng_next(&rng) % 3u), moved = rng_uniform(&rng) < 0.1f;
+            evr_ray r = evr_camera_ray(&cam, &pose, (float)x + 0.5f, (float)y + 0.5f);
+            const float depth = x < W / 2 ? 2.0f : 1.5f;
+            evr_v3 q = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
+            for (int k = 0; k < 8; k++) a.gbuf[8 * i + (size_t)k] = b.gbuf[8 * i + (size_t)k] = 0.0f;
+            a.gbuf[8 * i] = q.x; a.gbuf[8 * i + 1] = q.y; a.gbuf[8 * i + 2] = q.z; a.gbuf[8 * i + 5] = 1.0f;
+            a.gbuf[8 * i + 6] = 0.002f;
+            for (int k = 0; k < 8; k++) b.gbuf[8 * i + (size_t)k] = a.gbuf[8 * i + (size_t)k];
+            if (moved && (rng_next(&rng) & 1u)) b.gbuf[8 * i + 6] = 0.003f;
+            for (int l = 0; l < n; l++) {
+                evr_photon ph;
+                memset(&ph, 0, sizeof ph);
+                ph.p[0] = q.x + 0.01f * (rng_uniform(&rng) - 0.5f);
+                ph.p[1] = q.y + 0.01f * (rng_uniform(&rng) - 0.5f);
+                ph.p[2] = q.z;
+                ph.n[2] = 1.0f;
+                ph.flux[0] = 0.001f * rng_uniform(&rng);
+                ph.flux[1] = 0.002f * rng_uniform(&rng);
+                ph.flux[2] = 0.0005f;
+                ph.key = (uint32_t)l;
+                CHECK(evr_photon_buffer_insert(&a, x, y, &ph));
+                if (moved && l == 0) ph.flux[1] *= 3.0f;
+                if (!(moved && l == n - 1 && n > 1)) CHECK(evr_photon_buffer_insert(&b, x, y, &ph));
+            }
+        }
+    changed_sat(&b, &a, sat);
+    const evr_changed_cells ch = evr_changed_cells_from_sat(sat, b.width, b.height, before, base, xs);
+    changed = (int)base[b.height];
+    CHECK(changed == (int)sat[(size_t)b.height * (size_t)(b.width + 1) + (size_t)b.width]);
+    CHECK(changed > (W * H) / 20);
+    int checked = 0, nonzero = 0;
+    for (int y = 0; y < H; y += 3)
+        for (int x = 0; x < W; x += 2) {
+            evr_ray r = evr_camera_ray(&cam, &pose, (float)x + 0.5f, (float)y + 0.5f);
+            const float depth = x < W / 2 ? 2.0f : 1.5f;
+            evr_gather_point g;
+            g.p = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
+            g.n = evr_v3_make(0.0f, 0.0f, 1.0f);
+            g.dist = evr_v3_len(g.p);
+            g.k[0] = 0.2f; g.k[1] = 0.1f; g.k[2] = 0.05f;
+            evr_gather_sum sa, sb, sd;
+            evr_gather_point_sum(&a, &cam, &gp, &g, x, y, &sa);
+            evr_gather_point_sum(&b, &cam, &gp, &g, x, y, &sb);
+            sd = sa;
+            evr_gather_point_delta(&b, &a, &ch, &cam, &gp, &g, x, y, &sd);
+            CHECK(memcmp(&sd, &sb, sizeof sb) == 0);
+            const float l = evr_gather_sum_lum(&b, &cam, &gp, &g, x, y, &sd);
+            CHECK(l == evr_gather_point_lum(&b, &cam, &gp, &g, x, y));
+            nonzero += memcmp(&sa, &sb, sizeof sa) != 0;
+            checked++;
+        }
+    printf("fixed-point gathers: %d checked, %d changed by the %d changed cells, every one equal to a fresh gather\n", checked,
+           nonzero, changed);
+    CHECK(nonzero > checked / 2);
+    evr_photon_buffer_free(&a);
+    evr_photon_buffer_free(&b);
+}
+
 int main(void)
 {
     test_projection();
@@ -676,5 +777,6 @@ int main(void)
     test_pass();
     test_trail();
     test_gather_moved();
+    test_gather_delta();
     return check_report("test_photon");
 }

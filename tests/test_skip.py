@@ -19,6 +19,10 @@ cases.append(("square", ["--sensor", "davis346", "--res", "64x48", "--duration",
 cases.append(("cornell", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
 # global illumination: a pixel whose gather window saw no photon change keeps its intensity
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
+# wider windows (a still pixel's sums updated from the cells that changed), and the ring search
+# with a limit on the photons per estimate
+cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}

@@ -33,11 +33,15 @@ typedef struct {
     int have_prev;
     int window;                    /* cells around a pixel a gather may read */
     /* per pixel, its last gather: the point, normal and distance (key) and its luminance in the
-     * start and end buffers (ls, le; le to be made again where end_valid is 0). flat: ls == le
+     * start and end buffers (ls, le; le to be made again where end_valid is 0), se its sums. flat: ls == le
      * (the indirect light of the key did not change over the segment). missed: the pixel's last
      * sample met nothing (no indirect light). The same key with no change in the window since
      * gives the same estimate bit for bit (most samples of a still surface). */
-    struct evr_gi_memo { float key[7]; int inst, valid, end_valid, flat, missed; float ls, le; } *memo;
+    struct evr_gi_memo { float key[7]; int inst, valid, end_valid, flat, missed; float ls, le; evr_gather_sum se; } *memo;
+    /* gp.max_photons 0: the memo's se holds the fixed-point sums of its end gather, which the
+     * next segment updates from the changed cells (ch, in ch_before, ch_base, ch_x) */
+    evr_changed_cells ch;
+    uint32_t *ch_before, *ch_base, *ch_x;
     int image_width;
     int memo_off;                  /* EVR_GI_NO_MEMO set: no memo (tests) */
 } evr_cpu_gi;

@@ -165,6 +165,26 @@ void evr_photon_buffer_clear(evr_photon_buffer *b)
     *b->collisions = 0;
 }
 
+evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before, uint32_t *base, uint32_t *x)
+{
+    evr_changed_cells ch;
+    int cx, cy;
+    base[0] = 0;
+    for (cy = 0; cy < h; cy++) {
+        uint32_t *row = before + (size_t)cy * ((size_t)w + 1), n = 0;
+        for (cx = 0; cx < w; cx++) {
+            row[cx] = n;
+            if (evr_sat_count(sat, w, cx, cy, cx + 1, cy + 1)) x[base[cy] + n++] = (uint32_t)cx;
+        }
+        row[w] = n;
+        base[cy + 1] = base[cy] + n;
+    }
+    ch.before = before;
+    ch.base = base;
+    ch.x = x;
+    return ch;
+}
+
 void evr_photon_buffer_free(evr_photon_buffer *b)
 {
     free(b->gbuf);

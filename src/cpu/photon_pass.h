@@ -55,6 +55,10 @@ evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, 
 void evr_photon_buffer_clear(evr_photon_buffer *b);
 void evr_photon_buffer_free(evr_photon_buffer *b);
 
+/* The changed cells of a w x h buffer (core/photon.h's evr_changed_cells) from the summed-area
+ * table of its changed cells (evr_sat_count's): before needs (w + 1) h entries, base h + 1, x w h. */
+evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before, uint32_t *base, uint32_t *x);
+
 /* Fills buf->gbuf (allocated here when NULL; freed by evr_photon_buffer_free): the surface the
  * camera (pose at time f) sees through every cell's centre, guard band included, and the area
  * the cell covers there (pixel area at unit distance * depth^2 * cos(off-axis angle) / |cos of

@@ -696,6 +696,7 @@ struct slot {
     int num_tracks, num_keys;
     /* global illumination: the changed cells, the view the kernels read (which ring buffers) */
     dbuf<uint32_t> d_sat;
+    dbuf<uint32_t> d_ch_before, d_ch_base, d_ch_x;   /* the cells that changed (gp.max_photons 0) */
     dbuf<gpu_gi_view> d_gi_view;
     hbuf<gpu_gi_view> h_gi_view;
     hbuf<evr_photon_emitter> h_em;
@@ -787,7 +788,7 @@ struct cuda_backend {
     dbuf<float> d_gd_direct, d_gd_cache;
     dbuf<float2> d_gd_lum;
     dbuf<unsigned> d_gd_req, d_gd_count;
-    dbuf<int> d_gd_traced;
+    dbuf<int> d_gd_traced, d_gd_newpix;
     dbuf<gi_request> d_gd_requests;
     /* EVR_TIMELINE=path (hidden, for measurement): per segment, host times (evr_host_seconds) and
      * GPU times (seconds after tl_base, recorded at tl_h0 on the host), written at release */
@@ -989,6 +990,8 @@ static gi_deferred deferred_args(const cuda_backend *b)
     d.requests = b->d_gd_requests.p;
     d.lum = b->d_gd_lum.p;
     d.count = b->d_gd_count.p;
+    d.cap = (unsigned)b->d_gd_requests.cap;
+    d.newpix = b->d_gd_newpix.p;
     d.stride = b->setup.width * b->setup.height;
     return d;
 }
@@ -1002,6 +1005,7 @@ static void gi_deferred_release(cuda_backend *b)
     b->d_gd_traced.release();
     b->d_gd_cache.release();
     b->d_gd_count.release();
+    b->d_gd_newpix.release();
     for (int i = 0; i < NRING; i++) b->d_gi_ends[i].release();
 }
 
@@ -1030,7 +1034,7 @@ static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
     if (b->d_gd_direct.reserve(n, true) == cudaSuccess && b->d_gd_req.reserve(n, true) == cudaSuccess &&
         b->d_gd_lum.reserve(n, true) == cudaSuccess && b->d_gd_requests.reserve(n, true) == cudaSuccess &&
         b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
-        b->d_gd_count.reserve(1) == cudaSuccess) {
+        b->d_gd_count.reserve(3) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess) {
         b->gi_deferred = 1;
         gi_ends_alloc(b, npix);
         b->gather_grid = (unsigned)prop->multiProcessorCount * 16u;
@@ -1068,11 +1072,17 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
         }
         if (b->gi_deferred) {
             gi_deferred d = deferred_args(b);
-            CK(cudaMemsetAsync(d.count, 0, sizeof(unsigned), rs));
+            CK(cudaMemsetAsync(d.count, 0, 3 * sizeof(unsigned), rs));
             if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
             else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
             CK(cudaGetLastError());
-            gi_gather_kernel<<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+            if (b->gp.max_photons <= 0) {
+                gi_gather_known_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+                gi_gather_new_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+            } else {
+                gi_gather_known_kernel<false><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+                gi_gather_new_kernel<false><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+            }
             CK(cudaGetLastError());
             if (ideal) gi_pixel_kernel<0><<<grid, BLOCK, 0, rs>>>(a, d);
             else gi_pixel_kernel<1><<<grid, BLOCK, 0, rs>>>(a, d);
@@ -1143,6 +1153,7 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
     cudaStream_t rs = b->render;
     evr_status st;
     if ((st = evr_photon_emitters_build(hrs, f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
+    if (b->gp.flux_scale == 0.0f) b->gp.flux_scale = evr_gather_flux_scale(b->em.total_power, b->photons);   /* the run's */
     if (b->em.photons > (1u << 28)) {
         snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", b->em.photons);
         return EVR_ERR_ARG;
@@ -1237,12 +1248,20 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p, sl->d_rays.p);
     sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
     sat_cols_kernel<<<(unsigned)((eb->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    if (b->gp.max_photons <= 0) {
+        const evr_changed_cells ch = sl->h_gi_view.p->ch;
+        changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width,
+                                                                                                          eb->height, sl->d_ch_before.p);
+        changed_base_kernel<<<1, 32, 0, rs>>>(sl->d_ch_before.p, eb->width, eb->height, sl->d_ch_base.p);
+        changed_list_kernel<<<cgrid, BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width, eb->height, ch, sl->d_ch_x.p);
+    }
     CK(cudaGetLastError());
     if (sl->gi_passes) CK(cudaEventRecord(sl->gi_done, rs));
     /* the slot's last copy from its staging finished before its previous segment was collected */
     gpu_gi_view *v = sl->h_gi_view.p;
     v->end = *eb;
     v->start = *sb;
+    v->gp = b->gp;   /* with the run's flux scale, known after the first pass */
     v->ends_in = b->d_gi_ends[0].p ? b->d_gi_ends[sl->index % NRING].p : nullptr;
     v->ends_out = b->d_gi_ends[0].p ? b->d_gi_ends[(sl->index + 1) % NRING].p : nullptr;
     CK(cudaMemcpyAsync(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice, rs));
@@ -1285,10 +1304,18 @@ static evr_status gi_alloc(cuda_backend *b, slot *sl, int window, evr_error *err
     const size_t sat_n = (size_t)(shape->width + 1) * (size_t)(shape->height + 1);
     CK(sl->d_sat.reserve(sat_n));
     CK(cudaMemset(sl->d_sat.p, 0, sat_n * sizeof(uint32_t)));
+    if (b->gp.max_photons <= 0) {
+        CK(sl->d_ch_before.reserve(((size_t)shape->width + 1) * (size_t)shape->height));
+        CK(sl->d_ch_base.reserve((size_t)shape->height + 1));
+        CK(sl->d_ch_x.reserve((size_t)shape->width * (size_t)shape->height));
+    }
     CK(sl->h_gi_view.reserve(1));
     gpu_gi_view *v = sl->h_gi_view.p;
     v->end = v->start = *shape;
     v->sat = sl->d_sat.p;
+    v->ch.before = sl->d_ch_before.p;
+    v->ch.base = sl->d_ch_base.p;
+    v->ch.x = sl->d_ch_x.p;
     v->gp = b->gp;
     v->window = window;
     v->ends_in = nullptr;
@@ -1515,7 +1542,7 @@ static uint64_t device_bytes(const cuda_backend *b)
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) + bytes(sl->d_insts) +
              bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) + bytes(sl->d_sort_temp) + bytes(sl->d_count) +
              bytes(sl->d_rays) + bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames) +
-             bytes(sl->d_sat) + bytes(sl->d_em) + bytes(sl->d_cdf);
+             bytes(sl->d_sat) + bytes(sl->d_ch_before) + bytes(sl->d_ch_base) + bytes(sl->d_ch_x) + bytes(sl->d_em) + bytes(sl->d_cdf);
     }
     for (int i = 0; i < NRING; i++) n += bytes(b->gi_ring[i].slots) + bytes(b->gi_ring[i].count) + bytes(b->gi_ring[i].gbuf);
     n += bytes(b->d_gi_last);
@@ -1523,7 +1550,7 @@ static uint64_t device_bytes(const cuda_backend *b)
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
          bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) + bytes(b->d_trail_rays) + bytes(b->d_todo) +
          bytes(b->d_gd_direct) + bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +
-         bytes(b->d_gd_requests);
+         bytes(b->d_gd_requests) + bytes(b->d_gd_newpix);
     return n;
 }
 
@@ -1722,7 +1749,7 @@ static void cuda_release(evr_backend *base)
         sl->d_adapt.release(); sl->h_adapt.release();
         sl->h_count.release(); sl->h_rays.release(); sl->h_sorted.release(); sl->h_intensity.release();
         sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
-        sl->d_sat.release(); sl->h_gi_view.release();
+        sl->d_sat.release(); sl->d_ch_before.release(); sl->d_ch_base.release(); sl->d_ch_x.release(); sl->h_gi_view.release();
         sl->d_gi_view.release(); sl->h_em.release(); sl->d_em.release(); sl->h_cdf.release(); sl->d_cdf.release();
         if (sl->gi_started) cudaEventDestroy(sl->gi_started);
         if (sl->gi_done) cudaEventDestroy(sl->gi_done);

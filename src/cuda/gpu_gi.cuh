@@ -28,6 +28,7 @@
 struct gi_end {
     evr_gather_point g;
     float le;
+    evr_gather_sum s;              /* gp.max_photons 0: the fixed-point sums of le's gather */
 };
 
 /* What the render kernels read (device memory, one per slot). */
@@ -37,6 +38,7 @@ struct gpu_gi_view {
      * one before: a pixel with no such cell in its window had the same indirect light all through
      * both (its intensity may be kept) */
     const uint32_t *sat;
+    evr_changed_cells ch;          /* gp.max_photons 0: the cells that changed over this segment only */
     evr_gather_params gp;
     int window;                    /* cells around a pixel a gather may read */
     /* the deferred kernels' per-pixel last gathers: the previous segment's (read) and this one's
@@ -68,6 +70,27 @@ __device__ __noinline__ void gpu_gather_point(const evr_render_scene *rs, int in
     evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org, g);
 }
 
+/* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those
+ * over the end buffer from those over the start buffer and the changed cells, and the luminance
+ * from sums. Not inlined either: one luminance function for every kernel. */
+__device__ __noinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
+                                            const evr_gather_point *g, int x, int y, evr_gather_sum *s)
+{
+    evr_gather_point_sum(b, cam, &v->gp, g, x, y, s);
+}
+
+__device__ __noinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
+                                              int y, evr_gather_sum *s)
+{
+    evr_gather_point_delta(&v->end, &v->start, &v->ch, cam, &v->gp, g, x, y, s);
+}
+
+__device__ __noinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x, int y,
+                                          const evr_gather_sum *s)
+{
+    return evr_gather_sum_lum(&v->end, cam, &v->gp, g, x, y, s);
+}
+
 __device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
                                              const evr_gather_point *g, int x, int y)
 {
@@ -78,14 +101,27 @@ __device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const g
  * no change (the same cells give the same estimate), none at the start where it is known
  * (known_ls: the previous segment's end gather of the same point). Two walks: walking both
  * buffers together, cell by cell, made the gather kernel 12% slower (H200, Cornell box at
- * 1280x720, 0.5 s: 0.237 s against 0.210 s). */
+ * 1280x720, 0.5 s: 0.237 s against 0.210 s). With gp.max_photons 0 the end's sums are the
+ * start's plus the changed cells' terms (s: in, the start's sums where known_ls is given; out,
+ * the end's), a walk over the few changed cells of the window instead of all of it. */
+template <bool FIXED>
 __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                                int y, float *ls, float *le, const float *known_ls = nullptr)
+                                                int y, float *ls, float *le, const float *known_ls, evr_gather_sum *s)
 {
+    const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y);
+    if (FIXED) {
+        if (known_ls) {
+            *ls = *known_ls;
+        } else {
+            gpu_gather_sum(&v->start, v, cam, g, x, y, s);
+            *ls = gpu_sum_lum(v, cam, g, x, y, s);
+        }
+        if (changed) gpu_gather_delta(v, cam, g, x, y, s);
+        *le = changed ? gpu_sum_lum(v, cam, g, x, y, s) : *ls;
+        return;
+    }
     *ls = known_ls ? *known_ls : gpu_gather_lum(&v->start, v, cam, g, x, y);
-    *le = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y)
-              ? gpu_gather_lum(&v->end, v, cam, g, x, y)
-              : *ls;
+    *le = changed ? gpu_gather_lum(&v->end, v, cam, g, x, y) : *ls;
 }
 
 /* Whether two gather points are the same bit for bit (the same estimates). */
@@ -123,7 +159,11 @@ __device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_ren
 {
     evr_gather_point gp;
     gpu_gather_point(rs, inst, s, cam_org, &gp);
-    if (!gi_memo_take(m, inst, &gp)) gpu_gather_ends(g, &rs->camera, &gp, x, y, &m->ls, &m->le);
+    evr_gather_sum sums;
+    if (!gi_memo_take(m, inst, &gp)) {
+        if (g->gp.max_photons <= 0) gpu_gather_ends<true>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
+        else gpu_gather_ends<false>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
+    }
     return evr_gi_lerp(m->ls, m->le, f);
 }
 
@@ -304,6 +344,56 @@ __global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer
     sat[(size_t)(y + 1) * (size_t)(end.width + 1) + (size_t)(x + 1)] = now | last[cell];
     last[cell] = now;
     if (now) count_lanes(counters, GI_CHANGED);   /* this segment's changes, as the CPU counts them */
+}
+
+/* The list of the cells that changed over the segment (core/photon.h's evr_changed_cells, for
+ * gp.max_photons 0) from the per-cell flags photon_changed_kernel left in last: per row the
+ * count before each column (one warp a row, as sat_rows_kernel), then the rows' bases (one warp),
+ * then each changed cell's column at its entry. */
+__global__ void __launch_bounds__(BLOCK) changed_rows_kernel(const uint8_t *last, int w, int h, uint32_t *before)
+{
+    const int y = (int)((blockIdx.x * blockDim.x + threadIdx.x) / 32u);
+    const unsigned lane = threadIdx.x & 31u;
+    if (y >= h) return;   /* the whole warp */
+    uint32_t *row = before + (size_t)y * (size_t)(w + 1);
+    uint32_t carry = 0;
+    for (int x0 = 0; x0 < w; x0 += 32) {
+        const int x = x0 + (int)lane;
+        const uint32_t f = x < w ? (uint32_t)last[(size_t)y * (size_t)w + (size_t)x] : 0u;
+        uint32_t v = f;
+        for (int o = 1; o < 32; o <<= 1) {
+            const uint32_t u = __shfl_up_sync(0xffffffffu, v, (unsigned)o);
+            if (lane >= (unsigned)o) v += u;
+        }
+        if (x < w) row[x] = carry + v - f;   /* exclusive */
+        carry += __shfl_sync(0xffffffffu, v, 31);
+    }
+    if (lane == 0) row[w] = carry;
+}
+
+__global__ void changed_base_kernel(const uint32_t *before, int w, int h, uint32_t *base)
+{
+    const unsigned lane = threadIdx.x & 31u;
+    uint32_t carry = 0;
+    if (lane == 0) base[0] = 0;
+    for (int y0 = 0; y0 < h; y0 += 32) {
+        const int y = y0 + (int)lane;
+        uint32_t v = y < h ? before[(size_t)y * (size_t)(w + 1) + (size_t)w] : 0u;
+        for (int o = 1; o < 32; o <<= 1) {
+            const uint32_t u = __shfl_up_sync(0xffffffffu, v, (unsigned)o);
+            if (lane >= (unsigned)o) v += u;
+        }
+        if (y < h) base[y + 1] = carry + v;
+        carry += __shfl_sync(0xffffffffu, v, 31);
+    }
+}
+
+__global__ void __launch_bounds__(BLOCK) changed_list_kernel(const uint8_t *last, int w, int h, evr_changed_cells ch, uint32_t *xs)
+{
+    const int cell = blockIdx.x * blockDim.x + threadIdx.x;
+    if (cell >= w * h || !last[cell]) return;
+    const int x = cell % w, y = cell / w;
+    xs[ch.base[y] + ch.before[(size_t)y * (size_t)(w + 1) + (size_t)x]] = (uint32_t)x;
 }
 
 /* The summed-area table: prefix sums along rows, then columns. Rows: one warp per row, 32 cells
