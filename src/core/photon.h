@@ -813,10 +813,11 @@ EVR_HD static inline float evr_dot_rn(float ax, float ay, float az, float bx, fl
 }
 
 /* A gather's query: the point, its normal, the luminance weights of the flux (c), the distance
- * filter and kernel (r^2, sigma^2), the normal cosine and the flux scale. */
+ * filter r^2, the normal cosine, the flux scale and the kernel's constants. */
 typedef struct {
     evr_v3 p, n, c;
-    float r2, s2, normal_cos, flux_scale;
+    float r2, normal_cos, flux_scale;
+    float e, area_scale;   /* -1 / (2 sigma^2), 2^32 / sigma^2 */
 } evr_sum_query;
 
 /* Adds cell i's terms for query q to s (sub: subtracts them). Returns the photons taken. */
@@ -824,7 +825,7 @@ EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t 
                                              int sub)
 {
     const size_t npix = (size_t)b->width * (size_t)b->height;
-    const float e = -0.5f / q->s2, area_scale = 4294967296.0f / q->s2;
+    const float e = q->e, area_scale = q->area_scale;
     const evr_v3 p = q->p, n = q->n;
     uint64_t a = 0, aw = 0;
     int l, nl, used = 0;
@@ -870,10 +871,11 @@ EVR_HD static inline int evr_photon_gather_sum(const evr_photon_buffer *b, const
                                                evr_gather_sum *s)
 {
     int x0, y0, x1, y1, x, y, used = 0;
-    s->a = s->w = 0;
+    evr_gather_sum acc = {0, 0};   /* a local: kept in registers, not stored back cell by cell */
     evr_gather_window_cells(b, w, &x0, &y0, &x1, &y1);
     for (y = y0; y < y1; y++)
-        for (x = x0; x < x1; x++) used += evr_photon_cell_sum(b, (size_t)y * (size_t)b->width + (size_t)x, q, s, 0);
+        for (x = x0; x < x1; x++) used += evr_photon_cell_sum(b, (size_t)y * (size_t)b->width + (size_t)x, q, &acc, 0);
+    *s = acc;
     return used;
 }
 
@@ -908,16 +910,18 @@ EVR_HD static inline void evr_photon_gather_delta(const evr_photon_buffer *cur, 
 {
     const size_t W = (size_t)cur->width + 1;
     int x0, y0, x1, y1, y;
+    evr_gather_sum acc = *s;
     evr_gather_window_cells(cur, w, &x0, &y0, &x1, &y1);
     for (y = y0; y < y1; y++) {
         const uint32_t *row = ch->before + (size_t)y * W, b = ch->base[y], k1 = b + row[x1];
         uint32_t k;
         for (k = b + row[x0]; k < k1; k++) {
             const size_t i = (size_t)y * (size_t)cur->width + (size_t)ch->x[k];
-            evr_photon_cell_sum(cur, i, q, s, 0);
-            evr_photon_cell_sum(prev, i, q, s, 1);
+            evr_photon_cell_sum(cur, i, q, &acc, 0);
+            evr_photon_cell_sum(prev, i, q, &acc, 1);
         }
     }
+    *s = acc;
 }
 
 /* Sums the photons of rings 0 .. rings of the window around cell (cx, cy) that lie within
@@ -1087,9 +1091,10 @@ EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_b
     q->n = g->n;
     q->c = evr_v3_make(0.2126f * g->k[0], 0.7152f * g->k[1], 0.0722f * g->k[2]);   /* evr_luminance's weights */
     q->r2 = w.r2;
-    q->s2 = w.s2;
     q->normal_cos = gp->normal_cos;
     q->flux_scale = gp->flux_scale;
+    q->e = -0.5f / w.s2;
+    q->area_scale = 4294967296.0f / w.s2;
     return w;
 }
 
