@@ -368,10 +368,19 @@ __global__ void __launch_bounds__(BLOCK) static_hits_kernel(kernel_args a, gpu_s
     out[i] = sh;
 }
 
+/* A listed pixel whose direct light stays while its indirect light changes (deferred gathers):
+ * the skip kernel makes its samples, the trace kernel leaves it alone. */
+#define LIST_INDIRECT_ONLY 0x80000000u
+
 /* Change-driven sampling, first pass: a pixel that keeps its cached intensity runs its samples
- * through the pixel model here (no rays); the others are listed for the render kernel. */
+ * through the pixel model here (no rays); the others are listed for the render kernel. With
+ * deferred gathers (d.requests set), a pixel whose rays meet nothing that moves but whose gather
+ * window saw photons change gets here what gi_trace_kernel would make of it, without its rays:
+ * its first sample settles on its last traced sample's direct light and surface point (the
+ * same rays meet the same still surfaces: the same bits), and a gather request with the start
+ * known; it is listed for the gather and pixel kernels only. */
 template <int SENSOR>
-__global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
+__global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred d)
 {
     int pix, x, y;
     const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
@@ -379,18 +388,35 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
     evr_pixel_state st;
     evr_pixel_params own;
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
-    bool skip = false;
+    bool skip = false, indirect_only = false;
+    float cache = -1.0f;
     if (active) {
         evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
         evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
         skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
         /* global illumination: a pixel whose gather window saw photons change over this segment
          * or the last traces (its indirect light moves, or moved after its last sample) */
-        if (skip && a.gi)
-            skip = !evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height, a.gi->end.margin, a.gi->window, x, y);
+        if (skip && a.gi &&
+            evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height, a.gi->end.margin, a.gi->window, x, y)) {
+            skip = false;
+            /* as the trace kernel would settle it: its hit the cached one, the cache kept */
+            cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray, st.cache_dist);
+            indirect_only = d.requests && a.gi->ends_in && a.gi->ends_in[pix].g.dist >= 0.0f && cache >= 0.0f;
+        }
     }
     const unsigned at = warp_append(a.list_count, active && !skip);
-    if (active && !skip) a.list[at] = pix;
+    if (active && !skip) a.list[at] = indirect_only ? (unsigned)pix | LIST_INDIRECT_ONLY : (unsigned)pix;
+    const unsigned r = warp_append(d.count, indirect_only);   /* a request with the start known */
+    if (indirect_only) {
+        const gi_end *e = &a.gi->ends_in[pix];
+        d.requests[r].g = e->g;
+        d.requests[r].pix = pix;
+        d.requests[r].ls = e->le;
+        d.direct[at] = e->direct;   /* sample 0's entry */
+        d.req[at] = r;
+        d.traced[at] = 1;
+        d.cache_dist[at] = cache;
+    }
     const unsigned skipped = __ballot_sync(0xffffffffu, skip);
     if (!skipped) return;   /* the whole warp */
     if (lane == 0) atomicAdd(&a.rays[1], (unsigned long long)__popc(skipped));
@@ -410,12 +436,14 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a)
 struct launch_pixel {
     int i, pix, x, y;
     bool active;
+    bool indirect_only;   /* listed by the skip kernel with its samples made (LIST_INDIRECT_ONLY) */
     unsigned lane;
 };
 __device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pixel *p)
 {
     p->i = blockIdx.x * blockDim.x + threadIdx.x;
     p->lane = threadIdx.x & 31u;
+    p->indirect_only = false;
     if (!a.list) {   /* every pixel, in warp tiles */
         p->active = tiled_pixel(p->i, a.width, a.height, &p->pix, &p->x, &p->y);
         return true;
@@ -423,7 +451,9 @@ __device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pix
     const int n = (int)*a.list_count;
     if ((int)(blockIdx.x * blockDim.x) >= n) return false;
     p->active = p->i < n;
-    p->pix = p->active ? a.list[p->i] : 0;
+    const unsigned e = p->active ? (unsigned)a.list[p->i] : 0u;
+    p->indirect_only = (e & LIST_INDIRECT_ONLY) != 0u;
+    p->pix = (int)(e & ~LIST_INDIRECT_ONLY);
     p->x = p->active ? p->pix % a.width : 0;
     p->y = p->active ? p->pix / a.width : 0;
     return true;
@@ -1065,14 +1095,17 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
         d.p = b->setup.adapt;
         with_variant(b, [&](auto v) { adapt_kernel<decltype(v)::layout, decltype(v)::sensor, decltype(v)::gi><<<grid, BLOCK, 0, rs>>>(a, d); });
     } else {
+        gi_deferred d{};   /* no requests: none made by the skip kernel */
+        if (b->gi_deferred) {
+            d = deferred_args(b);
+            CK(cudaMemsetAsync(d.count, 0, 3 * sizeof(unsigned), rs));
+        }
         if (sl->reuse) {
-            if (ideal) skip_kernel<0><<<grid, BLOCK, 0, rs>>>(a);
-            else skip_kernel<1><<<grid, BLOCK, 0, rs>>>(a);
+            if (ideal) skip_kernel<0><<<grid, BLOCK, 0, rs>>>(a, d);
+            else skip_kernel<1><<<grid, BLOCK, 0, rs>>>(a, d);
             CK(cudaGetLastError());
         }
         if (b->gi_deferred) {
-            gi_deferred d = deferred_args(b);
-            CK(cudaMemsetAsync(d.count, 0, 3 * sizeof(unsigned), rs));
             if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
             else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
             CK(cudaGetLastError());

@@ -28,7 +28,37 @@
 struct gi_end {
     evr_gather_point g;
     float le;
+    float direct;                  /* the direct light of the same sample */
     evr_gather_sum s;              /* gp.max_photons 0: the fixed-point sums of le's gather */
+};
+
+#define GI_NO_REQUEST 0xffffffffu
+
+/* A deferred gather: the surface point and its pixel; ls: its start gather where known (the
+ * pixel's end gather of the previous segment at the same point: the requests at the front of
+ * the array, gi_deferred.count). */
+struct gi_request {
+    evr_gather_point g;
+    int pix;
+    float ls;
+    evr_gather_sum s;   /* gp.max_photons 0: the end's fixed-point sums (the gather kernel's) */
+};
+
+/* The deferred kernels' shared buffers (gpu_gi_deferred.cuh) (device memory, reused by every launch: the kernels of a
+ * segment run in order on the render stream). Per-sample arrays are [sample][thread]. */
+struct gi_deferred {
+    float *direct;        /* a traced sample's direct light */
+    unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
+    int *traced;          /* per thread: samples with an entry (traced or held); later samples keep the last */
+    float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
+    gi_request *requests;
+    float2 *lum;          /* per request: the gathers' luminance at the segment's start and end */
+    /* requests made: [0] with the start known (from the front of requests), [1] without (from
+     * the back); [2] pixels that made one without (listed in newpix) */
+    unsigned *count;
+    unsigned cap;         /* room in requests */
+    int *newpix;          /* the launch's threads (pixels) that made a request without the start known */
+    int stride;           /* threads of a launch at most: the pixel count */
 };
 
 /* What the render kernels read (device memory, one per slot). */

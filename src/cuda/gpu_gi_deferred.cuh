@@ -18,42 +18,13 @@
 #ifndef EVR_CUDA_GPU_GI_DEFERRED_CUH
 #define EVR_CUDA_GPU_GI_DEFERRED_CUH
 
-#define GI_NO_REQUEST 0xffffffffu
-
-/* A deferred gather: the surface point and its pixel; ls: its start gather where known (the
- * pixel's end gather of the previous segment at the same point: the requests at the front of
- * the array, gi_deferred.count). */
-struct gi_request {
-    evr_gather_point g;
-    int pix;
-    float ls;
-    evr_gather_sum s;   /* gp.max_photons 0: the end's fixed-point sums (the gather kernel's) */
-};
-
-/* The three kernels' shared buffers (device memory, reused by every launch: the kernels of a
- * segment run in order on the render stream). Per-sample arrays are [sample][thread]. */
-struct gi_deferred {
-    float *direct;        /* a traced sample's direct light */
-    unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
-    int *traced;          /* per thread: samples with an entry (traced or held); later samples keep the last */
-    float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
-    gi_request *requests;
-    float2 *lum;          /* per request: the gathers' luminance at the segment's start and end */
-    /* requests made: [0] with the start known (from the front of requests), [1] without (from
-     * the back); [2] pixels that made one without (listed in newpix) */
-    unsigned *count;
-    unsigned cap;         /* room in requests */
-    int *newpix;          /* the launch's threads (pixels) that made a request without the start known */
-    int stride;           /* threads of a launch at most: the pixel count */
-};
-
 /* First kernel: render_kernel's rays and settling, without the pixel model. */
 template <int LAYOUT>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args a, gi_deferred d)
 {
     launch_pixel lp;
     if (!launch_pixel_of(a, &lp)) return;
-    const bool active = lp.active;
+    const bool active = lp.active && !lp.indirect_only;   /* the skip kernel made the others' entries */
     const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     const float phi = active ? a.phase[pix] : 0.0f;
@@ -231,6 +202,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
             if (r != GI_NO_REQUEST) {
                 e.g = d.requests[r].g;
                 e.le = d.lum[r].y;
+                e.direct = direct;
                 e.s = d.requests[r].s;
             }
             a.gi->ends_out[pix] = e;
