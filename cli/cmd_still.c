@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "evray.h"
 #include "options.h"
+#include "core/shading.h"
 #include "io/png.h"
 #include "scene/scene.h"
 #include "still.h"
@@ -126,7 +127,7 @@ static int write_png(const char *path, const float *rgb, int w, int h, float exp
     return 1;
 }
 
-static float lum(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+static float lum(const float *c) { return evr_luminance(c[0], c[1], c[2]); }
 
 /* 1 when instance inst's node or mesh name is one of the comma-separated names. */
 static int in_region(const evr_scene *s, int inst, const char *names)

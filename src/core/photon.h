@@ -791,7 +791,10 @@ typedef struct {
 /* Fixed-point quanta per unit of flux for a pass of `photons` photons carrying total_power
  * (luminance flux): 2^40 quanta for the mean photon, whose flux is total_power / photons (the
  * photons are split by power), so a window of thousands of photons a few hundred times brighter
- * than the mean stays far below 2^64, and a photon 10^-6 of the mean still counts. */
+ * than the mean stays far below 2^64, and a photon 10^-6 of the mean still counts. The scale is
+ * the run's, from its first pass: a term is clamped at 2^52 quanta (evr_fix), so a photon over
+ * about 4000 times that pass's mean photon (lights that brighten that much later) would count
+ * for less than it carries. */
 EVR_HD static inline float evr_gather_flux_scale(float total_power, uint32_t photons)
 {
     float mean = photons > 0u ? total_power / (float)photons : 0.0f;
@@ -893,7 +896,7 @@ EVR_HD static inline float evr_photon_gather_sum_finish(const evr_photon_buffer 
  * entries base[y] .. base[y + 1] - 1 of x (their columns, ascending), and those of them in
  * columns x0 .. x1 - 1 are entries base[y] + before[y (w + 1) + x0] .. base[y] + before[y (w + 1)
  * + x1] - 1, where before[y (w + 1) + x] counts row y's changed cells left of column x (w: the
- * buffer's width). Built per segment by the backends (evr_changed_cells_row on the CPU). */
+ * buffer's width). Built per segment by the backends (evr_changed_cells_from_sat on the CPU). */
 typedef struct {
     const uint32_t *before;   /* (w + 1) per row */
     const uint32_t *base;     /* h + 1 */
@@ -1089,7 +1092,7 @@ EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_b
     const evr_gather_window w = evr_photon_gather_window(b, cam, x, y, g->dist, gp);
     q->p = g->p;
     q->n = g->n;
-    q->c = evr_v3_make(0.2126f * g->k[0], 0.7152f * g->k[1], 0.0722f * g->k[2]);   /* evr_luminance's weights */
+    q->c = evr_v3_make(EVR_LUMA_R * g->k[0], EVR_LUMA_G * g->k[1], EVR_LUMA_B * g->k[2]);
     q->r2 = w.r2;
     q->normal_cos = gp->normal_cos;
     q->flux_scale = gp->flux_scale;

@@ -15,9 +15,14 @@ EVR_HD static inline float evr_linear_to_srgb(float c)
 {
     return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
+/* Rec. 709 luminance weights (linear RGB) */
+#define EVR_LUMA_R 0.2126f
+#define EVR_LUMA_G 0.7152f
+#define EVR_LUMA_B 0.0722f
+
 EVR_HD static inline float evr_luminance(float r, float g, float b)
 {
-    return 0.2126f * r + 0.7152f * g + 0.0722f * b;
+    return EVR_LUMA_R * r + EVR_LUMA_G * g + EVR_LUMA_B * b;
 }
 
 /* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */

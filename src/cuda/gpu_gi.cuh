@@ -44,8 +44,9 @@ struct gi_request {
     evr_gather_sum s;   /* gp.max_photons 0: the end's fixed-point sums (the gather kernel's) */
 };
 
-/* The deferred kernels' shared buffers (gpu_gi_deferred.cuh) (device memory, reused by every launch: the kernels of a
- * segment run in order on the render stream). Per-sample arrays are [sample][thread]. */
+/* The shared buffers of the deferred kernels (gpu_gi_deferred.cuh; the skip kernel fills them for
+ * the pixels it settles): device memory, reused by every launch (the kernels of a segment run in
+ * order on the render stream). Per-sample arrays are [sample][thread]. */
 struct gi_deferred {
     float *direct;        /* a traced sample's direct light */
     unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
