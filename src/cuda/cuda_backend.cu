@@ -1067,7 +1067,7 @@ static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
         b->d_gd_count.reserve(3) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess) {
         b->gi_deferred = 1;
         gi_ends_alloc(b, npix);
-        b->gather_grid = (unsigned)prop->multiProcessorCount * 16u;
+        b->gather_grid = (unsigned)prop->multiProcessorCount * 64u;   /* grid-stride: 64 blocks an SM balanced the gathers best (16: 9% slower) */
         return;
     }
     (void)cudaGetLastError();   /* the failed allocation: not sticky, cleared */

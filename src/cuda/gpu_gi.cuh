@@ -103,20 +103,24 @@ __device__ __noinline__ void gpu_gather_point(const evr_render_scene *rs, int in
 
 /* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those
  * over the end buffer from those over the start buffer and the changed cells, and the luminance
- * from sums. Not inlined either: one luminance function for every kernel. */
-__device__ __noinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
+ * from sums. Inlined, unlike gpu_gather_lum: no product in them is followed by an addition a
+ * compiler could fuse it with (the terms' are explicit, EVR_MUL_RN), so every kernel computes the
+ * same bits (tests/test_cuda.py compares the inline and deferred kernels' events); not inlined,
+ * the calls spilled the gather loops' registers (gather kernels 105 -> 92 ms per 0.5 s of the
+ * Cornell box at 1280x720, H100). */
+__device__ __forceinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
                                             const evr_gather_point *g, int x, int y, evr_gather_sum *s)
 {
     evr_gather_point_sum(b, cam, &v->gp, g, x, y, s);
 }
 
-__device__ __noinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
+__device__ __forceinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
                                               int y, evr_gather_sum *s)
 {
     evr_gather_point_delta(&v->end, &v->start, &v->ch, cam, &v->gp, g, x, y, s);
 }
 
-__device__ __noinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x, int y,
+__device__ __forceinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x, int y,
                                           const evr_gather_sum *s)
 {
     return evr_gather_sum_lum(&v->end, cam, &v->gp, g, x, y, s);
