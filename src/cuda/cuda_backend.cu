@@ -1280,7 +1280,7 @@ static evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, 
     }
     photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p, sl->d_rays.p);
     sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
-    sat_cols_kernel<<<(unsigned)((eb->width + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    sat_cols_kernel<<<(unsigned)((eb->width + 31) / 32), 32 * SAT_CHUNKS, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
     if (b->gp.max_photons <= 0) {
         const evr_changed_cells ch = sl->h_gi_view.p->ch;
         changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width,
