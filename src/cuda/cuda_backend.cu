@@ -819,6 +819,7 @@ struct cuda_backend {
     dbuf<float2> d_gd_lum;
     dbuf<unsigned> d_gd_req, d_gd_count;
     dbuf<int> d_gd_traced, d_gd_newpix;
+    dbuf<unsigned long long> d_gd_delta;
     dbuf<gi_request> d_gd_requests;
     /* EVR_TIMELINE=path (hidden, for measurement): per segment, host times (evr_host_seconds) and
      * GPU times (seconds after tl_base, recorded at tl_h0 on the host), written at release */
@@ -1022,6 +1023,7 @@ static gi_deferred deferred_args(const cuda_backend *b)
     d.count = b->d_gd_count.p;
     d.cap = (unsigned)b->d_gd_requests.cap;
     d.newpix = b->d_gd_newpix.p;
+    d.delta = b->d_gd_delta.p;
     d.stride = b->setup.width * b->setup.height;
     return d;
 }
@@ -1036,6 +1038,7 @@ static void gi_deferred_release(cuda_backend *b)
     b->d_gd_cache.release();
     b->d_gd_count.release();
     b->d_gd_newpix.release();
+    b->d_gd_delta.release();
     for (int i = 0; i < NRING; i++) b->d_gi_ends[i].release();
 }
 
@@ -1064,7 +1067,8 @@ static void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
     if (b->d_gd_direct.reserve(n, true) == cudaSuccess && b->d_gd_req.reserve(n, true) == cudaSuccess &&
         b->d_gd_lum.reserve(n, true) == cudaSuccess && b->d_gd_requests.reserve(n, true) == cudaSuccess &&
         b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
-        b->d_gd_count.reserve(3) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess) {
+        b->d_gd_count.reserve(3) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_delta.reserve(2 * npix, true) == cudaSuccess) {
         b->gi_deferred = 1;
         gi_ends_alloc(b, npix);
         b->gather_grid = (unsigned)prop->multiProcessorCount * 64u;   /* grid-stride: 64 blocks an SM balanced the gathers best (16: 9% slower) */
@@ -1110,6 +1114,10 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
             else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
             CK(cudaGetLastError());
             if (b->gp.max_photons <= 0) {
+                if (b->d_gi_ends[0].p) {   /* what the changed cells add to the pixels' last gathers */
+                    CK(cudaMemsetAsync(d.delta, 0, 2 * (size_t)b->setup.width * (size_t)b->setup.height * sizeof(unsigned long long), rs));
+                    gi_scatter_kernel<<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+                }
                 gi_gather_known_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
                 gi_gather_new_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
             } else {
@@ -1583,7 +1591,7 @@ static uint64_t device_bytes(const cuda_backend *b)
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) + bytes(b->d_pvals_sorted) +
          bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) + bytes(b->d_trail_rays) + bytes(b->d_todo) +
          bytes(b->d_gd_direct) + bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +
-         bytes(b->d_gd_requests) + bytes(b->d_gd_newpix);
+         bytes(b->d_gd_requests) + bytes(b->d_gd_newpix) + bytes(b->d_gd_delta);
     return n;
 }
 

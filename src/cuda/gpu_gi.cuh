@@ -59,6 +59,7 @@ struct gi_deferred {
     unsigned *count;
     unsigned cap;         /* room in requests */
     int *newpix;          /* the launch's threads (pixels) that made a request without the start known */
+    unsigned long long *delta;   /* gp.max_photons 0: per pixel, what the changed cells add to its last gather's sums (a, w) */
     int stride;           /* threads of a launch at most: the pixel count */
 };
 
