@@ -195,8 +195,10 @@ static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const e
     evr_gather_point gp;
     evr_gather_point_at(s, mat, cam_org, &gp);
     if (g->gp.max_photons <= 0) {   /* fixed-point sums: the end's from the start's (se) and the cells that changed */
-        if (!end_only) evr_gather_point_sum(start_of(g), &rs->camera, &g->gp, &gp, x, y, se);
-        if (!end_only) *ls = evr_gather_sum_lum(&g->end, &rs->camera, &g->gp, &gp, x, y, se);
+        if (!end_only) {
+            evr_gather_point_sum(start_of(g), &rs->camera, &g->gp, &gp, x, y, se);
+            *ls = evr_gather_sum_lum(&g->end, &rs->camera, &g->gp, &gp, x, y, se);
+        }
         if (changed) evr_gather_point_delta(&g->end, start_of(g), &g->ch, &rs->camera, &g->gp, &gp, x, y, se);
         *le = changed ? evr_gather_sum_lum(&g->end, &rs->camera, &g->gp, &gp, x, y, se) : *ls;
         return;

@@ -137,21 +137,18 @@ __device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const g
  * no change (the same cells give the same estimate), none at the start where it is known
  * (known_ls: the previous segment's end gather of the same point). Two walks: walking both
  * buffers together, cell by cell, made the gather kernel 12% slower (H200, Cornell box at
- * 1280x720, 0.5 s: 0.237 s against 0.210 s). With gp.max_photons 0 the end's sums are the
- * start's plus the changed cells' terms (s: in, the start's sums where known_ls is given; out,
- * the end's), a walk over the few changed cells of the window instead of all of it. */
+ * 1280x720, 0.5 s: 0.237 s against 0.210 s). With gp.max_photons 0 (FIXED) the start is
+ * never given here (a known start's end is its sums plus gi_scatter_kernel's, in
+ * gi_gather_known_kernel), and the end's sums (s, out) are the start's plus the changed cells'
+ * terms, a walk over the few changed cells of the window instead of all of it. */
 template <bool FIXED>
 __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
                                                 int y, float *ls, float *le, const float *known_ls, evr_gather_sum *s)
 {
     const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y);
     if (FIXED) {
-        if (known_ls) {
-            *ls = *known_ls;
-        } else {
-            gpu_gather_sum(&v->start, v, cam, g, x, y, s);
-            *ls = gpu_sum_lum(v, cam, g, x, y, s);
-        }
+        gpu_gather_sum(&v->start, v, cam, g, x, y, s);
+        *ls = gpu_sum_lum(v, cam, g, x, y, s);
         if (changed) gpu_gather_delta(v, cam, g, x, y, s);
         *le = changed ? gpu_sum_lum(v, cam, g, x, y, s) : *ls;
         return;

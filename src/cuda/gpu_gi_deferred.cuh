@@ -199,7 +199,7 @@ __global__ void __launch_bounds__(BLOCK, 8) gi_gather_new_kernel(kernel_args a, 
         for (int k = (int)(lane % span); k < entries; k += (int)span) {
             const unsigned r = d.req[(size_t)k * (size_t)d.stride + (size_t)i];
             if (k > 0) prev = d.req[(size_t)(k - 1) * (size_t)d.stride + (size_t)i];
-            if (r == GI_NO_REQUEST || r < back || r == prev) continue;   /* a hit, a known start, or the sample before's */
+            if (r == GI_NO_REQUEST || r < back || r == prev) continue;   /* a miss, a known start, or the sample before's */
             const evr_gather_point g = d.requests[r].g;
             const int pix = d.requests[r].pix;
             float2 l;
