@@ -129,8 +129,7 @@ typedef struct {
 
 /* ---- host side ---- */
 
-/* Bottom level of every group of a scene. Groups are numbered in the order of their first
- * member, as the CPU backend numbers them. */
+/* Bottom level of every group of a scene (the groups of prep/instance_groups.h, in their order). */
 typedef struct {
     int layout;
     int grouped;               /* 0: built with EVR_GPU_BVH_UNGROUPED */
@@ -174,10 +173,10 @@ typedef struct {
     int stack_need;            /* top level's worst case plus the deepest group's */
 } evr_gpu_top;
 
-/* Groups the instances of s and builds the bottom level of every group with the given layout
- * (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no grouping). Reads the meshes,
- * the instances and the nodes (parent, animated, transforms at anim_start). On failure *out is
- * left empty (safe to free). */
+/* Groups the instances of s (evr_instance_groups_build) and builds the bottom level of every
+ * group with the given layout (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no
+ * grouping). Reads the meshes, the instances and the nodes (parent, animated, transforms at
+ * anim_start). On failure *out is left empty (safe to free). */
 evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err);
 void evr_gpu_bvh_free(evr_gpu_bvh *b);
 
