@@ -4,7 +4,7 @@
 
 #include "backend.h"
 #include "segment_planner.h"
-#include "skip_plan.h"
+#include "prep/skip_plan.h"
 #include "io/event_writer.h"
 #include "io/preview.h"
 #include "write_queue.h"

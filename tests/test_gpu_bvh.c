@@ -20,6 +20,7 @@
 #include "core/rng.h"
 #include "cuda/gpu_bvh.h"
 #include "cuda/gpu_traverse.h"
+#include "prep/swept_bounds.h"
 #include "scene/scene.h"
 
 #include <embree3/rtcore.h>
@@ -624,7 +625,7 @@ static void test_synthetic_bounds(void)
             int j, k, a;
             tr.keys = keys;
             tr.n = n;
-            evr_gpu_segment_bounds(box, box + 3, tr, lo, hi);
+            evr_swept_bounds(box, box + 3, tr, lo, hi);
             bad += check_box_holds(box, lo, hi, tr, 4000, &c);
             tested++;
             /* how tight: against the union of densely sampled boxes */

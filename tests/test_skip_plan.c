@@ -3,7 +3,7 @@
  * tracing everything once there are more moving tracks than that; the ray tests of core/skip.h
  * against those boxes; the still spans of a segment (before and after its motion). */
 #include "check.h"
-#include "skip_plan.h"
+#include "prep/skip_plan.h"
 #include "core/rng.h"
 
 #include <math.h>

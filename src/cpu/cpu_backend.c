@@ -7,7 +7,7 @@
 #include "core/skip.h"
 #include "cpu/workers.h"
 #include "cpu/cpu_gi.h"
-#include "cuda/gpu_bvh.h"
+#include "prep/instance_groups.h"
 
 #include <embree3/rtcore.h>
 #include <math.h>
@@ -29,18 +29,13 @@ typedef struct {
     evr_render_host host;          /* copy of the views; keys are set per segment */
     evr_run_setup setup;
     RTCDevice device;
-    /* Instances are grouped: every instance whose node never moves goes, baked into world space,
-     * into one static group; the instances of each moving node share one group. One Embree
-     * instance per group keeps overlapping instances (lids over an eyeball) out of each other's
-     * way in the top-level BVH. Past a size (evr_static_bake_limit in cuda/gpu_bvh.h, build_groups) the static
-     * instances are not baked: each is a group of its own, an Embree instance with its node's
-     * fixed transform of one scene per mesh that all its instances share. */
-    int num_groups;
+    /* One Embree instance per group of instances (prep/instance_groups.h) keeps overlapping
+     * instances (lids over an eyeball) out of each other's way in the top-level BVH: a baked
+     * group is one world-space scene, a static group an instance with its node's fixed transform
+     * of one scene per mesh that all its instances share, a moving group its node's scene moved
+     * by the node's motion keys. */
+    evr_instance_groups groups;
     RTCScene *group_scenes;
-    int *group_track;              /* motion track of the group, -1 for a static group */
-    int *group_instanced;          /* 1: a static instance of a shared per-mesh scene, not baked */
-    int *group_first;              /* members of group g: members[group_first[g] .. group_first[g+1]) */
-    int *members;                  /* scene instance index of each geometry */
     RTCScene top;
     int time_grid;                 /* the segment's motion keys split it into this many equal intervals (1: none moves) */
     int gi;                        /* global illumination on */
@@ -139,7 +134,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (!hit[i]) continue;
-        int inst = b->members[b->group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
+        int inst = b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
@@ -571,9 +566,9 @@ static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_erro
 {
     int g, k;
     b->time_grid = 1;
-    for (g = 0; g < b->num_groups; g++) {
-        int track = b->group_track[g];
-        if (track < 0) continue;   /* static group: set once */
+    for (g = 0; g < b->groups.num_groups; g++) {
+        int track = b->groups.group_node[g];   /* a moving group's node is its track */
+        if (b->groups.group_kind[g] != EVR_GROUP_MOVING) continue;   /* static: set once */
         int n = seg->track_count[track];
         if (n - 1 > b->time_grid) b->time_grid = n - 1;   /* 2^k + 1 uniform keys: the finest grid holds the others */
         RTCGeometry geom = rtcGetGeometry(b->top, (unsigned)g);
@@ -719,14 +714,11 @@ static void cpu_release(evr_backend *base)
     if (b->gi) evr_cpu_gi_free(&b->gi_state);
     if (b->top) rtcReleaseScene(b->top);
     if (b->group_scenes) {
-        for (i = 0; i < b->num_groups; i++)
+        for (i = 0; i < b->groups.num_groups; i++)
             if (b->group_scenes[i]) rtcReleaseScene(b->group_scenes[i]);
     }
     free(b->group_scenes);
-    free(b->group_track);
-    free(b->group_instanced);
-    free(b->group_first);
-    free(b->members);
+    evr_instance_groups_free(&b->groups);
     if (b->device) rtcReleaseDevice(b->device);
     if (b->tile_events) {
         for (i = 0; i < b->tiles_x * b->tiles_y; i++) evr_event_vec_free(&b->tile_events[i]);
@@ -773,75 +765,23 @@ static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, cons
     return 1;
 }
 
-static int node_never_moves(const evr_scene *s, int node)
-{
-    for (; node >= 0; node = s->nodes[node].parent)
-        if (s->nodes[node].animated) return 0;
-    return 1;
-}
-
-/* Groups the instances (see cpu_backend), numbered in the order of their first member, and
- * builds one Embree scene per group (per mesh for instanced static groups). */
+/* Groups the instances (see cpu_backend) and builds one Embree scene per group (per mesh for
+ * static groups). */
 static int build_groups(cpu_backend *b, const evr_scene *s)
 {
-    int n = s->num_instances, i, j, g, ok = 1, static_group = -1;
-    unsigned long long static_tris = 0;
-    int instance_static;
-    int *group_of = malloc(sizeof(int) * (size_t)(n + 1));
-    int *node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1));
-    int *at = NULL;
+    const evr_instance_groups *gr = &b->groups;
+    int i, j, g, ok = 1;
     RTCScene *mesh_scenes = calloc((size_t)s->num_meshes + 1, sizeof *mesh_scenes);
-    b->group_track = malloc(sizeof(int) * (size_t)(n + 1));
-    b->group_instanced = calloc((size_t)n + 1, sizeof(int));
-    b->group_first = calloc((size_t)n + 2, sizeof(int));
-    b->members = malloc(sizeof(int) * (size_t)(n + 1));
-    if (!group_of || !node_group || !mesh_scenes || !b->group_track || !b->group_instanced || !b->group_first ||
-        !b->members) {
-        free(group_of);
-        free(node_group);
+    if (!mesh_scenes || !evr_instance_groups_build(s, 1, &b->groups)) {
         free(mesh_scenes);
         return 0;
     }
-    for (i = 0; i < n; i++)
-        if (node_never_moves(s, s->instances[i].node)) static_tris += s->meshes[s->instances[i].mesh].num_triangles;
-    instance_static = static_tris > evr_static_bake_limit();   /* cuda/gpu_bvh.h */
-    for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
-    b->num_groups = 0;
-    for (i = 0; i < n; i++) {
-        int node = s->instances[i].node, moving = !node_never_moves(s, node);
-        int *grp = moving ? &node_group[node] : &static_group;
-        if (!moving && instance_static) {   /* a group of its own */
-            b->group_instanced[b->num_groups] = 1;
-            b->group_track[b->num_groups] = -1;
-            group_of[i] = b->num_groups++;
-            continue;
-        }
-        if (*grp < 0) {
-            *grp = b->num_groups;
-            b->group_track[b->num_groups++] = moving ? node : -1;
-        }
-        group_of[i] = *grp;
-    }
-    free(node_group);
-    /* members by group, ascending */
-    for (i = 0; i < n; i++) b->group_first[group_of[i] + 1]++;
-    for (g = 0; g < b->num_groups; g++) b->group_first[g + 1] += b->group_first[g];
-    at = malloc(sizeof(int) * ((size_t)b->num_groups + 1));
-    if (!at) {
-        free(group_of);
-        free(mesh_scenes);
-        return 0;
-    }
-    memcpy(at, b->group_first, sizeof(int) * (size_t)b->num_groups);
-    for (i = 0; i < n; i++) b->members[at[group_of[i]]++] = i;
-    free(at);
-    free(group_of);
-    b->group_scenes = calloc((size_t)b->num_groups + 1, sizeof *b->group_scenes);
+    b->group_scenes = calloc((size_t)gr->num_groups + 1, sizeof *b->group_scenes);
     if (!b->group_scenes) ok = 0;
-    for (g = 0; ok && g < b->num_groups; g++) {
+    for (g = 0; ok && g < gr->num_groups; g++) {
         RTCScene sc;
-        if (b->group_instanced[g]) {   /* the mesh's scene, built once, one reference per group */
-            int mesh = s->instances[b->members[b->group_first[g]]].mesh;
+        if (gr->group_kind[g] == EVR_GROUP_STATIC) {   /* the mesh's scene, built once, one reference per group */
+            int mesh = s->instances[gr->members[gr->group_first[g]]].mesh;
             if (!mesh_scenes[mesh]) {
                 if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
                 mesh_scenes[mesh] = sc;
@@ -856,11 +796,11 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
         if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
         b->group_scenes[g] = sc;
         rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
-        for (j = b->group_first[g]; j < b->group_first[g + 1]; j++) {
-            const evr_instance *in = &s->instances[b->members[j]];
+        for (j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
+            const evr_instance *in = &s->instances[gr->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
-            if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh], b->group_track[g] < 0 ? &world : NULL,
-                                   (unsigned)(j - b->group_first[g]))) {
+            if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh], gr->group_kind[g] == EVR_GROUP_BAKED ? &world : NULL,
+                                   (unsigned)(j - gr->group_first[g]))) {
                 ok = 0;
                 break;
             }
@@ -916,14 +856,15 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     /* rebuilt every segment, but over a handful of instances (thousands when static instances are
      * not baked: then nothing in it moves and Embree does not rebuild it): quality costs little */
     rtcSetSceneBuildQuality(b->top, RTC_BUILD_QUALITY_HIGH);
-    for (m = 0; m < b->num_groups; m++) {
+    for (m = 0; m < b->groups.num_groups; m++) {
+        const evr_instance_groups *gr = &b->groups;
         RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
         if (!g) goto embree_fail;
         rtcSetGeometryInstancedScene(g, b->group_scenes[m]);
-        if (b->group_track[m] < 0) {   /* static: baked into world space (identity), or the node's fixed
-                                          transform; no motion */
-            evr_m34 xf = b->group_instanced[m]
-                             ? evr_node_world_at(s, s->instances[b->members[b->group_first[m]]].node, s->anim_start)
+        if (gr->group_kind[m] != EVR_GROUP_MOVING) {   /* baked into world space (identity), or the
+                                                          node's fixed transform; no motion */
+            evr_m34 xf = gr->group_kind[m] == EVR_GROUP_STATIC
+                             ? evr_node_world_at(s, s->instances[gr->members[gr->group_first[m]]].node, s->anim_start)
                              : evr_m34_identity();
             rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
             rtcCommitGeometry(g);
@@ -936,8 +877,8 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         evr_cpu_trace_ctx tc;
         evr_status st;
         tc.top = b->top;
-        tc.members = b->members;
-        tc.group_first = b->group_first;
+        tc.members = b->groups.members;
+        tc.group_first = b->groups.group_first;
         b->gi = 1;
         if ((st = evr_cpu_gi_init(&b->gi_state, &tc, &b->setup, s, err)) != EVR_OK) {
             cpu_release(&b->base);

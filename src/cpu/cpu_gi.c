@@ -1,5 +1,6 @@
 /* Global illumination in the CPU event pipeline: see cpu_gi.h. */
 #include "cpu/cpu_gi.h"
+#include "prep/gi_params.h"
 #include "host_clock.h"
 #include "core/shading.h"
 

@@ -1,7 +1,7 @@
-/* The photon pass on the CPU (issue 5): emitters of a segment, the image-space photon buffer,
- * and the loop that traces every photon through a ray-tracing interface given as function
- * pointers, so any backend (the still renderer's Embree scene, the event pipeline's motion-
- * blurred Embree scene) can run it. Per-photon decisions are src/core/photon.h. */
+/* The photon pass on the CPU: the image-space photon buffer and the loop that traces every
+ * photon through a ray-tracing interface given as function pointers, so any CPU renderer (the
+ * still renderer's Embree scene, the event pipeline's motion-blurred Embree scene) can run it.
+ * Per-photon decisions are src/core/photon.h, the emitters prep/photon_emitters.h. */
 #ifndef EVR_CPU_PHOTON_PASS_H
 #define EVR_CPU_PHOTON_PASS_H
 
@@ -9,6 +9,7 @@
 #include "evray.h"
 #include "core/photon.h"
 #include "backend.h"
+#include "prep/photon_emitters.h"
 
 /* What a closest-hit query returns: the scene instance, its triangle, barycentrics, distance. */
 typedef struct {
@@ -26,29 +27,6 @@ typedef struct {
     /* 1 when anything lies along ray with distance in [tnear, tfar) */
     int (*occluded)(void *user, evr_ray ray, float tnear, float tfar, float f);
 } evr_tracer;
-
-/* The emitters of one pass and how the photons are split among them (by power). */
-typedef struct {
-    evr_photon_emitter *e;
-    int n, cap;
-    float *cdf;                    /* cumulative triangle areas of the emissive instances */
-    int cdf_n, cdf_cap;
-    float total_power;             /* luminance flux of all emitters */
-    uint32_t photons;              /* sum of the emitters' counts (== the photons asked for, give or take rounding) */
-} evr_photon_emitters;
-
-/* Emitters at normalized segment time f (light positions and emissive areas; bb: a sphere
- * holding the scene at every time of the segment): every light with non-zero power, every instance whose
- * material is emissive (its triangles' world areas at f); photons split by luminance power,
- * each emitter's count fixed by (powers, photons) alone, so a static scene gets the same photons
- * every segment. Reuses em's arrays (zero-initialize em before the first call). */
-evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_photon_bounds bb, uint32_t photons,
-                                     evr_photon_emitters *em, evr_error *err);
-void evr_photon_emitters_free(evr_photon_emitters *em);
-/* dst becomes a copy of src (dst's arrays reused); 0: out of memory (dst unchanged in size). */
-int evr_photon_emitters_copy(evr_photon_emitters *dst, const evr_photon_emitters *src);
-/* Whether two tables send the same photons: the same emitters, counts and areas. */
-int evr_photon_emitters_same(const evr_photon_emitters *a, const evr_photon_emitters *b);
 
 /* A buffer for a width x height image with a guard band of margin pixels. */
 evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers, int margin, evr_error *err);
@@ -89,10 +67,6 @@ typedef struct {
     const evr_skip_plan *plan;
 } evr_photon_trails;
 void evr_photon_trails_free(evr_photon_trails *tt);
-/* The bookkeeping of a pass that records every photon's trail, for the CPU's trails and the GPU's:
- * whether the recorded trails (*valid, made with emitter table *recorded) may be reused by a pass
- * with emitters em; then *recorded and *valid describe this pass's trails. */
-int evr_photon_trails_pass(evr_photon_emitters *recorded, int *valid, const evr_photon_emitters *em);
 
 /* Traces every photon of the emitters (threads over chunks of photons), keeps each photon that
  * stays where the camera (pose at the photon's time) sees it, and inserts it into buf (cleared
@@ -102,12 +76,5 @@ int evr_photon_trails_pass(evr_photon_emitters *recorded, int *valid, const evr_
 evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
                            const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
                            evr_photon_trails *trails, evr_error *err);
-
-/* The run's GI settings, the same for the CPU and CUDA backends: photons per pass (0 asked: one
- * per pixel), gather parameters, pass parameters (photons spread over the segment, the same
- * times every segment; directional lights emit over a disk round the scene's rest bounds, a
- * little larger), the buffer's guard band and the cells around a pixel a gather may read. */
-void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons, evr_gather_params *gp,
-                       evr_photon_params *pp, int *margin, int *window);
 
 #endif

@@ -21,7 +21,8 @@ extern "C" {
 #include "backend.h"
 #include "cuda/cuda_backend.h"
 #include "cuda/gpu_bvh.h"
-#include "cpu/photon_pass.h"   /* the host side of the photon pass: emitters, run parameters */
+#include "prep/gi_params.h"
+#include "prep/photon_emitters.h"
 }
 #include "core/rng.h"
 #include "core/shading.h"

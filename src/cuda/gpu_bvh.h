@@ -1,20 +1,9 @@
 /* Our own ray-tracing acceleration structure, for the CUDA backend (and for host tests that
  * check it against Embree where there is no GPU).
  *
- * Two levels over GROUPS of instances, grouped exactly as the CPU backend groups them
- * (cpu_backend.c, build_groups):
- *   static group  every instance whose node never moves (no animated node on its parent chain),
- *                 its mesh's triangles baked into world space with the node's transform at
- *                 evr_scene.anim_start; one group, identity transform, no motion. Unless baking
- *                 would copy more than 1M triangles (counted per instance; the environment
- *                 variable EVR_STATIC_BAKE_LIMIT sets another limit, 0: always): then every
- *                 static instance is a group of its own in its node's space (its node's fixed
- *                 track, no motion), and the groups of one mesh share one tree (a city of
- *                 thousands of instances of a dozen buildings stores each building once);
- *   moving group  the instances of one moving node, their meshes' triangles together in that
- *                 node's object space; moved by the node's track.
- * A ray that crosses overlapping instances (skin and orbit around an eyeball) then searches one
- * tree instead of one per instance.
+ * Two levels over the groups of instances that both backends use (prep/instance_groups.h: the
+ * never-moving instances baked into world space, or past the bake limit each in its node's
+ * space with one tree per mesh; the instances of each moving node in that node's object space).
  *   bottom  one BVH per group, built once per run by Embree's rtcBuildBVH (SAH with spatial
  *           splits, RTC_BUILD_QUALITY_HIGH) and flattened into wide nodes; every group's nodes
  *           and triangles live in one node array and one triangle array. Moving groups whose
@@ -140,15 +129,14 @@ typedef struct {
 
 /* ---- host side ---- */
 
-/* Bottom level of every group of a scene. Groups are numbered in the order of their first
- * member, as the CPU backend numbers them. */
+/* Bottom level of every group of a scene (the groups of prep/instance_groups.h, in their order). */
 typedef struct {
     int layout;
     int grouped;               /* 0: built with EVR_GPU_BVH_UNGROUPED */
     int num_groups;
     int num_scene_instances;
-    int static_group;          /* index of the static group, -1 when every instance moves or the
-                                  static instances are instanced */
+    /* the grouping (evr_instance_groups: its arrays, owned here) */
+    int static_group;          /* index of the baked static group, -1: none */
     int static_instanced;      /* 1: the static instances were past the bake limit: each is a group
                                   of its own in its node's space, the trees shared by mesh */
     int *group_node;           /* per group: the node whose object space it is in and whose track
@@ -185,10 +173,10 @@ typedef struct {
     int stack_need;            /* top level's worst case plus the deepest group's */
 } evr_gpu_top;
 
-/* Groups the instances of s and builds the bottom level of every group with the given layout
- * (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no grouping). Reads the meshes,
- * the instances and the nodes (parent, animated, transforms at anim_start). On failure *out is
- * left empty (safe to free). */
+/* Groups the instances of s (evr_instance_groups_build) and builds the bottom level of every
+ * group with the given layout (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no
+ * grouping). Reads the meshes, the instances and the nodes (parent, animated, transforms at
+ * anim_start). On failure *out is left empty (safe to free). */
 evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err);
 void evr_gpu_bvh_free(evr_gpu_bvh *b);
 
@@ -200,25 +188,6 @@ void evr_gpu_top_free(evr_gpu_top *top);
 
 /* A view of host arrays, for host traversal. */
 void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_top *top, evr_gpu_scene_view *v);
-
-/* World box that holds the object-space box [lo, hi] moved by track tr at every time of the
- * segment, f in [0, 1], with the interpolation of evr_motion_eval. Conservative: between
- * samples of the rotation and scaling, the box of the (linear) translation plus the boxes at
- * the two samples widened by a bound on how far a point can turn or stretch in between (slerp
- * at its angular speed, scale/skew change); the union over all steps. Samples are spaced so
- * that the widening is about 1% of the object's size (at most 64 per key interval). */
-/* Both backends bake every never-moving instance into one world-space tree, but past this many
- * triangles so copied (counted per instance) they keep static instances as instances of one tree
- * per mesh instead: 1,000,000, or the environment variable EVR_STATIC_BAKE_LIMIT (a triangle
- * count; 0: always instance, for tests and comparisons). */
-unsigned long long evr_static_bake_limit(void);
-
-void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
-                            float out_hi[3]);
-
-/* Float bounds that hold a double value: the float at or below it, at or above it. */
-float evr_round_down(double x);
-float evr_round_up(double x);
 
 #ifdef __cplusplus
 }

@@ -2,6 +2,8 @@
  * tree of temporary nodes through our callbacks (in memory Embree owns and frees with the
  * RTCBVH), which is then flattened into the layout the traversal reads. */
 #include "cuda/gpu_bvh.h"
+#include "prep/instance_groups.h"
+#include "prep/swept_bounds.h"
 #include "scene/scene.h"
 
 #include <embree3/rtcore.h>
@@ -78,17 +80,6 @@ static void *cb_create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuild
     l->n = (unsigned)n;
     for (i = 0; i < n; i++) l->prim[i] = prims[i].primID;   /* geomID may carry Embree's split bits */
     return l;
-}
-
-float evr_round_down(double x)
-{
-    float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
-}
-float evr_round_up(double x)
-{
-    float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
 }
 
 static inline float min_f(float a, float b) { return a < b ? a : b; }
@@ -635,69 +626,7 @@ void evr_gpu_bvh_free(evr_gpu_bvh *b)
     memset(b, 0, sizeof *b);
 }
 
-/* ---- grouping, as cpu_backend.c's build_groups ---- */
-
-static int node_never_moves(const evr_scene *s, int node)
-{
-    int guard = 0;
-    for (; node >= 0 && node < s->num_nodes && guard++ <= s->num_nodes; node = s->nodes[node].parent)
-        if (s->nodes[node].animated) return 0;
-    return 1;
-}
-
-#define EVR_STATIC_BAKE_LIMIT_DEFAULT 1000000ull
-unsigned long long evr_static_bake_limit(void)
-{
-    const char *v = getenv("EVR_STATIC_BAKE_LIMIT");
-    char *end;
-    unsigned long long x;
-    if (!v || !*v) return EVR_STATIC_BAKE_LIMIT_DEFAULT;
-    x = strtoull(v, &end, 10);
-    return *end ? EVR_STATIC_BAKE_LIMIT_DEFAULT : x;
-}
-
-/* Assigns every instance its group (numbered by first member) and lists the members. */
-static int make_groups(const evr_scene *s, evr_gpu_bvh *out, int grouped)
-{
-    int n = s->num_instances, i, g;
-    int *node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1)), *at;
-    unsigned long long static_tris = 0;
-    if (!node_group) return 0;
-    for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
-    for (i = 0; i < n; i++) {
-        int m = s->instances[i].mesh;
-        if (m >= 0 && m < s->num_meshes && node_never_moves(s, s->instances[i].node))
-            static_tris += s->meshes[m].num_triangles;
-    }
-    out->static_instanced = grouped && static_tris > evr_static_bake_limit();
-    out->static_group = -1;
-    out->num_groups = 0;
-    for (i = 0; i < n; i++) {
-        int node = s->instances[i].node, moving = !node_never_moves(s, node);
-        int *grp = moving ? &node_group[node] : &out->static_group;
-        if (!grouped || (!moving && out->static_instanced)) {
-            /* a group of its own, in its node's space (none: the world) */
-            out->instance_group[i] = out->num_groups;
-            out->group_node[out->num_groups++] = node >= 0 && node < s->num_nodes ? node : -1;
-            continue;
-        }
-        if (*grp < 0) {
-            *grp = out->num_groups;
-            out->group_node[out->num_groups++] = moving ? node : -1;
-        }
-        out->instance_group[i] = *grp;
-    }
-    free(node_group);
-    /* members by group, ascending */
-    for (i = 0; i < n; i++) out->group_first[out->instance_group[i] + 1]++;
-    for (g = 0; g < out->num_groups; g++) out->group_first[g + 1] += out->group_first[g];
-    at = malloc(sizeof(int) * ((size_t)out->num_groups + 1));
-    if (!at) return 0;
-    memcpy(at, out->group_first, sizeof(int) * (size_t)out->num_groups);
-    for (i = 0; i < n; i++) out->members[at[out->instance_group[i]]++] = i;
-    free(at);
-    return 1;
-}
+/* ---- groups sharing a tree ---- */
 
 /* A moving group whose members are consecutive scene instances can share its tree with another
  * such group of the same meshes: its triangles hold instances relative to the first member. */
@@ -845,6 +774,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
 {
     flat_ctx c;
     group_tris gt;
+    evr_instance_groups groups;
     evr_status st = EVR_OK;
     RTCDevice dev;
     int n = s->num_instances, g, *table = NULL;
@@ -860,16 +790,22 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     if (n < 0) return fail(err, EVR_ERR_ARG, "a negative instance count", NULL);
     out->layout = layout;
     out->num_scene_instances = n;
-    out->group_node = malloc(sizeof(int) * ((size_t)n + 1));
-    out->group_first = calloc((size_t)n + 2, sizeof(int));
-    out->members = malloc(sizeof(int) * ((size_t)n + 1));
-    out->instance_group = malloc(sizeof(int) * ((size_t)n + 1));
+    if (evr_instance_groups_build(s, out->grouped, &groups)) {   /* its arrays are ours from here */
+        out->num_groups = groups.num_groups;
+        out->static_group = groups.static_group;
+        out->static_instanced = groups.static_instanced;
+        out->group_node = groups.group_node;
+        out->group_first = groups.group_first;
+        out->members = groups.members;
+        out->instance_group = groups.instance_group;
+        free(groups.group_kind);
+    }
     out->group_root = malloc(sizeof(int32_t) * ((size_t)n + 1));
     out->group_instance_base = calloc((size_t)n + 1, sizeof(int32_t));
     out->group_stack = calloc((size_t)n + 1, sizeof(int));
     out->group_bounds = malloc(sizeof(float) * 6 * ((size_t)n + 1));
     if (!out->group_node || !out->group_first || !out->members || !out->instance_group || !out->group_root ||
-        !out->group_instance_base || !out->group_stack || !out->group_bounds || !make_groups(s, out, out->grouped)) {
+        !out->group_instance_base || !out->group_stack || !out->group_bounds) {
         evr_gpu_bvh_free(out);
         return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
     }
@@ -967,107 +903,6 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     return st;
 }
 
-/* ---- motion bounds ---- */
-
-static void extend_corners(const evr_m34 *m, const float lo[3], const float hi[3], double blo[3], double bhi[3])
-{
-    int c, k;
-    for (c = 0; c < 8; c++) {
-        evr_v3 p = evr_v3_make((c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]);
-        evr_v3 q = evr_m34_point(m, p);
-        double x[3] = {q.x, q.y, q.z};
-        for (k = 0; k < 3; k++) {
-            if (x[k] < blo[k]) blo[k] = x[k];
-            if (x[k] > bhi[k]) bhi[k] = x[k];
-        }
-    }
-}
-
-/* |U p| for the upper-triangular part of a key. */
-static double upper_apply_len(const evr_motion_key *k, const double p[3], int diff, const evr_motion_key *b)
-{
-    double s0 = k->scale[0], s1 = k->scale[1], s2 = k->scale[2];
-    double k0 = k->skew[0], k1 = k->skew[1], k2 = k->skew[2];
-    double x, y, z;
-    if (diff) {
-        s0 = b->scale[0] - s0; s1 = b->scale[1] - s1; s2 = b->scale[2] - s2;
-        k0 = b->skew[0] - k0; k1 = b->skew[1] - k1; k2 = b->skew[2] - k2;
-    }
-    x = s0 * p[0] + k0 * p[1] + k1 * p[2];
-    y = s1 * p[1] + k2 * p[2];
-    z = s2 * p[2];
-    return sqrt(x * x + y * y + z * z);
-}
-
-void evr_gpu_segment_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
-                            float out_hi[3])
-{
-    double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    double mag = 0.0;
-    int i, j, k;
-    if (tr.n <= 1) {
-        evr_m34 m = evr_motion_key_matrix(&tr.keys[0]);
-        extend_corners(&m, lo, hi, blo, bhi);
-    }
-    for (i = 0; i + 1 < tr.n; i++) {
-        /* x(s) = T(s) + Q(s) c, Q = R U, for s in [0, 1] and c in the box. Between two samples
-         * s0 < s1: T is linear, so T(s) lies in the box of T(s0), T(s1); Q(s) c lies within
-         * L h / 2 (h = s1 - s0) of Q(s0) c or Q(s1) c, L a bound on its speed:
-         * |d(Q c)/ds| <= w max|U(s) c| + |dU c|, w the rotation's angular speed (slerp:
-         * constant, the angle between the keys; normalized lerp for close keys: at most 1.0003
-         * times that); |U(s) c| is convex in s and c, so its maximum is at an end key and a
-         * corner of the box. Each step's box is the sum of the two; the result their union.
-         * Translation needs no samples: the samples follow the rotation and scaling only. */
-        evr_motion_key a = tr.keys[i], b = tr.keys[i + 1];
-        double plo[3], phi[3], pt[3];   /* previous sample: Q box and T */
-        double d = fabs((double)evr_quat_dot(a.rot, b.rot));
-        double qa = sqrt((double)evr_quat_dot(a.rot, a.rot)), qb = sqrt((double)evr_quat_dot(b.rot, b.rot));
-        double w, umax = 0.0, dumax = 0.0, L, margin;
-        evr_v3 ta = a.trans, tb = b.trans;
-        int steps, c;
-        d = qa > 0.0 && qb > 0.0 ? d / (qa * qb) : 1.0;
-        w = 2.0 * acos(d > 1.0 ? 1.0 : d) * 1.01 + 1e-6;
-        for (c = 0; c < 8; c++) {
-            double p[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
-            umax = fmax(umax, fmax(upper_apply_len(&a, p, 0, NULL), upper_apply_len(&b, p, 0, NULL)));
-            dumax = fmax(dumax, upper_apply_len(&a, p, 1, &b));
-        }
-        L = w * umax + dumax;
-        /* samples close enough that the widening is 1% of the object's size */
-        steps = (int)ceil(L / (2e-2 * (umax > 0.0 ? umax : 1.0)));
-        if (steps < 1) steps = 1;
-        if (steps > 64) steps = 64;
-        margin = L / (2.0 * steps);
-        a.trans = b.trans = evr_v3_make(0.0f, 0.0f, 0.0f);
-        for (j = 0; j <= steps; j++) {
-            float f = (float)j / (float)steps;
-            evr_motion_key key = evr_motion_key_lerp(&a, &b, f);
-            evr_m34 m = evr_motion_key_matrix(&key);
-            evr_v3 t = evr_v3_lerp(ta, tb, f);
-            double qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
-            double tt[3] = {t.x, t.y, t.z};
-            extend_corners(&m, lo, hi, qlo, qhi);
-            if (j > 0)
-                for (k = 0; k < 3; k++) {
-                    blo[k] = fmin(blo[k], fmin(pt[k], tt[k]) + fmin(plo[k], qlo[k]) - margin);
-                    bhi[k] = fmax(bhi[k], fmax(pt[k], tt[k]) + fmax(phi[k], qhi[k]) + margin);
-                }
-            for (k = 0; k < 3; k++) {
-                plo[k] = qlo[k];
-                phi[k] = qhi[k];
-                pt[k] = tt[k];
-            }
-        }
-    }
-    for (k = 0; k < 3; k++) mag = fmax(mag, fmax(fabs(blo[k]), fabs(bhi[k])));
-    for (k = 0; k < 3; k++) {
-        /* float evaluation of the transforms (in the traversal and here) is off by a few ulps */
-        double slack = 1e-6 * mag + 1e-30;
-        out_lo[k] = evr_round_down(blo[k] - slack);
-        out_hi[k] = evr_round_up(bhi[k] + slack);
-    }
-}
-
 /* ---- top level ---- */
 
 void evr_gpu_top_free(evr_gpu_top *top)
@@ -1136,7 +971,7 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
         } else {   /* every member is on the group's node: the first one's track is the group's */
             int track = rs->instances[b->members[b->group_first[g]]].track;
             evr_motion_track tr = evr_rs_track(rs, track);
-            evr_gpu_segment_bounds(gb, gb + 3, tr, lo, hi);
+            evr_swept_bounds(gb, gb + 3, tr, lo, hi);
             in->track = track;
             in->moving = tr.n > 1;
             if (!in->moving) {

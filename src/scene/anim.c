@@ -108,8 +108,7 @@ evr_m34 evr_node_world_at(const evr_scene *s, int node, double t)
 
 /* ---- motion keys ---- */
 
-/* 1 when the node or one of its ancestors has animation curves. */
-static int chain_animated(const evr_scene *s, int node)
+int evr_node_chain_animated(const evr_scene *s, int node)
 {
     int guard = 0;
     while (node >= 0 && node < s->num_nodes && guard++ <= s->num_nodes) {
@@ -194,7 +193,7 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
         evr_m34 m0 = evr_node_world_at(s, node, t0);
         keys[0] = evr_motion_key_from_matrix(&m0);
     }
-    if (max_keys < 2 || node < 0 || node >= s->num_nodes || !(t1 > t0) || !chain_animated(s, node))
+    if (max_keys < 2 || node < 0 || node >= s->num_nodes || !(t1 > t0) || !evr_node_chain_animated(s, node))
         return 1;
 
     /* Largest 2^k + 1 that fits. */

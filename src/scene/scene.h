@@ -109,6 +109,8 @@ struct evr_scene {
 /* Animation evaluation (scene/anim.c). */
 evr_m34 evr_node_local_at(const evr_node *n, double t);
 evr_m34 evr_node_world_at(const evr_scene *s, int node, double t);
+/* 1 when the node or one of its ancestors has animation curves (0 for -1, no node). */
+int evr_node_chain_animated(const evr_scene *s, int node);
 
 /* Motion keys of a node's world transform over [t0, t1]: the fewest uniformly spaced keys
  * (2^k + 1, at most max_keys) such that interpolating them matches the curves within tol

@@ -1,6 +1,6 @@
 /* Per-segment plan of change-driven sampling: see skip_plan.h and core/skip.h. */
-#include "skip_plan.h"
-#include "cuda/gpu_bvh.h"
+#include "prep/skip_plan.h"
+#include "prep/swept_bounds.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -179,13 +179,13 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
     const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
     const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
     const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
-    evr_gpu_segment_bounds(lo, hi, evr_rs_track(rs, tr), blo, bhi);
+    evr_swept_bounds(lo, hi, evr_rs_track(rs, tr), blo, bhi);
     if (t->prev_count[tr] > 0) {
         evr_motion_track prev;
         float plo[3], phi[3];
         prev.keys = &t->prev_last[tr];
         prev.n = 1;
-        evr_gpu_segment_bounds(lo, hi, prev, plo, phi);
+        evr_swept_bounds(lo, hi, prev, plo, phi);
         box_union(blo, bhi, plo, phi);
     }
 }
@@ -214,7 +214,7 @@ static double upper_diff_norm(const evr_motion_key *a, const evr_motion_key *b)
 
 /* One track's motion over the segment, for sweeping many boxes: each key's matrix and, per key
  * interval, the bound on how fast a point at unit distance from the origin moves (the same
- * bound as evr_gpu_segment_bounds: rotation at the slerp's angular speed times |U c|, plus the
+ * bound as evr_swept_bounds: rotation at the slerp's angular speed times |U c|, plus the
  * change of U). */
 typedef struct {
     int n;
@@ -248,7 +248,7 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
 /* World box of the object-space box [lo, hi] moved by the track over the segment: the boxes at
  * the keys, each key interval's pair widened by half its speed times the farthest corner's
  * distance (a point moving at speed L between two keys stays within L / 2 of one of them),
- * translation taken as its box. evr_gpu_segment_bounds bounds the same motion more tightly, with
+ * translation taken as its box. evr_swept_bounds bounds the same motion more tightly, with
  * samples between the keys; this one is for many boxes of one track (a moving mesh's parts, 1,024
  * per segment on the eye), its per-track work done once in track_sweep_init. */
 static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3], float out_hi[3])
