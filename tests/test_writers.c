@@ -20,6 +20,7 @@
 #include "io/event_reader.h"
 #include "io/event_writer.h"
 #include "io/json.h"
+#include "io/json_read.h"
 #include "io/preview.h"
 
 #define W 640
@@ -527,6 +528,77 @@ done:
     free(raw);
     evr_chunk_worker_free(w);
     free(dst);
+}
+
+/* The reader (io/json_read.h) takes back what the writer writes, and refuses what is not JSON. */
+static void test_json_read(void)
+{
+    evr_json j;
+    evr_jdoc d;
+    char *text, buf[64];
+    int root, a, c, k;
+    static const char *bad[] = {"", "{", "[1,]", "{\"a\" 1}", "{\"a\":}", "tru", "-", "1e", "\"open", "[1 2]"};
+
+    evr_json_init(&j, 1);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "s"); evr_json_string(&j, "q\"b\\n\nt\tc\x01" "e\xc3\xa9");
+    evr_json_key(&j, "a"); evr_json_begin_array(&j);
+    evr_json_integer(&j, -12); evr_json_number(&j, 0.1); evr_json_float(&j, 1e-7f); evr_json_boolean(&j, 1);
+    evr_json_null(&j); evr_json_begin_object(&j); evr_json_end_object(&j);
+    evr_json_end_array(&j);
+    evr_json_key(&j, "k\"ey"); evr_json_integer(&j, 7);
+    evr_json_end_object(&j);
+    text = evr_json_take(&j);
+    CHECK(text != NULL);
+    if (!text) return;
+    root = evr_jdoc_parse(&d, text, strlen(text));
+    CHECK(root >= 0 && evr_jdoc_type(&d, root) == EVR_JDOC_OBJECT);
+    CHECK(evr_jdoc_string(&d, evr_jdoc_get(&d, root, "s"), buf, sizeof buf) && !strcmp(buf, "q\"b\\n\nt\tc\x01" "e\xc3\xa9"));
+    a = evr_jdoc_get(&d, root, "a");
+    CHECK(evr_jdoc_count(&d, a) == 6);
+    c = evr_jdoc_first(&d, a);
+    CHECK(evr_jdoc_number(&d, c, 0) == -12.0);
+    c = evr_jdoc_next(&d, c);
+    CHECK(fabs(evr_jdoc_number(&d, c, 0) - 0.1) < 1e-15);
+    c = evr_jdoc_next(&d, c);
+    CHECK((float)evr_jdoc_number(&d, c, 0) == 1e-7f);
+    c = evr_jdoc_next(&d, c);
+    CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_BOOL);
+    c = evr_jdoc_next(&d, c);
+    CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_NULL && evr_jdoc_number(&d, c, 5.0) == 5.0);
+    c = evr_jdoc_next(&d, c);
+    CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_OBJECT && evr_jdoc_first(&d, c) < 0 && evr_jdoc_next(&d, c) < 0);
+    CHECK(evr_jdoc_number(&d, evr_jdoc_get(&d, root, "k\"ey"), 0) == 7.0);   /* an escaped key */
+    /* missing values chain: -1 answers as a value of the wrong type */
+    CHECK(evr_jdoc_get(&d, evr_jdoc_get(&d, root, "none"), "x") < 0);
+    CHECK(evr_jdoc_count(&d, -1) == 0 && evr_jdoc_first(&d, -1) < 0 && evr_jdoc_type(&d, -1) < 0);
+    CHECK(!evr_jdoc_string(&d, a, buf, sizeof buf) && buf[0] == 0);
+    evr_jdoc_free(&d);
+    free(text);
+
+    /* \u escapes with a surrogate pair, a text that does not end in 0 */
+    {
+        static const char t[] = "[\"\\u00e9\\ud83d\\ude00\"]xyz";
+        root = evr_jdoc_parse(&d, t, sizeof t - 4);
+        CHECK(evr_jdoc_string(&d, evr_jdoc_first(&d, root), buf, sizeof buf) && !strcmp(buf, "\xc3\xa9\xf0\x9f\x98\x80"));
+        evr_jdoc_free(&d);
+    }
+    for (k = 0; k < (int)(sizeof bad / sizeof bad[0]); k++) {
+        CHECK(evr_jdoc_parse(&d, bad[k], strlen(bad[k])) < 0 && !d.failed);
+        evr_jdoc_free(&d);
+    }
+    /* nesting deeper than EVR_JDOC_MAX_DEPTH */
+    {
+        char deep[2 * (EVR_JDOC_MAX_DEPTH + 2)];
+        for (k = 0; k < EVR_JDOC_MAX_DEPTH + 2; k++) {
+            deep[k] = '[';
+            deep[2 * (EVR_JDOC_MAX_DEPTH + 2) - 1 - k] = ']';
+        }
+        CHECK(evr_jdoc_parse(&d, deep, sizeof deep) < 0);
+        evr_jdoc_free(&d);
+        CHECK(evr_jdoc_parse(&d, deep + 2, sizeof deep - 4) >= 0);
+        evr_jdoc_free(&d);
+    }
 }
 
 /* Chunk compression: the shuffled layout, zero padding, and the pool's output equal to one
@@ -1131,6 +1203,7 @@ int main(void)
         return 1;
     }
     test_json();
+    test_json_read();
     test_chunk_compress();
     test_chunk_stored_blocks();
     test_deflate_runs();

@@ -1,4 +1,5 @@
-/* A tiny JSON text builder (for run.json and the configuration stored in event files).
+/* A tiny JSON text builder (for run.json and the configuration stored in event files); the
+ * reader beside it is io/json_read.h.
  *
  *     evr_json j;
  *     evr_json_init(&j, 1);                 // 1: indented, 0: compact
