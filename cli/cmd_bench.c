@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "host_clock.h"
 #include "evray.h"
+#include "evray_experimental.h"
 #include "io/event_reader.h"
 #include "io/plot.h"
 #include "options.h"
@@ -19,13 +20,14 @@
 
 static void remove_run(const char *dir)
 {
-    static const char *files[] = {"events.h5", "events.txt", "events.npy", "run.json", NULL};
     char p[4200];
     int i;
-    for (i = 0; files[i]; i++) {
-        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+    for (i = 0; evr_format_file(i); i++) {
+        snprintf(p, sizeof p, "%s/%s", dir, evr_format_file(i));
         remove(p);
     }
+    snprintf(p, sizeof p, "%s/run.json", dir);
+    remove(p);
     rmdir(dir);
 }
 
@@ -51,12 +53,11 @@ static double samples_per_pixel_s(const bench_figures *f)
 /* Reads the run's events (its first event file) into *ev. */
 static int read_run_events(const char *dir, evr_event **ev, size_t *n)
 {
-    static const char *files[] = {"events.h5", "events.npy", "events.txt", NULL};
     char p[4200];
     int i;
-    for (i = 0; files[i]; i++) {
+    for (i = 0; evr_format_file(i); i++) {   /* every format reads back to the same events */
         evr_error err = {{0}};
-        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+        snprintf(p, sizeof p, "%s/%s", dir, evr_format_file(i));
         if (access(p, R_OK) != 0) continue;
         if (evr_events_read(p, ev, n, NULL, NULL, &err) == EVR_OK) return 1;
         cli_error("%s", err.msg);

@@ -1,4 +1,5 @@
 #include "options.h"
+#include "evray_experimental.h"
 
 #include <errno.h>
 #include <math.h>
@@ -90,27 +91,11 @@ bad:
 
 int opt_formats(const char *text, int *formats)
 {
-    char buf[256];
-    int f = 0;
-    if (strlen(text) >= sizeof buf) {
-        cli_error("--format: value too long");
+    evr_error err;
+    if (evr_formats_parse("--format", text, formats, &err) != EVR_OK) {
+        cli_error("%s", err.msg);
         return 0;
     }
-    strcpy(buf, text);
-    char *tok = buf, *next;
-    for (; tok; tok = next) {
-        next = strchr(tok, ',');
-        if (next) *next++ = 0;
-        if (!strcmp(tok, "h5") || !strcmp(tok, "hdf5")) f |= EVR_FORMAT_H5;
-        else if (!strcmp(tok, "txt")) f |= EVR_FORMAT_TXT;
-        else if (!strcmp(tok, "npy")) f |= EVR_FORMAT_NPY;
-        else if (!strcmp(tok, "all")) f |= EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY;
-        else {
-            cli_error("--format: unknown format '%s' (h5, txt, npy, all; comma-separated)", tok);
-            return 0;
-        }
-    }
-    *formats = f;
     return 1;
 }
 

@@ -1,6 +1,7 @@
 /* Simulation parameters: defaults, checks, and the JSON form stored with every output. */
 #include "evray.h"
 #include "config_json.h"
+#include "io/event_formats.h"
 #include "io/json.h"
 #include "scene/scene.h"
 
@@ -180,7 +181,7 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
         BAD("GPU event capacity must be between 0 (automatic) and 2^31 (got %lld)", (long long)c->gpu_event_capacity);
     if (c->threads < 0 || c->threads > 4096) BAD("threads must be between 0 (all cores) and 4096 (got %d)", c->threads);
     if (!c->out_dir || !c->out_dir[0]) BAD("no output folder given");
-    if (!c->formats || (c->formats & ~(EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY))) BAD("no valid output format selected");
+    if (!c->formats || (c->formats & ~evr_event_formats_all())) BAD("no valid output format selected");
     if (c->frames_out && !c->frames_out[0]) BAD("frames folder is an empty path");
     if (!isfinite(c->frames_fps) || c->frames_fps < 0.0 || c->frames_fps > 1e6)
         BAD("frames fps must be a positive number of frames per second (got %g)", c->frames_fps);
@@ -269,9 +270,12 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
         evr_json_key(&j, "frames_max"); evr_json_float(&j, c->frames_max);
     }
     evr_json_key(&j, "formats"); evr_json_begin_array(&j);
-    if (c->formats & EVR_FORMAT_H5) evr_json_string(&j, "h5");
-    if (c->formats & EVR_FORMAT_TXT) evr_json_string(&j, "txt");
-    if (c->formats & EVR_FORMAT_NPY) evr_json_string(&j, "npy");
+    {
+        int k, count;
+        const evr_event_format *const *formats = evr_event_formats(&count);
+        for (k = 0; k < count; k++)
+            if (c->formats & (1 << k)) evr_json_string(&j, formats[k]->name);
+    }
     evr_json_end_array(&j);
     evr_json_end_object(&j);
     return evr_json_take(&j);

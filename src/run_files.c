@@ -1,5 +1,6 @@
 #include "run_files.h"
 #include "frames_out.h"
+#include "io/event_formats.h"
 #include "io/json.h"
 #include "io/preview.h"
 
@@ -86,27 +87,23 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
 
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
 {
-    static const struct { int bit; const char *file; } kinds[] = {
-        {EVR_FORMAT_H5, "events.h5"}, {EVR_FORMAT_TXT, "events.txt"}, {EVR_FORMAT_NPY, "events.npy"}};
+    int i, count;
+    const evr_event_format *const *formats = evr_event_formats(&count);
     evr_writer_meta meta;
     char p[4200];
-    int i;
     evr_status st;
     meta.width = sim->cfg.width;
     meta.height = sim->cfg.height;
     meta.config_json = sim->config_json;
     /* timestamps end with the run, moved by jitter and rounding to the resolution */
     meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + evr_sim_timestamp_slack_us(sim) + 1;
-    for (i = 0; i < 3; i++) {
-        if (!(sim->cfg.formats & kinds[i].bit)) continue;
-        if ((st = path_join(p, sizeof p, sim->out_dir, kinds[i].file, err)) != EVR_OK) return st;
+    for (i = 0; i < count && i < EVR_MAX_WRITERS; i++) {
+        if (!(sim->cfg.formats & (1 << i))) continue;
+        if ((st = path_join(p, sizeof p, sim->out_dir, formats[i]->file, err)) != EVR_OK) return st;
         evr_event_writer *w = NULL;
-        if (kinds[i].bit == EVR_FORMAT_H5) st = evr_h5_writer_open(p, &meta, &w, err);
-        else if (kinds[i].bit == EVR_FORMAT_TXT) st = evr_txt_writer_open(p, &meta, &w, err);
-        else st = evr_npy_writer_open(p, &meta, &w, err);
-        if (st != EVR_OK) return st;
+        if ((st = formats[i]->open(p, &meta, &w, err)) != EVR_OK) return st;
         sim->writers[sim->num_writers] = w;
-        sim->writer_names[sim->num_writers] = kinds[i].file;
+        sim->writer_names[sim->num_writers] = formats[i]->file;
         sim->num_writers++;
     }
     return EVR_OK;

@@ -9,7 +9,7 @@
 #include "io/preview.h"
 #include "write_queue.h"
 
-#define EVR_MAX_WRITERS 3
+#define EVR_MAX_WRITERS 16   /* formats a run may write (io/event_formats.h) */
 
 /* ON events and timestamp changes (t differing from the one before, prev for the first) of a
  * part of a batch of emitted events. */
