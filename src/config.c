@@ -34,11 +34,16 @@ static double field_number(const evr_config *c, const evr_config_option *o)
     }
 }
 
-void evr_config_defaults(evr_config *c)
+/* The smallest evr_config a caller may pass: the first version with a size field. When fields
+ * are added at the end, this stays and older callers' configurations get defaults for the rest. */
+#define EVR_CONFIG_FIRST_SIZE sizeof(evr_config)
+
+static void fill_defaults(evr_config *c)
 {
     int i, n;
     const evr_config_option *t = evr_config_table(&n);
     memset(c, 0, sizeof *c);
+    c->size = sizeof *c;
     for (i = 0; i < n; i++) {
         void *f = evr_config_field(c, &t[i]);
         switch (t[i].type) {
@@ -121,6 +126,32 @@ evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err)
     return EVR_OK;
 }
 
+void evr_config_init(evr_config *c, size_t size)
+{
+    evr_config d;
+    fill_defaults(&d);
+    if (size >= EVR_CONFIG_FIRST_SIZE && size <= sizeof d) {   /* an older caller: its own fields only */
+        memcpy(c, &d, size);
+        c->size = size;
+    } else if (size > sizeof d) {   /* a newer caller: ours, and a size it will be refused with */
+        memcpy(c, &d, sizeof d);
+        c->size = size;
+    }
+}
+
+evr_status evr_config_current(const evr_config *c, evr_config *out, evr_error *err)
+{
+    if (!c || c->size < EVR_CONFIG_FIRST_SIZE || c->size > sizeof *out) {
+        snprintf(err->msg, sizeof err->msg, "evr_config of %zu bytes is not one this evray (%zu bytes) knows: make it with evr_config_defaults",
+                 c ? c->size : (size_t)0, sizeof *out);
+        return EVR_ERR_ARG;
+    }
+    fill_defaults(out);   /* the fields an older caller does not have */
+    memcpy(out, c, c->size);
+    out->size = sizeof *out;
+    return EVR_OK;
+}
+
 #define BAD(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
 
 /* Whether a choice row's value is one of its choices. */
@@ -165,11 +196,14 @@ static evr_status check_range(const evr_config *c, const evr_config_option *o, e
     }
 }
 
-evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_error *err)
+evr_status evr_config_validate(const evr_config *given, const evr_scene *s, evr_error *err)
 {
     int i, n;
     evr_status st;
+    evr_config cur;
+    const evr_config *c = &cur;
     const evr_config_option *t = evr_config_table(&n);
+    if ((st = evr_config_current(given, &cur, err)) != EVR_OK) return st;
     for (i = 0; i < n; i++) {
         if (t[i].applies && !t[i].applies(c)) continue;
         if ((st = check_range(c, &t[i], err)) != EVR_OK) return st;

@@ -91,7 +91,9 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     evr_status st;
     int i;
     *out = NULL;
-    if ((st = evr_config_validate(c, s, err)) != EVR_OK) return st;
+    evr_config cur;
+    if ((st = evr_config_validate(c, s, err)) != EVR_OK || (st = evr_config_current(c, &cur, err)) != EVR_OK) return st;
+    c = &cur;   /* this library's evr_config, whatever the caller's size */
     evr_sim *sim = calloc(1, sizeof *sim);
     if (!sim) return nomem(err);
     sim->scene = s;

@@ -265,8 +265,26 @@ static void test_all_formats_written(void)
     evr_scene_release(scene);
 }
 
+/* The size field: set by evr_config_defaults, and a size the library does not know is refused. */
+static void test_size_field(void)
+{
+    evr_config c;
+    evr_error err = {{0}};
+    evr_sim *sim = NULL;
+    evr_config_defaults(&c);
+    CHECK(c.size == sizeof c);
+    CHECK_OK(evr_config_validate(&c, NULL, &err));
+    c.size = sizeof c - 8;
+    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG && strstr(err.msg, "evr_config_defaults") != NULL);
+    c.size = sizeof c + 8;
+    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG);
+    c.size = 0;
+    CHECK(evr_sim_new(NULL, &c, &sim, &err) == EVR_ERR_ARG && sim == NULL);
+}
+
 int main(void)
 {
+    test_size_field();
     test_documented_defaults();
     test_row_defaults();
     test_table_shape();
