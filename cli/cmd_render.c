@@ -1,5 +1,4 @@
 #include "commands.h"
-#include "host_clock.h"
 #include "evray.h"
 #include "evray_experimental.h"
 #include "options.h"
@@ -32,7 +31,7 @@ static int on_progress(void *user, const evr_stats *st)
         p->duration = st->sim_time * st->segments_total / st->segments_done;
     if (p->show) {
         double frac = st->segments_total ? (double)st->segments_done / st->segments_total : 1.0;
-        double el = evr_host_seconds() - p->started;
+        double el = evr_seconds() - p->started;
         double eta = frac > 0 ? el * (1.0 - frac) / frac : 0.0;
         char bar[31];
         int filled = (int)(frac * 30.0), i;
@@ -106,7 +105,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
 
     progress_state ps;
     ps.show = !quiet && isatty(2);
-    ps.started = evr_host_seconds();
+    ps.started = evr_seconds();
     ps.duration = 0;
     ps.duration = cfg.duration;
     st = evr_sim_run(sim, on_progress, &ps, &err);
