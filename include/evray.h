@@ -56,6 +56,9 @@ void evr_scene_release(evr_scene *s);
 char *evr_scene_describe(const evr_scene *s);
 
 /* ---- simulation ---- */
+/* Event output formats as bits of evr_config.formats: format i of the registry
+ * (src/io/event_formats.c) is bit 1 << i; formats without a constant here are found by name
+ * (evr_formats_parse, evr_format_name in evray_experimental.h). */
 typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
 
 /* auto: CUDA when this build has it and a usable GPU is present, else the CPU (with a notice). */

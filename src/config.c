@@ -97,13 +97,21 @@ const char *evr_sensor_canonical(const char *name)
     return p ? p->name : NULL;
 }
 
-const char *evr_sensor_list(void) { return "ideal, davis346, dvxplorer, prophesee-gen4"; }
+const char *evr_sensor_list(char *buf, size_t n)
+{
+    int i;
+    size_t len = 0;
+    buf[0] = 0;
+    for (i = 0; i < NUM_PRESETS && len < n; i++) len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? ", " : "", presets[i].name);
+    return buf;
+}
 
 evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err)
 {
     const sensor_preset *p = find_preset(name);
+    char list[128];
     if (!p) {
-        snprintf(err->msg, sizeof err->msg, "unknown sensor '%s' (%s)", name ? name : "", evr_sensor_list());
+        snprintf(err->msg, sizeof err->msg, "unknown sensor '%s' (%s)", name ? name : "", evr_sensor_list(list, sizeof list));
         return EVR_ERR_ARG;
     }
     c->sensor = p->name;

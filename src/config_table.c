@@ -78,7 +78,8 @@ static evr_status parse_event_capacity(evr_config *c, const char *v, evr_error *
 static evr_status parse_sensor(evr_config *c, const char *v, evr_error *err)
 {
     const char *name = evr_sensor_canonical(v);
-    if (!name) FAIL("--sensor: unknown sensor '%s' (%s)", v, evr_sensor_list());
+    char list[128];
+    if (!name) FAIL("--sensor: unknown sensor '%s' (%s)", v, evr_sensor_list(list, sizeof list));
     c->sensor = name;
     return EVR_OK;
 }
@@ -98,7 +99,9 @@ static evr_status check_max_dt(const evr_config *c, evr_error *err)
 }
 static evr_status check_sensor(const evr_config *c, evr_error *err)
 {
-    if (c->sensor && !evr_sensor_canonical(c->sensor)) FAIL("unknown sensor '%s' (%s)", c->sensor, evr_sensor_list());
+    char list[128];
+    if (c->sensor && !evr_sensor_canonical(c->sensor))
+        FAIL("unknown sensor '%s' (%s)", c->sensor, evr_sensor_list(list, sizeof list));
     return EVR_OK;
 }
 static evr_status check_time_res(const evr_config *c, evr_error *err)

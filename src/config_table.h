@@ -87,8 +87,9 @@ const evr_config_option *evr_config_table(int *count);
 void *evr_config_field(evr_config *c, const evr_config_option *o);
 const void *evr_config_field_const(const evr_config *c, const evr_config_option *o);
 
-/* Sensor presets (config.c): the names listed for a message, and whether name is one. */
-const char *evr_sensor_list(void);
+/* Sensor presets (config.c): their names listed for a message ("ideal, davis346, ..." into buf,
+ * returned), and the library's own copy of a preset's name (NULL: no such preset). */
+const char *evr_sensor_list(char *buf, size_t n);
 const char *evr_sensor_canonical(const char *name);
 
 #endif

@@ -9,9 +9,10 @@
 /* Defined beside each writer. */
 extern const evr_event_format evr_format_h5, evr_format_txt, evr_format_npy;
 
-#define NUM_FORMATS 3
+/* Format i is configuration bit 1 << i: new formats go at the end. */
+static const evr_event_format *const formats[] = {&evr_format_h5, &evr_format_txt, &evr_format_npy};
 
-static const evr_event_format *const formats[NUM_FORMATS] = {&evr_format_h5, &evr_format_txt, &evr_format_npy};
+#define NUM_FORMATS ((int)(sizeof formats / sizeof formats[0]))
 
 const evr_event_format *const *evr_event_formats(int *count)
 {
