@@ -1,13 +1,9 @@
 /* evray bench: one simulation and one row of figures; the reference design's table (--suite
  * seed); how the cost per sample grows (--sweep, CSV and PNG plot). */
 #include "commands.h"
-#include "host_clock.h"
 #include "evray.h"
-#include "io/event_reader.h"
-#include "io/plot.h"
+#include "evray_experimental.h"
 #include "options.h"
-#include "scene/demo_scenes.h"
-#include "scene/scene.h"
 
 #include <dirent.h>
 #include <stdio.h>
@@ -19,13 +15,14 @@
 
 static void remove_run(const char *dir)
 {
-    static const char *files[] = {"events.h5", "events.txt", "events.npy", "run.json", NULL};
     char p[4200];
     int i;
-    for (i = 0; files[i]; i++) {
-        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+    for (i = 0; evr_format_file(i); i++) {
+        snprintf(p, sizeof p, "%s/%s", dir, evr_format_file(i));
         remove(p);
     }
+    snprintf(p, sizeof p, "%s/run.json", dir);
+    remove(p);
     rmdir(dir);
 }
 
@@ -51,12 +48,11 @@ static double samples_per_pixel_s(const bench_figures *f)
 /* Reads the run's events (its first event file) into *ev. */
 static int read_run_events(const char *dir, evr_event **ev, size_t *n)
 {
-    static const char *files[] = {"events.h5", "events.npy", "events.txt", NULL};
     char p[4200];
     int i;
-    for (i = 0; files[i]; i++) {
+    for (i = 0; evr_format_file(i); i++) {   /* every format reads back to the same events */
         evr_error err = {{0}};
-        snprintf(p, sizeof p, "%s/%s", dir, files[i]);
+        snprintf(p, sizeof p, "%s/%s", dir, evr_format_file(i));
         if (access(p, R_OK) != 0) continue;
         if (evr_events_read(p, ev, n, NULL, NULL, &err) == EVR_OK) return 1;
         cli_error("%s", err.msg);
@@ -396,27 +392,26 @@ static int run_city_sweep(const evr_config *base, const char *kind, const char *
         evr_config cfg = *base;
         evr_scene *scene = NULL;
         evr_error err = {{0}};
-        unsigned long long mesh_tris = 0, scene_tris = 0;
+        uint64_t mesh_tris = 0, scene_tris = 0;
         double load_s;
-        int ninst, detail = is_tri ? details[i] : EVR_CITY_DETAIL, buildings = is_tri ? EVR_CITY_BUILDINGS : counts[i], k;
+        int ninst, detail = is_tri ? details[i] : EVR_CITY_DETAIL, buildings = is_tri ? EVR_CITY_BUILDINGS : counts[i];
         if (is_tri ? detail > max_detail : buildings > max_buildings) continue;
-        const double t0 = evr_host_seconds();
+        const double t0 = evr_seconds();
         if (evr_demo_city_load(detail, buildings, &scene, &err) != EVR_OK) {
             cli_error("%s", err.msg);
             return 1;
         }
-        load_s = evr_host_seconds() - t0;
-        for (k = 0; k < scene->num_meshes; k++) mesh_tris += scene->meshes[k].num_triangles;
-        for (k = 0; k < scene->num_instances; k++) scene_tris += scene->meshes[scene->instances[k].mesh].num_triangles;
-        ninst = scene->num_instances;
+        load_s = evr_seconds() - t0;
+        evr_scene_triangles(scene, &mesh_tris, &scene_tris);
+        ninst = evr_scene_num_instances(scene);
         rc = bench_run(scene, &cfg, 0, &f[n]);
         evr_scene_release(scene);
         if (rc != 0) return rc;
         q[n] = is_tri ? (double)scene_tris : (double)ninst;
         snprintf(extra[n], sizeof extra[n], ",%d,%d,%llu,%llu,%.4f,%.4f", detail, buildings,
-                 mesh_tris, scene_tris, load_s, f[n].s.time_setup);
-        printf("%7d %9d %11llu %13llu %7.2f %7.2f %12llu %9.3f %10.2f %12.4g %10llu\n", detail, buildings, mesh_tris,
-               scene_tris, load_s, f[n].s.time_setup, (unsigned long long)f[n].s.samples, f[n].s.wall_time,
+                 (unsigned long long)mesh_tris, (unsigned long long)scene_tris, load_s, f[n].s.time_setup);
+        printf("%7d %9d %11llu %13llu %7.2f %7.2f %12llu %9.3f %10.2f %12.4g %10llu\n", detail, buildings,
+               (unsigned long long)mesh_tris, (unsigned long long)scene_tris, load_s, f[n].s.time_setup, (unsigned long long)f[n].s.samples, f[n].s.wall_time,
                f[n].s.samples ? f[n].s.wall_time * 1e9 / (double)f[n].s.samples : 0.0, f[n].s.samples_per_second,
                (unsigned long long)(f[n].s.events_on + f[n].s.events_off));
         fflush(stdout);

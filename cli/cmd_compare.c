@@ -1,7 +1,6 @@
 #include "commands.h"
-#include "compare.h"
 #include "evray.h"
-#include "io/event_reader.h"
+#include "evray_experimental.h"
 #include "options.h"
 
 #include <stdio.h>

@@ -1,8 +1,7 @@
 /* evray plot: the event rate over time (ON and OFF per bin) and an events-per-pixel heat map. */
 #include "commands.h"
 #include "evray.h"
-#include "io/event_reader.h"
-#include "io/plot.h"
+#include "evray_experimental.h"
 #include "options.h"
 
 #include <math.h>

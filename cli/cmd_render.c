@@ -1,6 +1,6 @@
 #include "commands.h"
-#include "host_clock.h"
 #include "evray.h"
+#include "evray_experimental.h"
 #include "options.h"
 
 #include <signal.h>
@@ -31,7 +31,7 @@ static int on_progress(void *user, const evr_stats *st)
         p->duration = st->sim_time * st->segments_total / st->segments_done;
     if (p->show) {
         double frac = st->segments_total ? (double)st->segments_done / st->segments_total : 1.0;
-        double el = evr_host_seconds() - p->started;
+        double el = evr_seconds() - p->started;
         double eta = frac > 0 ? el * (1.0 - frac) / frac : 0.0;
         char bar[31];
         int filled = (int)(frac * 30.0), i;
@@ -45,98 +45,17 @@ static int on_progress(void *user, const evr_stats *st)
     return interrupted ? 1 : 0;
 }
 
-void render_options_help(void);
 static void help(void)
 {
-    puts("usage: evray render SCENE [options]\n"
-         "       evray [options]            (the built-in eye demo)\n"
-         "\n"
-         "Renders SCENE over time with every pixel sampling at its own times and writes the\n"
-         "time-sorted DVS events, previews and run.json into the run folder.\n"
-         "\n"
-         "output:\n"
-         "  -o, --out DIR              run folder (default ./evray-out)\n"
-         "  --force                    overwrite a non-empty run folder\n"
-         "  --format LIST              h5, txt, npy or all, comma-separated (default h5)\n"
-         "  --preview-window S         seconds per preview frame (default 0.05)\n"
-         "  --no-preview               no preview images\n"
-         "  -q, --quiet                no progress bar or summary\n"
-         "intensity frames for frame-based tools (v2e and the like):\n"
-         "  --frames-out DIR           also write frame k = every pixel's intensity at exactly\n"
-         "                             start + k/F (one sample at the pixel centre, unseen by the\n"
-         "                             pixel model), for every such time up to and including the end\n"
-         "                             (floor(duration*F) + 1 frames): DIR/frame_NNNNNN.png (8-bit\n"
-         "                             sRGB), DIR/frame_NNNNNN_linear16.png (16-bit linear) and\n"
-         "                             DIR/frames.csv (index,time_s,srgb8_png,linear16_png); DIR may\n"
-         "                             be inside the run folder or not, and must hold no frames\n"
-         "                             unless --force\n"
-         "  --frames-fps F             frames per second (default: the segment rate, --fps)\n"
-         "  --frames-exposure E        8-bit frames: intensity * E clamped to [0, 1], sRGB-encoded\n"
-         "                             (default 1: intensity 1 is white)\n"
-         "  --frames-max M             16-bit frames: value = round(intensity * 65535 / M), clamped\n"
-         "                             (default 4)\n"
-         "image and time:\n"
-         "  --res WxH                  resolution (default 346x260)\n"
-         "  --camera NAME              camera of the scene (default: the first)\n"
-         "  --duration S               seconds to simulate (default: the animation's length)\n"
-         "  --start S                  start time in the animation (default 0)\n"
-         "  --fps F                    segments per second (default: the scene's frame rate, else 30)\n"
-         "  --samples-per-frame N      samples per pixel per segment (default 10)\n"
-         "  --threads N                worker threads (default: all cores)\n"
-         "  --backend B                auto (default: CUDA when a GPU is usable, else CPU), cpu or cuda\n"
-         "  --gpu-bvh L                GPU BVH node layout: cw8 (default, compressed 8-wide) or bvh4\n"
-         "  --gpu-event-capacity N     events a GPU segment buffer holds at first (default: automatic; it\n"
-         "                             grows and the segment is rendered again whenever it overflows)\n"
-         "  --no-skip                  trace every sample (brute force); by default a pixel that nothing\n"
-         "                             moving can reach keeps its last intensity (identical events)\n"
-         "  --sampling S               uniform (default: --samples-per-frame samples per pixel per\n"
-         "                             segment) or adaptive: each pixel picks its next sample time so\n"
-         "                             that its log intensity moves by at most --adapt-frac of a\n"
-         "                             threshold and anything its rays meet moves by at most\n"
-         "                             2 * --adapt-frac pixels; a pixel nothing moving reaches samples\n"
-         "                             every --max-dt; a sample that changed by more than that is\n"
-         "                             held back while the interval before it is bisected down to\n"
-         "                             --min-dt (ignores --samples-per-frame and --no-skip)\n"
-         "  --adapt-frac F             adaptive: in (0, 1] (default 0.25)\n"
-         "  --min-dt S, --max-dt S     adaptive: bounds on the time between a pixel's samples, seconds\n"
-         "                             (default 20e-6; one segment); a moving camera or light samples\n"
-         "                             every pixel every --min-dt\n"
-         "global illumination (CPU and CUDA backends):\n"
-         "  --gi MODE                  none (default) or photon: image-space photon mapping, a photon\n"
-         "                             pass at every segment boundary and the indirect light linear in\n"
-         "                             time between them (the same photons every pass: a still scene\n"
-         "                             gets the same indirect light, so GI makes no events by itself)\n"
-         "  --photons N                photons per pass (default: one per pixel)\n"
-         "  --gather-radius R          distance filter, world units (default 2% of the scene's diagonal)\n"
-         "  --gather-max N             photons per estimate at most (default 0: no limit, every photon of the disk)\n"
-         "  --gather-window N          gather window half size at most, pixels (default 8)\n"
-         "  --photon-layers N          photons each pixel of the buffer holds (default 8)\n"
-         "  --gi-bounces N             indirect bounces of a photon (default 4)\n"
-         "sensor (laws, presets and their sources: docs/sensors.md; the default is the ideal sensor):\n"
-         "  --sensor NAME              preset: ideal, davis346, dvxplorer or prophesee-gen4; it sets the\n"
-         "                             defaults (and the resolution) that the options below override,\n"
-         "                             whatever their order\n"
-         "  --pos-thres C, --neg-thres C   ON/OFF contrast thresholds in log intensity (default 0.2)\n"
-         "  --thres C                  both thresholds\n"
-         "  --sigma-thres S            threshold mismatch: per-pixel thresholds drawn once from\n"
-         "                             N(threshold, S), a fixed pattern (default 0)\n"
-         "  --refractory S             refractory period in seconds (default 0)\n"
-         "  --cutoff-hz F              photoreceptor low-pass cutoff at full brightness, falling to 7%\n"
-         "                             of F for black (default 0: no filter)\n"
-         "  --full-intensity I         intensity that counts as full brightness (default 1)\n"
-         "  --leak-rate-hz R           leak ON events per second per pixel (default 0)\n"
-         "  --leak-jitter J            relative spread of the per-pixel leak rates (default 0.1)\n"
-         "  --shot-noise-rate-hz R     shot-noise events per second (ON + OFF) of a black pixel; a pixel\n"
-         "                             at full brightness has R/4 (default 0)\n"
-         "  --hot-pixel-fraction F     fraction of hot pixels (default 0)\n"
-         "  --hot-pixel-rate-hz R      ON events per second of a hot pixel (default 100)\n"
-         "  --time-res S               timestamp resolution in seconds, whole microseconds (default 1e-6)\n"
-         "  --time-jitter S            std dev of Gaussian timestamp jitter in seconds (default 0)\n"
-         "  --log-floor I              intensity below which the response is linear (default 0.02)\n"
-         "  --seed N                   seed of the per-pixel sample phases and of the sensor's fixed\n"
-         "                             pattern and noise (default 1)\n"
-         "shading:\n"
-         "  --ambient A                ambient light as a fraction of the base colour (default 0.02)");
+    char *options = evr_config_options_help();
+    fputs("usage: evray render SCENE [options]\n"
+          "       evray [options]            (the built-in eye demo)\n"
+          "\n"
+          "Renders SCENE over time with every pixel sampling at its own times and writes the\n"
+          "time-sorted DVS events, previews and run.json into the run folder.\n"
+          "\n", stdout);
+    if (options) fputs(options, stdout);   /* made from the configuration table */
+    free(options);
 }
 
 int cmd_render(int argc, char **argv, const char *default_demo)
@@ -186,7 +105,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
 
     progress_state ps;
     ps.show = !quiet && isatty(2);
-    ps.started = evr_host_seconds();
+    ps.started = evr_seconds();
     ps.duration = 0;
     ps.duration = cfg.duration;
     st = evr_sim_run(sim, on_progress, &ps, &err);

@@ -2,11 +2,8 @@
  * against a reference image. */
 #include "commands.h"
 #include "evray.h"
+#include "evray_experimental.h"
 #include "options.h"
-#include "core/shading.h"
-#include "io/png.h"
-#include "scene/scene.h"
-#include "still.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -127,12 +124,12 @@ static int write_png(const char *path, const float *rgb, int w, int h, float exp
     return 1;
 }
 
-static float lum(const float *c) { return evr_luminance(c[0], c[1], c[2]); }
+static float lum(const float *c) { return evr_rgb_luminance(c); }
 
 /* 1 when instance inst's node or mesh name is one of the comma-separated names. */
 static int in_region(const evr_scene *s, int inst, const char *names)
 {
-    const char *node = s->nodes[s->instances[inst].node].name, *mesh = s->meshes[s->instances[inst].mesh].name;
+    const char *node = evr_scene_instance_node(s, inst), *mesh = evr_scene_instance_mesh(s, inst);
     const char *p = names;
     while (*p) {
         const char *e = strchr(p, ',');
@@ -144,7 +141,7 @@ static int in_region(const evr_scene *s, int inst, const char *names)
     return 0;
 }
 
-static void compare(const evr_scene *s, const evr_still_result *r, const float *ref, const char *region)
+static void compare(const evr_scene *s, const evr_still_image *r, const float *ref, const char *region)
 {
     size_t npix = (size_t)r->width * (size_t)r->height, i;
     double se_all = 0, sum_all = 0, se_reg = 0, sum_reg = 0, se_ind = 0, sum_ind = 0;
@@ -271,8 +268,8 @@ int cmd_still(int argc, char **argv)
         return 1;
     }
     evr_error err = {{0}};
-    evr_still_result r;
-    evr_status st = evr_still_render(scene, &p, &r, &err);
+    evr_still_image r;
+    evr_status st = evr_still_image_render(scene, &p, &r, &err);
     if (st != EVR_OK) {
         cli_error("%s", err.msg);
         free(ref);
@@ -295,22 +292,21 @@ int cmd_still(int argc, char **argv)
                r.height, p.time, modes[p.gi], r.threads, r.seconds_setup, r.seconds_photons, r.seconds_shading);
         if (p.gi == EVR_GI_PATH) printf("path: %d paths per pixel, at most %d bounces\n", p.spp, p.max_bounces);
         if (p.gi == EVR_GI_PHOTON) {
-            const evr_photon_stats *ps = &r.photon;
-            double stored = (double)ps->visible;
+            double stored = (double)r.photons_visible;
             printf("photon: %llu paths, %llu stayed, %llu seen by the camera, %llu in the buffer, %llu collisions (%.2f%%); "
                    "%d layers, gather radius %.4g, %.1f photons per estimate\n",
-                   (unsigned long long)ps->paths, (unsigned long long)ps->stored_photons, (unsigned long long)ps->visible,
-                   (unsigned long long)ps->inserted, (unsigned long long)ps->collisions,
-                   stored > 0 ? 100.0 * (double)ps->collisions / stored : 0.0, r.photon_layers, r.gather_radius,
+                   (unsigned long long)r.photon_paths, (unsigned long long)r.photons_stayed, (unsigned long long)r.photons_visible,
+                   (unsigned long long)r.photons_inserted, (unsigned long long)r.photon_collisions,
+                   stored > 0 ? 100.0 * (double)r.photon_collisions / stored : 0.0, r.photon_layers, r.gather_radius,
                    r.photons_per_estimate);
-            if (stored > 0 && (double)ps->collisions > 0.03 * stored && r.photon_layers < 64)
+            if (stored > 0 && (double)r.photon_collisions > 0.03 * stored && r.photon_layers < 64)
                 printf("photon: note: more than 3%% of the photons found their pixel full; --photon-layers %d keeps them\n",
                        r.photon_layers * 2);
         }
     }
     if (ref) compare(scene, &r, ref, region);
     free(ref);
-    evr_still_result_free(&r);
+    evr_still_image_free(&r);
     evr_scene_release(scene);
     return rc;
 }

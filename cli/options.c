@@ -1,7 +1,6 @@
 #include "options.h"
+#include "evray_experimental.h"
 
-#include <errno.h>
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,102 +16,15 @@ void cli_error(const char *fmt, ...)
     fputc('\n', stderr);
 }
 
-int opt_double(const char *opt, const char *text, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end || errno || !isfinite(v)) {
-        cli_error("%s expects a number, got '%s'", opt, text);
-        return 0;
-    }
-    *out = v;
-    return 1;
-}
+/* The library parses; the program says what went wrong. */
+#define REPORT(call) do { evr_error err; if ((call) != EVR_OK) { cli_error("%s", err.msg); return 0; } return 1; } while (0)
 
-int opt_float(const char *opt, const char *text, float *out)
-{
-    double v;
-    if (!opt_double(opt, text, &v)) return 0;
-    *out = (float)v;
-    return 1;
-}
-
-int opt_int(const char *opt, const char *text, int *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(text, &end, 10);
-    if (end == text || *end || errno || v < -2147483647L || v > 2147483647L) {
-        cli_error("%s expects an integer, got '%s'", opt, text);
-        return 0;
-    }
-    *out = (int)v;
-    return 1;
-}
-
-int opt_u64(const char *opt, const char *text, uint64_t *out)
-{
-    char *end;
-    errno = 0;
-    if (text[0] == '-') {
-        cli_error("%s expects a non-negative integer, got '%s'", opt, text);
-        return 0;
-    }
-    unsigned long long v = strtoull(text, &end, 10);
-    if (end == text || *end || errno) {
-        cli_error("%s expects a non-negative integer, got '%s'", opt, text);
-        return 0;
-    }
-    *out = (uint64_t)v;
-    return 1;
-}
-
-int opt_size(const char *opt, const char *text, int *w, int *h)
-{
-    char *end, *end2;
-    errno = 0;
-    long a = strtol(text, &end, 10);
-    if (end == text || (*end != 'x' && *end != 'X')) goto bad;
-    long b = strtol(end + 1, &end2, 10);
-    if (end2 == end + 1 || *end2 || errno) goto bad;
-    if (a < 1 || b < 1 || a > 65535 || b > 65535) {
-        cli_error("%s: resolution %s is out of range (1 to 65535 pixels a side)", opt, text);
-        return 0;
-    }
-    *w = (int)a;
-    *h = (int)b;
-    return 1;
-bad:
-    cli_error("%s expects WIDTHxHEIGHT (e.g. 640x480), got '%s'", opt, text);
-    return 0;
-}
-
-int opt_formats(const char *text, int *formats)
-{
-    char buf[256];
-    int f = 0;
-    if (strlen(text) >= sizeof buf) {
-        cli_error("--format: value too long");
-        return 0;
-    }
-    strcpy(buf, text);
-    char *tok = buf, *next;
-    for (; tok; tok = next) {
-        next = strchr(tok, ',');
-        if (next) *next++ = 0;
-        if (!strcmp(tok, "h5") || !strcmp(tok, "hdf5")) f |= EVR_FORMAT_H5;
-        else if (!strcmp(tok, "txt")) f |= EVR_FORMAT_TXT;
-        else if (!strcmp(tok, "npy")) f |= EVR_FORMAT_NPY;
-        else if (!strcmp(tok, "all")) f |= EVR_FORMAT_H5 | EVR_FORMAT_TXT | EVR_FORMAT_NPY;
-        else {
-            cli_error("--format: unknown format '%s' (h5, txt, npy, all; comma-separated)", tok);
-            return 0;
-        }
-    }
-    *formats = f;
-    return 1;
-}
+int opt_double(const char *opt, const char *text, double *out) { REPORT(evr_parse_double(opt, text, out, &err)); }
+int opt_float(const char *opt, const char *text, float *out) { REPORT(evr_parse_float(opt, text, out, &err)); }
+int opt_int(const char *opt, const char *text, int *out) { REPORT(evr_parse_int(opt, text, out, &err)); }
+int opt_u64(const char *opt, const char *text, uint64_t *out) { REPORT(evr_parse_u64(opt, text, out, &err)); }
+int opt_size(const char *opt, const char *text, int *w, int *h) { REPORT(evr_parse_size(opt, text, w, h, &err)); }
+int opt_formats(const char *text, int *formats) { REPORT(evr_formats_parse("--format", text, formats, &err)); }
 
 int opt_is(const char *arg, const char *name)
 {

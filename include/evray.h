@@ -56,6 +56,9 @@ void evr_scene_release(evr_scene *s);
 char *evr_scene_describe(const evr_scene *s);
 
 /* ---- simulation ---- */
+/* Event output formats as bits of evr_config.formats: format i of the registry
+ * (src/io/event_formats.c) is bit 1 << i; formats without a constant here are found by name
+ * (evr_formats_parse, evr_format_name in evray_experimental.h). */
 typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
 
 /* auto: CUDA when this build has it and a usable GPU is present, else the CPU (with a notice). */
@@ -63,7 +66,13 @@ typedef enum { EVR_SAMPLING_UNIFORM = 0, EVR_SAMPLING_ADAPTIVE = 1 } evr_samplin
 
 typedef enum { EVR_BACKEND_AUTO = 0, EVR_BACKEND_CPU = 1, EVR_BACKEND_CUDA = 2 } evr_backend_kind;
 
+/* The simulation's settings. Make one with evr_config_defaults and change the fields you need:
+ * size tells the library which version of this struct the caller was compiled with, so that
+ * fields can be added (only ever at the end) without breaking compiled callers; a size the
+ * library does not know is refused with EVR_ERR_ARG. Strings are not copied by the setters here
+ * (evr_sim_new copies what it keeps). */
 typedef struct {
+    size_t size;                  /* sizeof(evr_config) as the caller sees it: set by evr_config_defaults */
     /* image and time */
     int width, height;            /* pixels */
     double duration;              /* seconds; <= 0: the scene's animation length */
@@ -131,13 +140,16 @@ typedef struct {
     int gi_bounces;               /* indirect bounces of a photon */
 } evr_config;
 
-void evr_config_defaults(evr_config *c);
+/* Fills c with the defaults (the ideal sensor at 346x260, docs/sensors.md) and sets c->size.
+ * The macro passes the size of the caller's evr_config. */
+void evr_config_init(evr_config *c, size_t size);
+#define evr_config_defaults(c) evr_config_init((c), sizeof(evr_config))
 /* Names of the sensor presets, NULL-terminated: ideal, davis346, dvxplorer, prophesee-gen4. */
 const char *const *evr_sensor_names(void);
 /* Applies a sensor preset: thresholds, mismatch, refractory period, bandwidth, noise, timestamp
  * resolution and (except for ideal) the resolution; other fields are kept. */
 evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err);
-/* Checks every value; fills err with the first problem. */
+/* Checks every value (and c->size); fills err with the first problem. */
 evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_error *err);
 
 typedef struct {
@@ -171,6 +183,8 @@ typedef struct evr_sim evr_sim;
 /* Called after every segment; return non-zero to stop after it. */
 typedef int (*evr_progress_fn)(void *user, const evr_stats *st);
 
+/* The scene must outlive the simulation: evr_sim_new keeps a pointer to it (not a copy), so
+ * release the simulation before the scene. The configuration is copied. */
 evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err);
 /* Runs to the end (or until progress asks to stop) and finalizes every output file. */
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err);

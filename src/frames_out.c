@@ -2,7 +2,7 @@
 #include "frames_out.h"
 #include "core/shading.h"
 #include "io/png.h"
-#include "run_files.h"
+#include "io/mkdir_p.h"
 
 #include <dirent.h>
 #include <errno.h>

@@ -1,5 +1,7 @@
 #include "run_files.h"
 #include "frames_out.h"
+#include "io/mkdir_p.h"
+#include "io/event_formats.h"
 #include "io/json.h"
 #include "io/preview.h"
 
@@ -22,22 +24,6 @@ static evr_status path_join(char *out, size_t n, const char *dir, const char *na
         return EVR_ERR_ARG;
     }
     return EVR_OK;
-}
-
-int evr_mkdir_p(const char *path)
-{
-    char tmp[4096];
-    size_t i, n = strlen(path);
-    if (n >= sizeof tmp) return -1;
-    memcpy(tmp, path, n + 1);
-    for (i = 1; i < n; i++) {
-        if (tmp[i] != '/') continue;
-        tmp[i] = 0;
-        if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
-        tmp[i] = '/';
-    }
-    if (mkdir(tmp, 0777) != 0 && errno != EEXIST) return -1;
-    return 0;
 }
 
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
@@ -86,27 +72,23 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
 
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
 {
-    static const struct { int bit; const char *file; } kinds[] = {
-        {EVR_FORMAT_H5, "events.h5"}, {EVR_FORMAT_TXT, "events.txt"}, {EVR_FORMAT_NPY, "events.npy"}};
+    int i, count;
+    const evr_event_format *const *formats = evr_event_formats(&count);
     evr_writer_meta meta;
     char p[4200];
-    int i;
     evr_status st;
     meta.width = sim->cfg.width;
     meta.height = sim->cfg.height;
     meta.config_json = sim->config_json;
     /* timestamps end with the run, moved by jitter and rounding to the resolution */
-    meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + evr_sim_timestamp_slack_us(sim) + 1;
-    for (i = 0; i < 3; i++) {
-        if (!(sim->cfg.formats & kinds[i].bit)) continue;
-        if ((st = path_join(p, sizeof p, sim->out_dir, kinds[i].file, err)) != EVR_OK) return st;
+    meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + sim->timestamp_slack_us + 1;
+    for (i = 0; i < count && i < EVR_MAX_WRITERS; i++) {
+        if (!(sim->cfg.formats & (1 << i))) continue;
+        if ((st = path_join(p, sizeof p, sim->out_dir, formats[i]->file, err)) != EVR_OK) return st;
         evr_event_writer *w = NULL;
-        if (kinds[i].bit == EVR_FORMAT_H5) st = evr_h5_writer_open(p, &meta, &w, err);
-        else if (kinds[i].bit == EVR_FORMAT_TXT) st = evr_txt_writer_open(p, &meta, &w, err);
-        else st = evr_npy_writer_open(p, &meta, &w, err);
-        if (st != EVR_OK) return st;
+        if ((st = formats[i]->open(p, &meta, &w, err)) != EVR_OK) return st;
         sim->writers[sim->num_writers] = w;
-        sim->writer_names[sim->num_writers] = kinds[i].file;
+        sim->writer_names[sim->num_writers] = formats[i]->file;
         sim->num_writers++;
     }
     return EVR_OK;
@@ -290,7 +272,7 @@ static char *run_json(const evr_sim *sim)
     return out;
 }
 
-evr_status evr_run_finish(evr_sim *sim, evr_error *err)
+evr_status evr_run_close(evr_sim *sim, evr_error *err)
 {
     evr_status st = EVR_OK;
     int w;
@@ -323,8 +305,12 @@ evr_status evr_run_finish(evr_sim *sim, evr_error *err)
             if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
             else sim->preview_frame++;
     }
-    if ((st = evr_frames_finish(sim, err)) != EVR_OK) return st;
-    evr_sim_set_wall(sim);   /* the run's wall time includes draining and closing every output */
+    return evr_frames_finish(sim, err);
+}
+
+evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
+{
+    evr_status st;
     char *text = run_json(sim);
     char p[4200], tmp[4300];
     if (!text) {

@@ -4,8 +4,6 @@
 
 #include "sim_internal.h"
 
-/* mkdir -p: 0 on success, -1 with errno set. */
-int evr_mkdir_p(const char *path);
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);
 /* Accumulates time-ordered events into event preview frames, writing each finished frame. */
@@ -14,8 +12,10 @@ evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, e
 int evr_run_preview_due(const evr_sim *sim, double t, int last);
 /* At a segment end (absolute time t): writes the intensity previews of the windows it ends. */
 evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last, evr_error *err);
-/* Completes every writer, the last preview and run.json. */
-evr_status evr_run_finish(evr_sim *sim, evr_error *err);
+/* Completes every writer, the last preview and the frames' list. */
+evr_status evr_run_close(evr_sim *sim, evr_error *err);
+/* Writes run.json (after evr_run_close, with the statistics final). */
+evr_status evr_run_write_json(evr_sim *sim, evr_error *err);
 /* Removes what this run wrote (temporary files, previews, the folder if it made it). */
 void evr_run_dir_discard(evr_sim *sim);
 

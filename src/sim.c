@@ -69,12 +69,31 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
     return EVR_OK;
 }
 
+/* How far timestamp jitter (clipped) and rounding to the resolution can move an event's
+ * timestamp from its crossing, in microseconds (0 for exact timestamps). */
+static int64_t timestamp_slack_us(const evr_sim *sim)
+{
+    if (sim->cfg.time_jitter <= 0.0 && sim->setup.pixel.time_res_us <= 1) return 0;
+    return (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
+}
+
+/* The run's wall time so far, and the rates that follow from it, into sim->st. */
+static void set_wall(evr_sim *sim)
+{
+    sim->st.wall_time = evr_host_seconds() - sim->wall0;
+    sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
+    sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
+    sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
+}
+
 evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err)
 {
     evr_status st;
     int i;
     *out = NULL;
-    if ((st = evr_config_validate(c, s, err)) != EVR_OK) return st;
+    evr_config cur;
+    if ((st = evr_config_validate(c, s, err)) != EVR_OK || (st = evr_config_current(c, &cur, err)) != EVR_OK) return st;
+    c = &cur;   /* this library's evr_config, whatever the caller's size */
     evr_sim *sim = calloc(1, sizeof *sim);
     if (!sim) return nomem(err);
     sim->scene = s;
@@ -133,6 +152,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.gather_window = c->gather_window;
     sim->setup.photon_layers = c->photon_layers;
     sim->setup.gi_bounces = c->gi_bounces;
+    sim->timestamp_slack_us = timestamp_slack_us(sim);
 
     int ntracks = s->num_nodes + 1;
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
@@ -341,7 +361,7 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     /* adaptive sampling: a pixel's last sample here is no earlier than t1 - max_dt */
     if (!final && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
-    if (!final) safe -= evr_sim_timestamp_slack_us(sim);
+    if (!final) safe -= sim->timestamp_slack_us;
     double t = evr_host_seconds();
     if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) != EVR_OK) return st;
     sim->time_render += evr_host_seconds() - t;
@@ -376,22 +396,8 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     sim->st.photons_reused = sim->backend->photons_reused;
     sim->st.photon_cells_changed = sim->backend->photon_cells_changed;
     sim->st.sim_time = t1 - sim->cfg.start;
-    evr_sim_set_wall(sim);
+    set_wall(sim);
     return EVR_OK;
-}
-
-int64_t evr_sim_timestamp_slack_us(const evr_sim *sim)
-{
-    if (sim->cfg.time_jitter <= 0.0 && sim->setup.pixel.time_res_us <= 1) return 0;
-    return (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
-}
-
-void evr_sim_set_wall(evr_sim *sim)
-{
-    sim->st.wall_time = evr_host_seconds() - sim->wall0;
-    sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
-    sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
-    sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
 }
 
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err)
@@ -435,8 +441,9 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
     }
     count_events_finish(sim);   /* the interrupted run's last batch */
     sim->st.interrupted = sim->st.segments_done < sim->num_segments;
-    /* evr_run_finish sets the wall time once the writers have finished their files */
-    if ((st = evr_run_finish(sim, err)) != EVR_OK) return st;
+    if ((st = evr_run_close(sim, err)) != EVR_OK) return st;
+    set_wall(sim);   /* the run's wall time includes draining and closing every output */
+    if ((st = evr_run_write_json(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
 }
 

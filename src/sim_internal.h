@@ -1,4 +1,6 @@
-/* The simulation object behind evr_sim: the segment loop's state. */
+/* The simulation object behind evr_sim: the segment loop's state, shared by the segment loop
+ * (sim.c), the run folder (run_files.c) and the intensity frames (frames_out.c). It declares no
+ * functions, so that each of them includes it without an include loop. */
 #ifndef EVR_SIM_INTERNAL_H
 #define EVR_SIM_INTERNAL_H
 
@@ -9,7 +11,7 @@
 #include "io/preview.h"
 #include "write_queue.h"
 
-#define EVR_MAX_WRITERS 3
+#define EVR_MAX_WRITERS 16   /* formats a run may write (io/event_formats.h) */
 
 /* ON events and timestamp changes (t differing from the one before, prev for the first) of a
  * part of a batch of emitted events. */
@@ -30,6 +32,7 @@ struct evr_sim {
     int camera;
     double fps, duration;
     int num_segments;
+    int64_t timestamp_slack_us;  /* how far jitter and rounding move a timestamp from its crossing */
     evr_render_host host;
     evr_run_setup setup;
     evr_backend *backend;
@@ -73,12 +76,5 @@ struct evr_sim {
     double time_plan_wait;       /* the segment loop waiting for the planner */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
-
-/* How far timestamp jitter (clipped) and rounding to the resolution can move an event's
- * timestamp from its crossing, in microseconds (0 for exact timestamps). */
-int64_t evr_sim_timestamp_slack_us(const evr_sim *sim);
-
-/* The run's wall time so far, and the rates that follow from it, into sim->st. */
-void evr_sim_set_wall(evr_sim *sim);
 
 #endif

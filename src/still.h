@@ -8,31 +8,11 @@
 
 #include <stdint.h>
 #include "evray.h"
+#include "evray_experimental.h"
 #include "cpu/photon_pass.h"
 
-typedef enum { EVR_GI_NONE = 0, EVR_GI_PHOTON = 1, EVR_GI_PATH = 2 } evr_gi_mode;
-
-typedef struct {
-    int width, height;
-    double time;                   /* seconds into the animation */
-    const char *camera;            /* NULL: the first */
-    evr_gi_mode gi;
-    int spp;                       /* path: paths per pixel */
-    uint32_t photons;              /* photon: photons per pass (0: 8 per pixel) */
-    float gather_radius;           /* photon: distance filter r, world units (<= 0: 2% of the scene's diagonal) */
-    int gather_max;                /* photon: photons per estimate at most */
-    int gather_window;             /* photon: the window's half size at most, pixels */
-    float gather_normal_cos;       /* photon: normals must agree to this cosine */
-    int photon_layers;             /* photon: photons per pixel of the buffer */
-    int gather_area;               /* photon: normalize over the surface the camera sees (evr_photon_gbuffer) */
-    int auto_layers;               /* photon: double the layers (up to 64) while > 3% of the photons collide */
-    int max_bounces;               /* indirect bounces (both methods) */
-    float ambient;
-    uint64_t seed;
-    int threads;                   /* 0: all cores */
-} evr_still_params;
-
-void evr_still_defaults(evr_still_params *p);
+/* evr_gi_mode, evr_still_params and evr_still_defaults are in evray_experimental.h, with the
+ * program's view of a result (evr_still_image_render). */
 
 typedef struct {
     int width, height;

@@ -19,7 +19,7 @@
  * flush; the next store of that chunk replaces it. ms_to_idx is small and goes through H5Dwrite.
  * HDF5's automatic error printing is switched off around every call (H5E_BEGIN_TRY) and its
  * error stack is turned into the message instead. */
-#include "io/event_writer.h"
+#include "io/event_formats.h"
 #include "io/chunk_compress.h"
 #include "par_pool.h"
 
@@ -695,3 +695,5 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     *out = &w->base;
     return EVR_OK;
 }
+
+const evr_event_format evr_format_h5 = {"h5", "hdf5", "events.h5", evr_h5_writer_open, "HDF5: events/x, y, t, p and ms_to_idx"};

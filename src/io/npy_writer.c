@@ -5,7 +5,7 @@
  * (padded with spaces, total header a multiple of 64 bytes) and rewritten in place at every
  * flush() and at finish(): the temporary file of an interrupted run is a valid array holding
  * every event up to the last flush. */
-#include "io/event_writer.h"
+#include "io/event_formats.h"
 #include "io/file_commit.h"
 #include "par_pool.h"
 
@@ -304,3 +304,5 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
     *out = &w->base;
     return EVR_OK;
 }
+
+const evr_event_format evr_format_npy = {"npy", NULL, "events.npy", evr_npy_writer_open, "NumPy structured array (t, x, y, p)"};

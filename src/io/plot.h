@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "evray.h"
+#include "evray_experimental.h"
 
 /* An RGB8 image, rows top to bottom, initially white. */
 typedef struct {
@@ -25,30 +26,7 @@ void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, 
 void evr_canvas_text(evr_canvas *c, int x, int y, int scale, const char *text, const uint8_t col[3]);
 int evr_text_width(const char *text, int scale);
 
-/* One line series: n points (x[i], y[i]) joined in order. */
-typedef struct {
-    const double *x, *y;
-    size_t n;
-    uint8_t color[3];
-    const char *label;            /* legend entry; NULL: none */
-    int markers;                  /* draw a small square at each point */
-} evr_plot_series;
-
-typedef struct {
-    int width, height;            /* image size in pixels */
-    const char *title, *xlabel, *ylabel;
-    int y_from_zero;              /* the y axis starts at 0 (else at the data's minimum) */
-} evr_plot_spec;
-
-/* Draws the series on shared axes (range from the data, "nice" ticks) and writes an RGB8 PNG. */
-evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const evr_plot_series *series,
-                              int nseries, evr_error *err);
-
-/* Draws per-pixel counts (w x h, row-major, y = 0 the top row) with a log colour map
- * (log(1 + count) / log(1 + max)), scaled up by a whole factor when the image is small, with a
- * title and a colour bar labelled in counts, and writes an RGB8 PNG. *out_w and *out_h (may be NULL)
- * receive the image size. */
-evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h, const char *title,
-                                int *out_w, int *out_h, evr_error *err);
+/* The line plots and heat maps (evr_plot_series, evr_plot_spec, evr_plot_lines_png,
+ * evr_plot_heatmap_png) are declared in evray_experimental.h. */
 
 #endif

@@ -5,13 +5,12 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "evray.h"
+#include "evray_experimental.h"
 
 /* channels: 1 (gray), 3 (RGB) or 4 (RGBA); bit_depth 8 or 16 (16-bit samples in native order).
  * Rows are top to bottom. *out is malloc'ed; free() it. */
 evr_status evr_png_encode(const void *pixels, int width, int height, int channels, int bit_depth,
                           void **out, size_t *out_size, evr_error *err);
-/* Writes under path + ".tmp" and renames when complete. */
-evr_status evr_png_write(const char *path, const void *pixels, int width, int height, int channels,
-                         int bit_depth, evr_error *err);
+/* evr_png_write (to a file) is declared in evray_experimental.h. */
 
 #endif

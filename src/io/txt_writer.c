@@ -1,7 +1,7 @@
 /* Text event files: one event per line, "t x y p", t in seconds with exactly six decimals (printed
  * from the integer microseconds, so no rounding), p 1 (ON) or 0 (OFF). No header line, so that
  * numpy.loadtxt and the usual event-camera tools read the file as is. */
-#include "io/event_writer.h"
+#include "io/event_formats.h"
 #include "io/file_commit.h"
 
 #include <errno.h>
@@ -160,3 +160,5 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, ev
     *out = &w->base;
     return EVR_OK;
 }
+
+const evr_event_format evr_format_txt = {"txt", NULL, "events.txt", evr_txt_writer_open, "text, one event a line (t x y p)"};

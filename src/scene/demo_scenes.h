@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 #include "evray.h"
+#include "evray_experimental.h"
 #include "scene/gltf_writer.h"
 
 /* Each adds its whole scene to an empty builder; failures are recorded in the builder. */
@@ -16,14 +17,10 @@ void evr_demo_build_cornell(evr_gltf *g);
 void evr_demo_build_cornell_still(evr_gltf *g);
 void evr_demo_build_city(evr_gltf *g);
 
-/* The city (demo_city.c) at a tessellation detail (>= 1; a building's triangles grow as
- * detail^2, its shape unchanged) and a building count (the lots nearest the centre); the
- * built-in scene "city" is the defaults. For scaling sweeps (evray bench --sweep). */
-#define EVR_CITY_DETAIL 1
-#define EVR_CITY_BUILDINGS 4096
+/* The city (demo_city.c) at a tessellation detail and a building count: EVR_CITY_DETAIL,
+ * EVR_CITY_BUILDINGS and evr_demo_city_load are in evray_experimental.h. */
 void evr_demo_build_city_with(evr_gltf *g, int detail, int count);
 evr_status evr_demo_city_glb(int detail, int count, void **glb, size_t *size, evr_error *err);
-evr_status evr_demo_city_load(int detail, int count, evr_scene **out, evr_error *err);
 
 /* A growing triangle mesh: positions, unit normals and texture coordinates per vertex. */
 typedef struct {

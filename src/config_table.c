@@ -1,0 +1,417 @@
+/* The rows of the configuration table (config_table.h says what each column means), in the
+ * order of evray render --help; json_rank gives the order of run.json's config object. */
+#include "config_table.h"
+#include "evray_experimental.h"
+#include "io/event_formats.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define F(field) offsetof(evr_config, field)
+#define NO_LIMIT HUGE_VAL
+
+/* ---- when a setting matters ---- */
+static int is_adaptive(const evr_config *c) { return c->sampling == EVR_SAMPLING_ADAPTIVE; }
+static int has_gi(const evr_config *c) { return c->gi != 0; }
+static int has_frames(const evr_config *c) { return c->frames_out != NULL; }
+
+/* ---- values that are not one field's ---- */
+static void json_scene(evr_json *j, const evr_config *c, const evr_config_run *r) { evr_json_string(j, r->scene); }
+static void json_camera(evr_json *j, const evr_config *c, const evr_config_run *r) { evr_json_string(j, r->camera); }
+static void json_duration(evr_json *j, const evr_config *c, const evr_config_run *r) { evr_json_number(j, r->duration); }
+static void json_fps(evr_json *j, const evr_config *c, const evr_config_run *r) { evr_json_number(j, r->fps); }
+static void json_backend(evr_json *j, const evr_config *c, const evr_config_run *r) { evr_json_string(j, r->backend); }
+static void json_max_dt(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    evr_json_number(j, fmax(c->max_dt > 0.0 ? c->max_dt : 1.0 / r->fps, c->min_dt));
+}
+static void json_frames_fps(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    evr_json_number(j, c->frames_fps > 0.0 ? c->frames_fps : r->fps);
+}
+static void json_formats(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    int k, count;
+    const evr_event_format *const *formats = evr_event_formats(&count);
+    evr_json_begin_array(j);
+    for (k = 0; k < count; k++)
+        if (c->formats & (1 << k)) evr_json_string(j, formats[k]->name);
+    evr_json_end_array(j);
+}
+
+/* ---- options that set more than their field, or check more than a range ---- */
+#define FAIL(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
+
+static evr_status parse_res(evr_config *c, const char *v, evr_error *err)
+{
+    return evr_parse_size("--res", v, &c->width, &c->height, err);
+}
+static evr_status parse_thres(evr_config *c, const char *v, evr_error *err)
+{
+    evr_status st = evr_parse_float("--thres", v, &c->pos_thres, err);
+    if (st == EVR_OK) c->neg_thres = c->pos_thres;
+    return st;
+}
+static evr_status parse_no_preview(evr_config *c, const char *v, evr_error *err)
+{
+    c->preview_window = 0.0;
+    return EVR_OK;
+}
+static evr_status parse_formats(evr_config *c, const char *v, evr_error *err)
+{
+    return evr_event_formats_parse("--format", v, &c->formats, err);
+}
+static evr_status parse_frames_out(evr_config *c, const char *v, evr_error *err)
+{
+    if (!v[0]) FAIL("--frames-out needs a folder");
+    c->frames_out = v;
+    return EVR_OK;
+}
+static evr_status parse_event_capacity(evr_config *c, const char *v, evr_error *err)
+{
+    uint64_t cap;
+    evr_status st = evr_parse_u64("--gpu-event-capacity", v, &cap, err);
+    if (st == EVR_OK) c->gpu_event_capacity = cap > ((uint64_t)1 << 40) ? ((int64_t)1 << 40) : (int64_t)cap;
+    return st;
+}
+static evr_status parse_sensor(evr_config *c, const char *v, evr_error *err)
+{
+    const char *name = evr_sensor_canonical(v);
+    char list[128];
+    if (!name) FAIL("--sensor: unknown sensor '%s' (%s)", v, evr_sensor_list(list, sizeof list));
+    c->sensor = name;
+    return EVR_OK;
+}
+
+static evr_status check_resolution(const evr_config *c, evr_error *err)
+{
+    if (c->width < 1 || c->height < 1 || c->width > 65535 || c->height > 65535)
+        FAIL("resolution %dx%d is out of range (1 to 65535 pixels a side)", c->width, c->height);
+    if ((double)c->width * (double)c->height > 1e9) FAIL("resolution %dx%d is too large", c->width, c->height);
+    return EVR_OK;
+}
+static evr_status check_max_dt(const evr_config *c, evr_error *err)
+{
+    if (!(c->max_dt <= 1.0) || c->max_dt < 0.0 || !isfinite(c->max_dt) || (c->max_dt > 0.0 && c->max_dt < c->min_dt))
+        FAIL("max dt must be between min dt (%g s) and 1 s, or 0 for one segment (got %g)", c->min_dt, c->max_dt);
+    return EVR_OK;
+}
+static evr_status check_sensor(const evr_config *c, evr_error *err)
+{
+    char list[128];
+    if (c->sensor && !evr_sensor_canonical(c->sensor))
+        FAIL("unknown sensor '%s' (%s)", c->sensor, evr_sensor_list(list, sizeof list));
+    return EVR_OK;
+}
+static evr_status check_time_res(const evr_config *c, evr_error *err)
+{
+    if (!(c->time_res >= 1e-6 * (1.0 - 1e-9)) || !(c->time_res <= 0.1) ||
+        fabs(c->time_res * 1e6 - floor(c->time_res * 1e6 + 0.5)) > 1e-6 * c->time_res * 1e6)
+        FAIL("timestamp resolution must be a whole number of microseconds from 1e-6 to 0.1 s (got %g)", c->time_res);
+    return EVR_OK;
+}
+static evr_status check_out_dir(const evr_config *c, evr_error *err)
+{
+    if (!c->out_dir || !c->out_dir[0]) FAIL("no output folder given");
+    return EVR_OK;
+}
+static evr_status check_formats(const evr_config *c, evr_error *err)
+{
+    if (!c->formats || (c->formats & ~evr_event_formats_all())) FAIL("no valid output format selected");
+    return EVR_OK;
+}
+static evr_status check_frames_out(const evr_config *c, evr_error *err)
+{
+    if (c->frames_out && !c->frames_out[0]) FAIL("frames folder is an empty path");
+    return EVR_OK;
+}
+
+static void help_formats(char *buf, size_t n)
+{
+    int k, count;
+    size_t len = 0;
+    const evr_event_format *const *formats = evr_event_formats(&count);
+    buf[0] = 0;
+    for (k = 0; k < count && len < n; k++) len += (size_t)snprintf(buf + len, n - len, "%s, ", formats[k]->name);
+    if (len >= 2 && len < n) buf[len - 2] = 0;
+    snprintf(buf + strlen(buf), n - strlen(buf), " or all, comma-separated (default %s)", formats[0]->name);
+}
+
+/* ---- choices ---- */
+static const evr_opt_choice sampling_choices[] = {
+    {"uniform", EVR_SAMPLING_UNIFORM, "uniform, per-pixel phase", NULL},
+    {"adaptive", EVR_SAMPLING_ADAPTIVE, "adaptive", NULL},
+    {NULL, -1, NULL, NULL}};
+static const evr_opt_choice backend_choices[] = {
+    {"auto", EVR_BACKEND_AUTO, "auto", NULL},
+    {"cpu", EVR_BACKEND_CPU, "cpu", NULL},
+    {"cuda", EVR_BACKEND_CUDA, "cuda", NULL},
+    {NULL, -1, NULL, NULL}};
+static const evr_opt_choice gpu_bvh_choices[] = {
+    {NULL, 0, "default", NULL},
+    {"bvh4", 4, "bvh4", NULL},
+    {"cw8", 8, "cw8", NULL},
+    {NULL, -1, NULL, NULL}};
+static const evr_opt_choice skip_choices[] = {   /* no_skip's names in run.json */
+    {NULL, 0, "exact", NULL},
+    {NULL, 1, "off", NULL},
+    {NULL, -1, NULL, NULL}};
+static const evr_opt_choice gi_choices[] = {
+    {"none", 0, "none", NULL},
+    {"photon", 1, "photon", NULL},
+    {"path", 0, NULL, "--gi path renders one image: use evray still (render takes none or photon)"},
+    {NULL, -1, NULL, NULL}};
+
+static const evr_config_option table[] = {
+    {.name = "scene", .json = "scene", .json_rank = 1, .json_value = json_scene},
+
+    /* ---- output ---- */
+    {.name = "out_dir", .type = EVR_OPT_STRING, .offset = F(out_dir), .def_text = "evray-out", .check = check_out_dir,
+     .flag = "--out", .alias = "-o",
+     .section = "output", .label = "-o, --out DIR", .help = "run folder (default ./evray-out)"},
+    {.name = "force", .type = EVR_OPT_FLAG, .offset = F(force),
+     .flag = "--force", .label = "--force", .help = "overwrite a non-empty run folder"},
+    {.name = "formats", .type = EVR_OPT_INT, .offset = F(formats), .def = EVR_FORMAT_H5, .check = check_formats,
+     .flag = "--format", .parse = parse_formats,
+     .label = "--format LIST", .help_text = help_formats,
+     .json = "formats", .json_rank = 46, .json_value = json_formats},
+    {.name = "preview_window", .type = EVR_OPT_DOUBLE, .offset = F(preview_window), .def = 0.05,
+     .lo = 0, .hi = NO_LIMIT, .what = "preview window must be >= 0 seconds",
+     .flag = "--preview-window", .label = "--preview-window S", .help = "seconds per preview frame (default 0.05)",
+     .json = "preview_window", .json_rank = 41},
+    {.name = "no_preview", .flag = "--no-preview", .no_value = 1, .parse = parse_no_preview,
+     .label = "--no-preview", .help = "no preview images"},
+    {.name = "quiet", .flag = "--quiet", .alias = "-q", .no_value = 1,   /* the program's */
+     .label = "-q, --quiet", .help = "no progress bar or summary"},
+
+    /* ---- intensity frames ---- */
+    {.name = "frames_out", .type = EVR_OPT_STRING, .offset = F(frames_out), .check = check_frames_out,
+     .flag = "--frames-out", .parse = parse_frames_out,
+     .section = "intensity frames for frame-based tools (v2e and the like)", .label = "--frames-out DIR",
+     .help = "also write frame k = every pixel's intensity at exactly\n"
+             "start + k/F (one sample at the pixel centre, unseen by the\n"
+             "pixel model), for every such time up to and including the end\n"
+             "(floor(duration*F) + 1 frames): DIR/frame_NNNNNN.png (8-bit\n"
+             "sRGB), DIR/frame_NNNNNN_linear16.png (16-bit linear) and\n"
+             "DIR/frames.csv (index,time_s,srgb8_png,linear16_png); DIR may\n"
+             "be inside the run folder or not, and must hold no frames\n"
+             "unless --force",
+     .json = "frames_out", .json_rank = 42},
+    {.name = "frames_fps", .type = EVR_OPT_DOUBLE, .offset = F(frames_fps), .def = 0.0,
+     .lo = 0, .hi = 1e6, .what = "frames fps must be a positive number of frames per second",
+     .flag = "--frames-fps", .cli_lo = 0, .cli_hi = NO_LIMIT, .cli_lo_open = 1, .cli_what = "%s must be a positive number (got %s)",
+     .label = "--frames-fps F", .help = "frames per second (default: the segment rate, --fps)",
+     .json = "frames_fps", .json_rank = 43, .json_if = has_frames, .json_value = json_frames_fps},
+    {.name = "frames_exposure", .type = EVR_OPT_FLOAT, .offset = F(frames_exposure), .def = 1.0,
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "frames exposure must be a positive number",
+     .flag = "--frames-exposure", .cli_lo = 0, .cli_hi = NO_LIMIT, .cli_lo_open = 1, .cli_what = "%s must be a positive number (got %s)",
+     .label = "--frames-exposure E", .help = "8-bit frames: intensity * E clamped to [0, 1], sRGB-encoded\n"
+                                             "(default 1: intensity 1 is white)",
+     .json = "frames_exposure", .json_rank = 44, .json_if = has_frames},
+    {.name = "frames_max", .type = EVR_OPT_FLOAT, .offset = F(frames_max), .def = 4.0,
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "frames max must be a positive intensity",
+     .flag = "--frames-max", .cli_lo = 0, .cli_hi = NO_LIMIT, .cli_lo_open = 1, .cli_what = "%s must be a positive intensity (got %s)",
+     .label = "--frames-max M", .help = "16-bit frames: value = round(intensity * 65535 / M), clamped\n"
+                                        "(default 4)",
+     .json = "frames_max", .json_rank = 45, .json_if = has_frames},
+
+    /* ---- image and time ---- */
+    {.name = "res", .flag = "--res", .parse = parse_res,
+     .section = "image and time", .label = "--res WxH", .help = "resolution (default 346x260)"},
+    {.name = "width", .type = EVR_OPT_INT, .offset = F(width), .def = 346, .check = check_resolution,   /* DAVIS346 */
+     .json = "width", .json_rank = 3},
+    {.name = "height", .type = EVR_OPT_INT, .offset = F(height), .def = 260,
+     .json = "height", .json_rank = 4},
+    {.name = "camera", .type = EVR_OPT_STRING, .offset = F(camera),
+     .flag = "--camera", .label = "--camera NAME", .help = "camera of the scene (default: the first)",
+     .json = "camera", .json_rank = 2, .json_value = json_camera},
+    {.name = "duration", .type = EVR_OPT_DOUBLE, .offset = F(duration), .def = 0.0,
+     .lo = 0, .hi = NO_LIMIT, .what = "duration must be a positive number of seconds",
+     .flag = "--duration", .cli_lo = 0, .cli_hi = NO_LIMIT, .cli_lo_open = 1,
+     .cli_what = "%s must be a positive number of seconds (got %s)",
+     .label = "--duration S", .help = "seconds to simulate (default: the animation's length)",
+     .json = "duration", .json_rank = 6, .json_value = json_duration},
+    {.name = "start", .type = EVR_OPT_DOUBLE, .offset = F(start), .def = 0.0,
+     .lo = 0, .hi = NO_LIMIT, .what = "start time must be >= 0 seconds",
+     .flag = "--start", .label = "--start S", .help = "start time in the animation (default 0)",
+     .json = "start", .json_rank = 5},
+    {.name = "fps", .type = EVR_OPT_DOUBLE, .offset = F(fps), .def = 0.0,
+     .lo = 0, .hi = 1e6, .what = "fps must be a positive number of segments per second",
+     .flag = "--fps", .cli_lo = 0, .cli_hi = NO_LIMIT, .cli_lo_open = 1, .cli_what = "%s must be a positive number (got %s)",
+     .label = "--fps F", .help = "segments per second (default: the scene's frame rate, else 30)",
+     .json = "fps", .json_rank = 7, .json_value = json_fps},
+    {.name = "samples_per_frame", .type = EVR_OPT_INT, .offset = F(samples_per_frame), .def = 10,
+     .lo = 1, .hi = 1000000, .what = "samples per frame must be between 1 and 1000000",
+     .flag = "--samples-per-frame", .label = "--samples-per-frame N", .help = "samples per pixel per segment (default 10)",
+     .json = "samples_per_frame", .json_rank = 8},
+    {.name = "threads", .type = EVR_OPT_INT, .offset = F(threads), .def = 0,
+     .lo = 0, .hi = 4096, .what = "threads must be between 0 (all cores) and 4096",
+     .flag = "--threads", .label = "--threads N", .help = "worker threads (default: all cores)"},
+    {.name = "backend", .type = EVR_OPT_CHOICE, .offset = F(backend), .def = EVR_BACKEND_AUTO,
+     .choices = backend_choices, .noun = "backend", .what = "unknown backend",
+     .flag = "--backend", .label = "--backend B", .help = "auto (default: CUDA when a GPU is usable, else CPU), cpu or cuda",
+     .json = "backend", .json_rank = 30, .json_value = json_backend},
+    {.name = "gpu_bvh", .type = EVR_OPT_CHOICE, .offset = F(gpu_bvh), .def = 0,
+     .choices = gpu_bvh_choices, .noun = "layout", .what = "unknown GPU BVH layout",
+     .flag = "--gpu-bvh", .label = "--gpu-bvh L", .help = "GPU BVH node layout: cw8 (default, compressed 8-wide) or bvh4",
+     .json = "gpu_bvh", .json_rank = 33},
+    {.name = "gpu_event_capacity", .type = EVR_OPT_INT64, .offset = F(gpu_event_capacity), .def = 0,
+     .lo = 0, .hi = 2147483648.0, .what = "GPU event capacity must be between 0 (automatic) and 2^31",
+     .flag = "--gpu-event-capacity", .parse = parse_event_capacity,
+     .label = "--gpu-event-capacity N", .help = "events a GPU segment buffer holds at first (default: automatic; it\n"
+                                                "grows and the segment is rendered again whenever it overflows)",
+     .json = "gpu_event_capacity", .json_rank = 31},
+    {.name = "no_skip", .type = EVR_OPT_FLAG, .offset = F(no_skip), .choices = skip_choices,
+     .flag = "--no-skip", .label = "--no-skip", .help = "trace every sample (brute force); by default a pixel that nothing\n"
+                                                       "moving can reach keeps its last intensity (identical events)",
+     .json = "skip", .json_rank = 32},
+    {.name = "sampling", .type = EVR_OPT_CHOICE, .offset = F(sampling), .def = EVR_SAMPLING_UNIFORM,
+     .choices = sampling_choices, .noun = "sampling", .what = "unknown sampling",
+     .flag = "--sampling", .label = "--sampling S",
+     .help = "uniform (default: --samples-per-frame samples per pixel per\n"
+             "segment) or adaptive: each pixel picks its next sample time so\n"
+             "that its log intensity moves by at most --adapt-frac of a\n"
+             "threshold and anything its rays meet moves by at most\n"
+             "2 * --adapt-frac pixels; a pixel nothing moving reaches samples\n"
+             "every --max-dt; a sample that changed by more than that is\n"
+             "held back while the interval before it is bisected down to\n"
+             "--min-dt (ignores --samples-per-frame and --no-skip)",
+     .json = "sampling", .json_rank = 9},
+    {.name = "adapt_frac", .type = EVR_OPT_FLOAT, .offset = F(adapt_frac), .def = 0.25,
+     .lo = 0, .hi = 1, .lo_open = 1, .what = "adapt fraction must be in (0, 1]",
+     .flag = "--adapt-frac", .cli_lo = 0, .cli_hi = 1, .cli_lo_open = 1, .cli_what = "%s must be in (0, 1] (got %s)",
+     .label = "--adapt-frac F", .help = "adaptive: in (0, 1] (default 0.25)",
+     .json = "adapt_frac", .json_rank = 10, .json_if = is_adaptive},
+    {.name = "min_dt", .type = EVR_OPT_DOUBLE, .offset = F(min_dt), .def = 20e-6,
+     .lo = 1e-6, .hi = 1, .what = "min dt must be between 1e-6 and 1 s",
+     .flag = "--min-dt", .cli_lo = 1e-6, .cli_hi = 1, .cli_what = "%s must be between 1e-6 and 1 seconds (got %s)",
+     .label = "--min-dt S, --max-dt S", .help = "adaptive: bounds on the time between a pixel's samples, seconds\n"
+                                                "(default 20e-6; one segment); a moving camera or light samples\n"
+                                                "every pixel every --min-dt",
+     .json = "min_dt", .json_rank = 11, .json_if = is_adaptive},
+    {.name = "max_dt", .type = EVR_OPT_DOUBLE, .offset = F(max_dt), .def = 0.0, .check = check_max_dt,   /* 0: one segment */
+     .flag = "--max-dt", .cli_lo = 0, .cli_hi = 1, .cli_lo_open = 1, .cli_what = "%s must be a number of seconds in (0, 1] (got %s)",
+     .json = "max_dt", .json_rank = 12, .json_if = is_adaptive, .json_value = json_max_dt},
+
+    /* ---- global illumination ---- */
+    {.name = "gi", .type = EVR_OPT_CHOICE, .offset = F(gi), .def = 0,
+     .choices = gi_choices, .noun = "mode", .what = "unknown global illumination mode",
+     .flag = "--gi", .section = "global illumination (CPU and CUDA backends)", .label = "--gi MODE",
+     .help = "none (default) or photon: image-space photon mapping, a photon\n"
+             "pass at every segment boundary and the indirect light linear in\n"
+             "time between them (the same photons every pass: a still scene\n"
+             "gets the same indirect light, so GI makes no events by itself)",
+     .json = "gi", .json_rank = 34},
+    {.name = "photons", .type = EVR_OPT_U32, .offset = F(photons), .def = 0,
+     .flag = "--photons", .cli_lo = 0, .cli_hi = 1 << 30, .cli_what = "%s: at most 2^30 photons per pass (got %s)",
+     .label = "--photons N", .help = "photons per pass (default: one per pixel)",
+     .json = "photons", .json_rank = 35, .json_if = has_gi},
+    {.name = "gather_radius", .type = EVR_OPT_FLOAT, .offset = F(gather_radius), .def = 0.0,
+     .lo = 0, .hi = NO_LIMIT, .what = "--gather-radius must be a positive number, or 0 for automatic", .applies = has_gi,
+     .flag = "--gather-radius", .label = "--gather-radius R",
+     .help = "distance filter, world units (default 2% of the scene's diagonal)",
+     .json = "gather_radius", .json_rank = 36, .json_if = has_gi},
+    {.name = "gather_max", .type = EVR_OPT_INT, .offset = F(gather_max), .def = 0,   /* no limit: every photon of the disk */
+     .lo = 0, .hi = 65536, .what = "--gather-max must be between 0 (no limit) and 65536", .applies = has_gi,
+     .flag = "--gather-max", .label = "--gather-max N",
+     .help = "photons per estimate at most (default 0: no limit, every photon of the disk)",
+     .json = "gather_max", .json_rank = 37, .json_if = has_gi},
+    {.name = "gather_window", .type = EVR_OPT_INT, .offset = F(gather_window), .def = 8,
+     .lo = 0, .hi = 256, .what = "--gather-window must be between 0 and 256 pixels", .applies = has_gi,
+     .flag = "--gather-window", .label = "--gather-window N", .help = "gather window half size at most, pixels (default 8)",
+     .json = "gather_window", .json_rank = 38, .json_if = has_gi},
+    {.name = "photon_layers", .type = EVR_OPT_INT, .offset = F(photon_layers), .def = 8,
+     .lo = 1, .hi = 64, .what = "--photon-layers must be between 1 and 64", .applies = has_gi,
+     .flag = "--photon-layers", .label = "--photon-layers N", .help = "photons each pixel of the buffer holds (default 8)",
+     .json = "photon_layers", .json_rank = 39, .json_if = has_gi},
+    {.name = "gi_bounces", .type = EVR_OPT_INT, .offset = F(gi_bounces), .def = 4,
+     .lo = 0, .hi = 64, .what = "--gi-bounces must be between 0 and 64", .applies = has_gi,
+     .flag = "--gi-bounces", .label = "--gi-bounces N", .help = "indirect bounces of a photon (default 4)",
+     .json = "gi_bounces", .json_rank = 40, .json_if = has_gi},
+
+    /* ---- sensor ---- */
+    {.name = "sensor", .type = EVR_OPT_STRING, .offset = F(sensor), .check = check_sensor,   /* NULL: ideal */
+     .flag = "--sensor", .parse = parse_sensor,
+     .section = "sensor (laws, presets and their sources: docs/sensors.md; the default is the ideal sensor)",
+     .label = "--sensor NAME", .help = "preset: ideal, davis346, dvxplorer or prophesee-gen4; it sets the\n"
+                                       "defaults (and the resolution) that the options below override,\n"
+                                       "whatever their order",
+     .json = "sensor", .json_rank = 17},
+    {.name = "pos_thres", .type = EVR_OPT_FLOAT, .offset = F(pos_thres), .def = 0.2,
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "ON threshold must be a positive number",
+     .flag = "--pos-thres", .label = "--pos-thres C, --neg-thres C",
+     .help = "ON/OFF contrast thresholds in log intensity (default 0.2)",
+     .json = "pos_thres", .json_rank = 13},
+    {.name = "neg_thres", .type = EVR_OPT_FLOAT, .offset = F(neg_thres), .def = 0.2,
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "OFF threshold must be a positive number",
+     .flag = "--neg-thres", .json = "neg_thres", .json_rank = 14},
+    {.name = "thres", .flag = "--thres", .parse = parse_thres, .label = "--thres C", .help = "both thresholds"},
+    {.name = "sigma_thres", .type = EVR_OPT_FLOAT, .offset = F(sigma_thres), .def = 0.0,
+     .lo = 0, .hi = NO_LIMIT, .what = "threshold mismatch must be >= 0",
+     .flag = "--sigma-thres", .label = "--sigma-thres S", .help = "threshold mismatch: per-pixel thresholds drawn once from\n"
+                                                                 "N(threshold, S), a fixed pattern (default 0)",
+     .json = "sigma_thres", .json_rank = 18},
+    {.name = "refractory", .type = EVR_OPT_FLOAT, .offset = F(refractory), .def = 0.0,
+     .lo = 0, .hi = NO_LIMIT, .what = "refractory period must be >= 0 seconds",
+     .flag = "--refractory", .label = "--refractory S", .help = "refractory period in seconds (default 0)",
+     .json = "refractory", .json_rank = 15},
+    {.name = "cutoff_hz", .type = EVR_OPT_FLOAT, .offset = F(cutoff_hz), .def = 0.0,
+     .lo = 0, .hi = 1e6, .what = "photoreceptor cutoff must be between 0 (off) and 1e6 Hz",
+     .flag = "--cutoff-hz", .label = "--cutoff-hz F", .help = "photoreceptor low-pass cutoff at full brightness, falling to 7%\n"
+                                                             "of F for black (default 0: no filter)",
+     .json = "cutoff_hz", .json_rank = 19},
+    {.name = "full_intensity", .type = EVR_OPT_FLOAT, .offset = F(full_intensity), .def = 1.0,   /* white diffuse under unit irradiance / pi */
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "full intensity must be a positive intensity",
+     .flag = "--full-intensity", .label = "--full-intensity I", .help = "intensity that counts as full brightness (default 1)",
+     .json = "full_intensity", .json_rank = 20},
+    {.name = "leak_rate", .type = EVR_OPT_FLOAT, .offset = F(leak_rate), .def = 0.0,
+     .lo = 0, .hi = 1e5, .what = "leak rate must be between 0 (off) and 1e5 Hz",
+     .flag = "--leak-rate-hz", .label = "--leak-rate-hz R", .help = "leak ON events per second per pixel (default 0)",
+     .json = "leak_rate_hz", .json_rank = 21},
+    {.name = "leak_jitter", .type = EVR_OPT_FLOAT, .offset = F(leak_jitter), .def = 0.1,   /* v2e's leak_jitter_fraction */
+     .lo = 0, .hi = NO_LIMIT, .what = "leak jitter must be >= 0",
+     .flag = "--leak-jitter", .label = "--leak-jitter J", .help = "relative spread of the per-pixel leak rates (default 0.1)",
+     .json = "leak_jitter", .json_rank = 22},
+    {.name = "shot_rate", .type = EVR_OPT_FLOAT, .offset = F(shot_rate), .def = 0.0,
+     .lo = 0, .hi = 1e5, .what = "shot noise rate must be between 0 (off) and 1e5 Hz",
+     .flag = "--shot-noise-rate-hz", .label = "--shot-noise-rate-hz R",
+     .help = "shot-noise events per second (ON + OFF) of a black pixel; a pixel\n"
+             "at full brightness has R/4 (default 0)",
+     .json = "shot_noise_rate_hz", .json_rank = 23},
+    {.name = "hot_fraction", .type = EVR_OPT_FLOAT, .offset = F(hot_fraction), .def = 0.0,
+     .lo = 0, .hi = 1, .what = "hot pixel fraction must be between 0 and 1",
+     .flag = "--hot-pixel-fraction", .label = "--hot-pixel-fraction F", .help = "fraction of hot pixels (default 0)",
+     .json = "hot_pixel_fraction", .json_rank = 24},
+    {.name = "hot_rate", .type = EVR_OPT_FLOAT, .offset = F(hot_rate), .def = 100.0,
+     .lo = 0, .hi = 1e5, .what = "hot pixel rate must be between 0 and 1e5 Hz",
+     .flag = "--hot-pixel-rate-hz", .label = "--hot-pixel-rate-hz R", .help = "ON events per second of a hot pixel (default 100)",
+     .json = "hot_pixel_rate_hz", .json_rank = 25},
+    {.name = "time_res", .type = EVR_OPT_DOUBLE, .offset = F(time_res), .def = 1e-6, .check = check_time_res,
+     .flag = "--time-res", .label = "--time-res S", .help = "timestamp resolution in seconds, whole microseconds (default 1e-6)",
+     .json = "time_res", .json_rank = 26},
+    {.name = "time_jitter", .type = EVR_OPT_DOUBLE, .offset = F(time_jitter), .def = 0.0,
+     .lo = 0, .hi = 0.1, .what = "timestamp jitter must be between 0 and 0.1 s",
+     .flag = "--time-jitter", .label = "--time-jitter S", .help = "std dev of Gaussian timestamp jitter in seconds (default 0)",
+     .json = "time_jitter", .json_rank = 27},
+    {.name = "log_floor", .type = EVR_OPT_FLOAT, .offset = F(log_floor), .def = 0.02,
+     .lo = 0, .hi = NO_LIMIT, .lo_open = 1, .what = "log floor must be a positive intensity",
+     .flag = "--log-floor", .label = "--log-floor I", .help = "intensity below which the response is linear (default 0.02)",
+     .json = "log_floor", .json_rank = 16},
+    {.name = "seed", .type = EVR_OPT_U64, .offset = F(seed), .def = 1,
+     .flag = "--seed", .label = "--seed N", .help = "seed of the per-pixel sample phases and of the sensor's fixed\n"
+                                                    "pattern and noise (default 1)",
+     .json = "seed", .json_rank = 29},
+
+    /* ---- shading ---- */
+    {.name = "ambient", .type = EVR_OPT_FLOAT, .offset = F(ambient), .def = 0.02,
+     .lo = 0, .hi = NO_LIMIT, .what = "ambient must be >= 0",
+     .flag = "--ambient", .section = "shading", .label = "--ambient A", .help = "ambient light as a fraction of the base colour (default 0.02)",
+     .json = "ambient", .json_rank = 28},
+};
+
+const evr_config_option *evr_config_table(int *count)
+{
+    *count = (int)(sizeof table / sizeof table[0]);
+    return table;
+}
