@@ -9,7 +9,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include "sim_internal.h"
+#include "sim_state.h"
 
 /* Plans the frames of the run (times, and which segment renders which); needs sim->fps,
  * duration and num_segments. Does nothing when no frames are asked for. */

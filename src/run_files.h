@@ -2,7 +2,7 @@
 #ifndef EVR_RUN_FILES_H
 #define EVR_RUN_FILES_H
 
-#include "sim_internal.h"
+#include "sim_state.h"
 
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);

@@ -1,6 +1,6 @@
 /* The segment loop: scene motion per segment -> backend -> time-ordered events -> writers,
  * previews and run statistics. */
-#include "sim_internal.h"
+#include "sim_state.h"
 #include "par_pool.h"
 #include "host_clock.h"
 #include "config_json.h"

@@ -38,7 +38,7 @@
 #define RAY_SCALE 1
 #endif
 
-#define MAX_KEYS 65          /* as the segment loop (sim_internal.h) */
+#define MAX_KEYS 65          /* as the segment loop (sim_state.h) */
 #define EDGE_EPS 1e-4f       /* barycentric distance to an edge that counts as "on the edge" */
 #define MAX_MISMATCH_RATE 1e-4
 

@@ -3,7 +3,9 @@
   through other headers; src/prep, which both use, pulls in neither;
 - src/core is self-contained: its quoted includes stay inside src/core;
 - no include loop: modules (the files of one stem, x.c x.h x.cu x.cuh, with x_internal.h counted
-  as x's) whose quoted includes lead back to themselves.
+  as x's) whose quoted includes lead back to themselves;
+- the program is built against the public headers: cli/ includes evray.h, evray_experimental.h
+  and its own headers only.
 Quoted includes resolve as the compiler resolves them: the includer's folder, then src/, then
 include/; angle-bracket (system) includes are not followed."""
 import os
@@ -124,6 +126,16 @@ for m in sorted({module(f) for f in files}):
     if m not in state:
         visit(m)
 failures += [f"include loop: {loop}" for loop in loops]
+
+# cli/ sees include/ only
+CLI = os.path.join(ROOT, "cli")
+own = {n for n in os.listdir(CLI) if n.endswith(".h")}
+for name in sorted(os.listdir(CLI)):
+    if name.endswith((".c", ".h")):
+        with open(os.path.join(CLI, name), encoding="utf-8", errors="replace") as fh:
+            for inc in INCLUDE.findall(strip_comments(fh.read())):
+                if inc not in ("evray.h", "evray_experimental.h") and inc not in own:
+                    failures.append(f'cli/{name} includes "{inc}": the program sees include/ only')
 
 for what in failures:
     print("CHECK failed:", what, file=sys.stderr)

@@ -1,8 +1,8 @@
 /* The simulation object behind evr_sim: the segment loop's state, shared by the segment loop
  * (sim.c), the run folder (run_files.c) and the intensity frames (frames_out.c). It declares no
  * functions, so that each of them includes it without an include loop. */
-#ifndef EVR_SIM_INTERNAL_H
-#define EVR_SIM_INTERNAL_H
+#ifndef EVR_SIM_STATE_H
+#define EVR_SIM_STATE_H
 
 #include "backend.h"
 #include "segment_planner.h"
