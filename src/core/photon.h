@@ -1,9 +1,9 @@
 /* Image-space photon mapping (issue 5): every per-photon and per-pixel decision, written once
  * for the CPU and for nvcc (EVR_HD, plain C, no allocation). The loops that trace rays live in
- * the backends (src/cpu/photon_pass.c on the CPU); this file holds:
- *   - the material mapping (glTF metallic/roughness -> t_diffuse, t_specular),
- *   - the stay / diffuse / mirror decision and the flux update,
- *   - cosine-distributed and mirror directions,
+ * the backends (src/cpu/photon_pass.c on the CPU); the material's part (glTF metallic/roughness
+ * -> t_diffuse, t_specular, the stay / diffuse / mirror decision, the bounce directions) is in
+ * core/material.h. This file holds:
+ *   - the flux update at a hit,
  *   - the low-discrepancy numbers of a photon (a pure function of emitter and photon number),
  *   - emission from point, spot and directional lights and from emissive triangles,
  *   - the image-space buffer (projection, lock-free insertion),
@@ -40,76 +40,6 @@
 #define EVR_ATOMIC_INC_U32(p) __atomic_fetch_add((p), 1u, __ATOMIC_RELAXED)
 #define EVR_MUL_RN(a, b) ((a) * (b))
 #endif
-
-/* ---- materials ---- */
-
-/* glTF metallic-roughness to the photon thresholds: reflectance R = max(base colour) clamped to
- * [0.05, 0.95]; mirror = metallic * (1 - roughness);
- * t_diffuse = 1 - R, t_specular = t_diffuse + R * (1 - mirror). */
-EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic, float roughness,
-                                                  float *t_diffuse, float *t_specular)
-{
-    float r = fmaxf(base_color[0], fmaxf(base_color[1], base_color[2]));
-    float m = fminf(fmaxf(metallic, 0.0f), 1.0f) * (1.0f - fminf(fmaxf(roughness, 0.0f), 1.0f));
-    r = fminf(fmaxf(r, 0.05f), 0.95f);
-    *t_diffuse = 1.0f - r;
-    *t_specular = *t_diffuse + r * (1.0f - m);
-}
-
-/* Share of the reflected light that is a mirror reflection. */
-EVR_HD static inline float evr_photon_mirror_share(float t_diffuse, float t_specular)
-{
-    float refl = 1.0f - t_diffuse;
-    return refl > 0.0f ? fminf(fmaxf((1.0f - t_specular) / refl, 0.0f), 1.0f) : 0.0f;
-}
-
-enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_DIFFUSE = 1, EVR_PHOTON_MIRROR = 2, EVR_PHOTON_ABSORB = 3 };
-
-/* The decision at a hit for random xi in [0, 1). *weight multiplies the flux: stay 1/t_diffuse,
- * bounce 1/(1 - t_diffuse) (times the albedo, which the caller applies), 1 for a bounce when
- * staying is not allowed. ABSORB only when nothing else is possible. */
-EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi, int allow_stay, float *weight)
-{
-    float td = fminf(fmaxf(t_diffuse, 0.0f), 1.0f), ts = fminf(fmaxf(t_specular, td), 1.0f);
-    if (allow_stay) {
-        if (xi < td) {
-            *weight = 1.0f / td;
-            return EVR_PHOTON_STAY;
-        }
-        if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
-        *weight = 1.0f / (1.0f - td);
-        return xi < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
-    }
-    if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
-    *weight = 1.0f;
-    /* xi spread over the bounce options only */
-    return td + xi * (1.0f - td) < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
-}
-
-/* Orthonormal basis around unit n (Duff et al. 2017). */
-EVR_HD static inline void evr_onb(evr_v3 n, evr_v3 *t, evr_v3 *b)
-{
-    float s = n.z >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (s + n.z), c = n.x * n.y * a;
-    *t = evr_v3_make(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
-    *b = evr_v3_make(c, s + n.y * n.y * a, -n.y);
-}
-
-/* Cosine-distributed direction around unit n from (u1, u2) in [0, 1)^2 (pdf cos / pi). */
-EVR_HD static inline evr_v3 evr_cosine_dir(evr_v3 n, float u1, float u2)
-{
-    evr_v3 t, b;
-    float r = sqrtf(u1), phi = 6.28318530718f * u2;
-    float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
-    evr_onb(n, &t, &b);
-    return evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
-}
-
-/* Mirror direction of incoming d about unit n. */
-EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
-{
-    return evr_v3_sub(d, evr_v3_scale(n, 2.0f * evr_v3_dot(d, n)));
-}
 
 /* Uniform direction on the sphere. */
 EVR_HD static inline evr_v3 evr_sphere_dir(float u1, float u2)
@@ -382,7 +312,7 @@ EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photo
     float w;
     const int first_light = p->pr.from_light && p->bounce == 0;
     const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
-    const int ev = evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, !first_light, &w);
+    const int ev = evr_material_photon_event(mat, s, p->pr.ray.dir, xi, !first_light, &w);
     int c;
     for (c = 0; c < 3; c++) absorbed[c] = stored[c] = 0.0f;
     if (ev == EVR_PHOTON_STAY) {
@@ -1048,7 +978,7 @@ EVR_HD static inline int evr_photon_gather_moved(const evr_photon_buffer *cur, c
  * mat: the diffuse share of the albedo over pi. */
 EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_view *mat, float k_rgb[3])
 {
-    float k = (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
+    float k = evr_material_diffuse_k(mat);
     k_rgb[0] = s->albedo[0] * k;
     k_rgb[1] = s->albedo[1] * k;
     k_rgb[2] = s->albedo[2] * k;

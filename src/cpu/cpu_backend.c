@@ -169,14 +169,14 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         if (!any) continue;
         rtcOccluded8(vmask, b->top, &ctx, &sr);
         for (i = 0; i < PACKET; i++)
-            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
+            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_material_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), wi[i], e[i], acc[i]);
     }
     for (i = 0; i < PACKET; i++) {
         if (!hit[i]) {   /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
             if (b->gi && valid[i] && t_hit) evr_cpu_gi_missed(&b->gi_state, xs[i], ys[i]);
             continue;
         }
-        out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
+        out[i] = evr_surface_intensity(&s[i], evr_v3_scale(ray[i].dir, -1.0f), acc[i], rs->ambient);
         if (direct) direct[i] = out[i];
         if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i], fs[i], t_hit != NULL);
     }

@@ -181,9 +181,9 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
         sr.dir = wi;
         if (gpu_trace<LAYOUT>(&a.view, rs, sr, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f, 1, &hit))
             continue;
-        evr_accumulate_lambert(s, wi, e, acc);
+        evr_material_add_light(s, evr_v3_scale(ray.dir, -1.0f), wi, e, acc);
     }
-    *direct = evr_surface_intensity(s, acc, rs->ambient);
+    *direct = evr_surface_intensity(s, evr_v3_scale(ray.dir, -1.0f), acc, rs->ambient);
     return true;
 }
 
