@@ -8,7 +8,7 @@
 #include "backend.h"
 #include "core/photon.h"
 #include "core/rng.h"
-#include "core/shading.h"
+#include "core/shade_hit.h"
 #include "scene/scene.h"
 
 #include <embree3/rtcore.h>
@@ -69,23 +69,24 @@ typedef struct {
     int *row_hits;
 } shade_ctx;
 
-/* Unshadowed-light sum acc (irradiance times cosine) at surface s, shadow rays included: the
- * event pipeline's direct term (sample_intensity8) one ray at a time. */
+/* core/shade_hit.h's shadow-ray query: the tracer's. */
+struct evr_occlusion {
+    const evr_tracer *tr;
+};
+
+static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
+{
+    return o->tr->occluded(o->tr->user, r, tnear, tfar, f);
+}
+
+/* The lights' sum acc at surface s seen along wo, shadow rays included (evr_shade_direct_sum):
+ * the event pipeline's direct term one ray at a time. */
 static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, float acc[3])
 {
-    const evr_render_scene *rs = c->rs;
-    int l;
-    acc[0] = acc[1] = acc[2] = 0.0f;
-    for (l = 0; l < rs->num_lights; l++) {
-        evr_v3 wi;
-        float dist, e[3];
-        if (!evr_light_incident(rs, &rs->lights[l], 0.0f, s->p, &wi, &dist, e) || evr_v3_dot(wi, s->n) <= 0.0f) continue;
-        evr_ray r;
-        r.org = s->p;
-        r.dir = wi;
-        if (c->tr.occluded(c->tr.user, r, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), 0.0f)) continue;
-        evr_material_add_light(s, wo, wi, e, acc);
-    }
+    struct evr_occlusion o;
+    unsigned rays = 0;
+    o.tr = &c->tr;
+    evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
 static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_view **mat, int *inst)
