@@ -169,4 +169,68 @@ EVR_HD static inline float evr_adapt_next_time(const evr_adapt_params *ap, float
     return moving && next >= seg && t < last ? last : next;
 }
 
+/* ---- the per-pixel state machine both backends run ----
+ * A pixel starts the segment at evr_adapt_start's time. Each traced sample becomes the pixel's
+ * candidate; evr_adapt_candidate either holds it back on the pixel's stack (trace the midpoint
+ * first) or takes it: then it goes through the pixel model, and evr_adapt_taken gives the next
+ * candidate (the latest held back) or the next time to trace. At or past the segment's length
+ * the pixel is done for the segment; its next time, less the length, is carried to the next. */
+
+typedef struct {
+    float t[EVR_ADAPT_DEPTH], intensity[EVR_ADAPT_DEPTH], hit[EVR_ADAPT_DEPTH];
+    int n;
+} evr_adapt_stack;
+
+/* The pixel's first sample time in the segment (seg: its length), from its state st, the next
+ * time next_t carried from the previous segment, its phase and its centre ray ray0. */
+EVR_HD static inline float evr_adapt_start(const evr_render_scene *rs, const evr_adapt_params *ap,
+                                           const evr_adapt_plan *pl, const evr_pixel_state *st, evr_ray ray0,
+                                           float next_t, float phase, float seg)
+{
+    float speed = 0.0f;
+    int jump = 0;
+    if (st->started && !pl->all_min) speed = evr_adapt_rays_speed(rs, pl, ray0, st->cache_dist, &jump);
+    return evr_adapt_first(ap, pl, st->started, next_t, st->t_prev, phase, speed, jump, seg);
+}
+
+/* The candidate sample (t, intensity, primary hit distance hit): 0 when it is held back (pushed;
+ * *t_trace: the time to trace first), 1 when it is taken: *step and *moving are set for
+ * evr_adapt_taken and the pixel's cache of change-driven sampling keeps its hit. Call before the
+ * sample goes through the pixel model (st is the state before it). */
+EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const evr_adapt_params *ap,
+                                             const evr_adapt_plan *pl, evr_pixel_state *st, const evr_pixel_params *p,
+                                             evr_ray ray0, evr_adapt_stack *sk, float t, float intensity, float hit,
+                                             float *t_trace, float *step, int *moving)
+{
+    float mid;
+    if (sk->n < EVR_ADAPT_DEPTH && evr_adapt_refine(ap, st, p, t, intensity, &mid)) {
+        sk->t[sk->n] = t;
+        sk->intensity[sk->n] = intensity;
+        sk->hit[sk->n] = hit;
+        sk->n++;
+        *t_trace = mid;   /* trace halfway first */
+        return 0;
+    }
+    *step = evr_adapt_after_sample(rs, ap, pl, st, p, ray0, hit, t, intensity, moving);
+    st->cache_dist = hit;
+    return 1;
+}
+
+/* After a taken sample at *t went through the pixel model: 1 with the next candidate in (*t,
+ * *intensity, *hit), the latest held back; else 0 with *t_trace the next time to trace (at or
+ * past seg: none in this segment). */
+EVR_HD static inline int evr_adapt_taken(const evr_adapt_params *ap, evr_adapt_stack *sk, float step, int moving,
+                                         float seg, float *t, float *intensity, float *hit, float *t_trace)
+{
+    if (sk->n > 0) {
+        sk->n--;
+        *t = sk->t[sk->n];
+        *intensity = sk->intensity[sk->n];
+        *hit = sk->hit[sk->n];
+        return 1;
+    }
+    *t_trace = evr_adapt_next_time(ap, *t, step, seg, moving);
+    return 0;
+}
+
 #endif

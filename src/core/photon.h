@@ -1,8 +1,8 @@
 /* Image-space photon mapping (issue 5): every per-photon and per-pixel decision, written once
  * for the CPU and for nvcc (EVR_HD, plain C, no allocation). The loops that trace rays live in
- * the backends (src/cpu/photon_pass.c on the CPU). This header includes them all:
- *   photon_scatter.h   the material mapping (glTF metallic/roughness -> t_diffuse, t_specular),
- *                      the stay / diffuse / mirror decision, cosine-distributed and mirror directions
+ * the backends (src/cpu/photon_pass.c on the CPU); the material's part (glTF metallic/roughness
+ * -> t_diffuse, t_specular, the stay / diffuse / mirror decision, the bounce directions) is in
+ * core/material.h. This header includes them all:
  *   photon_rand.h      the low-discrepancy numbers of a photon (a pure function of emitter and number)
  *   photon_emit.h      emission from point, spot and directional lights and from emissive triangles
  *   photon_path.h      a photon's path: its start and the flux update at each hit
@@ -35,7 +35,6 @@
 #include "core/shading.h"
 #include "core/skip.h"
 
-#include "core/photon_scatter.h"
 #include "core/photon_rand.h"
 #include "core/photon_emit.h"
 #include "core/photon_path.h"

@@ -5,7 +5,13 @@
 
 #include <stdint.h>
 #include "core/shading.h"
-#include "core/photon_scatter.h"
+
+/* Uniform direction on the sphere. */
+EVR_HD static inline evr_v3 evr_sphere_dir(float u1, float u2)
+{
+    float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 6.28318530718f * u2;
+    return evr_v3_make(r * cosf(phi), r * sinf(phi), z);
+}
 
 typedef struct {
     evr_ray ray;

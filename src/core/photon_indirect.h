@@ -5,7 +5,6 @@
 #define EVR_CORE_PHOTON_INDIRECT_H
 
 #include "core/shading.h"
-#include "core/photon_scatter.h"
 #include "core/photon_gather.h"
 #include "core/photon_fixed.h"
 
@@ -13,7 +12,7 @@
  * mat: the diffuse share of the albedo over pi. */
 EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_view *mat, float k_rgb[3])
 {
-    float k = (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
+    float k = evr_material_diffuse_k(mat);
     k_rgb[0] = s->albedo[0] * k;
     k_rgb[1] = s->albedo[1] * k;
     k_rgb[2] = s->albedo[2] * k;

@@ -7,7 +7,6 @@
 #include "core/shading.h"
 #include "core/photon_emit.h"
 #include "core/photon_rand.h"
-#include "core/photon_scatter.h"
 
 /* What a pass traces with (the CPU's and the GPU's). */
 typedef struct {
@@ -79,7 +78,7 @@ EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photo
     float w;
     const int first_light = p->pr.from_light && p->bounce == 0;
     const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
-    const int ev = evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, !first_light, &w);
+    const int ev = evr_material_photon_event(mat, s, p->pr.ray.dir, xi, !first_light, &w);
     int c;
     for (c = 0; c < 3; c++) absorbed[c] = stored[c] = 0.0f;
     if (ev == EVR_PHOTON_STAY) {

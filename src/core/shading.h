@@ -3,9 +3,7 @@
 #ifndef EVR_CORE_SHADING_H
 #define EVR_CORE_SHADING_H
 
-#include "core/render_scene.h"
-
-#define EVR_PI 3.14159265358979f
+#include "core/material.h"
 
 EVR_HD static inline float evr_srgb_to_linear(float c)
 {
@@ -25,37 +23,12 @@ EVR_HD static inline float evr_luminance(float r, float g, float b)
     return EVR_LUMA_R * r + EVR_LUMA_G * g + EVR_LUMA_B * b;
 }
 
-/* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
-EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v, float out[4])
-{
-    float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
-    float fx = floorf(x), fy = floorf(y);
-    float ax = x - fx, ay = y - fy;
-    int x0 = (int)fx % t->width, y0 = (int)fy % t->height;
-    if (x0 < 0) x0 += t->width;
-    if (y0 < 0) y0 += t->height;
-    int x1 = (x0 + 1) % t->width, y1 = (y0 + 1) % t->height;
-    const float *p00 = t->rgba + 4 * ((long)y0 * t->width + x0), *p10 = t->rgba + 4 * ((long)y0 * t->width + x1);
-    const float *p01 = t->rgba + 4 * ((long)y1 * t->width + x0), *p11 = t->rgba + 4 * ((long)y1 * t->width + x1);
-    int c;
-    for (c = 0; c < 4; c++)
-        out[c] = (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
-}
-
-typedef struct {
-    evr_v3 p;          /* world position */
-    evr_v3 n;          /* world shading normal, facing the incoming ray */
-    float albedo[3];
-    float emissive[3];
-} evr_surface;
-
 /* Fills the surface at barycentrics (u, v) of triangle prim of instance inst, whose transform at
  * the ray's time is xf; ray_dir is the incoming direction, t_hit the distance along it. */
 EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim, float u, float v,
                                          const evr_m34 *xf, evr_ray ray, float t_hit, evr_surface *s)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[inst].mesh];
-    const evr_material_view *mat = &rs->materials[m->material];
     uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1], i2 = m->indices[3 * prim + 2];
     float w = 1.0f - u - v;
     evr_v3 n0 = evr_v3_make(m->normals[3 * i0], m->normals[3 * i0 + 1], m->normals[3 * i0 + 2]);
@@ -66,21 +39,7 @@ EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, u
     if (evr_v3_dot(n, ray.dir) > 0.0f) n = evr_v3_scale(n, -1.0f);   /* two-sided */
     s->n = n;
     s->p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
-    s->albedo[0] = mat->base_color[0];
-    s->albedo[1] = mat->base_color[1];
-    s->albedo[2] = mat->base_color[2];
-    if (mat->base_texture >= 0 && m->uvs) {
-        float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
-        float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
-        float tex[4];
-        evr_texture_bilinear(&rs->textures[mat->base_texture], tu, tv, tex);
-        s->albedo[0] *= tex[0];
-        s->albedo[1] *= tex[1];
-        s->albedo[2] *= tex[2];
-    }
-    s->emissive[0] = mat->emissive[0];
-    s->emissive[1] = mat->emissive[1];
-    s->emissive[2] = mat->emissive[2];
+    evr_material_at(rs, m, i0, i1, i2, w, u, v, s);
 }
 
 /* Light arriving at p from light l at normalized segment time f: direction towards the light,
@@ -119,23 +78,13 @@ EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const ev
     return scale > 0.0f && (e_rgb[0] > 0.0f || e_rgb[1] > 0.0f || e_rgb[2] > 0.0f);
 }
 
-/* Adds an unshadowed light's Lambertian contribution (irradiance times cosine) to acc. */
-EVR_HD static inline void evr_accumulate_lambert(const evr_surface *s, evr_v3 wi, const float e_rgb[3], float acc[3])
+/* Sensor intensity of s seen along wo: the luminance of its radiance (evr_material_radiance)
+ * from the lights' sum acc (evr_material_add_light). */
+EVR_HD static inline float evr_surface_intensity(const evr_surface *s, evr_v3 wo, const float acc[3], float ambient)
 {
-    float c = evr_v3_dot(s->n, wi);
-    if (c <= 0.0f) return;
-    acc[0] += e_rgb[0] * c;
-    acc[1] += e_rgb[1] * c;
-    acc[2] += e_rgb[2] * c;
-}
-
-/* Sensor intensity: luminance of albedo * (ambient + E/pi) + emissive. */
-EVR_HD static inline float evr_surface_intensity(const evr_surface *s, const float acc[3], float ambient)
-{
-    float r = s->albedo[0] * (ambient + acc[0] / EVR_PI) + s->emissive[0];
-    float g = s->albedo[1] * (ambient + acc[1] / EVR_PI) + s->emissive[1];
-    float b = s->albedo[2] * (ambient + acc[2] / EVR_PI) + s->emissive[2];
-    return evr_luminance(r, g, b);
+    float rgb[3];
+    evr_material_radiance(s, wo, acc, ambient, rgb);
+    return evr_luminance(rgb[0], rgb[1], rgb[2]);
 }
 
 /* Where a shadow ray along wi starts, as a distance from the hit point: far enough that the

@@ -3,7 +3,9 @@
 #include "backend.h"
 #include "host_clock.h"
 #include "core/rng.h"
-#include "core/shading.h"
+#include "core/adaptive.h"
+#include "core/pixel_flow.h"
+#include "core/shade.h"
 #include "core/skip.h"
 #include "cpu/workers.h"
 #include "cpu/cpu_gi.h"
@@ -139,23 +141,20 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
     }
+    /* core/shade.h's steps light by light: each light's shadow rays as one packet */
     for (l = 0; l < rs->num_lights; l++) {
-        float e[PACKET][3];
-        evr_v3 wi[PACKET];
+        evr_light_ray lr[PACKET];
         int any = 0;
         for (i = 0; i < PACKET; i++) {
-            float dist;
             vmask[i] = 0;
-            if (!hit[i] || !evr_light_incident(rs, &rs->lights[l], fs[i], s[i].p, &wi[i], &dist, e[i]) ||
-                evr_v3_dot(wi[i], s[i].n) <= 0.0f)
-                continue;
+            if (!hit[i] || !evr_shade_light_ray(rs, l, fs[i], &s[i], &lr[i])) continue;
             vmask[i] = -1;
             any = 1;
             (*rays)++;
-            sr.org_x[i] = s[i].p.x; sr.org_y[i] = s[i].p.y; sr.org_z[i] = s[i].p.z;
-            sr.dir_x[i] = wi[i].x; sr.dir_y[i] = wi[i].y; sr.dir_z[i] = wi[i].z;
-            sr.tnear[i] = evr_shadow_tnear(&s[i], wi[i], rs->ray_eps);
-            sr.tfar[i] = dist * (1.0f - 1e-4f);
+            sr.org_x[i] = lr[i].ray.org.x; sr.org_y[i] = lr[i].ray.org.y; sr.org_z[i] = lr[i].ray.org.z;
+            sr.dir_x[i] = lr[i].ray.dir.x; sr.dir_y[i] = lr[i].ray.dir.y; sr.dir_z[i] = lr[i].ray.dir.z;
+            sr.tnear[i] = lr[i].tnear;
+            sr.tfar[i] = lr[i].tfar;
             sr.time[i] = rh.ray.time[i];
             sr.mask[i] = 0xffffffffu;
             sr.id[i] = (unsigned)i;
@@ -164,14 +163,14 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         if (!any) continue;
         rtcOccluded8(vmask, b->top, &ctx, &sr);
         for (i = 0; i < PACKET; i++)
-            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_accumulate_lambert(&s[i], wi[i], e[i], acc[i]);
+            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_shade_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), &lr[i], acc[i]);
     }
     for (i = 0; i < PACKET; i++) {
         if (!hit[i]) {   /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
             if (b->gi && valid[i] && t_hit) evr_cpu_gi_missed(&b->gi_state, xs[i], ys[i]);
             continue;
         }
-        out[i] = evr_surface_intensity(&s[i], acc[i], rs->ambient);
+        out[i] = evr_shade_intensity(rs, &s[i], evr_v3_scale(ray[i].dir, -1.0f), acc[i]);
         if (direct) direct[i] = out[i];
         if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i], fs[i], t_hit != NULL);
     }
@@ -188,24 +187,34 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
 
 static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
 
+/* core/pixel_flow.h's event sink: a tile's events. */
+struct evr_event_sink {
+    evr_event_vec *out;
+    atomic_int *failed;
+};
+
+static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+{
+    evr_event e;
+    if (!has) return 0;
+    e.t = t_us;
+    e.x = (uint16_t)x;
+    e.y = (uint16_t)y;
+    e.p = (int8_t)polarity;
+    if (!evr_event_vec_push(k->out, e)) atomic_store(k->failed, 1);
+    return 1;
+}
+
 /* One sample of pixel (x, y) (intensity at t seconds from the segment's start) through its pixel
- * model; its events go to out. */
-static void pixel_sample(cpu_backend *b, evr_pixel_state *st, const evr_pixel_params *pp, int ideal, float t, float intensity,
+ * model; its events go to out. Kept out of line with the loop inlined in it: inlined into its
+ * callers instead, GCC kept the loop as a call of many arguments (about 1% slower). */
+__attribute__((noinline)) static void pixel_sample(cpu_backend *b, evr_pixel_state *st, const evr_pixel_params *pp, int ideal, float t, float intensity,
                          int x, int y, evr_event_vec *out)
 {
-    evr_pixel_span sp;
-    float te;
-    int pol;
-    if (!evr_pixel_begin_s(st, pp, t, intensity, &sp, !ideal)) return;
-    while (evr_pixel_next_s(st, pp, &sp, &te, &pol, !ideal)) {
-        evr_event e;
-        e.t = evr_event_time_us_s(pp, b->seg->t0 + (double)te, x, y, !ideal);
-        e.x = (uint16_t)x;
-        e.y = (uint16_t)y;
-        e.p = (int8_t)pol;
-        if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
-    }
-    evr_pixel_end_s(st, &sp, !ideal);
+    struct evr_event_sink k;
+    k.out = out;
+    k.failed = &b->failed;
+    evr_pixel_sample_events(st, pp, evr_pixel_ideal_of(pp), !ideal, 1, t, intensity, b->seg->t0, x, y, &k);
 }
 
 /* A pixel of the tile in the segment's work. */
@@ -427,11 +436,6 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
  * it, eight at a time in packets (any pixels of the tile, each at its own time), then run what
  * they can through the pixel model: a sample that changed too much is held back on the pixel's
  * stack while the interval before it is refined (evr_adapt_refine). */
-typedef struct {
-    float t[EVR_ADAPT_DEPTH], intensity[EVR_ADAPT_DEPTH], hit[EVR_ADAPT_DEPTH];
-    int n;
-} adapt_stack;
-
 static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
@@ -447,7 +451,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
     const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
     evr_pixel_params pp[TILE * TILE];
-    adapt_stack stack[TILE * TILE];
+    evr_adapt_stack stack[TILE * TILE];
     float tnext[TILE * TILE];
     int act[TILE * TILE], nact = 0, j;
     out->n = 0;
@@ -455,19 +459,14 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         const int x = x0 + j % tw, y = y0 + j / tw;
         const size_t pix = (size_t)y * (size_t)w + (size_t)x;
         evr_pixel_state *st = &b->pixels[pix];
-        float speed = 0.0f;
-        int jump = 0;
         if (ideal) pp[j] = b->setup.pixel;
         else evr_pixel_params_at(&b->setup.pixel, x, y, &pp[j]);
         /* global illumination: a gather window whose photons changed forgets the pixel's last
          * gather (else its memo would keep the previous segment's indirect light) */
         if (b->gi) evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
         stack[j].n = 0;
-        if (st->started && !plan->all_min) {   /* what the last sample's rays meet in this segment */
-            evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-            speed = evr_adapt_rays_speed(rs, plan, ray, st->cache_dist, &jump);
-        }
-        tnext[j] = evr_adapt_first(ap, plan, st->started, b->next_t[pix], st->t_prev, b->phase[pix], speed, jump, dt);
+        const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+        tnext[j] = evr_adapt_start(rs, ap, plan, st, ray, b->next_t[pix], b->phase[pix], dt);
         if (tnext[j] < dt) act[nact++] = j;
     }
     while (nact > 0) {
@@ -488,44 +487,14 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 const int jj = js[i];
                 evr_pixel_state *st = &b->pixels[(size_t)ys[i] * (size_t)w + (size_t)xs[i]];
                 const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
-                adapt_stack *sk = &stack[jj];
-                float t = tnext[jj], in = intensity[i], hit = t_hit[i], mid;
+                evr_adapt_stack *sk = &stack[jj];
+                float t = tnext[jj], in = intensity[i], hit = t_hit[i], step;
+                int moving;
                 (*samples)++;
-                for (;;) {   /* the pixel's candidate sample (t, in, hit) */
-                    if (sk->n < EVR_ADAPT_DEPTH && evr_adapt_refine(ap, st, &pp[jj], t, in, &mid)) {
-                        sk->t[sk->n] = t;
-                        sk->intensity[sk->n] = in;
-                        sk->hit[sk->n] = hit;
-                        sk->n++;
-                        tnext[jj] = mid;   /* trace halfway first */
-                        break;
-                    }
-                    int moving;
-                    const float step = evr_adapt_after_sample(rs, ap, plan, st, &pp[jj], ray, hit, t, in, &moving);
-                    evr_pixel_span sp;
-                    float te;
-                    int pol;
-                    st->cache_dist = hit;
-                    if (evr_pixel_begin_s(st, &pp[jj], t, in, &sp, !ideal)) {
-                        while (evr_pixel_next_s(st, &pp[jj], &sp, &te, &pol, !ideal)) {
-                            evr_event e;
-                            e.t = evr_event_time_us_s(&pp[jj], seg->t0 + (double)te, xs[i], ys[i], !ideal);
-                            e.x = (uint16_t)xs[i];
-                            e.y = (uint16_t)ys[i];
-                            e.p = (int8_t)pol;
-                            if (!evr_event_vec_push(out, e)) atomic_store(&b->failed, 1);
-                        }
-                        evr_pixel_end_s(st, &sp, !ideal);
-                    }
-                    if (sk->n > 0) {   /* the sample held back next */
-                        sk->n--;
-                        t = sk->t[sk->n];
-                        in = sk->intensity[sk->n];
-                        hit = sk->hit[sk->n];
-                        continue;
-                    }
-                    tnext[jj] = evr_adapt_next_time(ap, t, step, dt, moving);
-                    break;
+                /* the pixel's candidate sample (t, in, hit): held back, or through the pixel model */
+                while (evr_adapt_candidate(rs, ap, plan, st, &pp[jj], ray, sk, t, in, hit, &tnext[jj], &step, &moving)) {
+                    pixel_sample(b, st, &pp[jj], ideal, t, in, xs[i], ys[i], out);
+                    if (!evr_adapt_taken(ap, sk, step, moving, dt, &t, &in, &hit, &tnext[jj])) break;
                 }
                 if (tnext[jj] < dt) act[kept++] = jj;   /* kept <= base + i: in place */
             }

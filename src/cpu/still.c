@@ -8,7 +8,7 @@
 #include "backend.h"
 #include "core/photon.h"
 #include "core/rng.h"
-#include "core/shading.h"
+#include "core/shade_hit.h"
 #include "scene/scene.h"
 
 #include <embree3/rtcore.h>
@@ -69,23 +69,24 @@ typedef struct {
     int *row_hits;
 } shade_ctx;
 
-/* Unshadowed-light sum acc (irradiance times cosine) at surface s, shadow rays included: the
- * event pipeline's direct term (sample_intensity8) one ray at a time. */
-static void direct_lights(const shade_ctx *c, const evr_surface *s, float acc[3])
+/* core/shade_hit.h's shadow-ray query: the tracer's. */
+struct evr_occlusion {
+    const evr_tracer *tr;
+};
+
+static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
 {
-    const evr_render_scene *rs = c->rs;
-    int l;
-    acc[0] = acc[1] = acc[2] = 0.0f;
-    for (l = 0; l < rs->num_lights; l++) {
-        evr_v3 wi;
-        float dist, e[3];
-        if (!evr_light_incident(rs, &rs->lights[l], 0.0f, s->p, &wi, &dist, e) || evr_v3_dot(wi, s->n) <= 0.0f) continue;
-        evr_ray r;
-        r.org = s->p;
-        r.dir = wi;
-        if (c->tr.occluded(c->tr.user, r, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), 0.0f)) continue;
-        evr_accumulate_lambert(s, wi, e, acc);
-    }
+    return o->tr->occluded(o->tr->user, r, tnear, tfar, f);
+}
+
+/* The lights' sum acc at surface s seen along wo, shadow rays included (evr_shade_direct_sum):
+ * the event pipeline's direct term one ray at a time. */
+static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, float acc[3])
+{
+    struct evr_occlusion o;
+    unsigned rays = 0;
+    o.tr = &c->tr;
+    evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
 static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_view **mat, int *inst)
@@ -114,11 +115,10 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
     int depth, dim = 0;
     out[0] = out[1] = out[2] = 0.0f;
     for (depth = 0; depth < c->p->max_bounces; depth++) {
-        float ms = evr_photon_mirror_share(m->t_diffuse, m->t_specular);
         float xi = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
         float u1 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
         float u2 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
-        evr_v3 wo = xi < ms ? evr_v3_norm(evr_mirror_dir(dir_in, s.n)) : evr_cosine_dir(s.n, u1, u2);
+        evr_v3 wo = evr_material_bounce_dir(&s, evr_material_path_event(m, &s, dir_in, xi), dir_in, u1, u2);
         beta[0] *= s.albedo[0];
         beta[1] *= s.albedo[1];
         beta[2] *= s.albedo[2];
@@ -134,11 +134,13 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
         r.org = s.p;
         r.dir = wo;
         if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), &y, &my, NULL)) return;
-        float acc[3], kd = (1.0f - evr_photon_mirror_share(my->t_diffuse, my->t_specular)) / EVR_PI;
-        direct_lights(c, &y, acc);
-        out[0] += beta[0] * (y.emissive[0] + y.albedo[0] * kd * acc[0]);
-        out[1] += beta[1] * (y.emissive[1] + y.albedo[1] * kd * acc[1]);
-        out[2] += beta[2] * (y.emissive[2] + y.albedo[2] * kd * acc[2]);
+        float acc[3], em[3], kd = evr_material_diffuse_k(my);
+        const evr_v3 back = evr_v3_scale(wo, -1.0f);
+        direct_lights(c, &y, back, acc);
+        evr_material_emission(&y, back, em);
+        out[0] += beta[0] * (em[0] + y.albedo[0] * kd * acc[0]);
+        out[1] += beta[1] * (em[1] + y.albedo[1] * kd * acc[1]);
+        out[2] += beta[2] * (em[2] + y.albedo[2] * kd * acc[2]);
         s = y;
         m = my;
         dir_in = wo;
@@ -164,11 +166,10 @@ static void shade_row(shade_ctx *c, int y)
         o->instance[i] = -1;
         if (!surface_of(c, ray, 0.0f, &s, &mat, &inst)) continue;
         o->instance[i] = inst;
-        direct_lights(c, &s, acc);
-        for (k = 0; k < 3; k++) {
-            dir[k] = s.albedo[k] * (rs->ambient + acc[k] / EVR_PI) + s.emissive[k];
-            rgb[k] = dir[k];
-        }
+        const evr_v3 wo = evr_v3_scale(ray.dir, -1.0f);
+        direct_lights(c, &s, wo, acc);
+        evr_material_radiance(&s, wo, acc, rs->ambient, dir);
+        for (k = 0; k < 3; k++) rgb[k] = dir[k];
         if (p->gi == EVR_GI_PHOTON) {
             float e[3], ind[3];
             float dist = evr_v3_len(evr_v3_sub(s.p, ray.org));

@@ -25,7 +25,8 @@ extern "C" {
 #include "prep/photon_emitters.h"
 }
 #include "core/rng.h"
-#include "core/shading.h"
+#include "core/shade_hit.h"
+#include "core/pixel_flow.h"
 #include "core/skip.h"
 #include "core/adaptive.h"
 #include "cuda/gpu_traverse.h"
@@ -131,6 +132,26 @@ __device__ __forceinline__ unsigned warp_append(unsigned *count, bool want)
 
 #include "cuda/gpu_gi.cuh"
 
+/* core/shade_hit.h's shadow-ray query: our traversal in the launch's node layout (a constant
+ * once inlined into a kernel of that layout); hit is scratch space the query may write. */
+struct evr_occlusion {
+    const kernel_args *a;
+    int layout;
+    evr_gpu_hit *hit;
+};
+
+EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
+{
+#ifdef __CUDA_ARCH__
+    if (o->layout == EVR_GPU_LAYOUT_CW8)
+        return gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
+    return gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
+#else
+    (void)o, (void)r, (void)tnear, (void)tfar, (void)f;
+    return 0;
+#endif
+}
+
 /* Direct light of one sample, as sample_intensity in cpu/cpu_backend.c, with our traversal; 0 on a
  * miss (returns false), else the surface met, its instance and the ray's origin for the gather. */
 template <int LAYOUT>
@@ -170,21 +191,11 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     *cam_org = ray.org;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
     evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, ray, hit.t, s);
-    float acc[3] = {0.0f, 0.0f, 0.0f};
-    for (int l = 0; l < rs->num_lights; l++) {
-        evr_v3 wi;
-        float dist, e[3];
-        if (!evr_light_incident(rs, &rs->lights[l], f, s->p, &wi, &dist, e)) continue;
-        if (evr_v3_dot(wi, s->n) <= 0.0f) continue;
-        (*rays)++;
-        evr_ray sr;
-        sr.org = s->p;
-        sr.dir = wi;
-        if (gpu_trace<LAYOUT>(&a.view, rs, sr, evr_shadow_tnear(s, wi, rs->ray_eps), dist * (1.0f - 1e-4f), f, 1, &hit))
-            continue;
-        evr_accumulate_lambert(s, wi, e, acc);
-    }
-    *direct = evr_surface_intensity(s, acc, rs->ambient);
+    struct evr_occlusion occ;
+    occ.a = &a;
+    occ.layout = LAYOUT;
+    occ.hit = &hit;
+    *direct = evr_shade_hit(rs, s, evr_v3_scale(ray.dir, -1.0f), f, &occ, rays);
     return true;
 }
 
@@ -264,41 +275,50 @@ __device__ __forceinline__ float pixel_begin(const kernel_args &a, bool active, 
     return a.phase[pix];
 }
 
-/* One sample (intensity at t seconds from the segment's start) through the pixel model; its
- * events are appended with warp-aggregated atomics. Every lane of the warp calls it together;
- * live: this lane has a sample. */
+/* core/pixel_flow.h's event sink: the segment's event keys, appended with warp-aggregated
+ * atomics (every lane of the warp pushes together). */
+struct evr_event_sink {
+    const kernel_args *a;
+    unsigned lane;
+};
+
+EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+{
+#ifdef __CUDA_ARCH__
+    const kernel_args &a = *k->a;
+    unsigned mask = __ballot_sync(0xffffffffu, has);
+    if (!mask) return 0;
+    unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
+    if (k->lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
+    base = __shfl_sync(0xffffffffu, base, leader);
+    if (has) {
+        unsigned idx = base + (unsigned)__popc(mask & ((1u << k->lane) - 1u));
+        if (t_us < a.base_us || t_us - a.base_us >= a.span_us) atomicAdd(&a.rays[KEY_RANGE], 1ull);   /* collect fails */
+        else if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, polarity);   /* else: re-run */
+    }
+    return 1;
+#else
+    (void)k, (void)has, (void)t_us, (void)x, (void)y, (void)polarity;
+    return 0;
+#endif
+}
+
+/* One sample (intensity at t seconds from the segment's start) through the pixel model
+ * (core/pixel_flow.h); its events are appended with warp-aggregated atomics. Every lane of the
+ * warp calls it together; live: this lane has a sample. */
 template <int SENSOR>
 __device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
                                                 bool live, float t, float intensity, int x, int y, unsigned lane)
 {
-    evr_pixel_span sp;
-    int more = 0;
-    if (live)
-        more = SENSOR ? evr_pixel_begin_s(&st, &own, t, intensity, &sp, 1)
-                      : evr_pixel_begin_ideal(&st, a.log_floor, t, intensity, &sp);
-    const int began = more;
-    for (;;) {
-        float te = 0.0f;
-        int pol = 0, has = 0;
-        if (more) {
-            has = SENSOR ? evr_pixel_next_s(&st, &own, &sp, &te, &pol, 1)
-                         : evr_pixel_next_ideal(&st, a.pos_thres, a.neg_thres, a.refractory, &sp, &te, &pol);
-            more = has;
-        }
-        unsigned mask = __ballot_sync(0xffffffffu, has);
-        if (!mask) break;
-        unsigned leader = (unsigned)__ffs(mask) - 1u, base = 0;
-        if (lane == leader) base = atomicAdd(a.count, (unsigned)__popc(mask));
-        base = __shfl_sync(0xffffffffu, base, leader);
-        if (has) {
-            unsigned idx = base + (unsigned)__popc(mask & ((1u << lane) - 1u));
-            long long t_us = SENSOR ? evr_event_time_us_s(&own, a.t0 + (double)te, x, y, 1)
-                                    : llround((a.t0 + (double)te) * 1e6);
-            if (t_us < a.base_us || t_us - a.base_us >= a.span_us) atomicAdd(&a.rays[KEY_RANGE], 1ull);   /* collect fails */
-            else if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, pol);   /* else: re-run */
-        }
-    }
-    if (began) evr_pixel_end_s(&st, &sp, SENSOR);
+    evr_pixel_ideal id;   /* the ideal kernel's parameters, from the launch's arguments */
+    id.log_floor = a.log_floor;
+    id.pos_thres = a.pos_thres;
+    id.neg_thres = a.neg_thres;
+    id.refractory = a.refractory;
+    struct evr_event_sink k;
+    k.a = &a;
+    k.lane = lane;
+    evr_pixel_sample_events(&st, &own, id, SENSOR, live, t, intensity, a.t0, x, y, &k);
 }
 
 /* The same at normalized segment time f (uniform sampling). */
@@ -545,14 +565,11 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
     if (active) {
         load_state<SENSOR>(a, pix, st);
         if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);
-        float speed = 0.0f;
-        int jump = 0;
-        if (st.started && !d.plan->all_min) speed = evr_adapt_rays_speed(&a.rs, d.plan, ray0, st.cache_dist, &jump);
-        t = evr_adapt_first(&d.p, d.plan, st.started, d.next_in[pix], st.t_prev, a.phase[pix], speed, jump, a.dt);
+        t = evr_adapt_start(&a.rs, &d.p, d.plan, &st, ray0, d.next_in[pix], a.phase[pix], a.dt);
         need = t < a.dt;
     }
-    float sk_t[EVR_ADAPT_DEPTH], sk_i[EVR_ADAPT_DEPTH], sk_h[EVR_ADAPT_DEPTH];
-    int n = 0;
+    evr_adapt_stack sk;
+    sk.n = 0;
     float ct = 0.0f, ci = 0.0f, ch = INFINITY;   /* the candidate sample: time, intensity, hit distance */
     bool cand = false;
     unsigned rays = 0, taken = 0;
@@ -569,35 +586,19 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
             taken++;
         }
         bool consume = false;
-        float step = 0.0f, mid = 0.0f;
+        float step = 0.0f;
         int moving = 0;
-        if (cand) {
-            if (n < EVR_ADAPT_DEPTH && evr_adapt_refine(&d.p, &st, &own, ct, ci, &mid)) {
-                sk_t[n] = ct;
-                sk_i[n] = ci;
-                sk_h[n] = ch;
-                n++;
-                t = mid;   /* trace halfway first */
+        if (cand) {   /* held back (trace t first) or taken */
+            consume = evr_adapt_candidate(&a.rs, &d.p, d.plan, &st, &own, ray0, &sk, ct, ci, ch, &t, &step, &moving);
+            if (!consume) {
                 need = true;
                 cand = false;
-            } else {
-                consume = true;
-                step = evr_adapt_after_sample(&a.rs, &d.p, d.plan, &st, &own, ray0, ch, ct, ci, &moving);
-                st.cache_dist = ch;
             }
         }
         pixel_sample_at<SENSOR>(a, st, own, consume, ct, ci, x, y, lane);
-        if (consume) {
-            if (n > 0) {   /* the sample held back next */
-                n--;
-                ct = sk_t[n];
-                ci = sk_i[n];
-                ch = sk_h[n];
-            } else {
-                cand = false;
-                t = evr_adapt_next_time(&d.p, ct, step, a.dt, moving);
-                need = t < a.dt;
-            }
+        if (consume && !evr_adapt_taken(&d.p, &sk, step, moving, a.dt, &ct, &ci, &ch, &t)) {
+            cand = false;   /* none held back: t is the next to trace */
+            need = t < a.dt;
         }
     }
     if (active) {

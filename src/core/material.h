@@ -1,0 +1,212 @@
+/* Materials: everything a surface's material decides at a hit, written once for direct light
+ * (core/shading.h, core/shade.h), the photon pass (core/photon.h) and the path tracer
+ * (src/cpu/still.c):
+ *   - the material record at the hit (evr_material_at: base colour times texture, emission),
+ *   - emission (evr_material_emission),
+ *   - the BSDF for a light direction (evr_material_add_light, then evr_material_radiance),
+ *   - the photon pass's stay / diffuse / mirror decision (evr_material_photon_event), the path
+ *     tracer's diffuse / mirror choice (evr_material_path_event) and the bounce directions,
+ *   - the diffuse share that turns an irradiance estimate into radiance (evr_material_diffuse_k).
+ * The model today is Lambert (albedo / pi) plus a mirror share for indirect light. A new model
+ * (glTF metallic-roughness: GGX/Smith with Fresnel, transmission) fills in these functions and
+ * adds its parameters to evr_material_view (core/render_scene.h) and to the record in
+ * evr_surface; the callers pass the shading frame (evr_surface's n), wo and wi already.
+ * Floating-point expressions here are the ones the golden events were made with: keep their
+ * order when editing (the GPU must not gain or lose fused multiply-adds). */
+#ifndef EVR_CORE_MATERIAL_H
+#define EVR_CORE_MATERIAL_H
+
+#include "core/render_scene.h"
+
+#define EVR_PI 3.14159265358979f
+
+/* A surface point as shading sees it: its shading frame (position, normal) and the hit's
+ * material record (the material evaluated there, textures applied). */
+typedef struct {
+    evr_v3 p;          /* world position */
+    evr_v3 n;          /* world shading normal, facing the incoming ray */
+    float albedo[3];
+    float emissive[3];
+} evr_surface;
+
+/* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
+EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v, float out[4])
+{
+    float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    float ax = x - fx, ay = y - fy;
+    int x0 = (int)fx % t->width, y0 = (int)fy % t->height;
+    if (x0 < 0) x0 += t->width;
+    if (y0 < 0) y0 += t->height;
+    int x1 = (x0 + 1) % t->width, y1 = (y0 + 1) % t->height;
+    const float *p00 = t->rgba + 4 * ((long)y0 * t->width + x0), *p10 = t->rgba + 4 * ((long)y0 * t->width + x1);
+    const float *p01 = t->rgba + 4 * ((long)y1 * t->width + x0), *p11 = t->rgba + 4 * ((long)y1 * t->width + x1);
+    int c;
+    for (c = 0; c < 4; c++)
+        out[c] = (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
+}
+
+/* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m. */
+EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m, uint32_t i0, uint32_t i1,
+                                          uint32_t i2, float w, float u, float v, evr_surface *s)
+{
+    const evr_material_view *mat = &rs->materials[m->material];
+    s->albedo[0] = mat->base_color[0];
+    s->albedo[1] = mat->base_color[1];
+    s->albedo[2] = mat->base_color[2];
+    if (mat->base_texture >= 0 && m->uvs) {
+        float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
+        float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
+        float tex[4];
+        evr_texture_bilinear(&rs->textures[mat->base_texture], tu, tv, tex);
+        s->albedo[0] *= tex[0];
+        s->albedo[1] *= tex[1];
+        s->albedo[2] *= tex[2];
+    }
+    s->emissive[0] = mat->emissive[0];
+    s->emissive[1] = mat->emissive[1];
+    s->emissive[2] = mat->emissive[2];
+}
+
+/* Radiance s emits towards wo (both sides emit). */
+EVR_HD static inline void evr_material_emission(const evr_surface *s, evr_v3 wo, float out[3])
+{
+    (void)wo;
+    out[0] = s->emissive[0];
+    out[1] = s->emissive[1];
+    out[2] = s->emissive[2];
+}
+
+/* ---- direct light: the BSDF for a light direction ---- */
+
+/* Adds one unshadowed light's contribution at s, seen along wo, arriving along wi with
+ * irradiance e_rgb (on a surface facing it), to acc. Lambert: acc sums irradiance times cosine;
+ * the BSDF's albedo / pi is applied once, in evr_material_radiance. */
+EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo, evr_v3 wi, const float e_rgb[3],
+                                                 float acc[3])
+{
+    (void)wo;
+    float c = evr_v3_dot(s->n, wi);
+    if (c <= 0.0f) return;
+    acc[0] += e_rgb[0] * c;
+    acc[1] += e_rgb[1] * c;
+    acc[2] += e_rgb[2] * c;
+}
+
+/* Radiance leaving s towards wo (RGB) from the lights' sum acc (evr_material_add_light), the
+ * ambient irradiance (a fraction of pi) and its emission. */
+EVR_HD static inline void evr_material_radiance(const evr_surface *s, evr_v3 wo, const float acc[3], float ambient,
+                                                float rgb[3])
+{
+    (void)wo;
+    rgb[0] = s->albedo[0] * (ambient + acc[0] / EVR_PI) + s->emissive[0];
+    rgb[1] = s->albedo[1] * (ambient + acc[1] / EVR_PI) + s->emissive[1];
+    rgb[2] = s->albedo[2] * (ambient + acc[2] / EVR_PI) + s->emissive[2];
+}
+
+/* ---- indirect light: photon thresholds, decisions and bounce directions ---- */
+
+/* glTF metallic-roughness to the photon thresholds: reflectance R = max(base colour) clamped to
+ * [0.05, 0.95]; mirror = metallic * (1 - roughness);
+ * t_diffuse = 1 - R, t_specular = t_diffuse + R * (1 - mirror). */
+EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic, float roughness,
+                                                  float *t_diffuse, float *t_specular)
+{
+    float r = fmaxf(base_color[0], fmaxf(base_color[1], base_color[2]));
+    float m = fminf(fmaxf(metallic, 0.0f), 1.0f) * (1.0f - fminf(fmaxf(roughness, 0.0f), 1.0f));
+    r = fminf(fmaxf(r, 0.05f), 0.95f);
+    *t_diffuse = 1.0f - r;
+    *t_specular = *t_diffuse + r * (1.0f - m);
+}
+
+/* Share of the reflected light that is a mirror reflection. */
+EVR_HD static inline float evr_photon_mirror_share(float t_diffuse, float t_specular)
+{
+    float refl = 1.0f - t_diffuse;
+    return refl > 0.0f ? fminf(fmaxf((1.0f - t_specular) / refl, 0.0f), 1.0f) : 0.0f;
+}
+
+enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_DIFFUSE = 1, EVR_PHOTON_MIRROR = 2, EVR_PHOTON_ABSORB = 3 };
+
+/* The decision at a hit for random xi in [0, 1). *weight multiplies the flux: stay 1/t_diffuse,
+ * bounce 1/(1 - t_diffuse) (times the albedo, which the caller applies), 1 for a bounce when
+ * staying is not allowed. ABSORB only when nothing else is possible. */
+EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi, int allow_stay, float *weight)
+{
+    float td = fminf(fmaxf(t_diffuse, 0.0f), 1.0f), ts = fminf(fmaxf(t_specular, td), 1.0f);
+    if (allow_stay) {
+        if (xi < td) {
+            *weight = 1.0f / td;
+            return EVR_PHOTON_STAY;
+        }
+        if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+        *weight = 1.0f / (1.0f - td);
+        return xi < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
+    }
+    if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+    *weight = 1.0f;
+    /* xi spread over the bounce options only */
+    return td + xi * (1.0f - td) < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
+}
+
+/* Orthonormal basis around unit n (Duff et al. 2017). */
+EVR_HD static inline void evr_onb(evr_v3 n, evr_v3 *t, evr_v3 *b)
+{
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z), c = n.x * n.y * a;
+    *t = evr_v3_make(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    *b = evr_v3_make(c, s + n.y * n.y * a, -n.y);
+}
+
+/* Cosine-distributed direction around unit n from (u1, u2) in [0, 1)^2 (pdf cos / pi). */
+EVR_HD static inline evr_v3 evr_cosine_dir(evr_v3 n, float u1, float u2)
+{
+    evr_v3 t, b;
+    float r = sqrtf(u1), phi = 6.28318530718f * u2;
+    float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
+    evr_onb(n, &t, &b);
+    return evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
+}
+
+/* Mirror direction of incoming d about unit n. */
+EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
+{
+    return evr_v3_sub(d, evr_v3_scale(n, 2.0f * evr_v3_dot(d, n)));
+}
+
+
+/* The photon pass's decision at a hit of material mat for random xi in [0, 1) (d_in: the
+ * photon's direction of travel): evr_photon_scatter's event and *weight. */
+EVR_HD static inline int evr_material_photon_event(const evr_material_view *mat, const evr_surface *s, evr_v3 d_in,
+                                                   float xi, int allow_stay, float *weight)
+{
+    (void)s;
+    (void)d_in;
+    return evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, allow_stay, weight);
+}
+
+/* The path tracer's choice at a hit of material mat for random xi in [0, 1): EVR_PHOTON_MIRROR
+ * with the mirror share's odds, else EVR_PHOTON_DIFFUSE (it never stays). */
+EVR_HD static inline int evr_material_path_event(const evr_material_view *mat, const evr_surface *s, evr_v3 d_in, float xi)
+{
+    (void)s;
+    (void)d_in;
+    float ms = evr_photon_mirror_share(mat->t_diffuse, mat->t_specular);
+    return xi < ms ? EVR_PHOTON_MIRROR : EVR_PHOTON_DIFFUSE;
+}
+
+/* The direction a bounce of kind ev (EVR_PHOTON_DIFFUSE or EVR_PHOTON_MIRROR) leaves s in, for a
+ * ray travelling along d_in; (u1, u2) in [0, 1)^2 pick the diffuse direction. */
+EVR_HD static inline evr_v3 evr_material_bounce_dir(const evr_surface *s, int ev, evr_v3 d_in, float u1, float u2)
+{
+    return ev == EVR_PHOTON_DIFFUSE ? evr_cosine_dir(s->n, u1, u2) : evr_v3_norm(evr_mirror_dir(d_in, s->n));
+}
+
+/* What multiplies the albedo and an irradiance for the indirect (diffusely reflected) radiance
+ * leaving a surface of material mat: the diffuse share over pi. */
+EVR_HD static inline float evr_material_diffuse_k(const evr_material_view *mat)
+{
+    return (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
+}
+
+#endif

@@ -1,0 +1,214 @@
+/* The per-pixel flow of src/core that every backend runs: the event loop with its sink
+ * (core/pixel_flow.h), adaptive sampling's state machine (core/adaptive.h) and the shading of a
+ * hit with its shadow-ray query (core/shade_hit.h), each driven here by a sink and an occlusion
+ * query of the test's own. */
+#include "check.h"
+#include "core/adaptive.h"
+#include "core/pixel_flow.h"
+#include "core/shade_hit.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct { long long t; int x, y, p; } ev_t;
+
+struct evr_event_sink {
+    ev_t ev[512];
+    int n, pushes;
+};
+
+static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+{
+    k->pushes++;
+    if (!has) return 0;
+    if (k->n < 512) {
+        k->ev[k->n].t = t_us;
+        k->ev[k->n].x = x;
+        k->ev[k->n].y = y;
+        k->ev[k->n].p = polarity;
+    }
+    k->n++;
+    return 1;
+}
+
+struct evr_occlusion {
+    int blocked, calls;
+    evr_ray last;
+    float tnear, tfar;
+};
+
+static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
+{
+    (void)f;
+    o->calls++;
+    o->last = r;
+    o->tnear = tnear;
+    o->tfar = tfar;
+    return o->blocked;
+}
+
+/* The loop as the backends wrote it before it moved to core: begin, next until none, end. */
+static int reference_events(evr_pixel_state *st, const evr_pixel_params *p, int sensor, float t, float in, double t0,
+                            int x, int y, ev_t *out)
+{
+    evr_pixel_span sp;
+    float te;
+    int pol, n = 0;
+    if (!evr_pixel_begin_s(st, p, t, in, &sp, sensor)) return 0;
+    while (evr_pixel_next_s(st, p, &sp, &te, &pol, sensor)) {
+        out[n].t = evr_event_time_us_s(p, t0 + (double)te, x, y, sensor);
+        out[n].p = pol;
+        n++;
+    }
+    evr_pixel_end_s(st, &sp, sensor);
+    return n;
+}
+
+static void test_event_loop(void)
+{
+    evr_pixel_params run = {.pos_thres = 0.2f, .neg_thres = 0.25f, .refractory = 1e-4f, .log_floor = 1e-3f,
+                            .full_intensity = 4.0f, .seed = 7};
+    int sensor;
+    for (sensor = 0; sensor <= 1; sensor++) {
+        evr_pixel_params p;
+        if (sensor) {
+            run.sigma_thres = 0.03f;
+            run.cutoff_hz = 200.0f;
+            run.shot_rate = 5.0f;
+            run.time_res_us = 10;
+        }
+        evr_pixel_params_at(&run, 3, 4, &p);
+        evr_pixel_state a, b;
+        struct evr_event_sink k;
+        ev_t ref[512];
+        int s, total = 0;
+        evr_pixel_reset(&a);
+        evr_pixel_reset(&b);
+        for (s = 0; s < 200; s++) {
+            const float t = 0.001f * (float)s, in = 1.0f + 0.9f * sinf(40.0f * t);
+            const int n = reference_events(&a, &p, sensor, t, in, 2.0, 3, 4, ref);
+            memset(&k, 0, sizeof k);
+            evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 1, t, in, 2.0, 3, 4, &k);
+            CHECK(k.n == n);
+            CHECK(k.pushes == n + 1);   /* one push with none ends the loop */
+            for (int i = 0; i < n && i < k.n; i++) {
+                CHECK(k.ev[i].t == ref[i].t && k.ev[i].p == ref[i].p);
+                CHECK(k.ev[i].x == 3 && k.ev[i].y == 4);
+            }
+            CHECK(memcmp(&a, &b, sizeof a) == 0);
+            total += n;
+        }
+        CHECK(total > 10);
+        /* a lane without a sample: the state is untouched, the sink is asked once */
+        memset(&k, 0, sizeof k);
+        evr_pixel_state c = b;
+        evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 0, 0.3f, 9.0f, 2.0, 3, 4, &k);
+        CHECK(k.n == 0 && k.pushes == 1);
+        CHECK(memcmp(&b, &c, sizeof b) == 0);
+    }
+}
+
+/* A step in intensity at t = 0.3 s: adaptive sampling's state machine refines the interval that
+ * straddles it down to about min_dt, and the pixel model sees its samples in time order. */
+static void test_adapt_machine(void)
+{
+    evr_render_scene rs;
+    evr_adapt_plan plan;
+    evr_adapt_params ap;
+    evr_pixel_params p = {.pos_thres = 0.2f, .neg_thres = 0.2f, .log_floor = 1e-3f};
+    evr_pixel_state st;
+    evr_adapt_stack sk;
+    struct evr_event_sink k;
+    evr_ray ray0;
+    const float seg = 1.0f;
+    float t, last = -1.0f;
+    int traced = 0, ok_order = 1;
+    memset(&rs, 0, sizeof rs);
+    memset(&plan, 0, sizeof plan);
+    memset(&k, 0, sizeof k);
+    ap.frac = 0.25f;
+    ap.min_dt = 1e-3f;
+    ap.max_dt = 0.1f;
+    ray0.org = evr_v3_make(0, 0, 0);
+    ray0.dir = evr_v3_make(0, 0, 1);
+    evr_pixel_reset(&st);
+    sk.n = 0;
+    t = evr_adapt_start(&rs, &ap, &plan, &st, ray0, 0.0f, 0.5f, seg);
+    CHECK_NEAR(t, 0.5e-3, 1e-9);   /* a pixel's very first sample: its phase times min_dt */
+    while (t < seg && traced < 1000) {
+        float in = t < 0.3f ? 1.0f : 2.0f, hit = INFINITY, step = 0.0f;
+        int moving = 0;
+        traced++;
+        while (evr_adapt_candidate(&rs, &ap, &plan, &st, &p, ray0, &sk, t, in, hit, &t, &step, &moving)) {
+            if (t < last) ok_order = 0;
+            last = t;
+            evr_pixel_sample_events(&st, &p, evr_pixel_ideal_of(&p), 0, 1, t, in, 0.0, 0, 0, &k);
+            if (!evr_adapt_taken(&ap, &sk, step, moving, seg, &t, &in, &hit, &t)) break;
+        }
+    }
+    CHECK(ok_order);
+    CHECK(sk.n == 0);
+    CHECK(traced > 10 && traced < 100);
+    CHECK(k.n == 3);   /* ln 2 = 0.69: three ON thresholds of 0.2 */
+    for (int i = 0; i < k.n && i < 3; i++) {
+        CHECK(k.ev[i].p == 1);
+        CHECK(fabs((double)k.ev[i].t * 1e-6 - 0.3) < 2.0 * ap.min_dt);
+    }
+}
+
+/* One point light straight above a white patch: E = I / d^2 at normal incidence. */
+static void test_shade_hit(void)
+{
+    evr_render_scene rs;
+    evr_light_view light;
+    evr_surface s;
+    struct evr_occlusion o;
+    const evr_v3 wo = evr_v3_make(0, 0, 1);
+    unsigned rays = 0;
+    memset(&rs, 0, sizeof rs);
+    memset(&light, 0, sizeof light);
+    memset(&o, 0, sizeof o);
+    light.type = 0;
+    light.track = -1;
+    light.color[0] = light.color[1] = light.color[2] = 8.0f;
+    light.pos = evr_v3_make(0, 0, 2);
+    rs.lights = &light;
+    rs.num_lights = 1;
+    rs.ambient = 0.1f;
+    rs.ray_eps = 1e-3f;
+    s.p = evr_v3_make(0, 0, 0);
+    s.n = evr_v3_make(0, 0, 1);
+    s.albedo[0] = s.albedo[1] = s.albedo[2] = 0.5f;
+    s.emissive[0] = s.emissive[1] = s.emissive[2] = 0.0f;
+    const float lit = evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays);
+    CHECK_NEAR(lit, 0.5 * (0.1 + 2.0 / EVR_PI), 1e-5);
+    CHECK(rays == 1 && o.calls == 1);
+    CHECK_NEAR(o.last.dir.z, 1.0, 1e-6);
+    CHECK_NEAR(o.tnear, 1e-3, 1e-9);
+    CHECK_NEAR(o.tfar, 2.0 * (1.0 - 1e-4), 1e-6);
+    o.blocked = 1;
+    CHECK_NEAR(evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays), 0.5 * 0.1, 1e-6);
+    /* the light behind the surface: no shadow ray */
+    s.n = evr_v3_make(0, 0, -1);
+    o.calls = 0;
+    CHECK_NEAR(evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays), 0.5 * 0.1, 1e-6);
+    CHECK(o.calls == 0);
+    /* the packet form (the CPU backend's steps light by light) gives the same bits */
+    {
+        evr_light_ray lr;
+        float acc[3] = {0.0f, 0.0f, 0.0f};
+        s.n = evr_v3_make(0, 0.6f, 0.8f);
+        o.blocked = 0;
+        CHECK(evr_shade_light_ray(&rs, 0, 0.0f, &s, &lr));
+        evr_shade_add_light(&s, wo, &lr, acc);
+        CHECK(evr_shade_intensity(&rs, &s, wo, acc) == evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays));
+    }
+}
+
+int main(void)
+{
+    test_event_loop();
+    test_adapt_machine();
+    test_shade_hit();
+    return check_report("test_flow");
+}
