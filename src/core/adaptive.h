@@ -23,7 +23,7 @@
  * nothing moving reaches samples every max_dt. Every sample goes through the pixel model
  * (core/pixel.h) as uniform sampling's do, so noise and leak (continuous-time processes inside
  * the model) are unchanged by longer spans. Both backends call these functions; the host fills an
- * evr_adapt_plan per segment (evr_adapt_plan_build, src/skip_plan.c). */
+ * evr_adapt_plan per segment (evr_adapt_plan_build, src/prep/skip_plan.c). */
 #ifndef EVR_CORE_ADAPTIVE_H
 #define EVR_CORE_ADAPTIVE_H
 

@@ -1,4 +1,4 @@
-/* Image-space photon mapping (issue 5): every per-photon and per-pixel decision, written once
+/* Image-space photon mapping: every per-photon and per-pixel decision, written once
  * for the CPU and for nvcc (EVR_HD, plain C, no allocation). The loops that trace rays live in
  * the backends (src/cpu/photon_pass.c on the CPU); the material's part (glTF metallic/roughness
  * -> t_diffuse, t_specular, the stay / diffuse / mirror decision, the bounce directions) is in

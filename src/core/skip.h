@@ -10,7 +10,7 @@
  * sample, gives identical events (noise included). A pixel that must trace traces its first
  * sample; when that sample's rays meet nothing moving in the segment, every later sample would
  * see the same triangles, so it keeps that intensity for the rest of the segment ("settles") and
- * its cache is clean. The host fills an evr_skip_plan per segment (src/skip_plan.c); both
+ * its cache is clean. The host fills an evr_skip_plan per segment (src/prep/skip_plan.c); both
  * backends run these functions per pixel. */
 #ifndef EVR_CORE_SKIP_H
 #define EVR_CORE_SKIP_H

@@ -1,5 +1,33 @@
 #include "io/file_commit.h"
 
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+char *evr_file_tmp_name(const char *path)
+{
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (tmp) {
+        memcpy(tmp, path, len);
+        memcpy(tmp + len, ".tmp", 5);
+    }
+    return tmp;
+}
+
+FILE *evr_file_create(const char *tmp, const char *who, evr_error *err)
+{
+    FILE *f = fopen(tmp, "wb");
+    if (!f) snprintf(err->msg, sizeof err->msg, "%s: cannot create %s: %s", who, tmp, strerror(errno));
+    return f;
+}
+
+void evr_file_discard(FILE *f, const char *tmp)
+{
+    fclose(f);
+    remove(tmp);
+}
+
 evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st, const char *who, evr_error *err)
 {
     int closed = fclose(f) == 0;

@@ -21,6 +21,7 @@
  * error stack is turned into the message instead. */
 #include "io/event_formats.h"
 #include "io/chunk_compress.h"
+#include "io/file_commit.h"
 #include "par_pool.h"
 
 #include <hdf5.h>
@@ -618,7 +619,6 @@ fail:
 evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
 {
     h5_writer *w;
-    size_t len;
     herr_t r = -1;
     const char *what = "cannot create";
 
@@ -628,7 +628,6 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         return EVR_ERR_ARG;
     }
     w = calloc(1, sizeof *w);
-    len = strlen(path);
     if (w) {
         /* a batch gives every thread a chunk of each column; about 40 MB with 16 threads */
         int threads = evr_par_threads(H5W_MAX_THREADS);
@@ -638,8 +637,8 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         w->batch = threads < H5W_MIN_BATCH ? H5W_MIN_BATCH : (size_t)threads;
         w->cap_stage = w->batch * H5W_CHUNK;
         for (int c = 0; c < H5W_COLUMNS; c++) room += column_room(w, c);
-        w->path = malloc(len + 1);
-        w->tmp = malloc(len + 5);
+        w->path = strdup(path);
+        w->tmp = evr_file_tmp_name(path);
         for (int i = 0; i < 2; i++) {
             w->set[i].stage = malloc(w->cap_stage * sizeof *w->set[i].stage);
             w->set[i].jobs = malloc(H5W_COLUMNS * w->batch * sizeof *w->set[i].jobs);
@@ -654,9 +653,6 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
         return EVR_ERR_NOMEM;
     }
-    memcpy(w->path, path, len + 1);
-    memcpy(w->tmp, path, len);
-    memcpy(w->tmp + len, ".tmp", 5);
 
     H5E_BEGIN_TRY {
         int32_t width = meta->width, height = meta->height;

@@ -239,8 +239,7 @@ static evr_status npy_flush(evr_event_writer *base, evr_error *err)
 static void npy_abort(evr_event_writer *base)
 {
     npy_writer *w = (npy_writer *)base;
-    fclose(w->f);
-    remove(w->tmp);
+    evr_file_discard(w->f, w->tmp);
     free_writer(w);
 }
 
@@ -259,7 +258,6 @@ static evr_status npy_finish(evr_event_writer *base, int64_t duration_us, evr_er
 evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
 {
     npy_writer *w;
-    size_t len;
     char h[256];
     (void)meta;
     *out = NULL;
@@ -267,11 +265,10 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
         snprintf(err->msg, sizeof err->msg, "npy writer: no path given");
         return EVR_ERR_ARG;
     }
-    len = strlen(path);
     w = calloc(1, sizeof *w);
     if (w) {
-        w->path = malloc(len + 1);
-        w->tmp = malloc(len + 5);
+        w->path = strdup(path);
+        w->tmp = evr_file_tmp_name(path);
         w->buf = malloc((size_t)NPY_BUFFER_RECORDS * NPY_RECORD);
         w->pool = evr_par_pool_new(evr_par_threads(NPY_THREADS));
     }
@@ -280,20 +277,15 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
         snprintf(err->msg, sizeof err->msg, "npy writer: out of memory");
         return EVR_ERR_NOMEM;
     }
-    memcpy(w->path, path, len + 1);
-    memcpy(w->tmp, path, len);
-    memcpy(w->tmp + len, ".tmp", 5);
     w->header_len = build_header(h, sizeof h, 0, 0);
-    w->f = fopen(w->tmp, "wb");
+    w->f = evr_file_create(w->tmp, "npy writer", err);
     if (!w->f) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot create %s: %s", w->tmp, strerror(errno));
         free_writer(w);
         return EVR_ERR_IO;
     }
     if (fwrite(h, 1, w->header_len, w->f) != w->header_len) {
         cannot_write(w, err);
-        fclose(w->f);
-        remove(w->tmp);
+        evr_file_discard(w->f, w->tmp);
         free_writer(w);
         return EVR_ERR_IO;
     }

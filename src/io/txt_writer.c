@@ -4,7 +4,6 @@
 #include "io/event_formats.h"
 #include "io/file_commit.h"
 
-#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -106,8 +105,7 @@ static evr_status txt_flush(evr_event_writer *base, evr_error *err)
 static void txt_abort(evr_event_writer *base)
 {
     txt_writer *w = (txt_writer *)base;
-    fclose(w->f);
-    remove(w->tmp);
+    evr_file_discard(w->f, w->tmp);
     free_writer(w);
 }
 
@@ -125,18 +123,16 @@ static evr_status txt_finish(evr_event_writer *base, int64_t duration_us, evr_er
 evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
 {
     txt_writer *w;
-    size_t len;
     (void)meta;
     *out = NULL;
     if (!path || !*path) {
         snprintf(err->msg, sizeof err->msg, "text writer: no path given");
         return EVR_ERR_ARG;
     }
-    len = strlen(path);
     w = calloc(1, sizeof *w);
     if (w) {
-        w->path = malloc(len + 1);
-        w->tmp = malloc(len + 5);
+        w->path = strdup(path);
+        w->tmp = evr_file_tmp_name(path);
         w->buf = malloc(TXT_BUFFER);
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
@@ -144,12 +140,8 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, ev
         snprintf(err->msg, sizeof err->msg, "text writer: out of memory");
         return EVR_ERR_NOMEM;
     }
-    memcpy(w->path, path, len + 1);
-    memcpy(w->tmp, path, len);
-    memcpy(w->tmp + len, ".tmp", 5);
-    w->f = fopen(w->tmp, "wb");
+    w->f = evr_file_create(w->tmp, "text writer", err);
     if (!w->f) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot create %s: %s", w->tmp, strerror(errno));
         free_writer(w);
         return EVR_ERR_IO;
     }
