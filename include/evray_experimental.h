@@ -155,7 +155,7 @@ evr_status evr_parse_int(const char *opt, const char *text, int *out, evr_error 
 evr_status evr_parse_u64(const char *opt, const char *text, uint64_t *out, evr_error *err);
 evr_status evr_parse_size(const char *opt, const char *text, int *w, int *h, evr_error *err);
 
-/* ---- the configuration's options (the table: src/config_table.c) ---- */
+/* ---- the configuration's options (the table: src/config/config_table.c) ---- */
 typedef struct evr_config_option evr_config_option;
 /* The option that arg starts ("--res", "--res=640x480", "-o"); *name is set to the name it used
  * (the option or its short alias). NULL when arg is none of them. */

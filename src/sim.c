@@ -3,11 +3,11 @@
 #include "sim_state.h"
 #include "par_pool.h"
 #include "host_clock.h"
-#include "config_json.h"
+#include "config/config_json.h"
 #include "io/json.h"
 #include "io/preview.h"
-#include "run_files.h"
-#include "frames_out.h"
+#include "run/run_files.h"
+#include "run/frames_out.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif

@@ -5,11 +5,11 @@
 #define EVR_SIM_STATE_H
 
 #include "backend.h"
-#include "segment_planner.h"
+#include "run/segment_planner.h"
 #include "prep/skip_plan.h"
 #include "io/event_writer.h"
 #include "io/preview.h"
-#include "write_queue.h"
+#include "run/write_queue.h"
 
 #define EVR_MAX_WRITERS 16   /* formats a run may write (io/event_formats.h) */
 

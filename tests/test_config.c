@@ -1,8 +1,8 @@
-/* The configuration table (src/config_table.c) drives the defaults, option parsing, help and
+/* The configuration table (src/config/config_table.c) drives the defaults, option parsing, help and
  * run.json; the format registry (src/io/event_formats.c) lists each format once and --format all
  * writes every one. */
 #include "check.h"
-#include "config_table.h"
+#include "config/config_table.h"
 #include "evray.h"
 #include "evray_experimental.h"
 #include "io/event_formats.h"

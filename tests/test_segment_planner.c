@@ -1,9 +1,9 @@
-/* The segment planner (src/segment_planner.c): segments are planned in order, each taken slot
+/* The segment planner (src/run/segment_planner.c): segments are planned in order, each taken slot
  * holds its own segment's plan (never one planned over it before release), the planner runs at
  * most EVR_PLANNER_SLOTS segments ahead of the releases, and stopping early leaves nothing
  * running. */
 #include "check.h"
-#include "segment_planner.h"
+#include "run/segment_planner.h"
 
 #include <string.h>
 

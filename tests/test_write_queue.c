@@ -1,7 +1,7 @@
 /* The writer thread: batches reach every writer in order, flushes follow the interval (after a
  * batch when it has passed, or once idle that long), errors come back to the caller. */
 #include "check.h"
-#include "write_queue.h"
+#include "run/write_queue.h"
 #include "host_clock.h"
 
 #include <stdatomic.h>

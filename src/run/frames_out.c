@@ -1,5 +1,5 @@
 /* Intensity frames for frame-based tools: planning, the folder, the PNGs and frames.csv. */
-#include "frames_out.h"
+#include "run/frames_out.h"
 #include "core/shading.h"
 #include "io/png.h"
 #include "io/mkdir_p.h"

@@ -1,8 +1,8 @@
 /* Simulation parameters: defaults, checks and the JSON form stored with every output, all made
  * from the configuration table (config_table.c); the sensor presets; the size rule of evr_config. */
 #include "evray.h"
-#include "config_json.h"
-#include "config_table.h"
+#include "config/config_json.h"
+#include "config/config_table.h"
 #include "io/json.h"
 #include "scene/scene.h"
 

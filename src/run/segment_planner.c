@@ -1,5 +1,5 @@
 /* The segment planner's thread and ring: see segment_planner.h. */
-#include "segment_planner.h"
+#include "run/segment_planner.h"
 #include "host_clock.h"
 
 #include <pthread.h>

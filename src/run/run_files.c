@@ -1,5 +1,5 @@
-#include "run_files.h"
-#include "frames_out.h"
+#include "run/run_files.h"
+#include "run/frames_out.h"
 #include "io/mkdir_p.h"
 #include "io/event_formats.h"
 #include "io/json.h"

@@ -1,6 +1,6 @@
 /* The configuration as options: values parsed strictly, options found and set by the table's
  * rows, and the options' help made from them. */
-#include "config_table.h"
+#include "config/config_table.h"
 #include "evray_experimental.h"
 
 #include <errno.h>

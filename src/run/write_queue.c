@@ -1,4 +1,4 @@
-#include "write_queue.h"
+#include "run/write_queue.h"
 #include "host_clock.h"
 #include "events.h"
 

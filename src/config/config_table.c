@@ -1,6 +1,6 @@
 /* The rows of the configuration table (config_table.h says what each column means), in the
  * order of evray render --help; json_rank gives the order of run.json's config object. */
-#include "config_table.h"
+#include "config/config_table.h"
 #include "evray_experimental.h"
 #include "io/event_formats.h"
 
