@@ -90,7 +90,7 @@ struct evr_backend {
 typedef struct {
     evr_render_scene rs;
     evr_mesh_view *meshes;
-    evr_material_view *materials;
+    evr_material_params *materials;
     evr_texture_view *textures;
     evr_instance_view *instances;
     evr_light_view *lights;

@@ -29,14 +29,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->meshes[i].num_triangles = m->num_triangles;
         h->meshes[i].material = m->material;
     }
-    for (i = 0; i < s->num_materials; i++) {
-        const evr_material *m = &s->materials[i];
-        memcpy(h->materials[i].base_color, m->base_color, sizeof m->base_color);
-        h->materials[i].base_texture = m->base_texture;
-        memcpy(h->materials[i].emissive, m->emissive, sizeof m->emissive);
-        h->materials[i].t_diffuse = m->t_diffuse;
-        h->materials[i].t_specular = m->t_specular;
-    }
+    for (i = 0; i < s->num_materials; i++) h->materials[i] = s->materials[i].p;
     for (i = 0; i < s->num_textures; i++) {
         h->textures[i].width = s->textures[i].width;
         h->textures[i].height = s->textures[i].height;

@@ -232,23 +232,23 @@ static void test_lights_materials(const char *path, int glb)
         const evr_material *e1 = &s->materials[s->meshes[tri].material];
         const evr_material *e2 = &s->materials[s->meshes[tri2].material];
         CHECK(strcmp(m->name, "embedded") == 0);
-        CHECK_NEAR(m->base_color[0], 0.5, 1e-6); CHECK_NEAR(m->base_color[1], 0.25, 1e-6);
-        CHECK_NEAR(m->base_color[2], 1.0, 1e-6); CHECK_NEAR(m->base_color[3], 1.0, 1e-6);
-        CHECK_NEAR(m->metallic, 0.25, 1e-6); CHECK_NEAR(m->roughness, 0.75, 1e-6);
+        CHECK_NEAR(m->p.base_color[0], 0.5, 1e-6); CHECK_NEAR(m->p.base_color[1], 0.25, 1e-6);
+        CHECK_NEAR(m->p.base_color[2], 1.0, 1e-6); CHECK_NEAR(m->p.base_color[3], 1.0, 1e-6);
+        CHECK_NEAR(m->p.metallic, 0.25, 1e-6); CHECK_NEAR(m->p.roughness, 0.75, 1e-6);
         /* emissive factor (1, 0.5, 0) times KHR_materials_emissive_strength 4 */
-        CHECK_NEAR(m->emissive[0], 4.0, 1e-5); CHECK_NEAR(m->emissive[1], 2.0, 1e-5); CHECK_NEAR(m->emissive[2], 0.0, 1e-6);
+        CHECK_NEAR(m->p.emissive[0], 4.0, 1e-5); CHECK_NEAR(m->p.emissive[1], 2.0, 1e-5); CHECK_NEAR(m->p.emissive[2], 0.0, 1e-6);
         CHECK(strcmp(e1->name, "external") == 0 && strcmp(e2->name, "external_again") == 0);
-        CHECK_NEAR(e1->emissive[0], 0.0, 1e-6);
-        CHECK_NEAR(e2->metallic, 0.0, 1e-6);
+        CHECK_NEAR(e1->p.emissive[0], 0.0, 1e-6);
+        CHECK_NEAR(e2->p.metallic, 0.0, 1e-6);
         /* two textures: the embedded image, and the external file shared by two materials */
         CHECK(s->num_textures == 2);
-        CHECK(m->base_texture >= 0 && e1->base_texture >= 0);
-        CHECK(e1->base_texture == e2->base_texture);
-        CHECK(m->base_texture != e1->base_texture);
-        if (s->num_textures == 2 && m->base_texture >= 0 && e1->base_texture >= 0) {
+        CHECK(m->p.base_texture >= 0 && e1->p.base_texture >= 0);
+        CHECK(e1->p.base_texture == e2->p.base_texture);
+        CHECK(m->p.base_texture != e1->p.base_texture);
+        if (s->num_textures == 2 && m->p.base_texture >= 0 && e1->p.base_texture >= 0) {
             int k;
             for (k = 0; k < 2; k++) {
-                const evr_texture *t = &s->textures[k == 0 ? m->base_texture : e1->base_texture];
+                const evr_texture *t = &s->textures[k == 0 ? m->p.base_texture : e1->p.base_texture];
                 CHECK(t->width == 2 && t->height == 2);
                 if (t->width != 2 || t->height != 2) continue;
                 /* row 0 is the image's first (top) row: red, then (0, 128, 255) */

@@ -360,7 +360,7 @@ static void test_emission(void)
         static const float pos[9] = {0, 0, 0, 2, 0, 0, 0, 1, 0}, nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
         static const uint32_t idx[3] = {0, 1, 2};
         evr_mesh_view m;
-        evr_material_view mat;
+        evr_material_params mat;
         evr_instance_view in;
         evr_photon_emitter em;
         const float cdf[1] = {1.0f};
@@ -452,7 +452,7 @@ static void test_pass(void)
 {
     const float rho = 0.5f;
     evr_mesh_view mesh;
-    evr_material_view mat;
+    evr_material_params mat;
     evr_instance_view inst;
     evr_light_view light;
     evr_motion_key keys[2];

@@ -8,9 +8,10 @@
  *     tracer's diffuse / mirror choice (evr_material_path_event) and the bounce directions,
  *   - the diffuse share that turns an irradiance estimate into radiance (evr_material_diffuse_k).
  * The model today is Lambert (albedo / pi) plus a mirror share for indirect light. A new model
- * (glTF metallic-roughness: GGX/Smith with Fresnel, transmission) fills in these functions and
- * adds its parameters to evr_material_view (core/render_scene.h) and to the record in
- * evr_surface; the callers pass the shading frame (evr_surface's n), wo and wi already.
+ * (glTF metallic-roughness: GGX/Smith with Fresnel, transmission) adds its parameters to
+ * evr_material_params and evr_material_defaults below, fills in these functions (and the record
+ * in evr_surface), and reads the parameters in scene/import_mesh.c; the callers pass the shading
+ * frame (evr_surface's n), wo and wi already.
  * Floating-point expressions here are the ones the golden events were made with: keep their
  * order when editing (the GPU must not gain or lose fused multiply-adds). */
 #ifndef EVR_CORE_MATERIAL_H
@@ -19,6 +20,20 @@
 #include "core/render_scene.h"
 
 #define EVR_PI 3.14159265358979f
+
+/* What a material is: the scene holds one per material (scene/scene.h), the backends read them
+ * (evr_render_scene.materials). A new model adds its parameters here, its defaults to
+ * evr_material_defaults and its reading to the import (scene/import_mesh.c). */
+struct evr_material_params {
+    float base_color[4];  /* linear RGBA factor */
+    int base_texture;     /* index into the textures (sRGB-encoded source), -1: none */
+    float emissive[3];    /* linear RGB, radiance units */
+    /* the photon pass's thresholds, 0 <= t_diffuse <= t_specular <= 1: from the material's
+     * extras "t_diffuse" and "t_specular" when the glTF gives them, else from base colour,
+     * metallic and roughness (evr_photon_material_map) */
+    float t_diffuse, t_specular;
+    float metallic, roughness;
+};
 
 /* A surface point as shading sees it: its shading frame (position, normal) and the hit's
  * material record (the material evaluated there, textures applied). */
@@ -50,7 +65,7 @@ EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float 
 EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m, uint32_t i0, uint32_t i1,
                                           uint32_t i2, float w, float u, float v, evr_surface *s)
 {
-    const evr_material_view *mat = &rs->materials[m->material];
+    const evr_material_params *mat = &rs->materials[m->material];
     s->albedo[0] = mat->base_color[0];
     s->albedo[1] = mat->base_color[1];
     s->albedo[2] = mat->base_color[2];
@@ -119,6 +134,17 @@ EVR_HD static inline void evr_photon_material_map(const float base_color[3], flo
     *t_specular = *t_diffuse + r * (1.0f - m);
 }
 
+/* A material before the file says anything of it: white, untextured, rough dielectric. */
+static inline void evr_material_defaults(evr_material_params *m)
+{
+    m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
+    m->base_texture = -1;
+    m->emissive[0] = m->emissive[1] = m->emissive[2] = 0.0f;
+    m->metallic = 0.0f;
+    m->roughness = 1.0f;
+    evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
+}
+
 /* Share of the reflected light that is a mirror reflection. */
 EVR_HD static inline float evr_photon_mirror_share(float t_diffuse, float t_specular)
 {
@@ -177,7 +203,7 @@ EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
 
 /* The photon pass's decision at a hit of material mat for random xi in [0, 1) (d_in: the
  * photon's direction of travel): evr_photon_scatter's event and *weight. */
-EVR_HD static inline int evr_material_photon_event(const evr_material_view *mat, const evr_surface *s, evr_v3 d_in,
+EVR_HD static inline int evr_material_photon_event(const evr_material_params *mat, const evr_surface *s, evr_v3 d_in,
                                                    float xi, int allow_stay, float *weight)
 {
     (void)s;
@@ -187,7 +213,7 @@ EVR_HD static inline int evr_material_photon_event(const evr_material_view *mat,
 
 /* The path tracer's choice at a hit of material mat for random xi in [0, 1): EVR_PHOTON_MIRROR
  * with the mirror share's odds, else EVR_PHOTON_DIFFUSE (it never stays). */
-EVR_HD static inline int evr_material_path_event(const evr_material_view *mat, const evr_surface *s, evr_v3 d_in, float xi)
+EVR_HD static inline int evr_material_path_event(const evr_material_params *mat, const evr_surface *s, evr_v3 d_in, float xi)
 {
     (void)s;
     (void)d_in;
@@ -204,7 +230,7 @@ EVR_HD static inline evr_v3 evr_material_bounce_dir(const evr_surface *s, int ev
 
 /* What multiplies the albedo and an irradiance for the indirect (diffusely reflected) radiance
  * leaving a surface of material mat: the diffuse share over pi. */
-EVR_HD static inline float evr_material_diffuse_k(const evr_material_view *mat)
+EVR_HD static inline float evr_material_diffuse_k(const evr_material_params *mat)
 {
     return (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
 }

@@ -138,7 +138,7 @@ EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs, con
                                                  evr_photon_ray *out)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[em->index].mesh];
-    const evr_material_view *mat = &rs->materials[m->material];
+    const evr_material_params *mat = &rs->materials[m->material];
     const float *c = cdf + em->tri_first;
     float side = u[0] < 0.5f ? 1.0f : -1.0f, x = (u[0] < 0.5f ? u[0] * 2.0f : u[0] * 2.0f - 1.0f) * em->area;
     int lo = 0, hi = em->ntri - 1;

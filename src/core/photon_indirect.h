@@ -10,7 +10,7 @@
 
 /* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s of material
  * mat: the diffuse share of the albedo over pi. */
-EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_view *mat, float k_rgb[3])
+EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_params *mat, float k_rgb[3])
 {
     float k = evr_material_diffuse_k(mat);
     k_rgb[0] = s->albedo[0] * k;
@@ -20,7 +20,7 @@ EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_
 
 /* Indirect radiance leaving surface s (material mat) from an irradiance estimate: the diffuse
  * share of the albedo over pi, per RGB channel (add its luminance to evr_surface_intensity). */
-EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_view *mat, const float e_rgb[3],
+EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_params *mat, const float e_rgb[3],
                                               float out_rgb[3])
 {
     float k[3];
@@ -39,7 +39,7 @@ typedef struct evr_gather_point {
     float k[3];
 } evr_gather_point;
 
-EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_view *mat, evr_v3 cam_org,
+EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_params *mat, evr_v3 cam_org,
                                               evr_gather_point *g)
 {
     g->p = s->p;
@@ -125,7 +125,7 @@ EVR_HD static inline float evr_gi_lerp(float ls, float le, float f)
 /* Luminance of the indirect light leaving surface s (material mat) seen from cam_org through
  * image pixel (x, y): the gather and the diffuse share. */
 EVR_HD static inline float evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
-                                                   const evr_gather_params *gp, const evr_material_view *mat,
+                                                   const evr_gather_params *gp, const evr_material_params *mat,
                                                    const evr_surface *s, evr_v3 cam_org, int x, int y)
 {
     evr_gather_point g;

@@ -72,7 +72,7 @@ EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs, const
  * path's ray is the next one to trace while bounce < max_hits; past that the path is capped) or
  * EVR_PHOTON_ABSORB (the path ends). absorbed[] gets the flux this hit absorbs (bookkeeping). */
 EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photon_params *pp, const evr_surface *s,
-                                             const evr_material_view *mat, float stored[3], float absorbed[3],
+                                             const evr_material_params *mat, float stored[3], float absorbed[3],
                                              uint32_t *key)
 {
     float w;

@@ -14,13 +14,8 @@ typedef struct {
     int material;
 } evr_mesh_view;
 
-typedef struct {
-    float base_color[4];
-    int base_texture;     /* -1: none */
-    float emissive[3];
-    /* photon mapping (src/core/photon.h): 0 <= t_diffuse <= t_specular <= 1 */
-    float t_diffuse, t_specular;
-} evr_material_view;
+/* A material's parameters, defined with the model that reads them in core/material.h. */
+typedef struct evr_material_params evr_material_params;
 
 typedef struct {
     int width, height;
@@ -42,7 +37,7 @@ typedef struct {
 
 typedef struct {
     const evr_mesh_view *meshes;
-    const evr_material_view *materials;
+    const evr_material_params *materials;
     const evr_texture_view *textures;
     const evr_instance_view *instances;
     const evr_light_view *lights;

@@ -189,7 +189,7 @@ int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int
  * photons at the segment's start (ls) and end (le); one gather where the window saw no change
  * over the segment (the same cells, the same estimate); end_only: le alone. (Walking the two
  * buffers together, cell by cell, was 4-6% faster here and 4% slower on the GPU: one walk kept.) */
-static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_material_view *mat, const evr_surface *s,
+static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_material_params *mat, const evr_surface *s,
                         evr_v3 cam_org, int x, int y, int end_only, float *ls, float *le, evr_gather_sum *se)
 {
     const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin, g->window, x, y);
@@ -211,7 +211,7 @@ static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const e
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
                           int y, float f, int memo)
 {
-    const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
+    const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
     if (!memo) {
         float ls, le;

@@ -249,7 +249,7 @@ static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail 
             add3(co->escaped, path.pr.flux, 1.0f);
             return;
         }
-        const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
+        const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), path.f);
         evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
         int ev = evr_photon_path_hit(&path, c->pp, &s, mat, stored, absorbed, &key);

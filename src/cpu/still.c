@@ -89,7 +89,7 @@ static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, f
     evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
-static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_view **mat, int *inst)
+static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_params **mat, int *inst)
 {
     const evr_render_scene *rs = c->rs;
     evr_trace_hit h;
@@ -104,13 +104,13 @@ static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface 
 /* One path from surface s0 (reached along dir_in): the radiance it reflects towards dir_in's
  * origin, excluding the direct term: paths of 1 .. max_bounces bounces ending on a light (next-
  * event estimation with the direct term's lights, diffuse share) or on an emissive surface. */
-static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_view *m0, evr_v3 dir_in,
+static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_params *m0, evr_v3 dir_in,
                         uint64_t pix, uint64_t sample, float out[3])
 {
     const evr_render_scene *rs = c->rs;
     const uint64_t seed = c->p->seed ^ 0x70617468ull;   /* "path" */
     evr_surface s = *s0;
-    const evr_material_view *m = m0;
+    const evr_material_params *m = m0;
     float beta[3] = {1.0f, 1.0f, 1.0f};
     int depth, dim = 0;
     out[0] = out[1] = out[2] = 0.0f;
@@ -130,7 +130,7 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
         if (!(beta[0] > 0.0f || beta[1] > 0.0f || beta[2] > 0.0f)) return;
         evr_ray r;
         evr_surface y;
-        const evr_material_view *my;
+        const evr_material_params *my;
         r.org = s.p;
         r.dir = wo;
         if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), &y, &my, NULL)) return;
@@ -160,7 +160,7 @@ static void shade_row(shade_ctx *c, int y)
         float *rgb = o->rgb + 3 * i, *dir = o->direct + 3 * i, acc[3];
         evr_ray ray = evr_camera_ray(&rs->camera, &c->pose, (float)x + 0.5f, (float)y + 0.5f);
         evr_surface s;
-        const evr_material_view *mat;
+        const evr_material_params *mat;
         int inst;
         rgb[0] = rgb[1] = rgb[2] = dir[0] = dir[1] = dir[2] = 0.0f;
         o->instance[i] = -1;

@@ -770,7 +770,7 @@ struct cuda_backend {
     dbuf<float> d_floats;                  /* all vertex data */
     dbuf<uint32_t> d_indices;
     dbuf<evr_mesh_view> d_meshes;
-    dbuf<evr_material_view> d_materials;
+    dbuf<evr_material_params> d_materials;
     dbuf<evr_texture_view> d_textures;
     dbuf<float> d_texels;
     dbuf<evr_instance_view> d_instances;
@@ -910,7 +910,7 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
     free(tv);
     CK(e);
     CK(b->d_materials.reserve((size_t)s->num_materials + 1));
-    CK(cudaMemcpy(b->d_materials.p, b->host.materials, ((size_t)s->num_materials + 1) * sizeof(evr_material_view), cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(b->d_materials.p, b->host.materials, ((size_t)s->num_materials + 1) * sizeof(evr_material_params), cudaMemcpyHostToDevice));
     CK(b->d_instances.reserve((size_t)s->num_instances + 1));
     CK(cudaMemcpy(b->d_instances.p, b->host.instances, ((size_t)s->num_instances + 1) * sizeof(evr_instance_view), cudaMemcpyHostToDevice));
     CK(b->d_lights.reserve((size_t)s->num_lights + 1));

@@ -258,7 +258,7 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
         const int hit = gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h);
         if (rays) evr_photon_trail_ray(t, rays, p.trail_len, a.plan, path.pr.ray, hit ? h.t : 1e30f);
         if (!hit) return;
-        const evr_material_view *mat = &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
+        const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), path.f);
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
         const int ev = evr_photon_path_hit(&path, &p.pp, &s, mat, stored, absorbed, &key);

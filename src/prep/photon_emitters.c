@@ -40,7 +40,7 @@ evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_ph
     }
     for (i = 0; i < rs->num_instances; i++) {
         const evr_mesh_view *m = &rs->meshes[rs->instances[i].mesh];
-        const evr_material_view *mat = &rs->materials[m->material];
+        const evr_material_params *mat = &rs->materials[m->material];
         float le = evr_luminance(mat->emissive[0], mat->emissive[1], mat->emissive[2]);
         evr_photon_emitter e;
         uint32_t t;

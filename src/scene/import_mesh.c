@@ -23,12 +23,7 @@ evr_status evr_import_materials(importer *im)
     if (!s->materials || !im->mat_uv) return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading materials");
     s->num_materials = n;
     for (i = 0; i < (unsigned)n; i++) {
-        evr_material *m = &s->materials[i];
-        m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
-        m->base_texture = -1;
-        m->metallic = 0.0f;
-        m->roughness = 1.0f;
-        evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
+        evr_material_defaults(&s->materials[i].p);
     }
     for (i = 0; i < ai->mNumMaterials; i++) {
         const struct aiMaterial *am = ai->mMaterials[i];
@@ -44,31 +39,31 @@ evr_status evr_import_materials(importer *im)
         else snprintf(m->name, sizeof m->name, "material%u", i);
         if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS ||
             aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS) {
-            m->base_color[0] = c.r; m->base_color[1] = c.g; m->base_color[2] = c.b; m->base_color[3] = c.a;
+            m->p.base_color[0] = c.r; m->p.base_color[1] = c.g; m->p.base_color[2] = c.b; m->p.base_color[3] = c.a;
         }
         if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS) {
             float k = 1.0f;
             one = 1;
             if (aiGetMaterialFloatArray(am, AI_MATKEY_EMISSIVE_INTENSITY, &f, &one) == aiReturn_SUCCESS) k = (float)f;
             else if (im->have_side && (int)i < im->side.num_materials) k = im->side.emissive_strength[i];
-            m->emissive[0] = c.r * k; m->emissive[1] = c.g * k; m->emissive[2] = c.b * k;
+            m->p.emissive[0] = c.r * k; m->p.emissive[1] = c.g * k; m->p.emissive[2] = c.b * k;
         }
         one = 1;
-        if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, &one) == aiReturn_SUCCESS) m->metallic = (float)f;
+        if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, &one) == aiReturn_SUCCESS) m->p.metallic = (float)f;
         one = 1;
-        if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, &one) == aiReturn_SUCCESS) m->roughness = (float)f;
-        evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
+        if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, &one) == aiReturn_SUCCESS) m->p.roughness = (float)f;
+        evr_photon_material_map(m->p.base_color, m->p.metallic, m->p.roughness, &m->p.t_diffuse, &m->p.t_specular);
         if (im->have_side && (int)i < im->side.num_materials &&
             (im->side.t_extras[2 * i] != T_ABSENT || im->side.t_extras[2 * i + 1] != T_ABSENT)) {
             float td = im->side.t_extras[2 * i], ts = im->side.t_extras[2 * i + 1];
-            if (td == T_ABSENT) td = m->t_diffuse;
-            if (ts == T_ABSENT) ts = td > m->t_specular ? td : m->t_specular;
+            if (td == T_ABSENT) td = m->p.t_diffuse;
+            if (ts == T_ABSENT) ts = td > m->p.t_specular ? td : m->p.t_specular;
             if (!(td >= 0.0f && td <= ts && ts <= 1.0f))
                 return evr_import_fail(im->err, EVR_ERR_FORMAT,
                             "material '%s': extras need 0 <= t_diffuse <= t_specular <= 1 (got %g, %g)", m->name,
                             (double)td, (double)ts);
-            m->t_diffuse = td;
-            m->t_specular = ts;
+            m->p.t_diffuse = td;
+            m->p.t_specular = ts;
         }
 
         for (tt = 0; tt < 2; tt++) {
@@ -77,7 +72,7 @@ evr_status evr_import_materials(importer *im)
             if (aiGetMaterialTexture(am, kinds[tt], 0, &str, NULL, &uv, NULL, NULL, NULL, NULL) != aiReturn_SUCCESS || !str.data[0])
                 continue;
             {
-                evr_status st = evr_import_texture(im, str.data, m->name, &m->base_texture);
+                evr_status st = evr_import_texture(im, str.data, m->name, &m->p.base_texture);
                 if (st != EVR_OK) return st;
             }
             im->mat_uv[i] = (int)uv;

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include "core/vec.h"
 #include "core/motion.h"
+#include "core/material.h"
 #include "evray.h"
 
 typedef struct {
@@ -23,13 +24,7 @@ typedef struct {
 
 typedef struct {
     char name[64];
-    float base_color[4];    /* linear RGBA factor */
-    int base_texture;       /* index into scene textures (sRGB-encoded source), -1 if none */
-    float emissive[3];      /* linear RGB, radiance units */
-    float metallic, roughness;
-    /* photon mapping thresholds (src/core/photon.h): from the material's extras "t_diffuse" and
-     * "t_specular" when the glTF gives them, else from base colour, metallic and roughness */
-    float t_diffuse, t_specular;
+    evr_material_params p;  /* core/material.h */
 } evr_material;
 
 typedef struct {
