@@ -31,7 +31,8 @@
 #include "core/pixel.h"
 #include "core/skip.h"
 
-#define EVR_ADAPT_PX_PER_FRAC 2.0f   /* image motion allowed between samples, pixels per unit of frac */
+/* image motion allowed between samples, pixels per unit of frac */
+#define EVR_ADAPT_PX_PER_FRAC 2.0f
 #define EVR_ADAPT_DEPTH 16           /* samples a pixel holds back while it refines an interval */
 
 typedef struct {

@@ -49,7 +49,8 @@
 #include "core/rng.h"
 #include <math.h>
 
-#define EVR_CUTOFF_DARK (20.0f / 255.0f)   /* cutoff law offset: a black pixel keeps 7.3% of the cutoff */
+/* cutoff law offset: a black pixel keeps 7.3% of the cutoff */
+#define EVR_CUTOFF_DARK (20.0f / 255.0f)
 #define EVR_SHOT_BRIGHT 0.25f              /* shot noise at full brightness / shot noise of a black pixel */
 #define EVR_JITTER_CLIP 4.0f               /* timestamp jitter is clipped to this many sigma */
 
