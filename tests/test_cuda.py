@@ -81,7 +81,7 @@ for scene, extra in (("eye", ["--res", "200x150", "--duration", "1.0", "--start"
         evs.append(open(os.path.join(d, "events.npy"), "rb").read())
     T.check(len(evs[0]) > 1000 and evs[0] == evs[1], f"{scene}: identical events with and without temporal coherence")
 
-# global illumination on the GPU (cuda/gpu_gi.cuh): the same photons as the CPU's up to float
+# global illumination on the GPU (cuda/cuda_gi.cu): the same photons as the CPU's up to float
 # differences of the traversals; the buffer is filled in photon order (deterministic: two runs give
 # the same events); a segment re-rendered after an overflow finds its own photons; a still Cornell
 # box makes no events
@@ -109,7 +109,7 @@ share = T.boundary_share(gi_runs["cuda"][1], st_gpu["segments"], 0.5)
 print(f"cornell GI on CUDA: {share:.3f} of the events within a tenth of a segment of a boundary")
 T.check(share < 0.3, "cornell GI on CUDA: events do not cluster at segment boundaries")
 T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: overflowing segments re-rendered, identical events")
-# the gathers deferred to a kernel of their own (cuda/gpu_gi_deferred.cuh, the default with uniform
+# the gathers deferred to a kernel of their own (cuda/cuda_gi_deferred.cu, the default with uniform
 # sampling) give the events of the render kernel that gathers inline (EVR_GI_INLINE=1) bit for
 # bit: with change-driven sampling, brute force and the full sensor model; and with a limit on the
 # photons per estimate (--gather-max 8: the ring search, not the fixed-point sums)

@@ -1,5 +1,5 @@
 /* A photon's path: its start (emitter, time, first ray) and what happens at each hit. The loop
- * that traces it is the backend's (src/cpu/photon_pass.c, src/cuda/gpu_gi.cuh). */
+ * that traces it is the backend's (src/cpu/photon_pass.c, src/cuda/cuda_gi.cu). */
 #ifndef EVR_CORE_PHOTON_PATH_H
 #define EVR_CORE_PHOTON_PATH_H
 

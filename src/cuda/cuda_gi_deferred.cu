@@ -12,11 +12,11 @@
  * (H100, Cornell box at 1280x720; docs/benchmarks.md): there it ran at the render kernel's
  * occupancy, its lanes beside lanes that trace. The samples, their intensities (direct + gathered,
  * the same float addition as gpu_sample) and the events are those of render_kernel<GI> bit for
- * bit; tests/test_cuda.py compares the two (EVR_GI_INLINE=1 selects the single kernel).
- *
- * Included by cuda_backend.cu after render_kernel (it uses its helpers). */
-#ifndef EVR_CUDA_GPU_GI_DEFERRED_CUH
-#define EVR_CUDA_GPU_GI_DEFERRED_CUH
+ * bit; tests/test_cuda.py compares the two (EVR_GI_INLINE=1 selects the single kernel). */
+#include "cuda/cuda_gi_deferred.cuh"
+#include "cuda/cuda_pixel.cuh"
+
+#include <stdlib.h>
 
 /* First kernel: render_kernel's rays and settling, without the pixel model. */
 template <int LAYOUT>
@@ -72,7 +72,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
          * pixel's last, at the same point) from the front, the others from the back, each kind
          * gathered by a kernel of its own */
         const bool known = want && last.g.dist >= 0.0f && gather_point_same(&last.g, &g);
-        const unsigned slot_known = warp_append(d.count, known), slot_new = warp_append(d.count + 1, want && !known);
+        const unsigned slot_known = warp_append(&d.count[REQ_KNOWN], known), slot_new = warp_append(&d.count[REQ_NEW], want && !known);
         if (want) {
             made_new |= !known;
             r = known ? slot_known : d.cap - 1u - slot_new;
@@ -96,7 +96,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             }
         }
     }
-    const unsigned at = warp_append(d.count + 2, made_new);
+    const unsigned at = warp_append(&d.count[REQ_NEW_PIXELS], made_new);
     if (made_new) d.newpix[at] = i;
     if (active) {
         if (tracing) cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
@@ -153,7 +153,7 @@ __global__ void __launch_bounds__(BLOCK) gi_scatter_kernel(kernel_args a, gi_def
 template <bool FIXED>
 __global__ void __launch_bounds__(BLOCK, 8) gi_gather_known_kernel(kernel_args a, gi_deferred d)
 {
-    const unsigned n = d.count[0];
+    const unsigned n = d.count[REQ_KNOWN];
     for (unsigned r = blockIdx.x * blockDim.x + threadIdx.x; r < n; r += gridDim.x * blockDim.x) {
         const evr_gather_point g = d.requests[r].g;
         const int pix = d.requests[r].pix, x = pix % a.width, y = pix / a.width;
@@ -187,9 +187,9 @@ __global__ void __launch_bounds__(BLOCK, 8) gi_gather_known_kernel(kernel_args a
 template <bool FIXED>
 __global__ void __launch_bounds__(BLOCK, 8) gi_gather_new_kernel(kernel_args a, gi_deferred d)
 {
-    const unsigned n = d.count[2], lane = threadIdx.x & 31u, warps = gridDim.x * blockDim.x / 32u;
+    const unsigned n = d.count[REQ_NEW_PIXELS], lane = threadIdx.x & 31u, warps = gridDim.x * blockDim.x / 32u;
     const unsigned span = a.samples < 32 ? (unsigned)a.samples : 32u, per_warp = 32u / span;   /* lanes a pixel, pixels a warp */
-    const unsigned back = d.cap - d.count[1];   /* the first request without the start known */
+    const unsigned back = d.cap - d.count[REQ_NEW];   /* the first request without the start known */
     if (lane >= per_warp * span) return;
     for (unsigned w = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; w * per_warp < n; w += warps) {
         const unsigned at = w * per_warp + lane / span;
@@ -261,4 +261,95 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     }
 }
 
-#endif
+gi_deferred deferred_args(const cuda_backend *b)
+{
+    gi_deferred d;
+    d.direct = b->d_gd_direct.p;
+    d.req = b->d_gd_req.p;
+    d.traced = b->d_gd_traced.p;
+    d.cache_dist = b->d_gd_cache.p;
+    d.requests = b->d_gd_requests.p;
+    d.lum = b->d_gd_lum.p;
+    d.count = b->d_gd_count.p;
+    d.cap = (unsigned)b->d_gd_requests.cap;
+    d.newpix = b->d_gd_newpix.p;
+    d.delta = b->d_gd_delta.p;
+    d.stride = b->setup.width * b->setup.height;
+    return d;
+}
+
+void gi_deferred_release(cuda_backend *b)
+{
+    b->d_gd_direct.release();
+    b->d_gd_req.release();
+    b->d_gd_lum.release();
+    b->d_gd_requests.release();
+    b->d_gd_traced.release();
+    b->d_gd_cache.release();
+    b->d_gd_count.release();
+    b->d_gd_newpix.release();
+    b->d_gd_delta.release();
+    for (int i = 0; i < NRING; i++) b->d_gi_ends[i].release();
+}
+
+/* The pixels' last gathers (gi_end), none known yet; without the memory, none are kept (every
+ * start gathered again). */
+static void gi_ends_alloc(cuda_backend *b, size_t npix)
+{
+    for (int i = 0; i < NRING; i++) {
+        if (b->d_gi_ends[i].reserve(npix, true) != cudaSuccess ||
+            cudaMemset(b->d_gi_ends[i].p, 0xff, npix * sizeof(gi_end)) != cudaSuccess) {   /* dist NaN: none */
+            (void)cudaGetLastError();
+            for (int j = 0; j < NRING; j++) b->d_gi_ends[j].release();
+            return;
+        }
+    }
+}
+
+/* The deferred gathers' buffers: every sample of every pixel may make a request (the moving
+ * object's pixels do). Where they do not fit in device memory the render kernel gathers inline,
+ * with a notice. EVR_GI_INLINE=1 (hidden, for tests and measurement) chooses that too. */
+void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
+{
+    b->gi_deferred = 0;
+    if (!b->gi || b->setup.adaptive || getenv("EVR_GI_INLINE")) return;
+    const size_t npix = (size_t)b->setup.width * b->setup.height, n = npix * (size_t)b->setup.samples_per_frame;
+    if (b->d_gd_direct.reserve(n, true) == cudaSuccess && b->d_gd_req.reserve(n, true) == cudaSuccess &&
+        b->d_gd_lum.reserve(n, true) == cudaSuccess && b->d_gd_requests.reserve(n, true) == cudaSuccess &&
+        b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_count.reserve(REQ_COUNTS) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_delta.reserve(2 * npix, true) == cudaSuccess) {
+        b->gi_deferred = 1;
+        gi_ends_alloc(b, npix);
+        b->gather_grid = (unsigned)prop->multiProcessorCount * 64u;   /* grid-stride: 64 blocks an SM balanced the gathers best (16: 9% slower) */
+        return;
+    }
+    (void)cudaGetLastError();   /* the failed allocation: not sticky, cleared */
+    gi_deferred_release(b);
+    fprintf(stderr, "evray: notice: not enough GPU memory to defer the gathers of %zu samples a segment; "
+                    "gathering inside the render kernel (slower)\n", n);
+}
+
+
+evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const gi_deferred &d, unsigned grid, evr_error *err)
+{
+    cudaStream_t rs = b->render;
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
+    else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
+    CK(cudaGetLastError());
+    if (b->gp.max_photons <= 0) {
+        if (b->d_gi_ends[0].p) {   /* what the changed cells add to the pixels' last gathers */
+            CK(cudaMemsetAsync(d.delta, 0, 2 * (size_t)b->setup.width * (size_t)b->setup.height * sizeof(unsigned long long), rs));
+            gi_scatter_kernel<<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+        }
+        gi_gather_known_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+        gi_gather_new_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+    } else {
+        gi_gather_known_kernel<false><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+        gi_gather_new_kernel<false><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
+    }
+    CK(cudaGetLastError());
+    if (evr_pixel_params_ideal(&b->setup.pixel)) gi_pixel_kernel<0><<<grid, BLOCK, 0, rs>>>(a, d);
+    else gi_pixel_kernel<1><<<grid, BLOCK, 0, rs>>>(a, d);
+    return EVR_OK;
+}

@@ -1,11 +1,8 @@
-/* Global illumination on the GPU (issue 5): the photon pass at a segment's end, the camera's
- * view of the buffer's cells, which cells changed over the segment, and the gathers of a sample
- * in the buffers of its segment's start and end, interpolated in time (evr_gi_lerp). Every
+/* Global illumination on the GPU: the photon pass at a segment's end, the camera's view of the
+ * buffer's cells, which cells changed over the segment (the kernels and their host side); the
+ * gathers of a sample in the buffers of its segment's start and end are cuda_gather.cuh's. Every
  * per-photon and per-pixel decision is src/core/photon.h, the very functions the CPU pass
  * (src/cpu/photon_pass.c, src/cpu/cpu_gi.c) runs; this file only schedules them.
- *
- * Included by cuda_backend.cu after gpu_trace (one translation unit: the kernels here trace
- * with the same traversal and take the same kernel_args).
  *
  * Deterministic insertion. The CPU inserts the visible photons in photon order, so a cell keeps
  * its first `layers` photons by key. Here every visible photon is appended (atomic counter) with
@@ -17,213 +14,15 @@
  * reads its own (its end) and the one before (its start), and one that overflows its event
  * buffer is rendered again at collect, after later segments' passes may have run, and must find
  * both. A still segment (nothing moved since the previous one) copies the previous buffer. */
-#ifndef EVR_CUDA_GPU_GI_CUH
-#define EVR_CUDA_GPU_GI_CUH
+#include "cuda/cuda_gi.cuh"
+#include "cuda/cuda_trace.cuh"
 
-#include "core/photon.h"
+#include <cub/device/device_radix_sort.cuh>
+#include <string.h>
 
-/* A pixel's last gather of a segment, kept for the next (the deferred kernels): its gather point
- * (dist NaN or negative: none) and its luminance at the segment's end, which is the next
- * segment's start bit for bit (the same buffer, the same point, the same pixel). */
-struct gi_end {
-    evr_gather_point g;
-    float le;
-    float direct;                  /* the direct light of the same sample */
-    evr_gather_sum s;              /* gp.max_photons 0: the fixed-point sums of le's gather */
-};
-
-#define GI_NO_REQUEST 0xffffffffu
-
-/* A deferred gather: the surface point and its pixel; ls: its start gather where known (the
- * pixel's end gather of the previous segment at the same point: the requests at the front of
- * the array, gi_deferred.count). */
-struct gi_request {
-    evr_gather_point g;
-    int pix;
-    float ls;
-    evr_gather_sum s;   /* gp.max_photons 0: the end's fixed-point sums (the gather kernel's) */
-};
-
-/* The shared buffers of the deferred kernels (gpu_gi_deferred.cuh; the skip kernel fills them for
- * the pixels it settles): device memory, reused by every launch (the kernels of a segment run in
- * order on the render stream). Per-sample arrays are [sample][thread]. */
-struct gi_deferred {
-    float *direct;        /* a traced sample's direct light */
-    unsigned *req;        /* its gather request, GI_NO_REQUEST for a miss (no light) */
-    int *traced;          /* per thread: samples with an entry (traced or held); later samples keep the last */
-    float *cache_dist;    /* per thread: the change-driven sampling cache after the segment */
-    gi_request *requests;
-    float2 *lum;          /* per request: the gathers' luminance at the segment's start and end */
-    /* requests made: [0] with the start known (from the front of requests), [1] without (from
-     * the back); [2] pixels that made one without (listed in newpix) */
-    unsigned *count;
-    unsigned cap;         /* room in requests */
-    int *newpix;          /* the launch's threads (pixels) that made a request without the start known */
-    unsigned long long *delta;   /* gp.max_photons 0: per pixel, what the changed cells add to its last gather's sums (a, w) */
-    int stride;           /* threads of a launch at most: the pixel count */
-};
-
-/* What the render kernels read (device memory, one per slot). */
-struct gpu_gi_view {
-    evr_photon_buffer end, start;  /* the photons at the segment's end and start (device pointers) */
-    /* summed-area table, (w + 1) x (h + 1), of the cells that changed over this segment or the
-     * one before: a pixel with no such cell in its window had the same indirect light all through
-     * both (its intensity may be kept) */
-    const uint32_t *sat;
-    evr_changed_cells ch;          /* gp.max_photons 0: the cells that changed over this segment only */
-    evr_gather_params gp;
-    int window;                    /* cells around a pixel a gather may read */
-    /* the deferred kernels' per-pixel last gathers: the previous segment's (read) and this one's
-     * (written), a ring indexed by segment as the pixel states; NULL where they did not fit */
-    const gi_end *ends_in;
-    gi_end *ends_out;
-};
-
-/* A pixel's last gather in this launch: the same point, normal, distance and instance in the
- * same buffers give the same estimates bit for bit (a traced pixel on a still surface). ls, le:
- * the estimates at the segment's start and end (gathers inside the render kernel); req: the
- * deferred gathers' request (gi_trace_kernel). */
-struct gi_memo {
-    uint32_t key[7];
-    int inst;
-    float ls, le;
-    unsigned req;
-    bool valid;
-};
-
-/* The gather point of surface s (instance inst) seen from cam_org, and a gather's luminance at
- * one: not inlined, so that the render kernel (gathers inline) and the deferred kernels
- * (gpu_gi_deferred.cuh) run the very same instructions: inlined into different kernels the
- * compiler may fuse a multiply and an add in one and not the other, and the events would differ
- * in the last bit of a few samples (13 of 6.5 M events at 1280x720 when both were inlined). */
-__device__ __noinline__ void gpu_gather_point(const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
-                                              evr_gather_point *g)
-{
-    evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org, g);
+extern "C" {
+#include "prep/photon_emitters.h"
 }
-
-/* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those
- * over the end buffer from those over the start buffer and the changed cells, and the luminance
- * from sums. Inlined, unlike gpu_gather_lum: no product in them is followed by an addition a
- * compiler could fuse it with (the terms' are explicit, EVR_MUL_RN), so every kernel computes the
- * same bits (tests/test_cuda.py compares the inline and deferred kernels' events); not inlined,
- * the calls spilled the gather loops' registers (gather kernels 105 -> 92 ms per 0.5 s of the
- * Cornell box at 1280x720, H100). */
-__device__ __forceinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
-                                            const evr_gather_point *g, int x, int y, evr_gather_sum *s)
-{
-    evr_gather_point_sum(b, cam, &v->gp, g, x, y, s);
-}
-
-__device__ __forceinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                              int y, evr_gather_sum *s)
-{
-    evr_gather_point_delta(&v->end, &v->start, &v->ch, cam, &v->gp, g, x, y, s);
-}
-
-__device__ __forceinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x, int y,
-                                          const evr_gather_sum *s)
-{
-    return evr_gather_sum_lum(&v->end, cam, &v->gp, g, x, y, s);
-}
-
-__device__ __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
-                                             const evr_gather_point *g, int x, int y)
-{
-    return evr_gather_point_lum(b, cam, &v->gp, g, x, y);
-}
-
-/* The gathers of point g (pixel (x, y)) at the segment's start and end; one where the window saw
- * no change (the same cells give the same estimate), none at the start where it is known
- * (known_ls: the previous segment's end gather of the same point). Two walks: walking both
- * buffers together, cell by cell, made the gather kernel 12% slower (H200, Cornell box at
- * 1280x720, 0.5 s: 0.237 s against 0.210 s). With gp.max_photons 0 (FIXED) the start is
- * never given here (a known start's end is its sums plus gi_scatter_kernel's, in
- * gi_gather_known_kernel), and the end's sums (s, out) are the start's plus the changed cells'
- * terms, a walk over the few changed cells of the window instead of all of it. */
-template <bool FIXED>
-__device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                                int y, float *ls, float *le, const float *known_ls, evr_gather_sum *s)
-{
-    const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y);
-    if (FIXED) {
-        gpu_gather_sum(&v->start, v, cam, g, x, y, s);
-        *ls = gpu_sum_lum(v, cam, g, x, y, s);
-        if (changed) gpu_gather_delta(v, cam, g, x, y, s);
-        *le = changed ? gpu_sum_lum(v, cam, g, x, y, s) : *ls;
-        return;
-    }
-    *ls = known_ls ? *known_ls : gpu_gather_lum(&v->start, v, cam, g, x, y);
-    *le = changed ? gpu_gather_lum(&v->end, v, cam, g, x, y) : *ls;
-}
-
-/* Whether two gather points are the same bit for bit (the same estimates). */
-__device__ __forceinline__ bool gather_point_same(const evr_gather_point *a, const evr_gather_point *b)
-{
-    const float fa[10] = {a->p.x, a->p.y, a->p.z, a->n.x, a->n.y, a->n.z, a->dist, a->k[0], a->k[1], a->k[2]};
-    const float fb[10] = {b->p.x, b->p.y, b->p.z, b->n.x, b->n.y, b->n.z, b->dist, b->k[0], b->k[1], b->k[2]};
-    unsigned d = 0;
-    for (int i = 0; i < 10; i++) d |= __float_as_uint(fa[i]) ^ __float_as_uint(fb[i]);
-    return d == 0;
-}
-
-/* Whether the memo holds gather point g of instance inst; if not, it takes it (the caller fills
- * lum or req). The albedo is the surface's at the point: same point, same triangle side. */
-__device__ __forceinline__ bool gi_memo_take(gi_memo *m, int inst, const evr_gather_point *g)
-{
-    const uint32_t key[7] = {__float_as_uint(g->p.x), __float_as_uint(g->p.y), __float_as_uint(g->p.z), __float_as_uint(g->n.x),
-                             __float_as_uint(g->n.y), __float_as_uint(g->n.z), __float_as_uint(g->dist)};
-    bool same = m->valid && m->inst == inst;
-    for (int k = 0; k < 7 && same; k++) same = m->key[k] == key[k];
-    if (same) return true;
-    for (int k = 0; k < 7; k++) m->key[k] = key[k];
-    m->inst = inst;
-    m->valid = true;
-    return false;
-}
-
-/* The indirect light of a sample at surface s of instance inst at normalized segment time f: the
- * pixel's memo, or gathers (the pixel's own thread walks its window; a version spreading each
- * window's cells over the warp's lanes was slower, measured on an H200: 2.07 s against 1.80 s of
- * render kernels for the Cornell box at 1280x720, 2 s: most windows are searched to the same
- * size, so the lanes of a warp were already busy in step). */
-__device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs, int inst, const evr_surface *s,
-                                             evr_v3 cam_org, int x, int y, float f, gi_memo *m)
-{
-    evr_gather_point gp;
-    gpu_gather_point(rs, inst, s, cam_org, &gp);
-    evr_gather_sum sums;
-    if (!gi_memo_take(m, inst, &gp)) {
-        if (g->gp.max_photons <= 0) gpu_gather_ends<true>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
-        else gpu_gather_ends<false>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
-    }
-    return evr_gi_lerp(m->ls, m->le, f);
-}
-
-/* Counters of a pass in the slot's counter array (after the render kernels' three). */
-/* the segment's counters (kernel_args.rays): 0 .. 2 rays, pixels skipped, samples traced (cuda_backend.cu);
- * then the photon pass's; KEY_RANGE: events outside the keys' time window (an internal error) */
-enum { GI_PATHS = 3, GI_INSERTED = 4, GI_COLLISIONS = 5, GI_CHANGED = 6, GI_REUSED = 7, KEY_RANGE = 8, GI_COUNTERS = 9 };
-
-struct photon_args {
-    const evr_photon_emitter *em;
-    int n_em;
-    const float *cdf;
-    evr_photon_params pp;
-    unsigned photons;
-    int margin, cells_w;
-    unsigned long long *sort_keys; /* (cell << 32) | photon key; all ones where no photon */
-    unsigned *sort_vals;           /* index into pending */
-    evr_photon *pending;
-    unsigned *pending_count;
-    /* trails (core/photon.h): NULL when they did not fit in memory */
-    evr_photon_trail *trails;
-    evr_trail_ray *trail_rays;
-    int trail_len;
-    int reuse;                     /* the trails are the previous pass's, with the same emitters */
-    unsigned *todo;                /* with reuse: the photons to trace (photon_reuse_kernel lists them) */
-    unsigned *todo_count;
-};
 
 /* Adds 1 per calling lane to counter c, one atomic per warp. */
 __device__ __forceinline__ void count_lanes(unsigned long long *counters, int c)
@@ -249,7 +48,7 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
     evr_photon_path path;
     if (!evr_photon_path_start(rs, p.em, p.n_em, p.cdf, &p.pp, i, &path)) return;
     t->started = 1;
-    count_lanes(a.rays, GI_PATHS);
+    count_lanes(a.counters, CTR_GI_PATHS);
     while (path.bounce < path.max_hits) {
         evr_gpu_hit h;
         evr_surface s;
@@ -289,7 +88,7 @@ __global__ void __launch_bounds__(BLOCK) photon_reuse_kernel(kernel_args a, phot
     if (i < p.photons) {
         const evr_trail_ray *rays = p.trail_rays + (size_t)i * (size_t)p.trail_len;
         if (evr_photon_trail_reusable(&p.trails[i], rays, a.plan)) {
-            count_lanes(a.rays, GI_REUSED);
+            count_lanes(a.counters, CTR_GI_REUSED);
             const evr_photon_trail t = p.trails[i];
             if (t.cell != EVR_TRAIL_NONE) photon_append(p, t.ph, t.cell);
         } else {
@@ -336,9 +135,9 @@ __global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long
     const unsigned rank = j - lo;
     if (rank < (unsigned)buf.layers) {
         buf.slots[(size_t)rank * (size_t)buf.width * (size_t)buf.height + cell] = pending[vals[j]];
-        atomicAdd(&counters[GI_INSERTED], 1ull);
+        atomicAdd(&counters[CTR_GI_INSERTED], 1ull);
     } else {
-        atomicAdd(&counters[GI_COLLISIONS], 1ull);
+        atomicAdd(&counters[CTR_GI_COLLISIONS], 1ull);
     }
     if (j + 1 == n || (unsigned)(keys[j + 1] >> 32) != cell) buf.count[cell] = rank + 1;   /* arrivals, as the CPU counts */
 }
@@ -376,7 +175,7 @@ __global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer
     const uint8_t now = !evr_photon_cell_same(&end, &start, (size_t)cell);
     sat[(size_t)(y + 1) * (size_t)(end.width + 1) + (size_t)(x + 1)] = now | last[cell];
     last[cell] = now;
-    if (now) count_lanes(counters, GI_CHANGED);   /* this segment's changes, as the CPU counts them */
+    if (now) count_lanes(counters, CTR_GI_CHANGED);   /* this segment's changes, as the CPU counts them */
 }
 
 /* The list of the cells that changed over the segment (core/photon.h's evr_changed_cells, for
@@ -478,4 +277,222 @@ __global__ void __launch_bounds__(32 * SAT_CHUNKS) sat_cols_kernel(uint32_t *sat
         for (int y = y0; y < y1; y++) sat[(size_t)y * W + (size_t)x] += carry;
 }
 
-#endif
+/* The pass's trails: reused where the previous pass recorded them with the same emitters; room
+ * for n photons (a pass that needs more starts them afresh). Without the memory, no trails (every
+ * photon traced, as before them), nor with EVR_NO_PHOTON_REUSE set (trails_off). */
+static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
+{
+    p->trails = nullptr;
+    p->trail_rays = nullptr;
+    p->trail_len = evr_photon_trail_len(&b->pp);
+    p->reuse = 0;
+    p->todo = nullptr;
+    p->todo_count = nullptr;
+    if (b->trails_off) return;
+    const size_t len = (size_t)p->trail_len;
+    if (n > b->d_trails.cap || (size_t)n * len > b->d_trail_rays.cap) {
+        b->trails_valid = 0;
+        if (b->d_trails.reserve(n, true) != cudaSuccess || b->d_trail_rays.reserve((size_t)n * len, true) != cudaSuccess) {
+            (void)cudaGetLastError();   /* not sticky: cleared */
+            b->d_trails.release();
+            b->d_trail_rays.release();
+            b->trails_off = 1;
+            return;
+        }
+    }
+    if (b->d_todo.reserve(n) != cudaSuccess || b->d_todo_count.reserve(1) != cudaSuccess) {
+        (void)cudaGetLastError();
+        b->trails_valid = 0;
+        return;   /* no reuse this pass, no trails recorded */
+    }
+    p->trails = b->d_trails.p;
+    p->trail_rays = b->d_trail_rays.p;
+    p->todo = b->d_todo.p;
+    p->todo_count = b->d_todo_count.p;
+    p->reuse = evr_photon_trails_pass(&b->trail_em, &b->trails_valid, &b->em);
+}
+
+/* One photon pass at normalized segment time f into buffer out, on the render stream:
+ * the photons, traced at f, and the camera's view of the cells at f. hrs: the segment's scene
+ * with host pointers (the emitters are built on the host). */
+static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs, float f, const evr_photon_buffer *out,
+                          evr_error *err)
+{
+    const size_t cells = (size_t)out->width * (size_t)out->height;
+    const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
+    cudaStream_t rs = b->render;
+    evr_status st;
+    if ((st = evr_photon_emitters_build(hrs, f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
+    if (b->gp.flux_scale == 0.0f) b->gp.flux_scale = evr_gather_flux_scale(b->em.total_power, b->photons);   /* the run's */
+    if (b->em.photons > (1u << 28)) {
+        snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", b->em.photons);
+        return EVR_ERR_ARG;
+    }
+    const unsigned n = b->em.n > 0 ? b->em.photons : 0u;
+    CK(sl->h_em.reserve((size_t)b->em.n + 1));
+    CK(sl->d_em.reserve((size_t)b->em.n + 1));
+    CK(sl->h_cdf.reserve((size_t)b->em.cdf_n + 1));
+    CK(sl->d_cdf.reserve((size_t)b->em.cdf_n + 1));
+    if (b->em.n) memcpy(sl->h_em.p, b->em.e, (size_t)b->em.n * sizeof(evr_photon_emitter));
+    if (b->em.cdf_n) memcpy(sl->h_cdf.p, b->em.cdf, (size_t)b->em.cdf_n * sizeof(float));
+    CK(cudaMemcpyAsync(sl->d_em.p, sl->h_em.p, ((size_t)b->em.n + 1) * sizeof(evr_photon_emitter), cudaMemcpyHostToDevice, rs));
+    CK(cudaMemcpyAsync(sl->d_cdf.p, sl->h_cdf.p, ((size_t)b->em.cdf_n + 1) * sizeof(float), cudaMemcpyHostToDevice, rs));
+    CK(b->d_pending.reserve((size_t)n + 1));
+    CK(b->d_pkeys.reserve((size_t)n + 1));
+    CK(b->d_pkeys_sorted.reserve((size_t)n + 1));
+    CK(b->d_pvals.reserve((size_t)n + 1));
+    CK(b->d_pvals_sorted.reserve((size_t)n + 1));
+    CK(cudaMemsetAsync(out->count, 0, cells * sizeof(uint32_t), rs));
+    CK(cudaMemsetAsync(b->d_pcount.p, 0, sizeof(unsigned), rs));
+    kernel_args a = make_args(b, sl);
+    if (n) {
+        photon_args p;
+        p.em = sl->d_em.p;
+        p.n_em = b->em.n;
+        p.cdf = sl->d_cdf.p;
+        p.pp = b->pp;
+        p.pp.ray_eps = hrs->ray_eps;
+        p.pp.f0 = p.pp.f1 = f;
+        p.photons = n;
+        p.margin = out->margin;
+        p.cells_w = out->width;
+        p.sort_keys = b->d_pkeys.p;
+        p.sort_vals = b->d_pvals.p;
+        p.pending = b->d_pending.p;
+        p.pending_count = b->d_pcount.p;
+        trail_args(b, n, &p);
+        CK(cudaMemsetAsync(b->d_pkeys.p, 0xff, (size_t)n * sizeof(unsigned long long), rs));
+        const unsigned pgrid = (n + BLOCK - 1) / BLOCK;
+        if (p.reuse) {
+            CK(cudaMemsetAsync(p.todo_count, 0, sizeof(unsigned), rs));
+            photon_reuse_kernel<<<pgrid, BLOCK, 0, rs>>>(a, p);
+            CK(cudaGetLastError());
+        }
+        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        else photon_kernel<EVR_GPU_LAYOUT_BVH4><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        CK(cudaGetLastError());
+        /* the cell in the high bits (up to 2^end - 1), the photon key in the low 32 */
+        int end_bit = 33;
+        while (end_bit < 64 && (1ull << (end_bit - 32)) <= cells) end_bit++;
+        size_t temp = 0;
+        CK(cub::DeviceRadixSort::SortPairs(nullptr, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
+                                           (int)n, 0, end_bit, rs));
+        CK(b->d_ptemp.reserve(temp));
+        CK(cub::DeviceRadixSort::SortPairs(b->d_ptemp.p, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
+                                           (int)n, 0, end_bit, rs));
+        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n, b->d_pending.p, *out, sl->d_counters.p);
+        CK(cudaGetLastError());
+    }
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    CK(cudaGetLastError());
+    sl->gi_passes++;
+    return EVR_OK;
+}
+
+/* The segment's photons on the render stream, before its render: the pass at its end (the first
+ * segment's at its start too), the cells that changed, the view its kernels read. A still segment
+ * (nothing moved in it or since the previous one) copies the previous segment's buffer. */
+evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
+{
+    const gi_buffer *end = &b->gi_ring[sl->index % NRING], *start = &b->gi_ring[(sl->index + NRING - 1) % NRING];
+    const evr_photon_buffer *eb = &end->ph, *sb = &start->ph;
+    const size_t cells = (size_t)eb->width * (size_t)eb->height;
+    const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
+    cudaStream_t rs = b->render;
+    evr_status st;
+    sl->gi_passes = 0;
+    CK(cudaMemsetAsync(sl->d_counters.p + CTR_GI_PATHS, 0, (CTR_COUNT - CTR_GI_PATHS) * sizeof(unsigned long long), rs));
+    if (evr_skip_plan_still(seg->skip) && b->gi_have_prev) {
+        CK(cudaMemcpyAsync(eb->count, sb->count, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->slots, sb->slots, cells * (size_t)eb->layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
+    } else {
+        CK(cudaEventRecord(sl->gi_started, rs));
+        if (!b->gi_have_prev) {
+            if ((st = gi_pass(b, sl, hrs, 0.0f, sb, err)) != EVR_OK) return st;
+            CK(cudaStreamSynchronize(rs));   /* the emitters' staging is the slot's: its copy done */
+        }
+        if ((st = gi_pass(b, sl, hrs, 1.0f, eb, err)) != EVR_OK) return st;
+    }
+    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p, sl->d_counters.p);
+    sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    sat_cols_kernel<<<(unsigned)((eb->width + 31) / 32), 32 * SAT_CHUNKS, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    if (b->gp.max_photons <= 0) {
+        const evr_changed_cells ch = sl->h_gi_view.p->ch;
+        changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width,
+                                                                                                          eb->height, sl->d_ch_before.p);
+        changed_base_kernel<<<1, 32, 0, rs>>>(sl->d_ch_before.p, eb->width, eb->height, sl->d_ch_base.p);
+        changed_list_kernel<<<cgrid, BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width, eb->height, ch, sl->d_ch_x.p);
+    }
+    CK(cudaGetLastError());
+    if (sl->gi_passes) CK(cudaEventRecord(sl->gi_done, rs));
+    /* the slot's last copy from its staging finished before its previous segment was collected */
+    gpu_gi_view *v = sl->h_gi_view.p;
+    v->end = *eb;
+    v->start = *sb;
+    v->gp = b->gp;   /* with the run's flux scale, known after the first pass */
+    v->ends_in = b->d_gi_ends[0].p ? b->d_gi_ends[sl->index % NRING].p : nullptr;
+    v->ends_out = b->d_gi_ends[0].p ? b->d_gi_ends[(sl->index + 1) % NRING].p : nullptr;
+    CK(cudaMemcpyAsync(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice, rs));
+    b->gi_have_prev = 1;
+    return EVR_OK;
+}
+
+/* Device memory of the ring's photon buffers and the per-cell changes (shared by the slots). */
+evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
+{
+    for (int i = 0; i < NRING; i++) {
+        gi_buffer *g = &b->gi_ring[i];
+        evr_photon_buffer *buf = &g->ph;
+        memset(buf, 0, sizeof *buf);
+        buf->width = b->setup.width + 2 * margin;
+        buf->height = b->setup.height + 2 * margin;
+        buf->layers = b->setup.photon_layers;
+        buf->margin = margin;
+        const size_t cells = (size_t)buf->width * (size_t)buf->height;
+        CK(g->slots.reserve(cells * (size_t)buf->layers));
+        CK(g->count.reserve(cells));
+        CK(g->gbuf.reserve(cells * 8));
+        CK(cudaMemset(g->count.p, 0, cells * sizeof(uint32_t)));
+        CK(cudaMemset(g->gbuf.p, 0, cells * 8 * sizeof(float)));
+        buf->slots = g->slots.p;
+        buf->count = g->count.p;
+        buf->gbuf = g->gbuf.p;
+        buf->collisions = nullptr;   /* the place kernel counts them (CTR_GI_COLLISIONS) */
+    }
+    const size_t cells = (size_t)b->gi_ring[0].ph.width * (size_t)b->gi_ring[0].ph.height;
+    CK(b->d_gi_last.reserve(cells));
+    CK(cudaMemset(b->d_gi_last.p, 0, cells));
+    return EVR_OK;
+}
+
+/* A slot's changed-cell table and the view its kernels read. */
+evr_status gi_alloc(cuda_backend *b, slot *sl, int window, evr_error *err)
+{
+    const evr_photon_buffer *shape = &b->gi_ring[0].ph;
+    const size_t sat_n = (size_t)(shape->width + 1) * (size_t)(shape->height + 1);
+    CK(sl->d_sat.reserve(sat_n));
+    CK(cudaMemset(sl->d_sat.p, 0, sat_n * sizeof(uint32_t)));
+    if (b->gp.max_photons <= 0) {
+        CK(sl->d_ch_before.reserve(((size_t)shape->width + 1) * (size_t)shape->height));
+        CK(sl->d_ch_base.reserve((size_t)shape->height + 1));
+        CK(sl->d_ch_x.reserve((size_t)shape->width * (size_t)shape->height));
+    }
+    CK(sl->h_gi_view.reserve(1));
+    gpu_gi_view *v = sl->h_gi_view.p;
+    v->end = v->start = *shape;
+    v->sat = sl->d_sat.p;
+    v->ch.before = sl->d_ch_before.p;
+    v->ch.base = sl->d_ch_base.p;
+    v->ch.x = sl->d_ch_x.p;
+    v->gp = b->gp;
+    v->window = window;
+    v->ends_in = nullptr;
+    v->ends_out = nullptr;
+    CK(sl->d_gi_view.reserve(1));
+    CK(cudaMemcpy(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice));
+    CK(cudaEventCreate(&sl->gi_started));
+    CK(cudaEventCreate(&sl->gi_done));
+    return EVR_OK;
+}

@@ -1,0 +1,434 @@
+/* The CUDA backend's segment pipeline: submit queues a segment's upload, photon passes and render
+ * on the render stream in the next free slot; when its render is done its events (64-bit keys)
+ * are sorted with CUB's radix sort and copied to pinned host memory on the slot's copy stream
+ * while later segments render; collect takes the oldest segment's events, renders it again with
+ * a larger buffer if its events overflowed (its input pixel states are unchanged: ring of NRING),
+ * decodes the sorted keys before emit_before on the thread pool and carries the rest on the
+ * device into the next segment's sort. */
+#include "cuda/cuda_pipeline.cuh"
+#include "cuda/cuda_gi.cuh"
+#include "cuda/cuda_gi_deferred.cuh"
+#include "cuda/cuda_render.cuh"
+#include "cuda/cuda_state.cuh"
+#include "host_clock.h"
+
+#include <cub/device/device_radix_sort.cuh>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Renders a slot's segment on the render stream and queues the read-back of its event count. */
+static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
+{
+    CK(cudaMemsetAsync(sl->d_count.p, 0, COUNT_N * sizeof(unsigned int), b->render));
+    CK(cudaMemsetAsync(sl->d_counters.p, 0, CTR_GI_PATHS * sizeof(unsigned long long), b->render));   /* the render's */
+    CK(cudaMemsetAsync(sl->d_counters.p + CTR_KEY_RANGE, 0, sizeof(unsigned long long), b->render));
+    kernel_args a = make_args(b, sl);
+    CK(cudaEventRecord(sl->started, b->render));
+    const unsigned grid = (tiled_threads(b->setup.width, b->setup.height) + BLOCK - 1) / BLOCK;   /* >= npix threads */
+    const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
+    const kernel_variant v = run_variant(b);
+    cudaStream_t rs = b->render;
+    if (b->setup.adaptive) {
+        adapt_args d;
+        d.next_in = b->d_next[sl->index % NRING].p;
+        d.next_out = b->d_next[(sl->index + 1) % NRING].p;
+        d.plan = sl->d_adapt.p;
+        d.p = b->setup.adapt;
+        cuda_launch_adapt(a, d, v, grid, rs);
+    } else {
+        gi_deferred d{};   /* no requests: none made by the skip kernel */
+        if (b->gi_deferred) {
+            d = deferred_args(b);
+            CK(cudaMemsetAsync(d.count, 0, REQ_COUNTS * sizeof(unsigned), rs));
+        }
+        if (sl->reuse) {
+            cuda_launch_skip(a, d, ideal, grid, rs);
+            CK(cudaGetLastError());
+        }
+        evr_status st;
+        if (b->gi_deferred) {
+            if ((st = gi_deferred_render(b, a, d, grid, err)) != EVR_OK) return st;
+        } else {
+            cuda_launch_render(a, v, grid, rs);
+        }
+    }
+    CK(cudaGetLastError());
+    CK(cudaEventRecord(sl->rendered, b->render));
+    if (sl->num_frames > 0) {   /* after the timed render: device time stays the events' */
+        cuda_launch_frames(a, v, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p, grid, rs);
+        CK(cudaGetLastError());
+        CK(cudaEventRecord(sl->framed, b->render));
+    }
+    CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
+    CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p + COUNT_EVENTS, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_counters.p, sl->d_counters.p, CTR_COUNT * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaEventRecord(sl->counted, sl->copy));
+    sl->copying = 0;
+    return EVR_OK;
+}
+
+/* Keys carried from the segment before, moved onto this segment's time base (both bases are
+ * whole microseconds, the times in range: start_copy checks them). */
+__global__ void carry_keys(const unsigned long long *from, size_t n, unsigned long long delta, unsigned long long *to)
+{
+    for (size_t i = blockIdx.x * (size_t)blockDim.x + threadIdx.x; i < n; i += (size_t)gridDim.x * blockDim.x)
+        to[i] = from[i] - delta;
+}
+
+/* Grows d to hold n keys, keeping its first keep (the buffer is reallocated rarely: doubling). */
+static cudaError_t grow_keeping(dbuf<unsigned long long> &d, size_t n, size_t keep, cudaStream_t s)
+{
+    if (n <= d.cap) return cudaSuccess;
+    dbuf<unsigned long long> g;
+    cudaError_t e = g.reserve(n);
+    if (e == cudaSuccess && keep) e = cudaMemcpyAsync(g.p, d.p, keep * sizeof(unsigned long long), cudaMemcpyDeviceToDevice, s);
+    if (e == cudaSuccess) e = cudaStreamSynchronize(s);
+    if (e != cudaSuccess) {
+        g.release();
+        return e;
+    }
+    d.release();
+    d.p = g.p;
+    d.cap = g.cap;
+    g.p = nullptr;
+    g.cap = 0;
+    return cudaSuccess;
+}
+
+cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n, size_t *temp)
+{
+    return cub::DeviceRadixSort::SortKeys(nullptr, *temp, keys, sorted, n, 0, 64);
+}
+
+/* Queues the sort and copy to the host of a rendered segment's n events, with the keys the
+ * segment before it carried (b->carry_*: its events at or after its emit_before), and of its
+ * intensity and frames, on the slot's copy stream. The segment before has been collected. */
+static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err)
+{
+    const size_t carried = b->carry_slot >= 0 ? b->carry_n : 0;
+    CK(cudaEventRecord(sl->sort_from, sl->copy));
+    if (carried) {
+        if (b->carry_t_lo < sl->base_us || b->carry_t_hi - sl->base_us >= slot_span_us(b, sl)) {
+            snprintf(err->msg, sizeof err->msg, "internal error: events carried to the segment at %.6f s fall outside its time window",
+                     sl->t0);
+            return EVR_ERR_BACKEND;
+        }
+        const int shift = key_time_shift(b->setup.width, b->setup.height);
+        const unsigned long long delta = (unsigned long long)(sl->base_us - b->carry_base_us) << shift;
+        CK(grow_keeping(sl->d_keys_ev, n + carried, n, sl->copy));
+        const unsigned blocks = (unsigned)((carried + BLOCK - 1) / BLOCK < 1024 ? (carried + BLOCK - 1) / BLOCK : 1024);
+        carry_keys<<<blocks, BLOCK, 0, sl->copy>>>(b->slots[b->carry_slot].d_keys_sorted.p + b->carry_at, carried, delta,
+                                                   sl->d_keys_ev.p + n);
+        CK(cudaGetLastError());
+    }
+    n += carried;
+    sl->total = n;
+    if (n) {
+        size_t temp = 0;
+        CK(sl->d_keys_sorted.reserve(n));
+        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->d_sort_temp.reserve(temp));
+        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sl->h_sorted.reserve(n));
+        CK(cudaEventRecord(sl->sorted, sl->copy));
+        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->want_intensity) {
+        size_t npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_intensity.reserve(npix));
+        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->num_frames) {
+        size_t nf = (size_t)sl->num_frames * (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_frames.reserve(nf));
+        CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
+        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+    }
+    CK(cudaEventRecord(sl->copied, sl->copy));
+    sl->copying = 1;
+    return EVR_OK;
+}
+
+/* Queues the sort and copy of the oldest submitted segment when its render is done (its count is
+ * on the host) and its events fit its buffer (else collect renders it again): it runs on the GPU
+ * while the host is busy elsewhere, instead of after the host asks for it. */
+static evr_status start_ready_copies(cuda_backend *b, evr_error *err)
+{
+    /* only the oldest: a sort takes the keys its segment before carries, known once collected */
+    if (!b->queued) return EVR_OK;
+    slot *sl = &b->slots[b->head];
+    if (sl->copying) return EVR_OK;
+    const cudaError_t e = cudaEventQuery(sl->counted);
+    if (e == cudaErrorNotReady) return EVR_OK;
+    CK(e);
+    const size_t n = *sl->h_count.p;
+    if (n > sl->d_keys_ev.cap) return EVR_OK;   /* collect renders it again */
+    return start_copy(b, sl, n, err);
+}
+
+evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err)
+{
+    cuda_backend *b = (cuda_backend *)base;
+    evr_status st;
+    const double tl_sub0 = evr_host_seconds();
+    if (b->queued == NSLOT) {
+        snprintf(err->msg, sizeof err->msg, "internal error: more than %d segments submitted", NSLOT);
+        return EVR_ERR_BACKEND;
+    }
+    /* the segments rendered since the last call: their sorts start now, before the host work below */
+    if ((st = start_ready_copies(b, err)) != EVR_OK) return st;
+    slot *sl = &b->slots[(b->head + b->queued) % NSLOT];
+    /* the slot's previous segment was collected, so its copy stream is idle */
+    CK(sl->d_keys_ev.reserve(b->capacity));
+    sl->index = seg->index;
+    sl->t0 = seg->t0;
+    sl->t1 = seg->t1;
+    sl->camera_static = seg->camera_static;
+    sl->want_intensity = seg->want_intensity;
+    sl->reuse = seg->skip->reuse;
+    *sl->h_plan.p = *seg->skip;
+    CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice, b->render));
+    if (b->setup.adaptive) {
+        *sl->h_adapt.p = *seg->adapt;
+        CK(cudaMemcpyAsync(sl->d_adapt.p, sl->h_adapt.p, sizeof(evr_adapt_plan), cudaMemcpyHostToDevice, b->render));
+    }
+    sl->num_frames = seg->num_frames > 0 ? seg->num_frames : 0;
+    if (sl->num_frames) {
+        size_t nf = (size_t)sl->num_frames, npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_frame_f.reserve(nf));
+        CK(sl->d_frame_f.reserve(nf));
+        CK(sl->d_frames.reserve(nf * npix));
+        for (int k = 0; k < sl->num_frames; k++) {
+            double f = seg->t1 > seg->t0 ? (seg->frame_times[k] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            sl->h_frame_f.p[k] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+        }
+        CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float), cudaMemcpyHostToDevice, b->render));
+    }
+    /* events reach back to the previous segment (a pixel's last sample there; with adaptive
+     * sampling up to max_dt back), and timestamp jitter and rounding move them by up to
+     * EVR_JITTER_CLIP sigma plus one resolution step either way; one more segment to spare. An
+     * event outside the window is counted (CTR_KEY_RANGE) and fails the run, never wraps. */
+    const evr_pixel_params *px = &b->setup.pixel;
+    double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter + (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
+    double dt = seg->t1 - seg->t0, back = 2.0 * dt + slack;
+    if (b->setup.adaptive) back += (double)b->setup.adapt.max_dt;   /* a pixel's last sample: up to max_dt back */
+    sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
+    double span_us = (back + dt + slack) * 1e6 + 2.0;
+    int tbits = 1;
+    while (tbits < 31 && (double)(1ull << tbits) < span_us) tbits++;
+    sl->end_bit = key_time_shift(b->setup.width, b->setup.height) + tbits;
+    sl->num_tracks = seg->num_tracks;
+    sl->num_keys = seg->num_keys;
+    CK(sl->h_keys.reserve((size_t)seg->num_keys));
+    CK(sl->h_tracks.reserve(2 * (size_t)seg->num_tracks));
+    memcpy(sl->h_keys.p, seg->keys, (size_t)seg->num_keys * sizeof(evr_motion_key));
+    memcpy(sl->h_tracks.p, seg->track_offset, (size_t)seg->num_tracks * sizeof(int));
+    memcpy(sl->h_tracks.p + seg->num_tracks, seg->track_count, (size_t)seg->num_tracks * sizeof(int));
+    /* top level over the instances, bounds over the whole segment */
+    evr_render_scene hrs = b->host.rs;
+    hrs.keys = sl->h_keys.p;
+    hrs.track_offset = sl->h_tracks.p;
+    hrs.track_count = sl->h_tracks.p + seg->num_tracks;
+    if ((st = evr_gpu_top_build(&b->bvh, &hrs, &sl->top, err)) != EVR_OK) return st;
+    CK(sl->d_keys.reserve((size_t)seg->num_keys));
+    CK(sl->d_tracks.reserve(2 * (size_t)seg->num_tracks));
+    CK(sl->d_insts.reserve(sl->top.num_insts + 1));
+    CK(cudaMemcpyAsync(sl->d_keys.p, sl->h_keys.p, (size_t)seg->num_keys * sizeof(evr_motion_key), cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_tracks.p, sl->h_tracks.p, 2 * (size_t)seg->num_tracks * sizeof(int), cudaMemcpyHostToDevice, b->render));
+    if (sl->top.nodes4) {
+        CK(sl->d_top4.reserve(sl->top.num_nodes + 1));
+        CK(cudaMemcpyAsync(sl->d_top4.p, sl->top.nodes4, sl->top.num_nodes * sizeof(evr_gpu_node4), cudaMemcpyHostToDevice, b->render));
+    }
+    if (sl->top.nodes8) {
+        CK(sl->d_top8.reserve(sl->top.num_nodes + 1));
+        CK(cudaMemcpyAsync(sl->d_top8.p, sl->top.nodes8, sl->top.num_nodes * sizeof(evr_gpu_node8), cudaMemcpyHostToDevice, b->render));
+    }
+    CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst), cudaMemcpyHostToDevice, b->render));
+    /* the host top-level arrays are reused by the next build of this slot only after collect,
+     * by which time these copies are done (collect synchronizes) */
+    /* a still camera: its rays' hits in the static group, made again when the camera has moved */
+    sl->static_gen = -1;
+    if (seg->camera_static && !b->static_off) {
+        const evr_motion_key *cam = &seg->keys[seg->track_offset[b->host.rs.camera_track]];
+        if (b->static_gen == 0 || memcmp(cam, &b->static_cam, sizeof *cam) != 0) {
+            const int npix = b->setup.width * b->setup.height;
+            CK(b->d_static.reserve((size_t)npix));
+            b->static_gen++;
+            kernel_args a = make_args(b, sl);
+            const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
+            cuda_launch_static_hits(a, b->bvh.layout, b->d_static.p, grid, b->render);
+            CK(cudaGetLastError());
+            b->static_cam = *cam;
+        }
+        sl->static_gen = b->static_gen;
+    }
+    if (b->gi && (st = gi_segment(b, sl, seg, &hrs, err)) != EVR_OK) return st;
+    if ((st = launch(b, sl, err)) != EVR_OK) return st;
+    b->queued++;
+    if (timeline_rec *r = timeline_at(&b->tl, seg->index)) {
+        r->sub0 = tl_sub0;
+        r->sub1 = evr_host_seconds();
+    }
+    return EVR_OK;
+}
+
+/* The event of a sorted key (pack_event's layout). */
+static inline evr_event decode_key(unsigned long long k, long long base_us, int xb, int yb)
+{
+    evr_event e;
+    e.t = base_us + (long long)(k >> (1 + xb + yb));
+    e.y = (uint16_t)((k >> (1 + xb)) & ((1u << yb) - 1u));
+    e.x = (uint16_t)((k >> 1) & ((1u << xb) - 1u));
+    e.p = (int8_t)(k & 1u);
+    return e;
+}
+
+/* Decodes n sorted keys into dst, a segment of many events in parts on the pool: on one thread it
+ * was most of the main thread's own time (the eye's 218.7 M events in 30 s at 1280x720), and
+ * threads started per segment cost about as much as the work. */
+struct decode_job {
+    const unsigned long long *keys;
+    size_t n, parts;
+    long long base_us;
+    int xb, yb;
+    evr_event *dst;
+};
+static void decode_part(void *ctx, int k, int)
+{
+    const decode_job *j = (const decode_job *)ctx;
+    size_t i0, i1;
+    evr_par_share(j->n, (int)j->parts, k, &i0, &i1);
+    for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
+}
+static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n, long long base_us, int xb, int yb,
+                        evr_event *dst)
+{
+    const size_t chunk = (size_t)1 << 17;
+    size_t parts = (n + chunk - 1) / chunk, most = (size_t)evr_par_pool_threads(pool);
+    if (parts > most) parts = most;
+    if (parts < 1) parts = 1;
+    decode_job j = {keys, n, parts, base_us, xb, yb, dst};
+    evr_par_pool_run(pool, (int)parts, decode_part, &j);
+}
+
+evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
+                               const float **frames, evr_error *err)
+{
+    cuda_backend *b = (cuda_backend *)base;
+    evr_status st;
+    if (!b->queued) {
+        snprintf(err->msg, sizeof err->msg, "internal error: collect without a submitted segment");
+        return EVR_ERR_BACKEND;
+    }
+    slot *sl = &b->slots[b->head];
+    double tw = evr_host_seconds();
+    const double tl_col0 = tw;
+    CK(cudaEventSynchronize(sl->counted));
+    const double tl_counted = evr_host_seconds();
+    base->wait_seconds += evr_host_seconds() - tw;
+    size_t n = *sl->h_count.p;
+    while (n > sl->d_keys_ev.cap) {
+        /* overflow: grow and render this segment again from its unchanged input states (the
+         * next segment, if rendering, reads states this re-run rewrites identically: wait) */
+        CK(cudaDeviceSynchronize());
+        CK(sl->d_keys_ev.reserve(n + n / 4));
+        if (sl->d_keys_ev.cap > b->capacity) b->capacity = sl->d_keys_ev.cap;   /* the other slots grow at their next submit */
+        if ((st = launch(b, sl, err)) != EVR_OK) return st;
+        CK(cudaEventSynchronize(sl->counted));
+        n = *sl->h_count.p;
+    }
+    if (sl->h_counters.p[CTR_KEY_RANGE]) {
+        snprintf(err->msg, sizeof err->msg, "internal error: %llu events of the segment at %.6f s fell outside its time window",
+                 (unsigned long long)sl->h_counters.p[CTR_KEY_RANGE], sl->t0);
+        return EVR_ERR_BACKEND;
+    }
+    base->rays += sl->h_counters.p[CTR_RAYS];
+    base->pixels_skipped += sl->h_counters.p[CTR_SKIPPED];
+    base->samples_traced += sl->h_counters.p[CTR_TRACED];
+    if (b->gi && sl->gi_passes) {
+        float gi_ms = 0.0f;
+        CK(cudaEventElapsedTime(&gi_ms, sl->gi_started, sl->gi_done));
+        base->photon_seconds += 1e-3 * (double)gi_ms;
+        base->photons_traced += sl->h_counters.p[CTR_GI_PATHS];
+        base->photons_reused += sl->h_counters.p[CTR_GI_REUSED];
+        base->photons_stored += sl->h_counters.p[CTR_GI_INSERTED];
+        base->photon_collisions += sl->h_counters.p[CTR_GI_COLLISIONS];
+        base->photon_cells_changed += sl->h_counters.p[CTR_GI_CHANGED];
+        base->photon_passes += (uint64_t)sl->gi_passes;
+        sl->gi_passes = 0;   /* a re-render at overflow does not run the passes again */
+    }
+    float ms = 0.0f;
+    CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
+    base->device_seconds += 1e-3 * (double)ms;
+    if (b->setup.adaptive) base->samples += sl->h_counters.p[CTR_TRACED];   /* the samples taken, all traced */
+    else base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
+    if (!sl->copying && (st = start_copy(b, sl, n, err)) != EVR_OK) return st;
+    tw = evr_host_seconds();
+    CK(cudaStreamSynchronize(sl->copy));
+    base->wait_seconds += evr_host_seconds() - tw;
+    const double tl_copied = evr_host_seconds();
+    if (timeline_rec *r = timeline_at(&b->tl, sl->index)) {
+        CK(timeline_gpu(&b->tl, r, sl->started, sl->rendered, sl->sort_from, sl->copied));
+        r->col0 = tl_col0;
+        r->counted = tl_counted;
+        r->copied = tl_copied;
+        r->n = n;
+    }
+    if (n) {
+        float sort_ms = 0.0f, copy_ms = 0.0f;
+        CK(cudaEventElapsedTime(&sort_ms, sl->sort_from, sl->sorted));
+        CK(cudaEventElapsedTime(&copy_ms, sl->sorted, sl->copied));
+        base->sort_seconds += 1e-3 * (double)sort_ms;
+        base->copy_seconds += 1e-3 * (double)copy_ms;
+    }
+    /* The keys before emit_before are decoded; the rest stay on the device and are sorted again
+     * with the next segment's, which can precede them (a pixel's first sample there reaches back
+     * to its last one here). On the host they had to be merged with the next segment's events:
+     * 0.21 s of the main thread for the 30 s eye, and a copy of them at every hand-over. */
+    const int xb = event_key_bits(b->setup.width), yb = event_key_bits(b->setup.height);
+    const int shift = key_time_shift(b->setup.width, b->setup.height);
+    const size_t total = sl->total;   /* its own n and those carried in */
+    size_t split = total;
+    if (emit_before_us != INT64_MAX) {
+        const long long rel = (long long)emit_before_us - sl->base_us;
+        const unsigned long long limit = rel <= 0 ? 0ull : (unsigned long long)rel << shift;   /* the first key at or after it */
+        size_t lo = 0, hi = total;
+        if (rel >= slot_span_us(b, sl)) lo = total;
+        while (lo < hi) {
+            const size_t mid = lo + (hi - lo) / 2;
+            if (sl->h_sorted.p[mid] < limit) lo = mid + 1;
+            else hi = mid;
+        }
+        split = lo;
+    }
+    b->carry_slot = split < total ? b->head : -1;
+    b->carry_at = split;
+    b->carry_n = total - split;
+    b->carry_base_us = sl->base_us;
+    if (split < total) {
+        b->carry_t_lo = decode_key(sl->h_sorted.p[split], sl->base_us, xb, yb).t;
+        b->carry_t_hi = decode_key(sl->h_sorted.p[total - 1], sl->base_us, xb, yb).t;
+    }
+    /* decoded straight after any events held back in out, the two runs merged where they overlap */
+    const size_t held = out->n;
+    if (!evr_event_vec_reserve(out, split)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    decode_keys(b->par, sl->h_sorted.p, split, sl->base_us, xb, yb, out->data + held);
+    out->n += split;
+    if (!evr_events_merge_runs(out, held, &b->scratch)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for events");
+        return EVR_ERR_NOMEM;
+    }
+    *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
+    *frames = sl->num_frames ? sl->h_frames.p : NULL;
+    base->device_bytes = device_bytes(b);
+    if (timeline_rec *r = timeline_at(&b->tl, sl->index)) r->col1 = evr_host_seconds();
+    b->head = (b->head + 1) % NSLOT;
+    b->queued--;
+    return start_ready_copies(b, err);
+}
+
