@@ -23,20 +23,30 @@ int cmd_compare(int argc, char **argv)
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            puts("usage: evray compare REF TEST [--tol-us 100] [--json]\n\n"
-                 "Matches TEST's events one-to-one against REF's (same pixel, same polarity, |dt| <= tolerance,\n"
-                 "in time order) and prints event counts and their ratio, precision, recall, F1, the median\n"
-                 "and 95th percentile |dt| of matches and the correlation of per-pixel event counts.\n"
-                 "Reads any format evray writes (.h5, .txt, .npy).");
+            puts(
+                "usage: evray compare REF TEST [--tol-us 100] [--json]\n\n"
+                "Matches TEST's events one-to-one against REF's (same pixel, same polarity, |dt| <= tolerance,\n"
+                "in time order) and prints event counts and their ratio, precision, recall, F1, the median\n"
+                "and 95th percentile |dt| of matches and the correlation of per-pixel event counts.\n"
+                "Reads any format evray writes (.h5, .txt, .npy).");
             return 0;
         }
         if (!strcmp(a, "--json")) json = 1;
         else if (opt_is(a, "--tol-us")) {
-            if (!(v = opt_value(argc, argv, &i, "--tol-us")) || !opt_double("--tol-us", v, &tol)) return 2;
-            if (tol < 0) { cli_error("--tol-us must be >= 0"); return 2; }
-        } else if (a[0] == '-' && a[1]) { cli_error("compare: unknown option '%s'", a); return 2; }
-        else if (np < 2) paths[np++] = a;
-        else { cli_error("compare takes two event files"); return 2; }
+            if (!(v = opt_value(argc, argv, &i, "--tol-us")) || !opt_double("--tol-us", v, &tol))
+                return 2;
+            if (tol < 0) {
+                cli_error("--tol-us must be >= 0");
+                return 2;
+            }
+        } else if (a[0] == '-' && a[1]) {
+            cli_error("compare: unknown option '%s'", a);
+            return 2;
+        } else if (np < 2) paths[np++] = a;
+        else {
+            cli_error("compare takes two event files");
+            return 2;
+        }
     }
     if (np != 2) {
         cli_error("compare needs two event files (evray compare REF TEST)");
@@ -67,20 +77,25 @@ int cmd_compare(int argc, char **argv)
         return 1;
     }
     if (json) {
-        printf("{\"tol_us\": %.17g, \"ref_on\": %llu, \"ref_off\": %llu, \"test_on\": %llu, \"test_off\": %llu, "
-               "\"count_ratio\": %.6f, \"matched\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"f1\": %.6f, "
-               "\"median_dt_us\": %.1f, \"p95_dt_us\": %.1f, \"pixel_count_correlation\": %.6f}\n",
-               tol, (unsigned long long)r.ref_on, (unsigned long long)r.ref_off, (unsigned long long)r.test_on,
-               (unsigned long long)r.test_off, r.count_ratio, (unsigned long long)r.matched, r.precision, r.recall,
-               r.f1, r.median_dt_us, r.p95_dt_us, r.pixel_count_correlation);
+        printf(
+            "{\"tol_us\": %.17g, \"ref_on\": %llu, \"ref_off\": %llu, \"test_on\": %llu, \"test_off\": %llu, "
+            "\"count_ratio\": %.6f, \"matched\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"f1\": %.6f, "
+            "\"median_dt_us\": %.1f, \"p95_dt_us\": %.1f, \"pixel_count_correlation\": %.6f}\n",
+            tol, (unsigned long long)r.ref_on, (unsigned long long)r.ref_off,
+            (unsigned long long)r.test_on, (unsigned long long)r.test_off, r.count_ratio,
+            (unsigned long long)r.matched, r.precision, r.recall, r.f1, r.median_dt_us, r.p95_dt_us,
+            r.pixel_count_correlation);
     } else {
-        printf("reference: %llu events (%llu ON, %llu OFF)\n", (unsigned long long)(r.ref_on + r.ref_off),
-               (unsigned long long)r.ref_on, (unsigned long long)r.ref_off);
-        printf("test:      %llu events (%llu ON, %llu OFF), ratio %.4f\n", (unsigned long long)(r.test_on + r.test_off),
-               (unsigned long long)r.test_on, (unsigned long long)r.test_off, r.count_ratio);
+        printf("reference: %llu events (%llu ON, %llu OFF)\n",
+               (unsigned long long)(r.ref_on + r.ref_off), (unsigned long long)r.ref_on,
+               (unsigned long long)r.ref_off);
+        printf("test:      %llu events (%llu ON, %llu OFF), ratio %.4f\n",
+               (unsigned long long)(r.test_on + r.test_off), (unsigned long long)r.test_on,
+               (unsigned long long)r.test_off, r.count_ratio);
         printf("matched within %.0f us: %llu; precision %.4f, recall %.4f, F1 %.4f\n", tol,
                (unsigned long long)r.matched, r.precision, r.recall, r.f1);
-        printf("|dt| of matches: median %.0f us, 95th percentile %.0f us\n", r.median_dt_us, r.p95_dt_us);
+        printf("|dt| of matches: median %.0f us, 95th percentile %.0f us\n", r.median_dt_us,
+               r.p95_dt_us);
         printf("per-pixel event count correlation: %.4f\n", r.pixel_count_correlation);
     }
     return 0;

@@ -42,12 +42,13 @@ int cmd_demo(int argc, char **argv)
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             const char *const *names = evr_demo_names();
-            puts("usage: evray demo [--scene NAME] [--export FILE.glb | render options]\n\n"
-                 "Renders a built-in scene (as `evray render`, same options), or with --export writes it\n"
-                 "as a binary glTF file that any glTF reader (and evray render) loads.\n\n"
-                 "  --scene NAME    built-in scene (default eye)\n"
-                 "  --export FILE   write the scene as glTF 2.0 binary and exit\n"
-                 "  --list          list the built-in scenes\n");
+            puts(
+                "usage: evray demo [--scene NAME] [--export FILE.glb | render options]\n\n"
+                "Renders a built-in scene (as `evray render`, same options), or with --export writes it\n"
+                "as a binary glTF file that any glTF reader (and evray render) loads.\n\n"
+                "  --scene NAME    built-in scene (default eye)\n"
+                "  --export FILE   write the scene as glTF 2.0 binary and exit\n"
+                "  --list          list the built-in scenes\n");
             fputs("scenes:", stdout);
             for (j = 0; names[j]; j++) printf(" %s", names[j]);
             fputs("\n", stdout);
@@ -66,9 +67,15 @@ int cmd_demo(int argc, char **argv)
     rest[nrest++] = argv[0];
     for (i = 1; i < argc; i++) {
         if (opt_is(argv[i], "--scene")) {
-            if (!(scene = opt_value(argc, argv, &i, "--scene"))) { free(rest); return 2; }
+            if (!(scene = opt_value(argc, argv, &i, "--scene"))) {
+                free(rest);
+                return 2;
+            }
         } else if (opt_is(argv[i], "--export")) {
-            if (!(export_path = opt_value(argc, argv, &i, "--export"))) { free(rest); return 2; }
+            if (!(export_path = opt_value(argc, argv, &i, "--export"))) {
+                free(rest);
+                return 2;
+            }
         } else {
             rest[nrest++] = argv[i];
         }

@@ -11,8 +11,9 @@ int cmd_info(int argc, char **argv)
     int i;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            puts("usage: evray info SCENE\n\nDescribes a scene as evray imports it: cameras, lights, animations and\n"
-                 "their time ranges, meshes, instances and triangles.");
+            puts(
+                "usage: evray info SCENE\n\nDescribes a scene as evray imports it: cameras, lights, animations and\n"
+                "their time ranges, meshes, instances and triangles.");
             return 0;
         }
         if (argv[i][0] == '-') {

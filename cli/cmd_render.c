@@ -27,7 +27,8 @@ typedef struct {
 static int on_progress(void *user, const evr_stats *st)
 {
     progress_state *p = (progress_state *)user;
-    if (p->duration <= 0 && st->segments_done > 0)   /* the animation's length: known from the first segment */
+    if (p->duration <= 0 &&
+        st->segments_done > 0) /* the animation's length: known from the first segment */
         p->duration = st->sim_time * st->segments_total / st->segments_done;
     if (p->show) {
         double frac = st->segments_total ? (double)st->segments_done / st->segments_total : 1.0;
@@ -53,8 +54,9 @@ static void help(void)
           "\n"
           "Renders SCENE over time with every pixel sampling at its own times and writes the\n"
           "time-sorted DVS events, previews and run.json into the run folder.\n"
-          "\n", stdout);
-    if (options) fputs(options, stdout);   /* made from the configuration table */
+          "\n",
+          stdout);
+    if (options) fputs(options, stdout); /* made from the configuration table */
     free(options);
 }
 
@@ -68,12 +70,24 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     if (!render_options_init(&ro, &cfg, 0, argc)) return 1;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); render_options_free(&ro); return 0; }
-        else if ((r = parse_render_option(argc, argv, &i, &ro)) < 0) { render_options_free(&ro); return 2; }
-        else if (r > 0) continue;
-        else if (a[0] == '-' && a[1]) { cli_error("unknown option '%s' (see evray render --help)", a); render_options_free(&ro); return 2; }
-        else if (!scene_path && !default_demo) scene_path = a;
-        else { cli_error("unexpected argument '%s'", a); render_options_free(&ro); return 2; }
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            render_options_free(&ro);
+            return 0;
+        } else if ((r = parse_render_option(argc, argv, &i, &ro)) < 0) {
+            render_options_free(&ro);
+            return 2;
+        } else if (r > 0) continue;
+        else if (a[0] == '-' && a[1]) {
+            cli_error("unknown option '%s' (see evray render --help)", a);
+            render_options_free(&ro);
+            return 2;
+        } else if (!scene_path && !default_demo) scene_path = a;
+        else {
+            cli_error("unexpected argument '%s'", a);
+            render_options_free(&ro);
+            return 2;
+        }
     }
     r = render_options_finish(&ro, argc, argv);
     cfg = ro.cfg;
@@ -81,7 +95,8 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     render_options_free(&ro);
     if (!r) return 2;
     if (!scene_path && !default_demo) {
-        cli_error("render needs a scene file (evray render SCENE [options]; evray demo for the built-in scene)");
+        cli_error(
+            "render needs a scene file (evray render SCENE [options]; evray demo for the built-in scene)");
         return 2;
     }
 
@@ -117,19 +132,25 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     } else {
         if (!quiet) {
             unsigned long long ev = (unsigned long long)(stats->events_on + stats->events_off);
-            printf("%s: %llu events (%llu ON, %llu OFF), %llu unique timestamps, %.3f s simulated\n",
-                   cfg.out_dir, ev, (unsigned long long)stats->events_on, (unsigned long long)stats->events_off,
-                   (unsigned long long)stats->unique_timestamps, stats->sim_time);
+            printf(
+                "%s: %llu events (%llu ON, %llu OFF), %llu unique timestamps, %.3f s simulated\n",
+                cfg.out_dir, ev, (unsigned long long)stats->events_on,
+                (unsigned long long)stats->events_off, (unsigned long long)stats->unique_timestamps,
+                stats->sim_time);
             printf("backend %s (%s)\n", stats->backend, stats->device);
-            printf("%llu samples, %llu rays in %.2f s: %.2f M samples/s, %.2f M rays/s, real-time factor %.4f\n",
-                   (unsigned long long)stats->samples, (unsigned long long)stats->rays, stats->wall_time,
-                   stats->samples_per_second / 1e6, stats->rays_per_second / 1e6, stats->realtime_factor);
+            printf(
+                "%llu samples, %llu rays in %.2f s: %.2f M samples/s, %.2f M rays/s, real-time factor %.4f\n",
+                (unsigned long long)stats->samples, (unsigned long long)stats->rays,
+                stats->wall_time, stats->samples_per_second / 1e6, stats->rays_per_second / 1e6,
+                stats->realtime_factor);
             if (ev == 0)
-                printf("no events: nothing in view changed brightness by a threshold over the simulated time "
-                       "(a static scene gives none with the ideal sensor)\n");
+                printf(
+                    "no events: nothing in view changed brightness by a threshold over the simulated time "
+                    "(a static scene gives none with the ideal sensor)\n");
         }
         if (st == EVR_ERR_INTERRUPTED) {
-            fprintf(stderr, "evray: interrupted: %s holds every event of the first %.3f s\n", cfg.out_dir, stats->sim_time);
+            fprintf(stderr, "evray: interrupted: %s holds every event of the first %.3f s\n",
+                    cfg.out_dir, stats->sim_time);
             rc = 130;
         }
     }

@@ -17,11 +17,11 @@ int cmd_still(int argc, char **argv);
  * option into cfg and notes where it stood; render_options_finish then starts again from base,
  * applies the preset and replays the other options over it. */
 typedef struct {
-    evr_config cfg;               /* the configuration (final after render_options_finish) */
-    evr_config base;              /* the configuration before any option */
+    evr_config cfg;  /* the configuration (final after render_options_finish) */
+    evr_config base; /* the configuration before any option */
     int quiet;
-    const char *sensor;           /* the last --sensor given, NULL: none */
-    unsigned char *starts;        /* per argv index: 1 where a render option starts */
+    const char *sensor;    /* the last --sensor given, NULL: none */
+    unsigned char *starts; /* per argv index: 1 where a render option starts */
     int argc;
 } render_options;
 

@@ -7,22 +7,24 @@
 
 static void usage(FILE *f)
 {
-    fputs("usage: evray [COMMAND] [OPTIONS]\n"
-          "\n"
-          "Simulates an event camera (DVS) looking at an animated 3D scene, with a ray tracer.\n"
-          "With no command, renders the built-in eye demo into ./evray-out/.\n"
-          "\n"
-          "commands:\n"
-          "  render SCENE [options]   render a scene file (glTF 2.0 .glb/.gltf or any format Assimp reads)\n"
-          "  info SCENE               describe a scene: cameras, lights, animations, meshes, triangles\n"
-          "  demo [--scene NAME] ...  render a built-in scene, or export it with --export FILE.glb\n"
-          "  bench [--scene NAME] ... one run, one row of speed figures (samples/s, rays/s, real-time factor)\n"
-          "  plot EVENTS [-o PNG]     event rate over time (ON/OFF per bin) and an events-per-pixel heat map\n"
-          "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
-          "  still SCENE -o OUT.png   one image at one time, optionally with global illumination (--gi)\n"
-          "\n"
-          "  evray COMMAND --help     options of a command\n"
-          "  evray --version          version of evray and its libraries\n", f);
+    fputs(
+        "usage: evray [COMMAND] [OPTIONS]\n"
+        "\n"
+        "Simulates an event camera (DVS) looking at an animated 3D scene, with a ray tracer.\n"
+        "With no command, renders the built-in eye demo into ./evray-out/.\n"
+        "\n"
+        "commands:\n"
+        "  render SCENE [options]   render a scene file (glTF 2.0 .glb/.gltf or any format Assimp reads)\n"
+        "  info SCENE               describe a scene: cameras, lights, animations, meshes, triangles\n"
+        "  demo [--scene NAME] ...  render a built-in scene, or export it with --export FILE.glb\n"
+        "  bench [--scene NAME] ... one run, one row of speed figures (samples/s, rays/s, real-time factor)\n"
+        "  plot EVENTS [-o PNG]     event rate over time (ON/OFF per bin) and an events-per-pixel heat map\n"
+        "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
+        "  still SCENE -o OUT.png   one image at one time, optionally with global illumination (--gi)\n"
+        "\n"
+        "  evray COMMAND --help     options of a command\n"
+        "  evray --version          version of evray and its libraries\n",
+        f);
 }
 
 int main(int argc, char **argv)
@@ -44,7 +46,7 @@ int main(int argc, char **argv)
     if (!strcmp(c, "bench")) return cmd_bench(argc - 1, argv + 1);
     if (!strcmp(c, "plot")) return cmd_plot(argc - 1, argv + 1);
     if (!strcmp(c, "still")) return cmd_still(argc - 1, argv + 1);
-    if (c[0] == '-') return cmd_render(argc, argv, "eye");   /* options for the default job */
+    if (c[0] == '-') return cmd_render(argc, argv, "eye"); /* options for the default job */
     fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
     return 2;
 }

@@ -17,14 +17,40 @@ void cli_error(const char *fmt, ...)
 }
 
 /* The library parses; the program says what went wrong. */
-#define REPORT(call) do { evr_error err; if ((call) != EVR_OK) { cli_error("%s", err.msg); return 0; } return 1; } while (0)
+#define REPORT(call)                  \
+    do {                              \
+        evr_error err;                \
+        if ((call) != EVR_OK) {       \
+            cli_error("%s", err.msg); \
+            return 0;                 \
+        }                             \
+        return 1;                     \
+    } while (0)
 
-int opt_double(const char *opt, const char *text, double *out) { REPORT(evr_parse_double(opt, text, out, &err)); }
-int opt_float(const char *opt, const char *text, float *out) { REPORT(evr_parse_float(opt, text, out, &err)); }
-int opt_int(const char *opt, const char *text, int *out) { REPORT(evr_parse_int(opt, text, out, &err)); }
-int opt_u64(const char *opt, const char *text, uint64_t *out) { REPORT(evr_parse_u64(opt, text, out, &err)); }
-int opt_size(const char *opt, const char *text, int *w, int *h) { REPORT(evr_parse_size(opt, text, w, h, &err)); }
-int opt_formats(const char *text, int *formats) { REPORT(evr_formats_parse("--format", text, formats, &err)); }
+int opt_double(const char *opt, const char *text, double *out)
+{
+    REPORT(evr_parse_double(opt, text, out, &err));
+}
+int opt_float(const char *opt, const char *text, float *out)
+{
+    REPORT(evr_parse_float(opt, text, out, &err));
+}
+int opt_int(const char *opt, const char *text, int *out)
+{
+    REPORT(evr_parse_int(opt, text, out, &err));
+}
+int opt_u64(const char *opt, const char *text, uint64_t *out)
+{
+    REPORT(evr_parse_u64(opt, text, out, &err));
+}
+int opt_size(const char *opt, const char *text, int *w, int *h)
+{
+    REPORT(evr_parse_size(opt, text, w, h, &err));
+}
+int opt_formats(const char *text, int *formats)
+{
+    REPORT(evr_formats_parse("--format", text, formats, &err));
+}
 
 int opt_is(const char *arg, const char *name)
 {

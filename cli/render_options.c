@@ -28,7 +28,8 @@ void render_options_free(render_options *ro)
 
 /* One option of the configuration table (evr_config_option_find), or -q; 1 consumed, 0 not one of
  * them, -1 error. A --sensor is noted in *sensor (render_options_finish applies its preset). */
-static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *quiet, const char **sensor)
+static int one_option(int argc, char **argv, int *ip, evr_config *cfg_, int *quiet,
+                      const char **sensor)
 {
     evr_config cfg = *cfg_;
     evr_error err;
@@ -64,14 +65,15 @@ int render_options_finish(render_options *ro, int argc, char **argv)
     evr_error err;
     const char *sensor = NULL;
     int quiet = ro->quiet, i;
-    if (!ro->sensor) return 1;   /* no preset: the options as given */
+    if (!ro->sensor) return 1; /* no preset: the options as given */
     if (evr_config_sensor(&cfg, ro->sensor, &err) != EVR_OK) {
         cli_error("%s", err.msg);
         return 0;
     }
     for (i = 1; i < argc && i < ro->argc; i++) {
         if (!ro->starts[i]) continue;
-        if (one_option(argc, argv, &i, &cfg, &quiet, &sensor) < 0) return 0;   /* parsed once already */
+        if (one_option(argc, argv, &i, &cfg, &quiet, &sensor) < 0)
+            return 0; /* parsed once already */
     }
     cfg.sensor = ro->sensor;
     ro->cfg = cfg;

@@ -19,15 +19,17 @@ extern "C" {
 
 typedef enum {
     EVR_OK = 0,
-    EVR_ERR_ARG,          /* a parameter value that makes no sense */
-    EVR_ERR_IO,           /* a file could not be read or written */
-    EVR_ERR_FORMAT,       /* a file was read but is not a usable scene or event file */
-    EVR_ERR_NOMEM,        /* out of memory */
-    EVR_ERR_BACKEND,      /* the ray tracer or device failed */
-    EVR_ERR_INTERRUPTED   /* stopped on request; outputs hold every finished segment */
+    EVR_ERR_ARG,        /* a parameter value that makes no sense */
+    EVR_ERR_IO,         /* a file could not be read or written */
+    EVR_ERR_FORMAT,     /* a file was read but is not a usable scene or event file */
+    EVR_ERR_NOMEM,      /* out of memory */
+    EVR_ERR_BACKEND,    /* the ray tracer or device failed */
+    EVR_ERR_INTERRUPTED /* stopped on request; outputs hold every finished segment */
 } evr_status;
 
-typedef struct { char msg[512]; } evr_error;
+typedef struct {
+    char msg[512];
+} evr_error;
 
 /* One DVS event. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in microseconds. */
 typedef struct {
@@ -42,7 +44,8 @@ typedef struct evr_scene evr_scene;
 /* Loads any format Assimp reads (glTF 2.0 .gltf/.glb first of all). */
 evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err);
 /* Loads from memory; hint is the file extension ("glb", "gltf", "obj", ...). */
-evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out, evr_error *err);
+evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out,
+                                 evr_error *err);
 /* Names of the built-in scenes, NULL-terminated. */
 const char *const *evr_demo_names(void);
 /* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
@@ -72,40 +75,41 @@ typedef enum { EVR_BACKEND_AUTO = 0, EVR_BACKEND_CPU = 1, EVR_BACKEND_CUDA = 2 }
  * library does not know is refused with EVR_ERR_ARG. Strings are not copied by the setters here
  * (evr_sim_new copies what it keeps). */
 typedef struct {
-    size_t size;                  /* sizeof(evr_config) as the caller sees it: set by evr_config_defaults */
+    size_t size; /* sizeof(evr_config) as the caller sees it: set by evr_config_defaults */
     /* image and time */
-    int width, height;            /* pixels */
-    double duration;              /* seconds; <= 0: the scene's animation length */
-    double start;                 /* seconds into the animation */
-    double fps;                   /* segments per second; <= 0: the scene's frame rate, else 30 */
-    int samples_per_frame;        /* samples per pixel per segment */
-    const char *camera;           /* camera name, NULL for the first */
+    int width, height;     /* pixels */
+    double duration;       /* seconds; <= 0: the scene's animation length */
+    double start;          /* seconds into the animation */
+    double fps;            /* segments per second; <= 0: the scene's frame rate, else 30 */
+    int samples_per_frame; /* samples per pixel per segment */
+    const char *camera;    /* camera name, NULL for the first */
     /* pixel model */
-    float pos_thres, neg_thres;   /* contrast thresholds in log intensity */
-    float refractory;             /* seconds */
-    float log_floor;              /* intensity below which log response turns linear */
+    float pos_thres, neg_thres; /* contrast thresholds in log intensity */
+    float refractory;           /* seconds */
+    float log_floor;            /* intensity below which log response turns linear */
     /* sensor non-idealities (laws, sources and presets in docs/sensors.md); 0 turns each off,
      * and with all of them off the sensor is ideal (the default) */
-    const char *sensor;           /* name of the preset applied by evr_config_sensor, NULL: none */
-    float sigma_thres;            /* threshold mismatch: std dev of the per-pixel thresholds, log units */
-    float cutoff_hz;              /* photoreceptor low-pass cutoff at full brightness, Hz */
-    float full_intensity;         /* intensity that counts as full brightness (bandwidth, shot noise) */
-    float leak_rate;              /* leak ON events per second per pixel, mean */
-    float leak_jitter;            /* relative std dev of the per-pixel leak rate */
-    float shot_rate;              /* shot-noise events (ON + OFF) per second of a black pixel */
-    float hot_fraction;           /* fraction of pixels that are hot */
-    float hot_rate;               /* ON events per second of a hot pixel */
-    double time_res;              /* timestamp resolution, seconds (a whole number of microseconds) */
-    double time_jitter;           /* std dev of Gaussian timestamp jitter, seconds */
+    const char *sensor;   /* name of the preset applied by evr_config_sensor, NULL: none */
+    float sigma_thres;    /* threshold mismatch: std dev of the per-pixel thresholds, log units */
+    float cutoff_hz;      /* photoreceptor low-pass cutoff at full brightness, Hz */
+    float full_intensity; /* intensity that counts as full brightness (bandwidth, shot noise) */
+    float leak_rate;      /* leak ON events per second per pixel, mean */
+    float leak_jitter;    /* relative std dev of the per-pixel leak rate */
+    float shot_rate;      /* shot-noise events (ON + OFF) per second of a black pixel */
+    float hot_fraction;   /* fraction of pixels that are hot */
+    float hot_rate;       /* ON events per second of a hot pixel */
+    double time_res;      /* timestamp resolution, seconds (a whole number of microseconds) */
+    double time_jitter;   /* std dev of Gaussian timestamp jitter, seconds */
     /* shading */
-    float ambient;                /* ambient fraction of the base colour */
+    float ambient; /* ambient fraction of the base colour */
     uint64_t seed;
-    int threads;                  /* 0: all cores */
+    int threads; /* 0: all cores */
     evr_backend_kind backend;
-    int gpu_bvh;                  /* GPU node layout: 0 default, 4 (BVH4, float boxes), 8 (CW8, compressed) */
-    int64_t gpu_event_capacity;   /* events a GPU segment buffer holds at first (0: automatic); it grows
+    int gpu_bvh; /* GPU node layout: 0 default, 4 (BVH4, float boxes), 8 (CW8, compressed) */
+    int64_t
+        gpu_event_capacity; /* events a GPU segment buffer holds at first (0: automatic); it grows
                                      and the segment is rendered again when it overflows */
-    int no_skip;                  /* 1: trace every sample (brute force) instead of reusing the
+    int no_skip;            /* 1: trace every sample (brute force) instead of reusing the
                                      intensity of pixels nothing moving can reach (identical events) */
     /* sampling: EVR_SAMPLING_UNIFORM, samples_per_frame per pixel per segment at the pixel's own
      * phase; EVR_SAMPLING_ADAPTIVE, each pixel picks its next sample time from how fast its log
@@ -113,31 +117,31 @@ typedef struct {
      * what its rays meet moves in the image (2 adapt_frac pixels between samples), within
      * [min_dt, max_dt] (docs/architecture.md, "Adaptive sampling") */
     int sampling;
-    float adapt_frac;             /* (0, 1] */
-    double min_dt, max_dt;        /* seconds; max_dt <= 0: one segment (1 / fps) */
+    float adapt_frac;      /* (0, 1] */
+    double min_dt, max_dt; /* seconds; max_dt <= 0: one segment (1 / fps) */
     /* output */
     const char *out_dir;
-    int formats;                  /* evr_format bits */
-    double preview_window;        /* seconds per preview frame; <= 0: no previews */
-    int force;                    /* overwrite an existing run folder (and frames in frames_out) */
+    int formats;           /* evr_format bits */
+    double preview_window; /* seconds per preview frame; <= 0: no previews */
+    int force;             /* overwrite an existing run folder (and frames in frames_out) */
     /* intensity frames for frame-based tools (v2e and the like): frame k is every pixel's
      * intensity at exactly t_k = start + k / frames_fps (one sample at the pixel centre, not seen
      * by the pixel model), for every t_k <= start + duration (both ends included), written to
      * frames_out as frame_NNNNNN.png (8-bit gray, sRGB-encoded: intensity * frames_exposure
      * clamped to [0, 1]), frame_NNNNNN_linear16.png (16-bit gray, linear:
      * round(intensity * 65535 / frames_max) clamped) and frames.csv (index, time, files) */
-    const char *frames_out;       /* folder; NULL: no frames */
-    double frames_fps;            /* frames per second; <= 0: the segment rate (fps) */
-    float frames_exposure;        /* 8-bit frames: intensity that maps to white is 1 / this */
-    float frames_max;             /* 16-bit frames: intensity that maps to 65535 */
+    const char *frames_out; /* folder; NULL: no frames */
+    double frames_fps;      /* frames per second; <= 0: the segment rate (fps) */
+    float frames_exposure;  /* 8-bit frames: intensity that maps to white is 1 / this */
+    float frames_max;       /* 16-bit frames: intensity that maps to 65535 */
     /* global illumination: image-space photon mapping (src/core/photon.h) */
-    int gi;                       /* 0: direct light only, 1: photon mapping */
-    uint32_t photons;             /* photons per segment (0: one per pixel) */
-    float gather_radius;          /* distance filter r, world units (<= 0: 2% of the scene's diagonal) */
-    int gather_max;               /* photons per estimate at most */
-    int gather_window;            /* the gather window's half size at most, pixels */
-    int photon_layers;            /* photons each pixel of the buffer holds */
-    int gi_bounces;               /* indirect bounces of a photon */
+    int gi;              /* 0: direct light only, 1: photon mapping */
+    uint32_t photons;    /* photons per segment (0: one per pixel) */
+    float gather_radius; /* distance filter r, world units (<= 0: 2% of the scene's diagonal) */
+    int gather_max;      /* photons per estimate at most */
+    int gather_window;   /* the gather window's half size at most, pixels */
+    int photon_layers;   /* photons each pixel of the buffer holds */
+    int gi_bounces;      /* indirect bounces of a photon */
 } evr_config;
 
 /* Fills c with the defaults (the ideal sensor at 346x260, docs/sensors.md) and sets c->size.
@@ -154,28 +158,29 @@ evr_status evr_config_validate(const evr_config *c, const evr_scene *s, evr_erro
 
 typedef struct {
     uint64_t events_on, events_off, unique_timestamps;
-    uint64_t samples, rays;       /* samples: every pixel sample, as brute force would take them
+    uint64_t samples, rays;  /* samples: every pixel sample, as brute force would take them
                                      (adaptive sampling: every sample taken, all traced) */
-    uint64_t samples_traced;      /* samples that traced rays; the rest reused a cached intensity */
-    uint64_t pixels_skipped;      /* pixel-segments that traced nothing (change-driven sampling) */
-    double sim_time;              /* seconds simulated */
-    double wall_time;             /* seconds */
+    uint64_t samples_traced; /* samples that traced rays; the rest reused a cached intensity */
+    uint64_t pixels_skipped; /* pixel-segments that traced nothing (change-driven sampling) */
+    double sim_time;         /* seconds simulated */
+    double wall_time;        /* seconds */
     double samples_per_second, rays_per_second, realtime_factor;
     int segments_done, segments_total;
     int interrupted;
     /* where the time went (seconds; filled at the end of a run) */
-    double time_setup;            /* scene to backend: BVH builds, uploads */
-    double time_render;           /* waiting for and taking in the backend's segments */
-    double time_device;           /* GPU kernels (0 on the CPU) */
-    double time_sort, time_copy;  /* event sort and device-to-host copy inside the backend */
-    double time_write;            /* the writer thread's busy time (overlaps rendering) */
-    double time_photons;          /* global illumination: the photon passes (GPU: device time) */
+    double time_setup;           /* scene to backend: BVH builds, uploads */
+    double time_render;          /* waiting for and taking in the backend's segments */
+    double time_device;          /* GPU kernels (0 on the CPU) */
+    double time_sort, time_copy; /* event sort and device-to-host copy inside the backend */
+    double time_write;           /* the writer thread's busy time (overlaps rendering) */
+    double time_photons;         /* global illumination: the photon passes (GPU: device time) */
     uint64_t photons_stored, photon_collisions, photon_cells_changed;
-    uint64_t photons_traced, photons_reused;   /* photon paths traced, and those that reused their trail */
-    uint64_t device_memory;       /* bytes the backend holds on the GPU (0 on the CPU) */
-    char backend[16];             /* the backend that ran: "cpu" or "cuda" */
-    char device[128];             /* CPU threads or the GPU's name */
-    char notice[256];             /* e.g. why auto fell back to the CPU; empty if nothing to say */
+    uint64_t photons_traced,
+        photons_reused;     /* photon paths traced, and those that reused their trail */
+    uint64_t device_memory; /* bytes the backend holds on the GPU (0 on the CPU) */
+    char backend[16];       /* the backend that ran: "cpu" or "cuda" */
+    char device[128];       /* CPU threads or the GPU's name */
+    char notice[256];       /* e.g. why auto fell back to the CPU; empty if nothing to say */
 } evr_stats;
 
 typedef struct evr_sim evr_sim;

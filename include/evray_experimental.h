@@ -37,7 +37,8 @@ double evr_seconds(void);
  * Polarity is returned as 1 (p > 0) or 0 (p <= 0, so -1/1 files read too). Events keep the file's
  * order. *ev is malloc'ed (free() it; NULL when *n is 0). width/height are set to -1 when the
  * format does not store them; either pointer may be NULL. */
-evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height, evr_error *err);
+evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height,
+                           evr_error *err);
 
 /* ---- accuracy of an event stream against a reference (src/compare.c) ---- */
 /* One-to-one matching of events at the same pixel with the same polarity within a time
@@ -45,15 +46,16 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
 typedef struct {
     uint64_t ref_on, ref_off, test_on, test_off;
     uint64_t matched;
-    double precision, recall, f1;        /* matched / test, matched / ref, harmonic mean */
-    double count_ratio;                  /* test events / reference events */
-    double median_dt_us, p95_dt_us;      /* |t_test - t_ref| of matched pairs */
-    double pixel_count_correlation;      /* Pearson correlation of per-pixel event counts */
+    double precision, recall, f1;   /* matched / test, matched / ref, harmonic mean */
+    double count_ratio;             /* test events / reference events */
+    double median_dt_us, p95_dt_us; /* |t_test - t_ref| of matched pairs */
+    double pixel_count_correlation; /* Pearson correlation of per-pixel event counts */
 } evr_compare_result;
 
 /* Both streams sorted by time. tol_us >= 0. */
-evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test, size_t ntest, int64_t tol_us,
-                              evr_compare_result *out, evr_error *err);
+evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test,
+                              size_t ntest, int64_t tol_us, evr_compare_result *out,
+                              evr_error *err);
 
 /* ---- charts and images (src/io/plot.c, src/io/png.c) ---- */
 /* One line series: n points (x[i], y[i]) joined in order. */
@@ -61,25 +63,25 @@ typedef struct {
     const double *x, *y;
     size_t n;
     uint8_t color[3];
-    const char *label;            /* legend entry; NULL: none */
-    int markers;                  /* draw a small square at each point */
+    const char *label; /* legend entry; NULL: none */
+    int markers;       /* draw a small square at each point */
 } evr_plot_series;
 
 typedef struct {
-    int width, height;            /* image size in pixels */
+    int width, height; /* image size in pixels */
     const char *title, *xlabel, *ylabel;
-    int y_from_zero;              /* the y axis starts at 0 (else at the data's minimum) */
+    int y_from_zero; /* the y axis starts at 0 (else at the data's minimum) */
 } evr_plot_spec;
 
 /* Draws the series on shared axes (range from the data, "nice" ticks) and writes an RGB8 PNG. */
-evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const evr_plot_series *series,
-                              int nseries, evr_error *err);
+evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec,
+                              const evr_plot_series *series, int nseries, evr_error *err);
 /* Draws per-pixel counts (w x h, row-major, y = 0 the top row) with a log colour map
  * (log(1 + count) / log(1 + max)), scaled up by a whole factor when the image is small, with a
  * title and a colour bar labelled in counts, and writes an RGB8 PNG. *out_w and *out_h (may be NULL)
  * receive the image size. */
-evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h, const char *title,
-                                int *out_w, int *out_h, evr_error *err);
+evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h,
+                                const char *title, int *out_w, int *out_h, evr_error *err);
 /* channels: 1 (gray), 3 (RGB) or 4 (RGBA); bit_depth 8 or 16 (16-bit samples in native order).
  * Rows are top to bottom. Writes under path + ".tmp" and renames when complete. */
 evr_status evr_png_write(const char *path, const void *pixels, int width, int height, int channels,
@@ -107,22 +109,23 @@ typedef enum { EVR_GI_NONE = 0, EVR_GI_PHOTON = 1, EVR_GI_PATH = 2 } evr_gi_mode
 
 typedef struct {
     int width, height;
-    double time;                   /* seconds into the animation */
-    const char *camera;            /* NULL: the first */
+    double time;        /* seconds into the animation */
+    const char *camera; /* NULL: the first */
     evr_gi_mode gi;
-    int spp;                       /* path: paths per pixel */
-    uint32_t photons;              /* photon: photons per pass (0: 8 per pixel) */
-    float gather_radius;           /* photon: distance filter r, world units (<= 0: 2% of the scene's diagonal) */
-    int gather_max;                /* photon: photons per estimate at most */
-    int gather_window;             /* photon: the window's half size at most, pixels */
-    float gather_normal_cos;       /* photon: normals must agree to this cosine */
-    int photon_layers;             /* photon: photons per pixel of the buffer */
-    int gather_area;               /* photon: normalize over the surface the camera sees (evr_photon_gbuffer) */
-    int auto_layers;               /* photon: double the layers (up to 64) while > 3% of the photons collide */
-    int max_bounces;               /* indirect bounces (both methods) */
+    int spp;          /* path: paths per pixel */
+    uint32_t photons; /* photon: photons per pass (0: 8 per pixel) */
+    float
+        gather_radius; /* photon: distance filter r, world units (<= 0: 2% of the scene's diagonal) */
+    int gather_max;    /* photon: photons per estimate at most */
+    int gather_window;       /* photon: the window's half size at most, pixels */
+    float gather_normal_cos; /* photon: normals must agree to this cosine */
+    int photon_layers;       /* photon: photons per pixel of the buffer */
+    int gather_area; /* photon: normalize over the surface the camera sees (evr_photon_gbuffer) */
+    int auto_layers; /* photon: double the layers (up to 64) while > 3% of the photons collide */
+    int max_bounces; /* indirect bounces (both methods) */
     float ambient;
     uint64_t seed;
-    int threads;                   /* 0: all cores */
+    int threads; /* 0: all cores */
 } evr_still_params;
 
 void evr_still_defaults(evr_still_params *p);
@@ -130,20 +133,21 @@ void evr_still_defaults(evr_still_params *p);
 /* A rendered image and its figures. */
 typedef struct {
     int width, height;
-    float *rgb;                    /* width * height * 3 linear radiance, rows top to bottom */
-    float *direct;                 /* the direct term alone (same layout) */
-    int *instance;                 /* scene instance seen at each pixel's centre, -1: none */
+    float *rgb;    /* width * height * 3 linear radiance, rows top to bottom */
+    float *direct; /* the direct term alone (same layout) */
+    int *instance; /* scene instance seen at each pixel's centre, -1: none */
     /* photon mode: the pass */
     uint64_t photon_paths, photons_stayed, photons_visible, photons_inserted, photon_collisions;
-    float gather_radius;           /* the radius used */
-    int photon_layers;             /* the layers used */
-    double photons_per_estimate;   /* mean photons per gather over hit pixels */
+    float gather_radius;         /* the radius used */
+    int photon_layers;           /* the layers used */
+    double photons_per_estimate; /* mean photons per gather over hit pixels */
     double seconds_setup, seconds_photons, seconds_shading;
     int threads;
-    void *result;                  /* the library's own */
+    void *result; /* the library's own */
 } evr_still_image;
 
-evr_status evr_still_image_render(const evr_scene *s, const evr_still_params *p, evr_still_image *out, evr_error *err);
+evr_status evr_still_image_render(const evr_scene *s, const evr_still_params *p,
+                                  evr_still_image *out, evr_error *err);
 void evr_still_image_free(evr_still_image *im);
 
 /* ---- numbers and sizes as options give them ---- */
@@ -163,7 +167,8 @@ const evr_config_option *evr_config_option_find(const char *arg, const char **na
 int evr_config_option_takes_value(const evr_config_option *o);
 /* Sets what the option sets from value (NULL for an option without one); strings are kept as
  * given, not copied. EVR_ERR_ARG with a one-line message when value is not valid for it. */
-evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, const char *value, evr_error *err);
+evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, const char *value,
+                                 evr_error *err);
 /* The options' help, by section, as `evray render --help` shows it (malloc'ed; NULL: no memory). */
 char *evr_config_options_help(void);
 

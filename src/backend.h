@@ -20,15 +20,15 @@ typedef struct {
     uint64_t seed;
     evr_pixel_params pixel;
     int threads;
-    int gpu_bvh;                  /* GPU node layout (0: default) */
-    int64_t gpu_event_capacity;   /* initial GPU event buffer (0: automatic) */
+    int gpu_bvh;                /* GPU node layout (0: default) */
+    int64_t gpu_event_capacity; /* initial GPU event buffer (0: automatic) */
     /* global illumination (CPU backend): image-space photon mapping, 0 photons: one per pixel */
     int gi;
     uint32_t photons;
-    float gather_radius;          /* world units (resolved: > 0) */
+    float gather_radius; /* world units (resolved: > 0) */
     int gather_max, gather_window, photon_layers, gi_bounces;
-    int adaptive;                 /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
-    evr_adapt_params adapt;       /* its parameters (max_dt resolved: > 0) */
+    int adaptive;           /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
+    evr_adapt_params adapt; /* its parameters (max_dt resolved: > 0) */
 } evr_run_setup;
 
 /* One segment: absolute times and the motion keys of every track (one track per scene node, and
@@ -39,8 +39,8 @@ typedef struct {
     const evr_motion_key *keys;
     const int *track_offset, *track_count;
     int num_tracks, num_keys;
-    int camera_static;            /* the camera does not move in this segment */
-    int want_intensity;           /* return every pixel's intensity at the segment's end */
+    int camera_static;  /* the camera does not move in this segment */
+    int want_intensity; /* return every pixel's intensity at the segment's end */
     /* Intensity frames wanted inside this segment: num_frames absolute times in [t0, t1] (t1 only
      * for the last segment). Each frame is every pixel's intensity at exactly that time, one
      * sample through the pixel centre with the samples' own camera, motion and shading code; the
@@ -68,22 +68,23 @@ struct evr_backend {
      * segment asked for it, else NULL; *frames to the segment's num_frames intensity frames, one
      * after the other (each row-major, top row first), or NULL when it asked for none. Both stay
      * valid until the next collect(). */
-    evr_status (*collect)(evr_backend *b, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
-                          const float **frames, evr_error *err);
+    evr_status (*collect)(evr_backend *b, evr_event_vec *out, int64_t emit_before_us,
+                          const float **intensity, const float **frames, evr_error *err);
     void (*release)(evr_backend *b);
-    int depth;                    /* segments the backend holds submitted and not yet collected, at most */
-    uint64_t samples, rays;       /* totals so far (samples: every pixel sample, traced or not;
+    int depth; /* segments the backend holds submitted and not yet collected, at most */
+    uint64_t samples, rays;  /* totals so far (samples: every pixel sample, traced or not;
                                      adaptive sampling: every sample taken) */
-    uint64_t samples_traced;      /* samples that traced rays (the others reused a cached intensity) */
-    uint64_t pixels_skipped;      /* pixel-segments that reused their cached intensity */
-    uint64_t photons_traced, photons_stored, photon_collisions, photon_passes;   /* GI */
-    uint64_t photons_reused;         /* GI: photons whose path was not traced again (their trail's outcome) */
-    uint64_t photon_cells_changed;   /* GI: buffer cells whose photons or view changed, all passes */
+    uint64_t samples_traced; /* samples that traced rays (the others reused a cached intensity) */
+    uint64_t pixels_skipped; /* pixel-segments that reused their cached intensity */
+    uint64_t photons_traced, photons_stored, photon_collisions, photon_passes; /* GI */
+    uint64_t
+        photons_reused; /* GI: photons whose path was not traced again (their trail's outcome) */
+    uint64_t photon_cells_changed; /* GI: buffer cells whose photons or view changed, all passes */
     double photon_seconds;
-    double device_seconds;        /* time the device spent rendering (GPU kernels; 0 on the CPU) */
-    double wait_seconds;          /* the calling thread blocked on the device in submit and collect (GPU) */
+    double device_seconds; /* time the device spent rendering (GPU kernels; 0 on the CPU) */
+    double wait_seconds; /* the calling thread blocked on the device in submit and collect (GPU) */
     double sort_seconds, copy_seconds;
-    uint64_t device_bytes;        /* memory held on the device */
+    uint64_t device_bytes; /* memory held on the device */
 };
 
 /* Host arrays behind an evr_render_scene (everything but the per-segment keys). */
@@ -94,15 +95,15 @@ typedef struct {
     evr_texture_view *textures;
     evr_instance_view *instances;
     evr_light_view *lights;
-    float scene_size;             /* diagonal of the rest-pose bounds */
+    float scene_size; /* diagonal of the rest-pose bounds */
 } evr_render_host;
 
-evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width, int height,
-                                float ambient, evr_error *err);
+evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,
+                                int height, float ambient, evr_error *err);
 void evr_render_host_free(evr_render_host *h);
 
-evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
-                               evr_backend **out, evr_error *err);
+evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
+                               const evr_run_setup *setup, evr_backend **out, evr_error *err);
 int evr_cpu_backend_threads(const evr_backend *b);
 
 #endif

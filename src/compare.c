@@ -6,18 +6,22 @@
 #include <string.h>
 
 /* Groups events by (pixel, polarity), keeping time order inside each group (counting sort). */
-static int group(const evr_event *ev, size_t n, int width, size_t ngroups, size_t **start, int64_t **times)
+static int group(const evr_event *ev, size_t n, int width, size_t ngroups, size_t **start,
+                 int64_t **times)
 {
     size_t i;
     *start = calloc(ngroups + 1, sizeof **start);
     *times = malloc((n + 1) * sizeof **times);
     if (!*start || !*times) return 0;
-    for (i = 0; i < n; i++) (*start)[((size_t)ev[i].y * (size_t)width + ev[i].x) * 2 + (ev[i].p ? 1 : 0) + 1]++;
+    for (i = 0; i < n; i++)
+        (*start)[((size_t)ev[i].y * (size_t)width + ev[i].x) * 2 + (ev[i].p ? 1 : 0) + 1]++;
     for (i = 1; i <= ngroups; i++) (*start)[i] += (*start)[i - 1];
     size_t *fill = malloc((ngroups + 1) * sizeof *fill);
     if (!fill) return 0;
     memcpy(fill, *start, (ngroups + 1) * sizeof *fill);
-    for (i = 0; i < n; i++) (*times)[fill[((size_t)ev[i].y * (size_t)width + ev[i].x) * 2 + (ev[i].p ? 1 : 0)]++] = ev[i].t;
+    for (i = 0; i < n; i++)
+        (*times)[fill[((size_t)ev[i].y * (size_t)width + ev[i].x) * 2 + (ev[i].p ? 1 : 0)]++] =
+            ev[i].t;
     free(fill);
     return 1;
 }
@@ -28,8 +32,8 @@ static int cmp_i64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test, size_t ntest, int64_t tol_us,
-                              evr_compare_result *out, evr_error *err)
+evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test,
+                              size_t ntest, int64_t tol_us, evr_compare_result *out, evr_error *err)
 {
     size_t i, g;
     int width = 1, height = 1;
@@ -37,19 +41,24 @@ evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event
     for (i = 0; i < nref; i++) {
         if (ref[i].x >= width) width = ref[i].x + 1;
         if (ref[i].y >= height) height = ref[i].y + 1;
-        if (ref[i].p) out->ref_on++; else out->ref_off++;
+        if (ref[i].p) out->ref_on++;
+        else out->ref_off++;
     }
     for (i = 0; i < ntest; i++) {
         if (test[i].x >= width) width = test[i].x + 1;
         if (test[i].y >= height) height = test[i].y + 1;
-        if (test[i].p) out->test_on++; else out->test_off++;
+        if (test[i].p) out->test_on++;
+        else out->test_off++;
     }
     size_t npix = (size_t)width * (size_t)height, ngroups = npix * 2;
     size_t *sa = NULL, *sb = NULL;
-    int64_t *ta = NULL, *tb = NULL, *dts = malloc((nref < ntest ? nref : ntest) * sizeof(int64_t) + 8);
+    int64_t *ta = NULL, *tb = NULL,
+            *dts = malloc((nref < ntest ? nref : ntest) * sizeof(int64_t) + 8);
     evr_status st = EVR_OK;
-    if (!dts || !group(ref, nref, width, ngroups, &sa, &ta) || !group(test, ntest, width, ngroups, &sb, &tb)) {
-        snprintf(err->msg, sizeof err->msg, "out of memory comparing %zu and %zu events", nref, ntest);
+    if (!dts || !group(ref, nref, width, ngroups, &sa, &ta) ||
+        !group(test, ntest, width, ngroups, &sb, &tb)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory comparing %zu and %zu events", nref,
+                 ntest);
         st = EVR_ERR_NOMEM;
         goto done;
     }
@@ -73,7 +82,9 @@ evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event
     out->matched = matched;
     out->precision = ntest ? (double)matched / (double)ntest : (nref ? 0.0 : 1.0);
     out->recall = nref ? (double)matched / (double)nref : (ntest ? 0.0 : 1.0);
-    out->f1 = out->precision + out->recall > 0 ? 2 * out->precision * out->recall / (out->precision + out->recall) : 0.0;
+    out->f1 = out->precision + out->recall > 0
+                  ? 2 * out->precision * out->recall / (out->precision + out->recall)
+                  : 0.0;
     out->count_ratio = nref ? (double)ntest / (double)nref : (ntest ? INFINITY : 1.0);
     if (matched) {
         qsort(dts, matched, sizeof *dts, cmp_i64);
@@ -85,10 +96,15 @@ evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event
         double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
         for (i = 0; i < npix; i++) {
             double x = (double)(sa[2 * i + 2] - sa[2 * i]), y = (double)(sb[2 * i + 2] - sb[2 * i]);
-            sx += x; sy += y; sxx += x * x; syy += y * y; sxy += x * y;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            syy += y * y;
+            sxy += x * y;
         }
         double nn = (double)npix, vx = sxx - sx * sx / nn, vy = syy - sy * sy / nn;
-        out->pixel_count_correlation = vx > 0 && vy > 0 ? (sxy - sx * sy / nn) / sqrt(vx * vy) : (vx == vy ? 1.0 : 0.0);
+        out->pixel_count_correlation =
+            vx > 0 && vy > 0 ? (sxy - sx * sy / nn) / sqrt(vx * vy) : (vx == vy ? 1.0 : 0.0);
     }
 done:
     free(sa);

@@ -55,7 +55,7 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     }
     uint64_t span = (uint64_t)(tmax - tmin);
     int tdigits = 0;
-    while (tdigits < 4 && span >> (16 * tdigits)) tdigits++;   /* a shift by 64 is undefined */
+    while (tdigits < 4 && span >> (16 * tdigits)) tdigits++; /* a shift by 64 is undefined */
     scratch->n = 0;
     if (!evr_event_vec_reserve(scratch, n)) return 0;
     size_t *count = malloc(65536 * sizeof *count);
@@ -65,8 +65,11 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
     for (pass = 0; pass < 2 + tdigits; pass++) {
         memset(count, 0, 65536 * sizeof *count);
         for (i = 0; i < n; i++) {
-            unsigned d = pass == 0 ? src[i].x : pass == 1 ? src[i].y
-                       : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
+            unsigned d =
+                pass == 0 ? src[i].x
+                : pass == 1
+                    ? src[i].y
+                    : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
             count[d]++;
         }
         size_t sum = 0, d;
@@ -79,14 +82,19 @@ int evr_events_sort(evr_event_vec *v, evr_event_vec *scratch)
         }
         if (trivial) continue;
         for (i = 0; i < n; i++) {
-            unsigned dg = pass == 0 ? src[i].x : pass == 1 ? src[i].y
-                        : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
+            unsigned dg =
+                pass == 0 ? src[i].x
+                : pass == 1
+                    ? src[i].y
+                    : (unsigned)(((uint64_t)(src[i].t - tmin) >> (16 * (pass - 2))) & 0xffff);
             dst[count[dg]++] = src[i];
         }
-        evr_event *tmp = src; src = dst; dst = tmp;
+        evr_event *tmp = src;
+        src = dst;
+        dst = tmp;
     }
     free(count);
-    if (src != v->data) {   /* result sits in scratch: swap the buffers */
+    if (src != v->data) { /* result sits in scratch: swap the buffers */
         evr_event *d = v->data;
         size_t c = v->cap;
         v->data = scratch->data;
@@ -102,7 +110,7 @@ int evr_events_merge_runs(evr_event_vec *v, size_t h, evr_event_vec *scratch)
 {
     evr_event *d = v->data;
     const size_t n = v->n;
-    if (h == 0 || h >= n || !evr_event_key_less(&d[h], &d[h - 1])) return 1;   /* already in order */
+    if (h == 0 || h >= n || !evr_event_key_less(&d[h], &d[h - 1])) return 1; /* already in order */
     /* lo: the first event of the first run that the second run's first precedes; end: the first
      * event of the second run that the first run's last does not follow */
     size_t lo = 0, hi = h;
@@ -122,7 +130,8 @@ int evr_events_merge_runs(evr_event_vec *v, size_t h, evr_event_vec *scratch)
     if (!evr_event_vec_append(scratch, d + lo, m)) return 0;
     /* forward merge into d[lo ..): the write index never passes the second run's read index */
     size_t i = 0, j = h, k = lo;
-    while (i < m && j < end) d[k++] = evr_event_key_less(&d[j], &scratch->data[i]) ? d[j++] : scratch->data[i++];
+    while (i < m && j < end)
+        d[k++] = evr_event_key_less(&d[j], &scratch->data[i]) ? d[j++] : scratch->data[i++];
     while (i < m) d[k++] = scratch->data[i++];
     scratch->n = 0;
     return 1;

@@ -16,21 +16,29 @@ float evr_rgb_luminance(const float rgb[3]) { return evr_luminance(rgb[0], rgb[1
 
 int evr_scene_num_instances(const evr_scene *s) { return s->num_instances; }
 
-const char *evr_scene_instance_node(const evr_scene *s, int i) { return s->nodes[s->instances[i].node].name; }
+const char *evr_scene_instance_node(const evr_scene *s, int i)
+{
+    return s->nodes[s->instances[i].node].name;
+}
 
-const char *evr_scene_instance_mesh(const evr_scene *s, int i) { return s->meshes[s->instances[i].mesh].name; }
+const char *evr_scene_instance_mesh(const evr_scene *s, int i)
+{
+    return s->meshes[s->instances[i].mesh].name;
+}
 
 void evr_scene_triangles(const evr_scene *s, uint64_t *mesh_triangles, uint64_t *scene_triangles)
 {
     int k;
     uint64_t m = 0, t = 0;
     for (k = 0; k < s->num_meshes; k++) m += (uint64_t)s->meshes[k].num_triangles;
-    for (k = 0; k < s->num_instances; k++) t += (uint64_t)s->meshes[s->instances[k].mesh].num_triangles;
+    for (k = 0; k < s->num_instances; k++)
+        t += (uint64_t)s->meshes[s->instances[k].mesh].num_triangles;
     *mesh_triangles = m;
     *scene_triangles = t;
 }
 
-evr_status evr_still_image_render(const evr_scene *s, const evr_still_params *p, evr_still_image *out, evr_error *err)
+evr_status evr_still_image_render(const evr_scene *s, const evr_still_params *p,
+                                  evr_still_image *out, evr_error *err)
 {
     evr_still_result *r = malloc(sizeof *r);
     evr_status st;

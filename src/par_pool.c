@@ -1,5 +1,5 @@
 /* The pool of par_pool.h: one job at a time, its parts handed out under one lock. */
-#define _GNU_SOURCE   /* sched_getaffinity, CPU_COUNT */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT */
 #include "par_pool.h"
 
 #include <pthread.h>
@@ -19,7 +19,7 @@ struct evr_par_pool {
     struct worker_arg *args;
     int started;
     int stop;
-    unsigned long generation;   /* counts the jobs: a worker joins each new one once */
+    unsigned long generation; /* counts the jobs: a worker joins each new one once */
     evr_par_fn fn;
     void *ctx;
     int parts, next, finished;
@@ -31,7 +31,8 @@ int evr_par_threads(int max)
 #ifdef __linux__
     /* the processors this process may run on (taskset, container cpusets) */
     cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0 && CPU_COUNT(&set) < n) n = CPU_COUNT(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0 && CPU_COUNT(&set) < n)
+        n = CPU_COUNT(&set);
 #endif
     if (n > max) n = max;
     return n < 1 ? 1 : (int)n;
@@ -84,16 +85,14 @@ evr_par_pool *evr_par_pool_new(int threads)
     for (int i = 1; i < threads; i++) {
         p->args[p->started].pool = p;
         p->args[p->started].thread = p->started + 1;
-        if (pthread_create(&p->tid[p->started], NULL, worker_main, &p->args[p->started]) != 0) break;
+        if (pthread_create(&p->tid[p->started], NULL, worker_main, &p->args[p->started]) != 0)
+            break;
         p->started++;
     }
     return p;
 }
 
-int evr_par_pool_threads(const evr_par_pool *p)
-{
-    return p ? p->started + 1 : 1;
-}
+int evr_par_pool_threads(const evr_par_pool *p) { return p ? p->started + 1 : 1; }
 
 void evr_par_pool_start(evr_par_pool *p, int parts, evr_par_fn fn, void *ctx)
 {
@@ -113,7 +112,7 @@ void evr_par_pool_wait(evr_par_pool *p)
 {
     if (!p) return;
     pthread_mutex_lock(&p->mu);
-    take_parts(p, 0);   /* what the pool's threads have not taken yet */
+    take_parts(p, 0); /* what the pool's threads have not taken yet */
     while (p->finished < p->parts) pthread_cond_wait(&p->done, &p->mu);
     p->parts = p->next = p->finished = 0;
     pthread_mutex_unlock(&p->mu);
@@ -122,7 +121,7 @@ void evr_par_pool_wait(evr_par_pool *p)
 void evr_par_pool_run(evr_par_pool *p, int parts, evr_par_fn fn, void *ctx)
 {
     if (parts <= 0) return;
-    if (!p || parts == 1) {   /* no pool, or nothing to share */
+    if (!p || parts == 1) { /* no pool, or nothing to share */
         for (int k = 0; k < parts; k++) fn(ctx, k, 0);
         return;
     }

@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width, int height,
-                                float ambient, evr_error *err)
+evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,
+                                int height, float ambient, evr_error *err)
 {
     int i;
     memset(h, 0, sizeof *h);

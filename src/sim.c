@@ -48,24 +48,29 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
         st = evr_cuda_backend_new(s, &sim->host, &sim->setup, &sim->backend, &cerr);
         if (st == EVR_OK) {
             snprintf(sim->st.backend, sizeof sim->st.backend, "cuda");
-            snprintf(sim->st.device, sizeof sim->st.device, "%s", evr_cuda_device_name(sim->backend));
+            snprintf(sim->st.device, sizeof sim->st.device, "%s",
+                     evr_cuda_device_name(sim->backend));
             return EVR_OK;
         }
         if (kind == EVR_BACKEND_CUDA) {
             *err = cerr;
             return st;
         }
-        snprintf(sim->st.notice, sizeof sim->st.notice, "CUDA backend not used: %s; running on the CPU", cerr.msg);
+        snprintf(sim->st.notice, sizeof sim->st.notice,
+                 "CUDA backend not used: %s; running on the CPU", cerr.msg);
     }
 #else
     if (kind == EVR_BACKEND_CUDA) {
-        snprintf(err->msg, sizeof err->msg, "this evray was built without CUDA (nvcc was not found at build time)");
+        snprintf(err->msg, sizeof err->msg,
+                 "this evray was built without CUDA (nvcc was not found at build time)");
         return EVR_ERR_BACKEND;
     }
 #endif
-    if ((st = evr_cpu_backend_new(s, &sim->host, &sim->setup, &sim->backend, err)) != EVR_OK) return st;
+    if ((st = evr_cpu_backend_new(s, &sim->host, &sim->setup, &sim->backend, err)) != EVR_OK)
+        return st;
     snprintf(sim->st.backend, sizeof sim->st.backend, "cpu");
-    snprintf(sim->st.device, sizeof sim->st.device, "%d CPU threads", evr_cpu_backend_threads(sim->backend));
+    snprintf(sim->st.device, sizeof sim->st.device, "%d CPU threads",
+             evr_cpu_backend_threads(sim->backend));
     return EVR_OK;
 }
 
@@ -74,15 +79,18 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
 static int64_t timestamp_slack_us(const evr_sim *sim)
 {
     if (sim->cfg.time_jitter <= 0.0 && sim->setup.pixel.time_res_us <= 1) return 0;
-    return (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) + sim->setup.pixel.time_res_us;
+    return (int64_t)ceil((double)EVR_JITTER_CLIP * sim->cfg.time_jitter * 1e6) +
+           sim->setup.pixel.time_res_us;
 }
 
 /* The run's wall time so far, and the rates that follow from it, into sim->st. */
 static void set_wall(evr_sim *sim)
 {
     sim->st.wall_time = evr_host_seconds() - sim->wall0;
-    sim->st.samples_per_second = sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
-    sim->st.rays_per_second = sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
+    sim->st.samples_per_second =
+        sim->st.wall_time > 0 ? (double)sim->st.samples / sim->st.wall_time : 0.0;
+    sim->st.rays_per_second =
+        sim->st.wall_time > 0 ? (double)sim->st.rays / sim->st.wall_time : 0.0;
     sim->st.realtime_factor = sim->st.wall_time > 0 ? sim->st.sim_time / sim->st.wall_time : 0.0;
 }
 
@@ -92,16 +100,18 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     int i;
     *out = NULL;
     evr_config cur;
-    if ((st = evr_config_validate(c, s, err)) != EVR_OK || (st = evr_config_current(c, &cur, err)) != EVR_OK) return st;
-    c = &cur;   /* this library's evr_config, whatever the caller's size */
+    if ((st = evr_config_validate(c, s, err)) != EVR_OK ||
+        (st = evr_config_current(c, &cur, err)) != EVR_OK)
+        return st;
+    c = &cur; /* this library's evr_config, whatever the caller's size */
     evr_sim *sim = calloc(1, sizeof *sim);
     if (!sim) return nomem(err);
     sim->scene = s;
     sim->cfg = *c;
     snprintf(sim->out_dir, sizeof sim->out_dir, "%s", c->out_dir);
     sim->cfg.out_dir = sim->out_dir;
-    sim->cfg.camera = NULL;   /* not owned; the index below is what counts */
-    if (c->sensor) {          /* not owned either: keep the library's own copy of the name */
+    sim->cfg.camera = NULL; /* not owned; the index below is what counts */
+    if (c->sensor) {        /* not owned either: keep the library's own copy of the name */
         const char *const *names = evr_sensor_names();
         for (i = 0; names[i]; i++)
             if (!strcmp(names[i], c->sensor)) sim->cfg.sensor = names[i];
@@ -110,11 +120,12 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
     if (c->duration > 0.0) sim->duration = c->duration;
     else if (s->anim_end > c->start) sim->duration = s->anim_end - c->start;
-    else sim->duration = 1.0;   /* a static scene: one second unless told */
+    else sim->duration = 1.0; /* a static scene: one second unless told */
     sim->num_segments = (int)ceil(sim->duration * sim->fps - 1e-9);
     if (sim->num_segments < 1) sim->num_segments = 1;
 
-    if ((st = evr_render_host_init(&sim->host, s, sim->camera, c->width, c->height, c->ambient, err)) != EVR_OK) {
+    if ((st = evr_render_host_init(&sim->host, s, sim->camera, c->width, c->height, c->ambient,
+                                   err)) != EVR_OK) {
         free(sim);
         return st;
     }
@@ -144,10 +155,12 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.adapt.frac = c->adapt_frac;
     sim->setup.adapt.min_dt = (float)c->min_dt;
     sim->setup.adapt.max_dt = (float)(c->max_dt > 0.0 ? c->max_dt : 1.0 / sim->fps);
-    if (sim->setup.adapt.max_dt < sim->setup.adapt.min_dt) sim->setup.adapt.max_dt = sim->setup.adapt.min_dt;
+    if (sim->setup.adapt.max_dt < sim->setup.adapt.min_dt)
+        sim->setup.adapt.max_dt = sim->setup.adapt.min_dt;
     sim->setup.gi = c->gi;
     sim->setup.photons = c->photons;
-    sim->setup.gather_radius = c->gather_radius > 0.0f ? c->gather_radius : 0.02f * sim->host.scene_size;
+    sim->setup.gather_radius =
+        c->gather_radius > 0.0f ? c->gather_radius : 0.02f * sim->host.scene_size;
     sim->setup.gather_max = c->gather_max;
     sim->setup.gather_window = c->gather_window;
     sim->setup.photon_layers = c->photon_layers;
@@ -156,10 +169,11 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
 
     int ntracks = s->num_nodes + 1;
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
-    sim->par = evr_par_pool_new(evr_par_threads(8));   /* NULL: counted on this thread */
-    if (!sim->node_used ||
-        !evr_skip_tracker_init(&sim->skip, ntracks) || !evr_skip_tracker_parts(&sim->skip, s) ||
-        !(sim->skipped_per_segment = calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
+    sim->par = evr_par_pool_new(evr_par_threads(8)); /* NULL: counted on this thread */
+    if (!sim->node_used || !evr_skip_tracker_init(&sim->skip, ntracks) ||
+        !evr_skip_tracker_parts(&sim->skip, s) ||
+        !(sim->skipped_per_segment =
+              calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
         evr_sim_release(sim);
         return nomem(err);
     }
@@ -184,7 +198,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
-    if ((st = evr_frames_check(sim, err)) != EVR_OK || (st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_check(sim, err)) != EVR_OK ||
+        (st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
         evr_sim_release(sim);
         return st;
     }
@@ -194,7 +209,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         return st;
     }
     if ((st = evr_run_writers_open(sim, err)) != EVR_OK ||
-        (st = evr_write_queue_start(sim->writers, sim->num_writers, EVR_WRITE_FLUSH_SECONDS, &sim->wq, err)) != EVR_OK) {
+        (st = evr_write_queue_start(sim->writers, sim->num_writers, EVR_WRITE_FLUSH_SECONDS,
+                                    &sim->wq, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -205,7 +221,10 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     return EVR_OK;
 }
 
-static double segment_start(const evr_sim *sim, int i) { return sim->cfg.start + (double)i / sim->fps; }
+static double segment_start(const evr_sim *sim, int i)
+{
+    return sim->cfg.start + (double)i / sim->fps;
+}
 static double segment_end(const evr_sim *sim, int i)
 {
     return i + 1 == sim->num_segments ? sim->cfg.start + sim->duration : segment_start(sim, i + 1);
@@ -234,13 +253,15 @@ static void plan_segment(void *user, int i, evr_planned_segment *out)
         off += c;
     }
     out->num_keys = off;
-    evr_skip_tracker_update(&sim->skip, out->keys, out->track_offset, out->track_count, sim->host.scene_size);
+    evr_skip_tracker_update(&sim->skip, out->keys, out->track_offset, out->track_count,
+                            sim->host.scene_size);
     evr_render_scene rs = sim->host.rs;
     rs.keys = out->keys;
     rs.track_offset = out->track_offset;
     rs.track_count = out->track_count;
     evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip && !sim->setup.adaptive, &out->plan);
-    if (sim->setup.adaptive) evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &out->adapt);
+    if (sim->setup.adaptive)
+        evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &out->adapt);
 }
 
 /* The sums of one part: branch-free in locals (ON and OFF alternate at random), about 10x faster
@@ -279,7 +300,7 @@ static void count_events_finish(evr_sim *sim)
  * count_events_finish: the write queue hands a taken buffer back no sooner than the next push. */
 static void count_events_start(evr_sim *sim, const evr_event *ev, size_t n)
 {
-    size_t parts = n >> 16;   /* 65,536 events a part at least */
+    size_t parts = n >> 16; /* 65,536 events a part at least */
     count_events_finish(sim);
     if (parts < 1) parts = 1;
     if (parts > EVR_COUNT_PARTS) parts = EVR_COUNT_PARTS;
@@ -294,7 +315,7 @@ static void count_events_start(evr_sim *sim, const evr_event *ev, size_t n)
     if (n) sim->last_t = ev[n - 1].t;
     sim->count_parts = (int)parts;
     if (sim->par) evr_par_pool_start(sim->par, (int)parts, count_part, sim->counting);
-    else evr_par_pool_run(NULL, (int)parts, count_part, sim->counting);   /* no pool: here, now */
+    else evr_par_pool_run(NULL, (int)parts, count_part, sim->counting); /* no pool: here, now */
 }
 
 /* Hands events up to (not including) limit_us to the writers and statistics. */
@@ -305,7 +326,7 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     evr_status st;
     if (n == 0) return EVR_OK;
     double t = evr_host_seconds();
-    count_events_start(sim, v->data, n);   /* finishes the batch before it first */
+    count_events_start(sim, v->data, n); /* finishes the batch before it first */
     sim->time_write += evr_host_seconds() - t;
     t = evr_host_seconds();
     if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
@@ -316,7 +337,6 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     sim->time_write += evr_host_seconds() - t;
     return EVR_OK;
 }
-
 
 static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 {
@@ -339,10 +359,11 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
     seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
-    double t = evr_host_seconds();   /* the CPU backend renders inside submit, a GPU only queues work */
+    double t =
+        evr_host_seconds(); /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
     sim->time_render += evr_host_seconds() - t;
-    evr_planner_release(sim->planner, i);   /* the backend has what it needs of the plan */
+    evr_planner_release(sim->planner, i); /* the backend has what it needs of the plan */
     return st;
 }
 
@@ -357,15 +378,20 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     /* Later segments can still produce events back to every pixel's last sample here, which
      * is no earlier than t0 + (n-1)/n of the segment: hold those back to keep file order (the
      * last segment the loop finishes holds back none). */
-    int64_t safe = final ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
+    int64_t safe =
+        final ? INT64_MAX : (int64_t)floor((t0 + (t1 - t0) * (double)(n - 1) / (double)n) * 1e6);
     /* adaptive sampling: a pixel's last sample here is no earlier than t1 - max_dt */
-    if (!final && sim->setup.adaptive) safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
+    if (!final && sim->setup.adaptive)
+        safe = (int64_t)floor((t1 - (double)sim->setup.adapt.max_dt) * 1e6) - 1;
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
     if (!final) safe -= sim->timestamp_slack_us;
     double t = evr_host_seconds();
-    if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) != EVR_OK) return st;
+    if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) !=
+        EVR_OK)
+        return st;
     sim->time_render += evr_host_seconds() - t;
-    if ((st = emit_events(sim, safe, err)) != EVR_OK) return st;   /* written and flushed on the writer thread */
+    if ((st = emit_events(sim, safe, err)) != EVR_OK)
+        return st; /* written and flushed on the writer thread */
     if (intensity) {
         t = evr_host_seconds();
         if ((st = evr_run_preview_intensity(sim, intensity, t1, last, err)) != EVR_OK) return st;
@@ -374,13 +400,15 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
     int first, count, k;
     evr_frames_of_segment(sim, i, &first, &count);
     if (count && !frames) {
-        snprintf(err->msg, sizeof err->msg, "internal error: the backend returned no intensity frames");
+        snprintf(err->msg, sizeof err->msg,
+                 "internal error: the backend returned no intensity frames");
         return EVR_ERR_BACKEND;
     }
     t = evr_host_seconds();
     for (k = 0; k < count; k++) {
         size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
-        if ((st = evr_frames_write(sim, first + k, frames + (size_t)k * npix, err)) != EVR_OK) return st;
+        if ((st = evr_frames_write(sim, first + k, frames + (size_t)k * npix, err)) != EVR_OK)
+            return st;
     }
     sim->time_preview += evr_host_seconds() - t;
     sim->st.segments_done = i + 1;
@@ -409,8 +437,9 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
      * one is taken in and written) */
     const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;
     if (!sim->planner) {
-        sim->planner = evr_planner_start(sim->num_segments, (size_t)(sim->scene->num_nodes + 1) * EVR_MAX_KEYS,
-                                         sim->scene->num_nodes + 1, plan_segment, sim);
+        sim->planner =
+            evr_planner_start(sim->num_segments, (size_t)(sim->scene->num_nodes + 1) * EVR_MAX_KEYS,
+                              sim->scene->num_nodes + 1, plan_segment, sim);
         if (!sim->planner) return nomem(err);
     }
     if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
@@ -421,11 +450,13 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         }
         if (st != EVR_OK) break;
         /* the last to finish: every segment submitted (or the run stopped), this the newest */
-        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, i + 1 == submitted, err)) != EVR_OK) break;
+        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, i + 1 == submitted, err)) !=
+            EVR_OK)
+            break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
     sim->time_motion = evr_planner_busy_seconds(sim->planner);
-    evr_planner_stop(sim->planner);   /* stops early when the run did */
+    evr_planner_stop(sim->planner); /* stops early when the run did */
     sim->planner = NULL;
     count_events_finish(sim);
     if (st != EVR_OK) {
@@ -433,16 +464,16 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
         evr_run_dir_discard(sim);
         return st;
     }
-    if (sim->pending.n) {   /* interrupted: keep every event of the finished segments */
+    if (sim->pending.n) { /* interrupted: keep every event of the finished segments */
         if ((st = emit_events(sim, INT64_MAX, err)) != EVR_OK) {
             evr_run_dir_discard(sim);
             return st;
         }
     }
-    count_events_finish(sim);   /* the interrupted run's last batch */
+    count_events_finish(sim); /* the interrupted run's last batch */
     sim->st.interrupted = sim->st.segments_done < sim->num_segments;
     if ((st = evr_run_close(sim, err)) != EVR_OK) return st;
-    set_wall(sim);   /* the run's wall time includes draining and closing every output */
+    set_wall(sim); /* the run's wall time includes draining and closing every output */
     if ((st = evr_run_write_json(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
 }

@@ -11,7 +11,7 @@
 #include "io/preview.h"
 #include "run/write_queue.h"
 
-#define EVR_MAX_WRITERS 16   /* formats a run may write (io/event_formats.h) */
+#define EVR_MAX_WRITERS 16 /* formats a run may write (io/event_formats.h) */
 
 /* ON events and timestamp changes (t differing from the one before, prev for the first) of a
  * part of a batch of emitted events. */
@@ -32,21 +32,21 @@ struct evr_sim {
     int camera;
     double fps, duration;
     int num_segments;
-    int64_t timestamp_slack_us;  /* how far jitter and rounding move a timestamp from its crossing */
+    int64_t timestamp_slack_us; /* how far jitter and rounding move a timestamp from its crossing */
     evr_render_host host;
     evr_run_setup setup;
     evr_backend *backend;
     evr_event_writer *writers[EVR_MAX_WRITERS];
     const char *writer_names[EVR_MAX_WRITERS];
     int num_writers;
-    evr_write_queue *wq;         /* writes on its own thread */
+    evr_write_queue *wq; /* writes on its own thread */
     char *config_json;
     /* per-segment motion and plans (segment_planner.h: the tracker is the planner thread's) */
     evr_planner *planner;
-    struct evr_par_pool *par;    /* threads for the passes over a segment's events (par_pool.h) */
+    struct evr_par_pool *par; /* threads for the passes over a segment's events (par_pool.h) */
     int *node_used;
     evr_skip_tracker skip;
-    uint32_t *skipped_per_segment;   /* pixels that traced nothing, per segment */
+    uint32_t *skipped_per_segment; /* pixels that traced nothing, per segment */
     /* events */
     evr_event_vec pending, scratch;
     int64_t last_t;
@@ -54,26 +54,27 @@ struct evr_sim {
     evr_event_counts counting[EVR_COUNT_PARTS];
     int count_parts;
     /* previews */
-    evr_event_frame preview;     /* event frame being accumulated (width 0: previews off) */
+    evr_event_frame preview; /* event frame being accumulated (width 0: previews off) */
     int64_t preview_window_us;
-    int64_t preview_frame;       /* index of the event frame being accumulated */
-    int64_t intensity_frame;     /* index of the next intensity frame due */
+    int64_t preview_frame;   /* index of the event frame being accumulated */
+    int64_t intensity_frame; /* index of the next intensity frame due */
     int previews_written;
     /* intensity frames for other tools (frames_out.h); num_frames 0: none */
     char frames_dir[4096];
     double frames_fps;
     int num_frames;
-    double *frame_times;         /* absolute time of every frame */
-    int *seg_first_frame;        /* segment i renders frames seg_first_frame[i] .. seg_first_frame[i + 1] - 1 */
-    int frames_written;          /* frames 0 .. frames_written - 1 are on disk */
+    double *frame_times; /* absolute time of every frame */
+    int *
+        seg_first_frame; /* segment i renders frames seg_first_frame[i] .. seg_first_frame[i + 1] - 1 */
+    int frames_written; /* frames 0 .. frames_written - 1 are on disk */
     int created_frames_dir;
     uint8_t *frame8;
     uint16_t *frame16;
     /* statistics */
     evr_stats st;
-    double wall0;                /* the run's start: its wall time ends when every output is complete */
-    double time_motion;          /* motion keys and the skip plan, per segment on the planner's thread */
-    double time_plan_wait;       /* the segment loop waiting for the planner */
+    double wall0;          /* the run's start: its wall time ends when every output is complete */
+    double time_motion;    /* motion keys and the skip plan, per segment on the planner's thread */
+    double time_plan_wait; /* the segment loop waiting for the planner */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 

@@ -16,18 +16,19 @@
 
 typedef struct {
     int width, height;
-    float *rgb;                    /* width * height * 3 linear radiance, rows top to bottom */
-    float *direct;                 /* the direct term alone (same layout) */
-    int *instance;                 /* scene instance seen at each pixel's centre, -1: none */
-    evr_photon_stats photon;       /* photon mode: the pass */
-    float gather_radius;           /* the radius used */
-    int photon_layers;             /* the layers used */
-    double photons_per_estimate;   /* mean photons per gather over hit pixels */
+    float *rgb;                  /* width * height * 3 linear radiance, rows top to bottom */
+    float *direct;               /* the direct term alone (same layout) */
+    int *instance;               /* scene instance seen at each pixel's centre, -1: none */
+    evr_photon_stats photon;     /* photon mode: the pass */
+    float gather_radius;         /* the radius used */
+    int photon_layers;           /* the layers used */
+    double photons_per_estimate; /* mean photons per gather over hit pixels */
     double seconds_setup, seconds_photons, seconds_shading;
     int threads;
 } evr_still_result;
 
-evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_still_result *out, evr_error *err);
+evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_still_result *out,
+                            evr_error *err);
 void evr_still_result_free(evr_still_result *r);
 
 #endif

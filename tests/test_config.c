@@ -20,16 +20,21 @@ static void test_documented_defaults(void)
     CHECK(c.width == 346 && c.height == 260);
     CHECK(c.duration == 0.0 && c.start == 0.0 && c.fps == 0.0);
     CHECK(c.samples_per_frame == 10 && c.camera == NULL);
-    CHECK(c.pos_thres == 0.2f && c.neg_thres == 0.2f && c.refractory == 0.0f && c.log_floor == 0.02f);
-    CHECK(c.sensor == NULL && c.sigma_thres == 0.0f && c.cutoff_hz == 0.0f && c.full_intensity == 1.0f);
+    CHECK(c.pos_thres == 0.2f && c.neg_thres == 0.2f && c.refractory == 0.0f &&
+          c.log_floor == 0.02f);
+    CHECK(c.sensor == NULL && c.sigma_thres == 0.0f && c.cutoff_hz == 0.0f &&
+          c.full_intensity == 1.0f);
     CHECK(c.leak_rate == 0.0f && c.leak_jitter == 0.1f && c.shot_rate == 0.0f);
-    CHECK(c.hot_fraction == 0.0f && c.hot_rate == 100.0f && c.time_res == 1e-6 && c.time_jitter == 0.0);
+    CHECK(c.hot_fraction == 0.0f && c.hot_rate == 100.0f && c.time_res == 1e-6 &&
+          c.time_jitter == 0.0);
     CHECK(c.ambient == 0.02f && c.seed == 1 && c.threads == 0 && c.backend == EVR_BACKEND_AUTO);
     CHECK(c.gpu_bvh == 0 && c.gpu_event_capacity == 0 && c.no_skip == 0);
-    CHECK(c.sampling == EVR_SAMPLING_UNIFORM && c.adapt_frac == 0.25f && c.min_dt == 20e-6 && c.max_dt == 0.0);
+    CHECK(c.sampling == EVR_SAMPLING_UNIFORM && c.adapt_frac == 0.25f && c.min_dt == 20e-6 &&
+          c.max_dt == 0.0);
     CHECK(c.out_dir && !strcmp(c.out_dir, "evray-out") && c.formats == EVR_FORMAT_H5);
     CHECK(c.preview_window == 0.05 && c.force == 0);
-    CHECK(c.frames_out == NULL && c.frames_fps == 0.0 && c.frames_exposure == 1.0f && c.frames_max == 4.0f);
+    CHECK(c.frames_out == NULL && c.frames_fps == 0.0 && c.frames_exposure == 1.0f &&
+          c.frames_max == 4.0f);
     CHECK(c.gi == 0 && c.photons == 0 && c.gather_radius == 0.0f && c.gather_max == 0);
     CHECK(c.gather_window == 8 && c.photon_layers == 8 && c.gi_bounces == 4);
 }
@@ -49,11 +54,16 @@ static void test_row_defaults(void)
         if (!f) continue;
         fields++;
         switch (t[i].type) {
-        case EVR_OPT_FLAG: case EVR_OPT_INT: case EVR_OPT_CHOICE: v = *(const int *)f; break;
+        case EVR_OPT_FLAG:
+        case EVR_OPT_INT:
+        case EVR_OPT_CHOICE: v = *(const int *)f; break;
         case EVR_OPT_INT64: v = (double)*(const int64_t *)f; break;
         case EVR_OPT_U32: v = *(const uint32_t *)f; break;
         case EVR_OPT_U64: v = (double)*(const uint64_t *)f; break;
-        case EVR_OPT_FLOAT: v = *(const float *)f; CHECK(*(const float *)f == (float)t[i].def); break;
+        case EVR_OPT_FLOAT:
+            v = *(const float *)f;
+            CHECK(*(const float *)f == (float)t[i].def);
+            break;
         case EVR_OPT_DOUBLE: v = *(const double *)f; break;
         case EVR_OPT_STRING: {
             const char *s = *(const char *const *)f;
@@ -71,12 +81,14 @@ static void test_row_defaults(void)
             char *end;
             double h = strtod(d + 9, &end);
             if (end != d + 9 && (*end == ')' || *end == ':' || *end == ';')) {
-                if (!((float)h == (float)t[i].def)) fprintf(stderr, "row %s: help says default %g, table %g\n", t[i].name, h, t[i].def);
+                if (!((float)h == (float)t[i].def))
+                    fprintf(stderr, "row %s: help says default %g, table %g\n", t[i].name, h,
+                            t[i].def);
                 CHECK((float)h == (float)t[i].def);
             }
         }
     }
-    CHECK(fields >= 48);   /* every field of evr_config has its row */
+    CHECK(fields >= 48); /* every field of evr_config has its row */
 }
 
 /* Names, options, JSON keys and ranks are unique; ranks run 1..N without a gap. */
@@ -90,8 +102,10 @@ static void test_table_shape(void)
         for (k = i + 1; k < n; k++) {
             CHECK(strcmp(t[i].name, t[k].name));
             if (t[i].flag && t[k].flag) CHECK(strcmp(t[i].flag, t[k].flag));
-            if (t[i].json && t[k].json) CHECK(strcmp(t[i].json, t[k].json) && t[i].json_rank != t[k].json_rank);
-            if (t[i].type != EVR_OPT_NONE && t[k].type != EVR_OPT_NONE) CHECK(t[i].offset != t[k].offset);
+            if (t[i].json && t[k].json)
+                CHECK(strcmp(t[i].json, t[k].json) && t[i].json_rank != t[k].json_rank);
+            if (t[i].type != EVR_OPT_NONE && t[k].type != EVR_OPT_NONE)
+                CHECK(t[i].offset != t[k].offset);
         }
     }
     for (i = 0; i < n; i++) CHECK(t[i].json_rank <= ranks);
@@ -110,7 +124,8 @@ static void check_sets(const char *flag, const char *text, size_t offset, size_t
     memcpy(&b, &a, sizeof a);
     CHECK(o != NULL);
     if (!o) return;
-    if (evr_config_option_set(&b, o, evr_config_option_takes_value(o) ? text : NULL, &err) != EVR_OK) {
+    if (evr_config_option_set(&b, o, evr_config_option_takes_value(o) ? text : NULL, &err) !=
+        EVR_OK) {
         fprintf(stderr, "%s %s: %s\n", flag, text, err.msg);
         CHECK(0);
         return;
@@ -128,7 +143,9 @@ static void check_sets(const char *flag, const char *text, size_t offset, size_t
 static size_t type_size(evr_opt_type t)
 {
     switch (t) {
-    case EVR_OPT_FLAG: case EVR_OPT_INT: case EVR_OPT_CHOICE: return sizeof(int);
+    case EVR_OPT_FLAG:
+    case EVR_OPT_INT:
+    case EVR_OPT_CHOICE: return sizeof(int);
     case EVR_OPT_INT64: return sizeof(int64_t);
     case EVR_OPT_U32: return sizeof(uint32_t);
     case EVR_OPT_U64: return sizeof(uint64_t);
@@ -154,9 +171,12 @@ static void test_options_set_their_field(void)
         if (!strcmp(t[i].name, "formats")) text = "txt";
         if (!strcmp(t[i].name, "time_res")) text = "2e-6";
         if (!strcmp(t[i].name, "min_dt")) text = "1e-4";
-        if (t[i].type == EVR_OPT_CHOICE)   /* a name other than the default's */
+        if (t[i].type == EVR_OPT_CHOICE) /* a name other than the default's */
             for (ch = t[i].choices; ch->name || ch->json; ch++)
-                if (ch->name && !ch->refuse && ch->value != (int)t[i].def) { text = ch->name; break; }
+                if (ch->name && !ch->refuse && ch->value != (int)t[i].def) {
+                    text = ch->name;
+                    break;
+                }
         check_sets(t[i].flag, text, t[i].offset, type_size(t[i].type));
         if (t[i].alias) check_sets(t[i].alias, text, t[i].offset, type_size(t[i].type));
     }
@@ -169,7 +189,8 @@ static void test_special_options(void)
     evr_error err = {{0}};
     const char *name;
     evr_config_defaults(&c);
-    CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--res=640x480", &name), "640x480", &err));
+    CHECK_OK(
+        evr_config_option_set(&c, evr_config_option_find("--res=640x480", &name), "640x480", &err));
     CHECK(c.width == 640 && c.height == 480 && !strcmp(name, "--res"));
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--thres", &name), "0.3", &err));
     CHECK(c.pos_thres == 0.3f && c.neg_thres == 0.3f);
@@ -177,28 +198,36 @@ static void test_special_options(void)
     CHECK(c.preview_window == 0.0);
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--format", &name), "all", &err));
     CHECK(c.formats == evr_event_formats_all());
-    CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--gpu-event-capacity", &name), "99999999999999", &err));
+    CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--gpu-event-capacity", &name),
+                                   "99999999999999", &err));
     CHECK(c.gpu_event_capacity == ((int64_t)1 << 40));
-    CHECK(evr_config_option_find("--force=1", &name) == NULL);      /* no value taken */
+    CHECK(evr_config_option_find("--force=1", &name) == NULL); /* no value taken */
     CHECK(evr_config_option_find("--threadsx", &name) == NULL);
     CHECK(evr_config_option_find("-o", &name) != NULL && !strcmp(name, "-o"));
-    CHECK(evr_config_option_set(&c, evr_config_option_find("--duration", &name), "0", &err) == EVR_ERR_ARG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--duration", &name), "0", &err) ==
+          EVR_ERR_ARG);
     CHECK(strstr(err.msg, "--duration must be a positive number of seconds") != NULL);
-    CHECK(evr_config_option_set(&c, evr_config_option_find("--photons", &name), "4294967297", &err) == EVR_ERR_ARG);
-    CHECK(evr_config_option_set(&c, evr_config_option_find("--gi", &name), "path", &err) == EVR_ERR_ARG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--photons", &name), "4294967297",
+                                &err) == EVR_ERR_ARG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--gi", &name), "path", &err) ==
+          EVR_ERR_ARG);
     CHECK(strstr(err.msg, "evray still") != NULL);
-    CHECK(evr_config_option_set(&c, evr_config_option_find("--backend", &name), "gpu", &err) == EVR_ERR_ARG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--backend", &name), "gpu", &err) ==
+          EVR_ERR_ARG);
     CHECK(!strcmp(err.msg, "--backend: unknown backend 'gpu' (auto, cpu, cuda)"));
-    CHECK(evr_config_option_set(&c, evr_config_option_find("--sensor", &name), "davis999", &err) == EVR_ERR_ARG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--sensor", &name), "davis999", &err) ==
+          EVR_ERR_ARG);
     /* the library's checks come from the same rows */
     evr_config_defaults(&c);
     c.samples_per_frame = 0;
-    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG && strstr(err.msg, "samples per frame") != NULL);
+    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
+          strstr(err.msg, "samples per frame") != NULL);
     evr_config_defaults(&c);
     c.gi = 1;
     c.photon_layers = 0;
-    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG && strstr(err.msg, "--photon-layers") != NULL);
-    c.gi = 0;   /* GI settings are checked only with GI on */
+    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
+          strstr(err.msg, "--photon-layers") != NULL);
+    c.gi = 0; /* GI settings are checked only with GI on */
     CHECK_OK(evr_config_validate(&c, NULL, &err));
 }
 
@@ -275,7 +304,8 @@ static void test_size_field(void)
     CHECK(c.size == sizeof c);
     CHECK_OK(evr_config_validate(&c, NULL, &err));
     c.size = sizeof c - 8;
-    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG && strstr(err.msg, "evr_config_defaults") != NULL);
+    CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
+          strstr(err.msg, "evr_config_defaults") != NULL);
     c.size = sizeof c + 8;
     CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG);
     c.size = 0;

@@ -16,17 +16,17 @@
 
 typedef struct {
     const char *name;
-    const char *meshes[8];          /* NULL-terminated */
+    const char *meshes[8]; /* NULL-terminated */
     const char *materials[8];
     int min_textures;
-    const char *textured_material;  /* a material whose base colour comes from an embedded PNG */
+    const char *textured_material; /* a material whose base colour comes from an embedded PNG */
     const char *camera;
     float camera_aspect, camera_znear;
     double camera_pos[3], camera_target[3];
     const char *light;
     int light_type;
-    const char *animated[4];        /* nodes with animation channels */
-    double anim_length;             /* seconds */
+    const char *animated[4]; /* nodes with animation channels */
+    double anim_length;      /* seconds */
     unsigned min_triangles, max_triangles;
 } expectation;
 
@@ -34,59 +34,115 @@ static const expectation expected[] = {
     {"eye",
      {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", NULL},
      {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "orbit", NULL},
-     5, "iris",
-     "eye_camera", 4.0f / 3.0f, 0.001f, {0.0, -0.010, 0.040}, {0.0, 0.0, 0.0},
-     "ir_led", aiLightSource_POINT,
+     5,
+     "iris",
+     "eye_camera",
+     4.0f / 3.0f,
+     0.001f,
+     {0.0, -0.010, 0.040},
+     {0.0, 0.0, 0.0},
+     "ir_led",
+     aiLightSource_POINT,
      {"eyeball", "upper_lid", "lower_lid", NULL},
-     30.0, 10000, 40000},
+     30.0,
+     10000,
+     40000},
     {"eye-drift",
      {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", NULL},
      {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "orbit", NULL},
-     5, "iris",
-     "eye_camera", 4.0f / 3.0f, 0.001f, {0.0, -0.010, 0.040}, {0.0, 0.0, 0.0},
-     "ir_led", aiLightSource_POINT,
+     5,
+     "iris",
+     "eye_camera",
+     4.0f / 3.0f,
+     0.001f,
+     {0.0, -0.010, 0.040},
+     {0.0, 0.0, 0.0},
+     "ir_led",
+     aiLightSource_POINT,
      {"eyeball", "upper_lid", "lower_lid", NULL},
-     30.0, 10000, 40000},
+     30.0,
+     10000,
+     40000},
     {"square",
      {"background", "square", NULL},
      {"background", "square", NULL},
-     0, NULL,
-     "square_camera", 1.0f, 0.1f, {0.0, 0.0, 4.0}, {0.0, 0.0, 0.0},
-     "lamp", aiLightSource_POINT,
+     0,
+     NULL,
+     "square_camera",
+     1.0f,
+     0.1f,
+     {0.0, 0.0, 4.0},
+     {0.0, 0.0, 0.0},
+     "lamp",
+     aiLightSource_POINT,
      {"square", NULL},
-     2.0, 4, 4},
+     2.0,
+     4,
+     4},
     {"disk",
      {"white_sectors", "black_sectors", "background", NULL},
      {"white", "black", "background", NULL},
-     0, NULL,
-     "disk_camera", 4.0f / 3.0f, 0.05f, {0.0, 0.0, 2.0}, {0.0, 0.0, 0.0},
-     "lamp", aiLightSource_POINT,
+     0,
+     NULL,
+     "disk_camera",
+     4.0f / 3.0f,
+     0.05f,
+     {0.0, 0.0, 2.0},
+     {0.0, 0.0, 0.0},
+     "lamp",
+     aiLightSource_POINT,
      {"disk", NULL},
-     2.0, 258, 258},
+     2.0,
+     258,
+     258},
     {"cornell",
      {"floor", "ceiling", "back_wall", "left_wall", "right_wall", "tall_box", "short_box", NULL},
      {"white", "red", "green", "light", NULL},
-     0, NULL,
-     "cornell_camera", 1.0f, 0.05f, {0.0, 0.5, 1.9}, {0.0, 0.5, 0.0},
-     "ceiling_light", aiLightSource_POINT,
+     0,
+     NULL,
+     "cornell_camera",
+     1.0f,
+     0.05f,
+     {0.0, 0.5, 1.9},
+     {0.0, 0.5, 0.0},
+     "ceiling_light",
+     aiLightSource_POINT,
      {"short_box", NULL},
-     2.0, 36, 36},
-    {"cornell-still",   /* the same room; the short box's animation holds it still */
+     2.0,
+     36,
+     36},
+    {"cornell-still", /* the same room; the short box's animation holds it still */
      {"floor", "ceiling", "back_wall", "left_wall", "right_wall", "tall_box", "short_box", NULL},
      {"white", "red", "green", "light", NULL},
-     0, NULL,
-     "cornell_camera", 1.0f, 0.05f, {0.0, 0.5, 1.9}, {0.0, 0.5, 0.0},
-     "ceiling_light", aiLightSource_POINT,
+     0,
+     NULL,
+     "cornell_camera",
+     1.0f,
+     0.05f,
+     {0.0, 0.5, 1.9},
+     {0.0, 0.5, 0.0},
+     "ceiling_light",
+     aiLightSource_POINT,
      {"short_box", NULL},
-     2.0, 36, 36},
-    {"city",   /* 12 building meshes, each stored once (4096 nodes share them), and the ground */
+     2.0,
+     36,
+     36},
+    {"city", /* 12 building meshes, each stored once (4096 nodes share them), and the ground */
      {"building_00", "building_07", "building_11", "ground", NULL},
      {"facade_00", "facade_11", "asphalt", NULL},
-     0, NULL,
-     "city_camera", 4.0f / 3.0f, 0.5f, {0.0, 34.0, 100.0}, {4.854101966, 25.0, 40.0},
-     "sun", aiLightSource_DIRECTIONAL,
+     0,
+     NULL,
+     "city_camera",
+     4.0f / 3.0f,
+     0.5f,
+     {0.0, 34.0, 100.0},
+     {4.854101966, 25.0, 40.0},
+     "sun",
+     aiLightSource_DIRECTIONAL,
      {"city_camera", NULL},
-     5.0, 40000, 80000},
+     5.0,
+     40000,
+     80000},
 };
 
 static uint32_t rd_u32(const unsigned char *p)
@@ -114,11 +170,12 @@ static void check_glb_layout(const unsigned char *b, size_t n)
             memcpy(json, b + 20, json_len);
             json[json_len] = 0;
             CHECK(strstr(json, "\"version\":\"2.0\"") != NULL);
-            if (strstr(json, "KHR_lights_punctual")) CHECK(strstr(json, "\"extensionsUsed\":[\"KHR_lights_punctual\"]") != NULL);
+            if (strstr(json, "KHR_lights_punctual"))
+                CHECK(strstr(json, "\"extensionsUsed\":[\"KHR_lights_punctual\"]") != NULL);
             free(json);
         }
     }
-    if (20 + (size_t)json_len == n) return;   /* no BIN chunk */
+    if (20 + (size_t)json_len == n) return; /* no BIN chunk */
     CHECK(20 + (size_t)json_len + 8 <= n);
     bin_len = rd_u32(b + 20 + json_len);
     CHECK(memcmp(b + 24 + json_len, "BIN\0", 4) == 0);
@@ -168,7 +225,8 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
     if (!s) return;
     for (k = 0; e->meshes[k]; k++) {
         int found = 0;
-        for (i = 0; i < s->mNumMeshes; i++) found |= strcmp(s->mMeshes[i]->mName.data, e->meshes[k]) == 0;
+        for (i = 0; i < s->mNumMeshes; i++)
+            found |= strcmp(s->mMeshes[i]->mName.data, e->meshes[k]) == 0;
         if (!found) fprintf(stderr, "%s: no mesh %s\n", e->name, e->meshes[k]);
         CHECK(found);
     }
@@ -178,14 +236,15 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
         CHECK(m->mNormals != NULL);
         CHECK(m->mPrimitiveTypes == aiPrimitiveType_TRIANGLE);
     }
-    if (tris < e->min_triangles || tris > e->max_triangles) fprintf(stderr, "%s: %u triangles\n", e->name, tris);
+    if (tris < e->min_triangles || tris > e->max_triangles)
+        fprintf(stderr, "%s: %u triangles\n", e->name, tris);
     CHECK(tris >= e->min_triangles && tris <= e->max_triangles);
     if (!full) return;
 
     for (k = 0; e->materials[k]; k++) CHECK(find_material(s, e->materials[k]) != NULL);
     CHECK((int)s->mNumTextures >= e->min_textures);
     for (i = 0; i < s->mNumTextures; i++) {
-        CHECK(s->mTextures[i]->mHeight == 0);   /* compressed (embedded PNG) */
+        CHECK(s->mTextures[i]->mHeight == 0); /* compressed (embedded PNG) */
         CHECK(strcmp(s->mTextures[i]->achFormatHint, "png") == 0);
         CHECK(s->mTextures[i]->mWidth > 8 && memcmp(s->mTextures[i]->pcData, "\x89PNG", 4) == 0);
     }
@@ -194,8 +253,8 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
         struct aiString path;
         CHECK(m != NULL);
         if (m) {
-            CHECK(aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &path, NULL, NULL, NULL, NULL, NULL, NULL) ==
-                  aiReturn_SUCCESS);
+            CHECK(aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &path, NULL, NULL, NULL, NULL,
+                                       NULL, NULL) == aiReturn_SUCCESS);
             CHECK(path.data[0] == '*' && atoi(path.data + 1) < (int)s->mNumTextures);
         }
     }
@@ -222,7 +281,7 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
             CHECK_NEAR(-w.a3, d[0] / l, 1e-5);
             CHECK_NEAR(-w.b3, d[1] / l, 1e-5);
             CHECK_NEAR(-w.c3, d[2] / l, 1e-5);
-            CHECK(w.b2 > 0.9);   /* up stays up */
+            CHECK(w.b2 > 0.9); /* up stays up */
         }
     }
     CHECK(s->mNumLights == 1);
@@ -241,7 +300,8 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
         for (k = 0; e->animated[k]; k++) {
             const struct aiNodeAnim *na = NULL;
             for (i = 0; i < a->mNumChannels; i++)
-                if (strcmp(a->mChannels[i]->mNodeName.data, e->animated[k]) == 0) na = a->mChannels[i];
+                if (strcmp(a->mChannels[i]->mNodeName.data, e->animated[k]) == 0)
+                    na = a->mChannels[i];
             CHECK(na != NULL);
             if (!na) continue;
             CHECK(na->mNumPositionKeys > 0 && na->mNumRotationKeys > 0 && na->mNumScalingKeys > 0);
@@ -274,7 +334,8 @@ static void check_square_numbers(const struct aiScene *s)
     na = s->mAnimations[0]->mChannels[0];
     CHECK(na->mNumPositionKeys == 2);
     if (na->mNumPositionKeys == 2) {
-        double tps = s->mAnimations[0]->mTicksPerSecond > 0.0 ? s->mAnimations[0]->mTicksPerSecond : 1.0;
+        double tps =
+            s->mAnimations[0]->mTicksPerSecond > 0.0 ? s->mAnimations[0]->mTicksPerSecond : 1.0;
         CHECK_NEAR(na->mPositionKeys[0].mTime / tps, 0.0, 1e-9);
         CHECK_NEAR(na->mPositionKeys[1].mTime / tps, 2.0, 1e-6);
         CHECK_NEAR(na->mPositionKeys[0].mValue.x, -1.0, 1e-7);
@@ -283,7 +344,8 @@ static void check_square_numbers(const struct aiScene *s)
     }
     /* glTF through Assimp: mHorizontalFOV = yfov * aspect, aspect 1 here */
     CHECK_NEAR(s->mCameras[0]->mHorizontalFOV, 2.0 * atan(0.25), 1e-6);
-    CHECK_NEAR(s->mLights[0]->mColorDiffuse.r, 16.0 * 3.14159265, 1e-4);   /* the lamp at the camera */
+    CHECK_NEAR(s->mLights[0]->mColorDiffuse.r, 16.0 * 3.14159265,
+               1e-4); /* the lamp at the camera */
 }
 
 int main(void)
@@ -333,8 +395,8 @@ int main(void)
         aiReleaseImport(s);
 
         /* the same through a file, as `evray demo --export` writes it */
-        snprintf(path, sizeof path, "%s/evray_test_demo_%ld_%s.glb", tmp && *tmp ? tmp : "/tmp", (long)getpid(),
-                 e->name);
+        snprintf(path, sizeof path, "%s/evray_test_demo_%ld_%s.glb", tmp && *tmp ? tmp : "/tmp",
+                 (long)getpid(), e->name);
         f = fopen(path, "wb");
         CHECK(f != NULL);
         if (f) {

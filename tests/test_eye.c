@@ -26,7 +26,8 @@ static double m34_diff(const evr_m34 *a, const evr_m34 *b)
     int i, j;
     for (i = 0; i < 3; i++)
         for (j = 0; j < 4; j++)
-            if (fabs((double)a->m[i][j] - b->m[i][j]) > d) d = fabs((double)a->m[i][j] - b->m[i][j]);
+            if (fabs((double)a->m[i][j] - b->m[i][j]) > d)
+                d = fabs((double)a->m[i][j] - b->m[i][j]);
     return d;
 }
 
@@ -72,7 +73,8 @@ int main(void)
         CHECK(eye->nodes[node[k]].r_curve.num_keys == eye->nodes[node[0]].r_curve.num_keys);
     }
     c = &eye->nodes[node[0]].r_curve;
-    printf("eye: %d keys per node; eye-drift: %d\n", c->num_keys, drift->nodes[dnode[0]].r_curve.num_keys);
+    printf("eye: %d keys per node; eye-drift: %d\n", c->num_keys,
+           drift->nodes[dnode[0]].r_curve.num_keys);
     CHECK(c->num_keys > 1000 && c->num_keys < 5000);
 
     /* Between two keys either nothing moves (all three nodes hold the same values) or the keys
@@ -111,7 +113,8 @@ int main(void)
                 first_b = tb;
             }
             for (k = 0; k < 3; k++) {
-                evr_m34 a = evr_node_world_at(eye, node[k], ta), b = evr_node_world_at(eye, node[k], tb);
+                evr_m34 a = evr_node_world_at(eye, node[k], ta),
+                        b = evr_node_world_at(eye, node[k], tb);
                 evr_m34 m = evr_node_world_at(eye, node[k], tm);
                 int f;
                 CHECK(same_key(&eye->nodes[node[k]].r_curve, i, j));
@@ -143,14 +146,16 @@ int main(void)
     CHECK(first_a > 0.0);
     if (first_a > 0.0) {
         double tm = 0.5 * (first_a + first_b);
-        evr_m34 a = evr_node_world_at(drift, dnode[0], first_a), m = evr_node_world_at(drift, dnode[0], tm);
+        evr_m34 a = evr_node_world_at(drift, dnode[0], first_a),
+                m = evr_node_world_at(drift, dnode[0], tm);
         evr_m34 e = evr_node_world_at(eye, node[0], tm);
         CHECK(memcmp(&a, &m, sizeof a) != 0);
         CHECK(m34_diff(&a, &m) > 1e-6);
-        CHECK(m34_diff(&e, &m) < 0.2 * 3.14159265 / 180.0);   /* drift is below 0.2 degrees */
+        CHECK(m34_diff(&e, &m) < 0.2 * 3.14159265 / 180.0); /* drift is below 0.2 degrees */
     }
-    for (k = 0; k < nmid; k++) {   /* the same plan: every fixation within the drift's amplitude */
-        evr_m34 a = evr_node_world_at(drift, dnode[0], mid[k]), b = evr_node_world_at(eye, node[0], mid[k]);
+    for (k = 0; k < nmid; k++) { /* the same plan: every fixation within the drift's amplitude */
+        evr_m34 a = evr_node_world_at(drift, dnode[0], mid[k]),
+                b = evr_node_world_at(eye, node[0], mid[k]);
         CHECK(m34_diff(&a, &b) < 0.2 * 3.14159265 / 180.0);
     }
     evr_scene_release(eye);

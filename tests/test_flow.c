@@ -10,14 +10,18 @@
 #include <math.h>
 #include <string.h>
 
-typedef struct { long long t; int x, y, p; } ev_t;
+typedef struct {
+    long long t;
+    int x, y, p;
+} ev_t;
 
 struct evr_event_sink {
     ev_t ev[512];
     int n, pushes;
 };
 
-static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x,
+                                      int y, int polarity)
 {
     k->pushes++;
     if (!has) return 0;
@@ -48,8 +52,8 @@ static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, 
 }
 
 /* The loop as the backends wrote it before it moved to core: begin, next until none, end. */
-static int reference_events(evr_pixel_state *st, const evr_pixel_params *p, int sensor, float t, float in, double t0,
-                            int x, int y, ev_t *out)
+static int reference_events(evr_pixel_state *st, const evr_pixel_params *p, int sensor, float t,
+                            float in, double t0, int x, int y, ev_t *out)
 {
     evr_pixel_span sp;
     float te;
@@ -66,8 +70,12 @@ static int reference_events(evr_pixel_state *st, const evr_pixel_params *p, int 
 
 static void test_event_loop(void)
 {
-    evr_pixel_params run = {.pos_thres = 0.2f, .neg_thres = 0.25f, .refractory = 1e-4f, .log_floor = 1e-3f,
-                            .full_intensity = 4.0f, .seed = 7};
+    evr_pixel_params run = {.pos_thres = 0.2f,
+                            .neg_thres = 0.25f,
+                            .refractory = 1e-4f,
+                            .log_floor = 1e-3f,
+                            .full_intensity = 4.0f,
+                            .seed = 7};
     int sensor;
     for (sensor = 0; sensor <= 1; sensor++) {
         evr_pixel_params p;
@@ -88,9 +96,10 @@ static void test_event_loop(void)
             const float t = 0.001f * (float)s, in = 1.0f + 0.9f * sinf(40.0f * t);
             const int n = reference_events(&a, &p, sensor, t, in, 2.0, 3, 4, ref);
             memset(&k, 0, sizeof k);
-            evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 1, t, in, 2.0, 3, 4, &k);
+            evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 1, t, in, 2.0, 3, 4,
+                                    &k);
             CHECK(k.n == n);
-            CHECK(k.pushes == n + 1);   /* one push with none ends the loop */
+            CHECK(k.pushes == n + 1); /* one push with none ends the loop */
             for (int i = 0; i < n && i < k.n; i++) {
                 CHECK(k.ev[i].t == ref[i].t && k.ev[i].p == ref[i].p);
                 CHECK(k.ev[i].x == 3 && k.ev[i].y == 4);
@@ -102,7 +111,8 @@ static void test_event_loop(void)
         /* a lane without a sample: the state is untouched, the sink is asked once */
         memset(&k, 0, sizeof k);
         evr_pixel_state c = b;
-        evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 0, 0.3f, 9.0f, 2.0, 3, 4, &k);
+        evr_pixel_sample_events(&b, &p, evr_pixel_ideal_of(&p), sensor, 0, 0.3f, 9.0f, 2.0, 3, 4,
+                                &k);
         CHECK(k.n == 0 && k.pushes == 1);
         CHECK(memcmp(&b, &c, sizeof b) == 0);
     }
@@ -134,12 +144,13 @@ static void test_adapt_machine(void)
     evr_pixel_reset(&st);
     sk.n = 0;
     t = evr_adapt_start(&rs, &ap, &plan, &st, ray0, 0.0f, 0.5f, seg);
-    CHECK_NEAR(t, 0.5e-3, 1e-9);   /* a pixel's very first sample: its phase times min_dt */
+    CHECK_NEAR(t, 0.5e-3, 1e-9); /* a pixel's very first sample: its phase times min_dt */
     while (t < seg && traced < 1000) {
         float in = t < 0.3f ? 1.0f : 2.0f, hit = INFINITY, step = 0.0f;
         int moving = 0;
         traced++;
-        while (evr_adapt_candidate(&rs, &ap, &plan, &st, &p, ray0, &sk, t, in, hit, &t, &step, &moving)) {
+        while (evr_adapt_candidate(&rs, &ap, &plan, &st, &p, ray0, &sk, t, in, hit, &t, &step,
+                                   &moving)) {
             if (t < last) ok_order = 0;
             last = t;
             evr_pixel_sample_events(&st, &p, evr_pixel_ideal_of(&p), 0, 1, t, in, 0.0, 0, 0, &k);
@@ -149,7 +160,7 @@ static void test_adapt_machine(void)
     CHECK(ok_order);
     CHECK(sk.n == 0);
     CHECK(traced > 10 && traced < 100);
-    CHECK(k.n == 3);   /* ln 2 = 0.69: three ON thresholds of 0.2 */
+    CHECK(k.n == 3); /* ln 2 = 0.69: three ON thresholds of 0.2 */
     for (int i = 0; i < k.n && i < 3; i++) {
         CHECK(k.ev[i].p == 1);
         CHECK(fabs((double)k.ev[i].t * 1e-6 - 0.3) < 2.0 * ap.min_dt);

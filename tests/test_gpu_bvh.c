@@ -38,8 +38,8 @@
 #define RAY_SCALE 1
 #endif
 
-#define MAX_KEYS 65          /* as the segment loop (sim_state.h) */
-#define EDGE_EPS 1e-4f       /* barycentric distance to an edge that counts as "on the edge" */
+#define MAX_KEYS 65    /* as the segment loop (sim_state.h) */
+#define EDGE_EPS 1e-4f /* barycentric distance to an edge that counts as "on the edge" */
 #define MAX_MISMATCH_RATE 1e-4
 
 static double now(void)
@@ -98,27 +98,40 @@ typedef struct {
     int num_groups;
     RTCScene *group_scenes;
     int *group_track, *group_first, *members;
-    int *group_instanced;   /* 1: a static instance of its mesh's scene (past the bake limit) */
+    int *group_instanced; /* 1: a static instance of its mesh's scene (past the bake limit) */
 } reference;
 
 static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
 {
     rtcInitQuaternionDecomposition(q);
-    q->scale_x = k->scale[0]; q->scale_y = k->scale[1]; q->scale_z = k->scale[2];
-    q->skew_xy = k->skew[0]; q->skew_xz = k->skew[1]; q->skew_yz = k->skew[2];
-    q->quaternion_r = k->rot.w; q->quaternion_i = k->rot.x; q->quaternion_j = k->rot.y; q->quaternion_k = k->rot.z;
-    q->translation_x = k->trans.x; q->translation_y = k->trans.y; q->translation_z = k->trans.z;
+    q->scale_x = k->scale[0];
+    q->scale_y = k->scale[1];
+    q->scale_z = k->scale[2];
+    q->skew_xy = k->skew[0];
+    q->skew_xz = k->skew[1];
+    q->skew_yz = k->skew[2];
+    q->quaternion_r = k->rot.w;
+    q->quaternion_i = k->rot.x;
+    q->quaternion_j = k->rot.y;
+    q->quaternion_k = k->rot.z;
+    q->translation_x = k->trans.x;
+    q->translation_y = k->trans.y;
+    q->translation_z = k->trans.z;
 }
 
-static void add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf, unsigned geom_id)
+static void add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf,
+                              unsigned geom_id)
 {
     uint32_t v;
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
-    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                        3 * sizeof(float), m->num_vertices);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), m->num_triangles);
     for (v = 0; v < m->num_vertices; v++) {
-        evr_v3 p = evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
+        evr_v3 p =
+            evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
         if (xf) p = evr_m34_point(xf, p);
         vb[3 * v] = p.x;
         vb[3 * v + 1] = p.y;
@@ -157,7 +170,8 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo, 
             group_of[i] = r->num_groups++;
             continue;
         }
-        for (g = 0; g < r->num_groups && (r->group_track[g] != track || r->group_instanced[g]); g++) {}
+        for (g = 0; g < r->num_groups && (r->group_track[g] != track || r->group_instanced[g]);
+             g++) {}
         if (g == r->num_groups) r->group_track[r->num_groups++] = track;
         group_of[i] = g;
     }
@@ -188,9 +202,11 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo, 
         RTCGeometry geom = rtcNewGeometry(r->dev, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(geom, r->group_scenes[g]);
         if (r->group_track[g] < 0) {
-            evr_m34 xf = r->group_instanced[g]
-                             ? evr_node_world_at(s, s->instances[r->members[r->group_first[g]]].node, s->anim_start)
-                             : evr_m34_identity();
+            evr_m34 xf =
+                r->group_instanced[g]
+                    ? evr_node_world_at(s, s->instances[r->members[r->group_first[g]]].node,
+                                        s->anim_start)
+                    : evr_m34_identity();
             rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
         } else {
             int track = r->group_track[g], nk = mo->count[track];
@@ -228,7 +244,8 @@ static int same_groups(const evr_scene *s, const evr_gpu_bvh *b, const reference
     if (b->num_groups != r->num_groups) return 0;
     for (g = 0; g < r->num_groups; g++) {
         /* an instanced static group is in its node's space */
-        int node = r->group_instanced[g] ? s->instances[r->members[r->group_first[g]]].node : r->group_track[g];
+        int node = r->group_instanced[g] ? s->instances[r->members[r->group_first[g]]].node
+                                         : r->group_track[g];
         if (b->group_node[g] != node || b->group_first[g + 1] != r->group_first[g + 1]) return 0;
         for (j = r->group_first[g]; j < r->group_first[g + 1]; j++)
             if (b->members[j] != r->members[j] || b->instance_group[r->members[j]] != g) return 0;
@@ -265,7 +282,8 @@ static float rnd(uint64_t *c) { return evr_uniform(evr_hash4(0x627668ull, (*c)++
 
 /* A random point on a random instance's surface at time f, in world space, and the surface's
  * (geometric) normal there. */
-static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, float f, uint64_t *c, evr_v3 *normal)
+static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, float f, uint64_t *c,
+                            evr_v3 *normal)
 {
     for (;;) {
         int i = (int)(rnd(c) * (float)s->num_instances) % s->num_instances;
@@ -280,14 +298,19 @@ static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, floa
         xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
         for (k = 0; k < 3; k++) {
             uint32_t vi = m->indices[3 * t + (uint32_t)k];
-            p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1], m->positions[3 * vi + 2]));
+            p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1],
+                                                  m->positions[3 * vi + 2]));
         }
         *normal = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
-        if (evr_v3_dot(*normal, *normal) == 0.0f) continue;   /* a degenerate triangle */
+        if (evr_v3_dot(*normal, *normal) == 0.0f) continue; /* a degenerate triangle */
         a = rnd(c);
         b = rnd(c);
-        if (a + b > 1.0f) { a = 1.0f - a; b = 1.0f - b; }
-        return evr_v3_add(evr_v3_add(evr_v3_scale(p[0], 1 - a - b), evr_v3_scale(p[1], a)), evr_v3_scale(p[2], b));
+        if (a + b > 1.0f) {
+            a = 1.0f - a;
+            b = 1.0f - b;
+        }
+        return evr_v3_add(evr_v3_add(evr_v3_scale(p[0], 1 - a - b), evr_v3_scale(p[1], a)),
+                          evr_v3_scale(p[2], b));
     }
 }
 
@@ -296,8 +319,8 @@ static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, floa
  * rays leave a surface (evr_shadow_tnear: eps / max(cos, 0.05) along the ray), not along the
  * first surface's plane; random rays
  * through the scene's box. */
-static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n_cam, int n_shadow, int n_random,
-                           uint64_t seed)
+static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n_cam, int n_shadow,
+                           int n_random, uint64_t seed)
 {
     test_ray *r = malloc(sizeof *r * (size_t)(n_cam + n_shadow + n_random));
     uint64_t c = seed;
@@ -306,7 +329,8 @@ static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n
     for (i = 0; i < n_cam; i++) {
         float f = rnd(&c);
         evr_m34 pose = evr_rs_camera_pose(rs, f);
-        r[i].ray = evr_camera_ray(&rs->camera, &pose, rnd(&c) * (float)rs->camera.width, rnd(&c) * (float)rs->camera.height);
+        r[i].ray = evr_camera_ray(&rs->camera, &pose, rnd(&c) * (float)rs->camera.width,
+                                  rnd(&c) * (float)rs->camera.height);
         r[i].tnear = 0.0f;
         r[i].tfar = INFINITY;
         r[i].f = f;
@@ -316,14 +340,23 @@ static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n
         evr_v3 na, nb, a = surface_point(s, rs, f, &c, &na), b = surface_point(s, rs, f, &c, &nb);
         evr_v3 dir = evr_v3_sub(b, a);
         d = evr_v3_len(dir);
-        if (!(d > 0.0f)) { i--; continue; }
+        if (!(d > 0.0f)) {
+            i--;
+            continue;
+        }
         dir = evr_v3_scale(dir, 1.0f / d);
         /* a ray lying in its start surface's plane: which side it passes is rounding, and the
          * renderer never traces one (it skips lights with dot(wi, n) <= 0) */
-        if (fabsf(evr_v3_dot(na, dir)) < 1e-3f) { i--; continue; }
+        if (fabsf(evr_v3_dot(na, dir)) < 1e-3f) {
+            i--;
+            continue;
+        }
         off_a = eps / fmaxf(fabsf(evr_v3_dot(na, dir)), 0.05f);
         off_b = eps / fmaxf(fabsf(evr_v3_dot(nb, dir)), 0.05f);
-        if (!(d > 2.0f * (off_a + off_b))) { i--; continue; }
+        if (!(d > 2.0f * (off_a + off_b))) {
+            i--;
+            continue;
+        }
         r[i].ray.org = a;
         r[i].ray.dir = dir;
         r[i].tnear = off_a;
@@ -332,7 +365,8 @@ static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n
     }
     for (; i < n_cam + n_shadow + n_random; i++) {
         evr_v3 lo = s->bounds_min, hi = s->bounds_max, o, d;
-        o = evr_v3_make(lo.x + (hi.x - lo.x) * (1.4f * rnd(&c) - 0.2f), lo.y + (hi.y - lo.y) * (1.4f * rnd(&c) - 0.2f),
+        o = evr_v3_make(lo.x + (hi.x - lo.x) * (1.4f * rnd(&c) - 0.2f),
+                        lo.y + (hi.y - lo.y) * (1.4f * rnd(&c) - 0.2f),
                         lo.z + (hi.z - lo.z) * (1.4f * rnd(&c) - 0.2f));
         do d = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
         while (evr_v3_dot(d, d) > 1.0f || evr_v3_dot(d, d) < 1e-4f);
@@ -362,12 +396,15 @@ static test_ray *make_rays(const evr_scene *s, const evr_render_scene *rs, int n
 enum { EX_NONE = 0, EX_EDGE = 1, EX_CONTACT = 2, EX_TIE = 3 };
 
 typedef struct {
-    const evr_mesh *meshes;        /* by rs->instances[i].mesh */
+    const evr_mesh *meshes; /* by rs->instances[i].mesh */
     const evr_render_scene *rs;
     float delta;
 } judge;
 
-static float edge_distance(const evr_gpu_hit *h) { return fminf(fminf(h->u, h->v), 1.0f - h->u - h->v); }
+static float edge_distance(const evr_gpu_hit *h)
+{
+    return fminf(fminf(h->u, h->v), 1.0f - h->u - h->v);
+}
 
 /* |cosine| between a ray and the (world-space) triangle it hit. */
 static float hit_cosine(const judge *j, const evr_gpu_hit *h, evr_ray ray, float f)
@@ -378,7 +415,8 @@ static float hit_cosine(const judge *j, const evr_gpu_hit *h, evr_ray ray, float
     int k;
     for (k = 0; k < 3; k++) {
         uint32_t vi = m->indices[3 * h->prim + (uint32_t)k];
-        p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1], m->positions[3 * vi + 2]));
+        p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1],
+                                              m->positions[3 * vi + 2]));
     }
     n = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
     return fabsf(evr_v3_dot(n, evr_v3_norm(ray.dir)));
@@ -390,7 +428,8 @@ static int t_agrees(float t1, float t2, float cosine, float delta)
     return dt <= 1e-4f * fmaxf(t1, t2) || dt * cosine <= delta;
 }
 
-static int same_hit(const judge *j, const evr_gpu_hit *a, const evr_gpu_hit *b, evr_ray ray, float f)
+static int same_hit(const judge *j, const evr_gpu_hit *a, const evr_gpu_hit *b, evr_ray ray,
+                    float f)
 {
     float c;
     if (a->instance != b->instance || a->prim != b->prim) return 0;
@@ -401,8 +440,8 @@ static int same_hit(const judge *j, const evr_gpu_hit *a, const evr_gpu_hit *b, 
 }
 
 /* How float epsilons explain hits a and b (either may be absent) of a ray over [0, tmax]. */
-static int explain(const judge *j, evr_ray ray, float f, float tmax, int h1, const evr_gpu_hit *a, int h2,
-                   const evr_gpu_hit *b)
+static int explain(const judge *j, evr_ray ray, float f, float tmax, int h1, const evr_gpu_hit *a,
+                   int h2, const evr_gpu_hit *b)
 {
     const evr_gpu_hit *h[2];
     int n = 0, k;
@@ -412,7 +451,8 @@ static int explain(const judge *j, evr_ray ray, float f, float tmax, int h1, con
         if (edge_distance(h[k]) < EDGE_EPS) return EX_EDGE;
     for (k = 0; k < n; k++) {
         float c = hit_cosine(j, h[k], ray, f);
-        if (h[k]->t * c <= j->delta || (isfinite(tmax) && (tmax - h[k]->t) * c <= j->delta)) return EX_CONTACT;
+        if (h[k]->t * c <= j->delta || (isfinite(tmax) && (tmax - h[k]->t) * c <= j->delta))
+            return EX_CONTACT;
     }
     if (n == 2 && (t_agrees(a->t, b->t, hit_cosine(j, a, ray, f), j->delta) ||
                    t_agrees(a->t, b->t, hit_cosine(j, b, ray, f), j->delta)))
@@ -433,7 +473,7 @@ static const char *const ray_kind_name[3] = {"camera", "shadow-like", "random"};
 
 typedef struct {
     long rays[3], hits[3];
-    long closest[3][4];     /* mismatches by ray kind and explanation (EX_NONE: unexplained) */
+    long closest[3][4]; /* mismatches by ray kind and explanation (EX_NONE: unexplained) */
     long occluded[3][4];
 } tally;
 
@@ -442,10 +482,11 @@ static long sum4(const long *x) { return x[0] + x[1] + x[2] + x[3]; }
 static void report_line(int kind, const tally *ty)
 {
     const long *c = ty->closest[kind], *o = ty->occluded[kind];
-    printf("    %-11s %7ld rays (%ld hit): closest differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld), "
-           "occlusion differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld)\n",
-           ray_kind_name[kind], ty->rays[kind], ty->hits[kind], sum4(c), c[EX_EDGE], c[EX_CONTACT], c[EX_TIE], c[EX_NONE],
-           sum4(o), o[EX_EDGE], o[EX_CONTACT], o[EX_TIE], o[EX_NONE]);
+    printf(
+        "    %-11s %7ld rays (%ld hit): closest differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld), "
+        "occlusion differ %ld (edge %ld, contact %ld, tie %ld, unexplained %ld)\n",
+        ray_kind_name[kind], ty->rays[kind], ty->hits[kind], sum4(c), c[EX_EDGE], c[EX_CONTACT],
+        c[EX_TIE], c[EX_NONE], sum4(o), o[EX_EDGE], o[EX_CONTACT], o[EX_TIE], o[EX_NONE]);
 }
 
 /* The nearest hit as the CUDA backend finds a camera ray's while the camera holds still: the
@@ -453,8 +494,8 @@ static void report_line(int kind, const tally *ty)
  * and those where it differs from the search of all groups (other than by an exact tie). */
 static long split_rays, split_differ;
 
-static void compare(const char *what, const judge *j, const evr_gpu_scene_view *v, const reference *ref,
-                    const test_ray *rays, const int *kind, int n, tally *ty)
+static void compare(const char *what, const judge *j, const evr_gpu_scene_view *v,
+                    const reference *ref, const test_ray *rays, const int *kind, int n, tally *ty)
 {
     const evr_render_scene *rs = j->rs;
     int i, printed = 0;
@@ -479,7 +520,8 @@ static void compare(const char *what, const judge *j, const evr_gpu_scene_view *
             memset(&st, 0, sizeof st);
             memset(&mv, 0, sizeof mv);
             const int hs = evr_trace_closest_groups(v, rs, cr, tmax, r->f, EVR_GROUPS_STATIC, &st);
-            const int hm = evr_trace_closest_groups(v, rs, cr, hs ? st.t : tmax, r->f, EVR_GROUPS_MOVING, &mv);
+            const int hm =
+                evr_trace_closest_groups(v, rs, cr, hs ? st.t : tmax, r->f, EVR_GROUPS_MOVING, &mv);
             const evr_gpu_hit *sp = hm ? &mv : &st;
             split_rays++;
             /* the same distance; another triangle there is a tie, either is the nearest */
@@ -492,9 +534,11 @@ static void compare(const char *what, const judge *j, const evr_gpu_scene_view *
             int ex = explain(j, cr, r->f, tmax, h1, &a, h2, &b);
             ty->closest[kd][ex]++;
             if (dump || (ex == EX_NONE && printed++ < 5))
-                printf("%s %s ray %d (class %d): ours %d inst %d prim %u t %.9g uv %.6g %.6g, Embree %d inst %d prim %u "
-                       "t %.9g uv %.6g %.6g\n", ex == EX_NONE ? "FAIL" : "note", what, i, ex, h1, a.instance, a.prim,
-                       a.t, a.u, a.v, h2, b.instance, b.prim, b.t, b.u, b.v);
+                printf(
+                    "%s %s ray %d (class %d): ours %d inst %d prim %u t %.9g uv %.6g %.6g, Embree %d inst %d prim %u "
+                    "t %.9g uv %.6g %.6g\n",
+                    ex == EX_NONE ? "FAIL" : "note", what, i, ex, h1, a.instance, a.prim, a.t, a.u,
+                    a.v, h2, b.instance, b.prim, b.t, b.u, b.v);
         }
         o1 = evr_trace_any(v, rs, r->ray, r->tnear, r->tfar, r->f);
         o2 = reference_occluded(ref, r->ray, r->tnear, r->tfar, r->f);
@@ -525,15 +569,16 @@ static void compare(const char *what, const judge *j, const evr_gpu_scene_view *
     }
 }
 
-static void timing(const char *what, const evr_gpu_scene_view *v, const evr_render_scene *rs, const reference *ref,
-                   const test_ray *rays, int n)
+static void timing(const char *what, const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                   const reference *ref, const test_ray *rays, int n)
 {
     double t0, t1, t2;
     long h1 = 0, h2 = 0;
     int i;
     evr_gpu_hit h;
     t0 = now();
-    for (i = 0; i < n; i++) h1 += evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
+    for (i = 0; i < n; i++)
+        h1 += evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
     t1 = now();
     for (i = 0; i < n; i++) h2 += reference_closest(ref, rays[i].ray, rays[i].tfar, rays[i].f, &h);
     t2 = now();
@@ -545,11 +590,12 @@ static void timing(const char *what, const evr_gpu_scene_view *v, const evr_rend
 
 static int inside(evr_v3 p, const float *lo, const float *hi)
 {
-    return p.x >= lo[0] && p.y >= lo[1] && p.z >= lo[2] && p.x <= hi[0] && p.y <= hi[1] && p.z <= hi[2];
+    return p.x >= lo[0] && p.y >= lo[1] && p.z >= lo[2] && p.x <= hi[0] && p.y <= hi[1] &&
+           p.z <= hi[2];
 }
 
-static long check_box_holds(const float box[6], const float *lo, const float *hi, evr_motion_track tr, int samples,
-                            uint64_t *c)
+static long check_box_holds(const float box[6], const float *lo, const float *hi,
+                            evr_motion_track tr, int samples, uint64_t *c)
 {
     long bad = 0;
     int j, k;
@@ -557,7 +603,8 @@ static long check_box_holds(const float box[6], const float *lo, const float *hi
         float f = j < samples / 2 ? (float)j / (float)(samples / 2) : rnd(c);
         evr_m34 xf = evr_motion_eval(tr, f);
         for (k = 0; k < 8; k++) {
-            evr_v3 p = evr_v3_make((k & 1) ? box[3] : box[0], (k & 2) ? box[4] : box[1], (k & 4) ? box[5] : box[2]);
+            evr_v3 p = evr_v3_make((k & 1) ? box[3] : box[0], (k & 2) ? box[4] : box[1],
+                                   (k & 4) ? box[5] : box[2]);
             if (!inside(evr_m34_point(&xf, p), lo, hi)) bad++;
         }
     }
@@ -565,20 +612,21 @@ static long check_box_holds(const float box[6], const float *lo, const float *hi
 }
 
 /* The top level's boxes hold every group at every time of the segment. */
-static long check_group_boxes(const evr_gpu_bvh *b, const evr_gpu_top *top, const evr_render_scene *rs, int samples,
-                              uint64_t *c)
+static long check_group_boxes(const evr_gpu_bvh *b, const evr_gpu_top *top,
+                              const evr_render_scene *rs, int samples, uint64_t *c)
 {
     long bad = 0;
     int g, k;
     for (g = 0; g < b->num_groups; g++) {
         const float *box = b->group_bounds + 6 * g, *lo = top->group_bounds + 6 * g, *hi = lo + 3;
         if (b->group_root[g] < 0) continue;
-        if (b->group_node[g] < 0) {   /* static: world space already */
+        if (b->group_node[g] < 0) { /* static: world space already */
             for (k = 0; k < 3; k++)
                 if (!(lo[k] <= box[k] && hi[k] >= box[k + 3])) bad++;
             continue;
         }
-        bad += check_box_holds(box, lo, hi, evr_rs_track(rs, rs->instances[b->members[b->group_first[g]]].track),
+        bad += check_box_holds(box, lo, hi,
+                               evr_rs_track(rs, rs->instances[b->members[b->group_first[g]]].track),
                                samples, c);
     }
     return bad;
@@ -606,9 +654,11 @@ static void test_synthetic_bounds(void)
                 k->scale[a] = 0.2f + 2.0f * rnd(&c);
                 k->skew[a] = 0.5f * rnd(&c) - 0.25f;
             }
-            if (set % 5 == 0) k->scale[2] = -k->scale[2];   /* mirrored */
-            k->trans = evr_v3_make(10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f);
-            k->rot = evr_quat_normalize(evr_quat_make(rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f));
+            if (set % 5 == 0) k->scale[2] = -k->scale[2]; /* mirrored */
+            k->trans =
+                evr_v3_make(10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f, 10.0f * rnd(&c) - 5.0f);
+            k->rot = evr_quat_normalize(
+                evr_quat_make(rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f, rnd(&c) - 0.5f));
             if (i > 0) {
                 /* up to ~120 degrees from the previous key (what evr_node_motion_keys allows), or
                  * nearly the same (the normalized-lerp branch of the slerp) */
@@ -621,7 +671,8 @@ static void test_synthetic_bounds(void)
         {
             evr_motion_track tr;
             double exact_vol = 1.0, vol = 1.0;
-            double elo[3] = {INFINITY, INFINITY, INFINITY}, ehi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double elo[3] = {INFINITY, INFINITY, INFINITY},
+                   ehi[3] = {-INFINITY, -INFINITY, -INFINITY};
             int j, k, a;
             tr.keys = keys;
             tr.n = n;
@@ -632,7 +683,8 @@ static void test_synthetic_bounds(void)
             for (j = 0; j <= 2000; j++) {
                 evr_m34 xf = evr_motion_eval(tr, (float)j / 2000.0f);
                 for (k = 0; k < 8; k++) {
-                    evr_v3 p = evr_m34_point(&xf, evr_v3_make((k & 1) ? box[3] : box[0], (k & 2) ? box[4] : box[1],
+                    evr_v3 p = evr_m34_point(&xf, evr_v3_make((k & 1) ? box[3] : box[0],
+                                                              (k & 2) ? box[4] : box[1],
                                                               (k & 4) ? box[5] : box[2]));
                     float q[3] = {p.x, p.y, p.z};
                     for (a = 0; a < 3; a++) {
@@ -648,8 +700,10 @@ static void test_synthetic_bounds(void)
             ratio += vol / exact_vol;
         }
     }
-    printf("synthetic tracks: %ld corner samples outside their segment box (of %ld tracks); boxes %.4f x the "
-           "sampled volume on average\n", bad, tested, ratio / (double)tested);
+    printf(
+        "synthetic tracks: %ld corner samples outside their segment box (of %ld tracks); boxes %.4f x the "
+        "sampled volume on average\n",
+        bad, tested, ratio / (double)tested);
     CHECK(bad == 0);
 }
 
@@ -677,7 +731,8 @@ static void make_sphere(int n, evr_mesh *mesh)
     for (f = 0; f < 6; f++)
         for (j = 0; j <= n; j++)
             for (i = 0; i <= n; i++) {
-                float a = 2.0f * (float)i / (float)n - 1.0f, b = 2.0f * (float)j / (float)n - 1.0f, p[3], l;
+                float a = 2.0f * (float)i / (float)n - 1.0f, b = 2.0f * (float)j / (float)n - 1.0f,
+                      p[3], l;
                 int ax = f % 3, sg = f < 3 ? 1 : -1;
                 p[ax] = (float)sg;
                 p[(ax + 1) % 3] = sg > 0 ? a : b;
@@ -686,10 +741,11 @@ static void make_sphere(int n, evr_mesh *mesh)
                 for (k = 0; k < 3; k++) pos[3 * vi + k] = p[k] / l;
                 vi++;
             }
-    for (u = 0; u < nv; u++) {   /* weld the copies along the cube's edges */
+    for (u = 0; u < nv; u++) { /* weld the copies along the cube's edges */
         remap[u] = u;
         for (w = 0; w < u; w++)
-            if (fabsf(pos[3 * w] - pos[3 * u]) < 1e-6f && fabsf(pos[3 * w + 1] - pos[3 * u + 1]) < 1e-6f &&
+            if (fabsf(pos[3 * w] - pos[3 * u]) < 1e-6f &&
+                fabsf(pos[3 * w + 1] - pos[3 * u + 1]) < 1e-6f &&
                 fabsf(pos[3 * w + 2] - pos[3 * u + 2]) < 1e-6f) {
                 remap[u] = remap[w];
                 break;
@@ -700,9 +756,16 @@ static void make_sphere(int n, evr_mesh *mesh)
             for (i = 0; i < n; i++) {
                 int b0 = f * (n + 1) * (n + 1);
                 int v00 = remap[b0 + j * (n + 1) + i], v10 = remap[b0 + j * (n + 1) + i + 1];
-                int v01 = remap[b0 + (j + 1) * (n + 1) + i], v11 = remap[b0 + (j + 1) * (n + 1) + i + 1];
-                idx[3 * ti] = (uint32_t)v00; idx[3 * ti + 1] = (uint32_t)v10; idx[3 * ti + 2] = (uint32_t)v11; ti++;
-                idx[3 * ti] = (uint32_t)v00; idx[3 * ti + 1] = (uint32_t)v11; idx[3 * ti + 2] = (uint32_t)v01; ti++;
+                int v01 = remap[b0 + (j + 1) * (n + 1) + i],
+                    v11 = remap[b0 + (j + 1) * (n + 1) + i + 1];
+                idx[3 * ti] = (uint32_t)v00;
+                idx[3 * ti + 1] = (uint32_t)v10;
+                idx[3 * ti + 2] = (uint32_t)v11;
+                ti++;
+                idx[3 * ti] = (uint32_t)v00;
+                idx[3 * ti + 1] = (uint32_t)v11;
+                idx[3 * ti + 2] = (uint32_t)v01;
+                ti++;
             }
     free(remap);
     memset(mesh, 0, sizeof *mesh);
@@ -732,9 +795,16 @@ static void make_sheet(int n, evr_mesh *mesh)
         }
     for (j = 0; j < n; j++)
         for (i = 0; i < n; i++) {
-            uint32_t v00 = (uint32_t)(j * (n + 1) + i), v10 = v00 + 1, v01 = v00 + (uint32_t)(n + 1), v11 = v01 + 1;
-            idx[3 * ti] = v00; idx[3 * ti + 1] = v10; idx[3 * ti + 2] = v11; ti++;
-            idx[3 * ti] = v00; idx[3 * ti + 1] = v11; idx[3 * ti + 2] = v01; ti++;
+            uint32_t v00 = (uint32_t)(j * (n + 1) + i), v10 = v00 + 1,
+                     v01 = v00 + (uint32_t)(n + 1), v11 = v01 + 1;
+            idx[3 * ti] = v00;
+            idx[3 * ti + 1] = v10;
+            idx[3 * ti + 2] = v11;
+            ti++;
+            idx[3 * ti] = v00;
+            idx[3 * ti + 1] = v11;
+            idx[3 * ti + 2] = v01;
+            ti++;
         }
     memset(mesh, 0, sizeof *mesh);
     mesh->num_vertices = (uint32_t)nv;
@@ -801,13 +871,18 @@ static void test_watertight(int layout, int animated)
         evr_ray r;
         evr_gpu_hit h;
         uint32_t t = (uint32_t)(rnd(&c) * (float)mesh.num_triangles) % mesh.num_triangles;
-        const float *p0 = mesh.positions + 3 * mesh.indices[3 * t], *p1 = mesh.positions + 3 * mesh.indices[3 * t + 1];
+        const float *p0 = mesh.positions + 3 * mesh.indices[3 * t],
+                    *p1 = mesh.positions + 3 * mesh.indices[3 * t + 1];
         evr_v3 target;
         int kind = k % 3;
-        if (kind == 0) target = evr_v3_make(p0[0], p0[1], p0[2]);                       /* a vertex */
-        else if (kind == 1) target = evr_v3_make(0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2]));
+        if (kind == 0) target = evr_v3_make(p0[0], p0[1], p0[2]); /* a vertex */
+        else if (kind == 1)
+            target =
+                evr_v3_make(0.5f * (p0[0] + p1[0]), 0.5f * (p0[1] + p1[1]), 0.5f * (p0[2] + p1[2]));
         else target = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
-        r.org = k % 2 ? evr_v3_make(0, 0, 0) : evr_v3_make(0.5f * rnd(&c) - 0.25f, 0.5f * rnd(&c) - 0.25f, 0.5f * rnd(&c) - 0.25f);
+        r.org = k % 2 ? evr_v3_make(0, 0, 0)
+                      : evr_v3_make(0.5f * rnd(&c) - 0.25f, 0.5f * rnd(&c) - 0.25f,
+                                    0.5f * rnd(&c) - 0.25f);
         r.dir = evr_v3_norm(evr_v3_sub(target, r.org));
         if (evr_v3_dot(r.dir, r.dir) == 0.0f) continue;
         rays++;
@@ -815,7 +890,8 @@ static void test_watertight(int layout, int animated)
         else if (!evr_trace_any(&view, &rs, r, 0.0f, INFINITY, 0.5f)) missed++;
     }
     printf("watertight (layout %s, %s group): %d of %d rays from inside a closed mesh escaped\n",
-           layout == EVR_GPU_LAYOUT_CW8 ? "CW8" : "BVH4", animated ? "a moving" : "the static", missed, rays);
+           layout == EVR_GPU_LAYOUT_CW8 ? "CW8" : "BVH4", animated ? "a moving" : "the static",
+           missed, rays);
     CHECK(missed == 0);
     evr_gpu_top_free(&top);
     evr_gpu_bvh_free(&bvh);
@@ -831,11 +907,13 @@ static evr_motion_key random_key(uint64_t *c, const evr_motion_key *prev)
         k.scale[a] = 0.3f + 0.7f * rnd(c);
         k.skew[a] = 0.4f * rnd(c) - 0.2f;
     }
-    k.rot = evr_quat_normalize(evr_quat_make(rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f));
+    k.rot = evr_quat_normalize(
+        evr_quat_make(rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f, rnd(c) - 0.5f));
     k.trans = evr_v3_make(16.0f * rnd(c) - 8.0f, 16.0f * rnd(c) - 8.0f, 16.0f * rnd(c) - 8.0f);
     if (prev) {
         k.rot = evr_quat_slerp(prev->rot, k.rot, 0.6f * rnd(c));
-        if (evr_quat_dot(prev->rot, k.rot) < 0.0f) k.rot = evr_quat_make(-k.rot.w, -k.rot.x, -k.rot.y, -k.rot.z);
+        if (evr_quat_dot(prev->rot, k.rot) < 0.0f)
+            k.rot = evr_quat_make(-k.rot.w, -k.rot.x, -k.rot.y, -k.rot.z);
         k.trans = evr_v3_lerp(prev->trans, k.trans, 0.1f);
     }
     return k;
@@ -856,7 +934,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     evr_instance *sinst = malloc(sizeof *sinst * (size_t)n_inst);
     evr_instance_view *inst = malloc(sizeof *inst * (size_t)n_inst);
     evr_motion_key *keys = malloc(sizeof *keys * ((size_t)n_inst + 1) * 5);
-    int *off = malloc(sizeof(int) * ((size_t)n_inst + 1)), *cnt = malloc(sizeof(int) * ((size_t)n_inst + 1));
+    int *off = malloc(sizeof(int) * ((size_t)n_inst + 1)),
+        *cnt = malloc(sizeof(int) * ((size_t)n_inst + 1));
     int *kind = malloc(sizeof(int) * (size_t)n_rays);
     test_ray *rays = malloc(sizeof *rays * (size_t)n_rays);
     reference ref, ref_inst;
@@ -879,9 +958,9 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     for (i = 0; i < n_inst; i++) {
         int node;
         if (i % 10 == 9) {
-            node = sinst[i - 1].node;   /* a second mesh on the previous instance's node */
+            node = sinst[i - 1].node; /* a second mesh on the previous instance's node */
         } else {
-            int n = i % 4 == 0 ? 1 : 2 + i % 4;   /* a quarter static, the rest 3 to 5 keys */
+            int n = i % 4 == 0 ? 1 : 2 + i % 4; /* a quarter static, the rest 3 to 5 keys */
             node = nn++;
             nodes[node].parent = i % 16 == 8 ? parent : -1;
             nodes[node].animated = i % 4 != 0;
@@ -918,7 +997,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
 
     for (i = 0; i < n_rays; i++) {
         evr_v3 d;
-        rays[i].ray.org = evr_v3_make(24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f);
+        rays[i].ray.org =
+            evr_v3_make(24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f, 24.0f * rnd(&c) - 12.0f);
         do d = evr_v3_make(2 * rnd(&c) - 1, 2 * rnd(&c) - 1, 2 * rnd(&c) - 1);
         while (evr_v3_dot(d, d) > 1.0f || evr_v3_dot(d, d) < 1e-4f);
         rays[i].ray.dir = evr_v3_norm(d);
@@ -943,7 +1023,7 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         if (li == 4) layout = EVR_GPU_LAYOUT_BVH4;
         memset(&top, 0, sizeof top);
         memset(&ty, 0, sizeof ty);
-        if (li >= 3) setenv("EVR_STATIC_BAKE_LIMIT", "0", 1);   /* past the limit: instance */
+        if (li >= 3) setenv("EVR_STATIC_BAKE_LIMIT", "0", 1); /* past the limit: instance */
         CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
         unsetenv("EVR_STATIC_BAKE_LIMIT");
         if (li >= 3) {
@@ -956,25 +1036,30 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
             CHECK(!bvh.static_instanced);
             CHECK(bvh.grouped && same_groups(&sc, &bvh, li < 3 ? &ref : &ref_inst));
             CHECK(bvh.static_group >= 0 &&
-                  bvh.group_first[bvh.static_group + 1] - bvh.group_first[bvh.static_group] == n_static);
+                  bvh.group_first[bvh.static_group + 1] - bvh.group_first[bvh.static_group] ==
+                      n_static);
             /* trees: the static group's, one per mesh for the single-mesh groups, two for the
              * two-mesh groups (mesh orders 0 1 and 1 0) */
             CHECK(bvh.num_trees == 5);
         } else {
             /* an instance a group, one tree per mesh */
-            CHECK(!bvh.grouped && bvh.num_groups == n_inst && bvh.static_group < 0 && bvh.num_trees == 2);
+            CHECK(!bvh.grouped && bvh.num_groups == n_inst && bvh.static_group < 0 &&
+                  bvh.num_trees == 2);
         }
         CHECK_OK(evr_gpu_top_build(&bvh, &rs, &top, &e_));
         evr_gpu_scene_view_host(&bvh, &top, &view);
         bad = check_group_boxes(&bvh, &top, &rs, 200, &c);
         CHECK(bad == 0);
         snprintf(what, sizeof what, "instances/%s", layout_name(layout));
-        if (li >= 3) snprintf(what, sizeof what, "instances/%s static instanced", layout_name(layout));
+        if (li >= 3)
+            snprintf(what, sizeof what, "instances/%s static instanced", layout_name(layout));
         compare(what, &j, &view, li >= 3 ? &ref_inst : &ref, rays, kind, n_rays, &ty);
-        printf("%d instances on %d nodes, layout %s%s: %d groups (%d instances static), %d trees, %u triangle "
-               "references; top level %u nodes, stack %d of %d\n", n_inst, nn, layout_name(layout),
-               li >= 3 ? " (static instanced)" : "", bvh.num_groups,
-               n_static, bvh.num_trees, bvh.num_tris, top.num_nodes, top.stack_need, EVR_GPU_STACK_SIZE);
+        printf(
+            "%d instances on %d nodes, layout %s%s: %d groups (%d instances static), %d trees, %u triangle "
+            "references; top level %u nodes, stack %d of %d\n",
+            n_inst, nn, layout_name(layout), li >= 3 ? " (static instanced)" : "", bvh.num_groups,
+            n_static, bvh.num_trees, bvh.num_tris, top.num_nodes, top.stack_need,
+            EVR_GPU_STACK_SIZE);
         report_line(RAY_RANDOM, &ty);
         CHECK(ty.closest[RAY_RANDOM][EX_NONE] == 0);
         CHECK(ty.occluded[RAY_RANDOM][EX_NONE] == 0);
@@ -1017,15 +1102,16 @@ static void describe_groups(const evr_scene *s, const evr_gpu_bvh *b, char *out,
         len += (size_t)snprintf(out + len, size - len, "%s%s:", g ? " | " : "",
                                 b->group_node[g] < 0 ? "static" : s->nodes[b->group_node[g]].name);
         for (k = b->group_first[g]; k < b->group_first[g + 1] && len < size; k++)
-            len += (size_t)snprintf(out + len, size - len, " %s", s->meshes[s->instances[b->members[k]].mesh].name);
+            len += (size_t)snprintf(out + len, size - len, " %s",
+                                    s->meshes[s->instances[b->members[k]].mesh].name);
     }
 }
 
 /* A scene's bottom level is built once per layout (its groups as expect_groups says, when not
  * NULL); every segment rebuilds the top level in place (as the backend does) and is checked
  * against an Embree scene with that segment's keys. */
-static void test_scene(const char *name, const char *expect_groups, const double *t0s, int nseg, int n_cam,
-                       int n_shadow, int n_random, totals *tot)
+static void test_scene(const char *name, const char *expect_groups, const double *t0s, int nseg,
+                       int n_cam, int n_shadow, int n_random, totals *tot)
 {
     evr_scene *s = NULL;
     evr_render_host host;
@@ -1046,10 +1132,11 @@ static void test_scene(const char *name, const char *expect_groups, const double
         char groups[512];
         memset(&top[li], 0, sizeof top[li]);
         CHECK_OK(evr_gpu_bvh_build(s, layouts[li], &bvh[li], &err));
-        printf("%s, layout %s: %u nodes of %zu bytes, %u triangle references for %u triangles, stack %d; build %.1f ms\n",
-               name, layout_name(layouts[li]), bvh[li].num_nodes,
-               layouts[li] == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4), bvh[li].num_tris, ntri,
-               bvh[li].max_stack, 1e3 * (now() - tb));
+        printf(
+            "%s, layout %s: %u nodes of %zu bytes, %u triangle references for %u triangles, stack %d; build %.1f ms\n",
+            name, layout_name(layouts[li]), bvh[li].num_nodes,
+            layouts[li] == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4),
+            bvh[li].num_tris, ntri, bvh[li].max_stack, 1e3 * (now() - tb));
         describe_groups(s, &bvh[li], groups, sizeof groups);
         printf("  %d groups (%d trees): %s\n", bvh[li].num_groups, bvh[li].num_trees, groups);
         if (expect_groups) CHECK(strcmp(groups, expect_groups) == 0);
@@ -1071,12 +1158,13 @@ static void test_scene(const char *name, const char *expect_groups, const double
         CHECK(same_groups(s, &bvh[0], &ref) && same_groups(s, &bvh[1], &ref));
         rays = make_rays(s, &host.rs, n_cam, n_shadow, n_random, 0x5eedull + (uint64_t)(t0 * 1000));
         kind = malloc(sizeof(int) * (size_t)n);
-        for (i = 0; i < n; i++) kind[i] = i < n_cam ? RAY_CAMERA : (i < n_cam + n_shadow ? RAY_SHADOW : RAY_RANDOM);
+        for (i = 0; i < n; i++)
+            kind[i] = i < n_cam ? RAY_CAMERA : (i < n_cam + n_shadow ? RAY_SHADOW : RAY_RANDOM);
         j.meshes = s->meshes;
         j.rs = &host.rs;
         j.delta = 1e-6f * host.scene_size;
-        printf("%s, segment %.4f .. %.4f s: %d instances (%d moving), %d rays\n", name, t0, t1, s->num_instances,
-               moving, n);
+        printf("%s, segment %.4f .. %.4f s: %d instances (%d moving), %d rays\n", name, t0, t1,
+               s->num_instances, moving, n);
 
         for (li = 0; li < 2; li++) {
             evr_gpu_scene_view view;
@@ -1089,8 +1177,8 @@ static void test_scene(const char *name, const char *expect_groups, const double
             CHECK_OK(evr_gpu_top_build(&bvh[li], &host.rs, &top[li], &err));
             evr_gpu_scene_view_host(&bvh[li], &top[li], &view);
             printf("  layout %s: top level %u nodes, %u groups, stack %d of %d, built in %.3f ms\n",
-                   layout_name(layouts[li]), top[li].num_nodes, top[li].num_insts, top[li].stack_need,
-                   EVR_GPU_STACK_SIZE, 1e3 * (now() - tt));
+                   layout_name(layouts[li]), top[li].num_nodes, top[li].num_insts,
+                   top[li].stack_need, EVR_GPU_STACK_SIZE, 1e3 * (now() - tt));
 
             /* segment boxes hold every group at every time */
             bad = check_group_boxes(&bvh[li], &top[li], &host.rs, 2000, &c);
@@ -1144,33 +1232,38 @@ int main(void)
     test_watertight(EVR_GPU_LAYOUT_CW8, 1);
     test_watertight(EVR_GPU_LAYOUT_BVH4, 1);
     printf("(%.1f s)\n", now() - t);
-    test_many_instances(600, 20000 / RAY_SCALE, &tot);   /* Embree takes ~1.5 ms per quaternion-motion instance */
+    test_many_instances(600, 20000 / RAY_SCALE,
+                        &tot); /* Embree takes ~1.5 ms per quaternion-motion instance */
     printf("(%.1f s)\n", now() - t);
     {
         /* a saccade starts at 1.025 s; a blink closes the upper lid over 0.665 .. 0.765 s */
         static const double eye_t0[2] = {1.0, 0.72}, square_t0[1] = {0.5};
         /* grouped as the CPU backend groups: skin and orbit never move; sclera and cornea are on
          * nodes of their own under the animated "eyeball" node, so each is a group */
-        test_scene("eye",
-                   "sclera: sclera | cornea: cornea | upper_lid: upper_lid | lower_lid: lower_lid | static: skin orbit",
-                   eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE, &tot);
+        test_scene(
+            "eye",
+            "sclera: sclera | cornea: cornea | upper_lid: upper_lid | lower_lid: lower_lid | static: skin orbit",
+            eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE, &tot);
         printf("(%.1f s)\n", now() - t);
-        test_scene("square", NULL, square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE, 10000 / RAY_SCALE, &tot);
+        test_scene("square", NULL, square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE,
+                   10000 / RAY_SCALE, &tot);
         printf("(%.1f s)\n", now() - t);
     }
     /* each ray is asked twice (closest and occlusion): rates are per question */
-    printf("all: %ld rays x 2 queries; disagreements %.2e per query (edge %.2e, contact %.2e, unexplained %ld); "
-           "camera and random rays alone %.2e\n",
-           tot.rays, (double)tot.mismatches / (2.0 * (double)tot.rays), (double)tot.edge / (2.0 * (double)tot.rays),
-           (double)tot.contact / (2.0 * (double)tot.rays), tot.unexplained,
-           (double)tot.well_mismatches / (2.0 * (double)tot.well_rays));
+    printf(
+        "all: %ld rays x 2 queries; disagreements %.2e per query (edge %.2e, contact %.2e, unexplained %ld); "
+        "camera and random rays alone %.2e\n",
+        tot.rays, (double)tot.mismatches / (2.0 * (double)tot.rays),
+        (double)tot.edge / (2.0 * (double)tot.rays), (double)tot.contact / (2.0 * (double)tot.rays),
+        tot.unexplained, (double)tot.well_mismatches / (2.0 * (double)tot.well_rays));
     CHECK(tot.rays >= 200000 / RAY_SCALE);
     CHECK(tot.unexplained == 0);
     CHECK((double)tot.mismatches / (2.0 * (double)tot.rays) < MAX_MISMATCH_RATE);
     CHECK((double)tot.edge / (2.0 * (double)tot.rays) < MAX_MISMATCH_RATE);
     CHECK((double)tot.well_mismatches / (2.0 * (double)tot.well_rays) < MAX_MISMATCH_RATE);
-    printf("static group's hit, then the others' nearer: %ld rays, %ld differ from one search of all groups\n",
-           split_rays, split_differ);
+    printf(
+        "static group's hit, then the others' nearer: %ld rays, %ld differ from one search of all groups\n",
+        split_rays, split_differ);
     CHECK(split_rays > 0 && split_differ == 0);
     return check_report("test_gpu_bvh");
 }

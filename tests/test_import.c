@@ -29,10 +29,7 @@ static int mesh_index(const evr_scene *s, const char *name)
     return -1;
 }
 
-static double srgb(double c)
-{
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
+static double srgb(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
 
 /* Camera pose in the world at time t: node world transform times the camera's local pose. */
 static evr_m34 camera_world(const evr_scene *s, int cam, double t)
@@ -48,7 +45,8 @@ static void check_one_line(evr_status st, evr_status want, const evr_error *err)
     CHECK(st == want);
     CHECK(err->msg[0] != 0);
     CHECK(strchr(err->msg, '\n') == NULL);
-    if (st != want) fprintf(stderr, "  got status %d (%s), wanted %d\n", (int)st, err->msg, (int)want);
+    if (st != want)
+        fprintf(stderr, "  got status %d (%s), wanted %d\n", (int)st, err->msg, (int)want);
 }
 
 static int write_bytes(const char *path, const void *data, size_t n)
@@ -70,7 +68,10 @@ static unsigned char *read_bytes(const char *path, size_t *n)
     len = ftell(f);
     fseek(f, 0, SEEK_SET);
     b = malloc((size_t)len + 1);
-    if (b && fread(b, 1, (size_t)len, f) != (size_t)len) { free(b); b = NULL; }
+    if (b && fread(b, 1, (size_t)len, f) != (size_t)len) {
+        free(b);
+        b = NULL;
+    }
     fclose(f);
     *n = (size_t)len;
     return b;
@@ -97,12 +98,15 @@ static void test_gltf_cameras(void)
     CHECK(main_cam == 0 && side_cam == 1);
     CHECK(evr_scene_find_camera(s, "no such camera") == -1);
     CHECK(evr_scene_find_camera(s, NULL) == 0);
-    if (main_cam != 0 || side_cam != 1) { evr_scene_release(s); return; }
+    if (main_cam != 0 || side_cam != 1) {
+        evr_scene_release(s);
+        return;
+    }
 
     /* quirk (b): Assimp stores yfov * aspect in mHorizontalFOV; we recover yfov */
     CHECK_NEAR(s->cameras[0].yfov, 0.5, 1e-6);
     CHECK_NEAR(s->cameras[0].aspect, 2.0, 1e-6);
-    CHECK_NEAR(s->cameras[1].yfov, 0.7, 1e-6);    /* no aspect: stored as is */
+    CHECK_NEAR(s->cameras[1].yfov, 0.7, 1e-6); /* no aspect: stored as is */
     CHECK(s->cameras[1].aspect == 0.0f);
     CHECK_NEAR(s->cameras[0].znear, 0.1, 1e-6);
     CHECK(!s->cameras[0].automatic);
@@ -110,10 +114,14 @@ static void test_gltf_cameras(void)
     /* quirk (c): the node's translation is not applied a second time through mPosition */
     CHECK(s->cameras[0].node == node_index(s, "cam_main"));
     w = camera_world(s, 0, 0.0);
-    CHECK_NEAR(w.m[0][3], 0.0, 1e-5); CHECK_NEAR(w.m[1][3], 1.0, 1e-5); CHECK_NEAR(w.m[2][3], 10.0, 1e-5);
-    CHECK_NEAR(w.m[2][2], 1.0, 1e-6);   /* looks along -Z */
-    w = camera_world(s, 1, 0.0);        /* turned 90 about Y: looks along -X, from (10,0,0) */
-    CHECK_NEAR(w.m[0][3], 10.0, 1e-5); CHECK_NEAR(w.m[1][3], 0.0, 1e-5); CHECK_NEAR(w.m[2][3], 0.0, 1e-5);
+    CHECK_NEAR(w.m[0][3], 0.0, 1e-5);
+    CHECK_NEAR(w.m[1][3], 1.0, 1e-5);
+    CHECK_NEAR(w.m[2][3], 10.0, 1e-5);
+    CHECK_NEAR(w.m[2][2], 1.0, 1e-6); /* looks along -Z */
+    w = camera_world(s, 1, 0.0);      /* turned 90 about Y: looks along -X, from (10,0,0) */
+    CHECK_NEAR(w.m[0][3], 10.0, 1e-5);
+    CHECK_NEAR(w.m[1][3], 0.0, 1e-5);
+    CHECK_NEAR(w.m[2][3], 0.0, 1e-5);
     CHECK_NEAR(-w.m[0][2], -1.0, 1e-5);
     CHECK_NEAR(w.m[1][1], 1.0, 1e-5);
 
@@ -130,10 +138,10 @@ static void test_gltf_cameras(void)
         evr_v3 right = evr_v3_make(cw.m[0][0], cw.m[1][0], cw.m[2][0]);
         CHECK(l->type == EVR_LIGHT_DIRECTIONAL);
         CHECK(l->node == s->cameras[0].node);
-        CHECK(evr_v3_dot(d, fwd) > 0.9f);       /* shines where the camera looks */
-        CHECK(evr_v3_dot(d, up) < -0.1f);       /* from above */
-        CHECK(evr_v3_dot(d, right) > 0.1f);     /* from the left */
-        CHECK_NEAR(l->color[0], PI_D, 1e-5);    /* E = pi: white Lambertian radiance 1 */
+        CHECK(evr_v3_dot(d, fwd) > 0.9f);    /* shines where the camera looks */
+        CHECK(evr_v3_dot(d, up) < -0.1f);    /* from above */
+        CHECK(evr_v3_dot(d, right) > 0.1f);  /* from the left */
+        CHECK_NEAR(l->color[0], PI_D, 1e-5); /* E = pi: white Lambertian radiance 1 */
         CHECK_NEAR(l->color[2], PI_D, 1e-5);
     }
     {
@@ -172,22 +180,28 @@ static void test_lights_materials(const char *path, int glb)
     for (i = 0; i < s->num_lights; i++) {
         const evr_light *l = &s->lights[i];
         evr_m34 w = evr_node_world_at(s, l->node, 0.0);
-        evr_v3 p = evr_m34_point(&w, l->position), d = evr_v3_norm(evr_m34_vector(&w, l->direction));
+        evr_v3 p = evr_m34_point(&w, l->position),
+               d = evr_v3_norm(evr_m34_vector(&w, l->direction));
         if (!strcmp(l->name, "bulb_node")) {
             CHECK(l->type == EVR_LIGHT_POINT);
             CHECK(l->node == node_index(s, "bulb_node"));
-            CHECK_NEAR(l->color[0], 10.0, 1e-5); CHECK_NEAR(l->color[1], 5.0, 1e-5); CHECK_NEAR(l->color[2], 2.5, 1e-5);
-            CHECK_NEAR(p.x, 1.0, 1e-5); CHECK_NEAR(p.y, 2.0, 1e-5); CHECK_NEAR(p.z, 3.0, 1e-5);
+            CHECK_NEAR(l->color[0], 10.0, 1e-5);
+            CHECK_NEAR(l->color[1], 5.0, 1e-5);
+            CHECK_NEAR(l->color[2], 2.5, 1e-5);
+            CHECK_NEAR(p.x, 1.0, 1e-5);
+            CHECK_NEAR(p.y, 2.0, 1e-5);
+            CHECK_NEAR(p.z, 3.0, 1e-5);
         } else if (!strcmp(l->name, "torch_node")) {
             CHECK(l->type == EVR_LIGHT_SPOT);
             CHECK_NEAR(l->color[1], 5.0, 1e-5);
-            CHECK_NEAR(l->inner_cone, 0.2, 1e-6);   /* glTF half angles, kept as they are */
+            CHECK_NEAR(l->inner_cone, 0.2, 1e-6); /* glTF half angles, kept as they are */
             CHECK_NEAR(l->outer_cone, 0.6, 1e-6);
             CHECK_NEAR(p.y, 4.0, 1e-5);
-            CHECK_NEAR(d.y, -1.0, 1e-5);            /* node turned -90 about X: -Z becomes -Y */
+            CHECK_NEAR(d.y, -1.0, 1e-5); /* node turned -90 about X: -Z becomes -Y */
         } else if (!strcmp(l->name, "sun_node")) {
             CHECK(l->type == EVR_LIGHT_DIRECTIONAL);
-            CHECK_NEAR(l->color[0], 0.0, 1e-6); CHECK_NEAR(l->color[1], 3.0, 1e-5);
+            CHECK_NEAR(l->color[0], 0.0, 1e-6);
+            CHECK_NEAR(l->color[1], 3.0, 1e-5);
             CHECK_NEAR(d.z, -1.0, 1e-5);
         } else {
             CHECK(!"unexpected light name");
@@ -208,8 +222,10 @@ static void test_lights_materials(const char *path, int glb)
         CHECK(evr_scene_find_camera(s, "automatic") == 0);
     }
     /* bounds: the cube (-0.5..0.5) and the triangles at x = 2 and x = -2 */
-    CHECK_NEAR(s->bounds_min.x, -2.0, 1e-6); CHECK_NEAR(s->bounds_max.x, 3.0, 1e-6);
-    CHECK_NEAR(s->bounds_min.y, -0.5, 1e-6); CHECK_NEAR(s->bounds_max.y, 1.0, 1e-6);
+    CHECK_NEAR(s->bounds_min.x, -2.0, 1e-6);
+    CHECK_NEAR(s->bounds_max.x, 3.0, 1e-6);
+    CHECK_NEAR(s->bounds_min.y, -0.5, 1e-6);
+    CHECK_NEAR(s->bounds_max.y, 1.0, 1e-6);
 
     /* points are dropped: three meshes, the points node places nothing */
     box = mesh_index(s, "box");
@@ -218,7 +234,10 @@ static void test_lights_materials(const char *path, int glb)
     CHECK(s->num_meshes == 3 && box >= 0 && tri >= 0 && tri2 >= 0);
     CHECK(s->num_instances == 3);
     for (i = 0; i < s->num_instances; i++) CHECK(s->instances[i].node != node_index(s, "points"));
-    if (box < 0 || tri < 0 || tri2 < 0) { evr_scene_release(s); return; }
+    if (box < 0 || tri < 0 || tri2 < 0) {
+        evr_scene_release(s);
+        return;
+    }
     CHECK(s->meshes[box].num_triangles == 12);
     CHECK(s->meshes[box].uvs == NULL);
     for (i = 0; i < (int)s->meshes[box].num_vertices; i++) {
@@ -232,11 +251,16 @@ static void test_lights_materials(const char *path, int glb)
         const evr_material *e1 = &s->materials[s->meshes[tri].material];
         const evr_material *e2 = &s->materials[s->meshes[tri2].material];
         CHECK(strcmp(m->name, "embedded") == 0);
-        CHECK_NEAR(m->p.base_color[0], 0.5, 1e-6); CHECK_NEAR(m->p.base_color[1], 0.25, 1e-6);
-        CHECK_NEAR(m->p.base_color[2], 1.0, 1e-6); CHECK_NEAR(m->p.base_color[3], 1.0, 1e-6);
-        CHECK_NEAR(m->p.metallic, 0.25, 1e-6); CHECK_NEAR(m->p.roughness, 0.75, 1e-6);
+        CHECK_NEAR(m->p.base_color[0], 0.5, 1e-6);
+        CHECK_NEAR(m->p.base_color[1], 0.25, 1e-6);
+        CHECK_NEAR(m->p.base_color[2], 1.0, 1e-6);
+        CHECK_NEAR(m->p.base_color[3], 1.0, 1e-6);
+        CHECK_NEAR(m->p.metallic, 0.25, 1e-6);
+        CHECK_NEAR(m->p.roughness, 0.75, 1e-6);
         /* emissive factor (1, 0.5, 0) times KHR_materials_emissive_strength 4 */
-        CHECK_NEAR(m->p.emissive[0], 4.0, 1e-5); CHECK_NEAR(m->p.emissive[1], 2.0, 1e-5); CHECK_NEAR(m->p.emissive[2], 0.0, 1e-6);
+        CHECK_NEAR(m->p.emissive[0], 4.0, 1e-5);
+        CHECK_NEAR(m->p.emissive[1], 2.0, 1e-5);
+        CHECK_NEAR(m->p.emissive[2], 0.0, 1e-6);
         CHECK(strcmp(e1->name, "external") == 0 && strcmp(e2->name, "external_again") == 0);
         CHECK_NEAR(e1->p.emissive[0], 0.0, 1e-6);
         CHECK_NEAR(e2->p.metallic, 0.0, 1e-6);
@@ -248,18 +272,21 @@ static void test_lights_materials(const char *path, int glb)
         if (s->num_textures == 2 && m->p.base_texture >= 0 && e1->p.base_texture >= 0) {
             int k;
             for (k = 0; k < 2; k++) {
-                const evr_texture *t = &s->textures[k == 0 ? m->p.base_texture : e1->p.base_texture];
+                const evr_texture *t =
+                    &s->textures[k == 0 ? m->p.base_texture : e1->p.base_texture];
                 CHECK(t->width == 2 && t->height == 2);
                 if (t->width != 2 || t->height != 2) continue;
                 /* row 0 is the image's first (top) row: red, then (0, 128, 255) */
-                CHECK_NEAR(t->rgba[0], 1.0, 1e-6); CHECK_NEAR(t->rgba[1], 0.0, 1e-6); CHECK_NEAR(t->rgba[3], 1.0, 1e-6);
+                CHECK_NEAR(t->rgba[0], 1.0, 1e-6);
+                CHECK_NEAR(t->rgba[1], 0.0, 1e-6);
+                CHECK_NEAR(t->rgba[3], 1.0, 1e-6);
                 CHECK_NEAR(t->rgba[4], 0.0, 1e-6);
-                CHECK_NEAR(t->rgba[5], srgb(128.0 / 255.0), 1e-6);   /* exact sRGB EOTF: 0.2158605 */
+                CHECK_NEAR(t->rgba[5], srgb(128.0 / 255.0), 1e-6); /* exact sRGB EOTF: 0.2158605 */
                 CHECK_NEAR(t->rgba[5], 0.2158605, 1e-6);
                 CHECK_NEAR(t->rgba[6], 1.0, 1e-6);
                 CHECK_NEAR(t->rgba[8], 0.0, 1e-6);
                 CHECK_NEAR(t->rgba[12], 1.0, 1e-6);
-                CHECK_NEAR(t->rgba[15], 128.0 / 255.0, 1e-6);      /* alpha stays linear */
+                CHECK_NEAR(t->rgba[15], 128.0 / 255.0, 1e-6); /* alpha stays linear */
             }
         }
     }
@@ -268,9 +295,16 @@ static void test_lights_materials(const char *path, int glb)
     if (s->meshes[tri].uvs && s->meshes[tri].num_vertices == 3) {
         for (i = 0; i < 3; i++) {
             const float *p = &s->meshes[tri].positions[3 * i], *uv = &s->meshes[tri].uvs[2 * i];
-            if (p[0] == 0.0f && p[1] == 0.0f) { CHECK_NEAR(uv[0], 0.25, 1e-6); CHECK_NEAR(uv[1], 0.75, 1e-6); }
-            else if (p[0] == 1.0f) { CHECK_NEAR(uv[0], 0.5, 1e-6); CHECK_NEAR(uv[1], 0.125, 1e-6); }
-            else { CHECK_NEAR(uv[0], 1.0, 1e-6); CHECK_NEAR(uv[1], 1.0, 1e-6); }
+            if (p[0] == 0.0f && p[1] == 0.0f) {
+                CHECK_NEAR(uv[0], 0.25, 1e-6);
+                CHECK_NEAR(uv[1], 0.75, 1e-6);
+            } else if (p[0] == 1.0f) {
+                CHECK_NEAR(uv[0], 0.5, 1e-6);
+                CHECK_NEAR(uv[1], 0.125, 1e-6);
+            } else {
+                CHECK_NEAR(uv[0], 1.0, 1e-6);
+                CHECK_NEAR(uv[1], 1.0, 1e-6);
+            }
         }
     }
     {
@@ -294,8 +328,10 @@ static void test_plain(void)
     }
     CHECK(s->num_cameras == 1 && s->cameras[0].automatic && s->cameras[0].node == -1);
     CHECK(s->num_lights == 1 && s->default_light == 1);
-    CHECK_NEAR(s->bounds_min.x, -1.5, 1e-6); CHECK_NEAR(s->bounds_max.x, 1.5, 1e-6);
-    CHECK_NEAR(s->bounds_min.z, -0.5, 1e-6); CHECK_NEAR(s->bounds_max.z, 0.5, 1e-6);
+    CHECK_NEAR(s->bounds_min.x, -1.5, 1e-6);
+    CHECK_NEAR(s->bounds_max.x, 1.5, 1e-6);
+    CHECK_NEAR(s->bounds_min.z, -0.5, 1e-6);
+    CHECK_NEAR(s->bounds_max.z, 0.5, 1e-6);
     if (s->num_lights == 1) {
         const evr_light *l = &s->lights[0];
         CHECK(l->node == -1);
@@ -363,7 +399,7 @@ static void test_memory(void)
 
 static void test_bad_inputs(void)
 {
-    evr_scene *s = (evr_scene *)&s;   /* must come back NULL */
+    evr_scene *s = (evr_scene *)&s; /* must come back NULL */
     evr_error err;
     evr_status st;
     char dir[] = "/tmp/evray_import_XXXXXX";
@@ -391,13 +427,18 @@ static void test_bad_inputs(void)
     st = evr_scene_load(NULL, &s, &err);
     check_one_line(st, EVR_ERR_ARG, &err);
 
-    if (!mkdtemp(dir)) { CHECK(!"mkdtemp"); return; }
+    if (!mkdtemp(dir)) {
+        CHECK(!"mkdtemp");
+        return;
+    }
     glb = read_bytes(DATA "lights.glb", &n);
     CHECK(glb != NULL && n > 100);
     if (glb) {
         size_t cut[3];
         int k;
-        cut[0] = n / 2; cut[1] = n - 30; cut[2] = 30;
+        cut[0] = n / 2;
+        cut[1] = n - 30;
+        cut[2] = 30;
         for (k = 0; k < 3; k++) {
             snprintf(path, sizeof path, "%s/truncated%d.glb", dir, k);
             CHECK(write_bytes(path, glb, cut[k]));

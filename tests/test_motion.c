@@ -60,7 +60,8 @@ int main(void)
         evr_quat m = evr_quat_slerp(a, b, 0.5f);
         CHECK(fabsf(evr_quat_dot(a, m)) > 0.99999f);
         /* 90 degrees about Z, halfway is 45 degrees */
-        evr_quat z0 = evr_quat_make(1, 0, 0, 0), z90 = evr_quat_make(cosf(0.7853982f), 0, 0, sinf(0.7853982f));
+        evr_quat z0 = evr_quat_make(1, 0, 0, 0),
+                 z90 = evr_quat_make(cosf(0.7853982f), 0, 0, sinf(0.7853982f));
         evr_quat h = evr_quat_slerp(z0, z90, 0.5f);
         CHECK_NEAR(2 * acosf(h.w), 0.7853982, 1e-5);
     }
@@ -98,11 +99,19 @@ int main(void)
             }
             struct RTCQuaternionDecomposition q;
             rtcInitQuaternionDecomposition(&q);
-            q.scale_x = keys[s].scale[0]; q.scale_y = keys[s].scale[1]; q.scale_z = keys[s].scale[2];
-            q.skew_xy = keys[s].skew[0]; q.skew_xz = keys[s].skew[1]; q.skew_yz = keys[s].skew[2];
-            q.quaternion_r = keys[s].rot.w; q.quaternion_i = keys[s].rot.x;
-            q.quaternion_j = keys[s].rot.y; q.quaternion_k = keys[s].rot.z;
-            q.translation_x = keys[s].trans.x; q.translation_y = keys[s].trans.y; q.translation_z = keys[s].trans.z;
+            q.scale_x = keys[s].scale[0];
+            q.scale_y = keys[s].scale[1];
+            q.scale_z = keys[s].scale[2];
+            q.skew_xy = keys[s].skew[0];
+            q.skew_xz = keys[s].skew[1];
+            q.skew_yz = keys[s].skew[2];
+            q.quaternion_r = keys[s].rot.w;
+            q.quaternion_i = keys[s].rot.x;
+            q.quaternion_j = keys[s].rot.y;
+            q.quaternion_k = keys[s].rot.z;
+            q.translation_x = keys[s].trans.x;
+            q.translation_y = keys[s].trans.y;
+            q.translation_z = keys[s].trans.z;
             rtcSetGeometryTransformQuaternion(inst, (unsigned)s, &q);
         }
         rtcCommitGeometry(inst);

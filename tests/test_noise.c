@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define W 1000   /* pixel p is (p % W, p / W) */
+#define W 1000 /* pixel p is (p % W, p / W) */
 
 static evr_pixel_params base_params(void)
 {
@@ -33,13 +33,13 @@ static evr_pixel_params base_params(void)
 typedef float (*intensity_fn)(int pix, double t, const void *user);
 
 typedef struct {
-    int *count_on, *count_off;     /* per pixel */
-    double *first, *last;          /* per pixel: first and last event time */
-    double min_gap;                /* smallest gap between two events of one pixel */
-    long long min_gap_us;          /* the same in quantized timestamps */
+    int *count_on, *count_off; /* per pixel */
+    double *first, *last;      /* per pixel: first and last event time */
+    double min_gap;            /* smallest gap between two events of one pixel */
+    long long min_gap_us;      /* the same in quantized timestamps */
     long long total_on, total_off;
-    long long not_multiple;        /* timestamps that are not multiples of the resolution */
-    double *times;                 /* optional: event times of pixel 0 */
+    long long not_multiple; /* timestamps that are not multiples of the resolution */
+    double *times;          /* optional: event times of pixel 0 */
     int ntimes, max_times;
 } tally;
 
@@ -65,8 +65,8 @@ static void tally_free(tally *t)
 
 /* Runs pixels [0, npix) for duration T in segments of length seg with n samples each, as the
  * backends do. */
-static void drive(const evr_pixel_params *run, int npix, double T, double seg, int n, intensity_fn I, const void *user,
-                  tally *out)
+static void drive(const evr_pixel_params *run, int npix, double T, double seg, int n,
+                  intensity_fn I, const void *user, tally *out)
 {
     int pix, i, k, nseg = (int)ceil(T / seg - 1e-9);
     for (pix = 0; pix < npix; pix++) {
@@ -85,13 +85,20 @@ static void drive(const evr_pixel_params *run, int npix, double T, double seg, i
                 evr_pixel_span sp;
                 float te;
                 int pol;
-                if (!evr_pixel_begin(&s, &pp, f * (float)seg, I(pix, t0 + (double)f * seg, user), &sp)) continue;
+                if (!evr_pixel_begin(&s, &pp, f * (float)seg, I(pix, t0 + (double)f * seg, user),
+                                     &sp))
+                    continue;
                 while (evr_pixel_next(&s, &pp, &sp, &te, &pol)) {
                     double t = t0 + (double)te;
                     long long us = evr_event_time_us(&pp, t, x, y);
                     if (pp.time_res_us > 1 && us % pp.time_res_us) out->not_multiple++;
-                    if (pol) { out->count_on[pix]++; out->total_on++; }
-                    else { out->count_off[pix]++; out->total_off++; }
+                    if (pol) {
+                        out->count_on[pix]++;
+                        out->total_on++;
+                    } else {
+                        out->count_off[pix]++;
+                        out->total_off++;
+                    }
                     if (seen) {
                         if (t - prev < out->min_gap) out->min_gap = t - prev;
                         if (us - prev_us < out->min_gap_us) out->min_gap_us = us - prev_us;
@@ -113,7 +120,8 @@ static void drive(const evr_pixel_params *run, int npix, double T, double seg, i
 
 static float constant_intensity(int pix, double t, const void *user)
 {
-    (void)pix; (void)t;
+    (void)pix;
+    (void)t;
     return *(const float *)user;
 }
 
@@ -131,7 +139,7 @@ static double phi_n(double z) { return exp(-0.5 * z * z) / sqrt(2.0 * 3.14159265
 static void test_mismatch(void)
 {
     const int npix = 40000;
-    const double R = 4.1;   /* nominal: floor(4.1 / 0.2) = 20 events */
+    const double R = 4.1; /* nominal: floor(4.1 / 0.2) = 20 events */
     evr_pixel_params p = base_params();
     tally t;
     int i;
@@ -142,11 +150,14 @@ static void test_mismatch(void)
         for (i = 0; i < npix; i++) {
             evr_pixel_params q;
             evr_pixel_params_at(&p, i % W, i / W, &q);
-            s1 += q.pos_thres; s2 += (double)q.pos_thres * q.pos_thres;
-            o1 += q.neg_thres; o2 += (double)q.neg_thres * q.neg_thres;
+            s1 += q.pos_thres;
+            s2 += (double)q.pos_thres * q.pos_thres;
+            o1 += q.neg_thres;
+            o2 += (double)q.neg_thres * q.neg_thres;
             so += (double)q.pos_thres * q.neg_thres;
         }
-        double m = s1 / npix, sd = sqrt(s2 / npix - m * m), mo = o1 / npix, sdo = sqrt(o2 / npix - mo * mo);
+        double m = s1 / npix, sd = sqrt(s2 / npix - m * m), mo = o1 / npix,
+               sdo = sqrt(o2 / npix - mo * mo);
         double corr = (so / npix - m * mo) / (sd * sdo);
         CHECK_NEAR(m, 0.2, 3.0 * 0.02 / sqrt(npix) + 1e-6);
         CHECK_NEAR(mo, 0.2, 3.0 * 0.02 / sqrt(npix) + 1e-6);
@@ -165,17 +176,20 @@ static void test_mismatch(void)
     double esd = sqrt(e2 - em * em);
     tally_init(&t, npix);
     drive(&p, npix, 0.6, 1.0 / 30.0, 10, ramp_intensity, &R, &t);
-    for (int pol = 0; pol < 2; pol++) {   /* ON counts of even pixels, OFF counts of odd ones */
+    for (int pol = 0; pol < 2; pol++) { /* ON counts of even pixels, OFF counts of odd ones */
         double s1 = 0, s2 = 0;
         int m = 0, wrong = 0;
         for (i = pol; i < npix; i += 2) {
             int c = pol ? t.count_off[i] : t.count_on[i];
             wrong += pol ? t.count_on[i] : t.count_off[i];
-            s1 += c; s2 += (double)c * c; m++;
+            s1 += c;
+            s2 += (double)c * c;
+            m++;
         }
         double mean = s1 / m, sd = sqrt(s2 / m - mean * mean);
-        printf("mismatch sigma 0.02, ramp of %.1f: %s counts mean %.3f sd %.3f (predicted %.3f, %.3f)\n", R,
-               pol ? "OFF" : "ON", mean, sd, em, esd);
+        printf(
+            "mismatch sigma 0.02, ramp of %.1f: %s counts mean %.3f sd %.3f (predicted %.3f, %.3f)\n",
+            R, pol ? "OFF" : "ON", mean, sd, em, esd);
         CHECK(wrong == 0);
         CHECK_NEAR(mean, em, 4.0 * esd / sqrt(m));
         CHECK_NEAR(sd, esd, 0.05 * esd);
@@ -187,7 +201,8 @@ static void test_mismatch(void)
         tally_init(&t2, npix);
         drive(&p, npix, 0.6, 1.0 / 30.0, 7, ramp_intensity, &R, &t2);
         int same = 1;
-        for (i = 0; i < npix; i++) same &= t.count_on[i] == t2.count_on[i] && t.count_off[i] == t2.count_off[i];
+        for (i = 0; i < npix; i++)
+            same &= t.count_on[i] == t2.count_on[i] && t.count_off[i] == t2.count_off[i];
         CHECK(same);
         tally_free(&t2);
     }
@@ -215,7 +230,7 @@ static void test_leak(void)
     double s1 = 0, s2 = 0, worst = 0;
     p.leak_rate = 1.0f;
     p.leak_jitter = 0.1f;
-    p.sigma_thres = 0.02f;   /* leak in units of the pixel's own threshold: the rate is unchanged */
+    p.sigma_thres = 0.02f; /* leak in units of the pixel's own threshold: the rate is unchanged */
     tally_init(&t, npix);
     drive(&p, npix, T, 1.0 / 30.0, 10, constant_intensity, &I, &t);
     double rate = (double)t.total_on / (npix * T);
@@ -231,10 +246,14 @@ static void test_leak(void)
         if (t.count_on[i] < 3) continue;
         double r = (t.count_on[i] - 1) / (t.last[i] - t.first[i]);
         if (fabs(r - expect) / expect > worst) worst = fabs(r - expect) / expect;
-        s1 += r; s2 += r * r; m++;
+        s1 += r;
+        s2 += r * r;
+        m++;
     }
     double mean = s1 / m, sd = sqrt(s2 / m - mean * mean);
-    printf("leak: per-pixel rates mean %.4f sd %.4f, worst relative error vs the pixel's rate %.2g\n", mean, sd, worst);
+    printf(
+        "leak: per-pixel rates mean %.4f sd %.4f, worst relative error vs the pixel's rate %.2g\n",
+        mean, sd, worst);
     CHECK(m > npix * 9 / 10);
     CHECK(worst < 1e-3);
     CHECK_NEAR(mean, 1.0, 0.01);
@@ -265,8 +284,9 @@ static void test_shot(void)
         drive(&p, npix, T, 1.0 / 30.0, 10, constant_intensity, &levels[l], &t);
         double rate = (double)(t.total_on + t.total_off) / (npix * T);
         double on = (double)t.total_on / (double)(t.total_on + t.total_off);
-        printf("shot noise %.1f Hz at intensity %.1f: %.4f events/s per pixel (expected %.4f), ON share %.3f\n", R,
-               (double)levels[l], rate, expect[l], on);
+        printf(
+            "shot noise %.1f Hz at intensity %.1f: %.4f events/s per pixel (expected %.4f), ON share %.3f\n",
+            R, (double)levels[l], rate, expect[l], on);
         CHECK_NEAR(rate, expect[l], 0.1 * expect[l]);
         CHECK_NEAR(rate, expect[l], 4.0 * sqrt(expect[l] / (npix * T)));
         CHECK_NEAR(on, 0.5, 0.02);
@@ -302,7 +322,9 @@ static void test_shot(void)
         while (ia < a.ntimes && a.times[ia] < 0.1) ia++;
         while (ib < b.ntimes && b.times[ib] < 0.1) ib++;
         if (a.ntimes - ia != b.ntimes - ib) same = 0;
-        for (; same && ia < a.ntimes && ib < b.ntimes; ia++, ib++) same &= fabs(a.times[ia] - b.times[ib]) < 2e-5;   /* float rebasing drifts ~1e-9 s a segment */
+        for (; same && ia < a.ntimes && ib < b.ntimes; ia++, ib++)
+            same &= fabs(a.times[ia] - b.times[ib]) <
+                    2e-5; /* float rebasing drifts ~1e-9 s a segment */
         CHECK(same);
         tally_free(&a);
         tally_free(&b);
@@ -329,8 +351,9 @@ static void test_hot(void)
         agree &= (t.count_on[i] > 0) == (q.hot > 0.0f);
     }
     double rate = (double)t.total_on / (hot * T), sd = sqrt(npix * F * (1.0 - F));
-    printf("hot pixels 1%% at 100 Hz: %d of %d pixels fire (expected %.0f +- %.0f), %.2f ON events/s each, %lld OFF\n",
-           hot, npix, npix * F, sd, rate, t.total_off);
+    printf(
+        "hot pixels 1%% at 100 Hz: %d of %d pixels fire (expected %.0f +- %.0f), %.2f ON events/s each, %lld OFF\n",
+        hot, npix, npix * F, sd, rate, t.total_off);
     CHECK(agree);
     CHECK(hot == flagged);
     CHECK_NEAR(hot, npix * F, 4.0 * sd);
@@ -363,8 +386,8 @@ static void test_refractory(void)
     p.time_res_us = 1;
     tally_init(&t, npix);
     drive(&p, npix, 2.0, 1.0 / 30.0, 20, busy_intensity, NULL, &t);
-    printf("refractory 1 ms with everything on: %lld events, smallest gap %.4g s (%lld us)\n", t.total_on + t.total_off,
-           t.min_gap, t.min_gap_us);
+    printf("refractory 1 ms with everything on: %lld events, smallest gap %.4g s (%lld us)\n",
+           t.total_on + t.total_off, t.min_gap, t.min_gap_us);
     CHECK(t.total_on + t.total_off > 10000);
     CHECK(t.min_gap >= 1e-3 - 1e-6);
     CHECK(t.min_gap_us >= 1000);
@@ -380,7 +403,8 @@ static void test_refractory(void)
         tally_init(&t, 200);
         drive(&q, 200, 5.0, 1.0 / 30.0, 10, constant_intensity, &I, &t);
         double rate = (double)t.total_on / (200 * 5.0);
-        printf("hot pixels at 500 Hz behind 1 ms refractory: %.1f events/s (expected %.1f)\n", rate, 500.0 / 1.5);
+        printf("hot pixels at 500 Hz behind 1 ms refractory: %.1f events/s (expected %.1f)\n", rate,
+               500.0 / 1.5);
         CHECK_NEAR(rate, 500.0 / 1.5, 0.03 * 500.0 / 1.5);
         tally_free(&t);
     }
@@ -393,7 +417,8 @@ static void test_lowpass(void)
     p.cutoff_hz = 10.0f;
     /* step from I = 2 to I = 2e (both at or above full brightness: the full cutoff, tau = 1 / (2 pi 10)) */
     {
-        const double tau = 1.0 / (2.0 * 3.14159265358979 * 10.0), La = log(2.0), Lb = log(2.0) + 1.0;
+        const double tau = 1.0 / (2.0 * 3.14159265358979 * 10.0), La = log(2.0),
+                     Lb = log(2.0) + 1.0;
         evr_pixel_state s;
         evr_pixel_span sp;
         float te;
@@ -401,7 +426,7 @@ static void test_lowpass(void)
         double worst = 0, ev[16];
         evr_pixel_reset(&s);
         evr_pixel_begin(&s, &p, 0.0f, 2.0f, &sp);
-        for (k = 1; k <= 150; k++) {   /* 9 tau: far from the level 1.0 the signal never reaches */
+        for (k = 1; k <= 150; k++) { /* 9 tau: far from the level 1.0 the signal never reaches */
             float t = k == 1 ? 1e-7f : (float)(k - 1) * 1e-3f;
             evr_pixel_begin(&s, &p, t, (float)(2.0 * exp(1.0)), &sp);
             while (evr_pixel_next(&s, &p, &sp, &te, &pol)) {
@@ -424,14 +449,16 @@ static void test_lowpass(void)
     }
     /* a dim pixel is slower: cutoff 10 * (0.1 + 20/255) / (1 + 20/255) Hz at a tenth of full brightness */
     {
-        const double fc = 10.0 * (0.1 + 20.0 / 255.0) / (1.0 + 20.0 / 255.0), tau = 1.0 / (2.0 * 3.14159265358979 * fc);
+        const double fc = 10.0 * (0.1 + 20.0 / 255.0) / (1.0 + 20.0 / 255.0),
+                     tau = 1.0 / (2.0 * 3.14159265358979 * fc);
         evr_pixel_state s;
         evr_pixel_span sp;
         float te;
         int pol, k;
         double worst = 0;
         evr_pixel_reset(&s);
-        const float Ia = (float)(0.1 * exp(-0.1)), Ib = 0.1f;   /* a step of 0.1 up to a tenth of full brightness */
+        const float Ia = (float)(0.1 * exp(-0.1)),
+                    Ib = 0.1f; /* a step of 0.1 up to a tenth of full brightness */
         evr_pixel_begin(&s, &p, 0.0f, Ia, &sp);
         evr_pixel_begin(&s, &p, 1e-7f, Ib, &sp);
         while (evr_pixel_next(&s, &p, &sp, &te, &pol)) {}
@@ -442,9 +469,11 @@ static void test_lowpass(void)
             while (evr_pixel_next(&s, &p, &sp, &te, &pol)) {}
             evr_pixel_end(&s, &sp);
             double expect = Lb + (La - Lb) * exp(-((double)t - 1e-7) / tau);
-            if (fabs(s.l_prev - expect) / (Lb - La) > worst) worst = fabs(s.l_prev - expect) / (Lb - La);
+            if (fabs(s.l_prev - expect) / (Lb - La) > worst)
+                worst = fabs(s.l_prev - expect) / (Lb - La);
         }
-        printf("low-pass at a tenth of full brightness: tau %.4f s, worst relative error %.2g\n", tau, worst);
+        printf("low-pass at a tenth of full brightness: tau %.4f s, worst relative error %.2g\n",
+               tau, worst);
         CHECK(worst < 1e-3);
     }
     /* exact for a ramp: one long interval and a thousand short ones end at the same value, the
@@ -470,7 +499,8 @@ static void test_lowpass(void)
             ys[c] = s.l_prev;
         }
         double L0 = log(1.5), expect = L0 + slope * T - slope * tau + slope * tau * exp(-T / tau);
-        printf("low-pass ramp: one interval %.7f, 1000 intervals %.7f, closed form %.7f\n", ys[0], ys[1], expect);
+        printf("low-pass ramp: one interval %.7f, 1000 intervals %.7f, closed form %.7f\n", ys[0],
+               ys[1], expect);
         CHECK_NEAR(ys[0], expect, 2e-6);
         CHECK_NEAR(ys[1], expect, 2e-5);
     }
@@ -512,7 +542,9 @@ static void test_timestamps(void)
             if (i < 100) CHECK(evr_event_time_us(&p, t, i % 13, 3) == us);
         }
         double m = s1 / n, sd = sqrt(s2 / n - m * m);
-        printf("timestamp jitter 20 us: mean %.3f us, sd %.3f us (with 1 us rounding), max %.1f us\n", m, sd, mx);
+        printf(
+            "timestamp jitter 20 us: mean %.3f us, sd %.3f us (with 1 us rounding), max %.1f us\n",
+            m, sd, mx);
         CHECK_NEAR(m, 0.0, 0.5);
         CHECK_NEAR(sd, sqrt(400.0 + 1.0 / 12.0), 0.5);
         CHECK(mx <= 4.0 * 20.0 + 1.0);
@@ -539,7 +571,8 @@ static void test_ideal(void)
     evr_pixel_params p = base_params(), q;
     CHECK(evr_pixel_params_ideal(&p));
     evr_pixel_params_at(&p, 3, 4, &q);
-    CHECK(q.pos_thres == p.pos_thres && q.neg_thres == p.neg_thres && q.leak == 0.0f && q.noise_rate == 0.0f);
+    CHECK(q.pos_thres == p.pos_thres && q.neg_thres == p.neg_thres && q.leak == 0.0f &&
+          q.noise_rate == 0.0f);
     p.time_res_us = 2;
     CHECK(!evr_pixel_params_ideal(&p));
     p = base_params();
@@ -548,7 +581,7 @@ static void test_ideal(void)
     p = base_params();
     p.cutoff_hz = 1.0f;
     CHECK(!evr_pixel_params_ideal(&p));
-    CHECK(sizeof(evr_pixel_state) == 36);   /* 32 + the cache of change-driven sampling */
+    CHECK(sizeof(evr_pixel_state) == 36); /* 32 + the cache of change-driven sampling */
 }
 
 /* With everything off, the full model and the ideal model's own code (what the GPU's ideal
@@ -582,7 +615,10 @@ static void test_paths_agree(void)
                     int pp;
                     if (!evr_pixel_begin_s(&s[path], &p, t, expf(l), &sp, path)) continue;
                     while (evr_pixel_next_s(&s[path], &p, &sp, &tt, &pp, path)) {
-                        if (n[path] < 64) { te[path][n[path]] = tt; pol[path][n[path]] = pp; }
+                        if (n[path] < 64) {
+                            te[path][n[path]] = tt;
+                            pol[path][n[path]] = pp;
+                        }
                         n[path]++;
                     }
                     evr_pixel_end_s(&s[path], &sp, path);
@@ -594,7 +630,8 @@ static void test_paths_agree(void)
             }
             evr_pixel_end_segment(&s[0], 0.03f);
             evr_pixel_end_segment(&s[1], 0.03f);
-            if (s[0].ref != s[1].ref || s[0].l_prev != s[1].l_prev || s[0].t_prev != s[1].t_prev) mismatches++;
+            if (s[0].ref != s[1].ref || s[0].l_prev != s[1].l_prev || s[0].t_prev != s[1].t_prev)
+                mismatches++;
         }
     }
     printf("ideal and full model paths: %d events, %d mismatches\n", total, mismatches);

@@ -21,7 +21,8 @@ static void part(void *ctx, int k, int thread)
     job_state *s = ctx;
     if (thread < 0 || thread >= s->threads) __atomic_store_n(&s->wrong_thread, 1, __ATOMIC_RELAXED);
     __atomic_add_fetch(&s->runs[k], 1, __ATOMIC_RELAXED);
-    if (__atomic_load_n(&current_job, __ATOMIC_RELAXED) != s->job) __atomic_store_n(&s->wrong_job, 1, __ATOMIC_RELAXED);
+    if (__atomic_load_n(&current_job, __ATOMIC_RELAXED) != s->job)
+        __atomic_store_n(&s->wrong_job, 1, __ATOMIC_RELAXED);
 }
 
 /* split: every other job started, then waited for, instead of run in one call */
@@ -54,13 +55,13 @@ int main(void)
     CHECK(p != NULL && evr_par_pool_threads(p) >= 1 && evr_par_pool_threads(p) <= 8);
     run_jobs(p, 5000, 0);
     run_jobs(p, 5000, 1);
-    evr_par_pool_run(p, 0, part, NULL);   /* nothing to do */
+    evr_par_pool_run(p, 0, part, NULL); /* nothing to do */
     evr_par_pool_free(p);
     evr_par_pool *one = evr_par_pool_new(1);
     CHECK(one != NULL && evr_par_pool_threads(one) == 1);
     run_jobs(one, 100, 1);
     evr_par_pool_free(one);
-    run_jobs(NULL, 100, 0);   /* no pool: the caller runs them */
+    run_jobs(NULL, 100, 0); /* no pool: the caller runs them */
     evr_par_pool_free(NULL);
     CHECK(evr_par_threads(16) >= 1 && evr_par_threads(16) <= 16 && evr_par_threads(1) == 1);
     return check_report("test_par_pool");

@@ -20,10 +20,13 @@ static void test_projection(void)
     evr_quat_to_m33(q, r);
     for (i = 0; i < 3; i++)
         for (j = 0; j < 3; j++) pose.m[i][j] = r[i][j];
-    pose.m[0][3] = 1.0f; pose.m[1][3] = -2.0f; pose.m[2][3] = 0.5f;
+    pose.m[0][3] = 1.0f;
+    pose.m[1][3] = -2.0f;
+    pose.m[2][3] = 0.5f;
     evr_m34 inv = evr_m34_inverse(&pose);
     for (i = 0; i < 50; i++) {
-        float px = 320.0f * (float)((i * 37) % 50) / 50.0f + 0.3f, py = 240.0f * (float)((i * 13) % 50) / 50.0f + 0.5f;
+        float px = 320.0f * (float)((i * 37) % 50) / 50.0f + 0.3f,
+              py = 240.0f * (float)((i * 13) % 50) / 50.0f + 0.5f;
         float t = 0.5f + (float)i * 0.3f, qx = -1.0f, qy = -1.0f;
         int x = -1, y = -1;
         evr_ray ray = evr_camera_ray(&c, &pose, px, py);
@@ -49,11 +52,11 @@ static void test_rings(void)
             int dx, dy, r = evr_ring_cell(k, &dx, &dy);
             int cheb = abs(dx) > abs(dy) ? abs(dx) : abs(dy);
             CHECK(r == cheb);
-            CHECK(r >= last);          /* rings in order */
+            CHECK(r >= last); /* rings in order */
             CHECK(r <= R);
             last = r;
             if (abs(dx) <= R && abs(dy) <= R) {
-                CHECK(!seen[(dy + R) * n + dx + R]);   /* each cell once */
+                CHECK(!seen[(dy + R) * n + dx + R]); /* each cell once */
                 seen[(dy + R) * n + dx + R] = 1;
             }
         }
@@ -72,7 +75,7 @@ static void test_gather_walk(void)
     int x, y, k;
     CHECK_OK(evr_photon_buffer_alloc(&b, n, n, 1, 0, &err));
     for (y = 0; y < n; y++)
-        for (x = 0; x < n; x++) {   /* one photon per cell, every one within reach, distinct fluxes */
+        for (x = 0; x < n; x++) { /* one photon per cell, every one within reach, distinct fluxes */
             evr_photon ph;
             memset(&ph, 0, sizeof ph);
             ph.p[0] = 0.01f * (float)(x - R) + 0.001f * (float)(y % 3);
@@ -94,10 +97,11 @@ static void test_gather_walk(void)
     }
     used = evr_photon_gather_rings(&b, R, R, R, p, nrm, lim2, 0.5f, s2, 1 << 30, acc, &stop, &area);
     CHECK(used == n * n && stop == -1);
-    CHECK(memcmp(acc, ref, sizeof acc) == 0);   /* the same order: the same bits */
+    CHECK(memcmp(acc, ref, sizeof acc) == 0); /* the same order: the same bits */
     for (k = 0; k < n * n; k++) {
         int dx, dy, ring = evr_ring_cell(k, &dx, &dy);
-        used = evr_photon_gather_rings(&b, R, R, R, p, nrm, lim2, 0.5f, s2, k + 1, acc, &stop, &area);
+        used =
+            evr_photon_gather_rings(&b, R, R, R, p, nrm, lim2, 0.5f, s2, k + 1, acc, &stop, &area);
         CHECK(used == k + 1 && stop == ring);
     }
     evr_photon_buffer_free(&b);
@@ -141,7 +145,9 @@ static void test_gather_units(void)
             evr_photon ph;
             int px = -1, py = -1;
             memset(&ph, 0, sizeof ph);
-            ph.p[0] = p.x; ph.p[1] = p.y; ph.p[2] = p.z;
+            ph.p[0] = p.x;
+            ph.p[1] = p.y;
+            ph.p[2] = p.z;
             ph.n[2] = 1.0f;
             ph.flux[0] = ph.flux[1] = ph.flux[2] = phi;
             ph.key = (uint32_t)(y * w + x);
@@ -150,24 +156,27 @@ static void test_gather_units(void)
             CHECK(evr_photon_buffer_insert(&b, px, py, &ph));
         }
     CHECK(*b.collisions == 0);
-    float pix = 2.0f * c.tan_half_y * depth / (float)h;   /* photon spacing on the plane (near the centre) */
+    float pix =
+        2.0f * c.tan_half_y * depth / (float)h; /* photon spacing on the plane (near the centre) */
     evr_gather_params gp;
     gp.radius = 6.0f * pix;
     gp.max_photons = 1000;
     gp.max_window = 64;
     gp.normal_cos = 0.5f;
     float e[3];
-    int used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth), evr_v3_make(0, 0, 1),
-                                 depth, &gp, e);
+    int used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth),
+                                 evr_v3_make(0, 0, 1), depth, &gp, e);
     CHECK(used > 100);
     CHECK_NEAR(e[0] / (phi / (pix * pix)), 1.0, 0.03);
-    {   /* no limit (max_photons 0): the fixed-point sums give the float walk's luminance */
+    { /* no limit (max_photons 0): the fixed-point sums give the float walk's luminance */
         evr_gather_params g0 = gp;
         evr_gather_point g;
         g.p = evr_v3_make(0.5f * pix, -0.5f * pix, -depth);
         g.n = evr_v3_make(0, 0, 1);
         g.dist = depth;
-        g.k[0] = 0.3f; g.k[1] = 0.2f; g.k[2] = 0.1f;
+        g.k[0] = 0.3f;
+        g.k[1] = 0.2f;
+        g.k[2] = 0.1f;
         const float l_float = evr_gather_point_lum(&b, &c, &gp, &g, w / 2, h / 2);
         g0.max_photons = 0;
         g0.flux_scale = evr_gather_flux_scale(phi * (float)(w * h), (uint32_t)(w * h));
@@ -177,20 +186,21 @@ static void test_gather_units(void)
     }
     /* at most max_photons: the radius shrinks, the estimate stays */
     gp.max_photons = 40;
-    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth), evr_v3_make(0, 0, 1),
-                             depth, &gp, e);
+    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0.5f * pix, -0.5f * pix, -depth),
+                             evr_v3_make(0, 0, 1), depth, &gp, e);
     CHECK(used >= 10 && used <= 80);
     CHECK_NEAR(e[0] / (phi / (pix * pix)), 1.0, 0.25);
     /* a photon facing away is skipped */
     gp.max_photons = 1000;
-    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0, 0, -depth), evr_v3_make(0, 0, -1), depth, &gp, e);
+    used = evr_photon_gather(&b, &c, w / 2, h / 2, evr_v3_make(0, 0, -depth), evr_v3_make(0, 0, -1),
+                             depth, &gp, e);
     CHECK(used == 0 && e[0] == 0.0f);
     /* half the plane (x < w / 2): at its edge the disk is half empty; the camera's view of the
      * cells (gbuf) tells the gather which half lies on the surface */
     {
         evr_photon_buffer hb;
         float e_disk[3], e_view[3];
-        const float a = pix * pix;   /* the area a cell covers on the plane */
+        const float a = pix * pix; /* the area a cell covers on the plane */
         CHECK_OK(evr_photon_buffer_alloc(&hb, w, h, layers, 0, &err));
         evr_photon_buffer_clear(&hb);
         hb.gbuf = calloc((size_t)w * (size_t)h * 8, sizeof(float));
@@ -201,24 +211,27 @@ static void test_gather_units(void)
                 evr_photon ph;
                 float *g = hb.gbuf + 8 * ((size_t)y * (size_t)w + (size_t)x);
                 memset(&ph, 0, sizeof ph);
-                ph.p[0] = g[0] = p.x; ph.p[1] = g[1] = p.y; ph.p[2] = g[2] = p.z;
+                ph.p[0] = g[0] = p.x;
+                ph.p[1] = g[1] = p.y;
+                ph.p[2] = g[2] = p.z;
                 ph.n[2] = g[5] = 1.0f;
-                g[6] = a;   /* (2 tan / H)^2 depth^2 cos(off axis) / cos(incidence), both cosines -r.dir.z */
+                g[6] =
+                    a; /* (2 tan / H)^2 depth^2 cos(off axis) / cos(incidence), both cosines -r.dir.z */
                 ph.flux[0] = ph.flux[1] = ph.flux[2] = phi;
                 evr_photon_buffer_insert(&hb, x, y, &ph);
             }
         gp.max_photons = 1000;
-        evr_v3 q = evr_v3_make(-0.5f * pix, -0.5f * pix, -depth);   /* the centre of pixel (31, 32) */
+        evr_v3 q = evr_v3_make(-0.5f * pix, -0.5f * pix, -depth); /* the centre of pixel (31, 32) */
         float *gb = hb.gbuf;
         evr_photon_gather(&hb, &c, w / 2 - 1, h / 2, q, evr_v3_make(0, 0, 1), depth, &gp, e_view);
         hb.gbuf = NULL;
         evr_photon_gather(&hb, &c, w / 2 - 1, h / 2, q, evr_v3_make(0, 0, 1), depth, &gp, e_disk);
         CHECK_NEAR(e_view[0] / (phi / (pix * pix)), 1.0, 0.08);
         CHECK(e_disk[0] / (phi / (pix * pix)) < 0.75);
-        printf("half plane edge: %.3f with the view, %.3f over the whole disk\n", e_view[0] / (phi / (pix * pix)),
-               e_disk[0] / (phi / (pix * pix)));
+        printf("half plane edge: %.3f with the view, %.3f over the whole disk\n",
+               e_view[0] / (phi / (pix * pix)), e_disk[0] / (phi / (pix * pix)));
         hb.gbuf = gb;
-        evr_photon_buffer_free(&hb);   /* frees gbuf too */
+        evr_photon_buffer_free(&hb); /* frees gbuf too */
     }
     /* one layer: the second photon of a pixel is a collision */
     evr_photon_buffer b1;
@@ -241,7 +254,7 @@ static void test_material(void)
     CHECK_NEAR(td, 0.275, 1e-6);
     CHECK_NEAR(ts, 1.0, 1e-6);
     CHECK_NEAR(evr_photon_mirror_share(td, ts), 0.0, 1e-6);
-    evr_photon_material_map(white, 1.0f, 0.0f, &td, &ts);   /* a polished metal: a mirror */
+    evr_photon_material_map(white, 1.0f, 0.0f, &td, &ts); /* a polished metal: a mirror */
     CHECK_NEAR(ts, td, 1e-6);
     CHECK_NEAR(evr_photon_mirror_share(td, ts), 1.0, 1e-6);
     evr_photon_material_map(black, 0.0f, 1.0f, &td, &ts);
@@ -252,7 +265,8 @@ static void test_material(void)
     CHECK(evr_photon_scatter(0.3f, 0.8f, 0.5f, 1, &w) == EVR_PHOTON_DIFFUSE);
     CHECK_NEAR(w, 1.0 / 0.7, 1e-5);
     CHECK(evr_photon_scatter(0.3f, 0.8f, 0.9f, 1, &w) == EVR_PHOTON_MIRROR);
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 0, &w) == EVR_PHOTON_DIFFUSE);   /* no stay at a light's first hit */
+    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 0, &w) ==
+          EVR_PHOTON_DIFFUSE); /* no stay at a light's first hit */
     CHECK_NEAR(w, 1.0, 1e-6);
     CHECK(evr_photon_scatter(0.3f, 0.8f, 0.95f, 0, &w) == EVR_PHOTON_MIRROR);
     CHECK(evr_photon_scatter(1.0f, 1.0f, 0.5f, 0, &w) == EVR_PHOTON_ABSORB);
@@ -262,7 +276,8 @@ static void test_material(void)
         double mc = 0.0;
         int i;
         for (i = 0; i < 4096; i++) {
-            evr_v3 d = evr_cosine_dir(n, evr_radical_inverse((uint32_t)i + 1, 2), evr_radical_inverse((uint32_t)i + 1, 3));
+            evr_v3 d = evr_cosine_dir(n, evr_radical_inverse((uint32_t)i + 1, 2),
+                                      evr_radical_inverse((uint32_t)i + 1, 3));
             CHECK(evr_v3_dot(d, n) >= -1e-6f);
             CHECK_NEAR(evr_v3_len(d), 1.0, 1e-5);
             mc += evr_v3_dot(d, n);
@@ -304,13 +319,13 @@ static void test_emission(void)
         float u[4];
         evr_photon_ray pr;
         for (k = 0; k < 4; k++) u[k] = evr_photon_rand(3, 0, j, k);
-        evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr);   /* 0 at the cone's rim (zero flux) */
+        evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr); /* 0 at the cone's rim (zero flux) */
         CHECK(evr_v3_dot(pr.ray.dir, l.dir) >= l.cos_outer - 1e-5f);
         CHECK_NEAR(evr_v3_len(pr.ray.dir), 1.0, 1e-5);
         CHECK(pr.from_light == 1);
         total += pr.flux[0];
     }
-    for (k = 0; k < 100000; k++) {   /* integral of I * falloff over the cone, midpoint rule in cos */
+    for (k = 0; k < 100000; k++) { /* integral of I * falloff over the cone, midpoint rule in cos */
         double cz = 1.0 - (k + 0.5) / 100000.0 * (1.0 - l.cos_outer);
         double a = (cz - l.cos_outer) / (l.cos_inner - l.cos_outer);
         a = a < 0 ? 0 : a > 1 ? 1 : a;
@@ -319,7 +334,7 @@ static void test_emission(void)
     CHECK_NEAR(total / want, 1.0, 0.01);
     /* a point light outside the scene's sphere: only towards it, flux I * the cone's solid angle */
     l.type = 0;
-    l.pos = evr_v3_make(1, 2, 13);   /* 10 from the centre, radius 2 */
+    l.pos = evr_v3_make(1, 2, 13); /* 10 from the centre, radius 2 */
     total = 0.0;
     {
         float cmax = sqrtf(1.0f - 4.0f / 100.0f), fl[3];
@@ -334,7 +349,7 @@ static void test_emission(void)
         CHECK_NEAR(total / (2.0 * 3.14159265358979 * (1.0 - cmax) * 2.0), 1.0, 1e-4);
         evr_photon_light_flux(&rs, &l, 0.0f, bb, fl);
         CHECK_NEAR(fl[0] / total, 1.0, 1e-4);
-        l.pos = evr_v3_make(1, 2.5f, 3);   /* inside: every direction */
+        l.pos = evr_v3_make(1, 2.5f, 3); /* inside: every direction */
         evr_photon_light_flux(&rs, &l, 0.0f, bb, fl);
         CHECK_NEAR(fl[0], 4.0 * 3.14159265358979 * 2.0, 1e-4);
     }
@@ -348,7 +363,7 @@ static void test_emission(void)
         for (k = 0; k < 4; k++) u[k] = evr_photon_rand(3, 1, j, k);
         evr_photon_emit_light(&rs, &l, 0.0f, bb, u, n, &pr);
         evr_v3 rel = evr_v3_sub(pr.ray.org, bb.center);
-        CHECK_NEAR(evr_v3_dot(rel, l.dir), -1.01 * bb.radius, 1e-4);   /* upstream of the sphere */
+        CHECK_NEAR(evr_v3_dot(rel, l.dir), -1.01 * bb.radius, 1e-4); /* upstream of the sphere */
         evr_v3 perp = evr_v3_sub(rel, evr_v3_scale(l.dir, evr_v3_dot(rel, l.dir)));
         CHECK(evr_v3_len(perp) <= bb.radius * 1.0001f);
         CHECK(pr.ray.dir.x == l.dir.x && pr.ray.dir.y == l.dir.y);
@@ -357,7 +372,8 @@ static void test_emission(void)
     CHECK_NEAR(total / (2.0 * 3.14159265358979 * 4.0), 1.0, 1e-4);
     /* an emissive triangle, both sides: flux 2 pi Le A, points on the triangle */
     {
-        static const float pos[9] = {0, 0, 0, 2, 0, 0, 0, 1, 0}, nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+        static const float pos[9] = {0, 0, 0, 2, 0, 0, 0, 1, 0},
+                           nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
         static const uint32_t idx[3] = {0, 1, 2};
         evr_mesh_view m;
         evr_material_params mat;
@@ -396,7 +412,7 @@ static void test_emission(void)
             total += pr.flux[0];
         }
         CHECK_NEAR(total / (2.0 * 3.14159265358979 * 0.5 * 1.0), 1.0, 1e-4);
-        CHECK(up > (int)n / 2 - 200 && up < (int)n / 2 + 200);   /* both sides */
+        CHECK(up > (int)n / 2 - 200 && up < (int)n / 2 + 200); /* both sides */
     }
 }
 
@@ -418,10 +434,14 @@ static void make_box(void)
             c[w] = (k & 2) ? 1.0f : -1.0f;
             memcpy(&box_pos[3 * (v + k)], c, sizeof c);
             box_nrm[3 * (v + k)] = box_nrm[3 * (v + k) + 1] = box_nrm[3 * (v + k) + 2] = 0.0f;
-            box_nrm[3 * (v + k) + axis] = -s;   /* inward */
+            box_nrm[3 * (v + k) + axis] = -s; /* inward */
         }
-        box_idx[t++] = (uint32_t)v; box_idx[t++] = (uint32_t)v + 1; box_idx[t++] = (uint32_t)v + 2;
-        box_idx[t++] = (uint32_t)v + 1; box_idx[t++] = (uint32_t)v + 3; box_idx[t++] = (uint32_t)v + 2;
+        box_idx[t++] = (uint32_t)v;
+        box_idx[t++] = (uint32_t)v + 1;
+        box_idx[t++] = (uint32_t)v + 2;
+        box_idx[t++] = (uint32_t)v + 1;
+        box_idx[t++] = (uint32_t)v + 3;
+        box_idx[t++] = (uint32_t)v + 2;
         v += 4;
     }
 }
@@ -441,10 +461,13 @@ static int same_buffer(const evr_photon_buffer *a, const evr_photon_buffer *b)
 {
     size_t npix = (size_t)a->width * (size_t)a->height, i;
     int l;
-    if (memcmp(a->count, b->count, npix * sizeof *a->count) || *a->collisions != *b->collisions) return 0;
+    if (memcmp(a->count, b->count, npix * sizeof *a->count) || *a->collisions != *b->collisions)
+        return 0;
     for (i = 0; i < npix; i++)
         for (l = 0; l < a->layers && (uint32_t)l < a->count[i]; l++)
-            if (memcmp(&a->slots[(size_t)l * npix + i], &b->slots[(size_t)l * npix + i], sizeof(evr_photon))) return 0;
+            if (memcmp(&a->slots[(size_t)l * npix + i], &b->slots[(size_t)l * npix + i],
+                       sizeof(evr_photon)))
+                return 0;
     return 1;
 }
 
@@ -480,7 +503,9 @@ static void test_pass(void)
     memset(&light, 0, sizeof light);
     light.type = 0;
     light.track = -1;
-    light.color[0] = 1.0f; light.color[1] = 0.5f; light.color[2] = 0.25f;
+    light.color[0] = 1.0f;
+    light.color[1] = 0.5f;
+    light.color[2] = 0.25f;
     light.pos = evr_v3_make(0.2f, 0.3f, -0.1f);
     keys[0] = evr_motion_key_from_matrix(&id);
     keys[1] = keys[0];
@@ -496,7 +521,7 @@ static void test_pass(void)
     rs.track_count = tcnt;
     rs.camera_track = 1;
     rs.camera_local = evr_m34_identity();
-    rs.camera_local.m[2][3] = 0.9f;   /* inside the box, looking at the back wall */
+    rs.camera_local.m[2][3] = 0.9f; /* inside the box, looking at the back wall */
     rs.camera = evr_camera_intr_make(48, 40, 1.2f);
     rs.ray_eps = 1e-5f;
 
@@ -546,9 +571,11 @@ static void test_pass(void)
         /* stored photons stand for the incident flux after the first hit: rho + rho^2 + ... */
         CHECK_NEAR(s1.stored[k] / (s1.emitted[k] * rho / (1.0 - rho)), 1.0, 0.03);
     }
-    printf("pass: %llu paths, %llu stayed, %llu visible, %llu inserted, %llu collisions; absorbed/emitted %.4f\n",
-           (unsigned long long)s1.paths, (unsigned long long)s1.stored_photons, (unsigned long long)s1.visible,
-           (unsigned long long)s1.inserted, (unsigned long long)s1.collisions, (s1.absorbed[0] + s1.capped[0]) / s1.emitted[0]);
+    printf(
+        "pass: %llu paths, %llu stayed, %llu visible, %llu inserted, %llu collisions; absorbed/emitted %.4f\n",
+        (unsigned long long)s1.paths, (unsigned long long)s1.stored_photons,
+        (unsigned long long)s1.visible, (unsigned long long)s1.inserted,
+        (unsigned long long)s1.collisions, (s1.absorbed[0] + s1.capped[0]) / s1.emitted[0]);
     CHECK(s1.paths == N);
     CHECK(s1.visible > 1000 && s1.inserted + s1.collisions == s1.visible);
     /* determinism: the same photons give the same buffer, whatever the thread count */
@@ -566,7 +593,8 @@ static void test_pass(void)
             if (b1.count[i]) {
                 const evr_photon *ph = &b1.slots[i];
                 CHECK(ph->flux[0] > 0.0f && ph->flux[1] > 0.0f);
-                CHECK_NEAR(ph->flux[1] / ph->flux[0], 0.5, 1e-4);   /* grey box keeps the light's colour */
+                CHECK_NEAR(ph->flux[1] / ph->flux[0], 0.5,
+                           1e-4); /* grey box keeps the light's colour */
                 found = 1;
             }
         CHECK(found);
@@ -587,8 +615,12 @@ static void test_trail(void)
     memset(&pl, 0, sizeof pl);
     pl.cache = pl.reuse = 1;
     pl.num_boxes = 1;
-    pl.lo[0][0] = 1.0f; pl.lo[0][1] = -1.0f; pl.lo[0][2] = -1.0f;   /* a box at x in [1, 2] */
-    pl.hi[0][0] = 2.0f; pl.hi[0][1] = 1.0f; pl.hi[0][2] = 1.0f;
+    pl.lo[0][0] = 1.0f;
+    pl.lo[0][1] = -1.0f;
+    pl.lo[0][2] = -1.0f; /* a box at x in [1, 2] */
+    pl.hi[0][0] = 2.0f;
+    pl.hi[0][1] = 1.0f;
+    pl.hi[0][2] = 1.0f;
     evr_photon_params pp;
     memset(&pp, 0, sizeof pp);
     pp.max_bounces = 1;
@@ -601,7 +633,7 @@ static void test_trail(void)
     evr_photon_trail_begin(&t, &pl);
     CHECK(t.clean && t.n == 0 && t.cell == EVR_TRAIL_NONE);
     evr_photon_trail_ray(&t, rays, len, &pl, up, 5.0f);
-    evr_photon_trail_ray(&t, rays, len, &pl, toward, 0.5f);   /* stops short of the box */
+    evr_photon_trail_ray(&t, rays, len, &pl, toward, 0.5f); /* stops short of the box */
     CHECK(t.clean && t.n == 2);
     CHECK(evr_photon_trail_reusable(&t, rays, &pl));
     /* the next segment's box covers x in [0.25, 2]: the second ray meets it */
@@ -609,7 +641,7 @@ static void test_trail(void)
     next.lo[0][0] = 0.25f;
     CHECK(!evr_photon_trail_reusable(&t, rays, &next));
     next.lo[0][0] = 1.0f;
-    next.reuse = 0;   /* the camera or a light moved */
+    next.reuse = 0; /* the camera or a light moved */
     CHECK(!evr_photon_trail_reusable(&t, rays, &next));
     /* a ray into the box (or to infinity toward it) leaves the trail unclean for good */
     evr_photon_trail_ray(&t, rays, len, &pl, toward, 1e30f);
@@ -634,7 +666,8 @@ static void changed_sat(const evr_photon_buffer *cur, const evr_photon_buffer *p
         uint32_t row = 0;
         for (int x = 0; x < w; x++) {
             row += !evr_photon_cell_same(cur, prev, (size_t)y * (size_t)w + (size_t)x);
-            sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
+            sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] =
+                sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
         }
     }
 }
@@ -644,12 +677,19 @@ static void changed_sat(const evr_photon_buffer *cur, const evr_photon_buffer *p
 static void test_gather_moved(void)
 {
     enum { N = 21 };
-    const evr_camera_intr cam = evr_camera_intr_make(N, N, 0.5f * EVR_PI);   /* tan(yfov / 2) = 1 */
-    evr_gather_params gp = {0.2f, 64, 8, 0.5f, 0.0f};   /* r, max, window, normal cosine, (fixed point: unused) */
+    const evr_camera_intr cam = evr_camera_intr_make(N, N, 0.5f * EVR_PI); /* tan(yfov / 2) = 1 */
+    evr_gather_params gp = {0.2f, 64, 8, 0.5f,
+                            0.0f}; /* r, max, window, normal cosine, (fixed point: unused) */
     const evr_v3 p = evr_v3_make(0.0f, 0.0f, 0.0f), nrm = evr_v3_make(0.0f, 0.0f, 1.0f);
-    const float dist = 1.0f;   /* pixel size 2/21 at the point: window half size ceil(0.2 / 0.095) + 1 = 4 */
+    const float dist =
+        1.0f; /* pixel size 2/21 at the point: window half size ceil(0.2 / 0.095) + 1 = 4 */
     static uint32_t sat[(N + 1) * (N + 1)];
-    struct { float x, nz; int cx, in_cur; int moved; const char *what; } cases[] = {
+    struct {
+        float x, nz;
+        int cx, in_cur;
+        int moved;
+        const char *what;
+    } cases[] = {
         {5.0f, 1.0f, 12, 1, 0, "a photon 5 m away"},
         {0.05f, 1.0f, 12, 1, 1, "a photon within r"},
         {0.05f, -1.0f, 12, 1, 0, "a photon within r facing away"},
@@ -662,7 +702,8 @@ static void test_gather_moved(void)
         CHECK_OK(evr_photon_buffer_alloc(&cur, N, N, 1, 0, &err));
         CHECK_OK(evr_photon_buffer_alloc(&prev, N, N, 1, 0, &err));
         changed_sat(&cur, &prev, sat);
-        CHECK(!evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, dist));   /* nothing changed */
+        CHECK(!evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm,
+                                       dist)); /* nothing changed */
         evr_photon ph;
         memset(&ph, 0, sizeof ph);
         ph.p[0] = cases[c].x;
@@ -670,8 +711,11 @@ static void test_gather_moved(void)
         ph.flux[0] = 1.0f;
         CHECK(evr_photon_buffer_insert(cases[c].in_cur ? &cur : &prev, cases[c].cx, 10, &ph));
         changed_sat(&cur, &prev, sat);
-        const int moved = evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, dist);
-        if (moved != cases[c].moved) fprintf(stderr, "gather moved by %s: %d, expected %d\n", cases[c].what, moved, cases[c].moved);
+        const int moved =
+            evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, dist);
+        if (moved != cases[c].moved)
+            fprintf(stderr, "gather moved by %s: %d, expected %d\n", cases[c].what, moved,
+                    cases[c].moved);
         CHECK(moved == cases[c].moved);
         evr_photon_buffer_free(&cur);
         evr_photon_buffer_free(&prev);
@@ -692,7 +736,8 @@ static void test_gather_delta(void)
     evr_gather_params gp = {0.15f, 0, 6, 0.5f, 0.0f};
     evr_photon_buffer a, b;
     evr_error err;
-    static uint32_t sat[(W + 3) * (H + 3)], before[(W + 3) * (H + 2)], base[H + 3], xs[(W + 2) * (H + 2)];
+    static uint32_t sat[(W + 3) * (H + 3)], before[(W + 3) * (H + 2)], base[H + 3],
+        xs[(W + 2) * (H + 2)];
     uint64_t rng = 12345;
     int changed = 0;
     gp.flux_scale = evr_gather_flux_scale(1.0f, 1000u);
@@ -711,8 +756,12 @@ static void test_gather_delta(void)
             evr_ray r = evr_camera_ray(&cam, &pose, (float)x + 0.5f, (float)y + 0.5f);
             const float depth = x < W / 2 ? 2.0f : 1.5f;
             evr_v3 q = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
-            for (int k = 0; k < 8; k++) a.gbuf[8 * i + (size_t)k] = b.gbuf[8 * i + (size_t)k] = 0.0f;
-            a.gbuf[8 * i] = q.x; a.gbuf[8 * i + 1] = q.y; a.gbuf[8 * i + 2] = q.z; a.gbuf[8 * i + 5] = 1.0f;
+            for (int k = 0; k < 8; k++)
+                a.gbuf[8 * i + (size_t)k] = b.gbuf[8 * i + (size_t)k] = 0.0f;
+            a.gbuf[8 * i] = q.x;
+            a.gbuf[8 * i + 1] = q.y;
+            a.gbuf[8 * i + 2] = q.z;
+            a.gbuf[8 * i + 5] = 1.0f;
             a.gbuf[8 * i + 6] = 0.002f;
             for (int k = 0; k < 8; k++) b.gbuf[8 * i + (size_t)k] = a.gbuf[8 * i + (size_t)k];
             if (moved && (rng_next(&rng) & 1u)) b.gbuf[8 * i + 6] = 0.003f;
@@ -733,7 +782,8 @@ static void test_gather_delta(void)
             }
         }
     changed_sat(&b, &a, sat);
-    const evr_changed_cells ch = evr_changed_cells_from_sat(sat, b.width, b.height, before, base, xs);
+    const evr_changed_cells ch =
+        evr_changed_cells_from_sat(sat, b.width, b.height, before, base, xs);
     changed = (int)base[b.height];
     CHECK(changed == (int)sat[(size_t)b.height * (size_t)(b.width + 1) + (size_t)b.width]);
     CHECK(changed > (W * H) / 20);
@@ -746,7 +796,9 @@ static void test_gather_delta(void)
             g.p = evr_v3_add(r.org, evr_v3_scale(r.dir, -depth / r.dir.z));
             g.n = evr_v3_make(0.0f, 0.0f, 1.0f);
             g.dist = evr_v3_len(g.p);
-            g.k[0] = 0.2f; g.k[1] = 0.1f; g.k[2] = 0.05f;
+            g.k[0] = 0.2f;
+            g.k[1] = 0.1f;
+            g.k[2] = 0.05f;
             evr_gather_sum sa, sb, sd;
             evr_gather_point_sum(&a, &cam, &gp, &g, x, y, &sa);
             evr_gather_point_sum(&b, &cam, &gp, &g, x, y, &sb);
@@ -758,8 +810,9 @@ static void test_gather_delta(void)
             nonzero += memcmp(&sa, &sb, sizeof sa) != 0;
             checked++;
         }
-    printf("fixed-point gathers: %d checked, %d changed by the %d changed cells, every one equal to a fresh gather\n", checked,
-           nonzero, changed);
+    printf(
+        "fixed-point gathers: %d checked, %d changed by the %d changed cells, every one equal to a fresh gather\n",
+        checked, nonzero, changed);
     CHECK(nonzero > checked / 2);
     evr_photon_buffer_free(&a);
     evr_photon_buffer_free(&b);

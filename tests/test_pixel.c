@@ -4,11 +4,15 @@
 
 #include <math.h>
 
-typedef struct { float t; int p; } ev_t;
+typedef struct {
+    float t;
+    int p;
+} ev_t;
 
 /* Feeds log intensity l(t) = l0 + slope * t sampled at n uniform times over [0, T] (the first
  * at t = 0 sets the reference); collects events. */
-static int run_ramp(const evr_pixel_params *p, float l0, float slope, float T, int n, ev_t *out, int max)
+static int run_ramp(const evr_pixel_params *p, float l0, float slope, float T, int n, ev_t *out,
+                    int max)
 {
     evr_pixel_state s;
     int k, count = 0;
@@ -21,7 +25,10 @@ static int run_ramp(const evr_pixel_params *p, float l0, float slope, float T, i
         int pol;
         if (!evr_pixel_begin(&s, p, t, intensity, &sp)) continue;
         while (evr_pixel_next(&s, p, &sp, &te, &pol)) {
-            if (count < max) { out[count].t = te; out[count].p = pol; }
+            if (count < max) {
+                out[count].t = te;
+                out[count].p = pol;
+            }
             count++;
         }
         evr_pixel_end(&s, &sp);
@@ -31,7 +38,8 @@ static int run_ramp(const evr_pixel_params *p, float l0, float slope, float T, i
 
 int main(void)
 {
-    evr_pixel_params p = {.pos_thres = 0.2f, .neg_thres = 0.25f, .refractory = 0.0f, .log_floor = 1e-3f};
+    evr_pixel_params p = {
+        .pos_thres = 0.2f, .neg_thres = 0.25f, .refractory = 0.0f, .log_floor = 1e-3f};
     ev_t ev[512];
     int i, n;
 
@@ -85,10 +93,11 @@ int main(void)
      * blind 2.5 ms, then its reference resets to the level at wake-up, so events come every
      * 3.5 ms: at 1, 4.5, 8, ... ms; never two closer than the period */
     {
-        evr_pixel_params pr = {.pos_thres = 0.2f, .neg_thres = 0.2f, .refractory = 2.5e-3f, .log_floor = 1e-3f};
-        float slope = 0.2f / 1e-3f;   /* one threshold per ms */
+        evr_pixel_params pr = {
+            .pos_thres = 0.2f, .neg_thres = 0.2f, .refractory = 2.5e-3f, .log_floor = 1e-3f};
+        float slope = 0.2f / 1e-3f; /* one threshold per ms */
         n = run_ramp(&pr, 0.0f, slope, 0.02f, 200, ev, 512);
-        CHECK(n == 6);   /* 1, 4.5, 8, 11.5, 15, 18.5 ms */
+        CHECK(n == 6); /* 1, 4.5, 8, 11.5, 15, 18.5 ms */
         for (i = 0; i < n && i < 6; i++) CHECK_NEAR(ev[i].t, 1e-3 + 3.5e-3 * i, 3e-6);
         for (i = 1; i < n; i++) CHECK(ev[i].t - ev[i - 1].t >= pr.refractory - 1e-6f);
         /* with coarse samples the wake-up and reset happen inside a sample interval: same times */
@@ -104,7 +113,7 @@ int main(void)
         float te;
         int pol, count = 0;
         evr_pixel_reset(&s);
-        evr_pixel_begin(&s, &p, 0.9f, 1.0f, &sp);            /* last sample of segment 0 (length 1) */
+        evr_pixel_begin(&s, &p, 0.9f, 1.0f, &sp); /* last sample of segment 0 (length 1) */
         evr_pixel_end_segment(&s, 1.0f);
         CHECK_NEAR(s.t_prev, -0.1, 1e-6);
         CHECK(evr_pixel_begin(&s, &p, 0.1f, expf(0.3f), &sp)); /* first sample of segment 1 */
@@ -117,7 +126,8 @@ int main(void)
 
     /* the log response is continuous with a continuous slope at the floor */
     CHECK_NEAR(evr_log_response(1e-3f, 1e-3f), logf(1e-3f), 1e-6);
-    CHECK_NEAR((evr_log_response(1.0001e-3f, 1e-3f) - evr_log_response(0.9999e-3f, 1e-3f)) / 2e-7, 1000.0, 10.0);
+    CHECK_NEAR((evr_log_response(1.0001e-3f, 1e-3f) - evr_log_response(0.9999e-3f, 1e-3f)) / 2e-7,
+               1000.0, 10.0);
     CHECK(isfinite(evr_log_response(0.0f, 1e-3f)));
     return check_report("test_pixel");
 }

@@ -8,10 +8,10 @@
 #include <string.h>
 
 typedef struct {
-    int next;          /* the segment the planner should plan next */
+    int next; /* the segment the planner should plan next */
     int out_of_order;
-    int *released;     /* segments released so far, read by the planner */
-    int too_far;       /* planned a segment more than EVR_PLANNER_SLOTS past the releases */
+    int *released; /* segments released so far, read by the planner */
+    int too_far;   /* planned a segment more than EVR_PLANNER_SLOTS past the releases */
 } plan_state;
 
 static void plan(void *user, int segment, evr_planned_segment *out)
@@ -19,7 +19,8 @@ static void plan(void *user, int segment, evr_planned_segment *out)
     plan_state *s = user;
     if (segment != s->next) s->out_of_order = 1;
     s->next = segment + 1;
-    if (segment - __atomic_load_n(s->released, __ATOMIC_ACQUIRE) >= EVR_PLANNER_SLOTS) s->too_far = 1;
+    if (segment - __atomic_load_n(s->released, __ATOMIC_ACQUIRE) >= EVR_PLANNER_SLOTS)
+        s->too_far = 1;
     out->num_keys = segment;
     out->track_count[0] = segment;
     out->keys[0].trans.x = (float)segment;
@@ -36,7 +37,8 @@ int main(void)
     CHECK(p != NULL);
     for (int i = 0; i < n; i++) {
         const evr_planned_segment *pl = evr_planner_take(p, i);
-        if (pl->num_keys != i || pl->track_count[0] != i || pl->keys[0].trans.x != (float)i) wrong++;
+        if (pl->num_keys != i || pl->track_count[0] != i || pl->keys[0].trans.x != (float)i)
+            wrong++;
         __atomic_store_n(&released, i + 1, __ATOMIC_RELEASE);
         evr_planner_release(p, i);
     }

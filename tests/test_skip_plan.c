@@ -83,8 +83,10 @@ static void ring_keys(evr_motion_key *keys, float deg0, float step)
     for (int k = 0; k < 5; k++) {
         const float a = (deg0 + step * (float)k) * 3.14159265f / 180.0f;
         evr_m34 m = evr_m34_identity();
-        m.m[0][0] = cosf(a); m.m[0][1] = -sinf(a);
-        m.m[1][0] = sinf(a); m.m[1][1] = cosf(a);
+        m.m[0][0] = cosf(a);
+        m.m[0][1] = -sinf(a);
+        m.m[1][0] = sinf(a);
+        m.m[1][1] = cosf(a);
         m.m[0][3] = 0.1f * (float)k;
         keys[k] = evr_motion_key_from_matrix(&m);
     }
@@ -107,7 +109,15 @@ static void test_parts(void)
     memset(&rs, 0, sizeof rs);
     for (int i = 0; i < RING; i++) {
         const float a = 1.5707963f * (float)i / RING, c = cosf(a), sn = sinf(a);
-        const float v[9] = {10.0f * c, 10.0f * sn, -0.2f, 10.5f * c, 10.5f * sn, 0.2f, 10.0f * c - 0.4f * sn, 10.0f * sn + 0.4f * c, 0.0f};
+        const float v[9] = {10.0f * c,
+                            10.0f * sn,
+                            -0.2f,
+                            10.5f * c,
+                            10.5f * sn,
+                            0.2f,
+                            10.0f * c - 0.4f * sn,
+                            10.0f * sn + 0.4f * c,
+                            0.0f};
         memcpy(&pos[9 * i], v, sizeof v);
         for (int k = 0; k < 3; k++) idx[3 * i + k] = (uint32_t)(3 * i + k);
     }
@@ -137,12 +147,13 @@ static void test_parts(void)
          * 40 degrees, so that the triangles pass the circle's extremes between keys (there the
          * boxes at the keys do not hold them) */
         ring_keys(keys, seg == 0 ? 0.0f : 160.0f, seg == 0 ? 10.0f : 40.0f);
-        if (seg == 1) {   /* where segment 0 ended */
+        if (seg == 1) { /* where segment 0 ended */
             evr_motion_key k0[5];
             ring_keys(k0, 0.0f, 10.0f);
             prev_end = evr_motion_eval((evr_motion_track){k0, 5}, 1.0f);
         }
-        keys[5] = evr_motion_key_from_matrix(&(evr_m34){{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}});   /* the camera's */
+        keys[5] = evr_motion_key_from_matrix(
+            &(evr_m34){{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}}); /* the camera's */
         evr_skip_tracker_update(&t, keys, offset, count, 1.0f);
         evr_skip_plan_build(&t, &s, &rs, 1, &pl);
         CHECK(pl.num_boxes == 1 && pl.part_first[1] - pl.part_first[0] > 1);
@@ -150,10 +161,14 @@ static void test_parts(void)
         for (int n = 0; n < 20000; n++) {
             /* a point of a triangle at a time of the segment (or, one in ten, the previous end) */
             float r1 = uni(&rng), r2 = uni(&rng), f = uni(&rng);
-            if (r1 + r2 > 1.0f) { r1 = 1.0f - r1; r2 = 1.0f - r2; }
+            if (r1 + r2 > 1.0f) {
+                r1 = 1.0f - r1;
+                r2 = 1.0f - r2;
+            }
             const int tri = (int)(uni(&rng) * RING) % RING;
             const float *v = &pos[9 * tri];
-            evr_v3 p = evr_v3_make(v[0] + r1 * (v[3] - v[0]) + r2 * (v[6] - v[0]), v[1] + r1 * (v[4] - v[1]) + r2 * (v[7] - v[1]),
+            evr_v3 p = evr_v3_make(v[0] + r1 * (v[3] - v[0]) + r2 * (v[6] - v[0]),
+                                   v[1] + r1 * (v[4] - v[1]) + r2 * (v[7] - v[1]),
                                    v[2] + r1 * (v[5] - v[2]) + r2 * (v[8] - v[2]));
             const int before = seg == 1 && n % 10 == 0;
             evr_m34 m = before ? prev_end : evr_motion_eval(evr_rs_track(&rs, 0), f);
@@ -164,7 +179,8 @@ static void test_parts(void)
             d = evr_v3_scale(d, 1.0f / len);
             /* where it was at the previous segment's end: in the instance's box (adaptive sampling
              * needs that), not in the parts (a clean cache needs only where things are now) */
-            if (before ? !evr_skip_segment_meets(o, d, len, pl.lo[0], pl.hi[0], pl.pad) : !evr_skip_ray_meets_any(&pl, o, d, len))
+            if (before ? !evr_skip_segment_meets(o, d, len, pl.lo[0], pl.hi[0], pl.pad)
+                       : !evr_skip_ray_meets_any(&pl, o, d, len))
                 missed++;
         }
         CHECK(missed == 0);
@@ -187,7 +203,8 @@ int main(void)
     plan_of(&w, 2, &pl);
     CHECK(pl.num_boxes == 10 && pl.reuse && pl.cache);
     for (b = 0; b < pl.num_boxes; b++)
-        CHECK(pl.lo[b][0] <= -1.0f && pl.hi[b][0] >= 2.0f && pl.lo[b][1] <= -1.0f && pl.hi[b][1] >= 1.0f);
+        CHECK(pl.lo[b][0] <= -1.0f && pl.hi[b][0] >= 2.0f && pl.lo[b][1] <= -1.0f &&
+              pl.hi[b][1] >= 1.0f);
 
     /* more moving instances than boxes: a box per track, each the union of its instances' */
     make_world(&w, 150, 3);
@@ -207,9 +224,11 @@ int main(void)
     {
         evr_v3 o = evr_v3_make(0.5f, 0.0f, 10.0f), d = evr_v3_make(0.0f, 0.0f, -1.0f);
         CHECK(evr_skip_ray_meets_any(&pl, o, d, INFINITY));
-        CHECK(!evr_skip_ray_meets_any(&pl, o, d, 8.0f));                        /* ends before the box */
-        CHECK(!evr_skip_ray_meets_any(&pl, evr_v3_make(5.0f, 0.0f, 10.0f), d, INFINITY));   /* beside it */
-        CHECK(evr_skip_ray_meets_any(&pl, evr_v3_make(1.9f, 0.0f, 10.0f), d, INFINITY));    /* the swept end */
+        CHECK(!evr_skip_ray_meets_any(&pl, o, d, 8.0f)); /* ends before the box */
+        CHECK(!evr_skip_ray_meets_any(&pl, evr_v3_make(5.0f, 0.0f, 10.0f), d,
+                                      INFINITY)); /* beside it */
+        CHECK(evr_skip_ray_meets_any(&pl, evr_v3_make(1.9f, 0.0f, 10.0f), d,
+                                     INFINITY)); /* the swept end */
     }
     /* still spans: one track of six keys, still, still (but for a billionth), still, moving,
      * moving, still: nothing moves before key 2 nor after key 4 */
@@ -223,28 +242,36 @@ int main(void)
             m.m[0][3] = x[k];
             w.keys[k] = evr_motion_key_from_matrix(&m);
         }
-        w.keys[6] = evr_motion_key_from_matrix(&m);   /* the camera's */
+        w.keys[6] = evr_motion_key_from_matrix(&m); /* the camera's */
         w.offset[0] = 0;
         w.count[0] = 6;
         w.offset[1] = 6;
         w.count[1] = 1;
         CHECK(evr_skip_tracker_init(&t, 2));
         evr_skip_tracker_update(&t, w.keys, w.offset, w.count, 1.0f);
-        CHECK(evr_motion_key_same(&w.keys[1], &w.keys[0]));   /* the billionth: snapped to the key before */
+        CHECK(evr_motion_key_same(&w.keys[1],
+                                  &w.keys[0])); /* the billionth: snapped to the key before */
         evr_skip_plan_build(&t, &w.s, &w.rs, 1, &pl);
         CHECK(pl.spans && pl.cache);
-        CHECK(fabsf(pl.still_before - 1.99f / 5.0f) < 1e-6f && fabsf(pl.still_after - 4.01f / 5.0f) < 1e-6f);
-        CHECK(evr_skip_still_span(&pl, 0.1f) == 1 && evr_skip_still_span(&pl, 0.5f) == 0 && evr_skip_still_span(&pl, 0.9f) == 2);
-        CHECK(evr_skip_held(&pl, 1, 1) && !evr_skip_held(&pl, 2, 1) && !evr_skip_held(&pl, 0, 0) && !evr_skip_held(&pl, 1, -1));
-        CHECK(evr_skip_trace_time(&pl, 0.1f) == 0.0f && evr_skip_trace_time(&pl, 0.9f) == 1.0f && evr_skip_trace_time(&pl, 0.5f) == 0.5f);
+        CHECK(fabsf(pl.still_before - 1.99f / 5.0f) < 1e-6f &&
+              fabsf(pl.still_after - 4.01f / 5.0f) < 1e-6f);
+        CHECK(evr_skip_still_span(&pl, 0.1f) == 1 && evr_skip_still_span(&pl, 0.5f) == 0 &&
+              evr_skip_still_span(&pl, 0.9f) == 2);
+        CHECK(evr_skip_held(&pl, 1, 1) && !evr_skip_held(&pl, 2, 1) && !evr_skip_held(&pl, 0, 0) &&
+              !evr_skip_held(&pl, 1, -1));
+        CHECK(evr_skip_trace_time(&pl, 0.1f) == 0.0f && evr_skip_trace_time(&pl, 0.9f) == 1.0f &&
+              evr_skip_trace_time(&pl, 0.5f) == 0.5f);
         /* the transform is the same bits anywhere in a span, and moves in between */
         evr_motion_track tr = evr_rs_track(&w.rs, 0);
-        evr_m34 a = evr_motion_eval(tr, 0.01f), b2 = evr_motion_eval(tr, 0.37f), c = evr_motion_eval(tr, 0.81f),
-                d = evr_motion_eval(tr, 0.999f), e = evr_motion_eval(tr, 0.5f);
-        CHECK(memcmp(&a, &b2, sizeof a) == 0 && memcmp(&c, &d, sizeof c) == 0 && e.m[0][3] > 0.0f && e.m[0][3] < 1.0f);
+        evr_m34 a = evr_motion_eval(tr, 0.01f), b2 = evr_motion_eval(tr, 0.37f),
+                c = evr_motion_eval(tr, 0.81f), d = evr_motion_eval(tr, 0.999f),
+                e = evr_motion_eval(tr, 0.5f);
+        CHECK(memcmp(&a, &b2, sizeof a) == 0 && memcmp(&c, &d, sizeof c) == 0 && e.m[0][3] > 0.0f &&
+              e.m[0][3] < 1.0f);
         /* brute force: the same spans (its samples traced at the same times), nothing held */
         evr_skip_plan_build(&t, &w.s, &w.rs, 0, &pl);
-        CHECK(pl.spans && !pl.cache && evr_skip_still_span(&pl, 0.1f) == 1 && !evr_skip_held(&pl, 1, 1));
+        CHECK(pl.spans && !pl.cache && evr_skip_still_span(&pl, 0.1f) == 1 &&
+              !evr_skip_held(&pl, 1, 1));
         evr_skip_tracker_free(&t);
     }
     test_parts();

@@ -12,10 +12,10 @@
 /* A writer that records what it is given; fail_flush makes every flush fail. */
 typedef struct {
     evr_event_writer base;
-    int64_t next_t;              /* the t the next event must have (events are 0, 1, 2, ...) */
+    int64_t next_t; /* the t the next event must have (events are 0, 1, 2, ...) */
     int in_order;
     size_t events, writes, flushes;
-    _Atomic size_t flushed_events;   /* read by the test while the thread may flush */
+    _Atomic size_t flushed_events; /* read by the test while the thread may flush */
     int fail_flush;
 } fake_writer;
 
@@ -122,7 +122,7 @@ int main(void)
         size_t flushed = 0;
         while (evr_host_seconds() - t0 < 10.0) {
             sleep_s(0.02);
-            CHECK_OK(evr_write_queue_drain(q, &err));   /* after drain the thread is not in a flush */
+            CHECK_OK(evr_write_queue_drain(q, &err)); /* after drain the thread is not in a flush */
             flushed = atomic_load(&a.flushed_events);
             if (flushed == 300) break;
         }

@@ -26,9 +26,14 @@
 #define W 640
 #define H 480
 
-typedef evr_status (*open_fn)(const char *, const evr_writer_meta *, evr_event_writer **, evr_error *);
+typedef evr_status (*open_fn)(const char *, const evr_writer_meta *, evr_event_writer **,
+                              evr_error *);
 
-static const struct { const char *ext; open_fn open; int stores_size; } formats[] = {
+static const struct {
+    const char *ext;
+    open_fn open;
+    int stores_size;
+} formats[] = {
     {"h5", evr_h5_writer_open, 1},
     {"txt", evr_txt_writer_open, 0},
     {"npy", evr_npy_writer_open, 0},
@@ -98,9 +103,9 @@ static evr_event *make_events(size_t n, int64_t *last_t)
     for (size_t i = 0; i < n; i++) {
         uint64_t r = rng_next(&s) % 100;
         if (i > 0) {
-            if (r < 30) t += 0;                                  /* same timestamp */
-            else if (r < 45) t = (t / 1000 + 1) * 1000;          /* next millisecond boundary */
-            else if (r < 48) t = (t / 1000 + 4) * 1000 + 999;    /* skip empty milliseconds */
+            if (r < 30) t += 0;                               /* same timestamp */
+            else if (r < 45) t = (t / 1000 + 1) * 1000;       /* next millisecond boundary */
+            else if (r < 48) t = (t / 1000 + 4) * 1000 + 999; /* skip empty milliseconds */
             else t += (int64_t)(rng_next(&s) % 300) + 1;
         }
         ev[i].t = t;
@@ -120,8 +125,9 @@ static int same_events(const evr_event *a, const evr_event *b, size_t n)
 {
     for (size_t i = 0; i < n; i++)
         if (a[i].t != b[i].t || a[i].x != b[i].x || a[i].y != b[i].y || a[i].p != b[i].p) {
-            fprintf(stderr, "event %zu differs: %lld %u %u %d vs %lld %u %u %d\n", i, (long long)a[i].t, a[i].x,
-                    a[i].y, a[i].p, (long long)b[i].t, b[i].x, b[i].y, b[i].p);
+            fprintf(stderr, "event %zu differs: %lld %u %u %d vs %lld %u %u %d\n", i,
+                    (long long)a[i].t, a[i].x, a[i].y, a[i].p, (long long)b[i].t, b[i].x, b[i].y,
+                    b[i].p);
             return 0;
         }
     return 1;
@@ -132,18 +138,22 @@ static char *make_config(void)
     evr_json j;
     evr_json_init(&j, 1);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "width"); evr_json_integer(&j, W);
-    evr_json_key(&j, "height"); evr_json_integer(&j, H);
-    evr_json_key(&j, "scene"); evr_json_string(&j, "demo \"spheres\"");
-    evr_json_key(&j, "pos_thres"); evr_json_float(&j, 0.2f);
+    evr_json_key(&j, "width");
+    evr_json_integer(&j, W);
+    evr_json_key(&j, "height");
+    evr_json_integer(&j, H);
+    evr_json_key(&j, "scene");
+    evr_json_string(&j, "demo \"spheres\"");
+    evr_json_key(&j, "pos_thres");
+    evr_json_float(&j, 0.2f);
     evr_json_end_object(&j);
     return evr_json_take(&j);
 }
 
 /* Writes the events in uneven segments (one empty) through one writer, checking along the way
  * that the temporary file is readable after each flush, then reads the result back. */
-static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n, int64_t duration_us,
-                        const char *config)
+static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n,
+                        int64_t duration_us, const char *config)
 {
     char path[512], tmp[600], partial[600];
     evr_writer_meta meta;
@@ -156,16 +166,19 @@ static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n
     meta.width = W;
     meta.height = H;
     meta.config_json = config;
-    meta.max_t_us = duration_us + 1;   /* every event before it: the HDF5 writer's t is uint32 */
+    meta.max_t_us = duration_us + 1; /* every event before it: the HDF5 writer's t is uint32 */
     snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     snprintf(partial, sizeof partial, "%s/partial.%s", dir, formats[f].ext);
     st = formats[f].open(path, &meta, &w, &err);
     CHECK(st == EVR_OK);
-    if (st != EVR_OK) { fprintf(stderr, "%s\n", err.msg); return; }
+    if (st != EVR_OK) {
+        fprintf(stderr, "%s\n", err.msg);
+        return;
+    }
     CHECK(file_exists(tmp));
     for (;;) {
-        size_t len = seg == 3 ? 0 : (seg * 397 + 11) % 1500;   /* segment 3 is empty */
+        size_t len = seg == 3 ? 0 : (seg * 397 + 11) % 1500; /* segment 3 is empty */
         if (len > n - at) len = n - at;
         st = w->write(w, ev + at, len, &err);
         CHECK(st == EVR_OK);
@@ -229,7 +242,10 @@ static void check_ms_to_idx(const char *path, const evr_event *ev, size_t n, int
     evr_error err;
     evr_status st = evr_h5_read_ms_to_idx(path, &idx, &nidx, &err);
     CHECK(st == EVR_OK);
-    if (st != EVR_OK) { fprintf(stderr, "%s\n", err.msg); return; }
+    if (st != EVR_OK) {
+        fprintf(stderr, "%s\n", err.msg);
+        return;
+    }
     CHECK(nidx == expect_n);
     for (size_t i = 0, k = 0; i < nidx; i++) {
         while (k < n && ev[k].t < (int64_t)i * 1000) k++;
@@ -250,10 +266,13 @@ static const size_t large_n = 400000;
 
 static void test_h5_large(const char *root)
 {
-    static const struct { size_t len; int flush; } steps[] = {
+    static const struct {
+        size_t len;
+        int flush;
+    } steps[] = {
         {1, 1}, {65535, 1}, {0, 1}, {0, 1}, {3, 0}, {300000, 1}, {7, 0}, {20000, 1}, {14454, 1},
     };
-    evr_writer_meta meta = {W, H, "{}", 0};   /* no bound on the timestamps: t is int64 */
+    evr_writer_meta meta = {W, H, "{}", 0}; /* no bound on the timestamps: t is int64 */
     evr_event_writer *w = NULL;
     evr_event *ev, *got = NULL;
     int64_t last_t;
@@ -271,7 +290,10 @@ static void test_h5_large(const char *root)
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     snprintf(partial, sizeof partial, "%s/partial.h5", root);
     CHECK_OK(evr_h5_writer_open(path, &meta, &w, &e_));
-    if (!w) { free(ev); return; }
+    if (!w) {
+        free(ev);
+        return;
+    }
     for (size_t s = 0; s < sizeof steps / sizeof steps[0]; s++) {
         CHECK(at + steps[s].len <= large_n);
         CHECK_OK(w->write(w, ev + at, steps[s].len, &e_));
@@ -342,7 +364,10 @@ static void test_h5_t_range(const char *root)
  * events before it kept (the finished file holds exactly those). */
 static void test_npy_large(const char *root)
 {
-    static const struct { size_t len; int flush; } steps[] = {
+    static const struct {
+        size_t len;
+        int flush;
+    } steps[] = {
         {1, 1}, {65535, 0}, {3, 1}, {300000, 1}, {7, 0}, {33000, 0}, {1454, 1},
     };
     const size_t n = 400000;
@@ -391,7 +416,8 @@ static void test_npy_large(const char *root)
         if (w) {
             CHECK_OK(w->write(w, ev, 5, &err));
             err.msg[0] = 0;
-            CHECK(w->write(w, ev + 5, 100000, &err) == EVR_ERR_ARG && strstr(err.msg, "out of time order") != NULL);
+            CHECK(w->write(w, ev + 5, 100000, &err) == EVR_ERR_ARG &&
+                  strstr(err.msg, "out of time order") != NULL);
             CHECK_OK(w->finish(w, ev[k - 1].t + 1, &err));
             CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &err));
             CHECK(ngot == k);
@@ -458,7 +484,8 @@ static size_t raw_inflate(const unsigned char *src, size_t n, unsigned char *out
  * room is refused, not overrun. */
 static void test_deflate_runs(void)
 {
-    static const size_t runs[] = {1, 2, 3, 4, 10, 257, 258, 259, 260, 261, 515, 516, 517, 1000, 65536};
+    static const size_t runs[] = {1,   2,   3,   4,   10,  257,  258,  259,
+                                  260, 261, 515, 516, 517, 1000, 65536};
     enum { N = 200000 };
     unsigned char *src = malloc(N), *dst = malloc(2 * N), *back = malloc(N);
     uint64_t s = 7;
@@ -468,14 +495,15 @@ static void test_deflate_runs(void)
         size_t n = 0, k = 0;
         while (n < N) {
             size_t len = kind == 2 ? 1 : runs[k++ % (sizeof runs / sizeof runs[0])];
-            unsigned char b = (unsigned char)(kind == 0 ? (k * 37) : rng_next(&s));   /* both sides of 144 */
+            unsigned char b =
+                (unsigned char)(kind == 0 ? (k * 37) : rng_next(&s)); /* both sides of 144 */
             for (size_t i = 0; i < len && n < N; i++) src[n++] = b;
         }
         size_t z = evr_deflate_runs(src, n, dst, 2 * N);
         CHECK(z > 0);
         CHECK(raw_inflate(dst, z, back, N) == n && memcmp(back, src, n) == 0);
-        if (kind == 0) CHECK(z < n / 10);   /* runs shrink */
-        CHECK(evr_deflate_runs(src, n, dst, z - 1) == 0);   /* one byte short */
+        if (kind == 0) CHECK(z < n / 10);                 /* runs shrink */
+        CHECK(evr_deflate_runs(src, n, dst, z - 1) == 0); /* one byte short */
     }
     size_t z = evr_deflate_runs(src, 0, dst, 16);
     CHECK(z > 0 && raw_inflate(dst, z, back, N) == 0);
@@ -502,19 +530,22 @@ static void test_chunk_stored_blocks(void)
     uint64_t s = 99;
     CHECK(v && raw && w && dst);
     if (!v || !raw || !w || !dst) goto done;
-    for (size_t i = 0; i < CE; i++) v[i] = (uint16_t)((rng_next(&s) & 0xff) | (i % 3) << 8);   /* random low, plain high byte */
+    for (size_t i = 0; i < CE; i++)
+        v[i] = (uint16_t)((rng_next(&s) & 0xff) | (i % 3) << 8); /* random low, plain high byte */
     evr_chunk_job j;
     memset(&j, 0, sizeof j);
     j.src = v;
     j.stride = sizeof(uint16_t);
     j.elem_size = 2;
-    j.count = CE - 5;   /* zero padded */
+    j.count = CE - 5; /* zero padded */
     j.chunk_elems = CE;
     j.level = 1;
     j.dst = dst;
     CHECK(evr_chunk_compress(&j, w));
-    CHECK(j.dst_size > CE && j.dst_size < (size_t)CE + CE / 4);   /* low plane stored, high plane compressed */
-    CHECK(dst[2] == 0x00 && dst[3] == 0xff && dst[4] == 0xff && dst[5] == 0x00 && dst[6] == 0x00);   /* 65,535 bytes */
+    CHECK(j.dst_size > CE &&
+          j.dst_size < (size_t)CE + CE / 4); /* low plane stored, high plane compressed */
+    CHECK(dst[2] == 0x00 && dst[3] == 0xff && dst[4] == 0xff && dst[5] == 0x00 &&
+          dst[6] == 0x00); /* 65,535 bytes */
     uLongf len = (uLongf)CE * 2;
     CHECK(uncompress(raw, &len, dst, (uLong)j.dst_size) == Z_OK && len == (uLongf)CE * 2);
     size_t bad = 0;
@@ -537,23 +568,35 @@ static void test_json_read(void)
     evr_jdoc d;
     char *text, buf[64];
     int root, a, c, k;
-    static const char *bad[] = {"", "{", "[1,]", "{\"a\" 1}", "{\"a\":}", "tru", "-", "1e", "\"open", "[1 2]"};
+    static const char *bad[] = {"",    "{", "[1,]", "{\"a\" 1}", "{\"a\":}",
+                                "tru", "-", "1e",   "\"open",    "[1 2]"};
 
     evr_json_init(&j, 1);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "s"); evr_json_string(&j, "q\"b\\n\nt\tc\x01" "e\xc3\xa9");
-    evr_json_key(&j, "a"); evr_json_begin_array(&j);
-    evr_json_integer(&j, -12); evr_json_number(&j, 0.1); evr_json_float(&j, 1e-7f); evr_json_boolean(&j, 1);
-    evr_json_null(&j); evr_json_begin_object(&j); evr_json_end_object(&j);
+    evr_json_key(&j, "s");
+    evr_json_string(&j, "q\"b\\n\nt\tc\x01"
+                        "e\xc3\xa9");
+    evr_json_key(&j, "a");
+    evr_json_begin_array(&j);
+    evr_json_integer(&j, -12);
+    evr_json_number(&j, 0.1);
+    evr_json_float(&j, 1e-7f);
+    evr_json_boolean(&j, 1);
+    evr_json_null(&j);
+    evr_json_begin_object(&j);
+    evr_json_end_object(&j);
     evr_json_end_array(&j);
-    evr_json_key(&j, "k\"ey"); evr_json_integer(&j, 7);
+    evr_json_key(&j, "k\"ey");
+    evr_json_integer(&j, 7);
     evr_json_end_object(&j);
     text = evr_json_take(&j);
     CHECK(text != NULL);
     if (!text) return;
     root = evr_jdoc_parse(&d, text, strlen(text));
     CHECK(root >= 0 && evr_jdoc_type(&d, root) == EVR_JDOC_OBJECT);
-    CHECK(evr_jdoc_string(&d, evr_jdoc_get(&d, root, "s"), buf, sizeof buf) && !strcmp(buf, "q\"b\\n\nt\tc\x01" "e\xc3\xa9"));
+    CHECK(evr_jdoc_string(&d, evr_jdoc_get(&d, root, "s"), buf, sizeof buf) &&
+          !strcmp(buf, "q\"b\\n\nt\tc\x01"
+                       "e\xc3\xa9"));
     a = evr_jdoc_get(&d, root, "a");
     CHECK(evr_jdoc_count(&d, a) == 6);
     c = evr_jdoc_first(&d, a);
@@ -567,8 +610,9 @@ static void test_json_read(void)
     c = evr_jdoc_next(&d, c);
     CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_NULL && evr_jdoc_number(&d, c, 5.0) == 5.0);
     c = evr_jdoc_next(&d, c);
-    CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_OBJECT && evr_jdoc_first(&d, c) < 0 && evr_jdoc_next(&d, c) < 0);
-    CHECK(evr_jdoc_number(&d, evr_jdoc_get(&d, root, "k\"ey"), 0) == 7.0);   /* an escaped key */
+    CHECK(evr_jdoc_type(&d, c) == EVR_JDOC_OBJECT && evr_jdoc_first(&d, c) < 0 &&
+          evr_jdoc_next(&d, c) < 0);
+    CHECK(evr_jdoc_number(&d, evr_jdoc_get(&d, root, "k\"ey"), 0) == 7.0); /* an escaped key */
     /* missing values chain: -1 answers as a value of the wrong type */
     CHECK(evr_jdoc_get(&d, evr_jdoc_get(&d, root, "none"), "x") < 0);
     CHECK(evr_jdoc_count(&d, -1) == 0 && evr_jdoc_first(&d, -1) < 0 && evr_jdoc_type(&d, -1) < 0);
@@ -580,7 +624,8 @@ static void test_json_read(void)
     {
         static const char t[] = "[\"\\u00e9\\ud83d\\ude00\"]xyz";
         root = evr_jdoc_parse(&d, t, sizeof t - 4);
-        CHECK(evr_jdoc_string(&d, evr_jdoc_first(&d, root), buf, sizeof buf) && !strcmp(buf, "\xc3\xa9\xf0\x9f\x98\x80"));
+        CHECK(evr_jdoc_string(&d, evr_jdoc_first(&d, root), buf, sizeof buf) &&
+              !strcmp(buf, "\xc3\xa9\xf0\x9f\x98\x80"));
         evr_jdoc_free(&d);
     }
     for (k = 0; k < (int)(sizeof bad / sizeof bad[0]); k++) {
@@ -624,7 +669,9 @@ static void test_chunk_compress(void)
     for (int c = 0; c < 3; c++)
         for (int k = 0; k < NCH; k++) {
             evr_chunk_job *j = &jobs[c * NCH + k];
-            size_t off = c == 0 ? offsetof(evr_event, t) : c == 1 ? offsetof(evr_event, x) : offsetof(evr_event, p);
+            size_t off = c == 0   ? offsetof(evr_event, t)
+                         : c == 1 ? offsetof(evr_event, x)
+                                  : offsetof(evr_event, p);
             memset(j, 0, sizeof *j);
             j->src = (const unsigned char *)(ev + (size_t)k * CE) + off;
             j->stride = sizeof(evr_event);
@@ -644,13 +691,15 @@ static void test_chunk_compress(void)
         CHECK(len == CE * es);
         for (size_t e = 0; e < CE; e++)
             for (size_t b = 0; b < es; b++) {
-                unsigned char want = e < j->count ? ((const unsigned char *)j->src)[e * j->stride + b] : 0;
+                unsigned char want =
+                    e < j->count ? ((const unsigned char *)j->src)[e * j->stride + b] : 0;
                 if (raw[b * CE + e] != want) bad++;
             }
         CHECK(bad == 0);
         /* a full chunk of x: its low bytes are random, stored as the stream's first block (7
          * bits of entropy per byte or more); p (one plane, the last) is compressed */
-        if (es == 2 && j->count == CE) CHECK(j->dst[2] == 0x00 && j->dst[3] == (CE & 0xff) && j->dst[4] == (CE >> 8));
+        if (es == 2 && j->count == CE)
+            CHECK(j->dst[2] == 0x00 && j->dst[3] == (CE & 0xff) && j->dst[4] == (CE >> 8));
         if (es == 1) CHECK(j->dst_size < (size_t)CE / 4);
     }
     /* the pool, with several threads and with the caller alone, makes the same bytes */
@@ -672,7 +721,8 @@ static void test_chunk_compress(void)
                 one.dst = ref + (size_t)i * bound;
                 CHECK(evr_chunk_compress(&one, scratch));
                 CHECK(jobs[i].ok && jobs[i].dst_size == one.dst_size);
-                if (jobs[i].dst_size == one.dst_size) CHECK(memcmp(jobs[i].dst, one.dst, one.dst_size) == 0);
+                if (jobs[i].dst_size == one.dst_size)
+                    CHECK(memcmp(jobs[i].dst, one.dst, one.dst_size) == 0);
             }
         }
         evr_chunk_pool_free(pool);
@@ -694,7 +744,7 @@ static void test_writers(const char *root, int *python_ok)
     int64_t last_t;
     evr_event *ev = make_events(n, &last_t);
     char *config = make_config();
-    int64_t duration = last_t + 2500;   /* not a whole number of milliseconds */
+    int64_t duration = last_t + 2500; /* not a whole number of milliseconds */
     char dir[512], path[600];
     CHECK(config != NULL);
 
@@ -762,11 +812,17 @@ static void test_writers(const char *root, int *python_ok)
         CHECK(evr_events_read("x.csv", &got, &ngot, NULL, NULL, &err) == EVR_ERR_ARG);
         snprintf(path, sizeof path, "%s/bad.txt", root);
         fp = fopen(path, "w");
-        if (fp) { fputs("# comment\n0.000001 1 2 1\n0.5 3\n", fp); fclose(fp); }
+        if (fp) {
+            fputs("# comment\n0.000001 1 2 1\n0.5 3\n", fp);
+            fclose(fp);
+        }
         CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_FORMAT);
         CHECK(strstr(err.msg, ":3:") != NULL);
         fp = fopen(path, "w");
-        if (fp) { fputs("# other tools' files\n\n1.5 3 4 -1\n2.0000005 5 6 1\n", fp); fclose(fp); }
+        if (fp) {
+            fputs("# other tools' files\n\n1.5 3 4 -1\n2.0000005 5 6 1\n", fp);
+            fclose(fp);
+        }
         CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_OK);
         CHECK(ngot == 2);
         if (ngot == 2) {
@@ -777,7 +833,10 @@ static void test_writers(const char *root, int *python_ok)
         got = NULL;
         snprintf(path, sizeof path, "%s/bad.npy", root);
         fp = fopen(path, "w");
-        if (fp) { fputs("not numpy", fp); fclose(fp); }
+        if (fp) {
+            fputs("not numpy", fp);
+            fclose(fp);
+        }
         CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_FORMAT);
         snprintf(path, sizeof path, "%s/bad.h5", root);
         CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_IO);
@@ -882,7 +941,8 @@ static void test_writers(const char *root, int *python_ok)
             *python_ok = 1;
         }
     } else {
-        printf("test_writers: python3 with h5py and numpy not found; skipping the independent reader\n");
+        printf(
+            "test_writers: python3 with h5py and numpy not found; skipping the independent reader\n");
     }
     free(config);
     free(ev);
@@ -906,59 +966,96 @@ static void test_json(void)
 
     evr_json_init(&j, 0);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "s"); evr_json_string(&j, "q\"b\\n\nt\tc\x01\x1f" "e\xc3\xa9");
-    evr_json_key(&j, "a"); evr_json_begin_array(&j);
+    evr_json_key(&j, "s");
+    evr_json_string(&j, "q\"b\\n\nt\tc\x01\x1f"
+                        "e\xc3\xa9");
+    evr_json_key(&j, "a");
+    evr_json_begin_array(&j);
     evr_json_integer(&j, 1);
-    evr_json_begin_object(&j); evr_json_end_object(&j);
-    evr_json_begin_array(&j); evr_json_end_array(&j);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "k"); evr_json_begin_array(&j); evr_json_boolean(&j, 1); evr_json_boolean(&j, 0);
-    evr_json_null(&j); evr_json_end_array(&j);
+    evr_json_end_object(&j);
+    evr_json_begin_array(&j);
+    evr_json_end_array(&j);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "k");
+    evr_json_begin_array(&j);
+    evr_json_boolean(&j, 1);
+    evr_json_boolean(&j, 0);
+    evr_json_null(&j);
+    evr_json_end_array(&j);
     evr_json_end_object(&j);
     evr_json_end_array(&j);
-    evr_json_key(&j, "n"); evr_json_begin_array(&j);
-    evr_json_number(&j, 0.1); evr_json_number(&j, 1.0 / 3.0); evr_json_number(&j, 1e300);
-    evr_json_number(&j, 0.0 / 0.0); evr_json_number(&j, -1.0 / 0.0); evr_json_number(&j, -2.5);
-    evr_json_float(&j, 0.2f); evr_json_float(&j, 1e-7f);
-    evr_json_integer(&j, INT64_MIN); evr_json_unsigned(&j, UINT64_MAX);
+    evr_json_key(&j, "n");
+    evr_json_begin_array(&j);
+    evr_json_number(&j, 0.1);
+    evr_json_number(&j, 1.0 / 3.0);
+    evr_json_number(&j, 1e300);
+    evr_json_number(&j, 0.0 / 0.0);
+    evr_json_number(&j, -1.0 / 0.0);
+    evr_json_number(&j, -2.5);
+    evr_json_float(&j, 0.2f);
+    evr_json_float(&j, 1e-7f);
+    evr_json_integer(&j, INT64_MIN);
+    evr_json_unsigned(&j, UINT64_MAX);
     evr_json_end_array(&j);
-    evr_json_key(&j, "z"); evr_json_string(&j, NULL);
+    evr_json_key(&j, "z");
+    evr_json_string(&j, NULL);
     evr_json_end_object(&j);
-    check_json(evr_json_take(&j),
-               "{\"s\":\"q\\\"b\\\\n\\nt\\tc\\u0001\\u001fe\xc3\xa9\",\"a\":[1,{},[],{\"k\":[true,false,null]}],"
-               "\"n\":[0.1,0.3333333333333333,1e+300,null,null,-2.5,0.2,1e-07,-9223372036854775808,"
-               "18446744073709551615],\"z\":null}");
+    check_json(
+        evr_json_take(&j),
+        "{\"s\":\"q\\\"b\\\\n\\nt\\tc\\u0001\\u001fe\xc3\xa9\",\"a\":[1,{},[],{\"k\":[true,false,null]}],"
+        "\"n\":[0.1,0.3333333333333333,1e+300,null,null,-2.5,0.2,1e-07,-9223372036854775808,"
+        "18446744073709551615],\"z\":null}");
 
     evr_json_init(&j, 1);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "a"); evr_json_integer(&j, 1);
-    evr_json_key(&j, "b"); evr_json_begin_array(&j); evr_json_integer(&j, 2);
-    evr_json_begin_object(&j); evr_json_key(&j, "c"); evr_json_string(&j, "d"); evr_json_end_object(&j);
-    evr_json_end_array(&j);
-    evr_json_key(&j, "e"); evr_json_begin_object(&j); evr_json_end_object(&j);
+    evr_json_key(&j, "a");
+    evr_json_integer(&j, 1);
+    evr_json_key(&j, "b");
+    evr_json_begin_array(&j);
+    evr_json_integer(&j, 2);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "c");
+    evr_json_string(&j, "d");
     evr_json_end_object(&j);
-    check_json(evr_json_take(&j), "{\n  \"a\": 1,\n  \"b\": [\n    2,\n    {\n      \"c\": \"d\"\n    }\n  ],\n"
-                                  "  \"e\": {}\n}");
+    evr_json_end_array(&j);
+    evr_json_key(&j, "e");
+    evr_json_begin_object(&j);
+    evr_json_end_object(&j);
+    evr_json_end_object(&j);
+    check_json(evr_json_take(&j),
+               "{\n  \"a\": 1,\n  \"b\": [\n    2,\n    {\n      \"c\": \"d\"\n    }\n  ],\n"
+               "  \"e\": {}\n}");
 
     /* a builder can be reused after take */
-    evr_json_begin_array(&j); evr_json_end_array(&j);
+    evr_json_begin_array(&j);
+    evr_json_end_array(&j);
     check_json(evr_json_take(&j), "[]");
     evr_json_string(&j, "top");
     check_json(evr_json_take(&j), "\"top\"");
 
     /* misuse: value without key, key in an array, mismatched end, unclosed, two top-level values */
     evr_json_init(&j, 0);
-    evr_json_begin_object(&j); evr_json_integer(&j, 1); evr_json_end_object(&j);
+    evr_json_begin_object(&j);
+    evr_json_integer(&j, 1);
+    evr_json_end_object(&j);
     CHECK(evr_json_take(&j) == NULL);
-    evr_json_begin_array(&j); evr_json_key(&j, "k"); evr_json_end_array(&j);
+    evr_json_begin_array(&j);
+    evr_json_key(&j, "k");
+    evr_json_end_array(&j);
     CHECK(evr_json_take(&j) == NULL);
-    evr_json_begin_array(&j); evr_json_end_object(&j);
+    evr_json_begin_array(&j);
+    evr_json_end_object(&j);
     CHECK(evr_json_take(&j) == NULL);
-    evr_json_begin_object(&j); evr_json_key(&j, "k");
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "k");
     CHECK(evr_json_take(&j) == NULL);
-    evr_json_begin_object(&j); evr_json_key(&j, "k"); evr_json_end_object(&j);
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "k");
+    evr_json_end_object(&j);
     CHECK(evr_json_take(&j) == NULL);
-    evr_json_integer(&j, 1); evr_json_integer(&j, 2);
+    evr_json_integer(&j, 1);
+    evr_json_integer(&j, 2);
     CHECK(evr_json_take(&j) == NULL);
     for (int i = 0; i < EVR_JSON_MAX_DEPTH + 1; i++) evr_json_begin_array(&j);
     for (int i = 0; i < EVR_JSON_MAX_DEPTH + 1; i++) evr_json_end_array(&j);
@@ -996,7 +1093,8 @@ static void test_tonemap(const char *root)
     int mono = 1;
 
     /* random values: the map must be monotonic */
-    for (int i = 0; i < N; i++) v[i] = (float)(rng_next(&s) % 100000) * 1e-3f * (i % 7 == 0 ? 50.0f : 1.0f);
+    for (int i = 0; i < N; i++)
+        v[i] = (float)(rng_next(&s) % 100000) * 1e-3f * (i % 7 == 0 ? 50.0f : 1.0f);
     CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
     for (int i = 0; i < N; i++)
         for (int k = i + 1; k < N; k += 97)
@@ -1007,7 +1105,8 @@ static void test_tonemap(const char *root)
     for (int i = 0; i < N; i++) v[i] = (float)i / (N - 1) * 10.0f;
     CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
     mono = 1;
-    for (int i = 1; i < N; i++) if (o[i] < o[i - 1]) mono = 0;
+    for (int i = 1; i < N; i++)
+        if (o[i] < o[i - 1]) mono = 0;
     CHECK(mono);
     CHECK(o[0] == 0);
     CHECK(o[N - 1] == 255);
@@ -1019,7 +1118,8 @@ static void test_tonemap(const char *root)
         int same = 1;
         for (int i = 0; i < N; i++) v[i] *= 1000.0f;
         CHECK_OK(evr_tonemap_reinhard(v, N, o2, &e_));
-        for (int i = 0; i < N; i++) if (abs((int)o[i] - (int)o2[i]) > 1) same = 0;
+        for (int i = 0; i < N; i++)
+            if (abs((int)o[i] - (int)o2[i]) > 1) same = 0;
         CHECK(same);
         free(o2);
     }
@@ -1032,8 +1132,8 @@ static void test_tonemap(const char *root)
     v[13] = -3.0f;
     v[14] = 1.0f / 0.0f;
     CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
-    CHECK(o[63] == 255);           /* value 1.0: at the 99.5th percentile */
-    CHECK(o[64] > 100);            /* value 0.5: bright, not pushed to black by the hot pixels */
+    CHECK(o[63] == 255); /* value 1.0: at the 99.5th percentile */
+    CHECK(o[64] > 100);  /* value 0.5: bright, not pushed to black by the hot pixels */
     CHECK(o[10] == 255 && o[14] == 255);
     CHECK(o[12] == 0 && o[13] == 0);
 
@@ -1042,7 +1142,8 @@ static void test_tonemap(const char *root)
     CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
     {
         int black = 1;
-        for (int i = 0; i < N; i++) if (o[i]) black = 0;
+        for (int i = 0; i < N; i++)
+            if (o[i]) black = 0;
         CHECK(black);
     }
 
@@ -1080,9 +1181,22 @@ static void test_event_frames(const char *root)
     unsigned char *img;
     memset(ev, 0, sizeof ev);
     /* (1,2): ON; (3,4): OFF; (5,6): two OFF one ON -> OFF; (7,0): one each, ON last -> ON */
-#define EV(T, X, Y, P) do { ev[n].t = (T); ev[n].x = (X); ev[n].y = (Y); ev[n].p = (P); n++; } while (0)
-    EV(0, 1, 2, 1); EV(1, 3, 4, 0); EV(2, 5, 6, 0); EV(3, 5, 6, 1); EV(4, 5, 6, 0);
-    EV(5, 7, 0, 0); EV(6, 7, 0, 1); EV(7, 100, 100, 1);   /* the last one is outside the image */
+#define EV(T, X, Y, P) \
+    do {               \
+        ev[n].t = (T); \
+        ev[n].x = (X); \
+        ev[n].y = (Y); \
+        ev[n].p = (P); \
+        n++;           \
+    } while (0)
+    EV(0, 1, 2, 1);
+    EV(1, 3, 4, 0);
+    EV(2, 5, 6, 0);
+    EV(3, 5, 6, 1);
+    EV(4, 5, 6, 0);
+    EV(5, 7, 0, 0);
+    EV(6, 7, 0, 1);
+    EV(7, 100, 100, 1); /* the last one is outside the image */
 #undef EV
     CHECK_OK(evr_event_frame_init(&f, 10, 8, &e_));
     evr_event_frame_add(&f, ev, (size_t)n);
@@ -1092,7 +1206,7 @@ static void test_event_frames(const char *root)
     img = stbi_load(path, &iw, &ih, &ic, 0);
     CHECK(img != NULL);
     if (img && iw == 10 && ih == 8 && ic == 3) {
-#define PX(X, Y) (img + 3 * ((Y) * 10 + (X)))
+#define PX(X, Y) (img + 3 * ((Y)*10 + (X)))
         CHECK(PX(1, 2)[0] == 0 && PX(1, 2)[1] == 0 && PX(1, 2)[2] == 255);
         CHECK(PX(3, 4)[0] == 255 && PX(3, 4)[1] == 0 && PX(3, 4)[2] == 0);
         CHECK(PX(5, 6)[0] == 255 && PX(5, 6)[2] == 0);
@@ -1112,7 +1226,11 @@ static void test_event_frames(const char *root)
         evr_event e2[5];
         char dir[560];
         memset(e2, 0, sizeof e2);
-        e2[0].t = 10; e2[1].t = 999; e2[2].t = 1000; e2[3].t = 3500; e2[4].t = 3999;
+        e2[0].t = 10;
+        e2[1].t = 999;
+        e2[2].t = 1000;
+        e2[3].t = 3500;
+        e2[4].t = 3999;
         snprintf(dir, sizeof dir, "%s/series", root);
         CHECK(mkdir(dir, 0700) == 0);
         CHECK_OK(evr_event_preview_new(4, 4, 1000, dir, "ev", &p, &e_));
@@ -1187,8 +1305,9 @@ static void bench_h5(const char *root)
     {
         struct stat st;
         long long size = stat(path, &st) == 0 ? (long long)st.st_size : -1;
-        printf("test_writers: hdf5 writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n", n, t1 - t0,
-               (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
+        printf(
+            "test_writers: hdf5 writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n",
+            n, t1 - t0, (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
     }
     remove(path);
     free(ev);

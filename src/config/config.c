@@ -25,7 +25,9 @@ static double field_number(const evr_config *c, const evr_config_option *o)
 {
     const void *f = evr_config_field_const(c, o);
     switch (o->type) {
-    case EVR_OPT_FLAG: case EVR_OPT_INT: case EVR_OPT_CHOICE: return *(const int *)f;
+    case EVR_OPT_FLAG:
+    case EVR_OPT_INT:
+    case EVR_OPT_CHOICE: return *(const int *)f;
     case EVR_OPT_INT64: return (double)*(const int64_t *)f;
     case EVR_OPT_U32: return *(const uint32_t *)f;
     case EVR_OPT_U64: return (double)*(const uint64_t *)f;
@@ -48,7 +50,9 @@ static void fill_defaults(evr_config *c)
     for (i = 0; i < n; i++) {
         void *f = evr_config_field(c, &t[i]);
         switch (t[i].type) {
-        case EVR_OPT_FLAG: case EVR_OPT_INT: case EVR_OPT_CHOICE: *(int *)f = (int)t[i].def; break;
+        case EVR_OPT_FLAG:
+        case EVR_OPT_INT:
+        case EVR_OPT_CHOICE: *(int *)f = (int)t[i].def; break;
         case EVR_OPT_INT64: *(int64_t *)f = (int64_t)t[i].def; break;
         case EVR_OPT_U32: *(uint32_t *)f = (uint32_t)t[i].def; break;
         case EVR_OPT_U64: *(uint64_t *)f = (uint64_t)t[i].def; break;
@@ -63,7 +67,7 @@ static void fill_defaults(evr_config *c)
 /* Sensor presets; docs/sensors.md gives the source of every value (keep the two in step). */
 typedef struct {
     const char *name;
-    int width, height;            /* 0: keep the resolution */
+    int width, height; /* 0: keep the resolution */
     float pos_thres, neg_thres, sigma_thres, refractory, cutoff_hz;
     float leak_rate, leak_jitter, shot_rate, hot_fraction, hot_rate;
     double time_res;
@@ -71,16 +75,20 @@ typedef struct {
 
 static const sensor_preset presets[] = {
     /* name            w     h    ON      OFF     sigma  refr    cutoff  leak   jit   shot  hot    hot Hz  t res */
-    {"ideal",          0,    0,   0.2f,   0.2f,   0.0f,  0.0f,   0.0f,   0.0f,  0.1f, 0.0f, 0.0f,  100.0f, 1e-6},
-    {"davis346",       346,  260, 0.134f, 0.255f, 0.03f, 1e-4f,  200.0f, 0.1f,  0.1f, 1.0f, 1e-4f, 100.0f, 1e-6},
-    {"dvxplorer",      640,  480, 0.2f,   0.2f,   0.03f, 1e-4f,  200.0f, 0.05f, 0.1f, 0.5f, 1e-4f, 100.0f, 1e-4},
-    {"prophesee-gen4", 1280, 720, 0.223f, 0.288f, 0.02f, 1e-4f,  500.0f, 0.05f, 0.1f, 0.1f, 1e-5f, 100.0f, 1e-6},
+    {"ideal", 0, 0, 0.2f, 0.2f, 0.0f, 0.0f, 0.0f, 0.0f, 0.1f, 0.0f, 0.0f, 100.0f, 1e-6},
+    {"davis346", 346, 260, 0.134f, 0.255f, 0.03f, 1e-4f, 200.0f, 0.1f, 0.1f, 1.0f, 1e-4f, 100.0f,
+     1e-6},
+    {"dvxplorer", 640, 480, 0.2f, 0.2f, 0.03f, 1e-4f, 200.0f, 0.05f, 0.1f, 0.5f, 1e-4f, 100.0f,
+     1e-4},
+    {"prophesee-gen4", 1280, 720, 0.223f, 0.288f, 0.02f, 1e-4f, 500.0f, 0.05f, 0.1f, 0.1f, 1e-5f,
+     100.0f, 1e-6},
 };
 #define NUM_PRESETS ((int)(sizeof presets / sizeof presets[0]))
 
 const char *const *evr_sensor_names(void)
 {
-    static const char *const names[NUM_PRESETS + 1] = {"ideal", "davis346", "dvxplorer", "prophesee-gen4", NULL};
+    static const char *const names[NUM_PRESETS + 1] = {"ideal", "davis346", "dvxplorer",
+                                                       "prophesee-gen4", NULL};
     return names;
 }
 
@@ -103,7 +111,8 @@ const char *evr_sensor_list(char *buf, size_t n)
     int i;
     size_t len = 0;
     buf[0] = 0;
-    for (i = 0; i < NUM_PRESETS && len < n; i++) len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? ", " : "", presets[i].name);
+    for (i = 0; i < NUM_PRESETS && len < n; i++)
+        len += (size_t)snprintf(buf + len, n - len, "%s%s", i ? ", " : "", presets[i].name);
     return buf;
 }
 
@@ -112,7 +121,8 @@ evr_status evr_config_sensor(evr_config *c, const char *name, evr_error *err)
     const sensor_preset *p = find_preset(name);
     char list[128];
     if (!p) {
-        snprintf(err->msg, sizeof err->msg, "unknown sensor '%s' (%s)", name ? name : "", evr_sensor_list(list, sizeof list));
+        snprintf(err->msg, sizeof err->msg, "unknown sensor '%s' (%s)", name ? name : "",
+                 evr_sensor_list(list, sizeof list));
         return EVR_ERR_ARG;
     }
     c->sensor = p->name;
@@ -139,10 +149,11 @@ void evr_config_init(evr_config *c, size_t size)
 {
     evr_config d;
     fill_defaults(&d);
-    if (size >= EVR_CONFIG_FIRST_SIZE && size <= sizeof d) {   /* an older caller: its own fields only */
+    if (size >= EVR_CONFIG_FIRST_SIZE &&
+        size <= sizeof d) { /* an older caller: its own fields only */
         memcpy(c, &d, size);
         c->size = size;
-    } else if (size > sizeof d) {   /* a newer caller: ours, and a size it will be refused with */
+    } else if (size > sizeof d) { /* a newer caller: ours, and a size it will be refused with */
         memcpy(c, &d, sizeof d);
         c->size = size;
     }
@@ -151,17 +162,23 @@ void evr_config_init(evr_config *c, size_t size)
 evr_status evr_config_current(const evr_config *c, evr_config *out, evr_error *err)
 {
     if (!c || c->size < EVR_CONFIG_FIRST_SIZE || c->size > sizeof *out) {
-        snprintf(err->msg, sizeof err->msg, "evr_config of %zu bytes is not one this evray (%zu bytes) knows: make it with evr_config_defaults",
-                 c ? c->size : (size_t)0, sizeof *out);
+        snprintf(
+            err->msg, sizeof err->msg,
+            "evr_config of %zu bytes is not one this evray (%zu bytes) knows: make it with evr_config_defaults",
+            c ? c->size : (size_t)0, sizeof *out);
         return EVR_ERR_ARG;
     }
-    fill_defaults(out);   /* the fields an older caller does not have */
+    fill_defaults(out); /* the fields an older caller does not have */
     memcpy(out, c, c->size);
     out->size = sizeof *out;
     return EVR_OK;
 }
 
-#define BAD(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
+#define BAD(...)                                          \
+    do {                                                  \
+        snprintf(err->msg, sizeof err->msg, __VA_ARGS__); \
+        return EVR_ERR_ARG;                               \
+    } while (0)
 
 /* Whether a choice row's value is one of its choices. */
 static int choice_known(const evr_config_option *o, int v)
@@ -179,7 +196,8 @@ static void choice_names(const evr_config_option *o, char *buf, size_t n)
     size_t len = 0;
     buf[0] = 0;
     for (ch = o->choices; ch->name || ch->json; ch++)
-        if (ch->name && !ch->refuse && len < n) len += (size_t)snprintf(buf + len, n - len, "%s%s", len ? ", " : "", ch->name);
+        if (ch->name && !ch->refuse && len < n)
+            len += (size_t)snprintf(buf + len, n - len, "%s%s", len ? ", " : "", ch->name);
 }
 
 /* Checks row o's range (or choices); fills err when it is out. */
@@ -199,8 +217,10 @@ static evr_status check_range(const evr_config *c, const evr_config_option *o, e
     if (ok) return EVR_OK;
     switch (o->type) {
     case EVR_OPT_INT: BAD("%s (got %d)", o->what, *(const int *)evr_config_field_const(c, o));
-    case EVR_OPT_INT64: BAD("%s (got %lld)", o->what, (long long)*(const int64_t *)evr_config_field_const(c, o));
-    case EVR_OPT_U32: case EVR_OPT_U64: BAD("%s (got %.0f)", o->what, v);
+    case EVR_OPT_INT64:
+        BAD("%s (got %lld)", o->what, (long long)*(const int64_t *)evr_config_field_const(c, o));
+    case EVR_OPT_U32:
+    case EVR_OPT_U64: BAD("%s (got %.0f)", o->what, v);
     default: BAD("%s (got %g)", o->what, v);
     }
 }
@@ -224,15 +244,20 @@ evr_status evr_config_validate(const evr_config *given, const evr_scene *s, evr_
             size_t len = 0;
             for (i = 0; i < s->num_cameras && len < 180; i++) {
                 if (s->cameras[i].automatic) continue;
-                len += (size_t)snprintf(names + len, sizeof names - len, "%s%.60s", len ? ", " : "", s->cameras[i].name);
+                len += (size_t)snprintf(names + len, sizeof names - len, "%s%.60s", len ? ", " : "",
+                                        s->cameras[i].name);
             }
-            BAD("no camera named '%s' in the scene (cameras: %s)", c->camera, names[0] ? names : "none");
+            BAD("no camera named '%s' in the scene (cameras: %s)", c->camera,
+                names[0] ? names : "none");
         }
         double end = s->anim_end;
         if (end > 0.0) {
-            if (c->start >= end) BAD("start time %g s is at or beyond the end of the animation (%g s)", c->start, end);
+            if (c->start >= end)
+                BAD("start time %g s is at or beyond the end of the animation (%g s)", c->start,
+                    end);
             if (c->duration > 0.0 && c->start + c->duration > end + 1e-6)
-                BAD("duration %g s from %g s goes beyond the end of the animation (%g s)", c->duration, c->start, end);
+                BAD("duration %g s from %g s goes beyond the end of the animation (%g s)",
+                    c->duration, c->start, end);
         }
     }
     return EVR_OK;
@@ -242,16 +267,21 @@ evr_status evr_config_validate(const evr_config *given, const evr_scene *s, evr_
 static void json_field(evr_json *j, const evr_config *c, const evr_config_option *o)
 {
     const void *f = evr_config_field_const(c, o);
-    if (o->choices) {   /* a choice, or a flag with names */
+    if (o->choices) { /* a choice, or a flag with names */
         const evr_opt_choice *ch;
         int v = *(const int *)f;
         for (ch = o->choices; ch->name || ch->json; ch++)
-            if (ch->json && ch->value == v) { evr_json_string(j, ch->json); return; }
+            if (ch->json && ch->value == v) {
+                evr_json_string(j, ch->json);
+                return;
+            }
         evr_json_integer(j, v);
         return;
     }
     switch (o->type) {
-    case EVR_OPT_FLAG: case EVR_OPT_INT: case EVR_OPT_CHOICE: evr_json_integer(j, *(const int *)f); break;
+    case EVR_OPT_FLAG:
+    case EVR_OPT_INT:
+    case EVR_OPT_CHOICE: evr_json_integer(j, *(const int *)f); break;
     case EVR_OPT_INT64: evr_json_integer(j, *(const int64_t *)f); break;
     case EVR_OPT_U32: evr_json_unsigned(j, *(const uint32_t *)f); break;
     case EVR_OPT_U64: evr_json_unsigned(j, *(const uint64_t *)f); break;
@@ -262,8 +292,8 @@ static void json_field(evr_json *j, const evr_config *c, const evr_config_option
     }
 }
 
-char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene, const char *camera,
-                         const char *backend, int pretty)
+char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene,
+                         const char *camera, const char *backend, int pretty)
 {
     int i, n, rank, found = 1;
     const evr_config_option *t = evr_config_table(&n);
@@ -276,7 +306,7 @@ char *evr_config_to_json(const evr_config *c, double duration, double fps, const
     run.backend = backend;
     evr_json_init(&j, pretty);
     evr_json_begin_object(&j);
-    for (rank = 1; found; rank++) {   /* the rows in json_rank order */
+    for (rank = 1; found; rank++) { /* the rows in json_rank order */
         found = 0;
         for (i = 0; i < n; i++) {
             if (t[i].json_rank != rank) continue;

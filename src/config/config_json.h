@@ -8,7 +8,7 @@
 evr_status evr_config_current(const evr_config *c, evr_config *out, evr_error *err);
 
 /* The configuration as JSON (malloc'ed), with the values the run actually uses. */
-char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene, const char *camera,
-                         const char *backend, int pretty);
+char *evr_config_to_json(const evr_config *c, double duration, double fps, const char *scene,
+                         const char *camera, const char *backend, int pretty);
 
 #endif

@@ -9,14 +9,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FAIL(...) do { snprintf(err->msg, sizeof err->msg, __VA_ARGS__); return EVR_ERR_ARG; } while (0)
+#define FAIL(...)                                         \
+    do {                                                  \
+        snprintf(err->msg, sizeof err->msg, __VA_ARGS__); \
+        return EVR_ERR_ARG;                               \
+    } while (0)
 
 evr_status evr_parse_double(const char *opt, const char *text, double *out, evr_error *err)
 {
     char *end;
     errno = 0;
     double v = strtod(text, &end);
-    if (end == text || *end || errno || !isfinite(v)) FAIL("%s expects a number, got '%s'", opt, text);
+    if (end == text || *end || errno || !isfinite(v))
+        FAIL("%s expects a number, got '%s'", opt, text);
     *out = v;
     return EVR_OK;
 }
@@ -46,7 +51,8 @@ evr_status evr_parse_u64(const char *opt, const char *text, uint64_t *out, evr_e
     errno = 0;
     if (text[0] == '-') FAIL("%s expects a non-negative integer, got '%s'", opt, text);
     unsigned long long v = strtoull(text, &end, 10);
-    if (end == text || *end || errno) FAIL("%s expects a non-negative integer, got '%s'", opt, text);
+    if (end == text || *end || errno)
+        FAIL("%s expects a non-negative integer, got '%s'", opt, text);
     *out = (uint64_t)v;
     return EVR_OK;
 }
@@ -87,7 +93,8 @@ const evr_config_option *evr_config_option_find(const char *arg, const char **na
         }
         len = strlen(flag);
         /* an option with a value may be given as --name=value */
-        if (!strncmp(arg, flag, len) && (arg[len] == 0 || (arg[len] == '=' && evr_config_option_takes_value(&t[i])))) {
+        if (!strncmp(arg, flag, len) &&
+            (arg[len] == 0 || (arg[len] == '=' && evr_config_option_takes_value(&t[i])))) {
             *name = flag;
             return &t[i];
         }
@@ -95,7 +102,8 @@ const evr_config_option *evr_config_option_find(const char *arg, const char **na
     return NULL;
 }
 
-static evr_status set_choice(evr_config *c, const evr_config_option *o, const char *v, evr_error *err)
+static evr_status set_choice(evr_config *c, const evr_config_option *o, const char *v,
+                             evr_error *err)
 {
     const evr_opt_choice *ch;
     char names[128];
@@ -109,11 +117,13 @@ static evr_status set_choice(evr_config *c, const evr_config_option *o, const ch
     names[0] = 0;
     for (ch = o->choices; ch->name || ch->json; ch++)
         if (ch->name && !ch->refuse && len < sizeof names)
-            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s", len ? ", " : "", ch->name);
+            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s", len ? ", " : "",
+                                    ch->name);
     FAIL("%s: unknown %s '%s' (%s)", o->flag, o->noun, v, names);
 }
 
-evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, const char *v, evr_error *err)
+evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, const char *v,
+                                 evr_error *err)
 {
     void *f = evr_config_field(c, o);
     double num = 0.0;
@@ -127,20 +137,35 @@ evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, cons
         *(int *)f = 1;
         return EVR_OK;
     }
-    if (o->type == EVR_OPT_NONE) return EVR_OK;   /* the program's own (-q) */
+    if (o->type == EVR_OPT_NONE) return EVR_OK; /* the program's own (-q) */
     if (!v) FAIL("%s needs a value", o->flag);
     switch (o->type) {
     case EVR_OPT_STRING: *(const char **)f = v; return EVR_OK;
     case EVR_OPT_CHOICE: return set_choice(c, o, v, err);
-    case EVR_OPT_INT: st = evr_parse_int(o->flag, v, &i, err); num = i; break;
-    case EVR_OPT_FLOAT: st = evr_parse_float(o->flag, v, &x, err); num = x; break;
-    case EVR_OPT_DOUBLE: st = evr_parse_double(o->flag, v, &d, err); num = d; break;
-    case EVR_OPT_INT64: case EVR_OPT_U32: case EVR_OPT_U64: st = evr_parse_u64(o->flag, v, &u, err); num = (double)u; break;
+    case EVR_OPT_INT:
+        st = evr_parse_int(o->flag, v, &i, err);
+        num = i;
+        break;
+    case EVR_OPT_FLOAT:
+        st = evr_parse_float(o->flag, v, &x, err);
+        num = x;
+        break;
+    case EVR_OPT_DOUBLE:
+        st = evr_parse_double(o->flag, v, &d, err);
+        num = d;
+        break;
+    case EVR_OPT_INT64:
+    case EVR_OPT_U32:
+    case EVR_OPT_U64:
+        st = evr_parse_u64(o->flag, v, &u, err);
+        num = (double)u;
+        break;
     default: break;
     }
     if (st != EVR_OK) return st;
     /* the stricter check of a value given on the command line, before it is stored */
-    if (o->cli_what && (!(num >= o->cli_lo) || !(num <= o->cli_hi) || (o->cli_lo_open && num == o->cli_lo)))
+    if (o->cli_what &&
+        (!(num >= o->cli_lo) || !(num <= o->cli_hi) || (o->cli_lo_open && num == o->cli_lo)))
         FAIL(o->cli_what, o->flag, v);
     switch (o->type) {
     case EVR_OPT_INT: *(int *)f = i; break;
@@ -155,7 +180,10 @@ evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, cons
 }
 
 /* Appends to a growing string; 0 when out of memory. */
-typedef struct { char *s; size_t len, cap; } text_buf;
+typedef struct {
+    char *s;
+    size_t len, cap;
+} text_buf;
 
 static int append(text_buf *b, const char *fmt, const char *x, const char *y)
 {
@@ -173,7 +201,7 @@ static int append(text_buf *b, const char *fmt, const char *x, const char *y)
     return 1;
 }
 
-#define HELP_COLUMN 26   /* label width; the text starts three columns later */
+#define HELP_COLUMN 26 /* label width; the text starts three columns later */
 
 char *evr_config_options_help(void)
 {
@@ -183,21 +211,23 @@ char *evr_config_options_help(void)
     char generated[512], line[512];
     for (i = 0; i < n && ok; i++) {
         const char *text = t[i].help, *p;
-        if (!t[i].label) continue;   /* a field without an option, or listed with the row before */
+        if (!t[i].label) continue; /* a field without an option, or listed with the row before */
         if (t[i].section) ok = append(&b, "%s:\n", t[i].section, NULL);
         if (t[i].help_text) {
             t[i].help_text(generated, sizeof generated);
             text = generated;
         }
         /* a label too wide for its column is followed by three spaces */
-        ok = ok && append(&b, strlen(t[i].label) > HELP_COLUMN ? "  %s   " : "  %-26s ", t[i].label, NULL);
-        for (p = text; ok && p; ) {
+        ok = ok && append(&b, strlen(t[i].label) > HELP_COLUMN ? "  %s   " : "  %-26s ", t[i].label,
+                          NULL);
+        for (p = text; ok && p;) {
             const char *nl = strchr(p, '\n');
             size_t len = nl ? (size_t)(nl - p) : strlen(p);
             if (len >= sizeof line) len = sizeof line - 1;
             memcpy(line, p, len);
             line[len] = 0;
-            ok = append(&b, p == text ? "%s\n" : "%29s%s\n", p == text ? line : "", p == text ? NULL : line);
+            ok = append(&b, p == text ? "%s\n" : "%29s%s\n", p == text ? line : "",
+                        p == text ? NULL : line);
             p = nl ? nl + 1 : NULL;
         }
     }

@@ -11,17 +11,17 @@
 #include "io/json.h"
 
 typedef enum {
-    EVR_OPT_NONE,      /* no field of its own: a program option (listed for --help) or one whose
+    EVR_OPT_NONE, /* no field of its own: a program option (listed for --help) or one whose
                           parse sets other fields (--res, --thres, --no-preview) */
-    EVR_OPT_FLAG,      /* int set to 1 by its option, which takes no value */
+    EVR_OPT_FLAG, /* int set to 1 by its option, which takes no value */
     EVR_OPT_INT,
     EVR_OPT_INT64,
     EVR_OPT_U32,
     EVR_OPT_U64,
     EVR_OPT_FLOAT,
     EVR_OPT_DOUBLE,
-    EVR_OPT_STRING,    /* const char *, kept as given (not copied) */
-    EVR_OPT_CHOICE     /* int (or an enum), one of choices */
+    EVR_OPT_STRING, /* const char *, kept as given (not copied) */
+    EVR_OPT_CHOICE  /* int (or an enum), one of choices */
 } evr_opt_type;
 
 /* One value of a CHOICE (or the JSON names of a FLAG): name on the command line (NULL: not
@@ -43,24 +43,26 @@ typedef struct {
 
 struct evr_config_option {
     /* the value */
-    const char *name;             /* the field's name in evr_config */
+    const char *name; /* the field's name in evr_config */
     evr_opt_type type;
-    size_t offset;                /* offsetof(evr_config, field) */
-    double def;                   /* default of a number, choice or flag */
-    const char *def_text;         /* default of a string */
-    const evr_opt_choice *choices;   /* ended by a row with value -1 and no names */
-    const char *noun;             /* what a choice is ("unknown NOUN 'x'") */
+    size_t offset;                 /* offsetof(evr_config, field) */
+    double def;                    /* default of a number, choice or flag */
+    const char *def_text;          /* default of a string */
+    const evr_opt_choice *choices; /* ended by a row with value -1 and no names */
+    const char *noun;              /* what a choice is ("unknown NOUN 'x'") */
     /* evr_config_validate: lo <= value <= hi (lo_open, hi_open: the bound excluded; floats must
      * be finite; choices must be listed) with the message "what (got value)" */
     double lo, hi;
     unsigned char lo_open, hi_open;
-    const char *what;             /* NULL: no range check */
-    int (*applies)(const evr_config *c);                    /* NULL: always checked */
-    evr_status (*check)(const evr_config *c, evr_error *err);   /* a check of its own (after the range) */
+    const char *what;                    /* NULL: no range check */
+    int (*applies)(const evr_config *c); /* NULL: always checked */
+    evr_status (*check)(const evr_config *c,
+                        evr_error *err); /* a check of its own (after the range) */
     /* the command line */
-    const char *flag, *alias;     /* "--out", "-o"; flag NULL: not an option */
-    int no_value;                 /* takes no value (flags always) */
-    evr_status (*parse)(evr_config *c, const char *value, evr_error *err);   /* instead of the type's */
+    const char *flag, *alias; /* "--out", "-o"; flag NULL: not an option */
+    int no_value;             /* takes no value (flags always) */
+    evr_status (*parse)(evr_config *c, const char *value,
+                        evr_error *err); /* instead of the type's */
     /* a stricter check of the value as given: cli_lo <= value <= cli_hi (cli_lo_open: excluded),
      * else the message cli_what, a format taking the option and the text */
     double cli_lo, cli_hi;

@@ -33,18 +33,18 @@
 
 /* image motion allowed between samples, pixels per unit of frac */
 #define EVR_ADAPT_PX_PER_FRAC 2.0f
-#define EVR_ADAPT_DEPTH 16           /* samples a pixel holds back while it refines an interval */
+#define EVR_ADAPT_DEPTH 16 /* samples a pixel holds back while it refines an interval */
 
 typedef struct {
-    float frac;                      /* fraction of a threshold (and 2 frac pixels) between samples */
-    float min_dt, max_dt;            /* seconds */
+    float frac;           /* fraction of a threshold (and 2 frac pixels) between samples */
+    float min_dt, max_dt; /* seconds */
 } evr_adapt_params;
 
 typedef struct {
-    int all_min;                     /* the camera or a light moves: every pixel samples every min_dt */
+    int all_min; /* the camera or a light moves: every pixel samples every min_dt */
     int num_boxes;
-    float pad;                       /* added to every box on every side */
-    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+    float pad; /* added to every box on every side */
+    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3]; /* swept bounds of what moves */
     float speed[EVR_SKIP_MAX_BOXES]; /* bound on the image speed of what each box holds, pixels/s
                                         (INFINITY: unbounded, e.g. the camera inside the box) */
     int jump[EVR_SKIP_MAX_BOXES];    /* it moved between the previous segment and this one */
@@ -54,8 +54,9 @@ typedef struct {
  * the primary ray up to its hit at t_hit (1e29 or more: nothing hit, the whole ray) and the
  * segments from the hit to every light that sends light there (as evr_skip_rays_meet). *jump is
  * set when one of them moved between the segments. 0 when they meet nothing that moves. */
-EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs, const evr_adapt_plan *pl, evr_ray ray,
-                                                float t_hit, int *jump)
+EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
+                                                const evr_adapt_plan *pl, evr_ray ray, float t_hit,
+                                                int *jump)
 {
     float v = 0.0f;
     uint64_t met = 0;
@@ -64,7 +65,8 @@ EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs, cons
     const int hit = t_hit < 1e29f;
     const float tmax = hit ? t_hit * 1.0001f + pl->pad : INFINITY;
     for (int b = 0; b < pl->num_boxes; b++)
-        if (evr_skip_segment_meets(ray.org, ray.dir, tmax, pl->lo[b], pl->hi[b], pl->pad)) met |= 1ull << b;
+        if (evr_skip_segment_meets(ray.org, ray.dir, tmax, pl->lo[b], pl->hi[b], pl->pad))
+            met |= 1ull << b;
     if (hit) {
         const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
         for (int l = 0; l < rs->num_lights; l++) {
@@ -72,7 +74,8 @@ EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs, cons
             float dist, e[3];
             if (!evr_light_incident(rs, &rs->lights[l], 0.0f, p, &wi, &dist, e)) continue;
             for (int b = 0; b < pl->num_boxes; b++)
-                if (!(met >> b & 1u) && evr_skip_segment_meets(p, wi, dist, pl->lo[b], pl->hi[b], pl->pad))
+                if (!(met >> b & 1u) &&
+                    evr_skip_segment_meets(p, wi, dist, pl->lo[b], pl->hi[b], pl->pad))
                     met |= 1ull << b;
         }
     }
@@ -99,8 +102,9 @@ EVR_HD static inline float evr_adapt_clamp(const evr_adapt_params *ap, float dt)
 /* The time to the next sample after one at t of log intensity l, the previous at t_prev with
  * l_prev (have_prev 0: none), thres the pixel's smaller threshold, speed the image speed bound of
  * what its rays meet (evr_adapt_rays_speed). */
-EVR_HD static inline float evr_adapt_next_dt(const evr_adapt_params *ap, const evr_adapt_plan *pl, int have_prev,
-                                             float t_prev, float l_prev, float t, float l, float thres, float speed)
+EVR_HD static inline float evr_adapt_next_dt(const evr_adapt_params *ap, const evr_adapt_plan *pl,
+                                             int have_prev, float t_prev, float l_prev, float t,
+                                             float l, float thres, float speed)
 {
     if (pl->all_min) return ap->min_dt;
     float dt = evr_adapt_motion_dt(ap, speed);
@@ -113,13 +117,15 @@ EVR_HD static inline float evr_adapt_next_dt(const evr_adapt_params *ap, const e
  * segment, brought forward as the segment's motion asks (speed and jump: evr_adapt_rays_speed of
  * the last sample's rays), never before the segment's start. A pixel's very first sample comes at
  * phase * min(min_dt, seg) (phase in [0, 1), the pixel's own; seg the segment's length). */
-EVR_HD static inline float evr_adapt_first(const evr_adapt_params *ap, const evr_adapt_plan *pl, int started,
-                                           float next_t, float t_prev, float phase, float speed, int jump, float seg)
+EVR_HD static inline float evr_adapt_first(const evr_adapt_params *ap, const evr_adapt_plan *pl,
+                                           int started, float next_t, float t_prev, float phase,
+                                           float speed, int jump, float seg)
 {
     if (!started) return phase * fminf(ap->min_dt, seg);
     if (pl->all_min) next_t = fminf(next_t, t_prev + ap->min_dt);
     if (jump) next_t = 0.0f;
-    else if (speed > 0.0f) next_t = fminf(next_t, t_prev + evr_adapt_clamp(ap, evr_adapt_motion_dt(ap, speed)));
+    else if (speed > 0.0f)
+        next_t = fminf(next_t, t_prev + evr_adapt_clamp(ap, evr_adapt_motion_dt(ap, speed)));
     return fmaxf(next_t, 0.0f);
 }
 
@@ -129,12 +135,14 @@ EVR_HD static inline float evr_adapt_first(const evr_adapt_params *ap, const evr
  * (from max(t_prev, 0)). An edge found between two samples so gets its time to about min_dt
  * in log2(interval / min_dt) samples, and the pixel model sees the samples in time order. */
 EVR_HD static inline int evr_adapt_refine(const evr_adapt_params *ap, const evr_pixel_state *s,
-                                          const evr_pixel_params *p, float t, float intensity, float *t_mid)
+                                          const evr_pixel_params *p, float t, float intensity,
+                                          float *t_mid)
 {
     if (!s->started) return 0;
     const float lo = fmaxf(s->t_prev, 0.0f);
     if (!(t - lo >= 2.0f * ap->min_dt)) return 0;
-    const float dl = fabsf(evr_log_response(intensity, p->log_floor) - evr_log_response(s->intensity, p->log_floor));
+    const float dl = fabsf(evr_log_response(intensity, p->log_floor) -
+                           evr_log_response(s->intensity, p->log_floor));
     if (!(dl > ap->frac * fminf(p->pos_thres, p->neg_thres))) return 0;
     *t_mid = 0.5f * (lo + t);
     return 1;
@@ -144,10 +152,11 @@ EVR_HD static inline int evr_adapt_refine(const evr_adapt_params *ap, const evr_
  * ray0 with hit distance t_hit) and before running it through the pixel model (s: the state
  * before the sample): returns the time to the next sample; *moving is set when something moving
  * can reach the pixel in this segment (evr_adapt_next_time). */
-EVR_HD static inline float evr_adapt_after_sample(const evr_render_scene *rs, const evr_adapt_params *ap,
-                                                  const evr_adapt_plan *pl, const evr_pixel_state *s,
-                                                  const evr_pixel_params *p, evr_ray ray0, float t_hit, float t,
-                                                  float intensity, int *moving)
+EVR_HD static inline float
+evr_adapt_after_sample(const evr_render_scene *rs, const evr_adapt_params *ap,
+                       const evr_adapt_plan *pl, const evr_pixel_state *s,
+                       const evr_pixel_params *p, evr_ray ray0, float t_hit, float t,
+                       float intensity, int *moving)
 {
     *moving = 1;
     if (pl->all_min) return ap->min_dt;
@@ -156,7 +165,8 @@ EVR_HD static inline float evr_adapt_after_sample(const evr_render_scene *rs, co
     *moving = speed > 0.0f;
     const float l = evr_log_response(intensity, p->log_floor);
     const float l_prev = evr_log_response(s->intensity, p->log_floor);
-    return evr_adapt_next_dt(ap, pl, s->started, s->t_prev, l_prev, t, l, fminf(p->pos_thres, p->neg_thres), speed);
+    return evr_adapt_next_dt(ap, pl, s->started, s->t_prev, l_prev, t, l,
+                             fminf(p->pos_thres, p->neg_thres), speed);
 }
 
 /* The time of the next sample after one at t, step later (evr_adapt_after_sample). A pixel that
@@ -164,7 +174,8 @@ EVR_HD static inline float evr_adapt_after_sample(const evr_render_scene *rs, co
  * length) takes one at the segment's end (min_dt / 2 before it) first: the next segment cannot
  * refine the part of an interval before its start (its motion keys are another segment's), so
  * that part stays short. At or past seg: no more samples in this segment. */
-EVR_HD static inline float evr_adapt_next_time(const evr_adapt_params *ap, float t, float step, float seg, int moving)
+EVR_HD static inline float evr_adapt_next_time(const evr_adapt_params *ap, float t, float step,
+                                               float seg, int moving)
 {
     const float next = t + step, last = seg - 0.5f * ap->min_dt;
     return moving && next >= seg && t < last ? last : next;
@@ -185,12 +196,13 @@ typedef struct {
 /* The pixel's first sample time in the segment (seg: its length), from its state st, the next
  * time next_t carried from the previous segment, its phase and its centre ray ray0. */
 EVR_HD static inline float evr_adapt_start(const evr_render_scene *rs, const evr_adapt_params *ap,
-                                           const evr_adapt_plan *pl, const evr_pixel_state *st, evr_ray ray0,
-                                           float next_t, float phase, float seg)
+                                           const evr_adapt_plan *pl, const evr_pixel_state *st,
+                                           evr_ray ray0, float next_t, float phase, float seg)
 {
     float speed = 0.0f;
     int jump = 0;
-    if (st->started && !pl->all_min) speed = evr_adapt_rays_speed(rs, pl, ray0, st->cache_dist, &jump);
+    if (st->started && !pl->all_min)
+        speed = evr_adapt_rays_speed(rs, pl, ray0, st->cache_dist, &jump);
     return evr_adapt_first(ap, pl, st->started, next_t, st->t_prev, phase, speed, jump, seg);
 }
 
@@ -199,9 +211,10 @@ EVR_HD static inline float evr_adapt_start(const evr_render_scene *rs, const evr
  * evr_adapt_taken and the pixel's cache of change-driven sampling keeps its hit. Call before the
  * sample goes through the pixel model (st is the state before it). */
 EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const evr_adapt_params *ap,
-                                             const evr_adapt_plan *pl, evr_pixel_state *st, const evr_pixel_params *p,
-                                             evr_ray ray0, evr_adapt_stack *sk, float t, float intensity, float hit,
-                                             float *t_trace, float *step, int *moving)
+                                             const evr_adapt_plan *pl, evr_pixel_state *st,
+                                             const evr_pixel_params *p, evr_ray ray0,
+                                             evr_adapt_stack *sk, float t, float intensity,
+                                             float hit, float *t_trace, float *step, int *moving)
 {
     float mid;
     if (sk->n < EVR_ADAPT_DEPTH && evr_adapt_refine(ap, st, p, t, intensity, &mid)) {
@@ -209,7 +222,7 @@ EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const e
         sk->intensity[sk->n] = intensity;
         sk->hit[sk->n] = hit;
         sk->n++;
-        *t_trace = mid;   /* trace halfway first */
+        *t_trace = mid; /* trace halfway first */
         return 0;
     }
     *step = evr_adapt_after_sample(rs, ap, pl, st, p, ray0, hit, t, intensity, moving);
@@ -220,8 +233,9 @@ EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const e
 /* After a taken sample at *t went through the pixel model: 1 with the next candidate in (*t,
  * *intensity, *hit), the latest held back; else 0 with *t_trace the next time to trace (at or
  * past seg: none in this segment). */
-EVR_HD static inline int evr_adapt_taken(const evr_adapt_params *ap, evr_adapt_stack *sk, float step, int moving,
-                                         float seg, float *t, float *intensity, float *hit, float *t_trace)
+EVR_HD static inline int evr_adapt_taken(const evr_adapt_params *ap, evr_adapt_stack *sk,
+                                         float step, int moving, float seg, float *t,
+                                         float *intensity, float *hit, float *t_trace)
 {
     if (sk->n > 0) {
         sk->n--;

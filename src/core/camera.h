@@ -7,11 +7,13 @@
 
 typedef struct {
     int width, height;
-    float tan_half_y;   /* tan(yfov / 2) */
-    float aspect;       /* width / height of the rendered image */
+    float tan_half_y; /* tan(yfov / 2) */
+    float aspect;     /* width / height of the rendered image */
 } evr_camera_intr;
 
-typedef struct { evr_v3 org, dir; } evr_ray;
+typedef struct {
+    evr_v3 org, dir;
+} evr_ray;
 
 EVR_HD static inline evr_camera_intr evr_camera_intr_make(int width, int height, float yfov)
 {
@@ -24,7 +26,8 @@ EVR_HD static inline evr_camera_intr evr_camera_intr_make(int width, int height,
 }
 
 /* Ray through image position (px, py) in pixels (pixel x's centre is x + 0.5). */
-EVR_HD static inline evr_ray evr_camera_ray(const evr_camera_intr *c, const evr_m34 *pose, float px, float py)
+EVR_HD static inline evr_ray evr_camera_ray(const evr_camera_intr *c, const evr_m34 *pose, float px,
+                                            float py)
 {
     float sx = (2.0f * px / (float)c->width - 1.0f) * c->tan_half_y * c->aspect;
     float sy = (1.0f - 2.0f * py / (float)c->height) * c->tan_half_y;
@@ -36,8 +39,8 @@ EVR_HD static inline evr_ray evr_camera_ray(const evr_camera_intr *c, const evr_
 
 /* Image position of a world point given the inverse pose (world to camera); returns 0 when the
  * point is behind the camera. */
-EVR_HD static inline int evr_camera_project(const evr_camera_intr *c, const evr_m34 *world_to_cam, evr_v3 p,
-                                            float *px, float *py)
+EVR_HD static inline int evr_camera_project(const evr_camera_intr *c, const evr_m34 *world_to_cam,
+                                            evr_v3 p, float *px, float *py)
 {
     evr_v3 q = evr_m34_point(world_to_cam, p);
     if (q.z >= 0.0f) return 0;

@@ -25,9 +25,9 @@
  * (evr_render_scene.materials). A new model adds its parameters here, its defaults to
  * evr_material_defaults and its reading to the import (scene/import_mesh.c). */
 struct evr_material_params {
-    float base_color[4];  /* linear RGBA factor */
-    int base_texture;     /* index into the textures (sRGB-encoded source), -1: none */
-    float emissive[3];    /* linear RGB, radiance units */
+    float base_color[4]; /* linear RGBA factor */
+    int base_texture;    /* index into the textures (sRGB-encoded source), -1: none */
+    float emissive[3];   /* linear RGB, radiance units */
     /* the photon pass's thresholds, 0 <= t_diffuse <= t_specular <= 1: from the material's
      * extras "t_diffuse" and "t_specular" when the glTF gives them, else from base colour,
      * metallic and roughness (evr_photon_material_map) */
@@ -38,14 +38,15 @@ struct evr_material_params {
 /* A surface point as shading sees it: its shading frame (position, normal) and the hit's
  * material record (the material evaluated there, textures applied). */
 typedef struct {
-    evr_v3 p;          /* world position */
-    evr_v3 n;          /* world shading normal, facing the incoming ray */
+    evr_v3 p; /* world position */
+    evr_v3 n; /* world shading normal, facing the incoming ray */
     float albedo[3];
     float emissive[3];
 } evr_surface;
 
 /* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
-EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v, float out[4])
+EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v,
+                                               float out[4])
 {
     float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
     float fx = floorf(x), fy = floorf(y);
@@ -54,16 +55,20 @@ EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float 
     if (x0 < 0) x0 += t->width;
     if (y0 < 0) y0 += t->height;
     int x1 = (x0 + 1) % t->width, y1 = (y0 + 1) % t->height;
-    const float *p00 = t->rgba + 4 * ((long)y0 * t->width + x0), *p10 = t->rgba + 4 * ((long)y0 * t->width + x1);
-    const float *p01 = t->rgba + 4 * ((long)y1 * t->width + x0), *p11 = t->rgba + 4 * ((long)y1 * t->width + x1);
+    const float *p00 = t->rgba + 4 * ((long)y0 * t->width + x0),
+                *p10 = t->rgba + 4 * ((long)y0 * t->width + x1);
+    const float *p01 = t->rgba + 4 * ((long)y1 * t->width + x0),
+                *p11 = t->rgba + 4 * ((long)y1 * t->width + x1);
     int c;
     for (c = 0; c < 4; c++)
-        out[c] = (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
+        out[c] =
+            (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
 }
 
 /* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m. */
-EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m, uint32_t i0, uint32_t i1,
-                                          uint32_t i2, float w, float u, float v, evr_surface *s)
+EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m,
+                                          uint32_t i0, uint32_t i1, uint32_t i2, float w, float u,
+                                          float v, evr_surface *s)
 {
     const evr_material_params *mat = &rs->materials[m->material];
     s->albedo[0] = mat->base_color[0];
@@ -97,8 +102,8 @@ EVR_HD static inline void evr_material_emission(const evr_surface *s, evr_v3 wo,
 /* Adds one unshadowed light's contribution at s, seen along wo, arriving along wi with
  * irradiance e_rgb (on a surface facing it), to acc. Lambert: acc sums irradiance times cosine;
  * the BSDF's albedo / pi is applied once, in evr_material_radiance. */
-EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo, evr_v3 wi, const float e_rgb[3],
-                                                 float acc[3])
+EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo, evr_v3 wi,
+                                                 const float e_rgb[3], float acc[3])
 {
     (void)wo;
     float c = evr_v3_dot(s->n, wi);
@@ -110,8 +115,8 @@ EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo
 
 /* Radiance leaving s towards wo (RGB) from the lights' sum acc (evr_material_add_light), the
  * ambient irradiance (a fraction of pi) and its emission. */
-EVR_HD static inline void evr_material_radiance(const evr_surface *s, evr_v3 wo, const float acc[3], float ambient,
-                                                float rgb[3])
+EVR_HD static inline void evr_material_radiance(const evr_surface *s, evr_v3 wo, const float acc[3],
+                                                float ambient, float rgb[3])
 {
     (void)wo;
     rgb[0] = s->albedo[0] * (ambient + acc[0] / EVR_PI) + s->emissive[0];
@@ -124,8 +129,9 @@ EVR_HD static inline void evr_material_radiance(const evr_surface *s, evr_v3 wo,
 /* glTF metallic-roughness to the photon thresholds: reflectance R = max(base colour) clamped to
  * [0.05, 0.95]; mirror = metallic * (1 - roughness);
  * t_diffuse = 1 - R, t_specular = t_diffuse + R * (1 - mirror). */
-EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic, float roughness,
-                                                  float *t_diffuse, float *t_specular)
+EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic,
+                                                  float roughness, float *t_diffuse,
+                                                  float *t_specular)
 {
     float r = fmaxf(base_color[0], fmaxf(base_color[1], base_color[2]));
     float m = fminf(fmaxf(metallic, 0.0f), 1.0f) * (1.0f - fminf(fmaxf(roughness, 0.0f), 1.0f));
@@ -142,7 +148,8 @@ static inline void evr_material_defaults(evr_material_params *m)
     m->emissive[0] = m->emissive[1] = m->emissive[2] = 0.0f;
     m->metallic = 0.0f;
     m->roughness = 1.0f;
-    evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse, &m->t_specular);
+    evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse,
+                            &m->t_specular);
 }
 
 /* Share of the reflected light that is a mirror reflection. */
@@ -157,7 +164,8 @@ enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_DIFFUSE = 1, EVR_PHOTON_MIRROR = 2, EVR_P
 /* The decision at a hit for random xi in [0, 1). *weight multiplies the flux: stay 1/t_diffuse,
  * bounce 1/(1 - t_diffuse) (times the albedo, which the caller applies), 1 for a bounce when
  * staying is not allowed. ABSORB only when nothing else is possible. */
-EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi, int allow_stay, float *weight)
+EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi,
+                                            int allow_stay, float *weight)
 {
     float td = fminf(fmaxf(t_diffuse, 0.0f), 1.0f), ts = fminf(fmaxf(t_specular, td), 1.0f);
     if (allow_stay) {
@@ -165,11 +173,17 @@ EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, f
             *weight = 1.0f / td;
             return EVR_PHOTON_STAY;
         }
-        if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+        if (td >= 1.0f) {
+            *weight = 0.0f;
+            return EVR_PHOTON_ABSORB;
+        }
         *weight = 1.0f / (1.0f - td);
         return xi < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
     }
-    if (td >= 1.0f) { *weight = 0.0f; return EVR_PHOTON_ABSORB; }
+    if (td >= 1.0f) {
+        *weight = 0.0f;
+        return EVR_PHOTON_ABSORB;
+    }
     *weight = 1.0f;
     /* xi spread over the bounce options only */
     return td + xi * (1.0f - td) < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
@@ -191,7 +205,8 @@ EVR_HD static inline evr_v3 evr_cosine_dir(evr_v3 n, float u1, float u2)
     float r = sqrtf(u1), phi = 6.28318530718f * u2;
     float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
     evr_onb(n, &t, &b);
-    return evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
+    return evr_v3_norm(
+        evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
 }
 
 /* Mirror direction of incoming d about unit n. */
@@ -200,11 +215,11 @@ EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
     return evr_v3_sub(d, evr_v3_scale(n, 2.0f * evr_v3_dot(d, n)));
 }
 
-
 /* The photon pass's decision at a hit of material mat for random xi in [0, 1) (d_in: the
  * photon's direction of travel): evr_photon_scatter's event and *weight. */
-EVR_HD static inline int evr_material_photon_event(const evr_material_params *mat, const evr_surface *s, evr_v3 d_in,
-                                                   float xi, int allow_stay, float *weight)
+EVR_HD static inline int evr_material_photon_event(const evr_material_params *mat,
+                                                   const evr_surface *s, evr_v3 d_in, float xi,
+                                                   int allow_stay, float *weight)
 {
     (void)s;
     (void)d_in;
@@ -213,7 +228,8 @@ EVR_HD static inline int evr_material_photon_event(const evr_material_params *ma
 
 /* The path tracer's choice at a hit of material mat for random xi in [0, 1): EVR_PHOTON_MIRROR
  * with the mirror share's odds, else EVR_PHOTON_DIFFUSE (it never stays). */
-EVR_HD static inline int evr_material_path_event(const evr_material_params *mat, const evr_surface *s, evr_v3 d_in, float xi)
+EVR_HD static inline int evr_material_path_event(const evr_material_params *mat,
+                                                 const evr_surface *s, evr_v3 d_in, float xi)
 {
     (void)s;
     (void)d_in;
@@ -223,9 +239,11 @@ EVR_HD static inline int evr_material_path_event(const evr_material_params *mat,
 
 /* The direction a bounce of kind ev (EVR_PHOTON_DIFFUSE or EVR_PHOTON_MIRROR) leaves s in, for a
  * ray travelling along d_in; (u1, u2) in [0, 1)^2 pick the diffuse direction. */
-EVR_HD static inline evr_v3 evr_material_bounce_dir(const evr_surface *s, int ev, evr_v3 d_in, float u1, float u2)
+EVR_HD static inline evr_v3 evr_material_bounce_dir(const evr_surface *s, int ev, evr_v3 d_in,
+                                                    float u1, float u2)
 {
-    return ev == EVR_PHOTON_DIFFUSE ? evr_cosine_dir(s->n, u1, u2) : evr_v3_norm(evr_mirror_dir(d_in, s->n));
+    return ev == EVR_PHOTON_DIFFUSE ? evr_cosine_dir(s->n, u1, u2)
+                                    : evr_v3_norm(evr_mirror_dir(d_in, s->n));
 }
 
 /* What multiplies the albedo and an irradiance for the indirect (diffusely reflected) radiance

@@ -8,16 +8,16 @@
 #include <stdint.h>
 #include "core/shading.h"
 
-#if defined(__CUDA_ARCH__)   /* nvcc's device pass; its host pass is the host compiler's */
+#if defined(__CUDA_ARCH__) /* nvcc's device pass; its host pass is the host compiler's */
 #define EVR_ATOMIC_INC_U32(p) atomicAdd((unsigned int *)(p), 1u)
 #else
 #define EVR_ATOMIC_INC_U32(p) __atomic_fetch_add((p), 1u, __ATOMIC_RELAXED)
 #endif
 
 typedef struct {
-    float p[3], n[3];     /* world position, normal on the side the photon came from */
-    float flux[3];        /* incident flux the photon stands for (RGB) */
-    uint32_t key;         /* photon number * 16 + bounce: a canonical order */
+    float p[3], n[3]; /* world position, normal on the side the photon came from */
+    float flux[3];    /* incident flux the photon stands for (RGB) */
+    uint32_t key;     /* photon number * 16 + bounce: a canonical order */
 } evr_photon;
 
 /* The image plus a guard band of `margin` pixels on every side (so that pixels near the image's
@@ -41,8 +41,8 @@ typedef struct {
 
 /* Image pixel of world point p for the camera (world_to_cam = inverse pose), which may lie up
  * to margin pixels outside the image; 0 when behind the camera or farther out. */
-EVR_HD static inline int evr_photon_pixel(const evr_camera_intr *c, const evr_m34 *world_to_cam, evr_v3 p, int margin,
-                                          int *x, int *y)
+EVR_HD static inline int evr_photon_pixel(const evr_camera_intr *c, const evr_m34 *world_to_cam,
+                                          evr_v3 p, int margin, int *x, int *y)
 {
     float px = -1e9f, py = -1e9f, m = (float)margin;
     if (!evr_camera_project(c, world_to_cam, p, &px, &py)) return 0;
@@ -57,8 +57,9 @@ EVR_HD static inline int evr_photon_pixel(const evr_camera_intr *c, const evr_m3
 /* A photon that stays at s at time f is kept where the camera sees it: the cell (x, y) it
  * lands in, and the ray r from s towards the camera that must be free over [*tnear, *tfar).
  * 0 when the camera is behind the surface or the point projects outside the image and its band. */
-EVR_HD static inline int evr_photon_view_ray(const evr_render_scene *rs, const evr_surface *s, float f, int margin,
-                                             float eps, int *x, int *y, evr_ray *r, float *tnear, float *tfar)
+EVR_HD static inline int evr_photon_view_ray(const evr_render_scene *rs, const evr_surface *s,
+                                             float f, int margin, float eps, int *x, int *y,
+                                             evr_ray *r, float *tnear, float *tfar)
 {
     evr_m34 pose = evr_rs_camera_pose(rs, f), inv = evr_m34_inverse(&pose);
     evr_v3 cam = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
@@ -74,12 +75,19 @@ EVR_HD static inline int evr_photon_view_ray(const evr_render_scene *rs, const e
 }
 
 /* The buffer's record of a photon stored at s. */
-EVR_HD static inline evr_photon evr_photon_make(const evr_surface *s, const float flux[3], uint32_t key)
+EVR_HD static inline evr_photon evr_photon_make(const evr_surface *s, const float flux[3],
+                                                uint32_t key)
 {
     evr_photon ph;
-    ph.p[0] = s->p.x; ph.p[1] = s->p.y; ph.p[2] = s->p.z;
-    ph.n[0] = s->n.x; ph.n[1] = s->n.y; ph.n[2] = s->n.z;
-    ph.flux[0] = flux[0]; ph.flux[1] = flux[1]; ph.flux[2] = flux[2];
+    ph.p[0] = s->p.x;
+    ph.p[1] = s->p.y;
+    ph.p[2] = s->p.z;
+    ph.n[0] = s->n.x;
+    ph.n[1] = s->n.y;
+    ph.n[2] = s->n.z;
+    ph.flux[0] = flux[0];
+    ph.flux[1] = flux[1];
+    ph.flux[2] = flux[2];
     ph.key = key;
     return ph;
 }
@@ -88,7 +96,8 @@ EVR_HD static inline evr_photon evr_photon_make(const evr_surface *s, const floa
  * dropped and counted as a collision. Returns 1 when stored. Threads inserting concurrently
  * store the same set of photons whenever no cell overflows (the order of a cell's layers may
  * differ: evr_photon_buffer_sort_cell restores the canonical order). */
-EVR_HD static inline int evr_photon_buffer_insert(evr_photon_buffer *b, int x, int y, const evr_photon *ph)
+EVR_HD static inline int evr_photon_buffer_insert(evr_photon_buffer *b, int x, int y,
+                                                  const evr_photon *ph)
 {
     size_t i = (size_t)(y + b->margin) * (size_t)b->width + (size_t)(x + b->margin);
     uint32_t k = EVR_ATOMIC_INC_U32(&b->count[i]);
@@ -114,23 +123,30 @@ EVR_HD static inline void evr_photon_buffer_sort_cell(evr_photon_buffer *b, size
 }
 
 /* The camera's ray (pose) through the centre of buffer cell (cx, cy), guard band included. */
-EVR_HD static inline evr_ray evr_photon_cell_ray(const evr_render_scene *rs, const evr_m34 *pose, const evr_photon_buffer *b,
-                                                 int cx, int cy)
+EVR_HD static inline evr_ray evr_photon_cell_ray(const evr_render_scene *rs, const evr_m34 *pose,
+                                                 const evr_photon_buffer *b, int cx, int cy)
 {
-    return evr_camera_ray(&rs->camera, pose, (float)(cx - b->margin) + 0.5f, (float)(cy - b->margin) + 0.5f);
+    return evr_camera_ray(&rs->camera, pose, (float)(cx - b->margin) + 0.5f,
+                          (float)(cy - b->margin) + 0.5f);
 }
 
 /* A cell's view (gbuf, 8 floats) from the surface s met at distance t along its ray; fwd: the
  * camera's forward axis. The area is the pixel's at unit distance * depth^2 * cos(off-axis
  * angle) / |cos of the incidence| (the cosine at least 0.1). */
-EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v3 fwd, const evr_surface *s, evr_ray ray,
-                                               float t, float g[8])
+EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v3 fwd,
+                                               const evr_surface *s, evr_ray ray, float t,
+                                               float g[8])
 {
-    const float a = 4.0f * rs->camera.tan_half_y * rs->camera.tan_half_y / ((float)rs->camera.height * (float)rs->camera.height);
+    const float a = 4.0f * rs->camera.tan_half_y * rs->camera.tan_half_y /
+                    ((float)rs->camera.height * (float)rs->camera.height);
     float ca = evr_v3_dot(ray.dir, fwd), z = t * ca;
     float ct = fmaxf(fabsf(evr_v3_dot(s->n, ray.dir)), 0.1f);
-    g[0] = s->p.x; g[1] = s->p.y; g[2] = s->p.z;
-    g[3] = s->n.x; g[4] = s->n.y; g[5] = s->n.z;
+    g[0] = s->p.x;
+    g[1] = s->p.y;
+    g[2] = s->p.z;
+    g[3] = s->n.x;
+    g[4] = s->n.y;
+    g[5] = s->n.z;
     g[6] = a * z * z * ca / ct;
     g[7] = 0.0f;
 }

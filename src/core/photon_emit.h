@@ -16,27 +16,30 @@ EVR_HD static inline evr_v3 evr_sphere_dir(float u1, float u2)
 typedef struct {
     evr_ray ray;
     float flux[3];
-    int from_light;   /* 1: a point, spot or directional light (never stays at the first hit) */
+    int from_light; /* 1: a point, spot or directional light (never stays at the first hit) */
 } evr_photon_ray;
 
 /* Emitters of a pass: every light with power, then every instance with an emissive material. */
 typedef struct {
-    int kind;          /* 0: light, 1: emissive instance */
-    int index;         /* light index or instance index */
-    float power;       /* luminance flux (what the photons are split by) */
-    uint32_t first;    /* photons [first, first + count) of the pass are this emitter's */
+    int kind;       /* 0: light, 1: emissive instance */
+    int index;      /* light index or instance index */
+    float power;    /* luminance flux (what the photons are split by) */
+    uint32_t first; /* photons [first, first + count) of the pass are this emitter's */
     uint32_t count;
-    int tri_first;     /* kind 1: triangles' cumulative areas at cdf[tri_first .. tri_first + ntri) */
+    int tri_first; /* kind 1: triangles' cumulative areas at cdf[tri_first .. tri_first + ntri) */
     int ntri;
-    float area;        /* kind 1: total area (world, at the pass's time) */
+    float area; /* kind 1: total area (world, at the pass's time) */
 } evr_photon_emitter;
 
 /* Scene bounds for directional lights: a sphere. */
-typedef struct { evr_v3 center; float radius; } evr_photon_bounds;
+typedef struct {
+    evr_v3 center;
+    float radius;
+} evr_photon_bounds;
 
 /* Position and direction of light l at normalized segment time f. */
-EVR_HD static inline void evr_photon_light_pose(const evr_render_scene *rs, const evr_light_view *l, float f, evr_v3 *pos,
-                                                evr_v3 *dir)
+EVR_HD static inline void evr_photon_light_pose(const evr_render_scene *rs, const evr_light_view *l,
+                                                float f, evr_v3 *pos, evr_v3 *dir)
 {
     *pos = l->pos;
     *dir = l->dir;
@@ -62,8 +65,8 @@ EVR_HD static inline float evr_photon_sphere_cos(evr_v3 p, evr_photon_bounds bb)
  * hit anything), else 4 pi I; spot 2 pi (1 - cos_outer) I times the mean smooth falloff
  * (approximate, for the split only: the photons carry the exact falloff); directional E pi R^2
  * over a disk of the scene's bounding radius. */
-EVR_HD static inline void evr_photon_light_flux(const evr_render_scene *rs, const evr_light_view *l, float f,
-                                                evr_photon_bounds bb, float out[3])
+EVR_HD static inline void evr_photon_light_flux(const evr_render_scene *rs, const evr_light_view *l,
+                                                float f, evr_photon_bounds bb, float out[3])
 {
     float k;
     if (l->type == 2) k = EVR_PI * bb.radius * bb.radius;
@@ -79,23 +82,24 @@ EVR_HD static inline void evr_photon_light_flux(const evr_render_scene *rs, cons
 }
 
 /* Photon number j (of count) of light l at normalized segment time f, from the numbers u[0..3]. */
-EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const evr_light_view *l, float f,
-                                               evr_photon_bounds bb, const float u[4], uint32_t count,
-                                               evr_photon_ray *out)
+EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const evr_light_view *l,
+                                               float f, evr_photon_bounds bb, const float u[4],
+                                               uint32_t count, evr_photon_ray *out)
 {
     evr_v3 lp, ld;
     float k;
     evr_photon_light_pose(rs, l, f, &lp, &ld);
     out->from_light = 1;
-    if (l->type == 2) {   /* directional: a disk across the scene's bounding sphere, upstream */
+    if (l->type == 2) { /* directional: a disk across the scene's bounding sphere, upstream */
         evr_v3 t, b;
         float r = bb.radius * sqrtf(u[0]), phi = 6.28318530718f * u[1];
         evr_onb(ld, &t, &b);
-        out->ray.org = evr_v3_add(evr_v3_sub(bb.center, evr_v3_scale(ld, 1.01f * bb.radius)),
-                                  evr_v3_add(evr_v3_scale(t, r * cosf(phi)), evr_v3_scale(b, r * sinf(phi))));
+        out->ray.org =
+            evr_v3_add(evr_v3_sub(bb.center, evr_v3_scale(ld, 1.01f * bb.radius)),
+                       evr_v3_add(evr_v3_scale(t, r * cosf(phi)), evr_v3_scale(b, r * sinf(phi))));
         out->ray.dir = ld;
         k = EVR_PI * bb.radius * bb.radius;
-    } else if (l->type == 1) {   /* spot: uniform in the outer cone, weighted by the falloff */
+    } else if (l->type == 1) { /* spot: uniform in the outer cone, weighted by the falloff */
         evr_v3 t, b;
         float cz = 1.0f - u[0] * (1.0f - l->cos_outer), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
         float phi = 6.28318530718f * u[1];
@@ -103,10 +107,11 @@ EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const
         a = fminf(fmaxf(a, 0.0f), 1.0f);
         evr_onb(ld, &t, &b);
         out->ray.org = lp;
-        out->ray.dir = evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
-                                              evr_v3_scale(ld, cz)));
+        out->ray.dir = evr_v3_norm(
+            evr_v3_add(evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
+                       evr_v3_scale(ld, cz)));
         k = 2.0f * EVR_PI * (1.0f - l->cos_outer) * a * a;
-    } else {   /* point: every direction, or only those towards the scene's sphere from outside it */
+    } else { /* point: every direction, or only those towards the scene's sphere from outside it */
         float cmax = evr_photon_sphere_cos(lp, bb);
         out->ray.org = lp;
         if (cmax > -1.0f) {
@@ -114,8 +119,9 @@ EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const
             float cz = 1.0f - u[0] * (1.0f - cmax), sz = sqrtf(fmaxf(0.0f, 1.0f - cz * cz));
             float phi = 6.28318530718f * u[1];
             evr_onb(axis, &t, &b);
-            out->ray.dir = evr_v3_norm(evr_v3_add(evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
-                                                  evr_v3_scale(axis, cz)));
+            out->ray.dir = evr_v3_norm(evr_v3_add(
+                evr_v3_add(evr_v3_scale(t, sz * cosf(phi)), evr_v3_scale(b, sz * sinf(phi))),
+                evr_v3_scale(axis, cz)));
             k = 2.0f * EVR_PI * (1.0f - cmax);
         } else {
             out->ray.dir = evr_sphere_dir(u[0], u[1]);
@@ -133,24 +139,29 @@ EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const
  * the side: both sides emit, as evr_surface_at's emission is two-sided), a point on it (u[1],
  * u[2]), a cosine-distributed direction (u[3], u[4]); flux = 2 pi Le * area / count.
  * cdf: the instance's cumulative world-space triangle areas (cdf[ntri - 1] == area). */
-EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs, const evr_photon_emitter *em,
-                                                 const float *cdf, const evr_m34 *xf, const float u[5],
+EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs,
+                                                 const evr_photon_emitter *em, const float *cdf,
+                                                 const evr_m34 *xf, const float u[5],
                                                  evr_photon_ray *out)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[em->index].mesh];
     const evr_material_params *mat = &rs->materials[m->material];
     const float *c = cdf + em->tri_first;
-    float side = u[0] < 0.5f ? 1.0f : -1.0f, x = (u[0] < 0.5f ? u[0] * 2.0f : u[0] * 2.0f - 1.0f) * em->area;
+    float side = u[0] < 0.5f ? 1.0f : -1.0f,
+          x = (u[0] < 0.5f ? u[0] * 2.0f : u[0] * 2.0f - 1.0f) * em->area;
     int lo = 0, hi = em->ntri - 1;
-    while (lo < hi) {   /* first triangle whose cumulative area exceeds x */
+    while (lo < hi) { /* first triangle whose cumulative area exceeds x */
         int mid = (lo + hi) / 2;
         if (c[mid] > x) hi = mid;
         else lo = mid + 1;
     }
     uint32_t i0 = m->indices[3 * lo], i1 = m->indices[3 * lo + 1], i2 = m->indices[3 * lo + 2];
-    evr_v3 p0 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1], m->positions[3 * i0 + 2]));
-    evr_v3 p1 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1], m->positions[3 * i1 + 2]));
-    evr_v3 p2 = evr_m34_point(xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1], m->positions[3 * i2 + 2]));
+    evr_v3 p0 = evr_m34_point(
+        xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1], m->positions[3 * i0 + 2]));
+    evr_v3 p1 = evr_m34_point(
+        xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1], m->positions[3 * i1 + 2]));
+    evr_v3 p2 = evr_m34_point(
+        xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1], m->positions[3 * i2 + 2]));
     float su = sqrtf(u[1]), b1 = 1.0f - su, b2 = u[2] * su;
     evr_v3 e1 = evr_v3_sub(p1, p0), e2 = evr_v3_sub(p2, p0);
     evr_v3 n = evr_v3_scale(evr_v3_norm(evr_v3_cross(e1, e2)), side);

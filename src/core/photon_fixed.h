@@ -20,7 +20,7 @@
 #include <stdint.h>
 #include "core/photon_gather.h"
 
-#if defined(__CUDA_ARCH__)   /* nvcc's device pass; its host pass is the host compiler's */
+#if defined(__CUDA_ARCH__) /* nvcc's device pass; its host pass is the host compiler's */
 /* a product that is never fused with an addition (nvcc fuses a * b + c into one rounding where
  * it likes; the C compiler here, ISO C without FMA, never does) */
 #define EVR_MUL_RN(a, b) __fmul_rn((a), (b))
@@ -29,8 +29,8 @@
 #endif
 
 typedef struct {
-    uint64_t a;      /* weighted luminance flux, in units of 1 / flux_scale */
-    uint64_t w;      /* the view's weighted area, in units of sigma^2 / 2^32 */
+    uint64_t a; /* weighted luminance flux, in units of 1 / flux_scale */
+    uint64_t w; /* the view's weighted area, in units of sigma^2 / 2^32 */
 } evr_gather_sum;
 
 /* Fixed-point quanta per unit of flux for a pass of `photons` photons carrying total_power
@@ -51,7 +51,9 @@ EVR_HD static inline float evr_gather_flux_scale(float total_power, uint32_t pho
  * x86-64, where a float to uint64_t conversion is a branch and two. */
 EVR_HD static inline uint64_t evr_fix(float v)
 {
-    return v > 0.0f ? (uint64_t)(int64_t)((v < 4503599627370496.0f ? v : 4503599627370496.0f) + 0.5f) : 0u;
+    return v > 0.0f
+               ? (uint64_t)(int64_t)((v < 4503599627370496.0f ? v : 4503599627370496.0f) + 0.5f)
+               : 0u;
 }
 
 /* a.b, rounded the same by every compiler: three products, two additions, left to right */
@@ -65,12 +67,12 @@ EVR_HD static inline float evr_dot_rn(float ax, float ay, float az, float bx, fl
 typedef struct {
     evr_v3 p, n, c;
     float r2, normal_cos, flux_scale;
-    float e, area_scale;   /* -1 / (2 sigma^2), 2^32 / sigma^2 */
+    float e, area_scale; /* -1 / (2 sigma^2), 2^32 / sigma^2 */
 } evr_sum_query;
 
 /* Adds cell i's terms for query q to s (sub: subtracts them). Returns the photons taken. */
-EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t i, const evr_sum_query *q, evr_gather_sum *s,
-                                             int sub)
+EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t i,
+                                             const evr_sum_query *q, evr_gather_sum *s, int sub)
 {
     const size_t npix = (size_t)b->width * (size_t)b->height;
     const float e = q->e, area_scale = q->area_scale;
@@ -80,7 +82,8 @@ EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t 
     if (b->gbuf) {
         const float *g = b->gbuf + 8 * i;
         float dx = g[0] - p.x, dy = g[1] - p.y, dz = g[2] - p.z;
-        float d2 = evr_dot_rn(dx, dy, dz, dx, dy, dz), c = evr_dot_rn(g[3], g[4], g[5], n.x, n.y, n.z);
+        float d2 = evr_dot_rn(dx, dy, dz, dx, dy, dz),
+              c = evr_dot_rn(g[3], g[4], g[5], n.x, n.y, n.z);
         if (g[6] > 0.0f && d2 <= q->r2 && c >= q->normal_cos)
             aw = evr_fix(EVR_MUL_RN(EVR_MUL_RN(expf(EVR_MUL_RN(d2, e)), g[6]), area_scale));
     }
@@ -88,7 +91,8 @@ EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t 
     for (l = 0; l < nl; l++) {
         const evr_photon *ph = &b->slots[(size_t)l * npix + i];
         float dx = ph->p[0] - p.x, dy = ph->p[1] - p.y, dz = ph->p[2] - p.z;
-        float d2 = evr_dot_rn(dx, dy, dz, dx, dy, dz), c = evr_dot_rn(ph->n[0], ph->n[1], ph->n[2], n.x, n.y, n.z);
+        float d2 = evr_dot_rn(dx, dy, dz, dx, dy, dz),
+              c = evr_dot_rn(ph->n[0], ph->n[1], ph->n[2], n.x, n.y, n.z);
         if (d2 > q->r2 || c < q->normal_cos) continue;
         const float lum = evr_dot_rn(ph->flux[0], ph->flux[1], ph->flux[2], q->c.x, q->c.y, q->c.z);
         a += evr_fix(EVR_MUL_RN(EVR_MUL_RN(expf(EVR_MUL_RN(d2, e)), q->flux_scale), lum));
@@ -105,7 +109,8 @@ EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t 
 }
 
 /* The cells of window w inside buffer b: columns x0 .. x1 - 1 of rows y0 .. y1 - 1. */
-EVR_HD static inline void evr_gather_window_cells(const evr_photon_buffer *b, const evr_gather_window *w, int *x0, int *y0,
+EVR_HD static inline void evr_gather_window_cells(const evr_photon_buffer *b,
+                                                  const evr_gather_window *w, int *x0, int *y0,
                                                   int *x1, int *y1)
 {
     *x0 = w->cx - w->h > 0 ? w->cx - w->h : 0;
@@ -115,21 +120,25 @@ EVR_HD static inline void evr_gather_window_cells(const evr_photon_buffer *b, co
 }
 
 /* The fixed-point sums of query q over window w of b. Returns the photons taken. */
-EVR_HD static inline int evr_photon_gather_sum(const evr_photon_buffer *b, const evr_gather_window *w, const evr_sum_query *q,
+EVR_HD static inline int evr_photon_gather_sum(const evr_photon_buffer *b,
+                                               const evr_gather_window *w, const evr_sum_query *q,
                                                evr_gather_sum *s)
 {
     int x0, y0, x1, y1, x, y, used = 0;
-    evr_gather_sum acc = {0, 0};   /* a local: kept in registers, not stored back cell by cell */
+    evr_gather_sum acc = {0, 0}; /* a local: kept in registers, not stored back cell by cell */
     evr_gather_window_cells(b, w, &x0, &y0, &x1, &y1);
     for (y = y0; y < y1; y++)
-        for (x = x0; x < x1; x++) used += evr_photon_cell_sum(b, (size_t)y * (size_t)b->width + (size_t)x, q, &acc, 0);
+        for (x = x0; x < x1; x++)
+            used += evr_photon_cell_sum(b, (size_t)y * (size_t)b->width + (size_t)x, q, &acc, 0);
     *s = acc;
     return used;
 }
 
 /* The luminance from the sums, normalized as evr_photon_gather_finish normalizes its float sums. */
-EVR_HD static inline float evr_photon_gather_sum_finish(const evr_photon_buffer *b, const evr_gather_window *w,
-                                                        const evr_gather_params *gp, const evr_gather_sum *s)
+EVR_HD static inline float evr_photon_gather_sum_finish(const evr_photon_buffer *b,
+                                                        const evr_gather_window *w,
+                                                        const evr_gather_params *gp,
+                                                        const evr_gather_sum *s)
 {
     const float acc[3] = {(float)s->a / gp->flux_scale, 0.0f, 0.0f};
     float e[3];
@@ -143,8 +152,8 @@ EVR_HD static inline float evr_photon_gather_sum_finish(const evr_photon_buffer 
  * + x1] - 1, where before[y (w + 1) + x] counts row y's changed cells left of column x (w: the
  * buffer's width). Built per segment by the backends (evr_changed_cells_from_sat on the CPU). */
 typedef struct {
-    const uint32_t *before;   /* (w + 1) per row */
-    const uint32_t *base;     /* h + 1 */
+    const uint32_t *before; /* (w + 1) per row */
+    const uint32_t *base;   /* h + 1 */
     const uint32_t *x;
 } evr_changed_cells;
 
@@ -152,9 +161,11 @@ typedef struct {
  * same point, the same window): the terms of every changed cell of the window (ch: the cells
  * that differ from prev to cur, or more: a listed cell that did not change adds nothing), those
  * of cur added and those of prev taken away. Bit for bit the sums of a fresh gather over cur. */
-EVR_HD static inline void evr_photon_gather_delta(const evr_photon_buffer *cur, const evr_photon_buffer *prev,
-                                                  const evr_changed_cells *ch, const evr_gather_window *w, const evr_sum_query *q,
-                                                  evr_gather_sum *s)
+EVR_HD static inline void evr_photon_gather_delta(const evr_photon_buffer *cur,
+                                                  const evr_photon_buffer *prev,
+                                                  const evr_changed_cells *ch,
+                                                  const evr_gather_window *w,
+                                                  const evr_sum_query *q, evr_gather_sum *s)
 {
     const size_t W = (size_t)cur->width + 1;
     int x0, y0, x1, y1, y;

@@ -13,16 +13,32 @@
  * the bottom row, up the left column). Returns the ring. */
 EVR_HD static inline int evr_ring_cell(int k, int *dx, int *dy)
 {
-    if (k <= 0) { *dx = 0; *dy = 0; return 0; }
+    if (k <= 0) {
+        *dx = 0;
+        *dy = 0;
+        return 0;
+    }
     int r = (int)((sqrtf((float)k) + 1.0f) * 0.5f);
-    while ((2 * r + 1) * (2 * r + 1) <= k) r++;   /* exact whatever sqrtf rounds to */
+    while ((2 * r + 1) * (2 * r + 1) <= k) r++; /* exact whatever sqrtf rounds to */
     while (r > 1 && (2 * r - 1) * (2 * r - 1) > k) r--;
     int j = k - (2 * r - 1) * (2 * r - 1), side = j / (2 * r), o = j % (2 * r);
     switch (side) {
-    case 0: *dx = -r + o; *dy = -r; break;
-    case 1: *dx = r; *dy = -r + o; break;
-    case 2: *dx = r - o; *dy = r; break;
-    default: *dx = -r; *dy = r - o; break;
+    case 0:
+        *dx = -r + o;
+        *dy = -r;
+        break;
+    case 1:
+        *dx = r;
+        *dy = -r + o;
+        break;
+    case 2:
+        *dx = r - o;
+        *dy = r;
+        break;
+    default:
+        *dx = -r;
+        *dy = r - o;
+        break;
     }
     return r;
 }
@@ -37,12 +53,13 @@ EVR_HD static inline float evr_gauss_kernel(float d2, float r)
 }
 
 typedef struct {
-    float radius;       /* distance filter r (world units): photons farther away are skipped */
-    int max_photons;    /* the search stops growing at this many photons (see evr_photon_gather);
+    float radius;     /* distance filter r (world units): photons farther away are skipped */
+    int max_photons;  /* the search stops growing at this many photons (see evr_photon_gather);
                          * 0: no limit, every photon of the disk (the fixed-point sum below) */
-    int max_window;     /* the window's half size in pixels is at most this */
-    float normal_cos;   /* photons whose normal differs more (cosine below) are skipped */
-    float flux_scale;   /* max_photons 0: fixed-point quanta per unit of flux (evr_gather_flux_scale) */
+    int max_window;   /* the window's half size in pixels is at most this */
+    float normal_cos; /* photons whose normal differs more (cosine below) are skipped */
+    float
+        flux_scale; /* max_photons 0: fixed-point quanta per unit of flux (evr_gather_flux_scale) */
 } evr_gather_params;
 
 /* One cell's share of a gather: the photons of buffer cell (x, y) (anywhere: a cell outside the
@@ -50,14 +67,15 @@ typedef struct {
  * Gaussian-weighted flux to acc (in layer order); with the camera's view of the cells, the
  * kernel's weight over the surface the cell shows (if it is like the query's) adds to *area_w.
  * Returns the photons taken. */
-EVR_HD static inline int evr_photon_gather_cell(const evr_photon_buffer *b, int x, int y, evr_v3 p, evr_v3 n, float lim2,
-                                                float normal_cos, float s2, float acc[3], float *area_w)
+EVR_HD static inline int evr_photon_gather_cell(const evr_photon_buffer *b, int x, int y, evr_v3 p,
+                                                evr_v3 n, float lim2, float normal_cos, float s2,
+                                                float acc[3], float *area_w)
 {
     const size_t npix = (size_t)b->width * (size_t)b->height;
     int l, nl, used = 0;
     if (x < 0 || y < 0 || x >= b->width || y >= b->height) return 0;
     size_t i = (size_t)y * (size_t)b->width + (size_t)x;
-    if (b->gbuf) {   /* the kernel's integral over the surfaces the camera sees here */
+    if (b->gbuf) { /* the kernel's integral over the surfaces the camera sees here */
         const float *g = b->gbuf + 8 * i;
         evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
         float d2 = evr_v3_dot(d, d);
@@ -88,8 +106,10 @@ typedef struct {
     float pix, r, r2, s2;
 } evr_gather_window;
 
-EVR_HD static inline evr_gather_window evr_photon_gather_window(const evr_photon_buffer *b, const evr_camera_intr *cam, int px,
-                                                                int py, float cam_dist, const evr_gather_params *gp)
+EVR_HD static inline evr_gather_window evr_photon_gather_window(const evr_photon_buffer *b,
+                                                                const evr_camera_intr *cam, int px,
+                                                                int py, float cam_dist,
+                                                                const evr_gather_params *gp)
 {
     evr_gather_window w;
     const float r = gp->radius;
@@ -107,7 +127,8 @@ EVR_HD static inline evr_gather_window evr_photon_gather_window(const evr_photon
 /* After the search stopped at ring stop (max photons reached): the disk the rings searched surely
  * cover (radius stop pixel sizes, at least half a pixel, at most r), returned as its radius^2,
  * and the rings that hold all of it (*rings: p lies anywhere in its pixel, one ring further). */
-EVR_HD static inline float evr_photon_gather_shrink(const evr_gather_window *w, int stop, int *rings)
+EVR_HD static inline float evr_photon_gather_shrink(const evr_gather_window *w, int stop,
+                                                    int *rings)
 {
     float rho = fminf(w->r, fmaxf((float)stop, 0.5f) * w->pix);
     *rings = stop + 1 < w->h ? stop + 1 : w->h;
@@ -117,7 +138,8 @@ EVR_HD static inline float evr_photon_gather_shrink(const evr_gather_window *w, 
 /* The irradiance from the sums over the disk of radius^2 lim2: the Gaussian's integral over the
  * disk, scaled by the share of the disk on surfaces like the query's where the disk spans enough
  * cells to measure it (the camera's view of the cells). */
-EVR_HD static inline void evr_photon_gather_finish(const evr_photon_buffer *b, const evr_gather_window *w, float lim2,
+EVR_HD static inline void evr_photon_gather_finish(const evr_photon_buffer *b,
+                                                   const evr_gather_window *w, float lim2,
                                                    const float acc[3], float area_w, float e_rgb[3])
 {
     float z = 2.0f * EVR_PI * w->s2 * (1.0f - expf(-lim2 / (2.0f * w->s2)));
@@ -131,9 +153,10 @@ EVR_HD static inline void evr_photon_gather_finish(const evr_photon_buffer *b, c
 /* Sums the photons of rings 0 .. rings of the window around cell (cx, cy) that lie within
  * sqrt(lim2) of p with a normal within the cosine; stops in the cell where max photons are
  * reached (returns the ring where it stopped in *stop_ring, or -1 when it did not stop). */
-EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int cx, int cy, int rings, evr_v3 p,
-                                                 evr_v3 n, float lim2, float normal_cos, float s2, int max,
-                                                 float acc[3], int *stop_ring, float *area_w)
+EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int cx, int cy,
+                                                 int rings, evr_v3 p, evr_v3 n, float lim2,
+                                                 float normal_cos, float s2, int max, float acc[3],
+                                                 int *stop_ring, float *area_w)
 {
     int r, side, o, used = 0;
     acc[0] = acc[1] = acc[2] = 0.0f;
@@ -150,7 +173,8 @@ EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int
             for (o = 0; o < 2 * r; o++) {
                 int dx = side == 0 ? -r + o : side == 1 ? r : side == 2 ? r - o : -r;
                 int dy = side == 0 ? -r : side == 1 ? -r + o : side == 2 ? r : r - o;
-                used += evr_photon_gather_cell(b, cx + dx, cy + dy, p, n, lim2, normal_cos, s2, acc, area_w);
+                used += evr_photon_gather_cell(b, cx + dx, cy + dy, p, n, lim2, normal_cos, s2, acc,
+                                               area_w);
                 if (used >= max) {
                     *stop_ring = r;
                     return used;
@@ -169,19 +193,21 @@ EVR_HD static inline int evr_photon_gather_rings(const evr_photon_buffer *b, int
  * cover (evr_photon_gather_shrink) and the estimate is every photon in that disk: on a surface
  * seen at a grazing angle the window reaches far along the surface but not across, and the
  * farthest photon taken would overstate the disk. Returns the photons used. */
-EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr_camera_intr *cam, int px, int py,
-                                           evr_v3 p, evr_v3 n, float cam_dist, const evr_gather_params *gp,
-                                           float e_rgb[3])
+EVR_HD static inline int evr_photon_gather(const evr_photon_buffer *b, const evr_camera_intr *cam,
+                                           int px, int py, evr_v3 p, evr_v3 n, float cam_dist,
+                                           const evr_gather_params *gp, float e_rgb[3])
 {
     const evr_gather_window w = evr_photon_gather_window(b, cam, px, py, cam_dist, gp);
     float acc[3], lim2 = w.r2, area_w;
     int stop, used;
-    const int max = gp->max_photons > 0 ? gp->max_photons : 0x7fffffff;   /* 0: no limit */
-    used = evr_photon_gather_rings(b, w.cx, w.cy, w.h, p, n, lim2, gp->normal_cos, w.s2, max, acc, &stop, &area_w);
-    if (stop >= 0) {   /* the limit: the disk the rings searched cover, all of its photons */
+    const int max = gp->max_photons > 0 ? gp->max_photons : 0x7fffffff; /* 0: no limit */
+    used = evr_photon_gather_rings(b, w.cx, w.cy, w.h, p, n, lim2, gp->normal_cos, w.s2, max, acc,
+                                   &stop, &area_w);
+    if (stop >= 0) { /* the limit: the disk the rings searched cover, all of its photons */
         int rings;
         lim2 = evr_photon_gather_shrink(&w, stop, &rings);
-        used = evr_photon_gather_rings(b, w.cx, w.cy, rings, p, n, lim2, gp->normal_cos, w.s2, 0x7fffffff, acc, &stop, &area_w);
+        used = evr_photon_gather_rings(b, w.cx, w.cy, rings, p, n, lim2, gp->normal_cos, w.s2,
+                                       0x7fffffff, acc, &stop, &area_w);
     }
     evr_photon_gather_finish(b, &w, lim2, acc, area_w, e_rgb);
     return used;

@@ -10,7 +10,8 @@
 
 /* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s of material
  * mat: the diffuse share of the albedo over pi. */
-EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_material_params *mat, float k_rgb[3])
+EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s,
+                                                const evr_material_params *mat, float k_rgb[3])
 {
     float k = evr_material_diffuse_k(mat);
     k_rgb[0] = s->albedo[0] * k;
@@ -20,8 +21,8 @@ EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, const evr_
 
 /* Indirect radiance leaving surface s (material mat) from an irradiance estimate: the diffuse
  * share of the albedo over pi, per RGB channel (add its luminance to evr_surface_intensity). */
-EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_params *mat, const float e_rgb[3],
-                                              float out_rgb[3])
+EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_params *mat,
+                                              const float e_rgb[3], float out_rgb[3])
 {
     float k[3];
     evr_photon_indirect_k(s, mat, k);
@@ -39,8 +40,8 @@ typedef struct evr_gather_point {
     float k[3];
 } evr_gather_point;
 
-EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_params *mat, evr_v3 cam_org,
-                                              evr_gather_point *g)
+EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_params *mat,
+                                              evr_v3 cam_org, evr_gather_point *g)
 {
     g->p = s->p;
     g->n = s->n;
@@ -49,9 +50,11 @@ EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_ma
 }
 
 /* max_photons 0: gather point g's query and window in b (pixel (x, y)). */
-EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_buffer *b, const evr_camera_intr *cam,
-                                                              const evr_gather_params *gp, const evr_gather_point *g, int x, int y,
-                                                              evr_sum_query *q)
+EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_buffer *b,
+                                                              const evr_camera_intr *cam,
+                                                              const evr_gather_params *gp,
+                                                              const evr_gather_point *g, int x,
+                                                              int y, evr_sum_query *q)
 {
     const evr_gather_window w = evr_photon_gather_window(b, cam, x, y, g->dist, gp);
     q->p = g->p;
@@ -67,16 +70,22 @@ EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_b
 
 /* max_photons 0: the luminance of the indirect light leaving gather point g (pixel (x, y)) from
  * its fixed-point sums s over buffer b (any buffer of b's shape: only its shape is read). */
-EVR_HD static inline float evr_gather_sum_lum(const evr_photon_buffer *b, const evr_camera_intr *cam, const evr_gather_params *gp,
-                                              const evr_gather_point *g, int x, int y, const evr_gather_sum *s)
+EVR_HD static inline float evr_gather_sum_lum(const evr_photon_buffer *b,
+                                              const evr_camera_intr *cam,
+                                              const evr_gather_params *gp,
+                                              const evr_gather_point *g, int x, int y,
+                                              const evr_gather_sum *s)
 {
     const evr_gather_window w = evr_photon_gather_window(b, cam, x, y, g->dist, gp);
     return evr_photon_gather_sum_finish(b, &w, gp, s);
 }
 
 /* max_photons 0: the sums of gather point g's window in b (pixel (x, y)). */
-EVR_HD static inline void evr_gather_point_sum(const evr_photon_buffer *b, const evr_camera_intr *cam, const evr_gather_params *gp,
-                                               const evr_gather_point *g, int x, int y, evr_gather_sum *s)
+EVR_HD static inline void evr_gather_point_sum(const evr_photon_buffer *b,
+                                               const evr_camera_intr *cam,
+                                               const evr_gather_params *gp,
+                                               const evr_gather_point *g, int x, int y,
+                                               evr_gather_sum *s)
 {
     evr_sum_query q;
     const evr_gather_window w = evr_gather_point_query(b, cam, gp, g, x, y, &q);
@@ -85,9 +94,11 @@ EVR_HD static inline void evr_gather_point_sum(const evr_photon_buffer *b, const
 
 /* max_photons 0: s, gather point g's sums over prev, becomes its sums over cur (ch: the cells
  * that changed from prev to cur). */
-EVR_HD static inline void evr_gather_point_delta(const evr_photon_buffer *cur, const evr_photon_buffer *prev,
-                                                 const evr_changed_cells *ch, const evr_camera_intr *cam, const evr_gather_params *gp,
-                                                 const evr_gather_point *g, int x, int y, evr_gather_sum *s)
+EVR_HD static inline void
+evr_gather_point_delta(const evr_photon_buffer *cur, const evr_photon_buffer *prev,
+                       const evr_changed_cells *ch, const evr_camera_intr *cam,
+                       const evr_gather_params *gp, const evr_gather_point *g, int x, int y,
+                       evr_gather_sum *s)
 {
     evr_sum_query q;
     const evr_gather_window w = evr_gather_point_query(cur, cam, gp, g, x, y, &q);
@@ -96,8 +107,10 @@ EVR_HD static inline void evr_gather_point_delta(const evr_photon_buffer *cur, c
 
 /* Luminance of the indirect light leaving gather point g seen through image pixel (x, y): the
  * limited search, or with max_photons 0 the fixed-point sums. */
-EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
-                                                const evr_gather_params *gp, const evr_gather_point *g, int x, int y)
+EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b,
+                                                const evr_camera_intr *cam,
+                                                const evr_gather_params *gp,
+                                                const evr_gather_point *g, int x, int y)
 {
     float e[3];
     if (gp->max_photons <= 0) {
@@ -117,16 +130,14 @@ EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b, cons
  * segment's indirect light a step: 60% of GI events within a tenth of a segment of a boundary).
  * fmaf: the same rounding on every backend and in every kernel, and exactly ls where le == ls
  * (still windows keep their light bit for bit). */
-EVR_HD static inline float evr_gi_lerp(float ls, float le, float f)
-{
-    return fmaf(f, le - ls, ls);
-}
+EVR_HD static inline float evr_gi_lerp(float ls, float le, float f) { return fmaf(f, le - ls, ls); }
 
 /* Luminance of the indirect light leaving surface s (material mat) seen from cam_org through
  * image pixel (x, y): the gather and the diffuse share. */
-EVR_HD static inline float evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
-                                                   const evr_gather_params *gp, const evr_material_params *mat,
-                                                   const evr_surface *s, evr_v3 cam_org, int x, int y)
+EVR_HD static inline float
+evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
+                        const evr_gather_params *gp, const evr_material_params *mat,
+                        const evr_surface *s, evr_v3 cam_org, int x, int y)
 {
     evr_gather_point g;
     evr_gather_point_at(s, mat, cam_org, &g);

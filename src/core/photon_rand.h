@@ -27,12 +27,14 @@ EVR_HD static inline float evr_photon_rand(uint64_t seed, int e, uint32_t j, int
 {
     if (dim < 5) {
         const uint32_t bases[5] = {2, 3, 5, 7, 11};
-        float x = evr_radical_inverse(j + 1u, bases[dim]) +
-                  evr_uniform(evr_hash4(seed, (uint64_t)e, 0x73686966ull /* "shif" */, (uint64_t)dim));
+        float x =
+            evr_radical_inverse(j + 1u, bases[dim]) +
+            evr_uniform(evr_hash4(seed, (uint64_t)e, 0x73686966ull /* "shif" */, (uint64_t)dim));
         x -= floorf(x);
         return fminf(x, 0.99999994f);
     }
-    return evr_uniform(evr_hash4(seed ^ 0x70686f746f6eull /* "photon" */, (uint64_t)e, (uint64_t)j, (uint64_t)dim));
+    return evr_uniform(evr_hash4(seed ^ 0x70686f746f6eull /* "photon" */, (uint64_t)e, (uint64_t)j,
+                                 (uint64_t)dim));
 }
 
 /* Normalized segment time of photon j: f0 + (f1 - f0) * frac(j * golden ratio). */

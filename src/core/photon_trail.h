@@ -20,10 +20,11 @@
 #define EVR_TRAIL_NONE 0xffffffffu
 
 typedef struct {
-    evr_photon ph;         /* what the path stored */
-    uint32_t cell;         /* its buffer cell; EVR_TRAIL_NONE: nothing stored (or no trail yet) */
-    uint16_t n;            /* rays recorded */
-    uint8_t clean, started;   /* clean: see above; started: the path had a start (evr_photon_path_start) */
+    evr_photon ph; /* what the path stored */
+    uint32_t cell; /* its buffer cell; EVR_TRAIL_NONE: nothing stored (or no trail yet) */
+    uint16_t n;    /* rays recorded */
+    uint8_t clean,
+        started; /* clean: see above; started: the path had a start (evr_photon_path_start) */
 } evr_photon_trail;
 
 typedef struct {
@@ -47,31 +48,37 @@ EVR_HD static inline void evr_photon_trail_begin(evr_photon_trail *t, const evr_
 }
 
 /* Records a ray of the path (len: the trail's capacity; a ray beyond it leaves the trail unclean). */
-EVR_HD static inline void evr_photon_trail_ray(evr_photon_trail *t, evr_trail_ray *rays, int len, const evr_skip_plan *pl,
-                                               evr_ray r, float tmax)
+EVR_HD static inline void evr_photon_trail_ray(evr_photon_trail *t, evr_trail_ray *rays, int len,
+                                               const evr_skip_plan *pl, evr_ray r, float tmax)
 {
-    if (!t->clean) return;   /* never reused: nothing more to keep */
+    if (!t->clean) return; /* never reused: nothing more to keep */
     if (t->n >= len || evr_skip_ray_meets_any(pl, r.org, r.dir, tmax)) {
         t->clean = 0;
         return;
     }
     evr_trail_ray *k = &rays[t->n++];
-    k->org[0] = r.org.x; k->org[1] = r.org.y; k->org[2] = r.org.z;
-    k->dir[0] = r.dir.x; k->dir[1] = r.dir.y; k->dir[2] = r.dir.z;
+    k->org[0] = r.org.x;
+    k->org[1] = r.org.y;
+    k->org[2] = r.org.z;
+    k->dir[0] = r.dir.x;
+    k->dir[1] = r.dir.y;
+    k->dir[2] = r.dir.z;
     k->tmax = tmax;
 }
 
 /* Whether a pass of plan pl may take the trail's outcome: clean, and none of its rays meets
  * what moves in the segment. The caller checks that the camera, lights and emitters are those
  * of the pass that recorded it. */
-EVR_HD static inline int evr_photon_trail_reusable(const evr_photon_trail *t, const evr_trail_ray *rays, const evr_skip_plan *pl)
+EVR_HD static inline int evr_photon_trail_reusable(const evr_photon_trail *t,
+                                                   const evr_trail_ray *rays,
+                                                   const evr_skip_plan *pl)
 {
     int k;
     if (!t->clean || !pl->reuse) return 0;
     for (k = 0; k < (int)t->n; k++) {
         const evr_trail_ray *r = &rays[k];
-        if (evr_skip_ray_meets_any(pl, evr_v3_make(r->org[0], r->org[1], r->org[2]), evr_v3_make(r->dir[0], r->dir[1], r->dir[2]),
-                                   r->tmax))
+        if (evr_skip_ray_meets_any(pl, evr_v3_make(r->org[0], r->org[1], r->org[2]),
+                                   evr_v3_make(r->dir[0], r->dir[1], r->dir[2]), r->tmax))
             return 0;
     }
     return 1;

@@ -51,55 +51,56 @@
 
 /* cutoff law offset: a black pixel keeps 7.3% of the cutoff */
 #define EVR_CUTOFF_DARK (20.0f / 255.0f)
-#define EVR_SHOT_BRIGHT 0.25f              /* shot noise at full brightness / shot noise of a black pixel */
-#define EVR_JITTER_CLIP 4.0f               /* timestamp jitter is clipped to this many sigma */
+#define EVR_SHOT_BRIGHT 0.25f /* shot noise at full brightness / shot noise of a black pixel */
+#define EVR_JITTER_CLIP 4.0f  /* timestamp jitter is clipped to this many sigma */
 
 /* Fixed counters of the per-pixel random streams. */
-#define EVR_TAG_THRES 0x7468726573ull      /* "thres" */
-#define EVR_TAG_LEAK 0x6c65616bull         /* "leak" */
-#define EVR_TAG_HOT 0x686f74ull            /* "hot" */
-#define EVR_TAG_NOISE 0x6e6f697365ull      /* "noise" */
-#define EVR_TAG_JITTER 0x6a6974746572ull   /* "jitter" */
+#define EVR_TAG_THRES 0x7468726573ull    /* "thres" */
+#define EVR_TAG_LEAK 0x6c65616bull       /* "leak" */
+#define EVR_TAG_HOT 0x686f74ull          /* "hot" */
+#define EVR_TAG_NOISE 0x6e6f697365ull    /* "noise" */
+#define EVR_TAG_JITTER 0x6a6974746572ull /* "jitter" */
 
 typedef struct {
     /* run-wide */
-    float pos_thres, neg_thres;   /* log-intensity contrast thresholds (> 0); per pixel after evr_pixel_params_at */
-    float refractory;             /* seconds */
-    float log_floor;              /* below this intensity the response is linear */
-    float sigma_thres;            /* threshold mismatch, log units (0: off) */
-    float cutoff_hz;              /* photoreceptor cutoff at full brightness (0: no filter) */
-    float full_intensity;         /* intensity of full brightness (bandwidth and shot-noise laws) */
-    float leak_rate;              /* mean leak ON events per second (0: off) */
-    float leak_jitter;            /* relative spread of the per-pixel leak rate */
-    float shot_rate;              /* shot-noise events per second (ON + OFF) of a black pixel (0: off) */
-    float hot_fraction;           /* fraction of hot pixels */
-    float hot_rate;               /* ON events per second of a hot pixel */
-    float time_jitter;            /* timestamp jitter, seconds (0: off) */
-    int time_res_us;              /* timestamp quantum, microseconds (<= 1: 1 us) */
+    float pos_thres,
+        neg_thres; /* log-intensity contrast thresholds (> 0); per pixel after evr_pixel_params_at */
+    float refractory;     /* seconds */
+    float log_floor;      /* below this intensity the response is linear */
+    float sigma_thres;    /* threshold mismatch, log units (0: off) */
+    float cutoff_hz;      /* photoreceptor cutoff at full brightness (0: no filter) */
+    float full_intensity; /* intensity of full brightness (bandwidth and shot-noise laws) */
+    float leak_rate;      /* mean leak ON events per second (0: off) */
+    float leak_jitter;    /* relative spread of the per-pixel leak rate */
+    float shot_rate;      /* shot-noise events per second (ON + OFF) of a black pixel (0: off) */
+    float hot_fraction;   /* fraction of hot pixels */
+    float hot_rate;       /* ON events per second of a hot pixel */
+    float time_jitter;    /* timestamp jitter, seconds (0: off) */
+    int time_res_us;      /* timestamp quantum, microseconds (<= 1: 1 us) */
     uint64_t seed;
     /* per pixel, set by evr_pixel_params_at (0 in the run-wide parameters) */
-    float leak;                   /* reference drift, log units per second */
-    float leak_phase;             /* initial reference offset, in ON thresholds below the first level */
-    float hot;                    /* this pixel's hot-pixel rate (0: not hot) */
-    float noise_rate;             /* rate of noise candidates: hot + shot_rate */
-    uint64_t key;                 /* the pixel's noise stream */
+    float leak;       /* reference drift, log units per second */
+    float leak_phase; /* initial reference offset, in ON thresholds below the first level */
+    float hot;        /* this pixel's hot-pixel rate (0: not hot) */
+    float noise_rate; /* rate of noise candidates: hot + shot_rate */
+    uint64_t key;     /* the pixel's noise stream */
 } evr_pixel_params;
 
 /* 32 bytes: it is copied per pixel per segment on the GPU. */
 typedef struct {
     /* the ideal model's state (its first 24 bytes, as before the sensor model) */
-    float ref;          /* reference log level at t_prev */
-    float l_prev;       /* (filtered) log intensity at the previous sample */
-    float t_prev;       /* time of the previous sample */
-    float refr_end;     /* end of the refractory period, while blind */
-    float intensity;    /* linear intensity at the previous sample (previews, bandwidth, shot noise) */
-    uint16_t started;   /* 0 until the first sample */
-    uint16_t blind;     /* 1 from an event until its refractory period ends and the reference resets */
+    float ref;       /* reference log level at t_prev */
+    float l_prev;    /* (filtered) log intensity at the previous sample */
+    float t_prev;    /* time of the previous sample */
+    float refr_end;  /* end of the refractory period, while blind */
+    float intensity; /* linear intensity at the previous sample (previews, bandwidth, shot noise) */
+    uint16_t started; /* 0 until the first sample */
+    uint16_t blind; /* 1 from an event until its refractory period ends and the reference resets */
     /* noise */
-    float noise_t;      /* time of the next noise candidate */
-    uint32_t noise_n;   /* index of that candidate in the pixel's noise stream */
+    float noise_t;    /* time of the next noise candidate */
+    uint32_t noise_n; /* index of that candidate in the pixel's noise stream */
     /* change-driven sampling (core/skip.h) */
-    float cache_dist;   /* hit distance of the last traced sample when its intensity may be reused
+    float cache_dist; /* hit distance of the last traced sample when its intensity may be reused
                            (INFINITY: it hit nothing), negative when it may not */
 } evr_pixel_state;
 
@@ -108,21 +109,23 @@ typedef struct {
  * inside the interval. */
 typedef struct {
     float t0, l0, t1, l1;
-    float cursor;       /* time up to which events have been emitted */
-    float i0, i1;       /* linear intensities at both ends */
-    float drift;        /* leak drift over the interval, taken off the reference at its end */
+    float cursor; /* time up to which events have been emitted */
+    float i0, i1; /* linear intensities at both ends */
+    float drift;  /* leak drift over the interval, taken off the reference at its end */
 } evr_pixel_span;
 
 /* 1 when every non-ideality is off: backends may then run the plain model (the GPU compiles a
  * kernel without the sensor code). */
 EVR_HD static inline int evr_pixel_params_ideal(const evr_pixel_params *p)
 {
-    return p->sigma_thres == 0.0f && p->cutoff_hz == 0.0f && p->leak_rate == 0.0f && p->shot_rate == 0.0f &&
-           (p->hot_fraction == 0.0f || p->hot_rate == 0.0f) && p->time_jitter == 0.0f && p->time_res_us <= 1;
+    return p->sigma_thres == 0.0f && p->cutoff_hz == 0.0f && p->leak_rate == 0.0f &&
+           p->shot_rate == 0.0f && (p->hot_fraction == 0.0f || p->hot_rate == 0.0f) &&
+           p->time_jitter == 0.0f && p->time_res_us <= 1;
 }
 
 /* The parameters of pixel (x, y): its fixed-pattern thresholds, leak and hot-pixel rate. */
-EVR_HD static inline void evr_pixel_params_at(const evr_pixel_params *run, int x, int y, evr_pixel_params *p)
+EVR_HD static inline void evr_pixel_params_at(const evr_pixel_params *run, int x, int y,
+                                              evr_pixel_params *p)
 {
     *p = *run;
     p->leak = 0.0f;
@@ -142,10 +145,12 @@ EVR_HD static inline void evr_pixel_params_at(const evr_pixel_params *run, int x
         p->leak_phase = evr_uniform(evr_mix64(h));
     }
     if (run->hot_fraction > 0.0f && run->hot_rate > 0.0f &&
-        evr_uniform(evr_hash4(run->seed, (uint64_t)x, (uint64_t)y, EVR_TAG_HOT)) < run->hot_fraction)
+        evr_uniform(evr_hash4(run->seed, (uint64_t)x, (uint64_t)y, EVR_TAG_HOT)) <
+            run->hot_fraction)
         p->hot = run->hot_rate;
     p->noise_rate = p->hot + run->shot_rate;
-    p->key = p->noise_rate > 0.0f ? evr_hash4(run->seed, (uint64_t)x, (uint64_t)y, EVR_TAG_NOISE) : 0;
+    p->key =
+        p->noise_rate > 0.0f ? evr_hash4(run->seed, (uint64_t)x, (uint64_t)y, EVR_TAG_NOISE) : 0;
 }
 
 /* Log response with a linear segment below the floor (value and slope continuous), so that
@@ -159,13 +164,15 @@ EVR_HD static inline float evr_log_response(float intensity, float floor_)
 /* Intensity as a fraction of full brightness, in [0, 1]. */
 EVR_HD static inline float evr_intensity_fraction(const evr_pixel_params *p, float intensity)
 {
-    return p->full_intensity > 0.0f ? fminf(fmaxf(intensity / p->full_intensity, 0.0f), 1.0f) : 1.0f;
+    return p->full_intensity > 0.0f ? fminf(fmaxf(intensity / p->full_intensity, 0.0f), 1.0f)
+                                    : 1.0f;
 }
 
 /* Time constant of the photoreceptor at this intensity: 1 / (2 pi f_c), f_c as above. */
 EVR_HD static inline float evr_lowpass_tau(const evr_pixel_params *p, float intensity)
 {
-    float fc = p->cutoff_hz * (evr_intensity_fraction(p, intensity) + EVR_CUTOFF_DARK) / (1.0f + EVR_CUTOFF_DARK);
+    float fc = p->cutoff_hz * (evr_intensity_fraction(p, intensity) + EVR_CUTOFF_DARK) /
+               (1.0f + EVR_CUTOFF_DARK);
     return 1.0f / (6.28318530718f * fc);
 }
 
@@ -175,7 +182,7 @@ EVR_HD static inline float evr_lowpass_step(float y0, float a, float b, float dt
 {
     if (!(dt > 0.0f)) return y0;
     float x = dt / tau;
-    float em1 = expm1f(-x);                       /* e^(-x) - 1, accurate for small x */
+    float em1 = expm1f(-x); /* e^(-x) - 1, accurate for small x */
     return b + (y0 - a) * (1.0f + em1) + (b - a) * (em1 / x);
 }
 
@@ -219,8 +226,8 @@ EVR_HD static inline void evr_pixel_reset(evr_pixel_state *s)
  * measured 40% slower on the square demo). Both forms give bit-identical events when everything
  * is off (tests/test_noise.c). */
 
-EVR_HD static inline int evr_pixel_begin_ideal(evr_pixel_state *s, float log_floor, float t, float intensity,
-                                               evr_pixel_span *sp)
+EVR_HD static inline int evr_pixel_begin_ideal(evr_pixel_state *s, float log_floor, float t,
+                                               float intensity, evr_pixel_span *sp)
 {
     float l = evr_log_response(intensity, log_floor);
     if (!s->started) {
@@ -242,11 +249,11 @@ EVR_HD static inline int evr_pixel_begin_ideal(evr_pixel_state *s, float log_flo
 
 /* Starts a new sample (t, intensity). Returns 0 for the pixel's very first sample, which only
  * sets the reference (no events can come from it). */
-EVR_HD static inline int evr_pixel_begin_s(evr_pixel_state *s, const evr_pixel_params *p, float t, float intensity,
-                                           evr_pixel_span *sp, const int sensor)
+EVR_HD static inline int evr_pixel_begin_s(evr_pixel_state *s, const evr_pixel_params *p, float t,
+                                           float intensity, evr_pixel_span *sp, const int sensor)
 {
     if (!sensor) {
-        sp->i0 = sp->i1 = sp->drift = 0.0f;   /* unused by the ideal model */
+        sp->i0 = sp->i1 = sp->drift = 0.0f; /* unused by the ideal model */
         return evr_pixel_begin_ideal(s, p->log_floor, t, intensity, sp);
     }
     float l = evr_log_response(intensity, p->log_floor);
@@ -257,7 +264,7 @@ EVR_HD static inline int evr_pixel_begin_s(evr_pixel_state *s, const evr_pixel_p
         s->l_prev = l;
         s->t_prev = t;
         s->intensity = intensity;
-        if (p->noise_rate > 0.0f) {   /* the process runs from the start of this first segment */
+        if (p->noise_rate > 0.0f) { /* the process runs from the start of this first segment */
             s->noise_n = 0;
             s->noise_t = evr_noise_gap(p, 0);
             while (s->noise_t < t) {
@@ -269,8 +276,8 @@ EVR_HD static inline int evr_pixel_begin_s(evr_pixel_state *s, const evr_pixel_p
     }
     float y = l;
     if (p->cutoff_hz > 0.0f)
-        y = evr_lowpass_step(s->l_prev, evr_log_response(s->intensity, p->log_floor), l, t - s->t_prev,
-                             evr_lowpass_tau(p, 0.5f * (s->intensity + intensity)));
+        y = evr_lowpass_step(s->l_prev, evr_log_response(s->intensity, p->log_floor), l,
+                             t - s->t_prev, evr_lowpass_tau(p, 0.5f * (s->intensity + intensity)));
     sp->t0 = s->t_prev;
     sp->l0 = s->l_prev;
     sp->t1 = t;
@@ -289,8 +296,8 @@ EVR_HD static inline int evr_pixel_begin_s(evr_pixel_state *s, const evr_pixel_p
     return 1;
 }
 
-EVR_HD static inline int evr_pixel_begin(evr_pixel_state *s, const evr_pixel_params *p, float t, float intensity,
-                                         evr_pixel_span *sp)
+EVR_HD static inline int evr_pixel_begin(evr_pixel_state *s, const evr_pixel_params *p, float t,
+                                         float intensity, evr_pixel_span *sp)
 {
     return evr_pixel_begin_s(s, p, t, intensity, sp, 1);
 }
@@ -310,7 +317,8 @@ EVR_HD static inline float evr_span_level_at(const evr_pixel_span *sp, float t)
 
 /* Takes the pixel's next noise candidate (at s->noise_t, inside the span): returns its polarity,
  * or -1 when thinning drops it. */
-EVR_HD static inline int evr__noise_take(evr_pixel_state *s, const evr_pixel_params *p, const evr_pixel_span *sp)
+EVR_HD static inline int evr__noise_take(evr_pixel_state *s, const evr_pixel_params *p,
+                                         const evr_pixel_span *sp)
 {
     uint64_t h = evr_noise_hash(p, s->noise_n);
     float r = (float)((h >> 16) & 0xffffffu) * (1.0f / 16777216.0f) * p->noise_rate;
@@ -327,13 +335,14 @@ EVR_HD static inline int evr__noise_take(evr_pixel_state *s, const evr_pixel_par
     return pol;
 }
 
-EVR_HD static inline int evr_pixel_next_ideal(evr_pixel_state *s, float pos_thres, float neg_thres, float refractory,
-                                              evr_pixel_span *sp, float *t_event, int *polarity)
+EVR_HD static inline int evr_pixel_next_ideal(evr_pixel_state *s, float pos_thres, float neg_thres,
+                                              float refractory, evr_pixel_span *sp, float *t_event,
+                                              int *polarity)
 {
     if (s->blind) {
-        if (s->refr_end > sp->t1) return 0;           /* blind for the rest of this span */
+        if (s->refr_end > sp->t1) return 0; /* blind for the rest of this span */
         sp->cursor = fmaxf(sp->cursor, s->refr_end);
-        s->ref = evr_span_level_at(sp, sp->cursor);   /* reset when the pixel wakes up */
+        s->ref = evr_span_level_at(sp, sp->cursor); /* reset when the pixel wakes up */
         s->blind = 0;
     }
     if (sp->l1 - s->ref >= pos_thres) {
@@ -359,21 +368,24 @@ EVR_HD static inline int evr_pixel_next_ideal(evr_pixel_state *s, float pos_thre
 
 /* Emits the next event of the span, if any: its time (relative to the segment) and polarity
  * (1 ON, 0 OFF). Call until it returns 0, then evr_pixel_end. */
-EVR_HD static inline int evr_pixel_next_s(evr_pixel_state *s, const evr_pixel_params *p, evr_pixel_span *sp,
-                                          float *t_event, int *polarity, const int sensor)
+EVR_HD static inline int evr_pixel_next_s(evr_pixel_state *s, const evr_pixel_params *p,
+                                          evr_pixel_span *sp, float *t_event, int *polarity,
+                                          const int sensor)
 {
-    if (!sensor) return evr_pixel_next_ideal(s, p->pos_thres, p->neg_thres, p->refractory, sp, t_event, polarity);
+    if (!sensor)
+        return evr_pixel_next_ideal(s, p->pos_thres, p->neg_thres, p->refractory, sp, t_event,
+                                    polarity);
     for (;;) {
         if (s->blind) {
-            if (p->noise_rate > 0.0f) {   /* candidates while blind are lost */
+            if (p->noise_rate > 0.0f) { /* candidates while blind are lost */
                 while (s->noise_t < s->refr_end && s->noise_t <= sp->t1) {
                     s->noise_n++;
                     s->noise_t += evr_noise_gap(p, s->noise_n);
                 }
             }
-            if (s->refr_end > sp->t1) return 0;           /* blind for the rest of this span */
+            if (s->refr_end > sp->t1) return 0; /* blind for the rest of this span */
             sp->cursor = fmaxf(sp->cursor, s->refr_end);
-            s->ref = evr_span_level_at(sp, sp->cursor);   /* reset when the pixel wakes up */
+            s->ref = evr_span_level_at(sp, sp->cursor); /* reset when the pixel wakes up */
             s->blind = 0;
         }
         float level = 0.0f, t = 0.0f;
@@ -390,10 +402,10 @@ EVR_HD static inline int evr_pixel_next_s(evr_pixel_state *s, const evr_pixel_pa
         if (p->noise_rate > 0.0f && s->noise_t <= sp->t1 && (pol < 0 || s->noise_t < t)) {
             float tn = fmaxf(s->noise_t, sp->cursor);
             int np = evr__noise_take(s, p, sp);
-            if (np < 0) continue;                         /* thinned out: look again */
+            if (np < 0) continue; /* thinned out: look again */
             t = tn;
             pol = np;
-            level = evr_span_level_at(sp, tn);            /* a noise event resets the pixel */
+            level = evr_span_level_at(sp, tn); /* a noise event resets the pixel */
         } else if (pol < 0) {
             return 0;
         }
@@ -409,31 +421,36 @@ EVR_HD static inline int evr_pixel_next_s(evr_pixel_state *s, const evr_pixel_pa
     }
 }
 
-EVR_HD static inline int evr_pixel_next(evr_pixel_state *s, const evr_pixel_params *p, evr_pixel_span *sp,
-                                        float *t_event, int *polarity)
+EVR_HD static inline int evr_pixel_next(evr_pixel_state *s, const evr_pixel_params *p,
+                                        evr_pixel_span *sp, float *t_event, int *polarity)
 {
     return evr_pixel_next_s(s, p, sp, t_event, polarity, 1);
 }
 
-EVR_HD static inline void evr_pixel_end_s(evr_pixel_state *s, const evr_pixel_span *sp, const int sensor)
+EVR_HD static inline void evr_pixel_end_s(evr_pixel_state *s, const evr_pixel_span *sp,
+                                          const int sensor)
 {
-    if (!sensor) {   /* the ideal model keeps its previous sample here */
+    if (!sensor) { /* the ideal model keeps its previous sample here */
         s->l_prev = sp->l1;
         s->t_prev = sp->t1;
         return;
     }
-    s->ref -= sp->drift;   /* back from the reference's moving frame */
+    s->ref -= sp->drift; /* back from the reference's moving frame */
 }
 
-EVR_HD static inline void evr_pixel_end(evr_pixel_state *s, const evr_pixel_span *sp) { evr_pixel_end_s(s, sp, 1); }
+EVR_HD static inline void evr_pixel_end(evr_pixel_state *s, const evr_pixel_span *sp)
+{
+    evr_pixel_end_s(s, sp, 1);
+}
 
 /* The ideal pixel given the same intensity at each of its remaining samples in the segment, the
  * last at time t_last: 1 when none of them can change anything but the previous sample, i.e. the
  * pixel is awake and its log intensity lies within both thresholds of the reference, or it stays
  * blind past t_last. Then evr_pixel_quiet_finish leaves it exactly as those samples through
  * evr_pixel_begin_ideal / next / end would (a pixel that keeps its intensity skips them). */
-EVR_HD static inline int evr_pixel_quiet_ideal(const evr_pixel_state *s, float log_floor, float pos_thres, float neg_thres,
-                                               float intensity, float t_last)
+EVR_HD static inline int evr_pixel_quiet_ideal(const evr_pixel_state *s, float log_floor,
+                                               float pos_thres, float neg_thres, float intensity,
+                                               float t_last)
 {
     if (!s->started) return 0;
     if (s->blind) return s->refr_end > t_last;
@@ -441,7 +458,8 @@ EVR_HD static inline int evr_pixel_quiet_ideal(const evr_pixel_state *s, float l
     return l - s->ref < pos_thres && s->ref - l < neg_thres;
 }
 
-EVR_HD static inline void evr_pixel_quiet_finish(evr_pixel_state *s, float log_floor, float intensity, float t_last)
+EVR_HD static inline void evr_pixel_quiet_finish(evr_pixel_state *s, float log_floor,
+                                                 float intensity, float t_last)
 {
     s->l_prev = evr_log_response(intensity, log_floor);
     s->t_prev = t_last;
@@ -458,16 +476,20 @@ EVR_HD static inline void evr_pixel_end_segment(evr_pixel_state *s, float segmen
 
 /* An event's timestamp in microseconds from its absolute time in seconds: jittered, then
  * quantized to the timestamp resolution. */
-EVR_HD static inline long long evr_event_time_us_s(const evr_pixel_params *p, double t, int x, int y, const int sensor)
+EVR_HD static inline long long evr_event_time_us_s(const evr_pixel_params *p, double t, int x,
+                                                   int y, const int sensor)
 {
     if (!sensor) return llround(t * 1e6);
     if (p->time_jitter > 0.0f) {
         float z0, z1;
-        evr_gauss2(evr_hash4(p->seed ^ EVR_TAG_JITTER, (uint64_t)x, (uint64_t)y, (uint64_t)llround(t * 1e6)), &z0, &z1);
+        evr_gauss2(evr_hash4(p->seed ^ EVR_TAG_JITTER, (uint64_t)x, (uint64_t)y,
+                             (uint64_t)llround(t * 1e6)),
+                   &z0, &z1);
         t += (double)(p->time_jitter * fminf(fmaxf(z0, -EVR_JITTER_CLIP), EVR_JITTER_CLIP));
         if (t < 0.0) t = 0.0;
     }
-    if (p->time_res_us > 1) return llround(t * 1e6 / (double)p->time_res_us) * (long long)p->time_res_us;
+    if (p->time_res_us > 1)
+        return llround(t * 1e6 / (double)p->time_res_us) * (long long)p->time_res_us;
     return llround(t * 1e6);
 }
 

@@ -8,7 +8,7 @@
 #include "core/camera.h"
 
 typedef struct {
-    const float *positions, *normals, *uvs;   /* uvs may be NULL */
+    const float *positions, *normals, *uvs; /* uvs may be NULL */
     const uint32_t *indices;
     uint32_t num_triangles;
     int material;
@@ -19,20 +19,20 @@ typedef struct evr_material_params evr_material_params;
 
 typedef struct {
     int width, height;
-    const float *rgba;    /* linear, 4 floats per texel */
+    const float *rgba; /* linear, 4 floats per texel */
 } evr_texture_view;
 
 typedef struct {
-    int type;             /* evr_light_type */
-    int track;            /* motion track index, -1: fixed (pos/dir are world) */
+    int type;  /* evr_light_type */
+    int track; /* motion track index, -1: fixed (pos/dir are world) */
     float color[3];
-    evr_v3 pos, dir;      /* in the track's space */
+    evr_v3 pos, dir; /* in the track's space */
     float cos_inner, cos_outer;
 } evr_light_view;
 
 typedef struct {
     int mesh;
-    int track;            /* motion track of the instance's node */
+    int track; /* motion track of the instance's node */
 } evr_instance_view;
 
 typedef struct {
@@ -46,10 +46,10 @@ typedef struct {
     const evr_motion_key *keys;
     const int *track_offset, *track_count;
     int camera_track;
-    evr_m34 camera_local;           /* camera pose in its track's space */
+    evr_m34 camera_local; /* camera pose in its track's space */
     evr_camera_intr camera;
-    float ambient;                  /* ambient irradiance as a fraction of pi (radiance = albedo * ambient) */
-    float ray_eps;                  /* offset for secondary rays, scaled to the scene */
+    float ambient; /* ambient irradiance as a fraction of pi (radiance = albedo * ambient) */
+    float ray_eps; /* offset for secondary rays, scaled to the scene */
 } evr_render_scene;
 
 EVR_HD static inline evr_motion_track evr_rs_track(const evr_render_scene *rs, int i)

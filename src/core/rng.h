@@ -21,10 +21,16 @@ EVR_HD static inline uint64_t evr_hash4(uint64_t seed, uint64_t a, uint64_t b, u
 }
 
 /* Uniform in [0, 1) with 24 random bits (exact in float). */
-EVR_HD static inline float evr_uniform(uint64_t h) { return (float)(h >> 40) * (1.0f / 16777216.0f); }
+EVR_HD static inline float evr_uniform(uint64_t h)
+{
+    return (float)(h >> 40) * (1.0f / 16777216.0f);
+}
 
 /* Uniform in (0, 1]: never 0, for logarithms. */
-EVR_HD static inline float evr_uniform_pos(uint64_t h) { return ((float)(h >> 40) + 1.0f) * (1.0f / 16777216.0f); }
+EVR_HD static inline float evr_uniform_pos(uint64_t h)
+{
+    return ((float)(h >> 40) + 1.0f) * (1.0f / 16777216.0f);
+}
 
 /* Two independent standard normal values from one hash (Box-Muller on its two 24-bit halves). */
 EVR_HD static inline void evr_gauss2(uint64_t h, float *z0, float *z1)

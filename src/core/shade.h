@@ -10,15 +10,15 @@
 
 /* One light's share at a hit: where it comes from and what it brings, and its shadow ray. */
 typedef struct {
-    evr_v3 wi;             /* towards the light */
-    float e[3];            /* irradiance on a surface facing it */
-    evr_ray ray;           /* the shadow ray, free over [tnear, tfar) when the light is visible */
+    evr_v3 wi;   /* towards the light */
+    float e[3];  /* irradiance on a surface facing it */
+    evr_ray ray; /* the shadow ray, free over [tnear, tfar) when the light is visible */
     float tnear, tfar;
 } evr_light_ray;
 
 /* Light l's share at surface s at time f: 0 when it sends nothing there (no shadow ray needed). */
-EVR_HD static inline int evr_shade_light_ray(const evr_render_scene *rs, int l, float f, const evr_surface *s,
-                                             evr_light_ray *lr)
+EVR_HD static inline int evr_shade_light_ray(const evr_render_scene *rs, int l, float f,
+                                             const evr_surface *s, evr_light_ray *lr)
 {
     float dist;
     if (!evr_light_incident(rs, &rs->lights[l], f, s->p, &lr->wi, &dist, lr->e)) return 0;
@@ -31,14 +31,15 @@ EVR_HD static inline int evr_shade_light_ray(const evr_render_scene *rs, int l, 
 }
 
 /* Adds a visible light's share (evr_shade_light_ray) to acc, s seen along wo. */
-EVR_HD static inline void evr_shade_add_light(const evr_surface *s, evr_v3 wo, const evr_light_ray *lr, float acc[3])
+EVR_HD static inline void evr_shade_add_light(const evr_surface *s, evr_v3 wo,
+                                              const evr_light_ray *lr, float acc[3])
 {
     evr_material_add_light(s, wo, lr->wi, lr->e, acc);
 }
 
 /* Sensor intensity of s seen along wo from the lights' sum acc, plus ambient and emission. */
-EVR_HD static inline float evr_shade_intensity(const evr_render_scene *rs, const evr_surface *s, evr_v3 wo,
-                                               const float acc[3])
+EVR_HD static inline float evr_shade_intensity(const evr_render_scene *rs, const evr_surface *s,
+                                               evr_v3 wo, const float acc[3])
 {
     return evr_surface_intensity(s, wo, acc, rs->ambient);
 }

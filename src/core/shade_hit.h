@@ -12,12 +12,14 @@
 struct evr_occlusion;
 
 /* 1 when something blocks ray r over [tnear, tfar) at normalized segment time f. */
-EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f);
+EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
+                                      float f);
 
 /* The lights' sum acc at s (irradiance times the BSDF's cosine, core/material.h) at time f,
  * each light's shadow ray through evr_occluded; *rays counts the shadow rays. */
-EVR_HD static inline void evr_shade_direct_sum(const evr_render_scene *rs, const evr_surface *s, evr_v3 wo, float f,
-                                               struct evr_occlusion *o, unsigned *rays, float acc[3])
+EVR_HD static inline void evr_shade_direct_sum(const evr_render_scene *rs, const evr_surface *s,
+                                               evr_v3 wo, float f, struct evr_occlusion *o,
+                                               unsigned *rays, float acc[3])
 {
     acc[0] = acc[1] = acc[2] = 0.0f;
     for (int l = 0; l < rs->num_lights; l++) {
@@ -30,8 +32,9 @@ EVR_HD static inline void evr_shade_direct_sum(const evr_render_scene *rs, const
 }
 
 /* The direct light of a hit as the sensor sees it: surface s seen along wo at time f. */
-EVR_HD static inline float evr_shade_hit(const evr_render_scene *rs, const evr_surface *s, evr_v3 wo, float f,
-                                         struct evr_occlusion *o, unsigned *rays)
+EVR_HD static inline float evr_shade_hit(const evr_render_scene *rs, const evr_surface *s,
+                                         evr_v3 wo, float f, struct evr_occlusion *o,
+                                         unsigned *rays)
 {
     float acc[3];
     evr_shade_direct_sum(rs, s, wo, f, o, rays, acc);

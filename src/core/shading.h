@@ -25,18 +25,21 @@ EVR_HD static inline float evr_luminance(float r, float g, float b)
 
 /* Fills the surface at barycentrics (u, v) of triangle prim of instance inst, whose transform at
  * the ray's time is xf; ray_dir is the incoming direction, t_hit the distance along it. */
-EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim, float u, float v,
-                                         const evr_m34 *xf, evr_ray ray, float t_hit, evr_surface *s)
+EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim,
+                                         float u, float v, const evr_m34 *xf, evr_ray ray,
+                                         float t_hit, evr_surface *s)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[inst].mesh];
-    uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1], i2 = m->indices[3 * prim + 2];
+    uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1],
+             i2 = m->indices[3 * prim + 2];
     float w = 1.0f - u - v;
     evr_v3 n0 = evr_v3_make(m->normals[3 * i0], m->normals[3 * i0 + 1], m->normals[3 * i0 + 2]);
     evr_v3 n1 = evr_v3_make(m->normals[3 * i1], m->normals[3 * i1 + 1], m->normals[3 * i1 + 2]);
     evr_v3 n2 = evr_v3_make(m->normals[3 * i2], m->normals[3 * i2 + 1], m->normals[3 * i2 + 2]);
-    evr_v3 n = evr_v3_add(evr_v3_add(evr_v3_scale(n0, w), evr_v3_scale(n1, u)), evr_v3_scale(n2, v));
+    evr_v3 n =
+        evr_v3_add(evr_v3_add(evr_v3_scale(n0, w), evr_v3_scale(n1, u)), evr_v3_scale(n2, v));
     n = evr_m34_normal(xf, n);
-    if (evr_v3_dot(n, ray.dir) > 0.0f) n = evr_v3_scale(n, -1.0f);   /* two-sided */
+    if (evr_v3_dot(n, ray.dir) > 0.0f) n = evr_v3_scale(n, -1.0f); /* two-sided */
     s->n = n;
     s->p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
     evr_material_at(rs, m, i0, i1, i2, w, u, v, s);
@@ -45,8 +48,9 @@ EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, u
 /* Light arriving at p from light l at normalized segment time f: direction towards the light,
  * distance to it (for the shadow ray; huge for directional) and irradiance on a surface facing
  * it. Returns 0 when no light arrives (outside a spot cone, zero power). */
-EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const evr_light_view *l, float f,
-                                            evr_v3 p, evr_v3 *wi, float *dist, float e_rgb[3])
+EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const evr_light_view *l,
+                                            float f, evr_v3 p, evr_v3 *wi, float *dist,
+                                            float e_rgb[3])
 {
     evr_v3 lp = l->pos, ld = l->dir;
     float scale = 1.0f;
@@ -55,7 +59,7 @@ EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const ev
         lp = evr_m34_point(&xf, lp);
         ld = evr_v3_norm(evr_m34_vector(&xf, ld));
     }
-    if (l->type == 2) {   /* directional */
+    if (l->type == 2) { /* directional */
         *wi = evr_v3_scale(ld, -1.0f);
         *dist = 1e30f;
     } else {
@@ -65,7 +69,7 @@ EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const ev
         *dist = sqrtf(d2);
         *wi = evr_v3_scale(d, 1.0f / *dist);
         scale = 1.0f / d2;
-        if (l->type == 1) {   /* spot: glTF's recommended smooth falloff */
+        if (l->type == 1) { /* spot: glTF's recommended smooth falloff */
             float cd = -evr_v3_dot(*wi, ld);
             float a = (cd - l->cos_outer) / fmaxf(l->cos_inner - l->cos_outer, 1e-4f);
             a = fminf(fmaxf(a, 0.0f), 1.0f);
@@ -80,7 +84,8 @@ EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const ev
 
 /* Sensor intensity of s seen along wo: the luminance of its radiance (evr_material_radiance)
  * from the lights' sum acc (evr_material_add_light). */
-EVR_HD static inline float evr_surface_intensity(const evr_surface *s, evr_v3 wo, const float acc[3], float ambient)
+EVR_HD static inline float evr_surface_intensity(const evr_surface *s, evr_v3 wo,
+                                                 const float acc[3], float ambient)
 {
     float rgb[3];
     evr_material_radiance(s, wo, acc, ambient, rgb);

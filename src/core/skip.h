@@ -22,13 +22,13 @@
 #define EVR_SKIP_MAX_PARTS 2048
 
 typedef struct {
-    int reuse;            /* clean caches may be reused this segment (camera and lights still, and
+    int reuse; /* clean caches may be reused this segment (camera and lights still, and
                              unchanged since the previous segment) */
-    int cache;            /* samples traced this segment may become clean caches (camera and
+    int cache; /* samples traced this segment may become clean caches (camera and
                              lights still in the segment) */
     int num_boxes;
-    float pad;            /* added to every box on every side (float error of the tests) */
-    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3];   /* swept bounds of what moves */
+    float pad; /* added to every box on every side (float error of the tests) */
+    float lo[EVR_SKIP_MAX_BOXES][3], hi[EVR_SKIP_MAX_BOXES][3]; /* swept bounds of what moves */
     /* tighter: box b's mesh split into parts, each part's triangles swept on their own (a ray
      * that meets box b can still pass between them: the eye's lids are thin sheets in a large
      * box), as a binary tree of boxes: box b's nodes are part_lo/hi[part_first[b] + n] for
@@ -79,8 +79,8 @@ EVR_HD static inline float evr_skip_trace_time(const evr_skip_plan *pl, float f)
 
 /* Whether the part [0, tmax] of the ray o + t d meets the box (padded): the slab test. Any NaN
  * makes it answer yes, so that a doubtful case is traced. */
-EVR_HD static inline int evr_skip_segment_meets(evr_v3 o, evr_v3 d, float tmax, const float lo[3], const float hi[3],
-                                                float pad)
+EVR_HD static inline int evr_skip_segment_meets(evr_v3 o, evr_v3 d, float tmax, const float lo[3],
+                                                const float hi[3], float pad)
 {
     const float org[3] = {o.x, o.y, o.z}, dir[3] = {d.x, d.y, d.z};
     float t0 = 0.0f, t1 = tmax;
@@ -105,31 +105,34 @@ EVR_HD static inline int evr_skip_segment_meets(evr_v3 o, evr_v3 d, float tmax, 
 }
 
 /* Whether the ray meets a leaf of box b's tree of parts (evr_skip_plan.part_first). */
-EVR_HD static inline int evr_skip_parts_meet(const evr_skip_plan *pl, int b, evr_v3 o, evr_v3 d, float tmax)
+EVR_HD static inline int evr_skip_parts_meet(const evr_skip_plan *pl, int b, evr_v3 o, evr_v3 d,
+                                             float tmax)
 {
     const int base = pl->part_first[b], n = pl->part_first[b + 1] - base;
     int stack[24], sp = 0, node = 0;
     for (;;) {
         const float *lo = pl->part_lo[base + node], *hi = pl->part_hi[base + node];
         if (!(lo[0] > hi[0]) && evr_skip_segment_meets(o, d, tmax, lo, hi, pl->pad)) {
-            if (2 * node + 1 >= n) return 1;   /* a leaf */
+            if (2 * node + 1 >= n) return 1; /* a leaf */
             if (sp < 24) {
                 stack[sp++] = 2 * node + 2;
                 node = 2 * node + 1;
                 continue;
             }
-            return 1;   /* deeper than planned for: say yes */
+            return 1; /* deeper than planned for: say yes */
         }
         if (sp == 0) return 0;
         node = stack[--sp];
     }
 }
 
-EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 o, evr_v3 d, float tmax)
+EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 o, evr_v3 d,
+                                                float tmax)
 {
     for (int b = 0; b < pl->num_boxes; b++) {
         if (!evr_skip_segment_meets(o, d, tmax, pl->lo[b], pl->hi[b], pl->pad)) continue;
-        if (pl->part_first[b] >= pl->part_first[b + 1] || evr_skip_parts_meet(pl, b, o, d, tmax)) return 1;
+        if (pl->part_first[b] >= pl->part_first[b + 1] || evr_skip_parts_meet(pl, b, o, d, tmax))
+            return 1;
     }
     return 0;
 }
@@ -138,12 +141,14 @@ EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 
  * t_hit (INFINITY or more than 1e29: nothing hit, the whole ray) and, from the hit point computed
  * exactly as the shading computes it, the segment to every light that sends light there (the
  * lights do not move when this is asked: their position at time 0 is theirs). */
-EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const evr_skip_plan *pl, evr_ray ray, float t_hit)
+EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const evr_skip_plan *pl,
+                                            evr_ray ray, float t_hit)
 {
     if (pl->num_boxes == 0) return 0;
     const int hit = t_hit < 1e29f;
     /* a little past the hit: the surface itself may lie on a box's face */
-    if (evr_skip_ray_meets_any(pl, ray.org, ray.dir, hit ? t_hit * 1.0001f + pl->pad : INFINITY)) return 1;
+    if (evr_skip_ray_meets_any(pl, ray.org, ray.dir, hit ? t_hit * 1.0001f + pl->pad : INFINITY))
+        return 1;
     if (!hit) return 0;
     const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
     for (int l = 0; l < rs->num_lights; l++) {
@@ -160,14 +165,16 @@ EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const ev
 #define EVR_SKIP_DIRTY (-1.0f)
 
 /* 1 when a pixel whose camera ray is `ray` keeps its last intensity for the whole segment. */
-EVR_HD static inline int evr_skip_pixel(const evr_render_scene *rs, const evr_skip_plan *pl, int started,
-                                        float cache_dist, evr_ray ray)
+EVR_HD static inline int evr_skip_pixel(const evr_render_scene *rs, const evr_skip_plan *pl,
+                                        int started, float cache_dist, evr_ray ray)
 {
-    return pl->reuse && started && cache_dist >= 0.0f && !evr_skip_rays_meet(rs, pl, ray, cache_dist);
+    return pl->reuse && started && cache_dist >= 0.0f &&
+           !evr_skip_rays_meet(rs, pl, ray, cache_dist);
 }
 
 /* The cache a traced pixel keeps: its last sample's hit distance if clean, else EVR_SKIP_DIRTY. */
-EVR_HD static inline float evr_skip_cache_after_trace(const evr_render_scene *rs, const evr_skip_plan *pl, evr_ray ray,
+EVR_HD static inline float evr_skip_cache_after_trace(const evr_render_scene *rs,
+                                                      const evr_skip_plan *pl, evr_ray ray,
                                                       float t_hit)
 {
     if (!pl->cache) return EVR_SKIP_DIRTY;

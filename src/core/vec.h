@@ -5,17 +5,45 @@
 #include <math.h>
 #include "core/hd.h"
 
-typedef struct { float x, y, z; } evr_v3;
-typedef struct { float w, x, y, z; } evr_quat;  /* w + xi + yj + zk, unit for rotations */
+typedef struct {
+    float x, y, z;
+} evr_v3;
+typedef struct {
+    float w, x, y, z;
+} evr_quat; /* w + xi + yj + zk, unit for rotations */
 /* Affine transform, row-major 3x4: p' = m[r][0..2] . p + m[r][3]. */
-typedef struct { float m[3][4]; } evr_m34;
+typedef struct {
+    float m[3][4];
+} evr_m34;
 
-EVR_HD static inline evr_v3 evr_v3_make(float x, float y, float z) { evr_v3 r; r.x = x; r.y = y; r.z = z; return r; }
-EVR_HD static inline evr_v3 evr_v3_add(evr_v3 a, evr_v3 b) { return evr_v3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
-EVR_HD static inline evr_v3 evr_v3_sub(evr_v3 a, evr_v3 b) { return evr_v3_make(a.x - b.x, a.y - b.y, a.z - b.z); }
-EVR_HD static inline evr_v3 evr_v3_mul(evr_v3 a, evr_v3 b) { return evr_v3_make(a.x * b.x, a.y * b.y, a.z * b.z); }
-EVR_HD static inline evr_v3 evr_v3_scale(evr_v3 a, float s) { return evr_v3_make(a.x * s, a.y * s, a.z * s); }
-EVR_HD static inline float evr_v3_dot(evr_v3 a, evr_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+EVR_HD static inline evr_v3 evr_v3_make(float x, float y, float z)
+{
+    evr_v3 r;
+    r.x = x;
+    r.y = y;
+    r.z = z;
+    return r;
+}
+EVR_HD static inline evr_v3 evr_v3_add(evr_v3 a, evr_v3 b)
+{
+    return evr_v3_make(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+EVR_HD static inline evr_v3 evr_v3_sub(evr_v3 a, evr_v3 b)
+{
+    return evr_v3_make(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+EVR_HD static inline evr_v3 evr_v3_mul(evr_v3 a, evr_v3 b)
+{
+    return evr_v3_make(a.x * b.x, a.y * b.y, a.z * b.z);
+}
+EVR_HD static inline evr_v3 evr_v3_scale(evr_v3 a, float s)
+{
+    return evr_v3_make(a.x * s, a.y * s, a.z * s);
+}
+EVR_HD static inline float evr_v3_dot(evr_v3 a, evr_v3 b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 EVR_HD static inline evr_v3 evr_v3_cross(evr_v3 a, evr_v3 b)
 {
     return evr_v3_make(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
@@ -33,9 +61,17 @@ EVR_HD static inline evr_v3 evr_v3_lerp(evr_v3 a, evr_v3 b, float f)
 
 EVR_HD static inline evr_quat evr_quat_make(float w, float x, float y, float z)
 {
-    evr_quat q; q.w = w; q.x = x; q.y = y; q.z = z; return q;
+    evr_quat q;
+    q.w = w;
+    q.x = x;
+    q.y = y;
+    q.z = z;
+    return q;
 }
-EVR_HD static inline float evr_quat_dot(evr_quat a, evr_quat b) { return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z; }
+EVR_HD static inline float evr_quat_dot(evr_quat a, evr_quat b)
+{
+    return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+}
 EVR_HD static inline evr_quat evr_quat_normalize(evr_quat q)
 {
     float l = sqrtf(evr_quat_dot(q, q));
@@ -53,10 +89,14 @@ EVR_HD static inline evr_quat evr_quat_mul(evr_quat a, evr_quat b)
 EVR_HD static inline evr_quat evr_quat_slerp(evr_quat a, evr_quat b, float f)
 {
     float d = evr_quat_dot(a, b);
-    if (d < 0.0f) { b = evr_quat_make(-b.w, -b.x, -b.y, -b.z); d = -d; }
+    if (d < 0.0f) {
+        b = evr_quat_make(-b.w, -b.x, -b.y, -b.z);
+        d = -d;
+    }
     float wa, wb;
-    if (d > 0.9995f) {              /* nearly parallel: lerp is exact to float precision */
-        wa = 1.0f - f; wb = f;
+    if (d > 0.9995f) { /* nearly parallel: lerp is exact to float precision */
+        wa = 1.0f - f;
+        wb = f;
     } else {
         float th = acosf(d), s = sinf(th);
         wa = sinf((1.0f - f) * th) / s;
@@ -71,9 +111,15 @@ EVR_HD static inline void evr_quat_to_m33(evr_quat q, float r[3][3])
     float xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
     float xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
     float wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-    r[0][0] = 1 - 2 * (yy + zz); r[0][1] = 2 * (xy - wz);     r[0][2] = 2 * (xz + wy);
-    r[1][0] = 2 * (xy + wz);     r[1][1] = 1 - 2 * (xx + zz); r[1][2] = 2 * (yz - wx);
-    r[2][0] = 2 * (xz - wy);     r[2][1] = 2 * (yz + wx);     r[2][2] = 1 - 2 * (xx + yy);
+    r[0][0] = 1 - 2 * (yy + zz);
+    r[0][1] = 2 * (xy - wz);
+    r[0][2] = 2 * (xz + wy);
+    r[1][0] = 2 * (xy + wz);
+    r[1][1] = 1 - 2 * (xx + zz);
+    r[1][2] = 2 * (yz - wx);
+    r[2][0] = 2 * (xz - wy);
+    r[2][1] = 2 * (yz + wx);
+    r[2][2] = 1 - 2 * (xx + yy);
 }
 
 EVR_HD static inline evr_m34 evr_m34_identity(void)
@@ -115,7 +161,8 @@ EVR_HD static inline evr_v3 evr_m34_normal(const evr_m34 *a, evr_v3 n)
     evr_v3 c2 = evr_v3_make(a->m[0][2], a->m[1][2], a->m[2][2]);
     evr_v3 r0 = evr_v3_cross(c1, c2), r1 = evr_v3_cross(c2, c0), r2 = evr_v3_cross(c0, c1);
     float det = evr_v3_dot(c0, r0);
-    evr_v3 out = evr_v3_add(evr_v3_add(evr_v3_scale(r0, n.x), evr_v3_scale(r1, n.y)), evr_v3_scale(r2, n.z));
+    evr_v3 out =
+        evr_v3_add(evr_v3_add(evr_v3_scale(r0, n.x), evr_v3_scale(r1, n.y)), evr_v3_scale(r2, n.z));
     return evr_v3_norm(det < 0.0f ? evr_v3_scale(out, -1.0f) : out);
 }
 /* Inverse of an affine transform, through the adjugate of the linear part. A singular matrix
@@ -128,7 +175,7 @@ EVR_HD static inline evr_m34 evr_m34_inverse(const evr_m34 *a)
     evr_v3 r[3];
     evr_m34 inv;
     int i;
-    r[0] = evr_v3_cross(c1, c2);   /* rows of the inverse, times det */
+    r[0] = evr_v3_cross(c1, c2); /* rows of the inverse, times det */
     r[1] = evr_v3_cross(c2, c0);
     r[2] = evr_v3_cross(c0, c1);
     float det = evr_v3_dot(c0, r[0]);

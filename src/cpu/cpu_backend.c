@@ -28,7 +28,7 @@
 typedef struct {
     evr_backend base;
     const evr_scene *scene;
-    evr_render_host host;          /* copy of the views; keys are set per segment */
+    evr_render_host host; /* copy of the views; keys are set per segment */
     evr_run_setup setup;
     RTCDevice device;
     /* One Embree instance per group of instances (prep/instance_groups.h) keeps overlapping
@@ -39,29 +39,29 @@ typedef struct {
     evr_instance_groups groups;
     RTCScene *group_scenes;
     RTCScene top;
-    int time_grid;                 /* the segment's motion keys split it into this many equal intervals (1: none moves) */
-    int gi;                        /* global illumination on */
+    int time_grid; /* the segment's motion keys split it into this many equal intervals (1: none moves) */
+    int gi;        /* global illumination on */
     evr_cpu_gi gi_state;
     evr_pixel_state *pixels;
-    float *phase;                  /* per-pixel sample-time offset in [0, 1) */
-    float *next_t;                 /* adaptive sampling: each pixel's next sample, segment-relative */
+    float *phase;  /* per-pixel sample-time offset in [0, 1) */
+    float *next_t; /* adaptive sampling: each pixel's next sample, segment-relative */
     int tiles_x, tiles_y;
     evr_event_vec *tile_events;
     /* results of submitted segments not yet collected (a ring of two) */
     evr_event_vec done[2], scratch;
     float *done_intensity[2];
     int done_has_intensity[2];
-    float *done_frames[2];         /* intensity frames of the segment (done_num_frames images) */
-    size_t done_frames_cap[2];     /* images done_frames has room for */
+    float *done_frames[2];     /* intensity frames of the segment (done_num_frames images) */
+    size_t done_frames_cap[2]; /* images done_frames has room for */
     int done_num_frames[2];
-    unsigned long long done_counts[2][4];   /* samples, rays, samples traced, pixels skipped */
+    unsigned long long done_counts[2][4]; /* samples, rays, samples traced, pixels skipped */
     int head, queued;
     char embree_error[256];
     /* per-segment work */
     const evr_segment *seg;
-    float *frame_f;                /* normalized segment time of each wanted frame */
+    float *frame_f; /* normalized segment time of each wanted frame */
     int frame_f_cap;
-    float *frame_out;              /* where the segment's frames go */
+    float *frame_out; /* where the segment's frames go */
     atomic_int next_tile;
     atomic_ullong samples, rays, samples_traced, pixels_skipped;
     atomic_int failed;
@@ -70,7 +70,9 @@ typedef struct {
 static void embree_error(void *user, enum RTCError code, const char *str)
 {
     cpu_backend *b = (cpu_backend *)user;
-    if (!b->embree_error[0]) snprintf(b->embree_error, sizeof b->embree_error, "Embree error %d: %s", (int)code, str ? str : "");
+    if (!b->embree_error[0])
+        snprintf(b->embree_error, sizeof b->embree_error, "Embree error %d: %s", (int)code,
+                 str ? str : "");
 }
 
 static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
@@ -97,9 +99,9 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
  * ray's hit distance (INFINITY: none); NULL for a frame's samples, which are not the pixel
  * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. */
 #define PACKET 8
-static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, const int *ys,
-                                   const float *fs, const int *valid, float *out, float *t_hit, float *direct,
-                                   unsigned long long *rays)
+static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
+                                   const int *ys, const float *fs, const int *valid, float *out,
+                                   float *t_hit, float *direct, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -108,7 +110,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     evr_ray ray[PACKET];
     evr_surface s[PACKET];
     float acc[PACKET][3];
-    _Alignas(32) int vmask[PACKET];   /* Embree reads the valid mask with aligned vector loads */
+    _Alignas(32) int vmask[PACKET]; /* Embree reads the valid mask with aligned vector loads */
     int hit[PACKET], inst_of[PACKET], i, l;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -116,11 +118,16 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
         ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
         vmask[i] = valid[i] ? -1 : 0;
-        rh.ray.org_x[i] = ray[i].org.x; rh.ray.org_y[i] = ray[i].org.y; rh.ray.org_z[i] = ray[i].org.z;
-        rh.ray.dir_x[i] = ray[i].dir.x; rh.ray.dir_y[i] = ray[i].dir.y; rh.ray.dir_z[i] = ray[i].dir.z;
+        rh.ray.org_x[i] = ray[i].org.x;
+        rh.ray.org_y[i] = ray[i].org.y;
+        rh.ray.org_z[i] = ray[i].org.z;
+        rh.ray.dir_x[i] = ray[i].dir.x;
+        rh.ray.dir_y[i] = ray[i].dir.y;
+        rh.ray.dir_z[i] = ray[i].dir.z;
         rh.ray.tnear[i] = 0.0f;
         rh.ray.tfar[i] = INFINITY;
-        rh.ray.time[i] = evr_skip_trace_time(b->seg->skip, fs[i]);   /* a still span: one time for Embree */
+        rh.ray.time[i] =
+            evr_skip_trace_time(b->seg->skip, fs[i]); /* a still span: one time for Embree */
         rh.ray.mask[i] = 0xffffffffu;
         rh.ray.id[i] = (unsigned)i;
         rh.ray.flags[i] = 0;
@@ -130,16 +137,18 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     }
     rtcIntersect8(vmask, b->top, &ctx, &rh);
     for (i = 0; i < PACKET; i++) {
-        out[i] = 0.0f;   /* nothing: black */
+        out[i] = 0.0f; /* nothing: black */
         if (direct) direct[i] = 0.0f;
         acc[i][0] = acc[i][1] = acc[i][2] = 0.0f;
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (!hit[i]) continue;
-        int inst = b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
+        int inst =
+            b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
-        evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i], rh.ray.tfar[i], &s[i]);
+        evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i],
+                       rh.ray.tfar[i], &s[i]);
     }
     /* core/shade.h's steps light by light: each light's shadow rays as one packet */
     for (l = 0; l < rs->num_lights; l++) {
@@ -151,8 +160,12 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             vmask[i] = -1;
             any = 1;
             (*rays)++;
-            sr.org_x[i] = lr[i].ray.org.x; sr.org_y[i] = lr[i].ray.org.y; sr.org_z[i] = lr[i].ray.org.z;
-            sr.dir_x[i] = lr[i].ray.dir.x; sr.dir_y[i] = lr[i].ray.dir.y; sr.dir_z[i] = lr[i].ray.dir.z;
+            sr.org_x[i] = lr[i].ray.org.x;
+            sr.org_y[i] = lr[i].ray.org.y;
+            sr.org_z[i] = lr[i].ray.org.z;
+            sr.dir_x[i] = lr[i].ray.dir.x;
+            sr.dir_y[i] = lr[i].ray.dir.y;
+            sr.dir_z[i] = lr[i].ray.dir.z;
             sr.tnear[i] = lr[i].tnear;
             sr.tfar[i] = lr[i].tfar;
             sr.time[i] = rh.ray.time[i];
@@ -163,22 +176,26 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         if (!any) continue;
         rtcOccluded8(vmask, b->top, &ctx, &sr);
         for (i = 0; i < PACKET; i++)
-            if (vmask[i] && sr.tfar[i] >= 0.0f) evr_shade_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), &lr[i], acc[i]);
+            if (vmask[i] && sr.tfar[i] >= 0.0f)
+                evr_shade_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), &lr[i], acc[i]);
     }
     for (i = 0; i < PACKET; i++) {
-        if (!hit[i]) {   /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
+        if (!hit[i]) { /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
             if (b->gi && valid[i] && t_hit) evr_cpu_gi_missed(&b->gi_state, xs[i], ys[i]);
             continue;
         }
         out[i] = evr_shade_intensity(rs, &s[i], evr_v3_scale(ray[i].dir, -1.0f), acc[i]);
         if (direct) direct[i] = out[i];
-        if (b->gi) out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i], ys[i], fs[i], t_hit != NULL);
+        if (b->gi)
+            out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i],
+                                          ys[i], fs[i], t_hit != NULL);
     }
 }
 
 /* The same for eight pixels of one row. */
-static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs, int y, const float *fs,
-                              const int *valid, float *out, float *t_hit, unsigned long long *rays)
+static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
+                              int y, const float *fs, const int *valid, float *out, float *t_hit,
+                              unsigned long long *rays)
 {
     int ys[PACKET], i;
     for (i = 0; i < PACKET; i++) ys[i] = y;
@@ -193,7 +210,8 @@ struct evr_event_sink {
     atomic_int *failed;
 };
 
-static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x,
+                                      int y, int polarity)
 {
     evr_event e;
     if (!has) return 0;
@@ -208,23 +226,26 @@ static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long lo
 /* One sample of pixel (x, y) (intensity at t seconds from the segment's start) through its pixel
  * model; its events go to out. Kept out of line with the loop inlined in it: inlined into its
  * callers instead, GCC kept the loop as a call of many arguments (about 1% slower). */
-__attribute__((noinline)) static void pixel_sample(cpu_backend *b, evr_pixel_state *st, const evr_pixel_params *pp, int ideal, float t, float intensity,
-                         int x, int y, evr_event_vec *out)
+__attribute__((noinline)) static void pixel_sample(cpu_backend *b, evr_pixel_state *st,
+                                                   const evr_pixel_params *pp, int ideal, float t,
+                                                   float intensity, int x, int y,
+                                                   evr_event_vec *out)
 {
     struct evr_event_sink k;
     k.out = out;
     k.failed = &b->failed;
-    evr_pixel_sample_events(st, pp, evr_pixel_ideal_of(pp), !ideal, 1, t, intensity, b->seg->t0, x, y, &k);
+    evr_pixel_sample_events(st, pp, evr_pixel_ideal_of(pp), !ideal, 1, t, intensity, b->seg->t0, x,
+                            y, &k);
 }
 
 /* A pixel of the tile in the segment's work. */
 typedef struct {
     evr_pixel_state *st;
-    evr_pixel_params pp;           /* its thresholds, leak and noise (a fixed pattern) */
-    evr_ray ray;                   /* its centre ray (the camera at the segment's start) */
-    float phi, t_last, t_hit;      /* sample phase; time of its last sample; last hit distance */
-    float direct;                  /* GI: its last traced sample's direct light */
-    int last_span;                 /* the still span (evr_skip_still_span) of its last traced sample */
+    evr_pixel_params pp;      /* its thresholds, leak and noise (a fixed pattern) */
+    evr_ray ray;              /* its centre ray (the camera at the segment's start) */
+    float phi, t_last, t_hit; /* sample phase; time of its last sample; last hit distance */
+    float direct;             /* GI: its last traced sample's direct light */
+    int last_span;            /* the still span (evr_skip_still_span) of its last traced sample */
     int x, y;
 } tile_pixel;
 
@@ -240,14 +261,16 @@ static int gi_lit(const cpu_backend *b, const tile_pixel *q)
  * direct light and its gathers' indirect light at f (evr_cpu_gi_last). */
 static float kept_intensity(const cpu_backend *b, const tile_pixel *q, float f)
 {
-    return gi_lit(b, q) ? q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f) : q->st->intensity;
+    return gi_lit(b, q) ? q->direct + evr_cpu_gi_last(&b->gi_state, q->x, q->y, f)
+                        : q->st->intensity;
 }
 
 /* The samples k0 .. n - 1 of a pixel that keeps its intensity: none when they cannot change it
  * (the ideal model, evr_pixel_quiet_ideal), else each through the pixel model. With GI, a pixel
  * that settled on a surface (gi_lit) keeps the direct light of that sample and its gather, whose
  * indirect light still moves in time (evr_cpu_gi_last). */
-static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n, float dt, evr_event_vec *out)
+static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n, float dt,
+                         evr_event_vec *out)
 {
     const float in = q->st->intensity;
     int k;
@@ -258,11 +281,14 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
         }
         return;
     }
-    if (ideal && evr_pixel_quiet_ideal(q->st, q->pp.log_floor, q->pp.pos_thres, q->pp.neg_thres, in, q->t_last)) {
+    if (ideal && evr_pixel_quiet_ideal(q->st, q->pp.log_floor, q->pp.pos_thres, q->pp.neg_thres, in,
+                                       q->t_last)) {
         evr_pixel_quiet_finish(q->st, q->pp.log_floor, in, q->t_last);
         return;
     }
-    for (k = k0; k < n; k++) pixel_sample(b, q->st, &q->pp, ideal, (((float)k + q->phi) / (float)n) * dt, in, q->x, q->y, out);
+    for (k = k0; k < n; k++)
+        pixel_sample(b, q->st, &q->pp, ideal, (((float)k + q->phi) / (float)n) * dt, in, q->x, q->y,
+                     out);
 }
 
 /* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
@@ -274,15 +300,16 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
  * settle (k0 == 0, k1 == 1): a pixel whose first sample's rays meet nothing that moves in the
  * segment keeps that intensity for the rest of the segment (its later samples run here); the
  * others are listed in *more. Each pixel's samples reach its pixel model in time order. */
-static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int count, int k0, int k1, int settle, int *more,
-                          int *num_more, const evr_m34 *pose_static, int ideal, float dt, evr_event_vec *out,
-                          unsigned long long *rays, unsigned long long *traced)
+static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int count, int k0,
+                          int k1, int settle, int *more, int *num_more, const evr_m34 *pose_static,
+                          int ideal, float dt, evr_event_vec *out, unsigned long long *rays,
+                          unsigned long long *traced)
 {
     const evr_render_scene *rs = &b->host.rs;
     const evr_segment *seg = b->seg;
     const int n = b->setup.samples_per_frame, grid = b->time_grid;
     int order[TILE * TILE], bucket[TILE * TILE], first[EVR_MAX_KEYS + 1];
-    float fk[TILE * TILE];   /* listed pixel j's normalized time at sample k */
+    float fk[TILE * TILE]; /* listed pixel j's normalized time at sample k */
     int c, i, j, k, g;
     for (k = k0; k < k1; k++) {
         int ntr = 0;
@@ -294,7 +321,8 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             const int span = evr_skip_still_span(seg->skip, f);
             if (evr_skip_held(seg->skip, span, q->last_span)) {
                 bucket[j] = -1;
-                pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y, out);
+                pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y,
+                             out);
                 continue;
             }
             q->last_span = span;
@@ -305,7 +333,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
         }
         for (g = 0; g < grid; g++) first[g + 1] += first[g];
         for (j = 0; j < count; j++)
-            if (bucket[j] >= 0) order[first[bucket[j]]++] = j;   /* list order within an interval */
+            if (bucket[j] >= 0) order[first[bucket[j]]++] = j; /* list order within an interval */
         for (c = 0; c < ntr; c += PACKET) {
             int xs[PACKET], ys[PACKET], valid[PACKET];
             float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
@@ -318,13 +346,15 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
                 ys[i] = q[i]->y;
                 fs[i] = fk[j];
             }
-            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, direct, rays);
+            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid,
+                                   intensity, t_hit, direct, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 (*traced)++;
                 q[i]->t_hit = t_hit[i];
                 q[i]->direct = direct[i];
-                pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i], out);
+                pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i],
+                             out);
             }
         }
     }
@@ -332,10 +362,10 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     for (j = 0; j < count; j++) {
         tile_pixel *q = &px[list[j]];
         float cd = evr_skip_cache_after_trace(rs, seg->skip, q->ray, q->t_hit);
-        if (cd >= 0.0f) {   /* settled: the same triangles at every sample */
+        if (cd >= 0.0f) { /* settled: the same triangles at every sample */
             q->st->cache_dist = cd;
             keep_samples(b, q, ideal, k1, n, dt, out);
-            q->t_hit = -1.0f;   /* its cache is set */
+            q->t_hit = -1.0f; /* its cache is set */
         } else {
             more[(*num_more)++] = list[j];
         }
@@ -346,8 +376,9 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
  * (change-driven sampling) and runs its samples without rays; the others trace, compacted into
  * full packets: first every such pixel's first sample, then the samples of those that did not
  * settle. A pixel's samples always reach its pixel model in time order. */
-static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays,
-                        unsigned long long *traced, unsigned long long *skipped)
+static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
+                        unsigned long long *rays, unsigned long long *traced,
+                        unsigned long long *skipped)
 {
     const evr_render_scene *rs = &b->host.rs;
     const evr_segment *seg = b->seg;
@@ -355,51 +386,60 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples, u
     const int w = b->setup.width, h = b->setup.height, n = b->setup.samples_per_frame;
     const float dt = (float)(seg->t1 - seg->t0);
     int tx = tile % b->tiles_x, ty = tile / b->tiles_x;
-    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w, y1 = y0 + TILE < h ? y0 + TILE : h;
+    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w,
+        y1 = y0 + TILE < h ? y0 + TILE : h;
     evr_event_vec *out = &b->tile_events[tile];
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
     const int ideal = evr_pixel_params_ideal(&b->setup.pixel);
     tile_pixel px[TILE * TILE];
-    int list[TILE * TILE] = {0}, more[TILE * TILE], count = 0, num_more = 0, np = 0, x, y, i;   /* zeroed: GCC cannot see the listed entries set */
+    int list[TILE * TILE] = {0}, more[TILE * TILE], count = 0, num_more = 0, np = 0, x, y,
+                    i; /* zeroed: GCC cannot see the listed entries set */
     out->n = 0;
     /* pixels in blocks of 4 x 2 (a packet's worth): rays of a packet then start close together in
      * both directions, which Embree's packet traversal rewards */
     for (int by = y0; by < y1; by += 2)
-    for (int bx = x0; bx < x1; bx += 4)
-    for (y = by; y < by + 2 && y < y1; y++) {
-        for (x = bx; x < bx + 4 && x < x1; x++, np++) {
-            tile_pixel *q = &px[np];
-            q->x = x;
-            q->y = y;
-            q->st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
-            q->phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
-            q->t_last = (((float)(n - 1) + q->phi) / (float)n) * dt;
-            q->t_hit = INFINITY;
-            q->last_span = -1;
-            if (ideal) q->pp = b->setup.pixel;
-            else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
-            /* global illumination: whether the pixel's indirect light may differ from its last sample's */
-            const int gi_changed = b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
-            /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
-            q->ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-            if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) && !gi_changed) {
-                (*skipped)++;
-                keep_samples(b, q, ideal, 0, n, dt, out);
-                evr_pixel_end_segment(q->st, dt);
-            } else {
-                list[count++] = np;
+        for (int bx = x0; bx < x1; bx += 4)
+            for (y = by; y < by + 2 && y < y1; y++) {
+                for (x = bx; x < bx + 4 && x < x1; x++, np++) {
+                    tile_pixel *q = &px[np];
+                    q->x = x;
+                    q->y = y;
+                    q->st = &b->pixels[(size_t)y * (size_t)w + (size_t)x];
+                    q->phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
+                    q->t_last = (((float)(n - 1) + q->phi) / (float)n) * dt;
+                    q->t_hit = INFINITY;
+                    q->last_span = -1;
+                    if (ideal) q->pp = b->setup.pixel;
+                    else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
+                    /* global illumination: whether the pixel's indirect light may differ from its last sample's */
+                    const int gi_changed =
+                        b->gi && evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
+                    /* change-driven sampling: a pixel nothing moving can reach keeps its intensity */
+                    q->ray =
+                        evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+                    if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) &&
+                        !gi_changed) {
+                        (*skipped)++;
+                        keep_samples(b, q, ideal, 0, n, dt, out);
+                        evr_pixel_end_segment(q->st, dt);
+                    } else {
+                        list[count++] = np;
+                    }
+                }
             }
-        }
-    }
-    trace_samples(b, px, list, count, 0, n < 1 ? n : 1, 1, more, &num_more, &pose_static, ideal, dt, out, rays, traced);
-    trace_samples(b, px, more, num_more, 1, n, 0, NULL, NULL, &pose_static, ideal, dt, out, rays, traced);
+    trace_samples(b, px, list, count, 0, n < 1 ? n : 1, 1, more, &num_more, &pose_static, ideal, dt,
+                  out, rays, traced);
+    trace_samples(b, px, more, num_more, 1, n, 0, NULL, NULL, &pose_static, ideal, dt, out, rays,
+                  traced);
     for (i = 0; i < count; i++) {
         tile_pixel *q = &px[list[i]];
-        if (q->t_hit >= 0.0f) q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit);
+        if (q->t_hit >= 0.0f)
+            q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit);
         evr_pixel_end_segment(q->st, dt);
     }
     render_frames(b, x0, y0, x1, y1);
-    *samples += (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
+    *samples +=
+        (unsigned long long)(x1 - x0) * (unsigned long long)(y1 - y0) * (unsigned long long)n;
 }
 
 /* Intensity frames: one sample per pixel at each frame's exact time, kept away from the pixel
@@ -425,7 +465,8 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
                     fs[i] = f;
                 }
                 sample_intensity8(b, &pose, xs, y, fs, valid, intensity, NULL, &frame_rays);
-                for (i = 0; i < PACKET && x + i < x1; i++) img[(size_t)y * (size_t)w + (size_t)(x + i)] = intensity[i];
+                for (i = 0; i < PACKET && x + i < x1; i++)
+                    img[(size_t)y * (size_t)w + (size_t)(x + i)] = intensity[i];
             }
         }
     }
@@ -436,7 +477,8 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
  * it, eight at a time in packets (any pixels of the tile, each at its own time), then run what
  * they can through the pixel model: a sample that changed too much is held back on the pixel's
  * stack while the interval before it is refined (evr_adapt_refine). */
-static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *samples, unsigned long long *rays)
+static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *samples,
+                                 unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     const evr_segment *seg = b->seg;
@@ -445,7 +487,8 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
     const int w = b->setup.width, h = b->setup.height;
     const float dt = (float)(seg->t1 - seg->t0);
     int tx = tile % b->tiles_x, ty = tile / b->tiles_x;
-    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w, y1 = y0 + TILE < h ? y0 + TILE : h;
+    int x0 = tx * TILE, y0 = ty * TILE, x1 = x0 + TILE < w ? x0 + TILE : w,
+        y1 = y0 + TILE < h ? y0 + TILE : h;
     const int tw = x1 - x0, npx = tw * (y1 - y0);
     evr_event_vec *out = &b->tile_events[tile];
     evr_m34 pose_static = evr_rs_camera_pose(rs, 0.0f);
@@ -465,7 +508,8 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
          * gather (else its memo would keep the previous segment's indirect light) */
         if (b->gi) evr_cpu_gi_pixel_begin(&b->gi_state, &rs->camera, x, y);
         stack[j].n = 0;
-        const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+        const evr_ray ray =
+            evr_camera_ray(&rs->camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
         tnext[j] = evr_adapt_start(rs, ap, plan, st, ray, b->next_t[pix], b->phase[pix], dt);
         if (tnext[j] < dt) act[nact++] = j;
     }
@@ -481,22 +525,26 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 ys[i] = y0 + js[i] / tw;
                 fs[i] = tnext[js[i]] / dt;
             }
-            sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid, intensity, t_hit, NULL, rays);
+            sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid,
+                                   intensity, t_hit, NULL, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 const int jj = js[i];
                 evr_pixel_state *st = &b->pixels[(size_t)ys[i] * (size_t)w + (size_t)xs[i]];
-                const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
+                const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f,
+                                                   (float)ys[i] + 0.5f);
                 evr_adapt_stack *sk = &stack[jj];
                 float t = tnext[jj], in = intensity[i], hit = t_hit[i], step;
                 int moving;
                 (*samples)++;
                 /* the pixel's candidate sample (t, in, hit): held back, or through the pixel model */
-                while (evr_adapt_candidate(rs, ap, plan, st, &pp[jj], ray, sk, t, in, hit, &tnext[jj], &step, &moving)) {
+                while (evr_adapt_candidate(rs, ap, plan, st, &pp[jj], ray, sk, t, in, hit,
+                                           &tnext[jj], &step, &moving)) {
                     pixel_sample(b, st, &pp[jj], ideal, t, in, xs[i], ys[i], out);
-                    if (!evr_adapt_taken(ap, sk, step, moving, dt, &t, &in, &hit, &tnext[jj])) break;
+                    if (!evr_adapt_taken(ap, sk, step, moving, dt, &t, &in, &hit, &tnext[jj]))
+                        break;
                 }
-                if (tnext[jj] < dt) act[kept++] = jj;   /* kept <= base + i: in place */
+                if (tnext[jj] < dt) act[kept++] = jj; /* kept <= base + i: in place */
             }
         }
         nact = kept;
@@ -523,7 +571,7 @@ static void *worker(void *arg)
         if (b->setup.adaptive) render_tile_adaptive(b, t, &samples, &rays);
         else render_tile(b, t, &samples, &rays, &traced, &skipped);
     }
-    if (b->setup.adaptive) traced = samples;   /* adaptive sampling traces every sample it takes */
+    if (b->setup.adaptive) traced = samples; /* adaptive sampling traces every sample it takes */
     atomic_fetch_add(&b->samples, samples);
     atomic_fetch_add(&b->rays, rays);
     atomic_fetch_add(&b->samples_traced, traced);
@@ -536,10 +584,11 @@ static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_erro
     int g, k;
     b->time_grid = 1;
     for (g = 0; g < b->groups.num_groups; g++) {
-        int track = b->groups.group_node[g];   /* a moving group's node is its track */
-        if (b->groups.group_kind[g] != EVR_GROUP_MOVING) continue;   /* static: set once */
+        int track = b->groups.group_node[g]; /* a moving group's node is its track */
+        if (b->groups.group_kind[g] != EVR_GROUP_MOVING) continue; /* static: set once */
         int n = seg->track_count[track];
-        if (n - 1 > b->time_grid) b->time_grid = n - 1;   /* 2^k + 1 uniform keys: the finest grid holds the others */
+        if (n - 1 > b->time_grid)
+            b->time_grid = n - 1; /* 2^k + 1 uniform keys: the finest grid holds the others */
         RTCGeometry geom = rtcGetGeometry(b->top, (unsigned)g);
         rtcSetGeometryTimeStepCount(geom, (unsigned)n);
         for (k = 0; k < n; k++) {
@@ -573,11 +622,14 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->host.rs.track_offset = seg->track_offset;
     b->host.rs.track_count = seg->track_count;
     if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
-    if (b->gi) {   /* the segment's photons: still when nothing moved since the previous segment */
-        if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, seg->skip, b->setup.threads, base, err)) != EVR_OK) return st;
+    if (b->gi) { /* the segment's photons: still when nothing moved since the previous segment */
+        if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, seg->skip, b->setup.threads, base,
+                                     err)) != EVR_OK)
+            return st;
     }
     if (seg->num_frames > 0) {
-        size_t npix = (size_t)b->setup.width * (size_t)b->setup.height, nf = (size_t)seg->num_frames;
+        size_t npix = (size_t)b->setup.width * (size_t)b->setup.height,
+               nf = (size_t)seg->num_frames;
         if (seg->num_frames > b->frame_f_cap) {
             float *ff = realloc(b->frame_f, nf * sizeof *ff);
             if (!ff) {
@@ -597,7 +649,8 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
             b->done_frames_cap[slot] = nf;
         }
         for (i = 0; i < seg->num_frames; i++) {
-            double f = seg->t1 > seg->t0 ? (seg->frame_times[i] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            double f =
+                seg->t1 > seg->t0 ? (seg->frame_times[i] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
             b->frame_f[i] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
         }
         b->frame_out = b->done_frames[slot];
@@ -628,7 +681,7 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
         snprintf(err->msg, sizeof err->msg, "%s", b->embree_error);
         return EVR_ERR_BACKEND;
     }
-    for (i = 0; i < ntiles; i++) {   /* tile order: deterministic whatever the thread count */
+    for (i = 0; i < ntiles; i++) { /* tile order: deterministic whatever the thread count */
         if (!evr_event_vec_append(out, b->tile_events[i].data, b->tile_events[i].n)) {
             snprintf(err->msg, sizeof err->msg, "out of memory for events");
             return EVR_ERR_NOMEM;
@@ -650,11 +703,11 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     return EVR_OK;
 }
 
-static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
-                              const float **frames, evr_error *err)
+static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us,
+                              const float **intensity, const float **frames, evr_error *err)
 {
     cpu_backend *b = (cpu_backend *)base;
-    (void)emit_before_us;   /* every event now: merged on the host */
+    (void)emit_before_us; /* every event now: merged on the host */
     if (!b->queued) {
         snprintf(err->msg, sizeof err->msg, "internal error: collect without a submitted segment");
         return EVR_ERR_BACKEND;
@@ -708,20 +761,24 @@ static void cpu_release(evr_backend *base)
 
 /* Adds a mesh to an Embree scene as geometry geom_id, its vertices transformed by xf (NULL:
  * object space). */
-static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf, unsigned geom_id)
+static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf,
+                             unsigned geom_id)
 {
     uint32_t v;
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return 0;
     rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
-    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                        3 * sizeof(float), m->num_vertices);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), m->num_triangles);
     if (!vb || !ib) {
         rtcReleaseGeometry(g);
         return 0;
     }
     for (v = 0; v < m->num_vertices; v++) {
-        evr_v3 p = evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
+        evr_v3 p =
+            evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
         if (xf) p = evr_m34_point(xf, p);
         vb[3 * v] = p.x;
         vb[3 * v + 1] = p.y;
@@ -749,26 +806,37 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
     if (!b->group_scenes) ok = 0;
     for (g = 0; ok && g < gr->num_groups; g++) {
         RTCScene sc;
-        if (gr->group_kind[g] == EVR_GROUP_STATIC) {   /* the mesh's scene, built once, one reference per group */
+        if (gr->group_kind[g] ==
+            EVR_GROUP_STATIC) { /* the mesh's scene, built once, one reference per group */
             int mesh = s->instances[gr->members[gr->group_first[g]]].mesh;
             if (!mesh_scenes[mesh]) {
-                if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
+                if (!(sc = rtcNewScene(b->device))) {
+                    ok = 0;
+                    break;
+                }
                 mesh_scenes[mesh] = sc;
                 rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
-                if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0)) { ok = 0; break; }
+                if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0)) {
+                    ok = 0;
+                    break;
+                }
                 rtcCommitScene(sc);
             }
             rtcRetainScene(mesh_scenes[mesh]);
             b->group_scenes[g] = mesh_scenes[mesh];
             continue;
         }
-        if (!(sc = rtcNewScene(b->device))) { ok = 0; break; }
+        if (!(sc = rtcNewScene(b->device))) {
+            ok = 0;
+            break;
+        }
         b->group_scenes[g] = sc;
         rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
         for (j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[gr->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
-            if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh], gr->group_kind[g] == EVR_GROUP_BAKED ? &world : NULL,
+            if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh],
+                                   gr->group_kind[g] == EVR_GROUP_BAKED ? &world : NULL,
                                    (unsigned)(j - gr->group_first[g]))) {
                 ok = 0;
                 break;
@@ -782,8 +850,8 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
     return ok;
 }
 
-evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
-                               evr_backend **out, evr_error *err)
+evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
+                               const evr_run_setup *setup, evr_backend **out, evr_error *err)
 {
     cpu_backend *b = calloc(1, sizeof *b);
     size_t npix = (size_t)setup->width * (size_t)setup->height, i;
@@ -806,15 +874,19 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
     b->done_intensity[0] = malloc(npix * sizeof(float));
     b->done_intensity[1] = malloc(npix * sizeof(float));
-    if (!b->pixels || !b->phase || !b->next_t || !b->tile_events || !b->done_intensity[0] || !b->done_intensity[1]) goto nomem;
+    if (!b->pixels || !b->phase || !b->next_t || !b->tile_events || !b->done_intensity[0] ||
+        !b->done_intensity[1])
+        goto nomem;
     for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
     for (y = 0; y < setup->height; y++)
         for (x = 0; x < setup->width; x++)
-            b->phase[(size_t)y * (size_t)setup->width + (size_t)x] = evr_pixel_phase(setup->seed, x, y);
+            b->phase[(size_t)y * (size_t)setup->width + (size_t)x] =
+                evr_pixel_phase(setup->seed, x, y);
 
     b->device = rtcNewDevice(NULL);
     if (!b->device) {
-        snprintf(err->msg, sizeof err->msg, "cannot create the Embree device (error %d)", (int)rtcGetDeviceError(NULL));
+        snprintf(err->msg, sizeof err->msg, "cannot create the Embree device (error %d)",
+                 (int)rtcGetDeviceError(NULL));
         cpu_release(&b->base);
         return EVR_ERR_BACKEND;
     }
@@ -830,11 +902,13 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
         RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
         if (!g) goto embree_fail;
         rtcSetGeometryInstancedScene(g, b->group_scenes[m]);
-        if (gr->group_kind[m] != EVR_GROUP_MOVING) {   /* baked into world space (identity), or the
+        if (gr->group_kind[m] != EVR_GROUP_MOVING) { /* baked into world space (identity), or the
                                                           node's fixed transform; no motion */
-            evr_m34 xf = gr->group_kind[m] == EVR_GROUP_STATIC
-                             ? evr_node_world_at(s, s->instances[gr->members[gr->group_first[m]]].node, s->anim_start)
-                             : evr_m34_identity();
+            evr_m34 xf =
+                gr->group_kind[m] == EVR_GROUP_STATIC
+                    ? evr_node_world_at(s, s->instances[gr->members[gr->group_first[m]]].node,
+                                        s->anim_start)
+                    : evr_m34_identity();
             rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
             rtcCommitGeometry(g);
         }
@@ -857,13 +931,18 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h, con
     *out = &b->base;
     return EVR_OK;
 embree_fail:
-    snprintf(err->msg, sizeof err->msg, "%s", b->embree_error[0] ? b->embree_error : "Embree failed to build the scene");
+    snprintf(err->msg, sizeof err->msg, "%s",
+             b->embree_error[0] ? b->embree_error : "Embree failed to build the scene");
     cpu_release(&b->base);
     return EVR_ERR_BACKEND;
 nomem:
-    snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d image", setup->width, setup->height);
+    snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d image", setup->width,
+             setup->height);
     cpu_release(b ? &b->base : NULL);
     return EVR_ERR_NOMEM;
 }
 
-int evr_cpu_backend_threads(const evr_backend *b) { return ((const cpu_backend *)b)->setup.threads; }
+int evr_cpu_backend_threads(const evr_backend *b)
+{
+    return ((const cpu_backend *)b)->setup.threads;
+}

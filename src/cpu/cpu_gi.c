@@ -10,14 +10,18 @@
 #include <string.h>
 #include <time.h>
 
-int evr_embree_closest1(RTCScene sc, const int *members, const int *group_first, evr_ray ray, float tnear, float tfar,
-                        float f, evr_trace_hit *hit)
+int evr_embree_closest1(RTCScene sc, const int *members, const int *group_first, evr_ray ray,
+                        float tnear, float tfar, float f, evr_trace_hit *hit)
 {
     struct RTCIntersectContext ctx;
     struct RTCRayHit rh;
     rtcInitIntersectContext(&ctx);
-    rh.ray.org_x = ray.org.x; rh.ray.org_y = ray.org.y; rh.ray.org_z = ray.org.z;
-    rh.ray.dir_x = ray.dir.x; rh.ray.dir_y = ray.dir.y; rh.ray.dir_z = ray.dir.z;
+    rh.ray.org_x = ray.org.x;
+    rh.ray.org_y = ray.org.y;
+    rh.ray.org_z = ray.org.z;
+    rh.ray.dir_x = ray.dir.x;
+    rh.ray.dir_y = ray.dir.y;
+    rh.ray.dir_z = ray.dir.z;
     rh.ray.tnear = tnear;
     rh.ray.tfar = tfar;
     rh.ray.time = f;
@@ -28,7 +32,8 @@ int evr_embree_closest1(RTCScene sc, const int *members, const int *group_first,
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(sc, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
-    hit->inst = members ? members[group_first[rh.hit.instID[0]] + (int)rh.hit.geomID] : (int)rh.hit.geomID;
+    hit->inst =
+        members ? members[group_first[rh.hit.instID[0]] + (int)rh.hit.geomID] : (int)rh.hit.geomID;
     hit->prim = rh.hit.primID;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
@@ -41,8 +46,12 @@ int evr_embree_occluded1(RTCScene sc, evr_ray ray, float tnear, float tfar, floa
     struct RTCIntersectContext ctx;
     struct RTCRay r;
     rtcInitIntersectContext(&ctx);
-    r.org_x = ray.org.x; r.org_y = ray.org.y; r.org_z = ray.org.z;
-    r.dir_x = ray.dir.x; r.dir_y = ray.dir.y; r.dir_z = ray.dir.z;
+    r.org_x = ray.org.x;
+    r.org_y = ray.org.y;
+    r.org_z = ray.org.z;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
     r.tnear = tnear;
     r.tfar = tfar;
     r.time = f;
@@ -64,8 +73,8 @@ static int gi_occluded(void *user, evr_ray ray, float tnear, float tfar, float f
     return evr_embree_occluded1(((const evr_cpu_trace_ctx *)user)->top, ray, tnear, tfar, f);
 }
 
-evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup, const evr_scene *s,
-                           evr_error *err)
+evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr_run_setup *setup,
+                           const evr_scene *s, evr_error *err)
 {
     evr_status st;
     int margin = 0;
@@ -75,11 +84,14 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     g->tr.user = &g->tc;
     g->tr.closest = gi_closest;
     g->tr.occluded = gi_occluded;
-    if ((st = evr_photon_buffer_alloc(&g->end, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK ||
-        (st = evr_photon_buffer_alloc(&g->start, setup->width, setup->height, setup->photon_layers, margin, err)) != EVR_OK)
+    if ((st = evr_photon_buffer_alloc(&g->end, setup->width, setup->height, setup->photon_layers,
+                                      margin, err)) != EVR_OK ||
+        (st = evr_photon_buffer_alloc(&g->start, setup->width, setup->height, setup->photon_layers,
+                                      margin, err)) != EVR_OK)
         return st;
     g->sat = calloc((size_t)(g->end.width + 1) * (size_t)(g->end.height + 1), sizeof *g->sat);
-    g->ch_before = malloc(((size_t)g->end.width + 1) * (size_t)g->end.height * sizeof *g->ch_before);
+    g->ch_before =
+        malloc(((size_t)g->end.width + 1) * (size_t)g->end.height * sizeof *g->ch_before);
     g->ch_base = malloc(((size_t)g->end.height + 1) * sizeof *g->ch_base);
     g->ch_x = malloc((size_t)g->end.width * (size_t)g->end.height * sizeof *g->ch_x);
     if (!g->sat || !g->ch_before || !g->ch_base || !g->ch_x) {
@@ -100,19 +112,23 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
 
 /* One photon pass at normalized segment time f into buffer out: the photons are a sample in time
  * (every one traced at f), the view of the cells too. */
-static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, float f, int threads,
-                          evr_photon_buffer *out, evr_backend *stats, evr_error *err)
+static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan,
+                          float f, int threads, evr_photon_buffer *out, evr_backend *stats,
+                          evr_error *err)
 {
     evr_status st;
     evr_photon_stats ps;
     g->pp.threads = threads;
     g->pp.ray_eps = rs->ray_eps;
     g->pp.f0 = g->pp.f1 = f;
-    if ((st = evr_photon_emitters_build(rs, f, g->pp.bounds, g->photons, &g->em, err)) != EVR_OK) return st;
-    if (g->gp.flux_scale == 0.0f) g->gp.flux_scale = evr_gather_flux_scale(g->em.total_power, g->photons);   /* the run's */
+    if ((st = evr_photon_emitters_build(rs, f, g->pp.bounds, g->photons, &g->em, err)) != EVR_OK)
+        return st;
+    if (g->gp.flux_scale == 0.0f)
+        g->gp.flux_scale = evr_gather_flux_scale(g->em.total_power, g->photons); /* the run's */
     memset(&ps, 0, sizeof ps);
     g->trails.plan = plan;
-    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, out, &ps, g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
+    if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, out, &ps,
+                              g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
         return st;
     if ((st = evr_photon_gbuffer(rs, &g->tr, f, out, threads, err)) != EVR_OK) return st;
     stats->photons_traced += ps.paths;
@@ -123,20 +139,20 @@ static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_s
     return EVR_OK;
 }
 
-evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan, int threads,
-                              evr_backend *stats, evr_error *err)
+evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan,
+                              int threads, evr_backend *stats, evr_error *err)
 {
     const int still = evr_skip_plan_still(plan);
     const int w = g->end.width, h = g->end.height;
     evr_status st;
     int x, y;
-    if (still && g->have_prev) {   /* the photons of the last segment's end, here at both ends */
+    if (still && g->have_prev) { /* the photons of the last segment's end, here at both ends */
         g->start_same = 1;
         memset(g->sat, 0, (size_t)(w + 1) * (size_t)(h + 1) * sizeof *g->sat);
         return EVR_OK;
     }
     const double t0 = evr_host_seconds();
-    if (g->have_prev) {   /* the previous segment's end (the last pass's) is this one's start */
+    if (g->have_prev) { /* the previous segment's end (the last pass's) is this one's start */
         evr_photon_buffer tmp = g->start;
         g->start = g->end;
         g->end = tmp;
@@ -150,10 +166,12 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
         for (x = 0; x < w; x++) {
             size_t i = (size_t)y * (size_t)w + (size_t)x;
             row += !evr_photon_cell_same(&g->end, &g->start, i);
-            g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] = g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
+            g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] =
+                g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
         }
     }
-    if (g->gp.max_photons <= 0) g->ch = evr_changed_cells_from_sat(g->sat, w, h, g->ch_before, g->ch_base, g->ch_x);
+    if (g->gp.max_photons <= 0)
+        g->ch = evr_changed_cells_from_sat(g->sat, w, h, g->ch_before, g->ch_base, g->ch_x);
     g->have_prev = 1;
     stats->photon_cells_changed += g->sat[(size_t)h * (size_t)(w + 1) + (size_t)w];
     stats->photon_seconds += evr_host_seconds() - t0;
@@ -168,20 +186,22 @@ static const evr_photon_buffer *start_of(const evr_cpu_gi *g)
 int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int y)
 {
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
-    if (m->valid && !m->end_valid) m->valid = 0;   /* its end was never gathered: forgotten */
-    if (m->valid) m->ls = m->le;                   /* the last segment's end is this one's start */
-    if (!m->valid && !m->missed) return 1;         /* nothing known of the last sample */
+    if (m->valid && !m->end_valid) m->valid = 0; /* its end was never gathered: forgotten */
+    if (m->valid) m->ls = m->le;                 /* the last segment's end is this one's start */
+    if (!m->valid && !m->missed) return 1;       /* nothing known of the last sample */
     const int was_flat = m->missed || m->flat;
-    int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin, g->window, x, y);
+    int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin,
+                                            g->window, x, y);
     /* the window changed: the pixel's last gather still holds if nothing that changed reaches it */
     if (changed && m->valid && !g->memo_off)
-        changed = evr_photon_gather_moved(&g->end, &g->start, g->sat, cam, &g->gp, x, y, evr_v3_make(m->key[0], m->key[1], m->key[2]),
+        changed = evr_photon_gather_moved(&g->end, &g->start, g->sat, cam, &g->gp, x, y,
+                                          evr_v3_make(m->key[0], m->key[1], m->key[2]),
                                           evr_v3_make(m->key[3], m->key[4], m->key[5]), m->key[6]);
     if (changed) {
         m->end_valid = 0;
         return !m->missed;
     }
-    m->flat = 1;   /* its end is its start */
+    m->flat = 1; /* its end is its start */
     return !was_flat;
 }
 
@@ -189,18 +209,23 @@ int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int
  * photons at the segment's start (ls) and end (le); one gather where the window saw no change
  * over the segment (the same cells, the same estimate); end_only: le alone. (Walking the two
  * buffers together, cell by cell, was 4-6% faster here and 4% slower on the GPU: one walk kept.) */
-static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_material_params *mat, const evr_surface *s,
-                        evr_v3 cam_org, int x, int y, int end_only, float *ls, float *le, evr_gather_sum *se)
+static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs,
+                        const evr_material_params *mat, const evr_surface *s, evr_v3 cam_org, int x,
+                        int y, int end_only, float *ls, float *le, evr_gather_sum *se)
 {
-    const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height, g->end.margin, g->window, x, y);
+    const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height,
+                                                  g->end.margin, g->window, x, y);
     evr_gather_point gp;
     evr_gather_point_at(s, mat, cam_org, &gp);
-    if (g->gp.max_photons <= 0) {   /* fixed-point sums: the end's from the start's (se) and the cells that changed */
+    if (g->gp.max_photons <=
+        0) { /* fixed-point sums: the end's from the start's (se) and the cells that changed */
         if (!end_only) {
             evr_gather_point_sum(start_of(g), &rs->camera, &g->gp, &gp, x, y, se);
             *ls = evr_gather_sum_lum(&g->end, &rs->camera, &g->gp, &gp, x, y, se);
         }
-        if (changed) evr_gather_point_delta(&g->end, start_of(g), &g->ch, &rs->camera, &g->gp, &gp, x, y, se);
+        if (changed)
+            evr_gather_point_delta(&g->end, start_of(g), &g->ch, &rs->camera, &g->gp, &gp, x, y,
+                                   se);
         *le = changed ? evr_gather_sum_lum(&g->end, &rs->camera, &g->gp, &gp, x, y, se) : *ls;
         return;
     }
@@ -208,8 +233,8 @@ static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const e
     *le = changed ? evr_gather_point_lum(&g->end, &rs->camera, &g->gp, &gp, x, y) : *ls;
 }
 
-float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org, int x,
-                          int y, float f, int memo)
+float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,
+                          const evr_surface *s, evr_v3 cam_org, int x, int y, float f, int memo)
 {
     const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];

@@ -14,12 +14,14 @@
 #include <xmmintrin.h>
 #endif
 
-evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers, int margin, evr_error *err)
+evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers,
+                                   int margin, evr_error *err)
 {
     size_t npix;
     memset(b, 0, sizeof *b);
     if (width <= 0 || height <= 0 || layers <= 0 || margin < 0 || margin > 4096) {
-        snprintf(err->msg, sizeof err->msg, "photon buffer: bad size %dx%d x %d layers, margin %d", width, height, layers, margin);
+        snprintf(err->msg, sizeof err->msg, "photon buffer: bad size %dx%d x %d layers, margin %d",
+                 width, height, layers, margin);
         return EVR_ERR_ARG;
     }
     b->width = width + 2 * margin;
@@ -32,7 +34,8 @@ evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, 
     b->collisions = calloc(1, sizeof *b->collisions);
     if (!b->slots || !b->count || !b->collisions) {
         evr_photon_buffer_free(b);
-        snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d photon buffer of %d layers", width, height, layers);
+        snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d photon buffer of %d layers",
+                 width, height, layers);
         return EVR_ERR_NOMEM;
     }
     return EVR_OK;
@@ -44,7 +47,8 @@ void evr_photon_buffer_clear(evr_photon_buffer *b)
     *b->collisions = 0;
 }
 
-evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before, uint32_t *base, uint32_t *x)
+evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before,
+                                             uint32_t *base, uint32_t *x)
 {
     evr_changed_cells ch;
     int cx, cy;
@@ -110,8 +114,8 @@ static void *gbuf_worker(void *arg)
     return NULL;
 }
 
-evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f, evr_photon_buffer *buf,
-                              int threads, evr_error *err)
+evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f,
+                              evr_photon_buffer *buf, int threads, evr_error *err)
 {
     gbuf_ctx c;
     if (!buf->gbuf) {
@@ -159,8 +163,8 @@ typedef struct {
     const evr_photon_params *pp;
     const evr_photon_emitters *em;
     int margin, cells_w;
-    evr_photon_trails *trails;     /* NULL: none */
-    int reuse;                     /* the trails are the previous pass's, with the same emitters */
+    evr_photon_trails *trails; /* NULL: none */
+    int reuse;                 /* the trails are the previous pass's, with the same emitters */
     chunk_out *chunks;
     int nchunks;
     atomic_int next;
@@ -179,7 +183,10 @@ static void push(chunk_out *co, const evr_photon *ph, int x, int y)
     if (co->n == co->cap) {
         size_t nc = co->cap ? 2 * co->cap : 256;
         pending *p = realloc(co->v, nc * sizeof *p);
-        if (!p) { co->failed = 1; return; }
+        if (!p) {
+            co->failed = 1;
+            return;
+        }
         co->v = p;
         co->cap = nc;
     }
@@ -190,13 +197,14 @@ static void push(chunk_out *co, const evr_photon *ph, int x, int y)
 }
 
 /* Keeps a photon that stays where the camera sees it (its view ray goes to the trail t). */
-static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float flux[3], uint32_t key, float f,
-                 evr_photon_trail *t, evr_trail_ray *rays)
+static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float flux[3],
+                 uint32_t key, float f, evr_photon_trail *t, evr_trail_ray *rays)
 {
     evr_ray r;
     float tnear, tfar;
     int x, y;
-    if (!evr_photon_view_ray(c->rs, s, f, c->margin, c->pp->ray_eps, &x, &y, &r, &tnear, &tfar)) return;
+    if (!evr_photon_view_ray(c->rs, s, f, c->margin, c->pp->ray_eps, &x, &y, &r, &tnear, &tfar))
+        return;
     const int occluded = c->tr->occluded(c->tr->user, r, tnear, tfar, f);
     if (t) evr_photon_trail_ray(t, rays, c->trails->len, c->trails->plan, r, tfar);
     if (occluded) return;
@@ -208,7 +216,8 @@ static void keep(pass_ctx *c, chunk_out *co, const evr_surface *s, const float f
     push(co, &ph, x, y);
 }
 
-static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t, evr_trail_ray *rays);
+static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t,
+                       evr_trail_ray *rays);
 
 /* Photon i: its trail's outcome where the pass may reuse it, else its path (recorded). */
 static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
@@ -223,14 +232,16 @@ static void trace_photon(pass_ctx *c, chunk_out *co, uint32_t i)
     if (c->reuse && evr_photon_trail_reusable(t, rays, tt->plan)) {
         co->reused++;
         if (t->cell != EVR_TRAIL_NONE)
-            push(co, &t->ph, (int)(t->cell % (uint32_t)c->cells_w) - c->margin, (int)(t->cell / (uint32_t)c->cells_w) - c->margin);
+            push(co, &t->ph, (int)(t->cell % (uint32_t)c->cells_w) - c->margin,
+                 (int)(t->cell / (uint32_t)c->cells_w) - c->margin);
         return;
     }
     evr_photon_trail_begin(t, tt->plan);
     trace_path(c, co, i, t, rays);
 }
 
-static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t, evr_trail_ray *rays)
+static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail *t,
+                       evr_trail_ray *rays)
 {
     const evr_render_scene *rs = c->rs;
     evr_photon_path path;
@@ -244,12 +255,15 @@ static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail 
         float stored[3], absorbed[3];
         uint32_t key = 0;
         const int hit = c->tr->closest(c->tr->user, path.pr.ray, path.tnear, INFINITY, path.f, &h);
-        if (t) evr_photon_trail_ray(t, rays, c->trails->len, c->trails->plan, path.pr.ray, hit ? h.t : 1e30f);
+        if (t)
+            evr_photon_trail_ray(t, rays, c->trails->len, c->trails->plan, path.pr.ray,
+                                 hit ? h.t : 1e30f);
         if (!hit) {
             add3(co->escaped, path.pr.flux, 1.0f);
             return;
         }
-        const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
+        const evr_material_params *mat =
+            &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), path.f);
         evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
         int ev = evr_photon_path_hit(&path, c->pp, &s, mat, stored, absorbed, &key);
@@ -282,7 +296,8 @@ static void *pass_worker(void *arg)
 }
 
 /* Room for the pass's trails and whether the previous pass's may be reused (see the header). */
-static int trails_prepare(evr_photon_trails *tt, const evr_photon_params *pp, const evr_photon_emitters *em)
+static int trails_prepare(evr_photon_trails *tt, const evr_photon_params *pp,
+                          const evr_photon_emitters *em)
 {
     const int len = evr_photon_trail_len(pp);
     if (em->photons > tt->cap || len != tt->len) {
@@ -306,9 +321,10 @@ void evr_photon_trails_free(evr_photon_trails *tt)
     memset(tt, 0, sizeof *tt);
 }
 
-evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
-                           const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
-                           evr_photon_trails *trails, evr_error *err)
+evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr,
+                           const evr_photon_params *pp, const evr_photon_emitters *em,
+                           evr_photon_buffer *buf, evr_photon_stats *st, evr_photon_trails *trails,
+                           evr_error *err)
 {
     pass_ctx c;
     int i, k;
@@ -328,7 +344,7 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
     c.em = em;
     c.margin = buf->margin;
     c.cells_w = buf->width;
-    if (trails) {   /* without the memory for them, every photon is traced (as without trails) */
+    if (trails) { /* without the memory for them, every photon is traced (as without trails) */
         c.reuse = trails_prepare(trails, pp, em);
         c.trails = c.reuse < 0 ? NULL : trails;
         if (c.reuse < 0) c.reuse = 0;
@@ -357,7 +373,9 @@ evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, con
         st->reused += co->reused;
         st->stored_photons += co->stored_photons;
         st->visible += co->n;
-        for (n = 0; n < co->n; n++) st->inserted += (uint64_t)evr_photon_buffer_insert(buf, co->v[n].x, co->v[n].y, &co->v[n].ph);
+        for (n = 0; n < co->n; n++)
+            st->inserted +=
+                (uint64_t)evr_photon_buffer_insert(buf, co->v[n].x, co->v[n].y, &co->v[n].ph);
         free(co->v);
     }
     free(c.chunks);

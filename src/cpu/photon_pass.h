@@ -29,21 +29,22 @@ typedef struct {
 } evr_tracer;
 
 /* A buffer for a width x height image with a guard band of margin pixels. */
-evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers, int margin, evr_error *err);
+evr_status evr_photon_buffer_alloc(evr_photon_buffer *b, int width, int height, int layers,
+                                   int margin, evr_error *err);
 void evr_photon_buffer_clear(evr_photon_buffer *b);
 void evr_photon_buffer_free(evr_photon_buffer *b);
 
 /* The changed cells of a w x h buffer (core/photon.h's evr_changed_cells) from the summed-area
  * table of its changed cells (evr_sat_count's): before needs (w + 1) h entries, base h + 1, x w h. */
-evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before, uint32_t *base, uint32_t *x);
+evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, uint32_t *before,
+                                             uint32_t *base, uint32_t *x);
 
 /* Fills buf->gbuf (allocated here when NULL; freed by evr_photon_buffer_free): the surface the
  * camera (pose at time f) sees through every cell's centre, guard band included, and the area
  * the cell covers there (pixel area at unit distance * depth^2 * cos(off-axis angle) / |cos of
  * the incidence|, the cosine at least 0.1). */
-evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f, evr_photon_buffer *buf,
-                              int threads, evr_error *err);
-
+evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f,
+                              evr_photon_buffer *buf, int threads, evr_error *err);
 
 /* Energy bookkeeping (RGB flux) and counts of one pass. Absorbed is the estimate
  * sum(first hits of light photons: F (1 - albedo)) + sum(stays: F / t_diffuse * (1 - albedo));
@@ -51,7 +52,7 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
 typedef struct {
     double emitted[3], stored[3], absorbed[3], escaped[3], capped[3];
     uint64_t paths, stored_photons, visible, inserted, collisions;
-    uint64_t reused;               /* photons that took their trail's outcome (not in the flux sums) */
+    uint64_t reused; /* photons that took their trail's outcome (not in the flux sums) */
     double seconds;
 } evr_photon_stats;
 
@@ -60,9 +61,9 @@ typedef struct {
 typedef struct {
     evr_photon_trail *t;
     evr_trail_ray *rays;
-    uint32_t cap;                  /* photons */
-    int len;                       /* rays per trail */
-    int valid;                     /* they hold the previous pass's, whose emitters were em */
+    uint32_t cap; /* photons */
+    int len;      /* rays per trail */
+    int valid;    /* they hold the previous pass's, whose emitters were em */
     evr_photon_emitters em;
     const evr_skip_plan *plan;
 } evr_photon_trails;
@@ -73,8 +74,9 @@ void evr_photon_trails_free(evr_photon_trails *tt);
  * first) in photon order: the buffer is identical for any thread count. trails (NULL: none): a
  * photon whose trail the plan lets it reuse takes its outcome instead of being traced; every
  * other photon's trail is recorded. The flux sums of st count traced photons only. */
-evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr, const evr_photon_params *pp,
-                           const evr_photon_emitters *em, evr_photon_buffer *buf, evr_photon_stats *st,
-                           evr_photon_trails *trails, evr_error *err);
+evr_status evr_photon_pass(const evr_render_scene *rs, const evr_tracer *tr,
+                           const evr_photon_params *pp, const evr_photon_emitters *em,
+                           evr_photon_buffer *buf, evr_photon_stats *st, evr_photon_trails *trails,
+                           evr_error *err);
 
 #endif

@@ -65,7 +65,7 @@ typedef struct {
     evr_gather_params gp;
     evr_still_result *out;
     atomic_int next_row;
-    double *row_used;              /* photons used per row (summed in row order) */
+    double *row_used; /* photons used per row (summed in row order) */
     int *row_hits;
 } shade_ctx;
 
@@ -89,7 +89,8 @@ static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, f
     evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
-static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s, const evr_material_params **mat, int *inst)
+static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface *s,
+                      const evr_material_params **mat, int *inst)
 {
     const evr_render_scene *rs = c->rs;
     evr_trace_hit h;
@@ -104,11 +105,11 @@ static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface 
 /* One path from surface s0 (reached along dir_in): the radiance it reflects towards dir_in's
  * origin, excluding the direct term: paths of 1 .. max_bounces bounces ending on a light (next-
  * event estimation with the direct term's lights, diffuse share) or on an emissive surface. */
-static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_params *m0, evr_v3 dir_in,
-                        uint64_t pix, uint64_t sample, float out[3])
+static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_params *m0,
+                        evr_v3 dir_in, uint64_t pix, uint64_t sample, float out[3])
 {
     const evr_render_scene *rs = c->rs;
-    const uint64_t seed = c->p->seed ^ 0x70617468ull;   /* "path" */
+    const uint64_t seed = c->p->seed ^ 0x70617468ull; /* "path" */
     evr_surface s = *s0;
     const evr_material_params *m = m0;
     float beta[3] = {1.0f, 1.0f, 1.0f};
@@ -118,14 +119,17 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
         float xi = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
         float u1 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
         float u2 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
-        evr_v3 wo = evr_material_bounce_dir(&s, evr_material_path_event(m, &s, dir_in, xi), dir_in, u1, u2);
+        evr_v3 wo =
+            evr_material_bounce_dir(&s, evr_material_path_event(m, &s, dir_in, xi), dir_in, u1, u2);
         beta[0] *= s.albedo[0];
         beta[1] *= s.albedo[1];
         beta[2] *= s.albedo[2];
-        if (depth >= 3) {   /* Russian roulette */
+        if (depth >= 3) { /* Russian roulette */
             float q = fminf(fmaxf(beta[0], fmaxf(beta[1], beta[2])), 0.95f);
             if (evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++)) >= q) return;
-            beta[0] /= q; beta[1] /= q; beta[2] /= q;
+            beta[0] /= q;
+            beta[1] /= q;
+            beta[2] /= q;
         }
         if (!(beta[0] > 0.0f || beta[1] > 0.0f || beta[2] > 0.0f)) return;
         evr_ray r;
@@ -218,7 +222,8 @@ void evr_still_result_free(evr_still_result *r)
     memset(r, 0, sizeof *r);
 }
 
-evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_still_result *out, evr_error *err)
+evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_still_result *out,
+                            evr_error *err)
 {
     evr_render_host host;
     evr_motion_key *keys = NULL;
@@ -239,7 +244,8 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     memset(&c, 0, sizeof c);
     memset(&host, 0, sizeof host);
     if (p->width <= 0 || p->height <= 0 || p->width > 16384 || p->height > 16384) {
-        snprintf(err->msg, sizeof err->msg, "resolution must be between 1x1 and 16384x16384 (got %dx%d)", p->width, p->height);
+        snprintf(err->msg, sizeof err->msg,
+                 "resolution must be between 1x1 and 16384x16384 (got %dx%d)", p->width, p->height);
         return EVR_ERR_ARG;
     }
     if (p->gi == EVR_GI_PATH && p->spp <= 0) {
@@ -247,11 +253,14 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         return EVR_ERR_ARG;
     }
     if (p->max_bounces < 1 || p->max_bounces > 15) {
-        snprintf(err->msg, sizeof err->msg, "--max-bounces must be between 1 and 15 (got %d)", p->max_bounces);
+        snprintf(err->msg, sizeof err->msg, "--max-bounces must be between 1 and 15 (got %d)",
+                 p->max_bounces);
         return EVR_ERR_ARG;
     }
-    if (p->gi == EVR_GI_PHOTON && (p->gather_max < 1 || p->photon_layers < 1 || p->photon_layers > 64 || p->gather_window < 0)) {
-        snprintf(err->msg, sizeof err->msg, "--gather-max must be >= 1 and --photon-layers between 1 and 64");
+    if (p->gi == EVR_GI_PHOTON && (p->gather_max < 1 || p->photon_layers < 1 ||
+                                   p->photon_layers > 64 || p->gather_window < 0)) {
+        snprintf(err->msg, sizeof err->msg,
+                 "--gather-max must be >= 1 and --photon-layers between 1 and 64");
         return EVR_ERR_ARG;
     }
     if (!(p->ambient >= 0.0f) || !isfinite(p->ambient)) {
@@ -263,7 +272,8 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         return EVR_ERR_ARG;
     }
     nthreads = evr_cpu_threads(nthreads);
-    if ((st = evr_render_host_init(&host, s, cam, p->width, p->height, p->ambient, err)) != EVR_OK) return st;
+    if ((st = evr_render_host_init(&host, s, cam, p->width, p->height, p->ambient, err)) != EVR_OK)
+        return st;
     npix = (size_t)p->width * (size_t)p->height;
     out->width = p->width;
     out->height = p->height;
@@ -276,7 +286,8 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     tcnt = malloc(((size_t)s->num_nodes + 1) * sizeof *tcnt);
     c.row_used = calloc((size_t)p->height, sizeof *c.row_used);
     c.row_hits = calloc((size_t)p->height, sizeof *c.row_hits);
-    if (!out->rgb || !out->direct || !out->instance || !keys || !toff || !tcnt || !c.row_used || !c.row_hits) {
+    if (!out->rgb || !out->direct || !out->instance || !keys || !toff || !tcnt || !c.row_used ||
+        !c.row_hits) {
         snprintf(err->msg, sizeof err->msg, "out of memory for a %dx%d image", p->width, p->height);
         st = EVR_ERR_NOMEM;
         goto done;
@@ -301,20 +312,24 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     rtcSetDeviceErrorFunction(dev, embree_error, emsg);
     sc = rtcNewScene(dev);
     rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
-    evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY), hi = evr_v3_make(-INFINITY, -INFINITY, -INFINITY);
+    evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY),
+           hi = evr_v3_make(-INFINITY, -INFINITY, -INFINITY);
     for (i = 0; i < s->num_instances; i++) {
         const evr_mesh *m = &s->meshes[s->instances[i].mesh];
         evr_m34 xf = evr_motion_eval(evr_rs_track(&host.rs, host.rs.instances[i].track), 0.0f);
         RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m->num_vertices);
-        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m->num_triangles);
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                            3 * sizeof(float), m->num_vertices);
+        unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                               3 * sizeof(unsigned), m->num_triangles);
         uint32_t v;
         if (!vb || !ib) {
             rtcReleaseGeometry(g);
             break;
         }
         for (v = 0; v < m->num_vertices; v++) {
-            evr_v3 q = evr_m34_point(&xf, evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]));
+            evr_v3 q = evr_m34_point(&xf, evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1],
+                                                      m->positions[3 * v + 2]));
             vb[3 * v] = q.x;
             vb[3 * v + 1] = q.y;
             vb[3 * v + 2] = q.z;
@@ -345,13 +360,18 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         evr_photon_params pp;
         evr_photon_bounds bb;
         double t1 = evr_host_seconds();
-        uint32_t nph = p->photons ? p->photons : (npix > (1u << 25) ? (1u << 28) : (uint32_t)(8 * npix));
+        uint32_t nph =
+            p->photons ? p->photons : (npix > (1u << 25) ? (1u << 28) : (uint32_t)(8 * npix));
         /* the scene at the time, baked: a sphere round its bounds (a little larger) */
         if (!(lo.x <= hi.x)) lo = hi = evr_v3_make(0.0f, 0.0f, 0.0f);
         bb.center = evr_v3_scale(evr_v3_add(lo, hi), 0.5f);
         bb.radius = 0.5f * evr_v3_len(evr_v3_sub(hi, lo)) * 1.001f + host.rs.ray_eps;
-        if ((st = evr_photon_emitters_build(&host.rs, 0.0f, bb, nph, &em, err)) != EVR_OK) goto done;
-        if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, p->photon_layers, p->gather_window < 16 ? p->gather_window : 16, err)) != EVR_OK) goto done;
+        if ((st = evr_photon_emitters_build(&host.rs, 0.0f, bb, nph, &em, err)) != EVR_OK)
+            goto done;
+        if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, p->photon_layers,
+                                          p->gather_window < 16 ? p->gather_window : 16, err)) !=
+            EVR_OK)
+            goto done;
         memset(&pp, 0, sizeof pp);
         pp.max_bounces = p->max_bounces;
         pp.f0 = pp.f1 = 0.0f;
@@ -359,17 +379,25 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         pp.threads = nthreads;
         pp.bounds = bb;
         pp.ray_eps = host.rs.ray_eps;
-        if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) != EVR_OK) goto done;
+        if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) !=
+            EVR_OK)
+            goto done;
         /* more than 3% of the photons found their pixel full: twice the layers (up to 64), again */
         while (p->auto_layers && buf.layers < 64 && out->photon.visible > 0 &&
                (double)out->photon.collisions > 0.03 * (double)out->photon.visible) {
             int layers = 2 * buf.layers, margin = buf.margin;
             evr_photon_buffer_free(&buf);
-            if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, layers > 64 ? 64 : layers, margin, err)) != EVR_OK) goto done;
-            if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) != EVR_OK) goto done;
+            if ((st = evr_photon_buffer_alloc(&buf, p->width, p->height, layers > 64 ? 64 : layers,
+                                              margin, err)) != EVR_OK)
+                goto done;
+            if ((st = evr_photon_pass(&host.rs, &c.tr, &pp, &em, &buf, &out->photon, NULL, err)) !=
+                EVR_OK)
+                goto done;
         }
         out->photon_layers = buf.layers;
-        if (p->gather_area && (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, nthreads, err)) != EVR_OK) goto done;
+        if (p->gather_area &&
+            (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, nthreads, err)) != EVR_OK)
+            goto done;
         c.buf = &buf;
         c.gp.radius = p->gather_radius > 0.0f ? p->gather_radius : 0.02f * host.scene_size;
         c.gp.max_photons = p->gather_max;

@@ -21,7 +21,7 @@ int evr_run_workers(void *(*fn)(void *), void *arg, int threads)
         if (pthread_create(&th[i], NULL, fn, arg) != 0) break;
         started++;
     }
-    fn(arg);   /* the calling thread works too */
+    fn(arg); /* the calling thread works too */
     for (i = 1; i <= started; i++) pthread_join(th[i], NULL);
     free(th);
     return 1;

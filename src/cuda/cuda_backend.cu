@@ -45,7 +45,8 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
         nf += (size_t)m->num_vertices * (m->uvs ? 8 : 6);
         ni += (size_t)m->num_triangles * 3;
     }
-    for (i = 0; i < s->num_textures; i++) nt += (size_t)s->textures[i].width * s->textures[i].height * 4;
+    for (i = 0; i < s->num_textures; i++)
+        nt += (size_t)s->textures[i].width * s->textures[i].height * 4;
     CK(b->d_floats.reserve(nf + 1));
     CK(b->d_indices.reserve(ni + 1));
     CK(b->d_texels.reserve(nt + 1));
@@ -63,53 +64,71 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
         const evr_mesh *m = &s->meshes[i];
         size_t nv = m->num_vertices;
         mv[i] = b->host.meshes[i];
-        e = cudaMemcpy(b->d_floats.p + of, m->positions, nv * 3 * sizeof(float), cudaMemcpyHostToDevice);
+        e = cudaMemcpy(b->d_floats.p + of, m->positions, nv * 3 * sizeof(float),
+                       cudaMemcpyHostToDevice);
         mv[i].positions = b->d_floats.p + of;
         of += nv * 3;
-        if (e == cudaSuccess) e = cudaMemcpy(b->d_floats.p + of, m->normals, nv * 3 * sizeof(float), cudaMemcpyHostToDevice);
+        if (e == cudaSuccess)
+            e = cudaMemcpy(b->d_floats.p + of, m->normals, nv * 3 * sizeof(float),
+                           cudaMemcpyHostToDevice);
         mv[i].normals = b->d_floats.p + of;
         of += nv * 3;
         mv[i].uvs = NULL;
         if (m->uvs && e == cudaSuccess) {
-            e = cudaMemcpy(b->d_floats.p + of, m->uvs, nv * 2 * sizeof(float), cudaMemcpyHostToDevice);
+            e = cudaMemcpy(b->d_floats.p + of, m->uvs, nv * 2 * sizeof(float),
+                           cudaMemcpyHostToDevice);
             mv[i].uvs = b->d_floats.p + of;
             of += nv * 2;
         }
         if (e == cudaSuccess)
-            e = cudaMemcpy(b->d_indices.p + oi, m->indices, (size_t)m->num_triangles * 3 * sizeof(uint32_t), cudaMemcpyHostToDevice);
+            e = cudaMemcpy(b->d_indices.p + oi, m->indices,
+                           (size_t)m->num_triangles * 3 * sizeof(uint32_t), cudaMemcpyHostToDevice);
         mv[i].indices = b->d_indices.p + oi;
         oi += (size_t)m->num_triangles * 3;
     }
     for (i = 0; i < s->num_textures && e == cudaSuccess; i++) {
         size_t n = (size_t)s->textures[i].width * s->textures[i].height * 4;
         tv[i] = b->host.textures[i];
-        e = cudaMemcpy(b->d_texels.p + ot, s->textures[i].rgba, n * sizeof(float), cudaMemcpyHostToDevice);
+        e = cudaMemcpy(b->d_texels.p + ot, s->textures[i].rgba, n * sizeof(float),
+                       cudaMemcpyHostToDevice);
         tv[i].rgba = b->d_texels.p + ot;
         ot += n;
     }
     if (e == cudaSuccess) e = b->d_meshes.reserve((size_t)s->num_meshes + 1);
-    if (e == cudaSuccess) e = cudaMemcpy(b->d_meshes.p, mv, ((size_t)s->num_meshes + 1) * sizeof *mv, cudaMemcpyHostToDevice);
+    if (e == cudaSuccess)
+        e = cudaMemcpy(b->d_meshes.p, mv, ((size_t)s->num_meshes + 1) * sizeof *mv,
+                       cudaMemcpyHostToDevice);
     if (e == cudaSuccess) e = b->d_textures.reserve((size_t)s->num_textures + 1);
-    if (e == cudaSuccess) e = cudaMemcpy(b->d_textures.p, tv, ((size_t)s->num_textures + 1) * sizeof *tv, cudaMemcpyHostToDevice);
+    if (e == cudaSuccess)
+        e = cudaMemcpy(b->d_textures.p, tv, ((size_t)s->num_textures + 1) * sizeof *tv,
+                       cudaMemcpyHostToDevice);
     free(mv);
     free(tv);
     CK(e);
     CK(b->d_materials.reserve((size_t)s->num_materials + 1));
-    CK(cudaMemcpy(b->d_materials.p, b->host.materials, ((size_t)s->num_materials + 1) * sizeof(evr_material_params), cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(b->d_materials.p, b->host.materials,
+                  ((size_t)s->num_materials + 1) * sizeof(evr_material_params),
+                  cudaMemcpyHostToDevice));
     CK(b->d_instances.reserve((size_t)s->num_instances + 1));
-    CK(cudaMemcpy(b->d_instances.p, b->host.instances, ((size_t)s->num_instances + 1) * sizeof(evr_instance_view), cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(b->d_instances.p, b->host.instances,
+                  ((size_t)s->num_instances + 1) * sizeof(evr_instance_view),
+                  cudaMemcpyHostToDevice));
     CK(b->d_lights.reserve((size_t)s->num_lights + 1));
-    CK(cudaMemcpy(b->d_lights.p, b->host.lights, ((size_t)s->num_lights + 1) * sizeof(evr_light_view), cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(b->d_lights.p, b->host.lights,
+                  ((size_t)s->num_lights + 1) * sizeof(evr_light_view), cudaMemcpyHostToDevice));
     if (b->bvh.nodes4) {
         CK(b->d_nodes4.reserve(b->bvh.num_nodes + 1));
-        CK(cudaMemcpy(b->d_nodes4.p, b->bvh.nodes4, b->bvh.num_nodes * sizeof(evr_gpu_node4), cudaMemcpyHostToDevice));
+        CK(cudaMemcpy(b->d_nodes4.p, b->bvh.nodes4, b->bvh.num_nodes * sizeof(evr_gpu_node4),
+                      cudaMemcpyHostToDevice));
     }
     if (b->bvh.nodes8) {
         CK(b->d_nodes8.reserve(b->bvh.num_nodes + 1));
-        CK(cudaMemcpy(b->d_nodes8.p, b->bvh.nodes8, b->bvh.num_nodes * sizeof(evr_gpu_node8), cudaMemcpyHostToDevice));
+        CK(cudaMemcpy(b->d_nodes8.p, b->bvh.nodes8, b->bvh.num_nodes * sizeof(evr_gpu_node8),
+                      cudaMemcpyHostToDevice));
     }
     CK(b->d_tris.reserve(b->bvh.num_tris + 1));
-    CK(cudaMemcpy(b->d_tris.p, b->bvh.tris, b->bvh.num_tris * sizeof(evr_gpu_tri), cudaMemcpyHostToDevice));
+    CK(cudaMemcpy(b->d_tris.p, b->bvh.tris, b->bvh.num_tris * sizeof(evr_gpu_tri),
+                  cudaMemcpyHostToDevice));
     return EVR_OK;
 }
 
@@ -121,17 +140,43 @@ static void cuda_release(evr_backend *base)
     timeline_close(&b->tl);
     for (int i = 0; i < NSLOT; i++) {
         slot *sl = &b->slots[i];
-        sl->h_keys.release(); sl->h_tracks.release(); sl->d_keys.release(); sl->d_tracks.release();
+        sl->h_keys.release();
+        sl->h_tracks.release();
+        sl->d_keys.release();
+        sl->d_tracks.release();
         evr_gpu_top_free(&sl->top);
-        sl->d_top4.release(); sl->d_top8.release(); sl->d_insts.release();
-        sl->d_keys_ev.release(); sl->d_keys_sorted.release(); sl->d_sort_temp.release();
-        sl->d_count.release(); sl->d_counters.release(); sl->d_intensity.release();
-        sl->d_plan.release(); sl->h_plan.release(); sl->d_list.release();
-        sl->d_adapt.release(); sl->h_adapt.release();
-        sl->h_count.release(); sl->h_counters.release(); sl->h_sorted.release(); sl->h_intensity.release();
-        sl->h_frame_f.release(); sl->d_frame_f.release(); sl->d_frames.release(); sl->h_frames.release();
-        sl->d_sat.release(); sl->d_ch_before.release(); sl->d_ch_base.release(); sl->d_ch_x.release(); sl->h_gi_view.release();
-        sl->d_gi_view.release(); sl->h_em.release(); sl->d_em.release(); sl->h_cdf.release(); sl->d_cdf.release();
+        sl->d_top4.release();
+        sl->d_top8.release();
+        sl->d_insts.release();
+        sl->d_keys_ev.release();
+        sl->d_keys_sorted.release();
+        sl->d_sort_temp.release();
+        sl->d_count.release();
+        sl->d_counters.release();
+        sl->d_intensity.release();
+        sl->d_plan.release();
+        sl->h_plan.release();
+        sl->d_list.release();
+        sl->d_adapt.release();
+        sl->h_adapt.release();
+        sl->h_count.release();
+        sl->h_counters.release();
+        sl->h_sorted.release();
+        sl->h_intensity.release();
+        sl->h_frame_f.release();
+        sl->d_frame_f.release();
+        sl->d_frames.release();
+        sl->h_frames.release();
+        sl->d_sat.release();
+        sl->d_ch_before.release();
+        sl->d_ch_base.release();
+        sl->d_ch_x.release();
+        sl->h_gi_view.release();
+        sl->d_gi_view.release();
+        sl->h_em.release();
+        sl->d_em.release();
+        sl->h_cdf.release();
+        sl->d_cdf.release();
         if (sl->gi_started) cudaEventDestroy(sl->gi_started);
         if (sl->gi_done) cudaEventDestroy(sl->gi_done);
         if (sl->framed) cudaEventDestroy(sl->framed);
@@ -143,9 +188,19 @@ static void cuda_release(evr_backend *base)
         if (sl->copied) cudaEventDestroy(sl->copied);
         if (sl->sort_from) cudaEventDestroy(sl->sort_from);
     }
-    b->d_floats.release(); b->d_indices.release(); b->d_meshes.release(); b->d_materials.release();
-    b->d_textures.release(); b->d_texels.release(); b->d_instances.release(); b->d_lights.release();
-    b->d_nodes4.release(); b->d_nodes8.release(); b->d_tris.release(); b->d_phase.release(); b->d_static.release();
+    b->d_floats.release();
+    b->d_indices.release();
+    b->d_meshes.release();
+    b->d_materials.release();
+    b->d_textures.release();
+    b->d_texels.release();
+    b->d_instances.release();
+    b->d_lights.release();
+    b->d_nodes4.release();
+    b->d_nodes8.release();
+    b->d_tris.release();
+    b->d_phase.release();
+    b->d_static.release();
     evr_par_pool_free(b->par);
     b->par = nullptr;
     b->d_sensor.release();
@@ -157,9 +212,17 @@ static void cuda_release(evr_backend *base)
         b->gi_ring[i].gbuf.release();
     }
     b->d_gi_last.release();
-    b->d_pending.release(); b->d_pkeys.release(); b->d_pkeys_sorted.release(); b->d_pvals.release();
-    b->d_pvals_sorted.release(); b->d_pcount.release(); b->d_ptemp.release();
-    b->d_trails.release(); b->d_trail_rays.release(); b->d_todo.release(); b->d_todo_count.release();
+    b->d_pending.release();
+    b->d_pkeys.release();
+    b->d_pkeys_sorted.release();
+    b->d_pvals.release();
+    b->d_pvals_sorted.release();
+    b->d_pcount.release();
+    b->d_ptemp.release();
+    b->d_trails.release();
+    b->d_trail_rays.release();
+    b->d_todo.release();
+    b->d_todo_count.release();
     evr_photon_emitters_free(&b->trail_em);
     gi_deferred_release(b);
     evr_photon_emitters_free(&b->em);
@@ -176,8 +239,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
     if (e != cudaSuccess || count == 0) {
         /* without an NVIDIA driver the runtime says "driver version is insufficient": say it plainly */
         const char *why = e == cudaSuccess || e == cudaErrorNoDevice ? "no NVIDIA GPU found"
-                        : e == cudaErrorInsufficientDriver ? "no NVIDIA driver, or one too old for CUDA 13"
-                        : cudaGetErrorString(e);
+                          : e == cudaErrorInsufficientDriver
+                              ? "no NVIDIA driver, or one too old for CUDA 13"
+                              : cudaGetErrorString(e);
         snprintf(err->msg, sizeof err->msg, "no usable CUDA device (%s)", why);
         return EVR_ERR_BACKEND;
     }
@@ -198,8 +262,10 @@ static evr_status init(cuda_backend *b, evr_error *err)
     }
     CK(b->d_phase.reserve(npix));
     CK(b->d_sensor.reserve(1));
-    CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params), cudaMemcpyHostToDevice));
-    cuda_launch_init_pixels(b->d_state[0].p, b->d_phase.p, b->setup.width, b->setup.height, (unsigned long long)b->setup.seed);
+    CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params),
+                  cudaMemcpyHostToDevice));
+    cuda_launch_init_pixels(b->d_state[0].p, b->d_phase.p, b->setup.width, b->setup.height,
+                            (unsigned long long)b->setup.seed);
     CK(cudaGetLastError());
     CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
     /* four events a pixel per segment: the eye's busiest segments at 1280x720 take 3.3 (a segment
@@ -214,10 +280,12 @@ static evr_status init(cuda_backend *b, evr_error *err)
     b->carry_slot = -1;
     int gi_margin = 0, gi_window = 0;
     b->gi = b->setup.gi;
-    if (b->gi) evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
-    b->trails_off = getenv("EVR_NO_PHOTON_REUSE") != NULL;   /* hidden, for tests and measurement: every photon traced */
+    if (b->gi)
+        evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
+    b->trails_off = getenv("EVR_NO_PHOTON_REUSE") !=
+                    NULL; /* hidden, for tests and measurement: every photon traced */
     b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;
-    b->par = evr_par_pool_new(evr_par_threads(8));   /* NULL: keys decoded on this thread */
+    b->par = evr_par_pool_new(evr_par_threads(8)); /* NULL: keys decoded on this thread */
     if (b->setup.gpu_event_capacity > 0) b->capacity = (size_t)b->setup.gpu_event_capacity;
     if (b->gi && (st = gi_ring_alloc(b, gi_margin, err)) != EVR_OK) return st;
     for (int i = 0; i < NSLOT; i++) {
@@ -242,7 +310,8 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(sl->d_keys_sorted.reserve(b->capacity));
         CK(sl->h_sorted.reserve(b->capacity));
         size_t temp = 0;
-        CK(event_sort_temp_bytes(sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)sl->d_keys_sorted.cap, &temp));
+        CK(event_sort_temp_bytes(sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)sl->d_keys_sorted.cap,
+                                 &temp));
         CK(sl->d_sort_temp.reserve(temp));
         CK(sl->d_count.reserve(COUNT_N));
         CK(sl->d_counters.reserve(CTR_COUNT));
@@ -265,8 +334,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
     return timeline_open(&b->tl, b->render, err);
 }
 
-extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_host *h, const evr_run_setup *setup,
-                                           evr_backend **out, evr_error *err)
+extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_host *h,
+                                           const evr_run_setup *setup, evr_backend **out,
+                                           evr_error *err)
 {
     cuda_backend *b = new (std::nothrow) cuda_backend();
     if (!b) {

@@ -6,13 +6,14 @@
 #include <cuda_runtime.h>
 #include <stdio.h>
 
-#define CK(call)                                                                                          \
-    do {                                                                                                  \
-        cudaError_t e_ = (call);                                                                          \
-        if (e_ != cudaSuccess) {                                                                          \
-            snprintf(err->msg, sizeof err->msg, "CUDA: %s failed: %s", #call, cudaGetErrorString(e_));   \
-            return e_ == cudaErrorMemoryAllocation ? EVR_ERR_NOMEM : EVR_ERR_BACKEND;                     \
-        }                                                                                                 \
+#define CK(call)                                                                      \
+    do {                                                                              \
+        cudaError_t e_ = (call);                                                      \
+        if (e_ != cudaSuccess) {                                                      \
+            snprintf(err->msg, sizeof err->msg, "CUDA: %s failed: %s", #call,         \
+                     cudaGetErrorString(e_));                                         \
+            return e_ == cudaErrorMemoryAllocation ? EVR_ERR_NOMEM : EVR_ERR_BACKEND; \
+        }                                                                             \
     } while (0)
 
 #endif

@@ -24,10 +24,12 @@ struct gi_memo {
  * into different kernels the compiler may fuse a multiply and an add in one and not the other,
  * and the events would differ in the last bit of a few samples (13 of 6.5 M events at 1280x720
  * when both were inlined). */
-__device__ static __noinline__ void gpu_gather_point(const evr_render_scene *rs, int inst, const evr_surface *s, evr_v3 cam_org,
+__device__ static __noinline__ void gpu_gather_point(const evr_render_scene *rs, int inst,
+                                                     const evr_surface *s, evr_v3 cam_org,
                                                      evr_gather_point *g)
 {
-    evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org, g);
+    evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org,
+                        g);
 }
 
 /* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those
@@ -37,25 +39,31 @@ __device__ static __noinline__ void gpu_gather_point(const evr_render_scene *rs,
  * same bits (tests/test_cuda.py compares the inline and deferred kernels' events); not inlined,
  * the calls spilled the gather loops' registers (gather kernels 105 -> 92 ms per 0.5 s of the
  * Cornell box at 1280x720, H100). */
-__device__ __forceinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
-                                            const evr_gather_point *g, int x, int y, evr_gather_sum *s)
+__device__ __forceinline__ void gpu_gather_sum(const evr_photon_buffer *b, const gpu_gi_view *v,
+                                               const evr_camera_intr *cam,
+                                               const evr_gather_point *g, int x, int y,
+                                               evr_gather_sum *s)
 {
     evr_gather_point_sum(b, cam, &v->gp, g, x, y, s);
 }
 
-__device__ __forceinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                              int y, evr_gather_sum *s)
+__device__ __forceinline__ void gpu_gather_delta(const gpu_gi_view *v, const evr_camera_intr *cam,
+                                                 const evr_gather_point *g, int x, int y,
+                                                 evr_gather_sum *s)
 {
     evr_gather_point_delta(&v->end, &v->start, &v->ch, cam, &v->gp, g, x, y, s);
 }
 
-__device__ __forceinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x, int y,
-                                          const evr_gather_sum *s)
+__device__ __forceinline__ float gpu_sum_lum(const gpu_gi_view *v, const evr_camera_intr *cam,
+                                             const evr_gather_point *g, int x, int y,
+                                             const evr_gather_sum *s)
 {
     return evr_gather_sum_lum(&v->end, cam, &v->gp, g, x, y, s);
 }
 
-__device__ static __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, const gpu_gi_view *v, const evr_camera_intr *cam,
+__device__ static __noinline__ float gpu_gather_lum(const evr_photon_buffer *b,
+                                                    const gpu_gi_view *v,
+                                                    const evr_camera_intr *cam,
                                                     const evr_gather_point *g, int x, int y)
 {
     return evr_gather_point_lum(b, cam, &v->gp, g, x, y);
@@ -70,10 +78,12 @@ __device__ static __noinline__ float gpu_gather_lum(const evr_photon_buffer *b, 
  * gi_gather_known_kernel), and the end's sums (s, out) are the start's plus the changed cells'
  * terms, a walk over the few changed cells of the window instead of all of it. */
 template <bool FIXED>
-__device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam, const evr_gather_point *g, int x,
-                                                int y, float *ls, float *le, const float *known_ls, evr_gather_sum *s)
+__device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_camera_intr *cam,
+                                                const evr_gather_point *g, int x, int y, float *ls,
+                                                float *le, const float *known_ls, evr_gather_sum *s)
 {
-    const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height, v->end.margin, v->window, x, y);
+    const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height,
+                                                   v->end.margin, v->window, x, y);
     if (FIXED) {
         gpu_gather_sum(&v->start, v, cam, g, x, y, s);
         *ls = gpu_sum_lum(v, cam, g, x, y, s);
@@ -86,10 +96,13 @@ __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_
 }
 
 /* Whether two gather points are the same bit for bit (the same estimates). */
-__device__ __forceinline__ bool gather_point_same(const evr_gather_point *a, const evr_gather_point *b)
+__device__ __forceinline__ bool gather_point_same(const evr_gather_point *a,
+                                                  const evr_gather_point *b)
 {
-    const float fa[10] = {a->p.x, a->p.y, a->p.z, a->n.x, a->n.y, a->n.z, a->dist, a->k[0], a->k[1], a->k[2]};
-    const float fb[10] = {b->p.x, b->p.y, b->p.z, b->n.x, b->n.y, b->n.z, b->dist, b->k[0], b->k[1], b->k[2]};
+    const float fa[10] = {a->p.x, a->p.y,  a->p.z,  a->n.x,  a->n.y,
+                          a->n.z, a->dist, a->k[0], a->k[1], a->k[2]};
+    const float fb[10] = {b->p.x, b->p.y,  b->p.z,  b->n.x,  b->n.y,
+                          b->n.z, b->dist, b->k[0], b->k[1], b->k[2]};
     unsigned d = 0;
     for (int i = 0; i < 10; i++) d |= __float_as_uint(fa[i]) ^ __float_as_uint(fb[i]);
     return d == 0;
@@ -99,8 +112,10 @@ __device__ __forceinline__ bool gather_point_same(const evr_gather_point *a, con
  * lum or req). The albedo is the surface's at the point: same point, same triangle side. */
 __device__ __forceinline__ bool gi_memo_take(gi_memo *m, int inst, const evr_gather_point *g)
 {
-    const uint32_t key[7] = {__float_as_uint(g->p.x), __float_as_uint(g->p.y), __float_as_uint(g->p.z), __float_as_uint(g->n.x),
-                             __float_as_uint(g->n.y), __float_as_uint(g->n.z), __float_as_uint(g->dist)};
+    const uint32_t key[7] = {__float_as_uint(g->p.x), __float_as_uint(g->p.y),
+                             __float_as_uint(g->p.z), __float_as_uint(g->n.x),
+                             __float_as_uint(g->n.y), __float_as_uint(g->n.z),
+                             __float_as_uint(g->dist)};
     bool same = m->valid && m->inst == inst;
     for (int k = 0; k < 7 && same; k++) same = m->key[k] == key[k];
     if (same) return true;
@@ -115,14 +130,16 @@ __device__ __forceinline__ bool gi_memo_take(gi_memo *m, int inst, const evr_gat
  * window's cells over the warp's lanes was slower, measured on an H200: 2.07 s against 1.80 s of
  * render kernels for the Cornell box at 1280x720, 2 s: most windows are searched to the same
  * size, so the lanes of a warp were already busy in step). */
-__device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs, int inst, const evr_surface *s,
-                                             evr_v3 cam_org, int x, int y, float f, gi_memo *m)
+__device__ __forceinline__ float gi_indirect(const gpu_gi_view *g, const evr_render_scene *rs,
+                                             int inst, const evr_surface *s, evr_v3 cam_org, int x,
+                                             int y, float f, gi_memo *m)
 {
     evr_gather_point gp;
     gpu_gather_point(rs, inst, s, cam_org, &gp);
     evr_gather_sum sums;
     if (!gi_memo_take(m, inst, &gp)) {
-        if (g->gp.max_photons <= 0) gpu_gather_ends<true>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
+        if (g->gp.max_photons <= 0)
+            gpu_gather_ends<true>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
         else gpu_gather_ends<false>(g, &rs->camera, &gp, x, y, &m->ls, &m->le, nullptr, &sums);
     }
     return evr_gi_lerp(m->ls, m->le, f);

@@ -32,9 +32,10 @@ __device__ __forceinline__ void count_lanes(unsigned long long *counters, int c)
 }
 
 /* Appends a visible photon in cell `cell` for the sort (its rank in the cell is its layer). */
-__device__ __forceinline__ void photon_append(const photon_args &p, const evr_photon &ph, unsigned cell)
+__device__ __forceinline__ void photon_append(const photon_args &p, const evr_photon &ph,
+                                              unsigned cell)
 {
-    const unsigned idx = atomicAdd(p.pending_count, 1u);   /* < photons: one stay per photon */
+    const unsigned idx = atomicAdd(p.pending_count, 1u); /* < photons: one stay per photon */
     p.pending[idx] = ph;
     p.sort_keys[idx] = ((unsigned long long)cell << 32) | ph.key;
     p.sort_vals[idx] = idx;
@@ -42,7 +43,8 @@ __device__ __forceinline__ void photon_append(const photon_args &p, const evr_ph
 
 /* Photon i's path (core/photon.h) and, where it stays, the camera's check; its rays go to trail t. */
 template <int LAYOUT>
-__device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned i, evr_photon_trail *t, evr_trail_ray *rays)
+__device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned i,
+                            evr_photon_trail *t, evr_trail_ray *rays)
 {
     const evr_render_scene *rs = &a.rs;
     evr_photon_path path;
@@ -54,10 +56,13 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
         evr_surface s;
         float stored[3], absorbed[3];
         uint32_t key = 0;
-        const int hit = gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h);
-        if (rays) evr_photon_trail_ray(t, rays, p.trail_len, a.plan, path.pr.ray, hit ? h.t : 1e30f);
+        const int hit =
+            gpu_trace<LAYOUT>(&a.view, rs, path.pr.ray, path.tnear, 1e30f, path.f, 0, &h);
+        if (rays)
+            evr_photon_trail_ray(t, rays, p.trail_len, a.plan, path.pr.ray, hit ? h.t : 1e30f);
         if (!hit) return;
-        const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
+        const evr_material_params *mat =
+            &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), path.f);
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.pr.ray, h.t, &s);
         const int ev = evr_photon_path_hit(&path, &p.pp, &s, mat, stored, absorbed, &key);
@@ -65,7 +70,8 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
             evr_ray r;
             float tn, tf;
             int x, y;
-            if (!evr_photon_view_ray(rs, &s, path.f, p.margin, p.pp.ray_eps, &x, &y, &r, &tn, &tf)) return;
+            if (!evr_photon_view_ray(rs, &s, path.f, p.margin, p.pp.ray_eps, &x, &y, &r, &tn, &tf))
+                return;
             const int occluded = gpu_trace<LAYOUT>(&a.view, rs, r, tn, tf, path.f, 1, &h);
             if (rays) evr_photon_trail_ray(t, rays, p.trail_len, a.plan, r, tf);
             if (occluded) return;
@@ -116,9 +122,10 @@ __global__ void __launch_bounds__(BLOCK) photon_kernel(kernel_args a, photon_arg
 }
 
 /* One thread per sorted photon: its layer is its rank among its cell's photons. */
-__global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long long *keys, const unsigned *vals, unsigned n,
-                                                             const evr_photon *pending, evr_photon_buffer buf,
-                                                             unsigned long long *counters)
+__global__ void __launch_bounds__(BLOCK)
+    photon_place_kernel(const unsigned long long *keys, const unsigned *vals, unsigned n,
+                        const evr_photon *pending, evr_photon_buffer buf,
+                        unsigned long long *counters)
 {
     const unsigned j = blockIdx.x * blockDim.x + threadIdx.x;
     if (j >= n) return;
@@ -127,7 +134,7 @@ __global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long
     const unsigned cell = (unsigned)(k >> 32);
     const unsigned long long first_key = (unsigned long long)cell << 32;
     unsigned lo = 0, hi = j;
-    while (lo < hi) {   /* the cell's first entry */
+    while (lo < hi) { /* the cell's first entry */
         unsigned mid = (lo + hi) / 2;
         if (keys[mid] < first_key) lo = mid + 1;
         else hi = mid;
@@ -139,12 +146,14 @@ __global__ void __launch_bounds__(BLOCK) photon_place_kernel(const unsigned long
     } else {
         atomicAdd(&counters[CTR_GI_COLLISIONS], 1ull);
     }
-    if (j + 1 == n || (unsigned)(keys[j + 1] >> 32) != cell) buf.count[cell] = rank + 1;   /* arrivals, as the CPU counts */
+    if (j + 1 == n || (unsigned)(keys[j + 1] >> 32) != cell)
+        buf.count[cell] = rank + 1; /* arrivals, as the CPU counts */
 }
 
 /* One thread per cell: what the camera sees through the cell's centre at normalized segment time f. */
 template <int LAYOUT>
-__global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_photon_buffer buf, float f)
+__global__ void __launch_bounds__(BLOCK)
+    photon_view_kernel(kernel_args a, evr_photon_buffer buf, float f)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= buf.width * buf.height) return;
@@ -166,8 +175,9 @@ __global__ void __launch_bounds__(BLOCK) photon_view_kernel(kernel_args a, evr_p
 /* Changed cells into the summed-area table's interior (row 0 and column 0 stay zero): 1 where
  * the photons or the view at the segment's end differ from its start's, or did over the segment
  * before (last, per cell: updated to this segment's). */
-__global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer end, evr_photon_buffer start, uint8_t *last,
-                                                               uint32_t *sat, unsigned long long *counters)
+__global__ void __launch_bounds__(BLOCK)
+    photon_changed_kernel(evr_photon_buffer end, evr_photon_buffer start, uint8_t *last,
+                          uint32_t *sat, unsigned long long *counters)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= end.width * end.height) return;
@@ -175,18 +185,20 @@ __global__ void __launch_bounds__(BLOCK) photon_changed_kernel(evr_photon_buffer
     const uint8_t now = !evr_photon_cell_same(&end, &start, (size_t)cell);
     sat[(size_t)(y + 1) * (size_t)(end.width + 1) + (size_t)(x + 1)] = now | last[cell];
     last[cell] = now;
-    if (now) count_lanes(counters, CTR_GI_CHANGED);   /* this segment's changes, as the CPU counts them */
+    if (now)
+        count_lanes(counters, CTR_GI_CHANGED); /* this segment's changes, as the CPU counts them */
 }
 
 /* The list of the cells that changed over the segment (core/photon.h's evr_changed_cells, for
  * gp.max_photons 0) from the per-cell flags photon_changed_kernel left in last: per row the
  * count before each column (one warp a row, as sat_rows_kernel), then the rows' bases (one warp),
  * then each changed cell's column at its entry. */
-__global__ void __launch_bounds__(BLOCK) changed_rows_kernel(const uint8_t *last, int w, int h, uint32_t *before)
+__global__ void __launch_bounds__(BLOCK)
+    changed_rows_kernel(const uint8_t *last, int w, int h, uint32_t *before)
 {
     const int y = (int)((blockIdx.x * blockDim.x + threadIdx.x) / 32u);
     const unsigned lane = threadIdx.x & 31u;
-    if (y >= h) return;   /* the whole warp */
+    if (y >= h) return; /* the whole warp */
     uint32_t *row = before + (size_t)y * (size_t)(w + 1);
     uint32_t carry = 0;
     for (int x0 = 0; x0 < w; x0 += 32) {
@@ -197,7 +209,7 @@ __global__ void __launch_bounds__(BLOCK) changed_rows_kernel(const uint8_t *last
             const uint32_t u = __shfl_up_sync(0xffffffffu, v, (unsigned)o);
             if (lane >= (unsigned)o) v += u;
         }
-        if (x < w) row[x] = carry + v - f;   /* exclusive */
+        if (x < w) row[x] = carry + v - f; /* exclusive */
         carry += __shfl_sync(0xffffffffu, v, 31);
     }
     if (lane == 0) row[w] = carry;
@@ -220,7 +232,8 @@ __global__ void changed_base_kernel(const uint32_t *before, int w, int h, uint32
     }
 }
 
-__global__ void __launch_bounds__(BLOCK) changed_list_kernel(const uint8_t *last, int w, int h, evr_changed_cells ch, uint32_t *xs)
+__global__ void __launch_bounds__(BLOCK)
+    changed_list_kernel(const uint8_t *last, int w, int h, evr_changed_cells ch, uint32_t *xs)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= w * h || !last[cell]) return;
@@ -235,7 +248,7 @@ __global__ void __launch_bounds__(BLOCK) sat_rows_kernel(uint32_t *sat, int w, i
 {
     const int y = (int)((blockIdx.x * blockDim.x + threadIdx.x) / 32u);
     const unsigned lane = threadIdx.x & 31u;
-    if (y >= h) return;   /* the whole warp */
+    if (y >= h) return; /* the whole warp */
     uint32_t *row = sat + (size_t)(y + 1) * (size_t)(w + 1) + 1;
     uint32_t carry = 0;
     for (int x0 = 0; x0 < w; x0 += 32) {
@@ -261,7 +274,8 @@ __global__ void __launch_bounds__(32 * SAT_CHUNKS) sat_cols_kernel(uint32_t *sat
     __shared__ uint32_t chunk_sum[SAT_CHUNKS][32];
     const int lane = (int)(threadIdx.x & 31u), c = (int)(threadIdx.x / 32u);
     const int x = (int)blockIdx.x * 32 + lane + 1;
-    const int rows = (h + SAT_CHUNKS - 1) / SAT_CHUNKS, y0 = 1 + c * rows, y1 = min(h + 1, y0 + rows);
+    const int rows = (h + SAT_CHUNKS - 1) / SAT_CHUNKS, y0 = 1 + c * rows,
+              y1 = min(h + 1, y0 + rows);
     const size_t W = (size_t)w + 1;
     uint32_t run = 0;
     if (x <= w)
@@ -292,8 +306,9 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     const size_t len = (size_t)p->trail_len;
     if (n > b->d_trails.cap || (size_t)n * len > b->d_trail_rays.cap) {
         b->trails_valid = 0;
-        if (b->d_trails.reserve(n, true) != cudaSuccess || b->d_trail_rays.reserve((size_t)n * len, true) != cudaSuccess) {
-            (void)cudaGetLastError();   /* not sticky: cleared */
+        if (b->d_trails.reserve(n, true) != cudaSuccess ||
+            b->d_trail_rays.reserve((size_t)n * len, true) != cudaSuccess) {
+            (void)cudaGetLastError(); /* not sticky: cleared */
             b->d_trails.release();
             b->d_trail_rays.release();
             b->trails_off = 1;
@@ -303,7 +318,7 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
     if (b->d_todo.reserve(n) != cudaSuccess || b->d_todo_count.reserve(1) != cudaSuccess) {
         (void)cudaGetLastError();
         b->trails_valid = 0;
-        return;   /* no reuse this pass, no trails recorded */
+        return; /* no reuse this pass, no trails recorded */
     }
     p->trails = b->d_trails.p;
     p->trail_rays = b->d_trail_rays.p;
@@ -315,15 +330,17 @@ static void trail_args(cuda_backend *b, unsigned n, photon_args *p)
 /* One photon pass at normalized segment time f into buffer out, on the render stream:
  * the photons, traced at f, and the camera's view of the cells at f. hrs: the segment's scene
  * with host pointers (the emitters are built on the host). */
-static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs, float f, const evr_photon_buffer *out,
-                          evr_error *err)
+static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs, float f,
+                          const evr_photon_buffer *out, evr_error *err)
 {
     const size_t cells = (size_t)out->width * (size_t)out->height;
     const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
     cudaStream_t rs = b->render;
     evr_status st;
-    if ((st = evr_photon_emitters_build(hrs, f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK) return st;
-    if (b->gp.flux_scale == 0.0f) b->gp.flux_scale = evr_gather_flux_scale(b->em.total_power, b->photons);   /* the run's */
+    if ((st = evr_photon_emitters_build(hrs, f, b->pp.bounds, b->photons, &b->em, err)) != EVR_OK)
+        return st;
+    if (b->gp.flux_scale == 0.0f)
+        b->gp.flux_scale = evr_gather_flux_scale(b->em.total_power, b->photons); /* the run's */
     if (b->em.photons > (1u << 28)) {
         snprintf(err->msg, sizeof err->msg, "too many photons (%u; at most 2^28)", b->em.photons);
         return EVR_ERR_ARG;
@@ -335,8 +352,10 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
     CK(sl->d_cdf.reserve((size_t)b->em.cdf_n + 1));
     if (b->em.n) memcpy(sl->h_em.p, b->em.e, (size_t)b->em.n * sizeof(evr_photon_emitter));
     if (b->em.cdf_n) memcpy(sl->h_cdf.p, b->em.cdf, (size_t)b->em.cdf_n * sizeof(float));
-    CK(cudaMemcpyAsync(sl->d_em.p, sl->h_em.p, ((size_t)b->em.n + 1) * sizeof(evr_photon_emitter), cudaMemcpyHostToDevice, rs));
-    CK(cudaMemcpyAsync(sl->d_cdf.p, sl->h_cdf.p, ((size_t)b->em.cdf_n + 1) * sizeof(float), cudaMemcpyHostToDevice, rs));
+    CK(cudaMemcpyAsync(sl->d_em.p, sl->h_em.p, ((size_t)b->em.n + 1) * sizeof(evr_photon_emitter),
+                       cudaMemcpyHostToDevice, rs));
+    CK(cudaMemcpyAsync(sl->d_cdf.p, sl->h_cdf.p, ((size_t)b->em.cdf_n + 1) * sizeof(float),
+                       cudaMemcpyHostToDevice, rs));
     CK(b->d_pending.reserve((size_t)n + 1));
     CK(b->d_pkeys.reserve((size_t)n + 1));
     CK(b->d_pkeys_sorted.reserve((size_t)n + 1));
@@ -368,22 +387,27 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
             photon_reuse_kernel<<<pgrid, BLOCK, 0, rs>>>(a, p);
             CK(cudaGetLastError());
         }
-        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
+            photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
         else photon_kernel<EVR_GPU_LAYOUT_BVH4><<<pgrid, BLOCK, 0, rs>>>(a, p);
         CK(cudaGetLastError());
         /* the cell in the high bits (up to 2^end - 1), the photon key in the low 32 */
         int end_bit = 33;
         while (end_bit < 64 && (1ull << (end_bit - 32)) <= cells) end_bit++;
         size_t temp = 0;
-        CK(cub::DeviceRadixSort::SortPairs(nullptr, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
-                                           (int)n, 0, end_bit, rs));
+        CK(cub::DeviceRadixSort::SortPairs(nullptr, temp, b->d_pkeys.p, b->d_pkeys_sorted.p,
+                                           b->d_pvals.p, b->d_pvals_sorted.p, (int)n, 0, end_bit,
+                                           rs));
         CK(b->d_ptemp.reserve(temp));
-        CK(cub::DeviceRadixSort::SortPairs(b->d_ptemp.p, temp, b->d_pkeys.p, b->d_pkeys_sorted.p, b->d_pvals.p, b->d_pvals_sorted.p,
-                                           (int)n, 0, end_bit, rs));
-        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n, b->d_pending.p, *out, sl->d_counters.p);
+        CK(cub::DeviceRadixSort::SortPairs(b->d_ptemp.p, temp, b->d_pkeys.p, b->d_pkeys_sorted.p,
+                                           b->d_pvals.p, b->d_pvals_sorted.p, (int)n, 0, end_bit,
+                                           rs));
+        photon_place_kernel<<<pgrid, BLOCK, 0, rs>>>(b->d_pkeys_sorted.p, b->d_pvals_sorted.p, n,
+                                                     b->d_pending.p, *out, sl->d_counters.p);
         CK(cudaGetLastError());
     }
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
+        photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
     else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
     CK(cudaGetLastError());
     sl->gi_passes++;
@@ -393,37 +417,48 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
 /* The segment's photons on the render stream, before its render: the pass at its end (the first
  * segment's at its start too), the cells that changed, the view its kernels read. A still segment
  * (nothing moved in it or since the previous one) copies the previous segment's buffer. */
-evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err)
+evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg,
+                      const evr_render_scene *hrs, evr_error *err)
 {
-    const gi_buffer *end = &b->gi_ring[sl->index % NRING], *start = &b->gi_ring[(sl->index + NRING - 1) % NRING];
+    const gi_buffer *end = &b->gi_ring[sl->index % NRING],
+                    *start = &b->gi_ring[(sl->index + NRING - 1) % NRING];
     const evr_photon_buffer *eb = &end->ph, *sb = &start->ph;
     const size_t cells = (size_t)eb->width * (size_t)eb->height;
     const unsigned cgrid = (unsigned)((cells + BLOCK - 1) / BLOCK);
     cudaStream_t rs = b->render;
     evr_status st;
     sl->gi_passes = 0;
-    CK(cudaMemsetAsync(sl->d_counters.p + CTR_GI_PATHS, 0, (CTR_COUNT - CTR_GI_PATHS) * sizeof(unsigned long long), rs));
+    CK(cudaMemsetAsync(sl->d_counters.p + CTR_GI_PATHS, 0,
+                       (CTR_COUNT - CTR_GI_PATHS) * sizeof(unsigned long long), rs));
     if (evr_skip_plan_still(seg->skip) && b->gi_have_prev) {
-        CK(cudaMemcpyAsync(eb->count, sb->count, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice, rs));
-        CK(cudaMemcpyAsync(eb->slots, sb->slots, cells * (size_t)eb->layers * sizeof(evr_photon), cudaMemcpyDeviceToDevice, rs));
-        CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->count, sb->count, cells * sizeof(uint32_t), cudaMemcpyDeviceToDevice,
+                           rs));
+        CK(cudaMemcpyAsync(eb->slots, sb->slots, cells * (size_t)eb->layers * sizeof(evr_photon),
+                           cudaMemcpyDeviceToDevice, rs));
+        CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice,
+                           rs));
     } else {
         CK(cudaEventRecord(sl->gi_started, rs));
         if (!b->gi_have_prev) {
             if ((st = gi_pass(b, sl, hrs, 0.0f, sb, err)) != EVR_OK) return st;
-            CK(cudaStreamSynchronize(rs));   /* the emitters' staging is the slot's: its copy done */
+            CK(cudaStreamSynchronize(rs)); /* the emitters' staging is the slot's: its copy done */
         }
         if ((st = gi_pass(b, sl, hrs, 1.0f, eb, err)) != EVR_OK) return st;
     }
-    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p, sl->d_counters.p);
-    sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
-    sat_cols_kernel<<<(unsigned)((eb->width + 31) / 32), 32 * SAT_CHUNKS, 0, rs>>>(sl->d_sat.p, eb->width, eb->height);
+    photon_changed_kernel<<<cgrid, BLOCK, 0, rs>>>(*eb, *sb, b->d_gi_last.p, sl->d_sat.p,
+                                                   sl->d_counters.p);
+    sat_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(
+        sl->d_sat.p, eb->width, eb->height);
+    sat_cols_kernel<<<(unsigned)((eb->width + 31) / 32), 32 * SAT_CHUNKS, 0, rs>>>(
+        sl->d_sat.p, eb->width, eb->height);
     if (b->gp.max_photons <= 0) {
         const evr_changed_cells ch = sl->h_gi_view.p->ch;
-        changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width,
-                                                                                                          eb->height, sl->d_ch_before.p);
-        changed_base_kernel<<<1, 32, 0, rs>>>(sl->d_ch_before.p, eb->width, eb->height, sl->d_ch_base.p);
-        changed_list_kernel<<<cgrid, BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width, eb->height, ch, sl->d_ch_x.p);
+        changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0,
+                              rs>>>(b->d_gi_last.p, eb->width, eb->height, sl->d_ch_before.p);
+        changed_base_kernel<<<1, 32, 0, rs>>>(sl->d_ch_before.p, eb->width, eb->height,
+                                              sl->d_ch_base.p);
+        changed_list_kernel<<<cgrid, BLOCK, 0, rs>>>(b->d_gi_last.p, eb->width, eb->height, ch,
+                                                     sl->d_ch_x.p);
     }
     CK(cudaGetLastError());
     if (sl->gi_passes) CK(cudaEventRecord(sl->gi_done, rs));
@@ -431,7 +466,7 @@ evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const e
     gpu_gi_view *v = sl->h_gi_view.p;
     v->end = *eb;
     v->start = *sb;
-    v->gp = b->gp;   /* with the run's flux scale, known after the first pass */
+    v->gp = b->gp; /* with the run's flux scale, known after the first pass */
     v->ends_in = b->d_gi_ends[0].p ? b->d_gi_ends[sl->index % NRING].p : nullptr;
     v->ends_out = b->d_gi_ends[0].p ? b->d_gi_ends[(sl->index + 1) % NRING].p : nullptr;
     CK(cudaMemcpyAsync(sl->d_gi_view.p, v, sizeof *v, cudaMemcpyHostToDevice, rs));
@@ -459,7 +494,7 @@ evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
         buf->slots = g->slots.p;
         buf->count = g->count.p;
         buf->gbuf = g->gbuf.p;
-        buf->collisions = nullptr;   /* the place kernel counts them (CTR_GI_COLLISIONS) */
+        buf->collisions = nullptr; /* the place kernel counts them (CTR_GI_COLLISIONS) */
     }
     const size_t cells = (size_t)b->gi_ring[0].ph.width * (size_t)b->gi_ring[0].ph.height;
     CK(b->d_gi_last.reserve(cells));

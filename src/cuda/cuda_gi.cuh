@@ -11,6 +11,7 @@ evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err);
 evr_status gi_alloc(cuda_backend *b, slot *sl, int window, evr_error *err);
 /* The segment's photons on the render stream, before its render. hrs: the segment's scene with
  * host pointers. */
-evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg, const evr_render_scene *hrs, evr_error *err);
+evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg,
+                      const evr_render_scene *hrs, evr_error *err);
 
 #endif

@@ -24,26 +24,28 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
 {
     launch_pixel lp;
     if (!launch_pixel_of(a, &lp)) return;
-    const bool active = lp.active && !lp.indirect_only;   /* the skip kernel made the others' entries */
+    const bool active =
+        lp.active && !lp.indirect_only; /* the skip kernel made the others' entries */
     const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     const float phi = active ? a.phase[pix] : 0.0f;
     unsigned rays = 0, traced = 0;
-    int entries = 0, last_span = -1;   /* samples with an entry; the still span of the last traced */
+    int entries = 0, last_span = -1; /* samples with an entry; the still span of the last traced */
     float t_hit = INFINITY, cache = -1.0f;
     bool tracing = active;
     gi_memo memo;
     memo.valid = false;
-    gi_end last;                       /* the pixel's last gather of the previous segment */
+    gi_end last; /* the pixel's last gather of the previous segment */
     last.g.dist = -1.0f;
-    if (active && a.gi->ends_in) {   /* its point and luminance (not the sums: the gather kernel's) */
+    if (active && a.gi->ends_in) { /* its point and luminance (not the sums: the gather kernel's) */
         last.g = a.gi->ends_in[pix].g;
         last.le = a.gi->ends_in[pix].le;
     }
-    bool made_new = false;             /* a request without the start known */
+    bool made_new = false; /* a request without the start known */
     const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
-    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-    float direct = 0.0f;               /* the last traced sample's, and its request */
+    const evr_ray ray0 =
+        evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    float direct = 0.0f; /* the last traced sample's, and its request */
     unsigned r = GI_NO_REQUEST;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
@@ -59,7 +61,8 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             evr_surface s;
             int inst = 0;
             evr_v3 org;
-            if (gpu_sample_direct<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit, a.coherence ? t_hit : INFINITY, &direct, &s, &inst,
+            if (gpu_sample_direct<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit,
+                                          a.coherence ? t_hit : INFINITY, &direct, &s, &inst,
                                           &org)) {
                 gpu_gather_point(&a.rs, inst, &s, org, &g);
                 if (gi_memo_take(&memo, inst, &g)) r = memo.req;
@@ -72,7 +75,8 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
          * pixel's last, at the same point) from the front, the others from the back, each kind
          * gathered by a kernel of its own */
         const bool known = want && last.g.dist >= 0.0f && gather_point_same(&last.g, &g);
-        const unsigned slot_known = warp_append(&d.count[REQ_KNOWN], known), slot_new = warp_append(&d.count[REQ_NEW], want && !known);
+        const unsigned slot_known = warp_append(&d.count[REQ_KNOWN], known),
+                       slot_new = warp_append(&d.count[REQ_NEW], want && !known);
         if (want) {
             made_new |= !known;
             r = known ? slot_known : d.cap - 1u - slot_new;
@@ -118,10 +122,11 @@ __global__ void __launch_bounds__(BLOCK) gi_scatter_kernel(kernel_args a, gi_def
 {
     const gpu_gi_view *v = a.gi;
     const int w = v->end.width, h = v->end.height, m = v->end.margin, reach = v->gp.max_window;
-    const unsigned n = v->ch.base[h], lane = threadIdx.x & 31u, warps = gridDim.x * blockDim.x / 32u;
+    const unsigned n = v->ch.base[h], lane = threadIdx.x & 31u,
+                   warps = gridDim.x * blockDim.x / 32u;
     const int side = 2 * reach + 1;
     for (unsigned k = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; k < n; k += warps) {
-        int lo = 0, hi = h - 1;   /* the cell's row: the last whose base <= k */
+        int lo = 0, hi = h - 1; /* the cell's row: the last whose base <= k */
         while (lo < hi) {
             const int mid = (lo + hi + 1) / 2;
             if (v->ch.base[mid] <= k) lo = mid;
@@ -134,10 +139,12 @@ __global__ void __launch_bounds__(BLOCK) gi_scatter_kernel(kernel_args a, gi_def
             if (px < 0 || py < 0 || px >= a.width || py >= a.height) continue;
             const int pix = py * a.width + px;
             const evr_gather_point g = v->ends_in[pix].g;
-            if (!(g.dist >= 0.0f)) continue;   /* no gather kept */
+            if (!(g.dist >= 0.0f)) continue; /* no gather kept */
             evr_sum_query q;
-            const evr_gather_window win = evr_gather_point_query(&v->end, &a.rs.camera, &v->gp, &g, px, py, &q);
-            if (abs(cx - win.cx) > win.h || abs(cy - win.cy) > win.h) continue;   /* outside its window */
+            const evr_gather_window win =
+                evr_gather_point_query(&v->end, &a.rs.camera, &v->gp, &g, px, py, &q);
+            if (abs(cx - win.cx) > win.h || abs(cy - win.cy) > win.h)
+                continue; /* outside its window */
             evr_gather_sum t = {0, 0};
             evr_photon_cell_sum(&v->end, cell, &q, &t, 0);
             evr_photon_cell_sum(&v->start, cell, &q, &t, 1);
@@ -160,10 +167,11 @@ __global__ void __launch_bounds__(BLOCK, 8) gi_gather_known_kernel(kernel_args a
         const float ls = d.requests[r].ls;
         float2 l;
         if (FIXED) {
-            evr_gather_sum s = a.gi->ends_in[pix].s;   /* the start's sums */
+            evr_gather_sum s = a.gi->ends_in[pix].s; /* the start's sums */
             l.x = ls;
             l.y = ls;
-            if (evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height, a.gi->end.margin, a.gi->window, x, y)) {
+            if (evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height,
+                                          a.gi->end.margin, a.gi->window, x, y)) {
                 s.a += d.delta[2 * (size_t)pix];
                 s.w += d.delta[2 * (size_t)pix + 1];
                 l.y = gpu_sum_lum(a.gi, &a.rs.camera, &g, x, y, &s);
@@ -187,9 +195,11 @@ __global__ void __launch_bounds__(BLOCK, 8) gi_gather_known_kernel(kernel_args a
 template <bool FIXED>
 __global__ void __launch_bounds__(BLOCK, 8) gi_gather_new_kernel(kernel_args a, gi_deferred d)
 {
-    const unsigned n = d.count[REQ_NEW_PIXELS], lane = threadIdx.x & 31u, warps = gridDim.x * blockDim.x / 32u;
-    const unsigned span = a.samples < 32 ? (unsigned)a.samples : 32u, per_warp = 32u / span;   /* lanes a pixel, pixels a warp */
-    const unsigned back = d.cap - d.count[REQ_NEW];   /* the first request without the start known */
+    const unsigned n = d.count[REQ_NEW_PIXELS], lane = threadIdx.x & 31u,
+                   warps = gridDim.x * blockDim.x / 32u;
+    const unsigned span = a.samples < 32 ? (unsigned)a.samples : 32u,
+                   per_warp = 32u / span;           /* lanes a pixel, pixels a warp */
+    const unsigned back = d.cap - d.count[REQ_NEW]; /* the first request without the start known */
     if (lane >= per_warp * span) return;
     for (unsigned w = (blockIdx.x * blockDim.x + threadIdx.x) / 32u; w * per_warp < n; w += warps) {
         const unsigned at = w * per_warp + lane / span;
@@ -199,12 +209,14 @@ __global__ void __launch_bounds__(BLOCK, 8) gi_gather_new_kernel(kernel_args a, 
         for (int k = (int)(lane % span); k < entries; k += (int)span) {
             const unsigned r = d.req[(size_t)k * (size_t)d.stride + (size_t)i];
             if (k > 0) prev = d.req[(size_t)(k - 1) * (size_t)d.stride + (size_t)i];
-            if (r == GI_NO_REQUEST || r < back || r == prev) continue;   /* a miss, a known start, or the sample before's */
+            if (r == GI_NO_REQUEST || r < back || r == prev)
+                continue; /* a miss, a known start, or the sample before's */
             const evr_gather_point g = d.requests[r].g;
             const int pix = d.requests[r].pix;
             float2 l;
             evr_gather_sum s;
-            gpu_gather_ends<FIXED>(a.gi, &a.rs.camera, &g, pix % a.width, pix / a.width, &l.x, &l.y, nullptr, &s);
+            gpu_gather_ends<FIXED>(a.gi, &a.rs.camera, &g, pix % a.width, pix / a.width, &l.x, &l.y,
+                                   nullptr, &s);
             d.lum[r] = l;
             if (FIXED) d.requests[r].s = s;
         }
@@ -228,13 +240,15 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     unsigned r = GI_NO_REQUEST;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
-        float intensity = st.intensity;   /* kept when settled on nothing */
+        float intensity = st.intensity; /* kept when settled on nothing */
         if (k < traced) {
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
             direct = d.direct[at];
             r = d.req[at];
         }
-        if (k < traced || r != GI_NO_REQUEST) {   /* settled on a surface: its last direct light, its gathers at f */
+        if (k < traced ||
+            r !=
+                GI_NO_REQUEST) { /* settled on a surface: its last direct light, its gathers at f */
             intensity = direct;
             if (r != GI_NO_REQUEST) {
                 const float2 l = d.lum[r];
@@ -247,7 +261,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
         st.cache_dist = d.cache_dist[i];
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
-        if (a.gi->ends_out) {   /* its last gather, for the next segment's start */
+        if (a.gi->ends_out) { /* its last gather, for the next segment's start */
             gi_end e{};
             e.g.dist = -1.0f;
             if (r != GI_NO_REQUEST) {
@@ -298,7 +312,8 @@ static void gi_ends_alloc(cuda_backend *b, size_t npix)
 {
     for (int i = 0; i < NRING; i++) {
         if (b->d_gi_ends[i].reserve(npix, true) != cudaSuccess ||
-            cudaMemset(b->d_gi_ends[i].p, 0xff, npix * sizeof(gi_end)) != cudaSuccess) {   /* dist NaN: none */
+            cudaMemset(b->d_gi_ends[i].p, 0xff, npix * sizeof(gi_end)) !=
+                cudaSuccess) { /* dist NaN: none */
             (void)cudaGetLastError();
             for (int j = 0; j < NRING; j++) b->d_gi_ends[j].release();
             return;
@@ -313,33 +328,46 @@ void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
 {
     b->gi_deferred = 0;
     if (!b->gi || b->setup.adaptive || getenv("EVR_GI_INLINE")) return;
-    const size_t npix = (size_t)b->setup.width * b->setup.height, n = npix * (size_t)b->setup.samples_per_frame;
-    if (b->d_gd_direct.reserve(n, true) == cudaSuccess && b->d_gd_req.reserve(n, true) == cudaSuccess &&
-        b->d_gd_lum.reserve(n, true) == cudaSuccess && b->d_gd_requests.reserve(n, true) == cudaSuccess &&
-        b->d_gd_traced.reserve(npix, true) == cudaSuccess && b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
-        b->d_gd_count.reserve(REQ_COUNTS) == cudaSuccess && b->d_gd_newpix.reserve(npix, true) == cudaSuccess &&
+    const size_t npix = (size_t)b->setup.width * b->setup.height,
+                 n = npix * (size_t)b->setup.samples_per_frame;
+    if (b->d_gd_direct.reserve(n, true) == cudaSuccess &&
+        b->d_gd_req.reserve(n, true) == cudaSuccess &&
+        b->d_gd_lum.reserve(n, true) == cudaSuccess &&
+        b->d_gd_requests.reserve(n, true) == cudaSuccess &&
+        b->d_gd_traced.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_cache.reserve(npix, true) == cudaSuccess &&
+        b->d_gd_count.reserve(REQ_COUNTS) == cudaSuccess &&
+        b->d_gd_newpix.reserve(npix, true) == cudaSuccess &&
         b->d_gd_delta.reserve(2 * npix, true) == cudaSuccess) {
         b->gi_deferred = 1;
         gi_ends_alloc(b, npix);
-        b->gather_grid = (unsigned)prop->multiProcessorCount * 64u;   /* grid-stride: 64 blocks an SM balanced the gathers best (16: 9% slower) */
+        b->gather_grid =
+            (unsigned)prop->multiProcessorCount *
+            64u; /* grid-stride: 64 blocks an SM balanced the gathers best (16: 9% slower) */
         return;
     }
-    (void)cudaGetLastError();   /* the failed allocation: not sticky, cleared */
+    (void)cudaGetLastError(); /* the failed allocation: not sticky, cleared */
     gi_deferred_release(b);
-    fprintf(stderr, "evray: notice: not enough GPU memory to defer the gathers of %zu samples a segment; "
-                    "gathering inside the render kernel (slower)\n", n);
+    fprintf(stderr,
+            "evray: notice: not enough GPU memory to defer the gathers of %zu samples a segment; "
+            "gathering inside the render kernel (slower)\n",
+            n);
 }
 
-
-evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const gi_deferred &d, unsigned grid, evr_error *err)
+evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const gi_deferred &d,
+                              unsigned grid, evr_error *err)
 {
     cudaStream_t rs = b->render;
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8) gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
+    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
+        gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
     else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
     CK(cudaGetLastError());
     if (b->gp.max_photons <= 0) {
-        if (b->d_gi_ends[0].p) {   /* what the changed cells add to the pixels' last gathers */
-            CK(cudaMemsetAsync(d.delta, 0, 2 * (size_t)b->setup.width * (size_t)b->setup.height * sizeof(unsigned long long), rs));
+        if (b->d_gi_ends[0].p) { /* what the changed cells add to the pixels' last gathers */
+            CK(cudaMemsetAsync(d.delta, 0,
+                               2 * (size_t)b->setup.width * (size_t)b->setup.height *
+                                   sizeof(unsigned long long),
+                               rs));
             gi_scatter_kernel<<<b->gather_grid, BLOCK, 0, rs>>>(a, d);
         }
         gi_gather_known_kernel<true><<<b->gather_grid, BLOCK, 0, rs>>>(a, d);

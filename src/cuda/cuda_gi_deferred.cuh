@@ -13,6 +13,7 @@ void gi_deferred_release(cuda_backend *b);
 gi_deferred deferred_args(const cuda_backend *b);
 /* The segment's render on the render stream after the skip kernel: the trace, gather and pixel
  * kernels. */
-evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const gi_deferred &d, unsigned grid, evr_error *err);
+evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const gi_deferred &d,
+                              unsigned grid, evr_error *err);
 
 #endif

@@ -46,6 +46,9 @@ template <typename T> using dbuf = growing_buffer<T, device_memory>;
 template <typename T> using hbuf = growing_buffer<T, pinned_memory>;
 
 /* Bytes of device memory a buffer holds. */
-template <typename T> static uint64_t bytes(const dbuf<T> &d) { return (uint64_t)d.cap * sizeof(T); }
+template <typename T> static uint64_t bytes(const dbuf<T> &d)
+{
+    return (uint64_t)d.cap * sizeof(T);
+}
 
 #endif

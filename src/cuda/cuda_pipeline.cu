@@ -22,11 +22,13 @@
 static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 {
     CK(cudaMemsetAsync(sl->d_count.p, 0, COUNT_N * sizeof(unsigned int), b->render));
-    CK(cudaMemsetAsync(sl->d_counters.p, 0, CTR_GI_PATHS * sizeof(unsigned long long), b->render));   /* the render's */
+    CK(cudaMemsetAsync(sl->d_counters.p, 0, CTR_GI_PATHS * sizeof(unsigned long long),
+                       b->render)); /* the render's */
     CK(cudaMemsetAsync(sl->d_counters.p + CTR_KEY_RANGE, 0, sizeof(unsigned long long), b->render));
     kernel_args a = make_args(b, sl);
     CK(cudaEventRecord(sl->started, b->render));
-    const unsigned grid = (tiled_threads(b->setup.width, b->setup.height) + BLOCK - 1) / BLOCK;   /* >= npix threads */
+    const unsigned grid =
+        (tiled_threads(b->setup.width, b->setup.height) + BLOCK - 1) / BLOCK; /* >= npix threads */
     const bool ideal = evr_pixel_params_ideal(&b->setup.pixel);
     const kernel_variant v = run_variant(b);
     cudaStream_t rs = b->render;
@@ -38,7 +40,7 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
         d.p = b->setup.adapt;
         cuda_launch_adapt(a, d, v, grid, rs);
     } else {
-        gi_deferred d{};   /* no requests: none made by the skip kernel */
+        gi_deferred d{}; /* no requests: none made by the skip kernel */
         if (b->gi_deferred) {
             d = deferred_args(b);
             CK(cudaMemsetAsync(d.count, 0, REQ_COUNTS * sizeof(unsigned), rs));
@@ -56,14 +58,16 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
     }
     CK(cudaGetLastError());
     CK(cudaEventRecord(sl->rendered, b->render));
-    if (sl->num_frames > 0) {   /* after the timed render: device time stays the events' */
+    if (sl->num_frames > 0) { /* after the timed render: device time stays the events' */
         cuda_launch_frames(a, v, sl->d_frame_f.p, sl->num_frames, sl->d_frames.p, grid, rs);
         CK(cudaGetLastError());
         CK(cudaEventRecord(sl->framed, b->render));
     }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
-    CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p + COUNT_EVENTS, sizeof(unsigned int), cudaMemcpyDeviceToHost, sl->copy));
-    CK(cudaMemcpyAsync(sl->h_counters.p, sl->d_counters.p, CTR_COUNT * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p + COUNT_EVENTS, sizeof(unsigned int),
+                       cudaMemcpyDeviceToHost, sl->copy));
+    CK(cudaMemcpyAsync(sl->h_counters.p, sl->d_counters.p, CTR_COUNT * sizeof(unsigned long long),
+                       cudaMemcpyDeviceToHost, sl->copy));
     CK(cudaEventRecord(sl->counted, sl->copy));
     sl->copying = 0;
     return EVR_OK;
@@ -71,9 +75,11 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
 
 /* Keys carried from the segment before, moved onto this segment's time base (both bases are
  * whole microseconds, the times in range: start_copy checks them). */
-__global__ void carry_keys(const unsigned long long *from, size_t n, unsigned long long delta, unsigned long long *to)
+__global__ void carry_keys(const unsigned long long *from, size_t n, unsigned long long delta,
+                           unsigned long long *to)
 {
-    for (size_t i = blockIdx.x * (size_t)blockDim.x + threadIdx.x; i < n; i += (size_t)gridDim.x * blockDim.x)
+    for (size_t i = blockIdx.x * (size_t)blockDim.x + threadIdx.x; i < n;
+         i += (size_t)gridDim.x * blockDim.x)
         to[i] = from[i] - delta;
 }
 
@@ -83,7 +89,9 @@ static cudaError_t grow_keeping(dbuf<unsigned long long> &d, size_t n, size_t ke
     if (n <= d.cap) return cudaSuccess;
     dbuf<unsigned long long> g;
     cudaError_t e = g.reserve(n);
-    if (e == cudaSuccess && keep) e = cudaMemcpyAsync(g.p, d.p, keep * sizeof(unsigned long long), cudaMemcpyDeviceToDevice, s);
+    if (e == cudaSuccess && keep)
+        e = cudaMemcpyAsync(g.p, d.p, keep * sizeof(unsigned long long), cudaMemcpyDeviceToDevice,
+                            s);
     if (e == cudaSuccess) e = cudaStreamSynchronize(s);
     if (e != cudaSuccess) {
         g.release();
@@ -97,7 +105,8 @@ static cudaError_t grow_keeping(dbuf<unsigned long long> &d, size_t n, size_t ke
     return cudaSuccess;
 }
 
-cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n, size_t *temp)
+cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n,
+                                  size_t *temp)
 {
     return cub::DeviceRadixSort::SortKeys(nullptr, *temp, keys, sorted, n, 0, 64);
 }
@@ -111,16 +120,21 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
     CK(cudaEventRecord(sl->sort_from, sl->copy));
     if (carried) {
         if (b->carry_t_lo < sl->base_us || b->carry_t_hi - sl->base_us >= slot_span_us(b, sl)) {
-            snprintf(err->msg, sizeof err->msg, "internal error: events carried to the segment at %.6f s fall outside its time window",
-                     sl->t0);
+            snprintf(
+                err->msg, sizeof err->msg,
+                "internal error: events carried to the segment at %.6f s fall outside its time window",
+                sl->t0);
             return EVR_ERR_BACKEND;
         }
         const int shift = key_time_shift(b->setup.width, b->setup.height);
-        const unsigned long long delta = (unsigned long long)(sl->base_us - b->carry_base_us) << shift;
+        const unsigned long long delta = (unsigned long long)(sl->base_us - b->carry_base_us)
+                                         << shift;
         CK(grow_keeping(sl->d_keys_ev, n + carried, n, sl->copy));
-        const unsigned blocks = (unsigned)((carried + BLOCK - 1) / BLOCK < 1024 ? (carried + BLOCK - 1) / BLOCK : 1024);
-        carry_keys<<<blocks, BLOCK, 0, sl->copy>>>(b->slots[b->carry_slot].d_keys_sorted.p + b->carry_at, carried, delta,
-                                                   sl->d_keys_ev.p + n);
+        const unsigned blocks =
+            (unsigned)((carried + BLOCK - 1) / BLOCK < 1024 ? (carried + BLOCK - 1) / BLOCK : 1024);
+        carry_keys<<<blocks, BLOCK, 0, sl->copy>>>(b->slots[b->carry_slot].d_keys_sorted.p +
+                                                       b->carry_at,
+                                                   carried, delta, sl->d_keys_ev.p + n);
         CK(cudaGetLastError());
     }
     n += carried;
@@ -128,23 +142,28 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
     if (n) {
         size_t temp = 0;
         CK(sl->d_keys_sorted.reserve(n));
-        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p,
+                                          (int)n, 0, sl->end_bit, sl->copy));
         CK(sl->d_sort_temp.reserve(temp));
-        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p,
+                                          sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
         CK(sl->h_sorted.reserve(n));
         CK(cudaEventRecord(sl->sorted, sl->copy));
-        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long), cudaMemcpyDeviceToHost, sl->copy));
+        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long),
+                           cudaMemcpyDeviceToHost, sl->copy));
     }
     if (sl->want_intensity) {
         size_t npix = (size_t)b->setup.width * b->setup.height;
         CK(sl->h_intensity.reserve(npix));
-        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+        CK(cudaMemcpyAsync(sl->h_intensity.p, sl->d_intensity.p, npix * sizeof(float),
+                           cudaMemcpyDeviceToHost, sl->copy));
     }
     if (sl->num_frames) {
         size_t nf = (size_t)sl->num_frames * (size_t)b->setup.width * b->setup.height;
         CK(sl->h_frames.reserve(nf));
         CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
-        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float), cudaMemcpyDeviceToHost, sl->copy));
+        CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float),
+                           cudaMemcpyDeviceToHost, sl->copy));
     }
     CK(cudaEventRecord(sl->copied, sl->copy));
     sl->copying = 1;
@@ -164,7 +183,7 @@ static evr_status start_ready_copies(cuda_backend *b, evr_error *err)
     if (e == cudaErrorNotReady) return EVR_OK;
     CK(e);
     const size_t n = *sl->h_count.p;
-    if (n > sl->d_keys_ev.cap) return EVR_OK;   /* collect renders it again */
+    if (n > sl->d_keys_ev.cap) return EVR_OK; /* collect renders it again */
     return start_copy(b, sl, n, err);
 }
 
@@ -174,7 +193,8 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     evr_status st;
     const double tl_sub0 = evr_host_seconds();
     if (b->queued == NSLOT) {
-        snprintf(err->msg, sizeof err->msg, "internal error: more than %d segments submitted", NSLOT);
+        snprintf(err->msg, sizeof err->msg, "internal error: more than %d segments submitted",
+                 NSLOT);
         return EVR_ERR_BACKEND;
     }
     /* the segments rendered since the last call: their sorts start now, before the host work below */
@@ -189,10 +209,12 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     sl->want_intensity = seg->want_intensity;
     sl->reuse = seg->skip->reuse;
     *sl->h_plan.p = *seg->skip;
-    CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice,
+                       b->render));
     if (b->setup.adaptive) {
         *sl->h_adapt.p = *seg->adapt;
-        CK(cudaMemcpyAsync(sl->d_adapt.p, sl->h_adapt.p, sizeof(evr_adapt_plan), cudaMemcpyHostToDevice, b->render));
+        CK(cudaMemcpyAsync(sl->d_adapt.p, sl->h_adapt.p, sizeof(evr_adapt_plan),
+                           cudaMemcpyHostToDevice, b->render));
     }
     sl->num_frames = seg->num_frames > 0 ? seg->num_frames : 0;
     if (sl->num_frames) {
@@ -201,19 +223,23 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
         CK(sl->d_frame_f.reserve(nf));
         CK(sl->d_frames.reserve(nf * npix));
         for (int k = 0; k < sl->num_frames; k++) {
-            double f = seg->t1 > seg->t0 ? (seg->frame_times[k] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            double f =
+                seg->t1 > seg->t0 ? (seg->frame_times[k] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
             sl->h_frame_f.p[k] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
         }
-        CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float), cudaMemcpyHostToDevice, b->render));
+        CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float),
+                           cudaMemcpyHostToDevice, b->render));
     }
     /* events reach back to the previous segment (a pixel's last sample there; with adaptive
      * sampling up to max_dt back), and timestamp jitter and rounding move them by up to
      * EVR_JITTER_CLIP sigma plus one resolution step either way; one more segment to spare. An
      * event outside the window is counted (CTR_KEY_RANGE) and fails the run, never wraps. */
     const evr_pixel_params *px = &b->setup.pixel;
-    double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter + (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
+    double slack = (double)EVR_JITTER_CLIP * (double)px->time_jitter +
+                   (px->time_res_us > 1 ? 1e-6 * (double)px->time_res_us : 0.0);
     double dt = seg->t1 - seg->t0, back = 2.0 * dt + slack;
-    if (b->setup.adaptive) back += (double)b->setup.adapt.max_dt;   /* a pixel's last sample: up to max_dt back */
+    if (b->setup.adaptive)
+        back += (double)b->setup.adapt.max_dt; /* a pixel's last sample: up to max_dt back */
     sl->base_us = (long long)floor((seg->t0 - back) * 1e6);
     double span_us = (back + dt + slack) * 1e6 + 2.0;
     int tbits = 1;
@@ -225,7 +251,8 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     CK(sl->h_tracks.reserve(2 * (size_t)seg->num_tracks));
     memcpy(sl->h_keys.p, seg->keys, (size_t)seg->num_keys * sizeof(evr_motion_key));
     memcpy(sl->h_tracks.p, seg->track_offset, (size_t)seg->num_tracks * sizeof(int));
-    memcpy(sl->h_tracks.p + seg->num_tracks, seg->track_count, (size_t)seg->num_tracks * sizeof(int));
+    memcpy(sl->h_tracks.p + seg->num_tracks, seg->track_count,
+           (size_t)seg->num_tracks * sizeof(int));
     /* top level over the instances, bounds over the whole segment */
     evr_render_scene hrs = b->host.rs;
     hrs.keys = sl->h_keys.p;
@@ -235,17 +262,22 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     CK(sl->d_keys.reserve((size_t)seg->num_keys));
     CK(sl->d_tracks.reserve(2 * (size_t)seg->num_tracks));
     CK(sl->d_insts.reserve(sl->top.num_insts + 1));
-    CK(cudaMemcpyAsync(sl->d_keys.p, sl->h_keys.p, (size_t)seg->num_keys * sizeof(evr_motion_key), cudaMemcpyHostToDevice, b->render));
-    CK(cudaMemcpyAsync(sl->d_tracks.p, sl->h_tracks.p, 2 * (size_t)seg->num_tracks * sizeof(int), cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_keys.p, sl->h_keys.p, (size_t)seg->num_keys * sizeof(evr_motion_key),
+                       cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_tracks.p, sl->h_tracks.p, 2 * (size_t)seg->num_tracks * sizeof(int),
+                       cudaMemcpyHostToDevice, b->render));
     if (sl->top.nodes4) {
         CK(sl->d_top4.reserve(sl->top.num_nodes + 1));
-        CK(cudaMemcpyAsync(sl->d_top4.p, sl->top.nodes4, sl->top.num_nodes * sizeof(evr_gpu_node4), cudaMemcpyHostToDevice, b->render));
+        CK(cudaMemcpyAsync(sl->d_top4.p, sl->top.nodes4, sl->top.num_nodes * sizeof(evr_gpu_node4),
+                           cudaMemcpyHostToDevice, b->render));
     }
     if (sl->top.nodes8) {
         CK(sl->d_top8.reserve(sl->top.num_nodes + 1));
-        CK(cudaMemcpyAsync(sl->d_top8.p, sl->top.nodes8, sl->top.num_nodes * sizeof(evr_gpu_node8), cudaMemcpyHostToDevice, b->render));
+        CK(cudaMemcpyAsync(sl->d_top8.p, sl->top.nodes8, sl->top.num_nodes * sizeof(evr_gpu_node8),
+                           cudaMemcpyHostToDevice, b->render));
     }
-    CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst), cudaMemcpyHostToDevice, b->render));
+    CK(cudaMemcpyAsync(sl->d_insts.p, sl->top.insts, sl->top.num_insts * sizeof(evr_gpu_inst),
+                       cudaMemcpyHostToDevice, b->render));
     /* the host top-level arrays are reused by the next build of this slot only after collect,
      * by which time these copies are done (collect synchronizes) */
     /* a still camera: its rays' hits in the static group, made again when the camera has moved */
@@ -302,8 +334,8 @@ static void decode_part(void *ctx, int k, int)
     evr_par_share(j->n, (int)j->parts, k, &i0, &i1);
     for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
 }
-static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n, long long base_us, int xb, int yb,
-                        evr_event *dst)
+static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n,
+                        long long base_us, int xb, int yb, evr_event *dst)
 {
     const size_t chunk = (size_t)1 << 17;
     size_t parts = (n + chunk - 1) / chunk, most = (size_t)evr_par_pool_threads(pool);
@@ -313,8 +345,8 @@ static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size
     evr_par_pool_run(pool, (int)parts, decode_part, &j);
 }
 
-evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us, const float **intensity,
-                               const float **frames, evr_error *err)
+evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us,
+                        const float **intensity, const float **frames, evr_error *err)
 {
     cuda_backend *b = (cuda_backend *)base;
     evr_status st;
@@ -334,14 +366,17 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
          * next segment, if rendering, reads states this re-run rewrites identically: wait) */
         CK(cudaDeviceSynchronize());
         CK(sl->d_keys_ev.reserve(n + n / 4));
-        if (sl->d_keys_ev.cap > b->capacity) b->capacity = sl->d_keys_ev.cap;   /* the other slots grow at their next submit */
+        if (sl->d_keys_ev.cap > b->capacity)
+            b->capacity = sl->d_keys_ev.cap; /* the other slots grow at their next submit */
         if ((st = launch(b, sl, err)) != EVR_OK) return st;
         CK(cudaEventSynchronize(sl->counted));
         n = *sl->h_count.p;
     }
     if (sl->h_counters.p[CTR_KEY_RANGE]) {
-        snprintf(err->msg, sizeof err->msg, "internal error: %llu events of the segment at %.6f s fell outside its time window",
-                 (unsigned long long)sl->h_counters.p[CTR_KEY_RANGE], sl->t0);
+        snprintf(
+            err->msg, sizeof err->msg,
+            "internal error: %llu events of the segment at %.6f s fell outside its time window",
+            (unsigned long long)sl->h_counters.p[CTR_KEY_RANGE], sl->t0);
         return EVR_ERR_BACKEND;
     }
     base->rays += sl->h_counters.p[CTR_RAYS];
@@ -357,13 +392,16 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
         base->photon_collisions += sl->h_counters.p[CTR_GI_COLLISIONS];
         base->photon_cells_changed += sl->h_counters.p[CTR_GI_CHANGED];
         base->photon_passes += (uint64_t)sl->gi_passes;
-        sl->gi_passes = 0;   /* a re-render at overflow does not run the passes again */
+        sl->gi_passes = 0; /* a re-render at overflow does not run the passes again */
     }
     float ms = 0.0f;
     CK(cudaEventElapsedTime(&ms, sl->started, sl->rendered));
     base->device_seconds += 1e-3 * (double)ms;
-    if (b->setup.adaptive) base->samples += sl->h_counters.p[CTR_TRACED];   /* the samples taken, all traced */
-    else base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height * (uint64_t)b->setup.samples_per_frame;
+    if (b->setup.adaptive)
+        base->samples += sl->h_counters.p[CTR_TRACED]; /* the samples taken, all traced */
+    else
+        base->samples += (uint64_t)b->setup.width * (uint64_t)b->setup.height *
+                         (uint64_t)b->setup.samples_per_frame;
     if (!sl->copying && (st = start_copy(b, sl, n, err)) != EVR_OK) return st;
     tw = evr_host_seconds();
     CK(cudaStreamSynchronize(sl->copy));
@@ -389,11 +427,12 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
      * 0.21 s of the main thread for the 30 s eye, and a copy of them at every hand-over. */
     const int xb = event_key_bits(b->setup.width), yb = event_key_bits(b->setup.height);
     const int shift = key_time_shift(b->setup.width, b->setup.height);
-    const size_t total = sl->total;   /* its own n and those carried in */
+    const size_t total = sl->total; /* its own n and those carried in */
     size_t split = total;
     if (emit_before_us != INT64_MAX) {
         const long long rel = (long long)emit_before_us - sl->base_us;
-        const unsigned long long limit = rel <= 0 ? 0ull : (unsigned long long)rel << shift;   /* the first key at or after it */
+        const unsigned long long limit =
+            rel <= 0 ? 0ull : (unsigned long long)rel << shift; /* the first key at or after it */
         size_t lo = 0, hi = total;
         if (rel >= slot_span_us(b, sl)) lo = total;
         while (lo < hi) {
@@ -431,4 +470,3 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
     b->queued--;
     return start_ready_copies(b, err);
 }
-

@@ -9,9 +9,10 @@ extern "C" {
 }
 
 evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err);
-evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us, const float **intensity, const float **frames,
-                        evr_error *err);
+evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us,
+                        const float **intensity, const float **frames, evr_error *err);
 /* Bytes of temporary storage the sort of n event keys takes (for the buffers made up front). */
-cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n, size_t *temp);
+cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n,
+                                  size_t *temp);
 
 #endif

@@ -10,7 +10,6 @@
 #include "cuda/cuda_gather.cuh"
 #include "cuda/cuda_trace.cuh"
 
-
 /* core/shade_hit.h's shadow-ray query: our traversal in the launch's node layout (a constant
  * once inlined into a kernel of that layout); hit is scratch space the query may write. */
 struct evr_occlusion {
@@ -19,7 +18,8 @@ struct evr_occlusion {
     evr_gpu_hit *hit;
 };
 
-EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
+EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
+                                      float f)
 {
 #ifdef __CUDA_ARCH__
     if (o->layout == EVR_GPU_LAYOUT_CW8)
@@ -34,8 +34,9 @@ EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float 
 /* Direct light of one sample, as sample_intensity in cpu/cpu_backend.c, with our traversal; 0 on a
  * miss (returns false), else the surface met, its instance and the ray's origin for the gather. */
 template <int LAYOUT>
-__device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
-                                         float *t_hit, float hint, float *direct, evr_surface *s, int *inst, evr_v3 *cam_org)
+__device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *pose, int x, int y,
+                                         float f, unsigned *rays, float *t_hit, float hint,
+                                         float *direct, evr_surface *s, int *inst, evr_v3 *cam_org)
 {
     const evr_render_scene *rs = &a.rs;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
@@ -52,8 +53,10 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
          * searched for a nearer one only (evr_trace_closest_groups) */
         const gpu_static_hit sh = a.static_hits[y * a.width + x];
         const float ts = sh.instance >= 0 ? sh.t : 1e30f;
-        if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, fminf(tf, ts), f, 0, &hit, EVR_GROUPS_MOVING) &&
-            (tf >= ts || !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, ts, f, 0, &hit, EVR_GROUPS_MOVING))) {
+        if (!gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, fminf(tf, ts), f, 0, &hit,
+                               EVR_GROUPS_MOVING) &&
+            (tf >= ts ||
+             !gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, ts, f, 0, &hit, EVR_GROUPS_MOVING))) {
             if (sh.instance < 0) return false;
             hit.t = sh.t;
             hit.u = sh.u;
@@ -81,24 +84,28 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
 /* Intensity of one sample; GI: plus the indirect light gathered from the segment's photons (memo:
  * the pixel's last gather). direct (may be NULL): the direct light alone. */
 template <int LAYOUT, int GI>
-__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f, unsigned *rays,
-                                  float *t_hit, gi_memo *memo, float hint = INFINITY, float *direct = nullptr)
+__device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f,
+                                   unsigned *rays, float *t_hit, gi_memo *memo,
+                                   float hint = INFINITY, float *direct = nullptr)
 {
     evr_surface s;
     int inst = 0;
     evr_v3 org;
     float out;
-    if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org)) return 0.0f;
+    if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org))
+        return 0.0f;
     if (direct) *direct = out;
     if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, f, memo);
     return out;
 }
 
-__device__ static unsigned long long pack_event(const kernel_args &a, long long t_abs_us, int x, int y, int p)
+__device__ static unsigned long long pack_event(const kernel_args &a, long long t_abs_us, int x,
+                                                int y, int p)
 {
     long long t_us = t_abs_us - a.base_us;
-    return ((unsigned long long)t_us << (1 + a.xbits + a.ybits)) | ((unsigned long long)y << (1 + a.xbits)) |
-           ((unsigned long long)x << 1) | (unsigned long long)p;
+    return ((unsigned long long)t_us << (1 + a.xbits + a.ybits)) |
+           ((unsigned long long)y << (1 + a.xbits)) | ((unsigned long long)x << 1) |
+           (unsigned long long)p;
 }
 
 /* The pixel's state: all of it for the sensor kernel, the ideal model's part (and the cache of
@@ -122,7 +129,8 @@ __device__ __forceinline__ void load_state(const kernel_args &a, int pix, evr_pi
 }
 
 template <int SENSOR>
-__device__ __forceinline__ void store_state(const kernel_args &a, int pix, const evr_pixel_state &st)
+__device__ __forceinline__ void store_state(const kernel_args &a, int pix,
+                                            const evr_pixel_state &st)
 {
     if (SENSOR) {
         a.state_out[pix] = st;
@@ -143,14 +151,15 @@ __device__ __forceinline__ void store_state(const kernel_args &a, int pix, const
 /* A launch's pixel before its samples: its state and (sensor kernel) its own parameters. Returns
  * its sample phase; an inactive lane (which still takes part in warp votes) gets a reset state. */
 template <int SENSOR>
-__device__ __forceinline__ float pixel_begin(const kernel_args &a, bool active, int pix, int x, int y, evr_pixel_state &st,
-                                             evr_pixel_params &own)
+__device__ __forceinline__ float pixel_begin(const kernel_args &a, bool active, int pix, int x,
+                                             int y, evr_pixel_state &st, evr_pixel_params &own)
 {
     evr_pixel_reset(&st);
     if (SENSOR) own = *a.sensor;
     if (!active) return 0.0f;
     load_state<SENSOR>(a, pix, st);
-    if (SENSOR) evr_pixel_params_at(a.sensor, x, y, &own);   /* fixed-pattern thresholds, leak, noise */
+    if (SENSOR)
+        evr_pixel_params_at(a.sensor, x, y, &own); /* fixed-pattern thresholds, leak, noise */
     return a.phase[pix];
 }
 
@@ -161,7 +170,8 @@ struct evr_event_sink {
     unsigned lane;
 };
 
-EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x, int y, int polarity)
+EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us,
+                                             int x, int y, int polarity)
 {
 #ifdef __CUDA_ARCH__
     const kernel_args &a = *k->a;
@@ -172,8 +182,10 @@ EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, 
     base = __shfl_sync(0xffffffffu, base, leader);
     if (has) {
         unsigned idx = base + (unsigned)__popc(mask & ((1u << k->lane) - 1u));
-        if (t_us < a.base_us || t_us - a.base_us >= a.span_us) atomicAdd(&a.counters[CTR_KEY_RANGE], 1ull);   /* collect fails */
-        else if (idx < a.capacity) a.keys[idx] = pack_event(a, t_us, x, y, polarity);   /* else: re-run */
+        if (t_us < a.base_us || t_us - a.base_us >= a.span_us)
+            atomicAdd(&a.counters[CTR_KEY_RANGE], 1ull); /* collect fails */
+        else if (idx < a.capacity)
+            a.keys[idx] = pack_event(a, t_us, x, y, polarity); /* else: re-run */
     }
     return 1;
 #else
@@ -186,10 +198,11 @@ EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, 
  * (core/pixel_flow.h); its events are appended with warp-aggregated atomics. Every lane of the
  * warp calls it together; live: this lane has a sample. */
 template <int SENSOR>
-__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
-                                                bool live, float t, float intensity, int x, int y, unsigned lane)
+__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st,
+                                                const evr_pixel_params &own, bool live, float t,
+                                                float intensity, int x, int y, unsigned lane)
 {
-    evr_pixel_ideal id;   /* the ideal kernel's parameters, from the launch's arguments */
+    evr_pixel_ideal id; /* the ideal kernel's parameters, from the launch's arguments */
     id.log_floor = a.log_floor;
     id.pos_thres = a.pos_thres;
     id.neg_thres = a.neg_thres;
@@ -202,14 +215,16 @@ __device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_
 
 /* The same at normalized segment time f (uniform sampling). */
 template <int SENSOR>
-__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own,
-                                             bool live, float f, float intensity, int x, int y, unsigned lane)
+__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st,
+                                             const evr_pixel_params &own, bool live, float f,
+                                             float intensity, int x, int y, unsigned lane)
 {
     pixel_sample_at<SENSOR>(a, st, own, live, f * a.dt, intensity, x, y, lane);
 }
 
 /* Adds the warp's rays and traced samples to the segment's counters. */
-__device__ __forceinline__ void add_counts(const kernel_args &a, unsigned lane, unsigned rays, unsigned traced)
+__device__ __forceinline__ void add_counts(const kernel_args &a, unsigned lane, unsigned rays,
+                                           unsigned traced)
 {
     unsigned long long r = rays, ts = traced;
     for (int o = 16; o > 0; o >>= 1) {
@@ -239,7 +254,7 @@ __device__ __forceinline__ bool tiled_pixel(int i, int w, int h, int *pix, int *
 struct launch_pixel {
     int i, pix, x, y;
     bool active;
-    bool indirect_only;   /* listed by the skip kernel with its samples made (LIST_INDIRECT_ONLY) */
+    bool indirect_only; /* listed by the skip kernel with its samples made (LIST_INDIRECT_ONLY) */
     unsigned lane;
 };
 __device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pixel *p)
@@ -247,7 +262,7 @@ __device__ __forceinline__ bool launch_pixel_of(const kernel_args &a, launch_pix
     p->i = blockIdx.x * blockDim.x + threadIdx.x;
     p->lane = threadIdx.x & 31u;
     p->indirect_only = false;
-    if (!a.list) {   /* every pixel, in warp tiles */
+    if (!a.list) { /* every pixel, in warp tiles */
         p->active = tiled_pixel(p->i, a.width, a.height, &p->pix, &p->x, &p->y);
         return true;
     }

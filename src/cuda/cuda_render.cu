@@ -43,7 +43,8 @@ template <int SENSOR>
 __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred d)
 {
     int pix, x, y;
-    const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
+    const bool active =
+        tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
     evr_pixel_params own;
@@ -57,36 +58,42 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
         /* global illumination: a pixel whose gather window saw photons change over this segment
          * or the last traces (its indirect light moves, or moved after its last sample) */
         if (skip && a.gi &&
-            evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height, a.gi->end.margin, a.gi->window, x, y)) {
+            evr_photon_window_changed(a.gi->sat, a.gi->end.width, a.gi->end.height,
+                                      a.gi->end.margin, a.gi->window, x, y)) {
             skip = false;
             /* as the trace kernel would settle it: its hit the cached one, the cache kept */
             cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray, st.cache_dist);
-            indirect_only = d.requests && a.gi->ends_in && a.gi->ends_in[pix].g.dist >= 0.0f && cache >= 0.0f;
+            indirect_only =
+                d.requests && a.gi->ends_in && a.gi->ends_in[pix].g.dist >= 0.0f && cache >= 0.0f;
         }
     }
     const unsigned at = warp_append(a.list_count, active && !skip);
-    if (active && !skip) a.list[at] = indirect_only ? (unsigned)pix | LIST_INDIRECT_ONLY : (unsigned)pix;
-    const unsigned r = warp_append(&d.count[REQ_KNOWN], indirect_only);   /* a request with the start known */
+    if (active && !skip)
+        a.list[at] = indirect_only ? (unsigned)pix | LIST_INDIRECT_ONLY : (unsigned)pix;
+    const unsigned r =
+        warp_append(&d.count[REQ_KNOWN], indirect_only); /* a request with the start known */
     if (indirect_only) {
         const gi_end *e = &a.gi->ends_in[pix];
         d.requests[r].g = e->g;
         d.requests[r].pix = pix;
         d.requests[r].ls = e->le;
-        d.direct[at] = e->direct;   /* sample 0's entry */
+        d.direct[at] = e->direct; /* sample 0's entry */
         d.req[at] = r;
         d.traced[at] = 1;
         d.cache_dist[at] = cache;
     }
     const unsigned skipped = __ballot_sync(0xffffffffu, skip);
-    if (!skipped) return;   /* the whole warp */
+    if (!skipped) return; /* the whole warp */
     if (lane == 0) atomicAdd(&a.counters[CTR_SKIPPED], (unsigned long long)__popc(skipped));
     const float kept = st.intensity;
     for (int k = 0; k < a.samples; k++)
-        pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y, lane);
+        pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y,
+                             lane);
     if (skip) {
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
-        if (a.gi && a.gi->ends_out) a.gi->ends_out[pix] = a.gi->ends_in[pix];   /* its last gather holds */
+        if (a.gi && a.gi->ends_out)
+            a.gi->ends_out[pix] = a.gi->ends_in[pix]; /* its last gather holds */
     }
 }
 /* SENSOR: 1 for the full sensor model of core/pixel.h (mismatch, bandwidth, leak, noise,
@@ -96,7 +103,8 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
  * version a few instructions longer was 40% slower on the square through instruction fetch).
  * With a list (change-driven sampling), thread i renders pixel list[i]. */
 template <int LAYOUT, int SENSOR, int GI>
-__global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render_kernel(kernel_args a)
+__global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
+    render_kernel(kernel_args a)
 {
     launch_pixel lp;
     if (!launch_pixel_of(a, &lp)) return;
@@ -104,7 +112,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
     const int pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     evr_pixel_state st;
-    evr_pixel_params own;                /* the sensor kernel's parameters of this pixel */
+    evr_pixel_params own; /* the sensor kernel's parameters of this pixel */
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     unsigned rays = 0, traced = 0;
     float t_hit = INFINITY, direct = 0.0f;
@@ -112,17 +120,23 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS) render
     gi_memo memo;
     memo.valid = false;
     evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
-    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-    int last_span = -1;   /* the still span of the last traced sample */
+    const evr_ray ray0 =
+        evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    int last_span = -1; /* the still span of the last traced sample */
     for (int k = 0; k < a.samples; k++) {
-        float f = ((float)k + phi) / (float)a.samples, intensity = st.intensity;   /* kept when settled or held */
+        float f = ((float)k + phi) / (float)a.samples,
+              intensity = st.intensity; /* kept when settled or held */
         const int span = evr_skip_still_span(a.plan, f);
         if (tracing && !evr_skip_held(a.plan, span, last_span)) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo, a.coherence ? t_hit : INFINITY, &direct);
+            intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo,
+                                               a.coherence ? t_hit : INFINITY, &direct);
             traced++;
             last_span = span;
-        } else if (GI && t_hit < INFINITY) {   /* settled or held on a surface: its direct light, its gathers at f */
+        } else if (
+            GI &&
+            t_hit <
+                INFINITY) { /* settled or held on a surface: its direct light, its gathers at f */
             intensity = direct + evr_gi_lerp(memo.ls, memo.le, f);
         }
         pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
@@ -153,13 +167,15 @@ template <int LAYOUT, int SENSOR, int GI>
 __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args d)
 {
     int pix, x, y;
-    const bool active = tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
+    const bool active =
+        tiled_pixel(blockIdx.x * blockDim.x + threadIdx.x, a.width, a.height, &pix, &x, &y);
     const unsigned lane = threadIdx.x & 31u;
     evr_pixel_state st;
     evr_pixel_reset(&st);
-    evr_pixel_params own = *a.sensor;   /* the run's parameters; per pixel for the sensor kernel */
+    evr_pixel_params own = *a.sensor; /* the run's parameters; per pixel for the sensor kernel */
     const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
-    const evr_ray ray0 = evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    const evr_ray ray0 =
+        evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     float t = 0.0f;
     bool need = false;
     if (active) {
@@ -170,7 +186,8 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
     }
     evr_adapt_stack sk;
     sk.n = 0;
-    float ct = 0.0f, ci = 0.0f, ch = INFINITY;   /* the candidate sample: time, intensity, hit distance */
+    float ct = 0.0f, ci = 0.0f,
+          ch = INFINITY; /* the candidate sample: time, intensity, hit distance */
     bool cand = false;
     unsigned rays = 0, taken = 0;
     gi_memo memo;
@@ -188,8 +205,9 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         bool consume = false;
         float step = 0.0f;
         int moving = 0;
-        if (cand) {   /* held back (trace t first) or taken */
-            consume = evr_adapt_candidate(&a.rs, &d.p, d.plan, &st, &own, ray0, &sk, ct, ci, ch, &t, &step, &moving);
+        if (cand) { /* held back (trace t first) or taken */
+            consume = evr_adapt_candidate(&a.rs, &d.p, d.plan, &st, &own, ray0, &sk, ct, ci, ch, &t,
+                                          &step, &moving);
             if (!consume) {
                 need = true;
                 cand = false;
@@ -197,7 +215,7 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         }
         pixel_sample_at<SENSOR>(a, st, own, consume, ct, ci, x, y, lane);
         if (consume && !evr_adapt_taken(&d.p, &sk, step, moving, a.dt, &ct, &ci, &ch, &t)) {
-            cand = false;   /* none held back: t is the next to trace */
+            cand = false; /* none held back: t is the next to trace */
             need = t < a.dt;
         }
     }
@@ -214,7 +232,8 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
  * frames[k * npix + pix]. A kernel of its own so that the render kernel and the pixel states are
  * untouched: events are the same with or without frames. Its rays are not counted. */
 template <int LAYOUT, int GI>
-__global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float *frame_f, int num_frames, float *frames)
+__global__ void __launch_bounds__(BLOCK)
+    frame_kernel(kernel_args a, const float *frame_f, int num_frames, float *frames)
 {
     const int npix = a.width * a.height;
     const int pix = blockIdx.x * blockDim.x + threadIdx.x;
@@ -227,12 +246,14 @@ __global__ void __launch_bounds__(BLOCK) frame_kernel(kernel_args a, const float
         const float f = frame_f[k];
         evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
         float t_hit;
-        frames[(size_t)k * (size_t)npix + (size_t)pix] = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo);
+        frames[(size_t)k * (size_t)npix + (size_t)pix] =
+            gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo);
     }
 }
 
 /* Every pixel's first state and its sample phase. */
-__global__ void init_pixels(evr_pixel_state *st, float *phase, int width, int height, unsigned long long seed)
+__global__ void init_pixels(evr_pixel_state *st, float *phase, int width, int height,
+                            unsigned long long seed)
 {
     int pix = blockIdx.x * blockDim.x + threadIdx.x;
     if (pix >= width * height) return;
@@ -260,13 +281,16 @@ template <typename F> static void with_variant(kernel_variant v, F f)
     else with_variant_of<EVR_GPU_LAYOUT_BVH4>(v.sensor, v.gi, f);
 }
 
-void cuda_launch_static_hits(const kernel_args &a, int layout, gpu_static_hit *out, unsigned grid, cudaStream_t s)
+void cuda_launch_static_hits(const kernel_args &a, int layout, gpu_static_hit *out, unsigned grid,
+                             cudaStream_t s)
 {
-    if (layout == EVR_GPU_LAYOUT_CW8) static_hits_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, s>>>(a, out);
+    if (layout == EVR_GPU_LAYOUT_CW8)
+        static_hits_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, s>>>(a, out);
     else static_hits_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, s>>>(a, out);
 }
 
-void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, bool ideal, unsigned grid, cudaStream_t s)
+void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, bool ideal, unsigned grid,
+                      cudaStream_t s)
 {
     if (ideal) skip_kernel<0><<<grid, BLOCK, 0, s>>>(a, d);
     else skip_kernel<1><<<grid, BLOCK, 0, s>>>(a, d);
@@ -274,23 +298,32 @@ void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, bool ideal, un
 
 void cuda_launch_render(const kernel_args &a, kernel_variant v, unsigned grid, cudaStream_t s)
 {
-    with_variant(v, [&](auto k) { render_kernel<decltype(k)::layout, decltype(k)::sensor, decltype(k)::gi><<<grid, BLOCK, 0, s>>>(a); });
-}
-
-void cuda_launch_adapt(const kernel_args &a, const adapt_args &d, kernel_variant v, unsigned grid, cudaStream_t s)
-{
-    with_variant(v, [&](auto k) { adapt_kernel<decltype(k)::layout, decltype(k)::sensor, decltype(k)::gi><<<grid, BLOCK, 0, s>>>(a, d); });
-}
-
-void cuda_launch_frames(const kernel_args &a, kernel_variant v, const float *frame_f, int num_frames, float *frames, unsigned grid,
-                        cudaStream_t s)
-{
     with_variant(v, [&](auto k) {
-        frame_kernel<decltype(k)::layout, decltype(k)::gi><<<grid, BLOCK, 0, s>>>(a, frame_f, num_frames, frames);
+        render_kernel<decltype(k)::layout, decltype(k)::sensor, decltype(k)::gi>
+            <<<grid, BLOCK, 0, s>>>(a);
     });
 }
 
-void cuda_launch_init_pixels(evr_pixel_state *st, float *phase, int width, int height, unsigned long long seed)
+void cuda_launch_adapt(const kernel_args &a, const adapt_args &d, kernel_variant v, unsigned grid,
+                       cudaStream_t s)
+{
+    with_variant(v, [&](auto k) {
+        adapt_kernel<decltype(k)::layout, decltype(k)::sensor, decltype(k)::gi>
+            <<<grid, BLOCK, 0, s>>>(a, d);
+    });
+}
+
+void cuda_launch_frames(const kernel_args &a, kernel_variant v, const float *frame_f,
+                        int num_frames, float *frames, unsigned grid, cudaStream_t s)
+{
+    with_variant(v, [&](auto k) {
+        frame_kernel<decltype(k)::layout, decltype(k)::gi>
+            <<<grid, BLOCK, 0, s>>>(a, frame_f, num_frames, frames);
+    });
+}
+
+void cuda_launch_init_pixels(evr_pixel_state *st, float *phase, int width, int height,
+                             unsigned long long seed)
 {
     const size_t npix = (size_t)width * (size_t)height;
     init_pixels<<<(unsigned)((npix + 255) / 256), 256>>>(st, phase, width, height, seed);

@@ -18,52 +18,54 @@ extern "C" {
 }
 
 #ifndef NSLOT
-#define NSLOT 4                 /* segments in flight: 4 measured 5-6% faster than 3 and than 6 (H100, eye 30 s) */
+#define NSLOT 4 /* segments in flight: 4 measured 5-6% faster than 3 and than 6 (H100, eye 30 s) */
 #endif
-#define NRING (NSLOT + 1)       /* pixel-state arrays: the in-flight segments' inputs and the last output */
+#define NRING \
+    (NSLOT + 1) /* pixel-state arrays: the in-flight segments' inputs and the last output */
 
 /* One segment in flight. */
 struct slot {
     int index;
     double t0, t1;
     int camera_static, want_intensity;
-    int num_frames;                    /* intensity frames wanted in this segment */
+    int num_frames; /* intensity frames wanted in this segment */
     long long base_us;
     int end_bit;
     hbuf<evr_motion_key> h_keys;
-    hbuf<int> h_tracks;                /* offsets then counts */
+    hbuf<int> h_tracks; /* offsets then counts */
     dbuf<evr_motion_key> d_keys;
     dbuf<int> d_tracks;
-    evr_gpu_top top;                   /* host top level */
+    evr_gpu_top top; /* host top level */
     dbuf<evr_gpu_node4> d_top4;
     dbuf<evr_gpu_node8> d_top8;
     dbuf<evr_gpu_inst> d_insts;
     dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
     dbuf<unsigned char> d_sort_temp;
-    dbuf<unsigned int> d_count;        /* indexed by launch_count */
-    dbuf<unsigned long long> d_counters;   /* indexed by segment_counter */
+    dbuf<unsigned int> d_count;          /* indexed by launch_count */
+    dbuf<unsigned long long> d_counters; /* indexed by segment_counter */
     dbuf<evr_skip_plan> d_plan;
     hbuf<evr_skip_plan> h_plan;
-    dbuf<int> d_list;                  /* pixels that trace (change-driven sampling) */
-    dbuf<evr_adapt_plan> d_adapt;      /* adaptive sampling's plan */
+    dbuf<int> d_list;             /* pixels that trace (change-driven sampling) */
+    dbuf<evr_adapt_plan> d_adapt; /* adaptive sampling's plan */
     hbuf<evr_adapt_plan> h_adapt;
-    int reuse;                         /* the plan lets pixels reuse their intensity */
+    int reuse; /* the plan lets pixels reuse their intensity */
     dbuf<float> d_intensity;
     hbuf<unsigned int> h_count;
     hbuf<unsigned long long> h_counters;
     hbuf<unsigned long long> h_sorted;
     hbuf<float> h_intensity;
-    hbuf<float> h_frame_f;             /* normalized times of the frames */
+    hbuf<float> h_frame_f; /* normalized times of the frames */
     dbuf<float> d_frame_f;
     dbuf<float> d_frames;
     hbuf<float> h_frames;
     cudaStream_t copy = nullptr;
-    cudaEvent_t framed = nullptr;      /* the frame kernel is done */
-    cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr, copied = nullptr;
+    cudaEvent_t framed = nullptr; /* the frame kernel is done */
+    cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr,
+                copied = nullptr;
     int num_tracks, num_keys;
     /* global illumination: the changed cells, the view the kernels read (which ring buffers) */
     dbuf<uint32_t> d_sat;
-    dbuf<uint32_t> d_ch_before, d_ch_base, d_ch_x;   /* the cells that changed (gp.max_photons 0) */
+    dbuf<uint32_t> d_ch_before, d_ch_base, d_ch_x; /* the cells that changed (gp.max_photons 0) */
     dbuf<gpu_gi_view> d_gi_view;
     hbuf<gpu_gi_view> h_gi_view;
     hbuf<evr_photon_emitter> h_em;
@@ -71,11 +73,11 @@ struct slot {
     hbuf<float> h_cdf;
     dbuf<float> d_cdf;
     cudaEvent_t gi_started = nullptr, gi_done = nullptr;
-    int gi_passes;                     /* photon passes run for this segment (0: a still copy) */
-    int copying;                       /* the sort and copy of this render's events are queued */
-    size_t total;                      /* keys sorted and copied: its own, then those carried in */
-    cudaEvent_t sort_from = nullptr;   /* start of the sort (copy stream) */
-    int static_gen = -1;               /* the static hits it renders with (cuda_backend.static_gen), -1: none */
+    int gi_passes;                   /* photon passes run for this segment (0: a still copy) */
+    int copying;                     /* the sort and copy of this render's events are queued */
+    size_t total;                    /* keys sorted and copied: its own, then those carried in */
+    cudaEvent_t sort_from = nullptr; /* start of the sort (copy stream) */
+    int static_gen = -1; /* the static hits it renders with (cuda_backend.static_gen), -1: none */
 };
 
 /* A photon buffer in device memory (cuda_gi.cu): a ring of them, indexed by segment. */
@@ -83,7 +85,7 @@ struct gi_buffer {
     dbuf<evr_photon> slots;
     dbuf<uint32_t> count;
     dbuf<float> gbuf;
-    evr_photon_buffer ph;              /* the shape and the device pointers */
+    evr_photon_buffer ph; /* the shape and the device pointers */
 };
 
 struct cuda_backend {
@@ -95,14 +97,14 @@ struct cuda_backend {
     dbuf<gpu_static_hit> d_static;
     evr_motion_key static_cam;
     int static_gen, static_off;
-    evr_par_pool *par;                 /* decodes the sorted keys (NULL: on the main thread) */
+    evr_par_pool *par; /* decodes the sorted keys (NULL: on the main thread) */
     evr_render_host host;
     evr_run_setup setup;
     evr_gpu_bvh bvh;
     int device;
     char device_name[256];
     /* scene on the device */
-    dbuf<float> d_floats;                  /* all vertex data */
+    dbuf<float> d_floats; /* all vertex data */
     dbuf<uint32_t> d_indices;
     dbuf<evr_mesh_view> d_meshes;
     dbuf<evr_material_params> d_materials;
@@ -114,13 +116,13 @@ struct cuda_backend {
     dbuf<evr_gpu_node8> d_nodes8;
     dbuf<evr_gpu_tri> d_tris;
     dbuf<evr_pixel_state> d_state[NRING];
-    dbuf<float> d_next[NRING];             /* adaptive sampling: next sample times, a ring as d_state */
+    dbuf<float> d_next[NRING]; /* adaptive sampling: next sample times, a ring as d_state */
     dbuf<float> d_phase;
-    dbuf<evr_pixel_params> d_sensor;       /* the run's pixel parameters, for the sensor kernel */
+    dbuf<evr_pixel_params> d_sensor; /* the run's pixel parameters, for the sensor kernel */
     cudaStream_t render = nullptr;
     slot slots[NSLOT];
     int head, queued;
-    size_t capacity;                       /* event keys per segment */
+    size_t capacity; /* event keys per segment */
     /* the collected segment's sorted keys at or after its emit_before, still on the device
      * (slots[carry_slot].d_keys_sorted from carry_at, carry_n of them, keys on carry_base_us,
      * times carry_t_lo .. carry_t_hi): sorted again with the next segment's (carry_slot -1: none) */
@@ -131,13 +133,14 @@ struct cuda_backend {
     /* global illumination (cuda_gi.cu): the pass's photons and their sort, shared by the slots
      * (one pass at a time on the render stream) */
     int gi, gi_have_prev;
-    gi_buffer gi_ring[NRING];              /* segment i ends in gi_ring[i % NRING], starts in the one before */
-    dbuf<uint8_t> d_gi_last;               /* per cell: changed over the last segment */
-    dbuf<gi_end> d_gi_ends[NRING];         /* deferred gathers: each pixel's last gather, a ring as d_state */
+    gi_buffer gi_ring[NRING]; /* segment i ends in gi_ring[i % NRING], starts in the one before */
+    dbuf<uint8_t> d_gi_last;  /* per cell: changed over the last segment */
+    dbuf<gi_end>
+        d_gi_ends[NRING]; /* deferred gathers: each pixel's last gather, a ring as d_state */
     uint32_t photons;
     evr_photon_params pp;
     evr_gather_params gp;
-    evr_photon_emitters em;                /* host: rebuilt per segment */
+    evr_photon_emitters em; /* host: rebuilt per segment */
     dbuf<evr_photon> d_pending;
     dbuf<unsigned long long> d_pkeys, d_pkeys_sorted;
     dbuf<unsigned> d_pvals, d_pvals_sorted, d_pcount;
@@ -145,7 +148,8 @@ struct cuda_backend {
     /* the photons' trails (core/photon.h) and the emitter table of the pass that recorded them */
     dbuf<evr_photon_trail> d_trails;
     dbuf<evr_trail_ray> d_trail_rays;
-    dbuf<unsigned> d_todo, d_todo_count;   /* the photons a pass traces when others reuse their trails */
+    dbuf<unsigned> d_todo,
+        d_todo_count; /* the photons a pass traces when others reuse their trails */
     int trails_valid, trails_off;
     evr_photon_emitters trail_em;
     /* GI with deferred gathers (cuda_gi_deferred.cu): off when its buffers do not fit, or with
@@ -158,7 +162,7 @@ struct cuda_backend {
     dbuf<int> d_gd_traced, d_gd_newpix;
     dbuf<unsigned long long> d_gd_delta;
     dbuf<gi_request> d_gd_requests;
-    cuda_timeline tl;                      /* EVR_TIMELINE (hidden, for measurement) */
+    cuda_timeline tl; /* EVR_TIMELINE (hidden, for measurement) */
 };
 
 /* Bits an event key gives a coordinate of n values, and those below an event key's time. */

@@ -12,7 +12,8 @@ evr_status timeline_open(cuda_timeline *tl, cudaStream_t s, evr_error *err)
     const char *path = getenv("EVR_TIMELINE");
     if (!path) return EVR_OK;
     if (!(tl->f = fopen(path, "w"))) {
-        snprintf(err->msg, sizeof err->msg, "cannot write the timeline %s (EVR_TIMELINE): %s", path, strerror(errno));
+        snprintf(err->msg, sizeof err->msg, "cannot write the timeline %s (EVR_TIMELINE): %s", path,
+                 strerror(errno));
         return EVR_ERR_IO;
     }
     CK(cudaEventCreate(&tl->base));
@@ -40,8 +41,8 @@ timeline_rec *timeline_at(cuda_timeline *tl, int i)
     return &tl->recs[i];
 }
 
-cudaError_t timeline_gpu(const cuda_timeline *tl, timeline_rec *r, cudaEvent_t started, cudaEvent_t rendered, cudaEvent_t sort_from,
-                         cudaEvent_t copied)
+cudaError_t timeline_gpu(const cuda_timeline *tl, timeline_rec *r, cudaEvent_t started,
+                         cudaEvent_t rendered, cudaEvent_t sort_from, cudaEvent_t copied)
 {
     const cudaEvent_t ev[4] = {started, rendered, sort_from, copied};
     double *g[4] = {&r->g_start, &r->g_rendered, &r->g_sort, &r->g_copied};
@@ -63,11 +64,13 @@ void timeline_close(cuda_timeline *tl)
     for (int i = 0; i < tl->cap; i++) {
         const timeline_rec *r = &tl->recs[i];
         if (r->sub1 == 0.0) continue;
-        fprintf(tl->f, "%d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %zu\n", i, r->sub0 - h0, r->sub1 - h0, r->col0 - h0,
-                r->counted - h0, r->copied - h0, r->col1 - h0, r->g_start, r->g_rendered, r->g_sort, r->g_copied, r->n);
+        fprintf(tl->f, "%d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %zu\n", i,
+                r->sub0 - h0, r->sub1 - h0, r->col0 - h0, r->counted - h0, r->copied - h0,
+                r->col1 - h0, r->g_start, r->g_rendered, r->g_sort, r->g_copied, r->n);
     }
     if (tl->lost) fprintf(tl->f, "# incomplete: out of memory for the timeline\n");
-    if (fclose(tl->f) != 0 || tl->lost) fprintf(stderr, "evray: warning: the timeline (EVR_TIMELINE) is incomplete\n");
+    if (fclose(tl->f) != 0 || tl->lost)
+        fprintf(stderr, "evray: warning: the timeline (EVR_TIMELINE) is incomplete\n");
     tl->f = nullptr;
     free(tl->recs);
     tl->recs = nullptr;

@@ -19,7 +19,7 @@ struct timeline_rec {
 };
 
 struct cuda_timeline {
-    FILE *f;                       /* NULL: no timeline */
+    FILE *f; /* NULL: no timeline */
     cudaEvent_t base;
     double h0;
     timeline_rec *recs;
@@ -31,8 +31,8 @@ evr_status timeline_open(cuda_timeline *tl, cudaStream_t s, evr_error *err);
 /* Segment i's record (NULL: no timeline, or no memory for it, which the file then says). */
 timeline_rec *timeline_at(cuda_timeline *tl, int i);
 /* The GPU times of a record: events started, rendered, sort started, copied (all complete). */
-cudaError_t timeline_gpu(const cuda_timeline *tl, timeline_rec *r, cudaEvent_t started, cudaEvent_t rendered, cudaEvent_t sort_from,
-                         cudaEvent_t copied);
+cudaError_t timeline_gpu(const cuda_timeline *tl, timeline_rec *r, cudaEvent_t started,
+                         cudaEvent_t rendered, cudaEvent_t sort_from, cudaEvent_t copied);
 /* Writes the timeline and frees it (the device synchronized). */
 void timeline_close(cuda_timeline *tl);
 

@@ -99,32 +99,32 @@ typedef struct {
  * leaves. */
 typedef struct {
     EVR_ALIGN16 float v0[3];
-    uint32_t prim;             /* triangle index in the instance's mesh */
+    uint32_t prim; /* triangle index in the instance's mesh */
     float v1[3];
-    int32_t instance;          /* scene instance, minus the group's instance_base */
+    int32_t instance; /* scene instance, minus the group's instance_base */
     float v2[3];
     uint32_t pad;
 } evr_gpu_tri;
 
 /* A group in the top level's leaf order, 64 bytes. */
 typedef struct {
-    EVR_ALIGN16 evr_m34 inv;   /* world to group space; valid when moving == 0 */
-    int32_t root;              /* root node of the group's bottom-level BVH */
-    int32_t track;             /* motion track (evr_render_scene), -1 in world space (static) */
-    int32_t instance_base;     /* added to a triangle's instance: the scene instance index */
-    int32_t moving;            /* 1: the transform changes in the segment, evaluate per ray */
+    EVR_ALIGN16 evr_m34 inv; /* world to group space; valid when moving == 0 */
+    int32_t root;            /* root node of the group's bottom-level BVH */
+    int32_t track;           /* motion track (evr_render_scene), -1 in world space (static) */
+    int32_t instance_base;   /* added to a triangle's instance: the scene instance index */
+    int32_t moving;          /* 1: the transform changes in the segment, evaluate per ray */
 } evr_gpu_inst;
 
 /* What the traversal reads; all pointers host or all device. */
 typedef struct {
-    int layout;                          /* EVR_GPU_LAYOUT_* */
-    const evr_gpu_node4 *nodes4;         /* bottom level, layout BVH4 (else NULL) */
-    const evr_gpu_node8 *nodes8;         /* bottom level, layout CW8 (else NULL) */
+    int layout;                  /* EVR_GPU_LAYOUT_* */
+    const evr_gpu_node4 *nodes4; /* bottom level, layout BVH4 (else NULL) */
+    const evr_gpu_node8 *nodes8; /* bottom level, layout CW8 (else NULL) */
     const evr_gpu_tri *tris;
-    const evr_gpu_node4 *top4;           /* top level, root at 0 */
+    const evr_gpu_node4 *top4; /* top level, root at 0 */
     const evr_gpu_node8 *top8;
     const evr_gpu_inst *insts;
-    uint32_t num_nodes, num_tris, num_top_nodes, num_insts;   /* num_top_nodes 0: nothing to hit */
+    uint32_t num_nodes, num_tris, num_top_nodes, num_insts; /* num_top_nodes 0: nothing to hit */
 } evr_gpu_scene_view;
 
 /* ---- host side ---- */
@@ -132,31 +132,31 @@ typedef struct {
 /* Bottom level of every group of a scene (the groups of prep/instance_groups.h, in their order). */
 typedef struct {
     int layout;
-    int grouped;               /* 0: built with EVR_GPU_BVH_UNGROUPED */
+    int grouped; /* 0: built with EVR_GPU_BVH_UNGROUPED */
     int num_groups;
     int num_scene_instances;
     /* the grouping (evr_instance_groups: its arrays, owned here) */
-    int static_group;          /* index of the baked static group, -1: none */
-    int static_instanced;      /* 1: the static instances were past the bake limit: each is a group
+    int static_group;     /* index of the baked static group, -1: none */
+    int static_instanced; /* 1: the static instances were past the bake limit: each is a group
                                   of its own in its node's space, the trees shared by mesh */
-    int *group_node;           /* per group: the node whose object space it is in and whose track
+    int *group_node;      /* per group: the node whose object space it is in and whose track
                                   moves it, -1: world space (the static group) */
-    int *group_first;          /* per group + 1: its members are members[group_first[g] ..
+    int *group_first;     /* per group + 1: its members are members[group_first[g] ..
                                   group_first[g + 1]), scene instance indices, ascending */
     int *members;
-    int *instance_group;       /* per scene instance: its group */
-    int32_t *group_root;       /* per group: root node, -1 for a group without usable triangles */
-    int32_t *group_instance_base;  /* per group: evr_gpu_inst.instance_base */
-    int *group_stack;          /* per group: stack entries its traversal needs at most */
-    float *group_bounds;       /* per group: box of its triangles in its space, lo xyz hi xyz */
-    int num_trees;             /* bottom-level BVHs built (groups that share one count once) */
-    int max_stack;             /* largest of group_stack */
+    int *instance_group; /* per scene instance: its group */
+    int32_t *group_root; /* per group: root node, -1 for a group without usable triangles */
+    int32_t *group_instance_base; /* per group: evr_gpu_inst.instance_base */
+    int *group_stack;             /* per group: stack entries its traversal needs at most */
+    float *group_bounds;          /* per group: box of its triangles in its space, lo xyz hi xyz */
+    int num_trees;                /* bottom-level BVHs built (groups that share one count once) */
+    int max_stack;                /* largest of group_stack */
     evr_gpu_node4 *nodes4;
     evr_gpu_node8 *nodes8;
     uint32_t num_nodes;
     evr_gpu_tri *tris;
-    uint32_t num_tris;         /* triangle references (>= the meshes' triangles with splits) */
-    void *device;              /* the Embree device (RTCDevice) its builds use */
+    uint32_t num_tris; /* triangle references (>= the meshes' triangles with splits) */
+    void *device;      /* the Embree device (RTCDevice) its builds use */
 } evr_gpu_bvh;
 
 /* Top level of one segment. Zero it before the first build; later builds reuse its memory. */
@@ -165,12 +165,12 @@ typedef struct {
     evr_gpu_node4 *nodes4;
     evr_gpu_node8 *nodes8;
     uint32_t num_nodes, cap_nodes;
-    evr_gpu_inst *insts;       /* one per group with triangles, in leaf order */
+    evr_gpu_inst *insts; /* one per group with triangles, in leaf order */
     uint32_t num_insts, cap_insts;
-    float *group_bounds;       /* per group: world box over the segment, lo xyz hi xyz (empty,
+    float *group_bounds; /* per group: world box over the segment, lo xyz hi xyz (empty,
                                   lo > hi, for a group left out) */
     int num_groups, cap_groups;
-    int stack_need;            /* top level's worst case plus the deepest group's */
+    int stack_need; /* top level's worst case plus the deepest group's */
 } evr_gpu_top;
 
 /* Groups the instances of s (evr_instance_groups_build) and builds the bottom level of every
@@ -183,7 +183,8 @@ void evr_gpu_bvh_free(evr_gpu_bvh *b);
 /* Builds the top level for the segment whose motion keys rs holds (rs->num_instances, equal to
  * the scene's; rs->instances[i].track, the same for every member of a moving group; rs->keys,
  * rs->track_offset, rs->track_count). */
-evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top, evr_error *err);
+evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top,
+                             evr_error *err);
 void evr_gpu_top_free(evr_gpu_top *top);
 
 /* A view of host arrays, for host traversal. */

@@ -38,7 +38,8 @@ void evr_gpu_bvh_free(evr_gpu_bvh *b)
 static int consecutive(const evr_gpu_bvh *b, int g)
 {
     int first = b->group_first[g], last = b->group_first[g + 1] - 1;
-    return b->group_node[g] >= 0 && last >= first && b->members[last] - b->members[first] == last - first;
+    return b->group_node[g] >= 0 && last >= first &&
+           b->members[last] - b->members[first] == last - first;
 }
 
 static uint64_t mesh_signature(const evr_scene *s, const evr_gpu_bvh *b, int g)
@@ -69,12 +70,12 @@ static const char *group_name(const evr_scene *s, const evr_gpu_bvh *b, int g)
 
 /* A group's triangles for the builder (buffers reused from group to group). */
 typedef struct {
-    struct RTCBuildPrimitive *prims;   /* room for 2 per triangle (spatial splits) */
-    float *tri;                        /* 9 floats per triangle */
+    struct RTCBuildPrimitive *prims; /* room for 2 per triangle (spatial splits) */
+    float *tri;                      /* 9 floats per triangle */
     uint32_t *prim;
     int32_t *inst;
     size_t cap;
-    float *verts;                      /* a baked mesh's vertices */
+    float *verts; /* a baked mesh's vertices */
     size_t cap_verts;
 } group_tris;
 
@@ -105,8 +106,8 @@ static int group_tris_reserve(group_tris *gt, size_t nt)
 /* Collects the usable triangles of group g (baked into world space for the static group, as
  * the CPU backend bakes them: each vertex through evr_m34_point in float) and their box.
  * Returns their number, or (size_t)-1 when out of memory. */
-static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int32_t base, group_tris *gt,
-                           float box[6])
+static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int32_t base,
+                           group_tris *gt, float box[6])
 {
     int j, k;
     size_t n = 0;
@@ -133,8 +134,9 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
                 gt->cap_verts = mesh->num_vertices;
             }
             for (v = 0; v < mesh->num_vertices; v++) {
-                evr_v3 p = evr_m34_point(&world, evr_v3_make(pos[3 * (size_t)v], pos[3 * (size_t)v + 1],
-                                                             pos[3 * (size_t)v + 2]));
+                evr_v3 p =
+                    evr_m34_point(&world, evr_v3_make(pos[3 * (size_t)v], pos[3 * (size_t)v + 1],
+                                                      pos[3 * (size_t)v + 2]));
                 gt->verts[3 * (size_t)v] = p.x;
                 gt->verts[3 * (size_t)v + 1] = p.y;
                 gt->verts[3 * (size_t)v + 2] = p.z;
@@ -147,7 +149,10 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
             int ok = 1, v;
             for (v = 0; v < 3; v++) {
                 uint32_t vi = mesh->indices[3 * t + (size_t)v];
-                if (vi >= mesh->num_vertices) { ok = 0; break; }
+                if (vi >= mesh->num_vertices) {
+                    ok = 0;
+                    break;
+                }
                 for (k = 0; k < 3; k++) {
                     float x = pos[3 * (size_t)vi + (size_t)k];
                     if (!isfinite(x)) ok = 0;
@@ -155,14 +160,18 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
                     hi[k] = fmaxf(hi[k], x);
                 }
             }
-            if (!ok) continue;   /* Embree skips such triangles too */
+            if (!ok) continue; /* Embree skips such triangles too */
             for (v = 0; v < 3; v++)
-                memcpy(gt->tri + 9 * n + 3 * (size_t)v, pos + 3 * (size_t)mesh->indices[3 * t + (size_t)v],
-                       3 * sizeof(float));
+                memcpy(gt->tri + 9 * n + 3 * (size_t)v,
+                       pos + 3 * (size_t)mesh->indices[3 * t + (size_t)v], 3 * sizeof(float));
             gt->prim[n] = (uint32_t)t;
             gt->inst[n] = (int32_t)i - base;
-            pr->lower_x = lo[0]; pr->lower_y = lo[1]; pr->lower_z = lo[2];
-            pr->upper_x = hi[0]; pr->upper_y = hi[1]; pr->upper_z = hi[2];
+            pr->lower_x = lo[0];
+            pr->lower_y = lo[1];
+            pr->lower_z = lo[2];
+            pr->upper_x = hi[0];
+            pr->upper_y = hi[1];
+            pr->upper_z = hi[2];
             pr->geomID = 0;
             pr->primID = (unsigned)n;
             for (k = 0; k < 3; k++) {
@@ -195,7 +204,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     if (n < 0) return fail(err, EVR_ERR_ARG, "a negative instance count", NULL);
     out->layout = layout;
     out->num_scene_instances = n;
-    if (evr_instance_groups_build(s, out->grouped, &groups)) {   /* its arrays are ours from here */
+    if (evr_instance_groups_build(s, out->grouped, &groups)) { /* its arrays are ours from here */
         out->num_groups = groups.num_groups;
         out->static_group = groups.static_group;
         out->static_instanced = groups.static_instanced;
@@ -209,8 +218,8 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     out->group_instance_base = calloc((size_t)n + 1, sizeof(int32_t));
     out->group_stack = calloc((size_t)n + 1, sizeof(int));
     out->group_bounds = malloc(sizeof(float) * 6 * ((size_t)n + 1));
-    if (!out->group_node || !out->group_first || !out->members || !out->instance_group || !out->group_root ||
-        !out->group_instance_base || !out->group_stack || !out->group_bounds) {
+    if (!out->group_node || !out->group_first || !out->members || !out->instance_group ||
+        !out->group_root || !out->group_instance_base || !out->group_stack || !out->group_bounds) {
         evr_gpu_bvh_free(out);
         return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
     }
@@ -221,7 +230,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         evr_gpu_bvh_free(out);
         return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
     }
-    memset(table, 0xff, sizeof(int) * table_mask);   /* -1: empty */
+    memset(table, 0xff, sizeof(int) * table_mask); /* -1: empty */
     table_mask--;
     dev = rtcNewDevice(NULL);
     if (!dev) {
@@ -244,7 +253,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
             base = out->members[out->group_first[g]];
             out->group_instance_base[g] = base;
             while (table[h] >= 0 && !same_meshes(s, out, g, table[h])) h = (h + 1) & table_mask;
-            if (table[h] >= 0) {   /* the same meshes as an earlier group: its tree */
+            if (table[h] >= 0) { /* the same meshes as an earlier group: its tree */
                 int o = table[h];
                 out->group_root[g] = out->group_root[o];
                 out->group_stack[g] = out->group_stack[o];
@@ -260,7 +269,8 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         }
         if (nt == 0) continue;
         if (nt > 0x3fffffff) {
-            st = fail(err, EVR_ERR_ARG, "a group of instances has too many triangles for the GPU BVH",
+            st = fail(err, EVR_ERR_ARG,
+                      "a group of instances has too many triangles for the GPU BVH",
                       group_name(s, out, g));
             break;
         }
@@ -288,7 +298,8 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
             break;
         }
         if (need >= EVR_GPU_STACK_SIZE) {
-            st = fail(err, EVR_ERR_BACKEND, "a group's BVH is too deep for the traversal stack", group_name(s, out, g));
+            st = fail(err, EVR_ERR_BACKEND, "a group's BVH is too deep for the traversal stack",
+                      group_name(s, out, g));
             break;
         }
         out->group_root[g] = (int32_t)root;
@@ -320,7 +331,8 @@ void evr_gpu_top_free(evr_gpu_top *top)
     memset(top, 0, sizeof *top);
 }
 
-evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top, evr_error *err)
+evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top,
+                             evr_error *err)
 {
     int ng = b->num_groups, g, k, need;
     size_t count = 0;
@@ -337,7 +349,8 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     top->num_insts = 0;
     top->stack_need = 0;
     if (rs->num_instances != b->num_scene_instances)
-        return fail(err, EVR_ERR_ARG, "the render scene's instances are not those the GPU BVH was built for", NULL);
+        return fail(err, EVR_ERR_ARG,
+                    "the render scene's instances are not those the GPU BVH was built for", NULL);
     if (ng > top->cap_groups || !top->group_bounds) {
         float *gb = realloc(top->group_bounds, sizeof(float) * 6 * ((size_t)ng + 1));
         if (!gb) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
@@ -365,7 +378,7 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
         memset(in, 0, sizeof *in);
         in->root = b->group_root[g];
         in->instance_base = b->group_instance_base[g];
-        if (b->group_node[g] < 0) {   /* world space (the static group) */
+        if (b->group_node[g] < 0) { /* world space (the static group) */
             for (k = 0; k < 3; k++) {
                 lo[k] = gb[k];
                 hi[k] = gb[k + 3];
@@ -373,7 +386,7 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
             in->track = -1;
             in->moving = 0;
             in->inv = evr_m34_identity();
-        } else {   /* every member is on the group's node: the first one's track is the group's */
+        } else { /* every member is on the group's node: the first one's track is the group's */
             int track = rs->instances[b->members[b->group_first[g]]].track;
             evr_motion_track tr = evr_rs_track(rs, track);
             evr_swept_bounds(gb, gb + 3, tr, lo, hi);
@@ -393,8 +406,12 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
             box[k] = fminf(box[k], lo[k]);
             box[k + 3] = fmaxf(box[k + 3], hi[k]);
         }
-        prims[count].lower_x = lo[0]; prims[count].lower_y = lo[1]; prims[count].lower_z = lo[2];
-        prims[count].upper_x = hi[0]; prims[count].upper_y = hi[1]; prims[count].upper_z = hi[2];
+        prims[count].lower_x = lo[0];
+        prims[count].lower_y = lo[1];
+        prims[count].lower_z = lo[2];
+        prims[count].upper_x = hi[0];
+        prims[count].upper_y = hi[1];
+        prims[count].upper_z = hi[2];
         prims[count].geomID = 0;
         prims[count].primID = (unsigned)count;
         count++;
@@ -402,7 +419,7 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     if (count == 0) {
         free(src);
         free(prims);
-        return EVR_OK;   /* nothing to hit */
+        return EVR_OK; /* nothing to hit */
     }
     memset(&c, 0, sizeof c);
     c.layout = b->layout;
@@ -415,8 +432,8 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     c.cap_items = top->cap_insts;
     /* one group per leaf: entering a group costs far more than a box test (and the CW8 traversal
      * finds a top-level leaf's group through its slot, evr__trace8) */
-    st = evr_gpu_tree_build((RTCDevice)b->device, &c, prims, count, count, RTC_BUILD_QUALITY_MEDIUM, 1, NULL, box,
-                            &root, err);
+    st = evr_gpu_tree_build((RTCDevice)b->device, &c, prims, count, count, RTC_BUILD_QUALITY_MEDIUM,
+                            1, NULL, box, &root, err);
     free(c.work);
     top->nodes4 = c.n4;
     top->nodes8 = c.n8;
@@ -430,7 +447,8 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     if (need < 0) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
     need += b->max_stack;
     if (need >= EVR_GPU_STACK_SIZE)
-        return fail(err, EVR_ERR_BACKEND, "the scene's BVH is too deep for the traversal stack", NULL);
+        return fail(err, EVR_ERR_BACKEND, "the scene's BVH is too deep for the traversal stack",
+                    NULL);
     top->num_nodes = c.num_nodes;
     top->num_insts = c.num_items;
     top->stack_need = need;

@@ -18,13 +18,13 @@ typedef struct {
 } split_source;
 
 typedef struct {
-    const void *ptr;               /* build_node or build_leaf */
-    uint32_t index;                /* node it becomes */
+    const void *ptr; /* build_node or build_leaf */
+    uint32_t index;  /* node it becomes */
 } flat_work;
 
 typedef struct {
     int layout;
-    int instances;                 /* items are instances (top level), else triangles */
+    int instances; /* items are instances (top level), else triangles */
     /* outputs, grown as needed (and kept across top-level builds) */
     evr_gpu_node4 *n4;
     evr_gpu_node8 *n8;
@@ -33,29 +33,32 @@ typedef struct {
     evr_gpu_inst *insts;
     uint32_t num_items, cap_items;
     /* item sources, by primID */
-    const float *tri9;             /* a group's triangles, 9 floats each */
-    const uint32_t *tri_prim;      /* their indices in their meshes */
-    const int32_t *tri_inst;       /* their instance fields */
-    const evr_gpu_inst *inst_src;  /* the top level's groups */
+    const float *tri9;            /* a group's triangles, 9 floats each */
+    const uint32_t *tri_prim;     /* their indices in their meshes */
+    const int32_t *tri_inst;      /* their instance fields */
+    const evr_gpu_inst *inst_src; /* the top level's groups */
     /* work list */
     flat_work *work;
     size_t num_work, cap_work;
-    const char *fail;              /* why flattening failed */
+    const char *fail; /* why flattening failed */
 } flat_ctx;
 
 /* Fills err with "what: detail" (detail may be NULL) and returns st. */
 static inline evr_status fail(evr_error *err, evr_status st, const char *what, const char *detail)
 {
-    if (err) snprintf(err->msg, sizeof err->msg, "%s%s%s", what, detail ? ": " : "", detail ? detail : "");
+    if (err)
+        snprintf(err->msg, sizeof err->msg, "%s%s%s", what, detail ? ": " : "",
+                 detail ? detail : "");
     return st;
 }
 
 /* Room for n build primitives, aligned as Embree wants them. */
 struct RTCBuildPrimitive *evr_gpu_tree_prims(size_t n);
 /* Runs Embree's builder over prims[0..n) (capacity cap) and flattens the result into c. */
-evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimitive *prims, size_t n, size_t cap,
-                              enum RTCBuildQuality quality, unsigned max_leaf, split_source *split,
-                              const float root_box[6], uint32_t *root_index, evr_error *err);
+evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimitive *prims, size_t n,
+                              size_t cap, enum RTCBuildQuality quality, unsigned max_leaf,
+                              split_source *split, const float root_box[6], uint32_t *root_index,
+                              evr_error *err);
 /* Worst-case stack entries of the traversal of the tree in nodes [first, end) rooted at first
  * (children always come after their parent); -1 when out of memory. */
 int evr_gpu_tree_stack_need(const flat_ctx *c, uint32_t first, uint32_t end);

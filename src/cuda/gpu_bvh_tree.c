@@ -13,18 +13,17 @@
 /* ---- the temporary tree Embree builds ---- */
 
 typedef struct {
-    int leaf;                      /* 0 */
+    int leaf; /* 0 */
     unsigned n;
     void *child[MAX_WIDTH];
-    float box[MAX_WIDTH][6];       /* lo xyz, hi xyz */
+    float box[MAX_WIDTH][6]; /* lo xyz, hi xyz */
 } build_node;
 
 typedef struct {
-    int leaf;                      /* 1 */
+    int leaf; /* 1 */
     unsigned n;
     uint32_t prim[];
 } build_leaf;
-
 
 static void *cb_create_node(RTCThreadLocalAllocator alloc, unsigned int n, void *user)
 {
@@ -32,7 +31,7 @@ static void *cb_create_node(RTCThreadLocalAllocator alloc, unsigned int n, void 
     (void)user;
     if (!b) return NULL;
     b->leaf = 0;
-    b->n = n;   /* more than MAX_WIDTH is caught when flattening */
+    b->n = n; /* more than MAX_WIDTH is caught when flattening */
     return b;
 }
 
@@ -59,7 +58,8 @@ static void cb_set_bounds(void *node, const struct RTCBounds **bounds, unsigned 
     }
 }
 
-static void *cb_create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPrimitive *prims, size_t n, void *user)
+static void *cb_create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPrimitive *prims,
+                            size_t n, void *user)
 {
     build_leaf *l = rtcThreadLocalAlloc(alloc, sizeof *l + n * sizeof(uint32_t), 16);
     size_t i;
@@ -67,7 +67,7 @@ static void *cb_create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuild
     if (!l) return NULL;
     l->leaf = 1;
     l->n = (unsigned)n;
-    for (i = 0; i < n; i++) l->prim[i] = prims[i].primID;   /* geomID may carry Embree's split bits */
+    for (i = 0; i < n; i++) l->prim[i] = prims[i].primID; /* geomID may carry Embree's split bits */
     return l;
 }
 
@@ -78,11 +78,12 @@ static inline float max_f(float a, float b) { return a > b ? a : b; }
  * pos, clipped to the reference's current box. Edge crossings are computed in float and the
  * boxes widened by their rounding error (a few ulps), so each box holds its part of the
  * triangle. Embree calls this for every candidate split: it must be cheap. */
-static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, float pos, struct RTCBounds *lb,
-                     struct RTCBounds *rb, void *user)
+static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, float pos,
+                     struct RTCBounds *lb, struct RTCBounds *rb, void *user)
 {
     const split_source *src = user;
-    const float pb[6] = {prim->lower_x, prim->lower_y, prim->lower_z, prim->upper_x, prim->upper_y, prim->upper_z};
+    const float pb[6] = {prim->lower_x, prim->lower_y, prim->lower_z,
+                         prim->upper_x, prim->upper_y, prim->upper_z};
     const float *t = src->tri + 9 * (size_t)prim->primID, *v[3];
     float l[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     float r[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
@@ -94,9 +95,15 @@ static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, flo
         const float *a = v[i], *b = v[i == 2 ? 0 : i + 1];
         float ad = a[dim], bd = b[dim];
         if (ad <= pos)
-            for (k = 0; k < 3; k++) { l[k] = min_f(l[k], a[k]); l[k + 3] = max_f(l[k + 3], a[k]); }
+            for (k = 0; k < 3; k++) {
+                l[k] = min_f(l[k], a[k]);
+                l[k + 3] = max_f(l[k + 3], a[k]);
+            }
         if (ad >= pos)
-            for (k = 0; k < 3; k++) { r[k] = min_f(r[k], a[k]); r[k + 3] = max_f(r[k + 3], a[k]); }
+            for (k = 0; k < 3; k++) {
+                r[k] = min_f(r[k], a[k]);
+                r[k + 3] = max_f(r[k + 3], a[k]);
+            }
         if ((ad < pos && bd > pos) || (ad > pos && bd < pos)) {
             float f = (pos - ad) / (bd - ad);
             for (k = 0; k < 3; k++) {
@@ -104,12 +111,14 @@ static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, flo
                 /* |error| <= a few ulps of the larger endpoint coordinate */
                 float e = 16.0f * FLT_EPSILON * max_f(fabsf(a[k]), fabsf(b[k])) + FLT_MIN;
                 float lo = k == (int)dim ? pos : x - e, hi = k == (int)dim ? pos : x + e;
-                l[k] = min_f(l[k], lo); l[k + 3] = max_f(l[k + 3], hi);
-                r[k] = min_f(r[k], lo); r[k + 3] = max_f(r[k + 3], hi);
+                l[k] = min_f(l[k], lo);
+                l[k + 3] = max_f(l[k + 3], hi);
+                r[k] = min_f(r[k], lo);
+                r[k + 3] = max_f(r[k + 3], hi);
             }
         }
     }
-    for (k = 0; k < 3; k++) {   /* clip to the reference's box */
+    for (k = 0; k < 3; k++) { /* clip to the reference's box */
         l[k] = max_f(l[k], pb[k]);
         l[k + 3] = min_f(l[k + 3], pb[k + 3]);
         r[k] = max_f(r[k], pb[k]);
@@ -129,10 +138,18 @@ static void cb_split(const struct RTCBuildPrimitive *prim, unsigned int dim, flo
         r[dim] = max_f(pos, pb[dim]);
         if (r[dim + 3] < r[dim]) r[dim + 3] = r[dim];
     }
-    lb->lower_x = l[0]; lb->lower_y = l[1]; lb->lower_z = l[2];
-    lb->upper_x = l[3]; lb->upper_y = l[4]; lb->upper_z = l[5];
-    rb->lower_x = r[0]; rb->lower_y = r[1]; rb->lower_z = r[2];
-    rb->upper_x = r[3]; rb->upper_y = r[4]; rb->upper_z = r[5];
+    lb->lower_x = l[0];
+    lb->lower_y = l[1];
+    lb->lower_z = l[2];
+    lb->upper_x = l[3];
+    lb->upper_y = l[4];
+    lb->upper_z = l[5];
+    rb->lower_x = r[0];
+    rb->lower_y = r[1];
+    rb->lower_z = r[2];
+    rb->upper_x = r[3];
+    rb->upper_y = r[4];
+    rb->upper_z = r[5];
 }
 
 /* ---- flattening ---- */
@@ -221,7 +238,8 @@ static int emit_items(flat_ctx *c, const build_leaf *l, uint32_t *first)
 }
 
 /* Children of a temporary node (a leaf at the root counts as a node with itself as only child). */
-static unsigned node_children(const void *p, const float root_box[6], const void **kid, float box[][6])
+static unsigned node_children(const void *p, const float root_box[6], const void **kid,
+                              float box[][6])
 {
     const build_node *b = p;
     unsigned i;
@@ -269,7 +287,7 @@ static int flatten_node4(flat_ctx *c, const void *p, uint32_t index, const float
         c->fail = "the builder made a node wider than 4";
         return 0;
     }
-    if (c->instances) {   /* slots by increasing area (inner children are sorted by distance anyway) */
+    if (c->instances) { /* slots by increasing area (inner children are sorted by distance anyway) */
         const void *k2[MAX_WIDTH];
         float b2[MAX_WIDTH][6];
         unsigned order[MAX_WIDTH];
@@ -290,8 +308,12 @@ static int flatten_node4(flat_ctx *c, const void *p, uint32_t index, const float
     for (i = 0; i < n; i++) {
         const build_leaf *l = kid[i];
         uint32_t at;
-        nd.lo_x[i] = box[i][0]; nd.lo_y[i] = box[i][1]; nd.lo_z[i] = box[i][2];
-        nd.hi_x[i] = box[i][3]; nd.hi_y[i] = box[i][4]; nd.hi_z[i] = box[i][5];
+        nd.lo_x[i] = box[i][0];
+        nd.lo_y[i] = box[i][1];
+        nd.lo_z[i] = box[i][2];
+        nd.hi_x[i] = box[i][3];
+        nd.hi_y[i] = box[i][4];
+        nd.hi_z[i] = box[i][5];
         if (l->leaf) {
             if (l->n == 0 || l->n > 0x7fffffffu || !emit_items(c, l, &at)) {
                 c->fail = "out of memory";
@@ -326,7 +348,8 @@ static int quant_exponent(float p, float hi)
     return e;
 }
 
-static int quantize_node8(evr_gpu_node8 *nd, float box[][6], const int *slot_kid, const float pbox[6])
+static int quantize_node8(evr_gpu_node8 *nd, float box[][6], const int *slot_kid,
+                          const float pbox[6])
 {
     int a, s;
     for (a = 0; a < 3; a++) {
@@ -389,9 +412,11 @@ static int flatten_node8(flat_ctx *c, const void *p, uint32_t index, const float
      * the octant's direction; greedy over the cheapest (child, slot) pairs. */
     for (i = 0; i < n; i++) {
         float d[3];
-        for (a = 0; a < 3; a++) d[a] = 0.5f * (box[i][a] + box[i][a + 3]) - 0.5f * (pbox[a] + pbox[a + 3]);
+        for (a = 0; a < 3; a++)
+            d[a] = 0.5f * (box[i][a] + box[i][a + 3]) - 0.5f * (pbox[a] + pbox[a + 3]);
         for (s = 0; s < 8; s++)
-            cost[i][s] = ((s & 1) ? -d[0] : d[0]) + ((s & 2) ? -d[1] : d[1]) + ((s & 4) ? -d[2] : d[2]);
+            cost[i][s] =
+                ((s & 1) ? -d[0] : d[0]) + ((s & 2) ? -d[1] : d[1]) + ((s & 4) ? -d[2] : d[2]);
         kid_slot[i] = -1;
     }
     for (s = 0; s < 8; s++) slot_kid[s] = -1;
@@ -427,7 +452,7 @@ static int flatten_node8(flat_ctx *c, const void *p, uint32_t index, const float
         for (i = 0, s = 0; s < 8; s++)
             if (slot_kid[s] >= 0) leaf_order[i++] = slot_kid[s];
     }
-    for (i = 0; i < n; i++) {   /* leaves */
+    for (i = 0; i < n; i++) { /* leaves */
         const build_leaf *l = kid[leaf_order[i]];
         uint32_t at;
         if (!l->leaf) continue;
@@ -442,7 +467,7 @@ static int flatten_node8(flat_ctx *c, const void *p, uint32_t index, const float
         nd.meta[kid_slot[leaf_order[i]]] = (uint8_t)((unary[l->n] << 5) | next_item_offset);
         next_item_offset += l->n;
     }
-    for (s = 0; s < 8; s++) {   /* inner children */
+    for (s = 0; s < 8; s++) { /* inner children */
         const build_leaf *l;
         k = slot_kid[s];
         if (k < 0) continue;
@@ -527,9 +552,10 @@ struct RTCBuildPrimitive *evr_gpu_tree_prims(size_t n)
 }
 
 /* Runs Embree's builder over prims[0..n) (capacity cap) and flattens the result. */
-evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimitive *prims, size_t n, size_t cap,
-                              enum RTCBuildQuality quality, unsigned max_leaf, split_source *split,
-                              const float root_box[6], uint32_t *root_index, evr_error *err)
+evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimitive *prims, size_t n,
+                              size_t cap, enum RTCBuildQuality quality, unsigned max_leaf,
+                              split_source *split, const float root_box[6], uint32_t *root_index,
+                              evr_error *err)
 {
     struct RTCBuildArguments args = rtcDefaultBuildArguments();
     RTCBVH bvh = rtcNewBVH(dev);

@@ -36,8 +36,8 @@
 
 typedef struct {
     float t, u, v;
-    int instance;          /* scene instance index */
-    uint32_t prim;         /* triangle index in the instance's mesh */
+    int instance;  /* scene instance index */
+    uint32_t prim; /* triangle index in the instance's mesh */
 } evr_gpu_hit;
 
 #ifdef __CUDA_ARCH__
@@ -66,7 +66,10 @@ typedef struct {
 
 EVR_HD static inline float evr__minf(float a, float b) { return a < b ? a : b; }
 EVR_HD static inline float evr__maxf(float a, float b) { return a > b ? a : b; }
-EVR_HD static inline float evr__sel3(float x, float y, float z, int k) { return k == 0 ? x : (k == 1 ? y : z); }
+EVR_HD static inline float evr__sel3(float x, float y, float z, int k)
+{
+    return k == 0 ? x : (k == 1 ? y : z);
+}
 
 /* 1/d, with |d| raised to 1e-18 first (no infinities, no 0 * inf in the slab test) */
 EVR_HD static inline float evr__rcp_safe(float d)
@@ -75,7 +78,7 @@ EVR_HD static inline float evr__rcp_safe(float d)
     return 1.0f / a;
 }
 
-EVR_HD static inline int evr__msb(uint32_t x)   /* x != 0 */
+EVR_HD static inline int evr__msb(uint32_t x) /* x != 0 */
 {
 #ifdef __CUDA_ARCH__
     return 31 - __clz((int)x);
@@ -139,18 +142,22 @@ EVR_HD static inline float evr__shear(float a, float s, float b)
 
 typedef struct {
     float ox, oy, oz, dx, dy, dz;
-    float ix, iy, iz;          /* safe reciprocals of the direction */
-    int kx, ky, kz;            /* watertight test: kz the dominant axis */
-    float sx, sy, sz;          /* its shear */
-    int oct_inv;               /* CW8: 7 - octant of the direction */
+    float ix, iy, iz; /* safe reciprocals of the direction */
+    int kx, ky, kz;   /* watertight test: kz the dominant axis */
+    float sx, sy, sz; /* its shear */
+    int oct_inv;      /* CW8: 7 - octant of the direction */
 } evr__tray;
 
 EVR_HD static inline void evr__tray_init(evr__tray *r, evr_v3 o, evr_v3 d)
 {
     float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z), dz;
     int kx, ky, kz, t;
-    r->ox = o.x; r->oy = o.y; r->oz = o.z;
-    r->dx = d.x; r->dy = d.y; r->dz = d.z;
+    r->ox = o.x;
+    r->oy = o.y;
+    r->oz = o.z;
+    r->dx = d.x;
+    r->dy = d.y;
+    r->dz = d.z;
     r->ix = evr__rcp_safe(d.x);
     r->iy = evr__rcp_safe(d.y);
     r->iz = evr__rcp_safe(d.z);
@@ -158,8 +165,14 @@ EVR_HD static inline void evr__tray_init(evr__tray *r, evr_v3 o, evr_v3 d)
     kx = kz == 2 ? 0 : kz + 1;
     ky = kx == 2 ? 0 : kx + 1;
     dz = evr__sel3(d.x, d.y, d.z, kz);
-    if (dz < 0.0f) { t = kx; kx = ky; ky = t; }   /* keeps the winding */
-    r->kx = kx; r->ky = ky; r->kz = kz;
+    if (dz < 0.0f) {
+        t = kx;
+        kx = ky;
+        ky = t;
+    } /* keeps the winding */
+    r->kx = kx;
+    r->ky = ky;
+    r->kz = kz;
     r->sx = evr__sel3(d.x, d.y, d.z, kx) / dz;
     r->sy = evr__sel3(d.x, d.y, d.z, ky) / dz;
     r->sz = 1.0f / dz;
@@ -168,44 +181,47 @@ EVR_HD static inline void evr__tray_init(evr__tray *r, evr_v3 o, evr_v3 d)
 
 /* Slab test of a box given by its planes nearest to the ray's origin (n) and farthest from it (f)
  * on each axis: entry distance in *tn when the ray's [tnear, tfar] meets it. */
-EVR_HD static inline int evr__slab(const evr__tray *r, float nx, float ny, float nz, float fx, float fy, float fz,
-                                   float tnear, float tfar, float *tn)
+EVR_HD static inline int evr__slab(const evr__tray *r, float nx, float ny, float nz, float fx,
+                                   float fy, float fz, float tnear, float tfar, float *tn)
 {
     const float tnx = (nx - r->ox) * r->ix, tny = (ny - r->oy) * r->iy, tnz = (nz - r->oz) * r->iz;
     const float tfx = (fx - r->ox) * r->ix, tfy = (fy - r->oy) * r->iy, tfz = (fz - r->oz) * r->iz;
     float a = evr__maxf(evr__maxf(tnx, tny), evr__maxf(tnz, tnear));
-    float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN), evr__minf(tfz * EVR__BOX_WIDEN, tfar));
+    float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN),
+                        evr__minf(tfz * EVR__BOX_WIDEN, tfar));
     *tn = a;
     return a <= b;
 }
 
 /* Slab test of the box [lo, hi]: entry distance in *tn when the ray's [tnear, tfar] meets it. */
-EVR_HD static inline int evr__box(const evr__tray *r, float lox, float loy, float loz, float hix, float hiy,
-                                  float hiz, float tnear, float tfar, float *tn)
+EVR_HD static inline int evr__box(const evr__tray *r, float lox, float loy, float loz, float hix,
+                                  float hiy, float hiz, float tnear, float tfar, float *tn)
 {
-    return evr__slab(r, r->ix >= 0.0f ? lox : hix, r->iy >= 0.0f ? loy : hiy, r->iz >= 0.0f ? loz : hiz,
-                     r->ix >= 0.0f ? hix : lox, r->iy >= 0.0f ? hiy : loy, r->iz >= 0.0f ? hiz : loz, tnear, tfar, tn);
+    return evr__slab(r, r->ix >= 0.0f ? lox : hix, r->iy >= 0.0f ? loy : hiy,
+                     r->iz >= 0.0f ? loz : hiz, r->ix >= 0.0f ? hix : lox,
+                     r->iy >= 0.0f ? hiy : loy, r->iz >= 0.0f ? hiz : loz, tnear, tfar, tn);
 }
 
 /* Watertight ray/triangle test (two-sided): t in (tnear, tfar], barycentrics as Embree's. */
-EVR_HD static inline int evr__tri(const evr__tray *r, const evr_gpu_tri *tri, float tnear, float tfar, float *t_out,
-                                  float *u_out, float *v_out)
+EVR_HD static inline int evr__tri(const evr__tray *r, const evr_gpu_tri *tri, float tnear,
+                                  float tfar, float *t_out, float *u_out, float *v_out)
 {
     float a0 = tri->v0[0] - r->ox, a1 = tri->v0[1] - r->oy, a2 = tri->v0[2] - r->oz;
     float b0 = tri->v1[0] - r->ox, b1 = tri->v1[1] - r->oy, b2 = tri->v1[2] - r->oz;
     float c0 = tri->v2[0] - r->ox, c1 = tri->v2[1] - r->oy, c2 = tri->v2[2] - r->oz;
-    float akz = evr__sel3(a0, a1, a2, r->kz), bkz = evr__sel3(b0, b1, b2, r->kz), ckz = evr__sel3(c0, c1, c2, r->kz);
+    float akz = evr__sel3(a0, a1, a2, r->kz), bkz = evr__sel3(b0, b1, b2, r->kz),
+          ckz = evr__sel3(c0, c1, c2, r->kz);
     float ax = evr__shear(evr__sel3(a0, a1, a2, r->kx), r->sx, akz);
     float ay = evr__shear(evr__sel3(a0, a1, a2, r->ky), r->sy, akz);
     float bx = evr__shear(evr__sel3(b0, b1, b2, r->kx), r->sx, bkz);
     float by = evr__shear(evr__sel3(b0, b1, b2, r->ky), r->sy, bkz);
     float cx = evr__shear(evr__sel3(c0, c1, c2, r->kx), r->sx, ckz);
     float cy = evr__shear(evr__sel3(c0, c1, c2, r->ky), r->sy, ckz);
-    float u = evr__cross2(cx, by, cy, bx);   /* weight of v0 */
-    float v = evr__cross2(ax, cy, ay, cx);   /* weight of v1 */
-    float w = evr__cross2(bx, ay, by, ax);   /* weight of v2 */
+    float u = evr__cross2(cx, by, cy, bx); /* weight of v0 */
+    float v = evr__cross2(ax, cy, ay, cx); /* weight of v1 */
+    float w = evr__cross2(bx, ay, by, ax); /* weight of v2 */
     float det, tt, adet;
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {   /* on an edge in float: decide exactly */
+    if (u == 0.0f || v == 0.0f || w == 0.0f) { /* on an edge in float: decide exactly */
         u = (float)((double)cx * (double)by - (double)cy * (double)bx);
         v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
         w = (float)((double)bx * (double)ay - (double)by * (double)ax);
@@ -223,30 +239,37 @@ EVR_HD static inline int evr__tri(const evr__tray *r, const evr_gpu_tri *tri, fl
     return 1;
 }
 
-typedef struct { uint32_t a, b; } evr__stack_entry;
+typedef struct {
+    uint32_t a, b;
+} evr__stack_entry;
 
 /* What a bottom-level search reports besides the distance. */
 typedef struct {
     uint32_t prim;
-    int32_t inst;          /* the triangle's instance field */
+    int32_t inst; /* the triangle's instance field */
     float u, v;
 } evr__tri_hit;
 
 /* ---- BVH4 ---- */
 
-#define EVR__CSWAP(i, j)                                                        \
-    do {                                                                        \
-        if (ct[j] < ct[i]) {                                                    \
-            float t_ = ct[i]; int c_ = ci[i];                                   \
-            ct[i] = ct[j]; ci[i] = ci[j]; ct[j] = t_; ci[j] = c_;               \
-        }                                                                       \
+#define EVR__CSWAP(i, j)      \
+    do {                      \
+        if (ct[j] < ct[i]) {  \
+            float t_ = ct[i]; \
+            int c_ = ci[i];   \
+            ct[i] = ct[j];    \
+            ci[i] = ci[j];    \
+            ct[j] = t_;       \
+            ci[j] = c_;       \
+        }                     \
     } while (0)
 
 /* Children of a BVH4 node that the ray meets, inner ones sorted by entry distance into
  * (ci, ct) (misses at +inf); leaves are handed back through leaf_first/leaf_count in slot
  * order (count 0: none). */
-EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r, float tnear, float tfar, int ci[4],
-                                     float ct[4], int leaf_first[4], uint32_t leaf_count[4])
+EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r, float tnear,
+                                     float tfar, int ci[4], float ct[4], int leaf_first[4],
+                                     uint32_t leaf_count[4])
 {
     int i;
     EVR__UNROLL
@@ -254,8 +277,8 @@ EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r,
         float tn;
         int c = n->child[i];
         uint32_t cnt = n->count[i];
-        int hit = c >= 0 && evr__box(r, n->lo_x[i], n->lo_y[i], n->lo_z[i], n->hi_x[i], n->hi_y[i], n->hi_z[i],
-                                     tnear, tfar, &tn);
+        int hit = c >= 0 && evr__box(r, n->lo_x[i], n->lo_y[i], n->lo_z[i], n->hi_x[i], n->hi_y[i],
+                                     n->hi_z[i], tnear, tfar, &tn);
         ci[i] = c;
         ct[i] = hit && cnt == 0 ? tn : INFINITY;
         leaf_first[i] = c;
@@ -270,9 +293,9 @@ EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r,
 
 /* Nearest (any != 0: first) triangle of one mesh in (tnear, *tfar]; shrinks *tfar. Uses the
  * stack above sp0. */
-EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
-                                    float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0,
-                                    evr__tri_hit *th)
+EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris, int root,
+                                    const evr__tray *r, float tnear, float *tfar, int any,
+                                    evr__stack_entry *stack, int sp0, evr__tri_hit *th)
 {
     int node = root, sp = sp0, found = 0;
     for (;;) {
@@ -322,7 +345,7 @@ EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tr
 
 /* ---- CW8 ---- */
 
-EVR_HD static inline float evr__exp2_biased(uint8_t e)   /* 2^(e - 127), e in 1..254 */
+EVR_HD static inline float evr__exp2_biased(uint8_t e) /* 2^(e - 127), e in 1..254 */
 {
     return evr__u2f((uint32_t)e << 23);
 }
@@ -350,13 +373,17 @@ EVR_HD static inline float evr__byte_float(uint64_t w, int i)
  * the ray's direction) and its eight quantized bytes read as one word; a child's box is then
  * p + q 2^e (one rounding: q 2^e is exact), as the build checked it, and the slab test is
  * evr__box's (evr__slab). */
-EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear, float tfar)
+EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear,
+                                         float tfar)
 {
-    const float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]), sz = evr__exp2_biased(n->e[2]);
+    const float sx = evr__exp2_biased(n->e[0]), sy = evr__exp2_biased(n->e[1]),
+                sz = evr__exp2_biased(n->e[2]);
     const float px = n->p[0], py = n->p[1], pz = n->p[2];
     const uint64_t meta = evr__node_word(n->meta);
-    const uint64_t lx = evr__node_word(n->qlo[0]), ly = evr__node_word(n->qlo[1]), lz = evr__node_word(n->qlo[2]);
-    const uint64_t hx = evr__node_word(n->qhi[0]), hy = evr__node_word(n->qhi[1]), hz = evr__node_word(n->qhi[2]);
+    const uint64_t lx = evr__node_word(n->qlo[0]), ly = evr__node_word(n->qlo[1]),
+                   lz = evr__node_word(n->qlo[2]);
+    const uint64_t hx = evr__node_word(n->qhi[0]), hy = evr__node_word(n->qhi[1]),
+                   hz = evr__node_word(n->qhi[2]);
     const uint64_t nx = r->ix >= 0.0f ? lx : hx, fx = r->ix >= 0.0f ? hx : lx;
     const uint64_t ny = r->iy >= 0.0f ? ly : hy, fy = r->iy >= 0.0f ? hy : ly;
     const uint64_t nz = r->iz >= 0.0f ? lz : hz, fz = r->iz >= 0.0f ? hz : lz;
@@ -370,7 +397,8 @@ EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray
         float tn;
         if (!evr__slab(r, px + evr__byte_float(nx, i) * sx, py + evr__byte_float(ny, i) * sy,
                        pz + evr__byte_float(nz, i) * sz, px + evr__byte_float(fx, i) * sx,
-                       py + evr__byte_float(fy, i) * sy, pz + evr__byte_float(fz, i) * sz, tnear, tfar, &tn))
+                       py + evr__byte_float(fy, i) * sy, pz + evr__byte_float(fz, i) * sz, tnear,
+                       tfar, &tn))
             continue;
         idx = m & 31u;
         if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
@@ -398,9 +426,9 @@ EVR_HD static inline uint32_t evr__group_next(uint32_t *base, uint32_t *hits, co
     return index;
 }
 
-EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
-                                    float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0,
-                                    evr__tri_hit *th)
+EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root,
+                                    const evr__tray *r, float tnear, float *tfar, int any,
+                                    evr__stack_entry *stack, int sp0, evr__tri_hit *th)
 {
     uint32_t ng_base = (uint32_t)root, ng_hits = 0x80000000u, tg_base = 0, tg_hits = 0;
     int sp = sp0, found = 0;
@@ -442,9 +470,10 @@ EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tr
 
 /* Searches one group with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
  * and fills hit (when not NULL). */
-EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
-                                       evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
-                                       evr__stack_entry *stack, int sp, evr_gpu_hit *hit)
+EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                                       const evr_gpu_inst *in, evr_v3 o, evr_v3 d, float f,
+                                       float tnear, float *tfar, int any, evr__stack_entry *stack,
+                                       int sp, evr_gpu_hit *hit)
 {
     evr_m34 inv;
     evr_v3 oo, od;
@@ -459,15 +488,14 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
     }
     oo = evr_m34_point(&inv, o);
     od = evr_m34_vector(&inv, d);
-    if (od.x == 0.0f && od.y == 0.0f && od.z == 0.0f) return 0;   /* a zero scale: nothing there */
+    if (od.x == 0.0f && od.y == 0.0f && od.z == 0.0f) return 0; /* a zero scale: nothing there */
     evr__tray_init(&r, oo, od);
     th.prim = 0;
     th.inst = 0;
     th.u = th.v = 0.0f;
     if (v->layout == EVR_GPU_LAYOUT_CW8)
         found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
-    else
-        found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
+    else found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
     if (found && hit) {
         hit->t = *tfar;
         hit->u = th.u;
@@ -486,11 +514,14 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
 #define EVR_GROUPS_STATIC 2
 EVR_HD static inline int evr__group_skipped(const evr_gpu_inst *in, int groups)
 {
-    return groups == EVR_GROUPS_MOVING ? in->track < 0 : groups == EVR_GROUPS_STATIC ? in->track >= 0 : 0;
+    return groups == EVR_GROUPS_MOVING   ? in->track < 0
+           : groups == EVR_GROUPS_STATIC ? in->track >= 0
+                                         : 0;
 }
 
-EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
-                                     float tfar, float f, int any, evr_gpu_hit *hit, int groups)
+EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                                     evr_ray ray, float tnear, float tfar, float f, int any,
+                                     evr_gpu_hit *hit, int groups)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -504,8 +535,8 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
         for (i = 0; i < 4; i++) {
             for (k = 0; k < lc[i]; k++) {
                 if (evr__group_skipped(&v->insts[(uint32_t)lf[i] + k], groups)) continue;
-                if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear, &tfar, any,
-                                  stack, sp, hit)) {
+                if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear,
+                                  &tfar, any, stack, sp, hit)) {
                     found = 1;
                     if (any) return 1;
                 }
@@ -535,8 +566,9 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
     return found;
 }
 
-EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
-                                     float tfar, float f, int any, evr_gpu_hit *hit, int groups)
+EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                                     evr_ray ray, float tnear, float tfar, float f, int any,
+                                     evr_gpu_hit *hit, int groups)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -556,8 +588,8 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
             int bit = evr__msb(tg_hits);
             tg_hits &= ~(1u << bit);
             if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
-            if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear, &tfar, any, stack,
-                              sp, hit)) {
+            if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear,
+                              &tfar, any, stack, sp, hit)) {
                 found = 1;
                 if (any) return 1;
             }
@@ -575,27 +607,30 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
 /* The nearest hit among some groups only (EVR_GROUPS_*), nearer than tmax (ties go to tmax).
  * The nearest hit of all groups is the static group's unless the others have one nearer (what
  * a camera ray's static hit, kept per pixel while the camera holds still, saves). */
-EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
+EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v,
+                                                  const evr_render_scene *rs, evr_ray ray,
                                                   float tmax, float f, int groups, evr_gpu_hit *hit)
 {
     if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
+    if (v->layout == EVR_GPU_LAYOUT_CW8)
+        return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
     return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
 }
 
 /* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
-EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
-                                           float tmax, float f, evr_gpu_hit *hit)
+EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                                           evr_ray ray, float tmax, float f, evr_gpu_hit *hit)
 {
     return evr_trace_closest_groups(v, rs, ray, tmax, f, EVR_GROUPS_ALL, hit);
 }
 
 /* Whether anything lies along the world ray in (tnear, tfar] at time f (stops at the first hit). */
-EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray,
-                                       float tnear, float tfar, float f)
+EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                                       evr_ray ray, float tnear, float tfar, float f)
 {
     if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8) return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
+    if (v->layout == EVR_GPU_LAYOUT_CW8)
+        return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
     return evr__trace4(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
 }
 

@@ -74,15 +74,16 @@ void evr_chunk_worker_free(evr_chunk_worker *w)
 
 /* The shuffle for one element size: es is a constant where it is inlined, so the inner loop is
  * unrolled. One pass over the source writes es output streams. */
-static inline void shuffle_es(unsigned char *out, const unsigned char *src, size_t stride, size_t count,
-                              size_t chunk_elems, size_t es)
+static inline void shuffle_es(unsigned char *out, const unsigned char *src, size_t stride,
+                              size_t count, size_t chunk_elems, size_t es)
 {
     for (size_t i = 0; i < count; i++) {
         const unsigned char *e = src + i * stride;
         for (size_t b = 0; b < es; b++) out[b * chunk_elems + i] = e[b];
     }
     if (count < chunk_elems)
-        for (size_t b = 0; b < es; b++) memset(out + b * chunk_elems + count, 0, chunk_elems - count);
+        for (size_t b = 0; b < es; b++)
+            memset(out + b * chunk_elems + count, 0, chunk_elems - count);
 }
 
 /* Whether p[0 .. n), of which `repeats` bytes equal the one before them (the runs deflate would
@@ -90,7 +91,7 @@ static inline void shuffle_es(unsigned char *out, const unsigned char *src, size
  * (order-0 entropy of its histogram). */
 static int plane_random(const unsigned char *p, size_t n, size_t repeats)
 {
-    uint32_t h[4][256] = {{0}};   /* four histograms: no store waits on the one before */
+    uint32_t h[4][256] = {{0}}; /* four histograms: no store waits on the one before */
     size_t i = 0;
     if (n < 2 || repeats * STORE_REPEATS > n) return 0;
     for (; i + 4 <= n; i += 4) {
@@ -113,23 +114,25 @@ static int plane_random(const unsigned char *p, size_t n, size_t repeats)
  * on a byte, so that the rest follows them as the stream's last blocks, a block of runs when the
  * rest is mostly runs, else libdeflate's raw deflate stream; then the Adler-32 of all of raw.
  * Returns its length, 0 when out of room. */
-static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned char *raw, size_t n, size_t es,
-                          unsigned char *dst, size_t room)
+static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned char *raw, size_t n,
+                          size_t es, unsigned char *dst, size_t room)
 {
     size_t stored = 0, at = 2, total = n * es, rest_repeats = 0;
-    for (size_t j = 0; j < es; j++) {   /* each plane's repeats, counted once */
+    for (size_t j = 0; j < es; j++) { /* each plane's repeats, counted once */
         const size_t r = evr_deflate_repeats(raw + j * n, n);
         if (j == stored && j + 1 < es && plane_random(raw + j * n, n, r)) stored++;
-        else rest_repeats += r + (j > stored && raw[j * n] == raw[j * n - 1]);   /* and across planes */
+        else
+            rest_repeats +=
+                r + (j > stored && raw[j * n] == raw[j * n - 1]); /* and across planes */
     }
     if (room < 6) return 0;
-    dst[0] = 0x78;   /* deflate, 32 KiB window */
-    dst[1] = 0x01;   /* no dictionary; (0x78 * 256 + 0x01) % 31 == 0 */
+    dst[0] = 0x78; /* deflate, 32 KiB window */
+    dst[1] = 0x01; /* no dictionary; (0x78 * 256 + 0x01) % 31 == 0 */
     for (size_t done = 0; done < stored * n;) {
         size_t len = stored * n - done;
         if (len > 65535) len = 65535;
         if (at + 5 + len > room) return 0;
-        dst[at++] = 0x00;   /* BFINAL 0, BTYPE 00 (stored), then padding to the byte */
+        dst[at++] = 0x00; /* BFINAL 0, BTYPE 00 (stored), then padding to the byte */
         dst[at++] = (unsigned char)(len & 0xff);
         dst[at++] = (unsigned char)(len >> 8);
         dst[at++] = (unsigned char)(~len & 0xff);
@@ -144,7 +147,9 @@ static size_t zlib_stream(struct libdeflate_compressor *comp, const unsigned cha
     size_t z = 0;
     if (rest_repeats * RUNS_REPEATS >= rest_n * (RUNS_REPEATS - 1))
         z = evr_deflate_runs(rest, rest_n, dst + at, room - at - 4);
-    if (z == 0) z = libdeflate_deflate_compress(comp, rest, rest_n, dst + at, room - at - 4);   /* else, or too long */
+    if (z == 0)
+        z = libdeflate_deflate_compress(comp, rest, rest_n, dst + at,
+                                        room - at - 4); /* else, or too long */
     if (z == 0) return 0;
     at += z;
     const uint32_t a = libdeflate_adler32(1, raw, total);
@@ -178,7 +183,8 @@ int evr_chunk_compress(evr_chunk_job *job, evr_chunk_worker *w)
     case 8: shuffle_es(scratch, src, job->stride, count, job->chunk_elems, 8); break;
     default: shuffle_es(scratch, src, job->stride, count, job->chunk_elems, job->elem_size); break;
     }
-    const size_t len = zlib_stream(w->comp, scratch, job->chunk_elems, job->elem_size, job->dst, evr_chunk_bound(raw));
+    const size_t len = zlib_stream(w->comp, scratch, job->chunk_elems, job->elem_size, job->dst,
+                                   evr_chunk_bound(raw));
     job->ok = len > 0;
     job->dst_size = len;
     return job->ok;
@@ -195,10 +201,12 @@ evr_chunk_pool *evr_chunk_pool_new(int threads, size_t max_chunk_bytes)
     evr_chunk_pool *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     p->par = evr_par_pool_new(threads);
-    p->threads = evr_par_pool_threads(p->par);   /* threads that cannot be started leave a smaller pool */
+    p->threads =
+        evr_par_pool_threads(p->par); /* threads that cannot be started leave a smaller pool */
     p->workers = calloc((size_t)p->threads, sizeof *p->workers);
     int ok = p->par && p->workers;
-    for (int i = 0; ok && i < p->threads; i++) ok = (p->workers[i] = evr_chunk_worker_new(max_chunk_bytes)) != NULL;
+    for (int i = 0; ok && i < p->threads; i++)
+        ok = (p->workers[i] = evr_chunk_worker_new(max_chunk_bytes)) != NULL;
     if (!ok) {
         evr_chunk_pool_free(p);
         return NULL;
@@ -230,15 +238,12 @@ int evr_chunk_pool_run(evr_chunk_pool *p, evr_chunk_job *jobs, size_t n)
     return evr_chunk_pool_wait(p);
 }
 
-int evr_chunk_pool_threads(const evr_chunk_pool *p)
-{
-    return p->threads;
-}
+int evr_chunk_pool_threads(const evr_chunk_pool *p) { return p->threads; }
 
 void evr_chunk_pool_free(evr_chunk_pool *p)
 {
     if (!p) return;
-    evr_par_pool_free(p->par);   /* finishes the parts it has started */
+    evr_par_pool_free(p->par); /* finishes the parts it has started */
     for (int i = 0; p->workers && i < p->threads; i++) evr_chunk_worker_free(p->workers[i]);
     free(p->workers);
     free(p);

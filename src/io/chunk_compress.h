@@ -27,16 +27,16 @@ extern "C" {
 
 typedef struct {
     /* in */
-    const void *src;        /* first element's bytes */
-    size_t stride;          /* bytes from one element to the next in src */
-    size_t elem_size;       /* bytes per element */
-    size_t count;           /* elements taken from src (at most chunk_elems) */
-    size_t chunk_elems;     /* elements in a chunk: the rest is zero */
-    int level;              /* libdeflate's compression level, 0 .. 12 */
-    unsigned char *dst;     /* room for evr_chunk_bound(chunk_elems * elem_size) bytes */
+    const void *src;    /* first element's bytes */
+    size_t stride;      /* bytes from one element to the next in src */
+    size_t elem_size;   /* bytes per element */
+    size_t count;       /* elements taken from src (at most chunk_elems) */
+    size_t chunk_elems; /* elements in a chunk: the rest is zero */
+    int level;          /* libdeflate's compression level, 0 .. 12 */
+    unsigned char *dst; /* room for evr_chunk_bound(chunk_elems * elem_size) bytes */
     /* out */
-    size_t dst_size;        /* compressed bytes */
-    int ok;                 /* 0: the compressor failed (out of memory) */
+    size_t dst_size; /* compressed bytes */
+    int ok;          /* 0: the compressor failed (out of memory) */
 } evr_chunk_job;
 
 typedef struct evr_chunk_pool evr_chunk_pool;
@@ -45,7 +45,7 @@ typedef struct evr_chunk_pool evr_chunk_pool;
  * compressor. NULL when out of memory. */
 typedef struct evr_chunk_worker evr_chunk_worker;
 evr_chunk_worker *evr_chunk_worker_new(size_t max_chunk_bytes);
-void evr_chunk_worker_free(evr_chunk_worker *w);   /* NULL is fine */
+void evr_chunk_worker_free(evr_chunk_worker *w); /* NULL is fine */
 
 /* Bytes that the compressed form of a chunk of raw_bytes bytes can take at most. */
 size_t evr_chunk_bound(size_t raw_bytes);

@@ -6,15 +6,17 @@
 #include <string.h>
 
 /* Lengths 3 .. 258 of a match: the symbol's base and its extra bits (RFC 1951, 3.2.5). */
-static const uint16_t len_base[29] = {3,  4,  5,  6,  7,  8,  9,  10, 11,  13,  15,  17,  19,  23, 27,
-                                      31, 35, 43, 51, 59, 67, 83, 99, 115, 131, 163, 195, 227, 258};
-static const uint8_t len_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
+static const uint16_t len_base[29] = {3,  4,  5,  6,   7,   8,   9,   10,  11, 13,
+                                      15, 17, 19, 23,  27,  31,  35,  43,  51, 59,
+                                      67, 83, 99, 115, 131, 163, 195, 227, 258};
+static const uint8_t len_extra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
+                                      2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
 
 typedef struct {
     unsigned char *p, *end;
-    uint64_t acc;   /* bits not yet written, the first in bit 0 */
+    uint64_t acc; /* bits not yet written, the first in bit 0 */
     int nbits;
-    int full;       /* dst ran out of room */
+    int full; /* dst ran out of room */
 } bit_writer;
 
 static inline void put_bits(bit_writer *w, uint32_t bits, int n)
@@ -51,10 +53,19 @@ static void make_fixed_codes(fixed_codes *c)
     for (int s = 0; s < 286; s++) {
         uint32_t code;
         int n;
-        if (s < 144) { code = 0x30u + (uint32_t)s; n = 8; }
-        else if (s < 256) { code = 0x190u + (uint32_t)(s - 144); n = 9; }
-        else if (s < 280) { code = (uint32_t)(s - 256); n = 7; }
-        else { code = 0xc0u + (uint32_t)(s - 280); n = 8; }
+        if (s < 144) {
+            code = 0x30u + (uint32_t)s;
+            n = 8;
+        } else if (s < 256) {
+            code = 0x190u + (uint32_t)(s - 144);
+            n = 9;
+        } else if (s < 280) {
+            code = (uint32_t)(s - 256);
+            n = 7;
+        } else {
+            code = 0xc0u + (uint32_t)(s - 280);
+            n = 8;
+        }
         c->code[s] = (uint16_t)reversed(code, n);
         c->len[s] = (uint8_t)n;
     }
@@ -72,7 +83,7 @@ static inline void put_match(bit_writer *w, const fixed_codes *c, int len)
     while (len_base[i] > len) i--;
     put_symbol(w, c, 257 + i);
     put_bits(w, (uint32_t)(len - len_base[i]), len_extra[i]);
-    put_bits(w, 0, 5);   /* distance 1: code 0 of the fixed 5-bit distance codes */
+    put_bits(w, 0, 5); /* distance 1: code 0 of the fixed 5-bit distance codes */
 }
 
 /* Bytes equal to b from src[i] on, at most n - i. */
@@ -93,11 +104,11 @@ static inline size_t run_from(const unsigned char *src, size_t i, size_t n, unsi
 size_t evr_deflate_runs(const unsigned char *src, size_t n, unsigned char *dst, size_t room)
 {
     bit_writer w = {dst, dst + room, 0, 0, 0};
-    fixed_codes c;   /* made per call: a few thousand operations against a chunk's scan */
+    fixed_codes c; /* made per call: a few thousand operations against a chunk's scan */
     size_t i = 0;
     make_fixed_codes(&c);
-    put_bits(&w, 1, 1);   /* BFINAL */
-    put_bits(&w, 1, 2);   /* BTYPE 01: fixed Huffman codes */
+    put_bits(&w, 1, 1); /* BFINAL */
+    put_bits(&w, 1, 2); /* BTYPE 01: fixed Huffman codes */
     while (i < n && !w.full) {
         const unsigned char b = src[i];
         put_symbol(&w, &c, b);
@@ -110,8 +121,8 @@ size_t evr_deflate_runs(const unsigned char *src, size_t n, unsigned char *dst, 
         }
         while (r--) put_symbol(&w, &c, b);
     }
-    put_symbol(&w, &c, 256);   /* end of block */
-    if (w.nbits > 0) put_bits(&w, 0, 8 - w.nbits);   /* to the byte */
+    put_symbol(&w, &c, 256);                       /* end of block */
+    if (w.nbits > 0) put_bits(&w, 0, 8 - w.nbits); /* to the byte */
     return w.full ? 0 : (size_t)(w.p - dst);
 }
 

@@ -41,10 +41,14 @@ evr_status evr_event_formats_parse(const char *opt, const char *text, int *out, 
             continue;
         }
         for (i = 0; i < NUM_FORMATS; i++)
-            if (!strcmp(tok, formats[i]->name) || (formats[i]->alias && !strcmp(tok, formats[i]->alias))) break;
+            if (!strcmp(tok, formats[i]->name) ||
+                (formats[i]->alias && !strcmp(tok, formats[i]->alias)))
+                break;
         if (i == NUM_FORMATS) {
-            for (i = 0; i < NUM_FORMATS; i++) len += (size_t)snprintf(names + len, sizeof names - len, "%s, ", formats[i]->name);
-            snprintf(err->msg, sizeof err->msg, "%s: unknown format '%s' (%sall; comma-separated)", opt, tok, names);
+            for (i = 0; i < NUM_FORMATS; i++)
+                len += (size_t)snprintf(names + len, sizeof names - len, "%s, ", formats[i]->name);
+            snprintf(err->msg, sizeof err->msg, "%s: unknown format '%s' (%sall; comma-separated)",
+                     opt, tok, names);
             return EVR_ERR_ARG;
         }
         f |= 1 << i;

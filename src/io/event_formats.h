@@ -9,11 +9,12 @@
 #include "io/event_writer.h"
 
 typedef struct {
-    const char *name;             /* --format name, and run.json's */
-    const char *alias;            /* another --format name, or NULL */
-    const char *file;             /* its file in the run folder */
-    evr_status (*open)(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
-    const char *help;             /* what the file is, in a few words */
+    const char *name;  /* --format name, and run.json's */
+    const char *alias; /* another --format name, or NULL */
+    const char *file;  /* its file in the run folder */
+    evr_status (*open)(const char *path, const evr_writer_meta *meta, evr_event_writer **out,
+                       evr_error *err);
+    const char *help; /* what the file is, in a few words */
 } evr_event_format;
 
 /* The formats, in bit order; *count is set to their number. */

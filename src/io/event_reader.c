@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define READ_BLOCK ((size_t)1 << 20)    /* events per block read from HDF5 and NPY files */
+#define READ_BLOCK ((size_t)1 << 20) /* events per block read from HDF5 and NPY files */
 
 static int ext_is(const char *path, const char *ext)
 {
@@ -94,7 +94,7 @@ static int parse_seconds(const char **sp, int64_t *out)
         }
     }
     if (!digits) return 0;
-    if (*s == 'e' || *s == 'E') {   /* rare: let strtod do it */
+    if (*s == 'e' || *s == 'E') { /* rare: let strtod do it */
         char *end;
         double v = strtod(*sp, &end);
         if (end == *sp || !isfinite(v) || fabs(v) > 9.2e12) return 0;
@@ -136,10 +136,15 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         long x, y, p;
         line++;
         s = skip_blanks(s);
-        if (*s == '\n' || *s == 0 || *s == '#') { s = next; continue; }
+        if (*s == '\n' || *s == 0 || *s == '#') {
+            s = next;
+            continue;
+        }
         if (!parse_seconds(&s, &t) || (s = skip_blanks(s), !parse_long(&s, &x)) ||
-            (s = skip_blanks(s), !parse_long(&s, &y)) || (s = skip_blanks(s), !parse_long(&s, &p)) ||
-            (s = skip_blanks(s), *s != '\n' && *s != 0) || x < 0 || x > 65535 || y < 0 || y > 65535) {
+            (s = skip_blanks(s), !parse_long(&s, &y)) ||
+            (s = skip_blanks(s), !parse_long(&s, &p)) ||
+            (s = skip_blanks(s), *s != '\n' && *s != 0) || x < 0 || x > 65535 || y < 0 ||
+            y > 65535) {
             snprintf(err->msg, sizeof err->msg, "%s:%zu: expected \"t x y p\"", path, line);
             st = EVR_ERR_FORMAT;
             goto done;
@@ -182,7 +187,7 @@ done:
 
 typedef struct {
     size_t offset;
-    int size;        /* bytes: 1, 2, 4 or 8 */
+    int size; /* bytes: 1, 2, 4 or 8 */
     int is_signed;
     int big_endian;
     int found;
@@ -210,7 +215,10 @@ static int npy_type(const char *t, npy_field *f)
 {
     f->big_endian = 0;
     if (*t == '<' || *t == '|' || *t == '=') t++;
-    else if (*t == '>') { f->big_endian = 1; t++; }
+    else if (*t == '>') {
+        f->big_endian = 1;
+        t++;
+    }
     if ((*t != 'i' && *t != 'u' && *t != 'b') || !t[1] || t[2]) return 0;
     f->is_signed = *t == 'i';
     f->size = t[1] - '0';
@@ -224,7 +232,8 @@ static int64_t npy_get(const unsigned char *rec, const npy_field *f)
         int shift = f->big_endian ? 8 * (f->size - 1 - b) : 8 * b;
         v |= (uint64_t)rec[f->offset + (size_t)b] << shift;
     }
-    if (f->is_signed && f->size < 8 && (v >> (8 * f->size - 1)) & 1) v |= ~(uint64_t)0 << (8 * f->size);
+    if (f->is_signed && f->size < 8 && (v >> (8 * f->size - 1)) & 1)
+        v |= ~(uint64_t)0 << (8 * f->size);
     return (int64_t)v;
 }
 
@@ -238,7 +247,7 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
 {
     char *data, *header = NULL;
     size_t size, hlen, start, itemsize = 0;
-    npy_field fields[4];             /* t, x, y, p */
+    npy_field fields[4]; /* t, x, y, p */
     static const char names[4] = {'t', 'x', 'y', 'p'};
     evr_event *out = NULL;
     uint64_t count = 0;
@@ -248,28 +257,50 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
 
     if (st != EVR_OK) return st;
     memset(fields, 0, sizeof fields);
-    if (size < 10 || memcmp(data, "\x93NUMPY", 6) != 0) { st = npy_bad(err, path, "no NumPy magic"); goto done; }
+    if (size < 10 || memcmp(data, "\x93NUMPY", 6) != 0) {
+        st = npy_bad(err, path, "no NumPy magic");
+        goto done;
+    }
     if (u[6] == 1) {
         hlen = (size_t)u[8] | (size_t)u[9] << 8;
         start = 10;
     } else if ((u[6] == 2 || u[6] == 3) && size >= 12) {
         hlen = (size_t)u[8] | (size_t)u[9] << 8 | (size_t)u[10] << 16 | (size_t)u[11] << 24;
         start = 12;
-    } else { st = npy_bad(err, path, "unknown format version"); goto done; }
-    if (hlen > size - start) { st = npy_bad(err, path, "truncated header"); goto done; }
+    } else {
+        st = npy_bad(err, path, "unknown format version");
+        goto done;
+    }
+    if (hlen > size - start) {
+        st = npy_bad(err, path, "truncated header");
+        goto done;
+    }
     header = malloc(hlen + 1);
-    if (!header) { snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path); st = EVR_ERR_NOMEM; goto done; }
+    if (!header) {
+        snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
+        st = EVR_ERR_NOMEM;
+        goto done;
+    }
     memcpy(header, data + start, hlen);
     header[hlen] = 0;
     start += hlen;
 
     /* descr: a list of ('name', 'type') pairs */
     s = strstr(header, "'descr'");
-    if (!s) { st = npy_bad(err, path, "no descr"); goto done; }
+    if (!s) {
+        st = npy_bad(err, path, "no descr");
+        goto done;
+    }
     s = skip_blanks(s + 7);
-    if (*s != ':') { st = npy_bad(err, path, "bad descr"); goto done; }
+    if (*s != ':') {
+        st = npy_bad(err, path, "bad descr");
+        goto done;
+    }
     s = skip_blanks(s + 1);
-    if (*s != '[') { st = npy_bad(err, path, "not a structured array"); goto done; }
+    if (*s != '[') {
+        st = npy_bad(err, path, "not a structured array");
+        goto done;
+    }
     s++;
     for (;;) {
         char name[64], type[16];
@@ -277,13 +308,19 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         s = skip_blanks(s);
         if (*s == ',') s = skip_blanks(s + 1);
         if (*s == ']') break;
-        if (*s != '(') { st = npy_bad(err, path, "bad descr"); goto done; }
+        if (*s != '(') {
+            st = npy_bad(err, path, "bad descr");
+            goto done;
+        }
         s = py_string(s + 1, name, sizeof name);
         if (s) s = skip_blanks(s);
         if (s && *s == ',') s = py_string(s + 1, type, sizeof type);
         else s = NULL;
         if (s) s = skip_blanks(s);
-        if (!s || *s != ')') { st = npy_bad(err, path, "unsupported field (nested or shaped)"); goto done; }
+        if (!s || *s != ')') {
+            st = npy_bad(err, path, "unsupported field (nested or shaped)");
+            goto done;
+        }
         s++;
         memset(&f, 0, sizeof f);
         int is_int = npy_type(type, &f);
@@ -292,12 +329,18 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
             const char *tt = type + (strchr("<>|=", type[0]) && type[0] ? 1 : 0);
             int sz = 0;
             if (tt[0] && isdigit((unsigned char)tt[1])) sz = atoi(tt + 1) * (tt[0] == 'U' ? 4 : 1);
-            if (sz <= 0) { st = npy_bad(err, path, "unknown field type"); goto done; }
+            if (sz <= 0) {
+                st = npy_bad(err, path, "unknown field type");
+                goto done;
+            }
             f.size = sz;
         }
         for (int k = 0; k < 4; k++) {
             if (name[0] == names[k] && name[1] == 0) {
-                if (!is_int) { st = npy_bad(err, path, "a field t, x, y or p is not an integer"); goto done; }
+                if (!is_int) {
+                    st = npy_bad(err, path, "a field t, x, y or p is not an integer");
+                    goto done;
+                }
                 fields[k] = f;
                 fields[k].offset = itemsize;
                 fields[k].found = 1;
@@ -306,33 +349,58 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         itemsize += (size_t)f.size;
     }
     for (int k = 0; k < 4; k++)
-        if (!fields[k].found) { st = npy_bad(err, path, "fields t, x, y, p missing"); goto done; }
+        if (!fields[k].found) {
+            st = npy_bad(err, path, "fields t, x, y, p missing");
+            goto done;
+        }
 
     s = strstr(header, "'shape'");
-    if (!s) { st = npy_bad(err, path, "no shape"); goto done; }
+    if (!s) {
+        st = npy_bad(err, path, "no shape");
+        goto done;
+    }
     s = skip_blanks(s + 7);
     if (*s == ':') s = skip_blanks(s + 1);
-    if (*s != '(') { st = npy_bad(err, path, "bad shape"); goto done; }
+    if (*s != '(') {
+        st = npy_bad(err, path, "bad shape");
+        goto done;
+    }
     s = skip_blanks(s + 1);
     {
         char *end;
         errno = 0;
         unsigned long long v = strtoull(s, &end, 10);
-        if (end == s || errno) { st = npy_bad(err, path, "shape is not 1-D"); goto done; }
+        if (end == s || errno) {
+            st = npy_bad(err, path, "shape is not 1-D");
+            goto done;
+        }
         s = skip_blanks(end);
         if (*s == ',') s = skip_blanks(s + 1);
-        if (*s != ')') { st = npy_bad(err, path, "shape is not 1-D"); goto done; }
+        if (*s != ')') {
+            st = npy_bad(err, path, "shape is not 1-D");
+            goto done;
+        }
         count = v;
     }
-    if (itemsize == 0 || count > (size - start) / itemsize) { st = npy_bad(err, path, "file shorter than its shape"); goto done; }
+    if (itemsize == 0 || count > (size - start) / itemsize) {
+        st = npy_bad(err, path, "file shorter than its shape");
+        goto done;
+    }
     if (count) {
         out = malloc((size_t)count * sizeof *out);
-        if (!out) { snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path); st = EVR_ERR_NOMEM; goto done; }
+        if (!out) {
+            snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
+            st = EVR_ERR_NOMEM;
+            goto done;
+        }
     }
     for (size_t i = 0; i < (size_t)count; i++) {
         const unsigned char *rec = u + start + i * itemsize;
         int64_t x = npy_get(rec, &fields[1]), y = npy_get(rec, &fields[2]);
-        if (x < 0 || x > 65535 || y < 0 || y > 65535) { st = npy_bad(err, path, "coordinate out of range"); goto done; }
+        if (x < 0 || x > 65535 || y < 0 || y > 65535) {
+            st = npy_bad(err, path, "coordinate out of range");
+            goto done;
+        }
         memset(&out[i], 0, sizeof out[i]);
         out[i].t = npy_get(rec, &fields[0]);
         out[i].x = (uint16_t)x;
@@ -353,13 +421,16 @@ done:
 
 /* ---- HDF5 ---- */
 
-typedef struct { char desc[200]; int got; } h5r_walk_data;
+typedef struct {
+    char desc[200];
+    int got;
+} h5r_walk_data;
 
 static herr_t h5r_walk(unsigned i, const H5E_error2_t *e, void *data)
 {
     h5r_walk_data *d = (h5r_walk_data *)data;
     (void)i;
-    if (!d->got && e->desc && e->desc[0]) {    /* keep the most specific one */
+    if (!d->got && e->desc && e->desc[0]) { /* keep the most specific one */
         snprintf(d->desc, sizeof d->desc, "%s", e->desc);
         d->got = 1;
     }
@@ -385,7 +456,9 @@ static int h5r_int_attr(hid_t file, const char *name)
         hid_t a = H5Aopen(file, name, H5P_DEFAULT);
         if (a >= 0) {
             hid_t space = H5Aget_space(a);
-            if (space >= 0 && H5Sget_simple_extent_npoints(space) == 1 && H5Aread(a, H5T_NATIVE_INT, &v) < 0) v = -1;
+            if (space >= 0 && H5Sget_simple_extent_npoints(space) == 1 &&
+                H5Aread(a, H5T_NATIVE_INT, &v) < 0)
+                v = -1;
             if (space >= 0) H5Sclose(space);
             H5Aclose(a);
         }
@@ -393,7 +466,8 @@ static int h5r_int_attr(hid_t file, const char *name)
     return v;
 }
 
-static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *width, int *height, evr_error *err)
+static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *width, int *height,
+                          evr_error *err)
 {
     static const char *const names[4] = {"events/x", "events/y", "events/t", "events/p"};
     hid_t file = -1, ds[4] = {-1, -1, -1, -1};
@@ -406,20 +480,32 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
     const char *what = NULL;
     int w = -1, h = -1;
 
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-        if (file < 0) { what = "cannot open as HDF5"; st = EVR_ERR_IO; }
+        if (file < 0) {
+            what = "cannot open as HDF5";
+            st = EVR_ERR_IO;
+        }
         for (int k = 0; k < 4 && st == EVR_OK; k++) {
             hid_t space;
             hsize_t dims[1];
             ds[k] = H5Dopen2(file, names[k], H5P_DEFAULT);
-            if (ds[k] < 0) { what = "no events/x, events/y, events/t, events/p datasets"; st = EVR_ERR_FORMAT; break; }
+            if (ds[k] < 0) {
+                what = "no events/x, events/y, events/t, events/p datasets";
+                st = EVR_ERR_FORMAT;
+                break;
+            }
             space = H5Dget_space(ds[k]);
-            if (space < 0 || H5Sget_simple_extent_ndims(space) != 1 || H5Sget_simple_extent_dims(space, dims, NULL) != 1) {
+            if (space < 0 || H5Sget_simple_extent_ndims(space) != 1 ||
+                H5Sget_simple_extent_dims(space, dims, NULL) != 1) {
                 what = "event datasets are not 1-D";
                 st = EVR_ERR_FORMAT;
             } else if (k == 0) count = dims[0];
-            else if (dims[0] != count) { what = "event datasets differ in length"; st = EVR_ERR_FORMAT; }
+            else if (dims[0] != count) {
+                what = "event datasets differ in length";
+                st = EVR_ERR_FORMAT;
+            }
             if (space >= 0) H5Sclose(space);
         }
         if (st == EVR_OK) {
@@ -428,7 +514,8 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
             H5Eclear2(H5E_DEFAULT);
             if (count) {
                 size_t block = count < READ_BLOCK ? (size_t)count : READ_BLOCK;
-                out = (size_t)count <= SIZE_MAX / sizeof *out ? malloc((size_t)count * sizeof *out) : NULL;
+                out = (size_t)count <= SIZE_MAX / sizeof *out ? malloc((size_t)count * sizeof *out)
+                                                              : NULL;
                 bx = malloc(block * sizeof *bx);
                 by = malloc(block * sizeof *by);
                 bt = malloc(block * sizeof *bt);
@@ -441,7 +528,8 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
         }
         for (hsize_t at = 0; st == EVR_OK && at < count; at += READ_BLOCK) {
             hsize_t start[1] = {at}, cnt[1] = {count - at < READ_BLOCK ? count - at : READ_BLOCK};
-            hid_t types[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64, H5T_NATIVE_INT8};
+            hid_t types[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64,
+                              H5T_NATIVE_INT8};
             void *bufs[4] = {bx, by, bt, bp};
             hid_t mspace = H5Screate_simple(1, cnt, NULL);
             for (int k = 0; k < 4 && st == EVR_OK; k++) {
@@ -469,13 +557,15 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
             if (ds[k] >= 0) H5Dclose(ds[k]);
         if (file >= 0) H5Fclose(file);
         H5Eclear2(H5E_DEFAULT);
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     free(bx);
     free(by);
     free(bt);
     free(bp);
     if (st != EVR_OK) {
-        if (st == EVR_ERR_NOMEM) snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
+        if (st == EVR_ERR_NOMEM)
+            snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
         free(out);
         return st;
     }
@@ -495,13 +585,21 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     const char *what = NULL;
     *idx = NULL;
     *n = 0;
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-        if (file < 0) { what = "cannot open as HDF5"; st = EVR_ERR_IO; }
-        if (st == EVR_OK && (ds = H5Dopen2(file, "ms_to_idx", H5P_DEFAULT)) < 0) { what = "no ms_to_idx dataset"; st = EVR_ERR_FORMAT; }
+        if (file < 0) {
+            what = "cannot open as HDF5";
+            st = EVR_ERR_IO;
+        }
+        if (st == EVR_OK && (ds = H5Dopen2(file, "ms_to_idx", H5P_DEFAULT)) < 0) {
+            what = "no ms_to_idx dataset";
+            st = EVR_ERR_FORMAT;
+        }
         if (st == EVR_OK) {
             space = H5Dget_space(ds);
-            if (space < 0 || H5Sget_simple_extent_ndims(space) != 1 || H5Sget_simple_extent_dims(space, dims, NULL) != 1) {
+            if (space < 0 || H5Sget_simple_extent_ndims(space) != 1 ||
+                H5Sget_simple_extent_dims(space, dims, NULL) != 1) {
                 what = "ms_to_idx is not 1-D";
                 st = EVR_ERR_FORMAT;
             }
@@ -519,9 +617,11 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
         if (ds >= 0) H5Dclose(ds);
         if (file >= 0) H5Fclose(file);
         H5Eclear2(H5E_DEFAULT);
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     if (st != EVR_OK) {
-        if (st == EVR_ERR_NOMEM) snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
+        if (st == EVR_ERR_NOMEM)
+            snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
         free(out);
         return st;
     }
@@ -530,7 +630,8 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     return EVR_OK;
 }
 
-evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height, evr_error *err)
+evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height,
+                           evr_error *err)
 {
     evr_status st;
     *ev = NULL;
@@ -545,7 +646,8 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
     if (ext_is(path, "txt")) st = read_txt(path, ev, n, err);
     else if (ext_is(path, "npy")) st = read_npy(path, ev, n, err);
     else {
-        snprintf(err->msg, sizeof err->msg, "%s: unknown event file type (expected .h5, .hdf5, .txt or .npy)", path);
+        snprintf(err->msg, sizeof err->msg,
+                 "%s: unknown event file type (expected .h5, .hdf5, .txt or .npy)", path);
         return EVR_ERR_ARG;
     }
     return st;

@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "evray.h"
-#include "evray_experimental.h"   /* evr_events_read */
+#include "evray_experimental.h" /* evr_events_read */
 
 /* Reads the ms_to_idx index of an HDF5 event file: (*idx)[i] is the index of the first event with
  * t >= i ms. *idx is malloc'ed (free() it). EVR_ERR_FORMAT when the file has no such index. */

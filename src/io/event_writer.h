@@ -32,8 +32,11 @@ typedef struct {
 } evr_writer_meta;
 
 /* path is the final name; writers write to path + ".tmp" until finish(). */
-evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
-evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
-evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err);
+evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out,
+                              evr_error *err);
+evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
+                               evr_event_writer **out, evr_error *err);
+evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
+                               evr_event_writer **out, evr_error *err);
 
 #endif

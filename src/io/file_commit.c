@@ -18,7 +18,8 @@ char *evr_file_tmp_name(const char *path)
 FILE *evr_file_create(const char *tmp, const char *who, evr_error *err)
 {
     FILE *f = fopen(tmp, "wb");
-    if (!f) snprintf(err->msg, sizeof err->msg, "%s: cannot create %s: %s", who, tmp, strerror(errno));
+    if (!f)
+        snprintf(err->msg, sizeof err->msg, "%s: cannot create %s: %s", who, tmp, strerror(errno));
     return f;
 }
 
@@ -28,7 +29,8 @@ void evr_file_discard(FILE *f, const char *tmp)
     remove(tmp);
 }
 
-evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st, const char *who, evr_error *err)
+evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st,
+                           const char *who, evr_error *err)
 {
     int closed = fclose(f) == 0;
     if (st == EVR_OK && !closed) {

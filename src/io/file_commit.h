@@ -17,6 +17,7 @@ void evr_file_discard(FILE *f, const char *tmp);
 
 /* st is the status so far (an earlier failure keeps its message); who names the writer in
  * messages. Returns the final status. */
-evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st, const char *who, evr_error *err);
+evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st,
+                           const char *who, evr_error *err);
 
 #endif

@@ -31,12 +31,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define H5W_CHUNK (1u << 16)     /* elements per chunk */
+#define H5W_CHUNK (1u << 16) /* elements per chunk */
 #define H5W_MS_CHUNK 4096u
-#define H5W_DEFLATE 1   /* libdeflate's level 1: smaller than zlib's level 3 and 2-3x faster (chunk_compress.c) */
-#define H5W_MAX_THREADS 16       /* compression threads, the caller included */
-#define H5W_MIN_BATCH 4          /* chunks staged before they are stored, at least */
-#define H5W_COLUMNS 4            /* t, x, y, p: the largest elements first */
+#define H5W_DEFLATE \
+    1 /* libdeflate's level 1: smaller than zlib's level 3 and 2-3x faster (chunk_compress.c) */
+#define H5W_MAX_THREADS 16 /* compression threads, the caller included */
+#define H5W_MIN_BATCH 4    /* chunks staged before they are stored, at least */
+#define H5W_COLUMNS 4      /* t, x, y, p: the largest elements first */
 /* Staging (checking and copying arriving events, finding the millisecond index) on this many
  * threads, the writer's included: alone it was most of the writer thread's time and bound by
  * one core's memory bandwidth (the eye's 218.7 M events: 0.8 of 1.15 s busy, H100 machine) */
@@ -52,16 +53,16 @@ typedef struct {
 } h5_set;
 
 typedef struct {
-    evr_event_writer base;       /* first: the interface pointer is the writer pointer */
+    evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     hid_t file, group;
     hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
     /* staged events, from dataset index written on (p already 0 or 1), in set[fill].stage */
-    size_t nstage, cap_stage;    /* cap_stage: a whole number of chunks */
-    uint64_t written;            /* events in full chunks stored (a multiple of H5W_CHUNK) */
-    uint64_t tail_stored;        /* events of the partial chunk at written stored by a flush */
-    uint64_t extent;             /* length of the event datasets */
-    uint64_t total;              /* events received (written + staged) */
+    size_t nstage, cap_stage; /* cap_stage: a whole number of chunks */
+    uint64_t written;         /* events in full chunks stored (a multiple of H5W_CHUNK) */
+    uint64_t tail_stored;     /* events of the partial chunk at written stored by a flush */
+    uint64_t extent;          /* length of the event datasets */
+    uint64_t total;           /* events received (written + staged) */
     /* compression: one job per column and chunk, each with its output room in zbuf; two sets,
      * set[fill] staging, the other compressing (inflight) a full batch from dataset index
      * inflight_at */
@@ -70,25 +71,28 @@ typedef struct {
     h5_set set[2];
     int fill, inflight;
     uint64_t inflight_at;
-    size_t batch;                /* chunks in a full stage */
+    size_t batch; /* chunks in a full stage */
     int64_t last_t;
     int have_last;
-    int t32;                     /* events/t is uint32 (else int64) */
+    int t32; /* events/t is uint32 (else int64) */
     /* ms_to_idx entries computed but not yet appended */
     uint64_t *ms;
     size_t nms, cap_ms;
-    uint64_t ms_written;         /* entries in the dataset */
-    uint64_t next_ms;            /* index of the next entry to compute */
+    uint64_t ms_written; /* entries in the dataset */
+    uint64_t next_ms;    /* index of the next entry to compute */
 } h5_writer;
 
 /* Collects the most specific HDF5 error description (the walk starts where the error arose). */
-typedef struct { char desc[200]; int got; } h5_walk_data;
+typedef struct {
+    char desc[200];
+    int got;
+} h5_walk_data;
 
 static herr_t h5_walk(unsigned n, const H5E_error2_t *e, void *data)
 {
     h5_walk_data *d = (h5_walk_data *)data;
     (void)n;
-    if (!d->got && e->desc && e->desc[0]) {    /* keep the most specific one */
+    if (!d->got && e->desc && e->desc[0]) { /* keep the most specific one */
         snprintf(d->desc, sizeof d->desc, "%s", e->desc);
         d->got = 1;
     }
@@ -131,14 +135,16 @@ static herr_t append(hid_t ds, hid_t mtype, const void *data, uint64_t old, size
     if (H5Dset_extent(ds, size) < 0) return -1;
     fspace = H5Dget_space(ds);
     mspace = H5Screate_simple(1, count, NULL);
-    if (fspace >= 0 && mspace >= 0 && H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, count, NULL) >= 0)
+    if (fspace >= 0 && mspace >= 0 &&
+        H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, count, NULL) >= 0)
         r = H5Dwrite(ds, mtype, mspace, fspace, H5P_DEFAULT, data);
     if (mspace >= 0) H5Sclose(mspace);
     if (fspace >= 0) H5Sclose(fspace);
     return r;
 }
 
-static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, const void *value)
+static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
+                                const void *value)
 {
     hid_t space = H5Screate(H5S_SCALAR), a = -1;
     herr_t r = -1;
@@ -162,7 +168,8 @@ static herr_t write_string_attr(hid_t loc, const char *name, const char *text)
     return r;
 }
 
-static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid_t mtype, const void *value)
+static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
+                                   const void *value)
 {
     hid_t space = H5Screate(H5S_SCALAR), ds = -1;
     herr_t r = -1;
@@ -176,13 +183,24 @@ static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid
 static void close_all(h5_writer *w)
 {
     hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms};
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
-            if (*ids[i] >= 0) { H5Dclose(*ids[i]); *ids[i] = -1; }
-        if (w->group >= 0) { H5Gclose(w->group); w->group = -1; }
-        if (w->file >= 0) { H5Fclose(w->file); w->file = -1; }
+            if (*ids[i] >= 0) {
+                H5Dclose(*ids[i]);
+                *ids[i] = -1;
+            }
+        if (w->group >= 0) {
+            H5Gclose(w->group);
+            w->group = -1;
+        }
+        if (w->file >= 0) {
+            H5Fclose(w->file);
+            w->file = -1;
+        }
         H5Eclear2(H5E_DEFAULT);
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
 }
 
 static void free_writer(h5_writer *w)
@@ -225,14 +243,15 @@ static int push_ms(h5_writer *w, uint64_t value)
  * uint32 t is the low four bytes of evr_event's int64 (little-endian, as the datasets). */
 static size_t column_size(const h5_writer *w, int c)
 {
-    static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t), sizeof(int8_t)};
+    static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t),
+                                             sizeof(int8_t)};
     return c == 0 && w->t32 ? sizeof(uint32_t) : size[c];
 }
 
 static size_t column_offset(int c)
 {
-    static const size_t off[H5W_COLUMNS] = {offsetof(evr_event, t), offsetof(evr_event, x), offsetof(evr_event, y),
-                                            offsetof(evr_event, p)};
+    static const size_t off[H5W_COLUMNS] = {offsetof(evr_event, t), offsetof(evr_event, x),
+                                            offsetof(evr_event, y), offsetof(evr_event, p)};
     return off[c];
 }
 
@@ -274,12 +293,13 @@ static size_t make_jobs(const h5_writer *w, h5_set *set, size_t nchunks, size_t 
 
 /* Stores the compressed chunks of jobs (nchunks per column) from dataset index at on, the
  * datasets first extended to `extent` events when shorter. */
-static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nchunks, uint64_t at, uint64_t extent,
-                             evr_error *err)
+static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nchunks, uint64_t at,
+                             uint64_t extent, evr_error *err)
 {
     herr_t r = 0;
     if (extent < w->extent) extent = w->extent;
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         hsize_t size[1] = {(hsize_t)extent};
         for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
             if (extent != w->extent && H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
@@ -287,9 +307,11 @@ static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nch
             for (int c = 0; c < H5W_COLUMNS && r >= 0; c++) {
                 const evr_chunk_job *j = &jobs[(size_t)c * nchunks + k];
                 hsize_t offset[1] = {(hsize_t)(at + k * H5W_CHUNK)};
-                r = H5Dwrite_chunk(column_dataset(w, c), H5P_DEFAULT, 0, offset, j->dst_size, j->dst);
+                r = H5Dwrite_chunk(column_dataset(w, c), H5P_DEFAULT, 0, offset, j->dst_size,
+                                   j->dst);
             }
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
     w->extent = extent;
     return EVR_OK;
@@ -325,9 +347,10 @@ static evr_status store_full(h5_writer *w, evr_error *err)
     w->written += w->batch * H5W_CHUNK;
     w->nstage = 0;
     w->tail_stored = 0;
-    w->fill = 1 - w->fill;   /* the landed batch's set stages next */
+    w->fill = 1 - w->fill; /* the landed batch's set stages next */
     if (was_inflight)
-        return put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at, prev_at + w->batch * H5W_CHUNK, err);
+        return put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at,
+                          prev_at + w->batch * H5W_CHUNK, err);
     return EVR_OK;
 }
 
@@ -338,7 +361,7 @@ static evr_status store(h5_writer *w, int tail, evr_error *err)
 {
     size_t nfull = w->nstage / H5W_CHUNK, rest = w->nstage % H5W_CHUNK;
     size_t nchunks, njobs;
-    uint64_t done = nfull ? 0 : w->tail_stored;   /* events of the partial chunk on file */
+    uint64_t done = nfull ? 0 : w->tail_stored; /* events of the partial chunk on file */
     evr_status st = land_inflight(w, err);
     if (st != EVR_OK) return st;
     if (!(tail && rest > done)) tail = 0;
@@ -348,7 +371,8 @@ static evr_status store(h5_writer *w, int tail, evr_error *err)
     h5_set *set = &w->set[w->fill];
     njobs = make_jobs(w, set, nchunks, nfull, rest);
     if (!evr_chunk_pool_run(w->pool, set->jobs, njobs)) return compress_failed(err);
-    st = put_chunks(w, set->jobs, nchunks, w->written, w->written + nfull * H5W_CHUNK + (tail ? rest : 0), err);
+    st = put_chunks(w, set->jobs, nchunks, w->written,
+                    w->written + nfull * H5W_CHUNK + (tail ? rest : 0), err);
     if (st != EVR_OK) return st;
     if (nfull) {
         w->written += nfull * H5W_CHUNK;
@@ -366,9 +390,11 @@ static evr_status drain(h5_writer *w, evr_error *err)
     herr_t r = 0;
     evr_status st = store(w, 1, err);
     if (st != EVR_OK) return st;
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         if (w->nms && append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, w->nms) < 0) r = -1;
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     if (r < 0) return h5_fail(err, "cannot append events to", w->tmp);
     w->ms_written += w->nms;
     w->nms = 0;
@@ -404,7 +430,7 @@ typedef struct {
     const evr_event *ev;
     evr_event *dst;
     size_t m;
-    uint64_t base;               /* dataset index of ev[0] */
+    uint64_t base; /* dataset index of ev[0] */
     int t32;
     struct stage_part {
         uint64_t *ms;
@@ -419,7 +445,7 @@ static void stage_part(void *ctx, int k, int thread)
     struct stage_part *p = &j->part[k];
     size_t a, b;
     (void)thread;
-    evr_par_share(j->m - 1, H5W_STAGE_PARTS, k, &a, &b);   /* of events 1 .. m - 1 */
+    evr_par_share(j->m - 1, H5W_STAGE_PARTS, k, &a, &b); /* of events 1 .. m - 1 */
     a++;
     b++;
     p->nms = 0;
@@ -470,9 +496,11 @@ static int stage_parallel(h5_writer *w, const evr_event *ev, size_t m, evr_event
         entries += j.part[k].nms;
     }
     if (!ok) r = 0;
-    else if (!reserve_ms(w, entries)) r = -1;   /* before any entry: the index stays whole */
+    else if (!reserve_ms(w, entries)) r = -1; /* before any entry: the index stays whole */
     for (int k = 0; r > 0 && k < H5W_STAGE_PARTS; k++) {
-        if (j.part[k].nms) memcpy(w->ms + w->nms, j.part[k].ms, j.part[k].nms * sizeof *w->ms);   /* ms NULL when none */
+        if (j.part[k].nms)
+            memcpy(w->ms + w->nms, j.part[k].ms,
+                   j.part[k].nms * sizeof *w->ms); /* ms NULL when none */
         w->nms += j.part[k].nms;
         w->next_ms += j.part[k].nms;
     }
@@ -482,8 +510,8 @@ static int stage_parallel(h5_writer *w, const evr_event *ev, size_t m, evr_event
 
 /* Stages ev[from .. to) one by one (dataset index w->total + k for ev[k]); *last_t is the time of
  * the event before. On a refused event, keeps those before it (stop_staging) and says why. */
-static evr_status stage_serial(h5_writer *w, const evr_event *ev, evr_event *dst, size_t from, size_t to,
-                               int64_t *last_t, evr_error *err)
+static evr_status stage_serial(h5_writer *w, const evr_event *ev, evr_event *dst, size_t from,
+                               size_t to, int64_t *last_t, evr_error *err)
 {
     /* the first millisecond boundary not passed yet (ms entries stay below 2^63 / 1000 as long
      * as timestamps are int64) */
@@ -491,12 +519,14 @@ static evr_status stage_serial(h5_writer *w, const evr_event *ev, evr_event *dst
     for (size_t k = from; k < to; k++) {
         const evr_event *e = &ev[k];
         if (e->t < *last_t) {
-            snprintf(err->msg, sizeof err->msg, "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
+            snprintf(err->msg, sizeof err->msg,
+                     "hdf5 writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
                      e->t, *last_t);
             return stop_staging(w, k, *last_t, EVR_ERR_ARG);
         }
         if (w->t32 && (uint64_t)e->t > UINT32_MAX) {
-            snprintf(err->msg, sizeof err->msg, "hdf5 writer: timestamp %" PRId64 " us outside events/t's uint32 range", e->t);
+            snprintf(err->msg, sizeof err->msg,
+                     "hdf5 writer: timestamp %" PRId64 " us outside events/t's uint32 range", e->t);
             return stop_staging(w, k, *last_t, EVR_ERR_ARG);
         }
         *last_t = e->t;
@@ -554,9 +584,8 @@ static evr_status h5_flush(evr_event_writer *base, evr_error *err)
     herr_t r;
     evr_status st = drain(w, err);
     if (st != EVR_OK) return st;
-    H5E_BEGIN_TRY {
-        r = H5Fflush(w->file, H5F_SCOPE_GLOBAL);
-    } H5E_END_TRY;
+    H5E_BEGIN_TRY { r = H5Fflush(w->file, H5F_SCOPE_GLOBAL); }
+    H5E_END_TRY;
     if (r < 0) return h5_fail(err, "cannot flush", w->tmp);
     return EVR_OK;
 }
@@ -584,7 +613,8 @@ static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_err
         }
     st = drain(w, err);
     if (st != EVR_OK) goto fail;
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         int8_t complete = 1;
         r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
         if (r >= 0) {
@@ -597,7 +627,8 @@ static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_err
             if (H5Fclose(w->file) < 0) r = -1;
             w->file = -1;
         }
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     if (r < 0) {
         st = h5_fail(err, "cannot complete", w->tmp);
         goto fail;
@@ -616,7 +647,8 @@ fail:
     return st;
 }
 
-evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
+evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out,
+                              evr_error *err)
 {
     h5_writer *w;
     herr_t r = -1;
@@ -647,14 +679,15 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         w->pool = evr_chunk_pool_new(threads, H5W_CHUNK * sizeof(int64_t));
         w->stage_pool = evr_par_pool_new(evr_par_threads(H5W_STAGE_THREADS));
     }
-    if (!w || !w->path || !w->tmp || !w->set[0].stage || !w->set[0].jobs || !w->set[0].zbuf || !w->set[1].stage ||
-        !w->set[1].jobs || !w->set[1].zbuf || !w->pool || !w->stage_pool) {
+    if (!w || !w->path || !w->tmp || !w->set[0].stage || !w->set[0].jobs || !w->set[0].zbuf ||
+        !w->set[1].stage || !w->set[1].jobs || !w->set[1].zbuf || !w->pool || !w->stage_pool) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: out of memory");
         return EVR_ERR_NOMEM;
     }
 
-    H5E_BEGIN_TRY {
+    H5E_BEGIN_TRY
+    {
         int32_t width = meta->width, height = meta->height;
         int64_t zero = 0;
         int8_t incomplete = 0;
@@ -665,17 +698,23 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         }
         if (w->group >= 0) w->ds_x = make_extendible(w->group, "x", H5T_STD_U16LE, H5W_CHUNK);
         if (w->ds_x >= 0) w->ds_y = make_extendible(w->group, "y", H5T_STD_U16LE, H5W_CHUNK);
-        if (w->ds_y >= 0) w->ds_t = make_extendible(w->group, "t", w->t32 ? H5T_STD_U32LE : H5T_STD_I64LE, H5W_CHUNK);
+        if (w->ds_y >= 0)
+            w->ds_t =
+                make_extendible(w->group, "t", w->t32 ? H5T_STD_U32LE : H5T_STD_I64LE, H5W_CHUNK);
         if (w->ds_t >= 0) w->ds_p = make_extendible(w->group, "p", H5T_STD_I8LE, H5W_CHUNK);
-        if (w->ds_p >= 0) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
+        if (w->ds_p >= 0)
+            w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
         if (w->ds_ms >= 0 &&
-            write_scalar_dataset(w->file, "t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &zero) >= 0 &&
+            write_scalar_dataset(w->file, "t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &zero) >=
+                0 &&
             write_scalar_attr(w->file, "width", H5T_STD_I32LE, H5T_NATIVE_INT32, &width) >= 0 &&
             write_scalar_attr(w->file, "height", H5T_STD_I32LE, H5T_NATIVE_INT32, &height) >= 0 &&
-            write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &incomplete) >= 0 &&
+            write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &incomplete) >=
+                0 &&
             write_string_attr(w->file, "config", meta->config_json ? meta->config_json : "{}") >= 0)
             r = H5Fflush(w->file, H5F_SCOPE_GLOBAL);
-    } H5E_END_TRY;
+    }
+    H5E_END_TRY;
     if (r < 0) {
         evr_status st = h5_fail(err, what, w->tmp);
         int created = w->file >= 0;
@@ -692,4 +731,5 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     return EVR_OK;
 }
 
-const evr_event_format evr_format_h5 = {"h5", "hdf5", "events.h5", evr_h5_writer_open, "HDF5: events/x, y, t, p and ms_to_idx"};
+const evr_event_format evr_format_h5 = {"h5", "hdf5", "events.h5", evr_h5_writer_open,
+                                        "HDF5: events/x, y, t, p and ms_to_idx"};

@@ -26,7 +26,10 @@ static void put(evr_json *j, const char *s, size_t n)
         size_t cap = j->cap ? j->cap : 256;
         while (cap < j->len + n + 1) cap *= 2;
         char *p = realloc(j->buf, cap);
-        if (!p) { j->failed = 1; return; }
+        if (!p) {
+            j->failed = 1;
+            return;
+        }
         j->buf = p;
         j->cap = cap;
     }
@@ -58,10 +61,16 @@ static void separate(evr_json *j)
 static int begin_value(evr_json *j)
 {
     if (j->failed) return 0;
-    if (j->done) { j->failed = 1; return 0; }
+    if (j->done) {
+        j->failed = 1;
+        return 0;
+    }
     if (j->depth == 0) return 1;
     if (j->kind[j->depth - 1] == '{') {
-        if (!j->after_key) { j->failed = 1; return 0; }
+        if (!j->after_key) {
+            j->failed = 1;
+            return 0;
+        }
         j->after_key = 0;
         return 1;
     }
@@ -78,7 +87,10 @@ static void open_(evr_json *j, char kind)
 {
     char c = kind;
     if (!begin_value(j)) return;
-    if (j->depth >= EVR_JSON_MAX_DEPTH) { j->failed = 1; return; }
+    if (j->depth >= EVR_JSON_MAX_DEPTH) {
+        j->failed = 1;
+        return;
+    }
     put(j, &c, 1);
     j->kind[j->depth] = (unsigned char)kind;
     j->count[j->depth] = 0;
@@ -120,8 +132,13 @@ static void quoted(evr_json *j, const char *s)
         else if (c == '\b') esc = "\\b";
         else if (c == '\f') esc = "\\f";
         else if (c < 0x20 || c == 0x7f) {
-            u[0] = '\\'; u[1] = 'u'; u[2] = '0'; u[3] = '0';
-            u[4] = hex[c >> 4]; u[5] = hex[c & 15]; u[6] = 0;
+            u[0] = '\\';
+            u[1] = 'u';
+            u[2] = '0';
+            u[3] = '0';
+            u[4] = hex[c >> 4];
+            u[5] = hex[c & 15];
+            u[6] = 0;
             esc = u;
         }
         if (esc) {
@@ -149,7 +166,10 @@ void evr_json_key(evr_json *j, const char *name)
 
 void evr_json_string(evr_json *j, const char *s)
 {
-    if (!s) { evr_json_null(j); return; }
+    if (!s) {
+        evr_json_null(j);
+        return;
+    }
     if (!begin_value(j)) return;
     quoted(j, s);
     end_value(j);
@@ -166,7 +186,10 @@ static void put_number_text(evr_json *j, char *t)
 void evr_json_number(evr_json *j, double v)
 {
     char t[40];
-    if (!isfinite(v)) { evr_json_null(j); return; }
+    if (!isfinite(v)) {
+        evr_json_null(j);
+        return;
+    }
     if (!begin_value(j)) return;
     for (int prec = 15; prec <= 17; prec++) {
         snprintf(t, sizeof t, "%.*g", prec, v);
@@ -179,7 +202,10 @@ void evr_json_number(evr_json *j, double v)
 void evr_json_float(evr_json *j, float v)
 {
     char t[40];
-    if (!isfinite(v)) { evr_json_null(j); return; }
+    if (!isfinite(v)) {
+        evr_json_null(j);
+        return;
+    }
     if (!begin_value(j)) return;
     for (int prec = 6; prec <= 9; prec++) {
         snprintf(t, sizeof t, "%.*g", prec, (double)v);

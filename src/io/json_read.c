@@ -10,7 +10,10 @@ static int j_new(evr_jdoc *d, unsigned char type)
     if (d->n == d->cap) {
         int ncap = d->cap ? d->cap * 2 : 256;
         evr_jdoc_value *nv = realloc(d->v, (size_t)ncap * sizeof *nv);
-        if (!nv) { d->failed = 1; return -1; }
+        if (!nv) {
+            d->failed = 1;
+            return -1;
+        }
         d->v = nv;
         d->cap = ncap;
     }
@@ -49,18 +52,36 @@ static int j_number(evr_jdoc *d, double *out)
     size_t p = d->pos;
     double mant = 0.0, sign = 1.0;
     int exp10 = 0, esign = 1, e = 0, digits = 0;
-    if (p < d->len && d->text[p] == '-') { sign = -1.0; p++; }
-    while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') { mant = mant * 10.0 + (d->text[p] - '0'); p++; digits++; }
+    if (p < d->len && d->text[p] == '-') {
+        sign = -1.0;
+        p++;
+    }
+    while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') {
+        mant = mant * 10.0 + (d->text[p] - '0');
+        p++;
+        digits++;
+    }
     if (p < d->len && d->text[p] == '.') {
         p++;
-        while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') { mant = mant * 10.0 + (d->text[p] - '0'); exp10--; p++; digits++; }
+        while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') {
+            mant = mant * 10.0 + (d->text[p] - '0');
+            exp10--;
+            p++;
+            digits++;
+        }
     }
     if (!digits) return 0;
     if (p < d->len && (d->text[p] == 'e' || d->text[p] == 'E')) {
         p++;
-        if (p < d->len && (d->text[p] == '+' || d->text[p] == '-')) { if (d->text[p] == '-') esign = -1; p++; }
+        if (p < d->len && (d->text[p] == '+' || d->text[p] == '-')) {
+            if (d->text[p] == '-') esign = -1;
+            p++;
+        }
         if (p >= d->len || d->text[p] < '0' || d->text[p] > '9') return 0;
-        while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') { if (e < 10000) e = e * 10 + (d->text[p] - '0'); p++; }
+        while (p < d->len && d->text[p] >= '0' && d->text[p] <= '9') {
+            if (e < 10000) e = e * 10 + (d->text[p] - '0');
+            p++;
+        }
     }
     *out = sign * mant * pow(10.0, (double)(exp10 + esign * e));
     d->pos = p;
@@ -73,15 +94,19 @@ static int j_container(evr_jdoc *d, int depth, int is_obj)
 {
     int self = j_new(d, is_obj ? EVR_JDOC_OBJECT : EVR_JDOC_ARRAY), last = -1;
     if (self < 0) return -1;
-    d->pos++;   /* '{' or '[' */
+    d->pos++; /* '{' or '[' */
     j_ws(d);
-    if (d->pos < d->len && d->text[d->pos] == (is_obj ? '}' : ']')) { d->pos++; return self; }
+    if (d->pos < d->len && d->text[d->pos] == (is_obj ? '}' : ']')) {
+        d->pos++;
+        return self;
+    }
     for (;;) {
         size_t koff = 0, klen = 0;
         int child;
         j_ws(d);
         if (is_obj) {
-            if (d->pos >= d->len || d->text[d->pos] != '"' || !j_string_span(d, &koff, &klen)) return -1;
+            if (d->pos >= d->len || d->text[d->pos] != '"' || !j_string_span(d, &koff, &klen))
+                return -1;
             j_ws(d);
             if (d->pos >= d->len || d->text[d->pos] != ':') return -1;
             d->pos++;
@@ -96,8 +121,14 @@ static int j_container(evr_jdoc *d, int depth, int is_obj)
         d->v[self].count++;
         j_ws(d);
         if (d->pos >= d->len) return -1;
-        if (d->text[d->pos] == ',') { d->pos++; continue; }
-        if (d->text[d->pos] == (is_obj ? '}' : ']')) { d->pos++; return self; }
+        if (d->text[d->pos] == ',') {
+            d->pos++;
+            continue;
+        }
+        if (d->text[d->pos] == (is_obj ? '}' : ']')) {
+            d->pos++;
+            return self;
+        }
         return -1;
     }
 }
@@ -152,14 +183,24 @@ static size_t put_utf8(char *out, size_t o, size_t cap, unsigned cp)
 {
     char tmp[4];
     size_t n, i;
-    if (cp < 0x80) { tmp[0] = (char)cp; n = 1; }
-    else if (cp < 0x800) { tmp[0] = (char)(0xC0 | (cp >> 6)); tmp[1] = (char)(0x80 | (cp & 0x3F)); n = 2; }
-    else if (cp < 0x10000) {
-        tmp[0] = (char)(0xE0 | (cp >> 12)); tmp[1] = (char)(0x80 | ((cp >> 6) & 0x3F));
-        tmp[2] = (char)(0x80 | (cp & 0x3F)); n = 3;
+    if (cp < 0x80) {
+        tmp[0] = (char)cp;
+        n = 1;
+    } else if (cp < 0x800) {
+        tmp[0] = (char)(0xC0 | (cp >> 6));
+        tmp[1] = (char)(0x80 | (cp & 0x3F));
+        n = 2;
+    } else if (cp < 0x10000) {
+        tmp[0] = (char)(0xE0 | (cp >> 12));
+        tmp[1] = (char)(0x80 | ((cp >> 6) & 0x3F));
+        tmp[2] = (char)(0x80 | (cp & 0x3F));
+        n = 3;
     } else {
-        tmp[0] = (char)(0xF0 | (cp >> 18)); tmp[1] = (char)(0x80 | ((cp >> 12) & 0x3F));
-        tmp[2] = (char)(0x80 | ((cp >> 6) & 0x3F)); tmp[3] = (char)(0x80 | (cp & 0x3F)); n = 4;
+        tmp[0] = (char)(0xF0 | (cp >> 18));
+        tmp[1] = (char)(0x80 | ((cp >> 12) & 0x3F));
+        tmp[2] = (char)(0x80 | ((cp >> 6) & 0x3F));
+        tmp[3] = (char)(0x80 | (cp & 0x3F));
+        n = 4;
     }
     for (i = 0; i < n && o + 1 < cap; i++) out[o++] = tmp[i];
     return o;
@@ -169,10 +210,16 @@ static unsigned read_hex4(const char *s, size_t len, size_t i, int *ok)
 {
     unsigned v = 0;
     int k;
-    if (i + 4 > len) { *ok = 0; return 0; }
+    if (i + 4 > len) {
+        *ok = 0;
+        return 0;
+    }
     for (k = 0; k < 4; k++) {
         int h = hexval(s[i + (size_t)k]);
-        if (h < 0) { *ok = 0; return 0; }
+        if (h < 0) {
+            *ok = 0;
+            return 0;
+        }
         v = v * 16 + (unsigned)h;
     }
     return v;
@@ -184,7 +231,10 @@ static void j_decode(const char *s, size_t len, char *out, size_t cap)
     size_t i = 0, o = 0;
     while (i < len && o + 1 < cap) {
         char c = s[i++];
-        if (c != '\\' || i >= len) { out[o++] = c; continue; }
+        if (c != '\\' || i >= len) {
+            out[o++] = c;
+            continue;
+        }
         c = s[i++];
         switch (c) {
         case 'b': out[o++] = '\b'; break;
@@ -207,7 +257,7 @@ static void j_decode(const char *s, size_t len, char *out, size_t cap)
             o = put_utf8(out, o, cap, cp);
             break;
         }
-        default: out[o++] = c; break;   /* \" \\ \/ */
+        default: out[o++] = c; break; /* \" \\ \/ */
         }
     }
     out[o] = 0;
@@ -228,10 +278,7 @@ void evr_jdoc_free(evr_jdoc *d)
     d->n = d->cap = 0;
 }
 
-int evr_jdoc_type(const evr_jdoc *d, int v)
-{
-    return v >= 0 ? d->v[v].type : -1;
-}
+int evr_jdoc_type(const evr_jdoc *d, int v) { return v >= 0 ? d->v[v].type : -1; }
 
 int evr_jdoc_get(const evr_jdoc *d, int obj, const char *key)
 {
@@ -250,15 +297,9 @@ int evr_jdoc_get(const evr_jdoc *d, int obj, const char *key)
     return -1;
 }
 
-int evr_jdoc_first(const evr_jdoc *d, int v)
-{
-    return v >= 0 ? d->v[v].first : -1;
-}
+int evr_jdoc_first(const evr_jdoc *d, int v) { return v >= 0 ? d->v[v].first : -1; }
 
-int evr_jdoc_next(const evr_jdoc *d, int c)
-{
-    return c >= 0 ? d->v[c].next : -1;
-}
+int evr_jdoc_next(const evr_jdoc *d, int c) { return c >= 0 ? d->v[c].next : -1; }
 
 int evr_jdoc_count(const evr_jdoc *d, int arr)
 {
@@ -272,7 +313,10 @@ double evr_jdoc_number(const evr_jdoc *d, int v, double def)
 
 int evr_jdoc_string(const evr_jdoc *d, int v, char *out, size_t cap)
 {
-    if (v < 0 || d->v[v].type != EVR_JDOC_STRING) { out[0] = 0; return 0; }
+    if (v < 0 || d->v[v].type != EVR_JDOC_STRING) {
+        out[0] = 0;
+        return 0;
+    }
     j_decode(d->text + d->v[v].off, d->v[v].len, out, cap);
     return 1;
 }

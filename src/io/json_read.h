@@ -19,24 +19,31 @@
 
 #define EVR_JDOC_MAX_DEPTH 128
 
-enum { EVR_JDOC_NULL, EVR_JDOC_BOOL, EVR_JDOC_NUMBER, EVR_JDOC_STRING, EVR_JDOC_ARRAY, EVR_JDOC_OBJECT };
+enum {
+    EVR_JDOC_NULL,
+    EVR_JDOC_BOOL,
+    EVR_JDOC_NUMBER,
+    EVR_JDOC_STRING,
+    EVR_JDOC_ARRAY,
+    EVR_JDOC_OBJECT
+};
 
 /* One value; read it through the accessors. */
 typedef struct {
-    unsigned char type;       /* EVR_JDOC_* */
-    int first, next;          /* first child, next sibling; -1 for none */
-    int count;                /* children */
-    size_t off, len;          /* strings: the raw (escaped) text between the quotes */
-    size_t key_off, key_len;  /* object members: the raw key */
-    double num;               /* numbers; booleans 1 or 0 */
+    unsigned char type;      /* EVR_JDOC_* */
+    int first, next;         /* first child, next sibling; -1 for none */
+    int count;               /* children */
+    size_t off, len;         /* strings: the raw (escaped) text between the quotes */
+    size_t key_off, key_len; /* object members: the raw key */
+    double num;              /* numbers; booleans 1 or 0 */
 } evr_jdoc_value;
 
 typedef struct {
-    const char *text;         /* the parsed text (not copied: it must outlive the document) */
-    size_t len, pos;          /* pos: where parsing stopped (near the error when it failed) */
+    const char *text; /* the parsed text (not copied: it must outlive the document) */
+    size_t len, pos;  /* pos: where parsing stopped (near the error when it failed) */
     evr_jdoc_value *v;
     int n, cap;
-    int failed;               /* out of memory */
+    int failed; /* out of memory */
 } evr_jdoc;
 
 /* Parses text[0 .. len) (which need not end in 0). Returns the root value, or -1 when the text is

@@ -27,18 +27,18 @@
 #define NPY_PARTS 16
 
 typedef struct {
-    evr_event_writer base;       /* first: the interface pointer is the writer pointer */
+    evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     FILE *f;
     unsigned char *buf;
-    size_t nbuf;                 /* records in buf */
-    uint64_t count;              /* records in the file */
-    size_t header_len;           /* bytes before the first record */
+    size_t nbuf;       /* records in buf */
+    uint64_t count;    /* records in the file */
+    size_t header_len; /* bytes before the first record */
     int64_t last_t;
     int have_last;
     evr_par_pool *pool;
-    unsigned char *big;          /* a large write's records */
-    size_t big_cap;              /* records big has room for */
+    unsigned char *big; /* a large write's records */
+    size_t big_cap;     /* records big has room for */
 } npy_writer;
 
 /* Builds the whole header (magic, version, length, dict, padding, newline) for count records.
@@ -46,7 +46,8 @@ typedef struct {
 static size_t build_header(char *out, size_t cap, uint64_t count, size_t total)
 {
     char dict[256];
-    int n = snprintf(dict, sizeof dict, "{'descr': %s, 'fortran_order': False, 'shape': (%" PRIu64 ",), }", NPY_DESCR,
+    int n = snprintf(dict, sizeof dict,
+                     "{'descr': %s, 'fortran_order': False, 'shape': (%" PRIu64 ",), }", NPY_DESCR,
                      count);
     size_t digits = (size_t)snprintf(NULL, 0, "%" PRIu64, count);
     if (total == 0) total = ((10 + (size_t)n - digits + 20 + 1) + 63) / 64 * 64;
@@ -81,7 +82,8 @@ static evr_status cannot_write(const npy_writer *w, evr_error *err)
 
 static evr_status drain(npy_writer *w, evr_error *err)
 {
-    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf) return cannot_write(w, err);
+    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf)
+        return cannot_write(w, err);
     w->count += w->nbuf;
     w->nbuf = 0;
     return EVR_OK;
@@ -116,9 +118,9 @@ typedef struct {
     size_t n;
     unsigned char *big;
     int fd;
-    off_t at;                    /* file offset of ev[0]'s record */
+    off_t at; /* file offset of ev[0]'s record */
     int pass;
-    int bad[NPY_PARTS];          /* pass 0: an event out of order; pass 1: a failed write */
+    int bad[NPY_PARTS]; /* pass 0: an event out of order; pass 1: a failed write */
 } npy_job;
 
 static void npy_part(void *ctx, int k, int thread)
@@ -157,13 +159,14 @@ static void npy_part(void *ctx, int k, int thread)
 /* Writes ev[0 .. n) (n >= NPY_PAR_MIN, ev[0] not before the last event written) on the pool after
  * the buffered records (*st: how it went); returns 0, nothing written, when an event is out of
  * order or there is no room to pack them: the serial path then writes them or reports it. */
-static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err, evr_status *st)
+static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err,
+                          evr_status *st)
 {
     npy_job j;
     *st = EVR_OK;
     if (n > w->big_cap) {
         unsigned char *p = realloc(w->big, n * NPY_RECORD);
-        if (!p) return 0;   /* the serial path needs no room */
+        if (!p) return 0; /* the serial path needs no room */
         w->big = p;
         w->big_cap = n;
     }
@@ -210,7 +213,8 @@ static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t 
         const evr_event *e = &ev[i];
         unsigned char *r;
         if (w->have_last && e->t < w->last_t) {
-            snprintf(err->msg, sizeof err->msg, "npy writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
+            snprintf(err->msg, sizeof err->msg,
+                     "npy writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
                      e->t, w->last_t);
             return EVR_ERR_ARG;
         }
@@ -255,7 +259,8 @@ static evr_status npy_finish(evr_event_writer *base, int64_t duration_us, evr_er
     return st;
 }
 
-evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
+evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
+                               evr_event_writer **out, evr_error *err)
 {
     npy_writer *w;
     char h[256];
@@ -297,4 +302,5 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta, ev
     return EVR_OK;
 }
 
-const evr_event_format evr_format_npy = {"npy", NULL, "events.npy", evr_npy_writer_open, "NumPy structured array (t, x, y, p)"};
+const evr_event_format evr_format_npy = {"npy", NULL, "events.npy", evr_npy_writer_open,
+                                         "NumPy structured array (t, x, y, p)"};

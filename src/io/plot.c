@@ -52,10 +52,12 @@ void evr_canvas_rect(evr_canvas *c, int x0, int y0, int x1, int y1, const uint8_
     if (x1 > c->w) x1 = c->w;
     if (y1 > c->h) y1 = c->h;
     for (y = y0; y < y1; y++)
-        for (x = x0; x < x1; x++) memcpy(c->rgb + ((size_t)y * (size_t)c->w + (size_t)x) * 3, col, 3);
+        for (x = x0; x < x1; x++)
+            memcpy(c->rgb + ((size_t)y * (size_t)c->w + (size_t)x) * 3, col, 3);
 }
 
-void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, int thick, const uint8_t col[3])
+void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, int thick,
+                     const uint8_t col[3])
 {
     double dx = x1 - x0, dy = y1 - y0, len = fabs(dx) > fabs(dy) ? fabs(dx) : fabs(dy);
     int steps = (int)ceil(len), k, lo = -(thick - 1) / 2, hi = thick / 2;
@@ -89,8 +91,9 @@ void evr_canvas_text(evr_canvas *c, int x, int y, int scale, const char *text, c
             if (ys[v] < mny) mny = ys[v];
             if (ys[v] > mxy) mxy = ys[v];
         }
-        evr_canvas_rect(c, x + (int)lroundf(mnx * (float)scale), y + (int)lroundf(mny * (float)scale),
-                        x + (int)lroundf(mxx * (float)scale), y + (int)lroundf(mxy * (float)scale), col);
+        evr_canvas_rect(c, x + (int)lroundf(mnx * (float)scale),
+                        y + (int)lroundf(mny * (float)scale), x + (int)lroundf(mxx * (float)scale),
+                        y + (int)lroundf(mxy * (float)scale), col);
     }
 }
 
@@ -113,8 +116,8 @@ static void fmt_tick(char *s, size_t n, double v, double step)
     else snprintf(s, n, "%.10g", v);
 }
 
-evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const evr_plot_series *series,
-                              int nseries, evr_error *err)
+evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec,
+                              const evr_plot_series *series, int nseries, evr_error *err)
 {
     evr_canvas c;
     evr_status st;
@@ -131,11 +134,21 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
             if (series[i].y[k] < ymin) ymin = series[i].y[k];
             if (series[i].y[k] > ymax) ymax = series[i].y[k];
         }
-    if (!(xmin <= xmax)) { xmin = 0.0; xmax = 1.0; ymin = 0.0; ymax = 1.0; }
+    if (!(xmin <= xmax)) {
+        xmin = 0.0;
+        xmax = 1.0;
+        ymin = 0.0;
+        ymax = 1.0;
+    }
     if (spec->y_from_zero && ymin > 0.0) ymin = 0.0;
-    if (xmax - xmin <= 0.0) { xmin -= 0.5; xmax += 0.5; }
-    if (ymax - ymin <= 0.0) { ymax += ymax != 0.0 ? fabs(ymax) * 0.1 : 1.0; }
-    ymax += (ymax - ymin) * 0.04;   /* headroom: the highest point does not touch the frame */
+    if (xmax - xmin <= 0.0) {
+        xmin -= 0.5;
+        xmax += 0.5;
+    }
+    if (ymax - ymin <= 0.0) {
+        ymax += ymax != 0.0 ? fabs(ymax) * 0.1 : 1.0;
+    }
+    ymax += (ymax - ymin) * 0.04; /* headroom: the highest point does not touch the frame */
     ys = nice_step(ymax - ymin, 5);
     ymax = ceil(ymax / ys - 1e-9) * ys;
     if (!spec->y_from_zero) ymin = floor(ymin / ys + 1e-9) * ys;
@@ -144,11 +157,12 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
     ph = c.h - top - bottom;
     if (pw < 10 || ph < 10) {
         evr_canvas_release(&c);
-        snprintf(err->msg, sizeof err->msg, "plot size %dx%d is too small", spec->width, spec->height);
+        snprintf(err->msg, sizeof err->msg, "plot size %dx%d is too small", spec->width,
+                 spec->height);
         return EVR_ERR_ARG;
     }
-#define PX(X) (left + ((X) - xmin) / (xmax - xmin) * pw)
-#define PY(Y) (top + ph - ((Y) - ymin) / (ymax - ymin) * ph)
+#define PX(X) (left + ((X)-xmin) / (xmax - xmin) * pw)
+#define PY(Y) (top + ph - ((Y)-ymin) / (ymax - ymin) * ph)
     /* grid and ticks */
     for (v = ceil(ymin / ys - 1e-9) * ys; v <= ymax + ys * 1e-6; v += ys) {
         int y = (int)lround(PY(v));
@@ -168,7 +182,8 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
     for (i = 0; i < nseries; i++) {
         const evr_plot_series *se = &series[i];
         for (k = 0; k + 1 < se->n; k++)
-            evr_canvas_line(&c, PX(se->x[k]), PY(se->y[k]), PX(se->x[k + 1]), PY(se->y[k + 1]), 2, se->color);
+            evr_canvas_line(&c, PX(se->x[k]), PY(se->y[k]), PX(se->x[k + 1]), PY(se->y[k + 1]), 2,
+                            se->color);
         if (se->markers)
             for (k = 0; k < se->n; k++) {
                 int x = (int)lround(PX(se->x[k])), y = (int)lround(PY(se->y[k]));
@@ -182,8 +197,11 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
     evr_canvas_rect(&c, left, top + ph, left + pw + 1, top + ph + 1, BLACK);
     evr_canvas_rect(&c, left, top, left + 1, top + ph, BLACK);
     evr_canvas_rect(&c, left + pw, top, left + pw + 1, top + ph, BLACK);
-    if (spec->title) evr_canvas_text(&c, (c.w - evr_text_width(spec->title, 2)) / 2, 8, 2, spec->title, BLACK);
-    if (spec->xlabel) evr_canvas_text(&c, left + (pw - evr_text_width(spec->xlabel, 1)) / 2, c.h - 22, 1, spec->xlabel, BLACK);
+    if (spec->title)
+        evr_canvas_text(&c, (c.w - evr_text_width(spec->title, 2)) / 2, 8, 2, spec->title, BLACK);
+    if (spec->xlabel)
+        evr_canvas_text(&c, left + (pw - evr_text_width(spec->xlabel, 1)) / 2, c.h - 22, 1,
+                        spec->xlabel, BLACK);
     if (spec->ylabel) evr_canvas_text(&c, 6, top - 14, 1, spec->ylabel, BLACK);
     {
         int ly = top + 8;
@@ -191,7 +209,8 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
             int tw;
             if (!series[i].label) continue;
             tw = evr_text_width(series[i].label, 1);
-            evr_canvas_rect(&c, left + pw - tw - 36, ly + 2, left + pw - tw - 16, ly + 5, series[i].color);
+            evr_canvas_rect(&c, left + pw - tw - 36, ly + 2, left + pw - tw - 16, ly + 5,
+                            series[i].color);
             evr_canvas_text(&c, left + pw - tw - 10, ly, 1, series[i].label, BLACK);
             ly += 14;
         }
@@ -204,17 +223,18 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec, const
 /* A perceptual-ish dark-to-bright map (black, purple, red, orange, yellow, white), v in [0, 1]. */
 static void colormap(double v, uint8_t out[3])
 {
-    static const double stops[6][3] = {{0, 0, 4}, {87, 16, 110}, {188, 55, 84}, {249, 142, 9}, {252, 255, 164},
-                                       {255, 255, 255}};
+    static const double stops[6][3] = {{0, 0, 4},     {87, 16, 110},   {188, 55, 84},
+                                       {249, 142, 9}, {252, 255, 164}, {255, 255, 255}};
     double t = (v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v) * 4.0;
     int i = (int)t, ch;
     if (i > 3) i = 3;
     t -= i;
-    for (ch = 0; ch < 3; ch++) out[ch] = (uint8_t)lround(stops[i][ch] + (stops[i + 1][ch] - stops[i][ch]) * t);
+    for (ch = 0; ch < 3; ch++)
+        out[ch] = (uint8_t)lround(stops[i][ch] + (stops[i + 1][ch] - stops[i][ch]) * t);
 }
 
-evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h, const char *title,
-                                int *out_w, int *out_h, evr_error *err)
+evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h,
+                                const char *title, int *out_w, int *out_h, evr_error *err)
 {
     evr_canvas c;
     evr_status st;

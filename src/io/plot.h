@@ -20,10 +20,12 @@ void evr_canvas_release(evr_canvas *c);
 /* Fills [x0,x1) x [y0,y1), clipped to the image. */
 void evr_canvas_rect(evr_canvas *c, int x0, int y0, int x1, int y1, const uint8_t col[3]);
 /* A line of the given thickness (pixels), clipped to the image. */
-void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, int thick, const uint8_t col[3]);
+void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, int thick,
+                     const uint8_t col[3]);
 /* Text with its top-left corner at (x, y); each font pixel is scale x scale image pixels.
  * The font is about 6 pixels wide and 7 high per character at scale 1. */
-void evr_canvas_text(evr_canvas *c, int x, int y, int scale, const char *text, const uint8_t col[3]);
+void evr_canvas_text(evr_canvas *c, int x, int y, int scale, const char *text,
+                     const uint8_t col[3]);
 int evr_text_width(const char *text, int scale);
 
 /* The line plots and heat maps (evr_plot_series, evr_plot_spec, evr_plot_lines_png,

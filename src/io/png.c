@@ -19,7 +19,10 @@ static void png_mem_write(png_structp png, png_bytep bytes, png_size_t n)
         size_t cap = m->cap ? m->cap * 2 : 65536;
         while (cap < m->size + n) cap *= 2;
         unsigned char *p = realloc(m->data, cap);
-        if (!p) { m->failed = 1; return; }
+        if (!p) {
+            m->failed = 1;
+            return;
+        }
         m->data = p;
         m->cap = cap;
     }
@@ -41,8 +44,10 @@ evr_status evr_png_encode(const void *pixels, int width, int height, int channel
     volatile evr_status st = EVR_OK;
     int y;
 
-    if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || (bit_depth != 8 && bit_depth != 16)) {
-        snprintf(err->msg, sizeof err->msg, "png: bad image shape %dx%dx%d/%d", width, height, channels, bit_depth);
+    if (width <= 0 || height <= 0 || channels < 1 || channels > 4 ||
+        (bit_depth != 8 && bit_depth != 16)) {
+        snprintf(err->msg, sizeof err->msg, "png: bad image shape %dx%dx%d/%d", width, height,
+                 channels, bit_depth);
         return EVR_ERR_ARG;
     }
     rows = malloc(sizeof(png_bytep) * (size_t)height);
@@ -59,16 +64,18 @@ evr_status evr_png_encode(const void *pixels, int width, int height, int channel
         goto done;
     }
     png_set_write_fn(png, &mem, png_mem_write, png_mem_flush);
-    png_set_compression_level(png, 3);   /* previews are many: favour speed */
-    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, bit_depth, color_types[channels],
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_compression_level(png, 3); /* previews are many: favour speed */
+    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, bit_depth,
+                 color_types[channels], PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     if (bit_depth == 16) {
         const uint16_t probe = 1;
-        if (*(const unsigned char *)&probe == 1) png_set_swap(png);   /* PNG is big-endian */
+        if (*(const unsigned char *)&probe == 1) png_set_swap(png); /* PNG is big-endian */
     }
     for (y = 0; y < height; y++)
-        rows[y] = (png_bytep)pixels + (size_t)y * (size_t)width * (size_t)channels * (size_t)(bit_depth / 8);
+        rows[y] = (png_bytep)pixels +
+                  (size_t)y * (size_t)width * (size_t)channels * (size_t)(bit_depth / 8);
     png_write_image(png, rows);
     png_write_end(png, NULL);
     if (mem.failed) {

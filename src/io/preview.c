@@ -48,8 +48,9 @@ void evr_event_frame_add(evr_event_frame *f, const evr_event *ev, size_t n)
         size_t k;
         if (ev[i].x >= f->width || ev[i].y >= f->height) continue;
         k = (size_t)ev[i].y * (size_t)f->width + ev[i].x;
-        if (ev[i].p) { if (f->on[k] < UINT32_MAX) f->on[k]++; }
-        else if (f->off[k] < UINT32_MAX) f->off[k]++;
+        if (ev[i].p) {
+            if (f->on[k] < UINT32_MAX) f->on[k]++;
+        } else if (f->off[k] < UINT32_MAX) f->off[k]++;
         f->last[k] = ev[i].p ? 1 : 0;
         f->events++;
     }
@@ -61,7 +62,10 @@ void evr_event_frame_render(const evr_event_frame *f, uint8_t *rgb)
     for (size_t k = 0; k < n; k++) {
         uint8_t *c = rgb + 3 * k;
         uint32_t on = f->on[k], off = f->off[k];
-        if (!on && !off) { c[0] = c[1] = c[2] = 255; continue; }
+        if (!on && !off) {
+            c[0] = c[1] = c[2] = 255;
+            continue;
+        }
         int is_on = on != off ? on > off : f->last[k];
         c[0] = is_on ? 0 : 255;
         c[1] = 0;
@@ -96,19 +100,20 @@ void evr_event_frame_release(evr_event_frame *f)
 struct evr_event_preview {
     evr_event_frame frame;
     int64_t window_us;
-    int64_t index;               /* window the frame accumulates */
+    int64_t index; /* window the frame accumulates */
     char *dir, *prefix;
     int frames;
 };
 
-evr_status evr_event_preview_new(int width, int height, int64_t window_us, const char *dir, const char *prefix,
-                                 evr_event_preview **out, evr_error *err)
+evr_status evr_event_preview_new(int width, int height, int64_t window_us, const char *dir,
+                                 const char *prefix, evr_event_preview **out, evr_error *err)
 {
     evr_event_preview *p;
     evr_status st;
     *out = NULL;
     if (window_us <= 0 || !dir || !prefix) {
-        snprintf(err->msg, sizeof err->msg, "event preview: bad window %lld us or no folder", (long long)window_us);
+        snprintf(err->msg, sizeof err->msg, "event preview: bad window %lld us or no folder",
+                 (long long)window_us);
         return EVR_ERR_ARG;
     }
     p = calloc(1, sizeof *p);
@@ -164,7 +169,8 @@ evr_status evr_event_preview_advance(evr_event_preview *p, int64_t t_us, evr_err
     return EVR_OK;
 }
 
-evr_status evr_event_preview_add(evr_event_preview *p, const evr_event *ev, size_t n, evr_error *err)
+evr_status evr_event_preview_add(evr_event_preview *p, const evr_event *ev, size_t n,
+                                 evr_error *err)
 {
     size_t i = 0;
     while (i < n && ev[i].t < 0) i++;
@@ -249,9 +255,10 @@ evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr
     }
     for (size_t i = 0; i < n; i++) tmp[i] = clean(linear[i]);
     white = select_kth(tmp, n, (size_t)floor(0.995 * (double)(n - 1) + 0.5));
-    if (!(white > 0.0)) {               /* mostly black: take the brightest value */
+    if (!(white > 0.0)) { /* mostly black: take the brightest value */
         white = 0.0;
-        for (size_t i = 0; i < n; i++) if (tmp[i] > white) white = tmp[i];
+        for (size_t i = 0; i < n; i++)
+            if (tmp[i] > white) white = tmp[i];
     }
     free(tmp);
     if (!(white > 0.0)) {
@@ -265,7 +272,7 @@ evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr
     lw = white * scale;
     for (size_t i = 0; i < n; i++) {
         double l = (double)clean(linear[i]) * scale, v;
-        if (l >= lw) v = 1.0;           /* the curve reaches 1 at the white point */
+        if (l >= lw) v = 1.0; /* the curve reaches 1 at the white point */
         else v = l * (1.0 + l / (lw * lw)) / (1.0 + l);
         if (v > 1.0) v = 1.0;
         v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
@@ -275,7 +282,8 @@ evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr
     return EVR_OK;
 }
 
-evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h, evr_error *err)
+evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h,
+                                     evr_error *err)
 {
     uint8_t *gray;
     evr_status st;

@@ -15,9 +15,9 @@
  * takes the polarity of the pixel's latest event. */
 typedef struct {
     int width, height;
-    uint32_t *on, *off;          /* width * height counts */
-    int8_t *last;                /* polarity of the latest event per pixel */
-    uint64_t events;             /* events added since the last clear (inside the image) */
+    uint32_t *on, *off; /* width * height counts */
+    int8_t *last;       /* polarity of the latest event per pixel */
+    uint64_t events;    /* events added since the last clear (inside the image) */
 } evr_event_frame;
 
 evr_status evr_event_frame_init(evr_event_frame *f, int width, int height, evr_error *err);
@@ -36,10 +36,11 @@ void evr_event_frame_release(evr_event_frame *f);
  * t = 0 are ignored; events must come in time order (a late one is counted in the open window). */
 typedef struct evr_event_preview evr_event_preview;
 
-evr_status evr_event_preview_new(int width, int height, int64_t window_us, const char *dir, const char *prefix,
-                                 evr_event_preview **out, evr_error *err);
+evr_status evr_event_preview_new(int width, int height, int64_t window_us, const char *dir,
+                                 const char *prefix, evr_event_preview **out, evr_error *err);
 /* Adds events, writing every window that ends at or before the time of an added event. */
-evr_status evr_event_preview_add(evr_event_preview *p, const evr_event *ev, size_t n, evr_error *err);
+evr_status evr_event_preview_add(evr_event_preview *p, const evr_event *ev, size_t n,
+                                 evr_error *err);
 /* Says no event before t_us is to come (call after each segment with its end time): writes every
  * window that ends at or before t_us. */
 evr_status evr_event_preview_advance(evr_event_preview *p, int64_t t_us, evr_error *err);
@@ -58,6 +59,7 @@ void evr_event_preview_release(evr_event_preview *p);
  * monotonic within a frame. Negative and NaN values count as 0. */
 evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr_error *err);
 /* Tone maps a w x h linear luminance frame as above and writes an 8-bit gray PNG. */
-evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h, evr_error *err);
+evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h,
+                                     evr_error *err);
 
 #endif

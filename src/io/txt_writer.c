@@ -10,10 +10,10 @@
 #include <string.h>
 
 #define TXT_BUFFER (1u << 20)
-#define TXT_LINE_MAX 64          /* "-9223372036854.775808 65535 65535 1\n" fits easily */
+#define TXT_LINE_MAX 64 /* "-9223372036854.775808 65535 65535 1\n" fits easily */
 
 typedef struct {
-    evr_event_writer base;       /* first: the interface pointer is the writer pointer */
+    evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     FILE *f;
     char *buf;
@@ -26,7 +26,10 @@ static char *put_uint(char *o, uint64_t v)
 {
     char d[20];
     int n = 0;
-    do { d[n++] = (char)('0' + v % 10); v /= 10; } while (v);
+    do {
+        d[n++] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v);
     while (n) *o++ = d[--n];
     return o;
 }
@@ -75,7 +78,8 @@ static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t 
     txt_writer *w = (txt_writer *)base;
     for (size_t i = 0; i < n; i++) {
         if (w->have_last && ev[i].t < w->last_t) {
-            snprintf(err->msg, sizeof err->msg, "text writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
+            snprintf(err->msg, sizeof err->msg,
+                     "text writer: events out of time order (%" PRId64 " us after %" PRId64 " us)",
                      ev[i].t, w->last_t);
             return EVR_ERR_ARG;
         }
@@ -120,7 +124,8 @@ static evr_status txt_finish(evr_event_writer *base, int64_t duration_us, evr_er
     return st;
 }
 
-evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, evr_event_writer **out, evr_error *err)
+evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
+                               evr_event_writer **out, evr_error *err)
 {
     txt_writer *w;
     (void)meta;
@@ -153,4 +158,5 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta, ev
     return EVR_OK;
 }
 
-const evr_event_format evr_format_txt = {"txt", NULL, "events.txt", evr_txt_writer_open, "text, one event a line (t x y p)"};
+const evr_event_format evr_format_txt = {"txt", NULL, "events.txt", evr_txt_writer_open,
+                                         "text, one event a line (t x y p)"};

@@ -4,11 +4,12 @@
 
 #include <string.h>
 
-void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons, evr_gather_params *gp,
-                       evr_photon_params *pp, int *margin, int *window)
+void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons,
+                       evr_gather_params *gp, evr_photon_params *pp, int *margin, int *window)
 {
     evr_v3 lo = s->bounds_min, hi = s->bounds_max;
-    *photons = setup->photons ? setup->photons : (uint32_t)((size_t)setup->width * (size_t)setup->height);
+    *photons =
+        setup->photons ? setup->photons : (uint32_t)((size_t)setup->width * (size_t)setup->height);
     memset(gp, 0, sizeof *gp);
     gp->radius = setup->gather_radius;
     gp->max_photons = setup->gather_max;

@@ -10,7 +10,7 @@
  * per pixel), gather parameters, pass parameters (photons spread over the segment, the same
  * times every segment; directional lights emit over a disk round the scene's rest bounds, a
  * little larger), the buffer's guard band and the cells around a pixel a gather may read. */
-void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons, evr_gather_params *gp,
-                       evr_photon_params *pp, int *margin, int *window);
+void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons,
+                       evr_gather_params *gp, evr_photon_params *pp, int *margin, int *window);
 
 #endif

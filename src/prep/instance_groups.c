@@ -41,8 +41,8 @@ int evr_instance_groups_build(const evr_scene *s, int grouped, evr_instance_grou
     out->members = malloc(sizeof(int) * ((size_t)n + 1));
     out->instance_group = malloc(sizeof(int) * ((size_t)n + 1));
     node_group = malloc(sizeof(int) * ((size_t)s->num_nodes + 1));
-    if (!out->group_kind || !out->group_node || !out->group_first || !out->members || !out->instance_group ||
-        !node_group) {
+    if (!out->group_kind || !out->group_node || !out->group_first || !out->members ||
+        !out->instance_group || !node_group) {
         free(node_group);
         evr_instance_groups_free(out);
         return 0;

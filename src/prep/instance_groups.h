@@ -21,16 +21,16 @@
 
 typedef struct {
     int num_groups;
-    int static_group;          /* the baked group, -1: none (every instance moves, or the static
+    int static_group;     /* the baked group, -1: none (every instance moves, or the static
                                   instances are past the bake limit) */
-    int static_instanced;      /* 1: the static instances were past the bake limit (static groups) */
-    int *group_kind;           /* per group: EVR_GROUP_* */
-    int *group_node;           /* per group: the node whose space it is in (a moving group's node
+    int static_instanced; /* 1: the static instances were past the bake limit (static groups) */
+    int *group_kind;      /* per group: EVR_GROUP_* */
+    int *group_node;      /* per group: the node whose space it is in (a moving group's node
                                   is also its motion track), -1: world space */
-    int *group_first;          /* per group + 1: its members are members[group_first[g] ..
+    int *group_first;     /* per group + 1: its members are members[group_first[g] ..
                                   group_first[g + 1]), scene instance indices, ascending */
     int *members;
-    int *instance_group;       /* per scene instance: its group */
+    int *instance_group; /* per scene instance: its group */
 } evr_instance_groups;
 
 /* Groups the instances of s as above; grouped 0: no grouping, every instance a group of its own

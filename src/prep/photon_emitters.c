@@ -19,8 +19,8 @@ static int emitter_push(evr_photon_emitters *em, const evr_photon_emitter *e)
     return 1;
 }
 
-evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_photon_bounds bb, uint32_t photons,
-                                     evr_photon_emitters *em, evr_error *err)
+evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_photon_bounds bb,
+                                     uint32_t photons, evr_photon_emitters *em, evr_error *err)
 {
     int i;
     uint32_t next = 0;
@@ -57,9 +57,15 @@ evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_ph
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
         for (t = 0; t < m->num_triangles; t++) {
             uint32_t i0 = m->indices[3 * t], i1 = m->indices[3 * t + 1], i2 = m->indices[3 * t + 2];
-            evr_v3 p0 = evr_m34_point(&xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1], m->positions[3 * i0 + 2]));
-            evr_v3 p1 = evr_m34_point(&xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1], m->positions[3 * i1 + 2]));
-            evr_v3 p2 = evr_m34_point(&xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1], m->positions[3 * i2 + 2]));
+            evr_v3 p0 =
+                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1],
+                                               m->positions[3 * i0 + 2]));
+            evr_v3 p1 =
+                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1],
+                                               m->positions[3 * i1 + 2]));
+            evr_v3 p2 =
+                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1],
+                                               m->positions[3 * i2 + 2]));
             area += 0.5 * (double)evr_v3_len(evr_v3_cross(evr_v3_sub(p1, p0), evr_v3_sub(p2, p0)));
             em->cdf[em->cdf_n + (int)t] = (float)area;
         }
@@ -70,7 +76,7 @@ evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_ph
         e.tri_first = em->cdf_n;
         e.ntri = (int)m->num_triangles;
         e.area = (float)area;
-        e.power = (float)(2.0 * EVR_PI * area) * le;   /* both sides */
+        e.power = (float)(2.0 * EVR_PI * area) * le; /* both sides */
         em->cdf_n += (int)m->num_triangles;
         if (!emitter_push(em, &e)) goto nomem;
     }

@@ -82,7 +82,8 @@ static void split_parts(const evr_mesh *m, keyed_tri *k, size_t n, int depth, fl
     for (size_t i = 0; i < n; i++) {
         const uint32_t *ix = &m->indices[3 * k[i].tri];
         for (int a = 0; a < 3; a++) {
-            const float v = m->positions[3 * ix[0] + a] + m->positions[3 * ix[1] + a] + m->positions[3 * ix[2] + a];
+            const float v = m->positions[3 * ix[0] + a] + m->positions[3 * ix[1] + a] +
+                            m->positions[3 * ix[2] + a];
             c[a] = fminf(c[a], v);
             c[a + 3] = fmaxf(c[a + 3], v);
         }
@@ -92,7 +93,8 @@ static void split_parts(const evr_mesh *m, keyed_tri *k, size_t n, int depth, fl
         if (c[a + 3] - c[a] > c[axis + 3] - c[axis]) axis = a;
     for (size_t i = 0; i < n; i++) {
         const uint32_t *ix = &m->indices[3 * k[i].tri];
-        k[i].key = m->positions[3 * ix[0] + axis] + m->positions[3 * ix[1] + axis] + m->positions[3 * ix[2] + axis];
+        k[i].key = m->positions[3 * ix[0] + axis] + m->positions[3 * ix[1] + axis] +
+                   m->positions[3 * ix[2] + axis];
     }
     qsort(k, n, sizeof *k, keyed_cmp);
     split_parts(m, k, n / 2, depth - 1, out);
@@ -105,7 +107,7 @@ static const float (*mesh_parts(evr_skip_tracker *t, const evr_scene *s, int i))
     if (!t->mesh_parts || i < 0 || i >= t->num_meshes) return NULL;
     if (!t->mesh_parts[i]) {
         const evr_mesh *m = &s->meshes[i];
-        float (*out)[6] = malloc(sizeof *out * EVR_SKIP_MESH_PARTS);
+        float(*out)[6] = malloc(sizeof *out * EVR_SKIP_MESH_PARTS);
         keyed_tri *k = malloc(sizeof *k * (m->num_triangles ? m->num_triangles : 1));
         if (!k || !out) {
             free(k);
@@ -119,7 +121,7 @@ static const float (*mesh_parts(evr_skip_tracker *t, const evr_scene *s, int i))
         free(k);
         t->mesh_parts[i] = out;
     }
-    return (const float (*)[6])t->mesh_parts[i];
+    return (const float(*)[6])t->mesh_parts[i];
 }
 
 static int close_to(float a, float b, float tol) { return fabsf(a - b) <= tol; }
@@ -132,8 +134,9 @@ static int keys_close(const evr_motion_key *a, const evr_motion_key *b, float si
         if (!close_to(a->scale[i], b->scale[i], r * fmaxf(1.0f, fabsf(a->scale[i]))) ||
             !close_to(a->skew[i], b->skew[i], r * fmaxf(1.0f, fabsf(a->skew[i]))))
             return 0;
-    return close_to(a->rot.w, b->rot.w, r) && close_to(a->rot.x, b->rot.x, r) && close_to(a->rot.y, b->rot.y, r) &&
-           close_to(a->rot.z, b->rot.z, r) && close_to(a->trans.x, b->trans.x, d + r * fabsf(a->trans.x)) &&
+    return close_to(a->rot.w, b->rot.w, r) && close_to(a->rot.x, b->rot.x, r) &&
+           close_to(a->rot.y, b->rot.y, r) && close_to(a->rot.z, b->rot.z, r) &&
+           close_to(a->trans.x, b->trans.x, d + r * fabsf(a->trans.x)) &&
            close_to(a->trans.y, b->trans.y, d + r * fabsf(a->trans.y)) &&
            close_to(a->trans.z, b->trans.z, d + r * fabsf(a->trans.z));
 }
@@ -142,14 +145,15 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
                              const int *track_count, float scene_size)
 {
     int i, j;
-    if (t->have_prev) {   /* the segment seen last is now the previous one */
+    if (t->have_prev) { /* the segment seen last is now the previous one */
         memcpy(t->prev_last, t->last, sizeof *t->last * (size_t)t->num_tracks);
         memcpy(t->prev_count, t->last_count, sizeof *t->last_count * (size_t)t->num_tracks);
     }
     for (i = 0; i < t->num_tracks; i++) {
         evr_motion_key *k = keys + track_offset[i];
         int n = track_count[i];
-        if (n == 1 && t->have_prev && t->prev_count[i] == 1 && keys_close(&k[0], &t->prev_last[i], scene_size))
+        if (n == 1 && t->have_prev && t->prev_count[i] == 1 &&
+            keys_close(&k[0], &t->prev_last[i], scene_size))
             k[0] = t->prev_last[i];
         /* the same inside the segment: a key as close to the one before is that key, so that a
          * part of the segment where the track holds still is still bit for bit */
@@ -172,8 +176,8 @@ static void box_union(float lo[3], float hi[3], const float l2[3], const float h
 }
 
 /* World box of instance i over the segment, and where it was at the previous segment's end. */
-static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, float blo[3],
-                         float bhi[3])
+static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                         int i, float blo[3], float bhi[3])
 {
     const int tr = rs->instances[i].track;
     const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
@@ -194,11 +198,11 @@ static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const ev
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
-
-static double upper_norm(const evr_motion_key *k)   /* Frobenius norm of U */
+static double upper_norm(const evr_motion_key *k) /* Frobenius norm of U */
 {
     double n = 0.0;
-    for (int a = 0; a < 3; a++) n += (double)k->scale[a] * k->scale[a] + (double)k->skew[a] * k->skew[a];
+    for (int a = 0; a < 3; a++)
+        n += (double)k->scale[a] * k->scale[a] + (double)k->skew[a] * k->skew[a];
     return sqrt(n);
 }
 
@@ -218,9 +222,9 @@ static double upper_diff_norm(const evr_motion_key *a, const evr_motion_key *b)
  * change of U). */
 typedef struct {
     int n;
-    double m[EVR_MAX_KEYS][3][4]; /* each key's matrix */
-    double am[EVR_MAX_KEYS][3][3];/* |linear part|, for the box of a box (Arvo) */
-    double speed[EVR_MAX_KEYS];   /* per interval, per unit of |c| */
+    double m[EVR_MAX_KEYS][3][4];  /* each key's matrix */
+    double am[EVR_MAX_KEYS][3][3]; /* |linear part|, for the box of a box (Arvo) */
+    double speed[EVR_MAX_KEYS];    /* per interval, per unit of |c| */
 } track_sweep;
 
 static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts)
@@ -238,7 +242,8 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
     for (int k = 0; k + 1 < ts->n; k++) {
         const evr_motion_key *a = &tk.keys[k], *b = &tk.keys[k + 1];
         double d = fabs((double)evr_quat_dot(a->rot, b->rot));
-        const double qa = sqrt((double)evr_quat_dot(a->rot, a->rot)), qb = sqrt((double)evr_quat_dot(b->rot, b->rot));
+        const double qa = sqrt((double)evr_quat_dot(a->rot, a->rot)),
+                     qb = sqrt((double)evr_quat_dot(b->rot, b->rot));
         d = qa > 0.0 && qb > 0.0 ? d / (qa * qb) : 1.0;
         const double w = 2.0 * acos(d > 1.0 ? 1.0 : d) * 1.01 + 1e-6;
         ts->speed[k] = w * fmax(upper_norm(a), upper_norm(b)) + upper_diff_norm(a, b);
@@ -251,12 +256,14 @@ static void track_sweep_init(const evr_render_scene *rs, int tr, track_sweep *ts
  * translation taken as its box. evr_swept_bounds bounds the same motion more tightly, with
  * samples between the keys; this one is for many boxes of one track (a moving mesh's parts, 1,024
  * per segment on the eye), its per-track work done once in track_sweep_init. */
-static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3], float out_hi[3])
+static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3], float out_lo[3],
+                      float out_hi[3])
 {
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double pc[3] = {0.0, 0.0, 0.0}, ph[3] = {0.0, 0.0, 0.0}, r = 0.0, mag = 0.0, mc[3], mh[3];
     for (int c = 0; c < 8; c++) {
-        const double x = c & 1 ? hi[0] : lo[0], y = c & 2 ? hi[1] : lo[1], z = c & 4 ? hi[2] : lo[2];
+        const double x = c & 1 ? hi[0] : lo[0], y = c & 2 ? hi[1] : lo[1],
+                     z = c & 4 ? hi[2] : lo[2];
         r = dmax(r, sqrt(x * x + y * y + z * z));
     }
     for (int a = 0; a < 3; a++) {
@@ -265,14 +272,14 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
     }
     for (int k = 0; k < ts->n; k++) {
         double c[3], h[3];
-        for (int a = 0; a < 3; a++) {   /* the box at key k, about its translation (Arvo) */
+        for (int a = 0; a < 3; a++) { /* the box at key k, about its translation (Arvo) */
             c[a] = ts->m[k][a][0] * mc[0] + ts->m[k][a][1] * mc[1] + ts->m[k][a][2] * mc[2];
             h[a] = ts->am[k][a][0] * mh[0] + ts->am[k][a][1] * mh[1] + ts->am[k][a][2] * mh[2];
             const double t = ts->m[k][a][3];
             blo[a] = dmin(blo[a], t + c[a] - h[a]);
             bhi[a] = dmax(bhi[a], t + c[a] + h[a]);
         }
-        if (k > 0) {   /* the interval from key k - 1 */
+        if (k > 0) { /* the interval from key k - 1 */
             const double margin = 0.5 * ts->speed[k - 1] * r;
             for (int a = 0; a < 3; a++) {
                 const double t0 = ts->m[k - 1][a][3], t1 = ts->m[k][a][3];
@@ -299,10 +306,10 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
  * children. Where the part was before the segment does not matter here: a pixel's cache is
  * clean only if its rays met nothing that moved in its own segment, so it holds the static
  * scene's answer, and it holds now when its rays meet nothing where things are now. */
-static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i, int leaves,
-                      evr_skip_plan *pl, int b, track_sweep *ts)
+static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i,
+                      int leaves, evr_skip_plan *pl, int b, track_sweep *ts)
 {
-    const float (*parts)[6] = mesh_parts(t, s, rs->instances[i].mesh);
+    const float(*parts)[6] = mesh_parts(t, s, rs->instances[i].mesh);
     const int base = pl->part_first[b], per = EVR_SKIP_MESH_PARTS / leaves;
     if (!parts) {
         pl->part_first[b + 1] = base;
@@ -310,9 +317,11 @@ static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_
     }
     track_sweep_init(rs, rs->instances[i].track, ts);
     for (int l = 0; l < leaves; l++) {
-        float box[6], *lo = pl->part_lo[base + leaves - 1 + l], *hi = pl->part_hi[base + leaves - 1 + l];
+        float box[6], *lo = pl->part_lo[base + leaves - 1 + l],
+                      *hi = pl->part_hi[base + leaves - 1 + l];
         empty_box(box);
-        for (int q = l * per; q < (l + 1) * per; q++) box_union(box, box + 3, parts[q], parts[q] + 3);
+        for (int q = l * per; q < (l + 1) * per; q++)
+            box_union(box, box + 3, parts[q], parts[q] + 3);
         if (box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5]) {
             sweep_box(ts, box, box + 3, lo, hi);
         } else {
@@ -366,8 +375,8 @@ static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t, ev
     }
 }
 
-void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
-                         evr_skip_plan *pl)
+void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                         int enabled, evr_skip_plan *pl)
 {
     int i, tr, per_track = 0;
     int box_track[EVR_SKIP_MAX_BOXES];
@@ -407,7 +416,7 @@ void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_rend
             memcpy(pl->hi[b], hi, sizeof hi);
             box_track[b] = tr;
             pl->num_boxes++;
-        } else {   /* too many moving things to bound: trace all */
+        } else { /* too many moving things to bound: trace all */
             pl->num_boxes = 0;
             return;
         }
@@ -427,7 +436,8 @@ void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_rend
 
 /* Largest distance a point of box [lo, hi] (object space) moves between keys a and b: a point of
  * the box is a convex combination of its corners, and the keys' transforms are affine. */
-static float corner_move(const float lo[3], const float hi[3], const evr_motion_key *a, const evr_motion_key *b)
+static float corner_move(const float lo[3], const float hi[3], const evr_motion_key *a,
+                         const evr_motion_key *b)
 {
     evr_m34 ma = evr_motion_key_matrix(a), mb = evr_motion_key_matrix(b);
     float d = 0.0f;
@@ -467,13 +477,14 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
         const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
         float blo[3], bhi[3], r2 = 0.0f, move = 0.0f, jump = 0.0f;
         instance_box(t, s, rs, i, blo, bhi);
-        for (k = 0; k < 3; k++) {   /* distance from the camera to the box */
+        for (k = 0; k < 3; k++) { /* distance from the camera to the box */
             const float e = k == 0 ? eye.x : k == 1 ? eye.y : eye.z;
             const float d = e < blo[k] ? blo[k] - e : e > bhi[k] ? e - bhi[k] : 0.0f;
             r2 += d * d;
         }
         const evr_motion_track tk = evr_rs_track(rs, tr);
-        for (k = 0; k + 1 < tk.n; k++) move = fmaxf(move, corner_move(lo, hi, &tk.keys[k], &tk.keys[k + 1]));
+        for (k = 0; k + 1 < tk.n; k++)
+            move = fmaxf(move, corner_move(lo, hi, &tk.keys[k], &tk.keys[k + 1]));
         if (t->prev_count[tr] > 0) jump = corner_move(lo, hi, &t->prev_last[tr], &tk.keys[0]);
         const float r = sqrtf(r2);
         /* keys are close (< 120 degrees apart, 1e-5 of the scene from the curves): 1.25 covers
@@ -487,7 +498,7 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
             memcpy(pl->lo[b], blo, sizeof blo);
             memcpy(pl->hi[b], bhi, sizeof bhi);
             pl->speed[b] = 0.0f;
-        } else {   /* too many: the last box holds the rest */
+        } else { /* too many: the last box holds the rest */
             b = EVR_SKIP_MAX_BOXES - 1;
             box_union(pl->lo[b], pl->hi[b], blo, bhi);
         }

@@ -9,11 +9,11 @@
 
 typedef struct {
     int num_tracks;
-    int have_prev;                /* a previous segment's keys are known */
-    evr_motion_key *prev_last;    /* per track: the last key of the previous segment */
-    int *prev_count;              /* per track: its key count there */
-    int *moved;                   /* per track: moves in this segment or changed since the last */
-    evr_motion_key *last;         /* per track: the last key of the segment seen last */
+    int have_prev;             /* a previous segment's keys are known */
+    evr_motion_key *prev_last; /* per track: the last key of the previous segment */
+    int *prev_count;           /* per track: its key count there */
+    int *moved;                /* per track: moves in this segment or changed since the last */
+    evr_motion_key *last;      /* per track: the last key of the segment seen last */
     int *last_count;
     /* mesh parts (evr_skip_tracker_parts; NULL: the plan bounds whole meshes): per mesh NULL or
      * EVR_SKIP_MESH_PARTS object-space boxes, lo xyz hi xyz (empty: lo > hi), made when the mesh
@@ -42,8 +42,8 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
 
 /* Fills the plan of the segment whose keys the tracker saw last: enabled 0 (--no-skip) gives a
  * plan that neither reuses nor caches. rs holds the segment's keys. */
-void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int enabled,
-                         evr_skip_plan *pl);
+void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                         int enabled, evr_skip_plan *pl);
 
 /* Fills the adaptive-sampling plan (core/adaptive.h) of the same segment: the swept bounds of
  * every instance that moves in it or changed since the previous one (all of them in one box past

@@ -15,11 +15,13 @@ float evr_round_up(double x)
     return (double)f < x ? nextafterf(f, INFINITY) : f;
 }
 
-static void extend_corners(const evr_m34 *m, const float lo[3], const float hi[3], double blo[3], double bhi[3])
+static void extend_corners(const evr_m34 *m, const float lo[3], const float hi[3], double blo[3],
+                           double bhi[3])
 {
     int c, k;
     for (c = 0; c < 8; c++) {
-        evr_v3 p = evr_v3_make((c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]);
+        evr_v3 p =
+            evr_v3_make((c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]);
         evr_v3 q = evr_m34_point(m, p);
         double x[3] = {q.x, q.y, q.z};
         for (k = 0; k < 3; k++) {
@@ -30,14 +32,19 @@ static void extend_corners(const evr_m34 *m, const float lo[3], const float hi[3
 }
 
 /* |U p| for the upper-triangular part of a key. */
-static double upper_apply_len(const evr_motion_key *k, const double p[3], int diff, const evr_motion_key *b)
+static double upper_apply_len(const evr_motion_key *k, const double p[3], int diff,
+                              const evr_motion_key *b)
 {
     double s0 = k->scale[0], s1 = k->scale[1], s2 = k->scale[2];
     double k0 = k->skew[0], k1 = k->skew[1], k2 = k->skew[2];
     double x, y, z;
     if (diff) {
-        s0 = b->scale[0] - s0; s1 = b->scale[1] - s1; s2 = b->scale[2] - s2;
-        k0 = b->skew[0] - k0; k1 = b->skew[1] - k1; k2 = b->skew[2] - k2;
+        s0 = b->scale[0] - s0;
+        s1 = b->scale[1] - s1;
+        s2 = b->scale[2] - s2;
+        k0 = b->skew[0] - k0;
+        k1 = b->skew[1] - k1;
+        k2 = b->skew[2] - k2;
     }
     x = s0 * p[0] + k0 * p[1] + k1 * p[2];
     y = s1 * p[1] + k2 * p[2];
@@ -45,7 +52,8 @@ static double upper_apply_len(const evr_motion_key *k, const double p[3], int di
     return sqrt(x * x + y * y + z * z);
 }
 
-void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3], float out_hi[3])
+void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
+                      float out_hi[3])
 {
     double blo[3] = {INFINITY, INFINITY, INFINITY}, bhi[3] = {-INFINITY, -INFINITY, -INFINITY};
     double mag = 0.0;
@@ -64,17 +72,20 @@ void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr,
          * corner of the box. Each step's box is the sum of the two; the result their union.
          * Translation needs no samples: the samples follow the rotation and scaling only. */
         evr_motion_key a = tr.keys[i], b = tr.keys[i + 1];
-        double plo[3], phi[3], pt[3];   /* previous sample: Q box and T */
+        double plo[3], phi[3], pt[3]; /* previous sample: Q box and T */
         double d = fabs((double)evr_quat_dot(a.rot, b.rot));
-        double qa = sqrt((double)evr_quat_dot(a.rot, a.rot)), qb = sqrt((double)evr_quat_dot(b.rot, b.rot));
+        double qa = sqrt((double)evr_quat_dot(a.rot, a.rot)),
+               qb = sqrt((double)evr_quat_dot(b.rot, b.rot));
         double w, umax = 0.0, dumax = 0.0, L, margin;
         evr_v3 ta = a.trans, tb = b.trans;
         int steps, c;
         d = qa > 0.0 && qb > 0.0 ? d / (qa * qb) : 1.0;
         w = 2.0 * acos(d > 1.0 ? 1.0 : d) * 1.01 + 1e-6;
         for (c = 0; c < 8; c++) {
-            double p[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
-            umax = fmax(umax, fmax(upper_apply_len(&a, p, 0, NULL), upper_apply_len(&b, p, 0, NULL)));
+            double p[3] = {(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1],
+                           (c & 4) ? hi[2] : lo[2]};
+            umax =
+                fmax(umax, fmax(upper_apply_len(&a, p, 0, NULL), upper_apply_len(&b, p, 0, NULL)));
             dumax = fmax(dumax, upper_apply_len(&a, p, 1, &b));
         }
         L = w * umax + dumax;
@@ -89,7 +100,8 @@ void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr,
             evr_motion_key key = evr_motion_key_lerp(&a, &b, f);
             evr_m34 m = evr_motion_key_matrix(&key);
             evr_v3 t = evr_v3_lerp(ta, tb, f);
-            double qlo[3] = {INFINITY, INFINITY, INFINITY}, qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double qlo[3] = {INFINITY, INFINITY, INFINITY},
+                   qhi[3] = {-INFINITY, -INFINITY, -INFINITY};
             double tt[3] = {t.x, t.y, t.z};
             extend_corners(&m, lo, hi, qlo, qhi);
             if (j > 0)

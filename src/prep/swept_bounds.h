@@ -15,7 +15,8 @@ extern "C" {
  * the two samples widened by a bound on how far a point can turn or stretch in between (slerp
  * at its angular speed, scale/skew change); the union over all steps. Samples are spaced so
  * that the widening is about 1% of the object's size (at most 64 per key interval). */
-void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3], float out_hi[3]);
+void evr_swept_bounds(const float lo[3], const float hi[3], evr_motion_track tr, float out_lo[3],
+                      float out_hi[3]);
 
 /* Float bounds that hold a double value: the float at or below it, at or above it. */
 float evr_round_down(double x);

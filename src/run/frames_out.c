@@ -13,14 +13,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#define MAX_FRAMES 1000000   /* six-digit file numbers */
+#define MAX_FRAMES 1000000 /* six-digit file numbers */
 
 void evr_frame_to_srgb8(const float *linear, size_t n, float exposure, uint8_t *out)
 {
     size_t i;
     for (i = 0; i < n; i++) {
         float v = linear[i] * exposure;
-        if (!(v > 0.0f)) v = 0.0f;   /* also NaN */
+        if (!(v > 0.0f)) v = 0.0f; /* also NaN */
         if (v > 1.0f) v = 1.0f;
         out[i] = (uint8_t)lrintf(evr_linear_to_srgb(v) * 255.0f);
     }
@@ -41,16 +41,18 @@ evr_status evr_frames_plan(evr_sim *sim, evr_error *err)
 {
     int i, k;
     if (!sim->cfg.frames_out) return EVR_OK;
-    if (snprintf(sim->frames_dir, sizeof sim->frames_dir, "%s", sim->cfg.frames_out) >= (int)sizeof sim->frames_dir) {
+    if (snprintf(sim->frames_dir, sizeof sim->frames_dir, "%s", sim->cfg.frames_out) >=
+        (int)sizeof sim->frames_dir) {
         snprintf(err->msg, sizeof err->msg, "frames folder path too long");
         return EVR_ERR_ARG;
     }
-    sim->cfg.frames_out = sim->frames_dir;   /* the caller's string is not ours to keep */
+    sim->cfg.frames_out = sim->frames_dir; /* the caller's string is not ours to keep */
     sim->frames_fps = sim->cfg.frames_fps > 0.0 ? sim->cfg.frames_fps : sim->fps;
-    double n = floor(sim->duration * sim->frames_fps + 1e-9) + 1.0;   /* both ends included */
+    double n = floor(sim->duration * sim->frames_fps + 1e-9) + 1.0; /* both ends included */
     if (n > MAX_FRAMES) {
-        snprintf(err->msg, sizeof err->msg, "%.0f intensity frames (%g s at %g frames/s) is more than %d",
-                 n, sim->duration, sim->frames_fps, MAX_FRAMES);
+        snprintf(err->msg, sizeof err->msg,
+                 "%.0f intensity frames (%g s at %g frames/s) is more than %d", n, sim->duration,
+                 sim->frames_fps, MAX_FRAMES);
         return EVR_ERR_ARG;
     }
     sim->num_frames = (int)n;
@@ -60,7 +62,8 @@ evr_status evr_frames_plan(evr_sim *sim, evr_error *err)
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;
     }
-    for (k = 0; k < sim->num_frames; k++) sim->frame_times[k] = sim->cfg.start + (double)k / sim->frames_fps;
+    for (k = 0; k < sim->num_frames; k++)
+        sim->frame_times[k] = sim->cfg.start + (double)k / sim->frames_fps;
     /* segment i covers [start + i/fps, start + (i+1)/fps), the last one up to and including the end */
     for (i = 0, k = 0; i < sim->num_segments; i++) {
         int last = i + 1 == sim->num_segments;
@@ -88,7 +91,8 @@ static int is_frame_file(const char *name)
     size_t n = strlen(name);
     if (!strcmp(name, "frames.csv") || !strcmp(name, "frames.csv.tmp")) return 1;
     if (strncmp(name, "frame_", 6)) return 0;
-    return (n > 10 && !strcmp(name + n - 4, ".png")) || (n > 14 && !strcmp(name + n - 8, ".png.tmp"));
+    return (n > 10 && !strcmp(name + n - 4, ".png")) ||
+           (n > 14 && !strcmp(name + n - 8, ".png.tmp"));
 }
 
 /* Whether the folder holds frames; -1 when it cannot be read (errno set). */
@@ -117,16 +121,20 @@ evr_status evr_frames_check(const evr_sim *sim, evr_error *err)
     if (!sim->num_frames) return EVR_OK;
     if (stat(sim->frames_dir, &sb) != 0) return EVR_OK;
     if (!S_ISDIR(sb.st_mode)) {
-        snprintf(err->msg, sizeof err->msg, "frames path %s exists and is not a folder", sim->frames_dir);
+        snprintf(err->msg, sizeof err->msg, "frames path %s exists and is not a folder",
+                 sim->frames_dir);
         return EVR_ERR_ARG;
     }
     int h = holds_frames(sim->frames_dir, 0);
     if (h < 0) {
-        snprintf(err->msg, sizeof err->msg, "cannot open frames folder %s: %s", sim->frames_dir, strerror(errno));
+        snprintf(err->msg, sizeof err->msg, "cannot open frames folder %s: %s", sim->frames_dir,
+                 strerror(errno));
         return EVR_ERR_IO;
     }
     if (h && !sim->cfg.force) {
-        snprintf(err->msg, sizeof err->msg, "frames folder %s already holds frames (use --force to overwrite)", sim->frames_dir);
+        snprintf(err->msg, sizeof err->msg,
+                 "frames folder %s already holds frames (use --force to overwrite)",
+                 sim->frames_dir);
         return EVR_ERR_ARG;
     }
     return EVR_OK;
@@ -138,10 +146,11 @@ evr_status evr_frames_prepare(evr_sim *sim, evr_error *err)
     size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
     if (!sim->num_frames) return EVR_OK;
     if (stat(sim->frames_dir, &sb) == 0) {
-        if (sim->cfg.force) holds_frames(sim->frames_dir, 1);   /* stale frames of an earlier run */
+        if (sim->cfg.force) holds_frames(sim->frames_dir, 1); /* stale frames of an earlier run */
     } else {
         if (evr_mkdir_p(sim->frames_dir) != 0) {
-            snprintf(err->msg, sizeof err->msg, "cannot create frames folder %s: %s", sim->frames_dir, strerror(errno));
+            snprintf(err->msg, sizeof err->msg, "cannot create frames folder %s: %s",
+                     sim->frames_dir, strerror(errno));
             return EVR_ERR_IO;
         }
         sim->created_frames_dir = 1;
@@ -170,7 +179,7 @@ evr_status evr_frames_write(evr_sim *sim, int k, const float *linear, evr_error 
     frame_names(k, n8, n16, sizeof n8);
     evr_frame_to_srgb8(linear, npix, sim->cfg.frames_exposure, sim->frame8);
     evr_frame_to_linear16(linear, npix, sim->cfg.frames_max, sim->frame16);
-    sim->frames_written = k + 1;   /* for discard: either file may be on disk from here on */
+    sim->frames_written = k + 1; /* for discard: either file may be on disk from here on */
     if ((size_t)snprintf(p, sizeof p, "%s/%s", sim->frames_dir, n8) >= sizeof p) {
         snprintf(err->msg, sizeof err->msg, "frames folder path too long");
         return EVR_ERR_ARG;

@@ -32,26 +32,31 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
     char p[4200];
     if (stat(sim->out_dir, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode)) {
-            snprintf(err->msg, sizeof err->msg, "output path %s exists and is not a folder", sim->out_dir);
+            snprintf(err->msg, sizeof err->msg, "output path %s exists and is not a folder",
+                     sim->out_dir);
             return EVR_ERR_ARG;
         }
         DIR *d = opendir(sim->out_dir);
         struct dirent *de;
         int empty = 1;
         if (!d) {
-            snprintf(err->msg, sizeof err->msg, "cannot open output folder %s: %s", sim->out_dir, strerror(errno));
+            snprintf(err->msg, sizeof err->msg, "cannot open output folder %s: %s", sim->out_dir,
+                     strerror(errno));
             return EVR_ERR_IO;
         }
         while ((de = readdir(d)) != NULL)
             if (strcmp(de->d_name, ".") && strcmp(de->d_name, "..")) empty = 0;
         closedir(d);
         if (!empty && !sim->cfg.force) {
-            snprintf(err->msg, sizeof err->msg, "run folder %s already exists and is not empty (use --force to overwrite)", sim->out_dir);
+            snprintf(err->msg, sizeof err->msg,
+                     "run folder %s already exists and is not empty (use --force to overwrite)",
+                     sim->out_dir);
             return EVR_ERR_ARG;
         }
     } else {
         if (evr_mkdir_p(sim->out_dir) != 0) {
-            snprintf(err->msg, sizeof err->msg, "cannot create output folder %s: %s", sim->out_dir, strerror(errno));
+            snprintf(err->msg, sizeof err->msg, "cannot create output folder %s: %s", sim->out_dir,
+                     strerror(errno));
             return EVR_ERR_IO;
         }
         sim->created_dir = 1;
@@ -81,7 +86,8 @@ evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
     meta.height = sim->cfg.height;
     meta.config_json = sim->config_json;
     /* timestamps end with the run, moved by jitter and rounding to the resolution */
-    meta.max_t_us = (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + sim->timestamp_slack_us + 1;
+    meta.max_t_us =
+        (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + sim->timestamp_slack_us + 1;
     for (i = 0; i < count && i < EVR_MAX_WRITERS; i++) {
         if (!(sim->cfg.formats & (1 << i))) continue;
         if ((st = path_join(p, sizeof p, sim->out_dir, formats[i]->file, err)) != EVR_OK) return st;
@@ -114,7 +120,7 @@ evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, e
     int64_t start_us = (int64_t)llround(sim->cfg.start * 1e6);
     while (i < n) {
         int64_t frame = (ev[i].t - start_us) / sim->preview_window_us;
-        while (frame > sim->preview_frame) {   /* frames with no events are written too */
+        while (frame > sim->preview_frame) { /* frames with no events are written too */
             if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
             sim->preview_frame++;
         }
@@ -131,27 +137,32 @@ evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, e
 static int intensity_frame_due(const evr_sim *sim, int64_t frame, double t, int last)
 {
     int64_t rel_us = (int64_t)llround((t - sim->cfg.start) * 1e6);
-    return (frame + 1) * sim->preview_window_us <= rel_us || (last && frame * sim->preview_window_us < rel_us);
+    return (frame + 1) * sim->preview_window_us <= rel_us ||
+           (last && frame * sim->preview_window_us < rel_us);
 }
 
 int evr_run_preview_due(const evr_sim *sim, double t, int last)
 {
-    if (!sim->preview.width) return 0;   /* previews off */
+    if (!sim->preview.width) return 0; /* previews off */
     /* frames already due at an earlier segment end are written when that one is collected */
     int64_t next = sim->intensity_frame;
-    while (sim->preview_window_us > 0 && intensity_frame_due(sim, next, t - 1.0 / sim->fps, 0)) next++;
+    while (sim->preview_window_us > 0 && intensity_frame_due(sim, next, t - 1.0 / sim->fps, 0))
+        next++;
     return intensity_frame_due(sim, next, t, last);
 }
 
-evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last, evr_error *err)
+evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last,
+                                     evr_error *err)
 {
     char name[64], p[4200];
     evr_status st;
     if (!sim->preview.width) return EVR_OK;
     while (intensity_frame_due(sim, sim->intensity_frame, t, last)) {
-        snprintf(name, sizeof name, "preview/intensity_%06lld.png", (long long)sim->intensity_frame);
+        snprintf(name, sizeof name, "preview/intensity_%06lld.png",
+                 (long long)sim->intensity_frame);
         if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
-        if ((st = evr_preview_intensity_png(p, intensity, sim->cfg.width, sim->cfg.height, err)) != EVR_OK)
+        if ((st = evr_preview_intensity_png(p, intensity, sim->cfg.width, sim->cfg.height, err)) !=
+            EVR_OK)
             return st;
         sim->intensity_frame++;
     }
@@ -166,93 +177,165 @@ static char *run_json(const evr_sim *sim)
     int i;
     long tris = 0;
     char buf[64];
-    for (i = 0; i < sc->num_instances; i++) tris += (long)sc->meshes[sc->instances[i].mesh].num_triangles;
+    for (i = 0; i < sc->num_instances; i++)
+        tris += (long)sc->meshes[sc->instances[i].mesh].num_triangles;
     evr_json_init(&j, 1);
     evr_json_begin_object(&j);
-    evr_json_key(&j, "evray_version"); evr_json_string(&j, EVR_VERSION);
-    evr_json_key(&j, "versions"); evr_json_begin_object(&j);
-    snprintf(buf, sizeof buf, "%u.%u.%u", aiGetVersionMajor(), aiGetVersionMinor(), aiGetVersionPatch());
-    evr_json_key(&j, "assimp"); evr_json_string(&j, buf);
-    evr_json_key(&j, "embree"); evr_json_string(&j, RTC_VERSION_STRING);
+    evr_json_key(&j, "evray_version");
+    evr_json_string(&j, EVR_VERSION);
+    evr_json_key(&j, "versions");
+    evr_json_begin_object(&j);
+    snprintf(buf, sizeof buf, "%u.%u.%u", aiGetVersionMajor(), aiGetVersionMinor(),
+             aiGetVersionPatch());
+    evr_json_key(&j, "assimp");
+    evr_json_string(&j, buf);
+    evr_json_key(&j, "embree");
+    evr_json_string(&j, RTC_VERSION_STRING);
     snprintf(buf, sizeof buf, "%d.%d.%d", H5_VERS_MAJOR, H5_VERS_MINOR, H5_VERS_RELEASE);
-    evr_json_key(&j, "hdf5"); evr_json_string(&j, buf);
+    evr_json_key(&j, "hdf5");
+    evr_json_string(&j, buf);
     evr_json_end_object(&j);
-    evr_json_key(&j, "config"); evr_json_begin_object(&j);
-    evr_json_end_object(&j);   /* replaced below by the full configuration text */
-    evr_json_key(&j, "scene"); evr_json_begin_object(&j);
-    evr_json_key(&j, "source"); evr_json_string(&j, sc->source);
-    evr_json_key(&j, "camera"); evr_json_string(&j, sc->cameras[sim->camera].name);
-    evr_json_key(&j, "automatic_camera"); evr_json_boolean(&j, sc->cameras[sim->camera].automatic);
-    evr_json_key(&j, "default_light"); evr_json_boolean(&j, sc->default_light);
-    evr_json_key(&j, "instances"); evr_json_integer(&j, sc->num_instances);
-    evr_json_key(&j, "triangles"); evr_json_integer(&j, tris);
-    evr_json_key(&j, "lights"); evr_json_integer(&j, sc->num_lights);
-    evr_json_key(&j, "animation_end"); evr_json_number(&j, sc->anim_end);
+    evr_json_key(&j, "config");
+    evr_json_begin_object(&j);
+    evr_json_end_object(&j); /* replaced below by the full configuration text */
+    evr_json_key(&j, "scene");
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "source");
+    evr_json_string(&j, sc->source);
+    evr_json_key(&j, "camera");
+    evr_json_string(&j, sc->cameras[sim->camera].name);
+    evr_json_key(&j, "automatic_camera");
+    evr_json_boolean(&j, sc->cameras[sim->camera].automatic);
+    evr_json_key(&j, "default_light");
+    evr_json_boolean(&j, sc->default_light);
+    evr_json_key(&j, "instances");
+    evr_json_integer(&j, sc->num_instances);
+    evr_json_key(&j, "triangles");
+    evr_json_integer(&j, tris);
+    evr_json_key(&j, "lights");
+    evr_json_integer(&j, sc->num_lights);
+    evr_json_key(&j, "animation_end");
+    evr_json_number(&j, sc->anim_end);
     evr_json_end_object(&j);
-    evr_json_key(&j, "outputs"); evr_json_begin_array(&j);
+    evr_json_key(&j, "outputs");
+    evr_json_begin_array(&j);
     for (i = 0; i < sim->num_writers; i++) evr_json_string(&j, sim->writer_names[i]);
     evr_json_end_array(&j);
-    evr_json_key(&j, "backend"); evr_json_string(&j, s->backend);
-    evr_json_key(&j, "device"); evr_json_string(&j, s->device);
-    if (s->notice[0]) { evr_json_key(&j, "notice"); evr_json_string(&j, s->notice); }
-    evr_json_key(&j, "stats"); evr_json_begin_object(&j);
-    evr_json_key(&j, "events"); evr_json_unsigned(&j, s->events_on + s->events_off);
-    evr_json_key(&j, "events_on"); evr_json_unsigned(&j, s->events_on);
-    evr_json_key(&j, "events_off"); evr_json_unsigned(&j, s->events_off);
-    evr_json_key(&j, "unique_timestamps"); evr_json_unsigned(&j, s->unique_timestamps);
-    evr_json_key(&j, "samples"); evr_json_unsigned(&j, s->samples);
-    evr_json_key(&j, "rays"); evr_json_unsigned(&j, s->rays);
+    evr_json_key(&j, "backend");
+    evr_json_string(&j, s->backend);
+    evr_json_key(&j, "device");
+    evr_json_string(&j, s->device);
+    if (s->notice[0]) {
+        evr_json_key(&j, "notice");
+        evr_json_string(&j, s->notice);
+    }
+    evr_json_key(&j, "stats");
+    evr_json_begin_object(&j);
+    evr_json_key(&j, "events");
+    evr_json_unsigned(&j, s->events_on + s->events_off);
+    evr_json_key(&j, "events_on");
+    evr_json_unsigned(&j, s->events_on);
+    evr_json_key(&j, "events_off");
+    evr_json_unsigned(&j, s->events_off);
+    evr_json_key(&j, "unique_timestamps");
+    evr_json_unsigned(&j, s->unique_timestamps);
+    evr_json_key(&j, "samples");
+    evr_json_unsigned(&j, s->samples);
+    evr_json_key(&j, "rays");
+    evr_json_unsigned(&j, s->rays);
     /* change-driven sampling: samples is what brute force takes, samples_traced what was traced */
-    evr_json_key(&j, "samples_traced"); evr_json_unsigned(&j, s->samples_traced);
-    evr_json_key(&j, "pixels_skipped"); evr_json_unsigned(&j, s->pixels_skipped);
-    evr_json_key(&j, "equivalent_samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
-    evr_json_key(&j, "traced_samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples_traced / s->wall_time : 0.0);
+    evr_json_key(&j, "samples_traced");
+    evr_json_unsigned(&j, s->samples_traced);
+    evr_json_key(&j, "pixels_skipped");
+    evr_json_unsigned(&j, s->pixels_skipped);
+    evr_json_key(&j, "equivalent_samples_per_second");
+    evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
+    evr_json_key(&j, "traced_samples_per_second");
+    evr_json_number(&j, s->wall_time > 0 ? (double)s->samples_traced / s->wall_time : 0.0);
     if (sim->skipped_per_segment) {
         int seg;
         evr_json_key(&j, "pixels_skipped_per_segment");
         evr_json_begin_array(&j);
-        for (seg = 0; seg < s->segments_done; seg++) evr_json_unsigned(&j, sim->skipped_per_segment[seg]);
+        for (seg = 0; seg < s->segments_done; seg++)
+            evr_json_unsigned(&j, sim->skipped_per_segment[seg]);
         evr_json_end_array(&j);
     }
-    if (sim->cfg.gi) {   /* the photon passes (a still segment reuses the previous segment's photons) */
-        evr_json_key(&j, "photon_passes"); evr_json_unsigned(&j, sim->backend->photon_passes);
-        evr_json_key(&j, "photons_traced"); evr_json_unsigned(&j, sim->backend->photons_traced);
-        evr_json_key(&j, "photons_reused"); evr_json_unsigned(&j, sim->backend->photons_reused);
-        evr_json_key(&j, "photons_stored"); evr_json_unsigned(&j, sim->backend->photons_stored);
-        evr_json_key(&j, "photon_collisions"); evr_json_unsigned(&j, sim->backend->photon_collisions);
-        evr_json_key(&j, "photon_cells_changed"); evr_json_unsigned(&j, sim->backend->photon_cells_changed);
-        evr_json_key(&j, "time_photons_seconds"); evr_json_number(&j, sim->backend->photon_seconds);
+    if (sim->cfg
+            .gi) { /* the photon passes (a still segment reuses the previous segment's photons) */
+        evr_json_key(&j, "photon_passes");
+        evr_json_unsigned(&j, sim->backend->photon_passes);
+        evr_json_key(&j, "photons_traced");
+        evr_json_unsigned(&j, sim->backend->photons_traced);
+        evr_json_key(&j, "photons_reused");
+        evr_json_unsigned(&j, sim->backend->photons_reused);
+        evr_json_key(&j, "photons_stored");
+        evr_json_unsigned(&j, sim->backend->photons_stored);
+        evr_json_key(&j, "photon_collisions");
+        evr_json_unsigned(&j, sim->backend->photon_collisions);
+        evr_json_key(&j, "photon_cells_changed");
+        evr_json_unsigned(&j, sim->backend->photon_cells_changed);
+        evr_json_key(&j, "time_photons_seconds");
+        evr_json_number(&j, sim->backend->photon_seconds);
     }
-    evr_json_key(&j, "segments"); evr_json_integer(&j, s->segments_done);
-    evr_json_key(&j, "segments_planned"); evr_json_integer(&j, s->segments_total);
-    evr_json_key(&j, "interrupted"); evr_json_boolean(&j, s->interrupted);
-    evr_json_key(&j, "simulated_seconds"); evr_json_number(&j, s->sim_time);
-    evr_json_key(&j, "wall_seconds"); evr_json_number(&j, s->wall_time);
-    evr_json_key(&j, "samples_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
-    evr_json_key(&j, "rays_per_second"); evr_json_number(&j, s->wall_time > 0 ? (double)s->rays / s->wall_time : 0.0);
-    evr_json_key(&j, "realtime_factor"); evr_json_number(&j, s->wall_time > 0 ? s->sim_time / s->wall_time : 0.0);
-    {   /* adaptive sampling: samples are those taken (all traced), their rate varies per pixel */
+    evr_json_key(&j, "segments");
+    evr_json_integer(&j, s->segments_done);
+    evr_json_key(&j, "segments_planned");
+    evr_json_integer(&j, s->segments_total);
+    evr_json_key(&j, "interrupted");
+    evr_json_boolean(&j, s->interrupted);
+    evr_json_key(&j, "simulated_seconds");
+    evr_json_number(&j, s->sim_time);
+    evr_json_key(&j, "wall_seconds");
+    evr_json_number(&j, s->wall_time);
+    evr_json_key(&j, "samples_per_second");
+    evr_json_number(&j, s->wall_time > 0 ? (double)s->samples / s->wall_time : 0.0);
+    evr_json_key(&j, "rays_per_second");
+    evr_json_number(&j, s->wall_time > 0 ? (double)s->rays / s->wall_time : 0.0);
+    evr_json_key(&j, "realtime_factor");
+    evr_json_number(&j, s->wall_time > 0 ? s->sim_time / s->wall_time : 0.0);
+    { /* adaptive sampling: samples are those taken (all traced), their rate varies per pixel */
         double pix_s = (double)sim->cfg.width * (double)sim->cfg.height * s->sim_time;
         double spps = pix_s > 0.0 ? (double)s->samples / pix_s : 0.0;
-        evr_json_key(&j, "samples_per_pixel_per_second"); evr_json_number(&j, spps);
+        evr_json_key(&j, "samples_per_pixel_per_second");
+        evr_json_number(&j, spps);
         evr_json_key(&j, "mean_sample_interval_seconds");
-        evr_json_number(&j, sim->setup.adaptive ? (spps > 0.0 ? 1.0 / spps : 0.0) : 1.0 / (sim->fps * sim->cfg.samples_per_frame));
+        evr_json_number(&j, sim->setup.adaptive ? (spps > 0.0 ? 1.0 / spps : 0.0)
+                                                : 1.0 / (sim->fps * sim->cfg.samples_per_frame));
     }
-    evr_json_key(&j, "time_setup_seconds"); evr_json_number(&j, sim->time_setup);
-    evr_json_key(&j, "time_render_seconds"); evr_json_number(&j, sim->time_render);
-    evr_json_key(&j, "time_motion_seconds"); evr_json_number(&j, sim->time_motion);
-    evr_json_key(&j, "time_plan_wait_seconds"); evr_json_number(&j, sim->time_plan_wait);
-    evr_json_key(&j, "time_device_seconds"); evr_json_number(&j, sim->backend->device_seconds);
-    evr_json_key(&j, "time_device_wait_seconds"); evr_json_number(&j, sim->backend->wait_seconds);
-    evr_json_key(&j, "device_samples_per_second"); evr_json_number(&j, sim->backend->device_seconds > 0 ? (double)s->samples / sim->backend->device_seconds : 0.0);
-    evr_json_key(&j, "time_sort_seconds"); evr_json_number(&j, s->time_sort);
-    evr_json_key(&j, "time_copy_seconds"); evr_json_number(&j, s->time_copy);
-    evr_json_key(&j, "device_memory_bytes"); evr_json_unsigned(&j, s->device_memory);
-    evr_json_key(&j, "time_write_wait_seconds"); evr_json_number(&j, sim->time_write);
-    evr_json_key(&j, "time_write_thread_seconds"); evr_json_number(&j, sim->time_write_thread);
-    evr_json_key(&j, "time_preview_seconds"); evr_json_number(&j, sim->time_preview);
-    evr_json_key(&j, "preview_frames"); evr_json_integer(&j, sim->previews_written);
-    if (sim->num_frames) { evr_json_key(&j, "intensity_frames"); evr_json_integer(&j, sim->frames_written); }
+    evr_json_key(&j, "time_setup_seconds");
+    evr_json_number(&j, sim->time_setup);
+    evr_json_key(&j, "time_render_seconds");
+    evr_json_number(&j, sim->time_render);
+    evr_json_key(&j, "time_motion_seconds");
+    evr_json_number(&j, sim->time_motion);
+    evr_json_key(&j, "time_plan_wait_seconds");
+    evr_json_number(&j, sim->time_plan_wait);
+    evr_json_key(&j, "time_device_seconds");
+    evr_json_number(&j, sim->backend->device_seconds);
+    evr_json_key(&j, "time_device_wait_seconds");
+    evr_json_number(&j, sim->backend->wait_seconds);
+    evr_json_key(&j, "device_samples_per_second");
+    evr_json_number(&j, sim->backend->device_seconds > 0
+                            ? (double)s->samples / sim->backend->device_seconds
+                            : 0.0);
+    evr_json_key(&j, "time_sort_seconds");
+    evr_json_number(&j, s->time_sort);
+    evr_json_key(&j, "time_copy_seconds");
+    evr_json_number(&j, s->time_copy);
+    evr_json_key(&j, "device_memory_bytes");
+    evr_json_unsigned(&j, s->device_memory);
+    evr_json_key(&j, "time_write_wait_seconds");
+    evr_json_number(&j, sim->time_write);
+    evr_json_key(&j, "time_write_thread_seconds");
+    evr_json_number(&j, sim->time_write_thread);
+    evr_json_key(&j, "time_preview_seconds");
+    evr_json_number(&j, sim->time_preview);
+    evr_json_key(&j, "preview_frames");
+    evr_json_integer(&j, sim->previews_written);
+    if (sim->num_frames) {
+        evr_json_key(&j, "intensity_frames");
+        evr_json_integer(&j, sim->frames_written);
+    }
     evr_json_end_object(&j);
     evr_json_end_object(&j);
     char *text = evr_json_take(&j);
@@ -263,7 +346,10 @@ static char *run_json(const evr_sim *sim)
     if (!at) return text;
     size_t before = (size_t)(at - text), clen = strlen(sim->config_json), mlen = strlen(marker);
     char *out = malloc(strlen(text) + clen + 16);
-    if (!out) { free(text); return NULL; }
+    if (!out) {
+        free(text);
+        return NULL;
+    }
     memcpy(out, text, before);
     memcpy(out + before, "\"config\": ", 10);
     memcpy(out + before + 10, sim->config_json, clen);
@@ -317,7 +403,10 @@ evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
         snprintf(err->msg, sizeof err->msg, "out of memory writing run.json");
         return EVR_ERR_NOMEM;
     }
-    if ((st = path_join(p, sizeof p, sim->out_dir, "run.json", err)) != EVR_OK) { free(text); return st; }
+    if ((st = path_join(p, sizeof p, sim->out_dir, "run.json", err)) != EVR_OK) {
+        free(text);
+        return st;
+    }
     snprintf(tmp, sizeof tmp, "%s.tmp", p);
     FILE *f = fopen(tmp, "w");
     int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
@@ -336,7 +425,7 @@ void evr_run_dir_discard(evr_sim *sim)
     int w;
     char p[4200];
     evr_frames_discard(sim);
-    evr_write_queue_stop(sim->wq);   /* the thread must be done with the writers */
+    evr_write_queue_stop(sim->wq); /* the thread must be done with the writers */
     sim->wq = NULL;
     for (w = 0; w < sim->num_writers; w++) {
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
@@ -349,7 +438,8 @@ void evr_run_dir_discard(evr_sim *sim)
         struct dirent *de;
         char f[4600];
         while ((de = readdir(d)) != NULL) {
-            if (strncmp(de->d_name, "events_", 7) && strncmp(de->d_name, "intensity_", 10)) continue;
+            if (strncmp(de->d_name, "events_", 7) && strncmp(de->d_name, "intensity_", 10))
+                continue;
             snprintf(f, sizeof f, "%s/%s", p, de->d_name);
             remove(f);
         }

@@ -11,7 +11,8 @@ evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, e
 /* Whether a segment ending at absolute time t ends a preview window (so its intensities are due). */
 int evr_run_preview_due(const evr_sim *sim, double t, int last);
 /* At a segment end (absolute time t): writes the intensity previews of the windows it ends. */
-evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last, evr_error *err);
+evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last,
+                                     evr_error *err);
 /* Completes every writer, the last preview and the frames' list. */
 evr_status evr_run_close(evr_sim *sim, evr_error *err);
 /* Writes run.json (after evr_run_close, with the statistics final). */

@@ -14,10 +14,10 @@ struct evr_planner {
     int started;
     pthread_mutex_t mu;
     pthread_cond_t cv;
-    int planned;      /* segments 0 .. planned - 1 are planned */
-    int released;     /* the slots of segments 0 .. released - 1 are free again */
+    int planned;  /* segments 0 .. planned - 1 are planned */
+    int released; /* the slots of segments 0 .. released - 1 are free again */
     int stop;
-    double busy;      /* seconds in fn */
+    double busy; /* seconds in fn */
 };
 
 static void plan_one(evr_planner *p, int i)
@@ -46,7 +46,8 @@ static void *planner_main(void *arg)
     return NULL;
 }
 
-evr_planner *evr_planner_start(int num_segments, size_t keys_cap, int num_tracks, evr_plan_fn fn, void *user)
+evr_planner *evr_planner_start(int num_segments, size_t keys_cap, int num_tracks, evr_plan_fn fn,
+                               void *user)
 {
     evr_planner *p = calloc(1, sizeof *p);
     if (!p) return NULL;

@@ -14,12 +14,13 @@
 #include "core/skip.h"
 
 #ifndef EVR_PLANNER_SLOTS
-#define EVR_PLANNER_SLOTS 32   /* 53 KB each; with 8 the H100 loop waited 0.15-0.24 s for the 30 s eye's plans, with 32 0.02 s */
+#define EVR_PLANNER_SLOTS \
+    32 /* 53 KB each; with 8 the H100 loop waited 0.15-0.24 s for the 30 s eye's plans, with 32 0.02 s */
 #endif
 
 typedef struct {
-    evr_motion_key *keys;              /* room for keys_cap keys */
-    int *track_offset, *track_count;   /* num_tracks each */
+    evr_motion_key *keys;            /* room for keys_cap keys */
+    int *track_offset, *track_count; /* num_tracks each */
     int num_keys;
     evr_skip_plan plan;
     evr_adapt_plan adapt;
@@ -32,7 +33,8 @@ typedef struct evr_planner evr_planner;
 
 /* Starts planning segments 0 .. num_segments - 1 with fn. NULL when out of memory; without a
  * thread (it could not be started) evr_planner_take plans on the caller's. */
-evr_planner *evr_planner_start(int num_segments, size_t keys_cap, int num_tracks, evr_plan_fn fn, void *user);
+evr_planner *evr_planner_start(int num_segments, size_t keys_cap, int num_tracks, evr_plan_fn fn,
+                               void *user);
 
 /* Segment `segment`'s plan, once made (segments are taken in order). */
 const evr_planned_segment *evr_planner_take(evr_planner *p, int segment);

@@ -18,14 +18,14 @@ struct evr_write_queue {
     double flush_seconds;
     pthread_t thread;
     pthread_mutex_t mu;
-    pthread_cond_t cv;     /* on CLOCK_MONOTONIC, the host clock, for the timed flush */
+    pthread_cond_t cv; /* on CLOCK_MONOTONIC, the host clock, for the timed flush */
     evr_event_vec slots[QUEUE_SLOTS];
-    int head, count;       /* pending batches: slots[head], slots[head + 1], ... */
-    int busy;              /* the thread is writing the batch at head, or flushing */
-    int dirty;             /* batches written since the last flush */
-    double last_flush;     /* host seconds */
+    int head, count;   /* pending batches: slots[head], slots[head + 1], ... */
+    int busy;          /* the thread is writing the batch at head, or flushing */
+    int dirty;         /* batches written since the last flush */
+    double last_flush; /* host seconds */
     int stop;
-    evr_status status;     /* first error of the writer thread */
+    evr_status status; /* first error of the writer thread */
     evr_error err;
     double busy_seconds, wait_seconds;
 };
@@ -36,8 +36,10 @@ static evr_status write_batch(evr_write_queue *q, const evr_event_vec *v, int fl
 {
     evr_status st = EVR_OK;
     int w;
-    for (w = 0; v && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->write(q->writers[w], v->data, v->n, err);
-    for (w = 0; flush && w < q->num_writers && st == EVR_OK; w++) st = q->writers[w]->flush(q->writers[w], err);
+    for (w = 0; v && w < q->num_writers && st == EVR_OK; w++)
+        st = q->writers[w]->write(q->writers[w], v->data, v->n, err);
+    for (w = 0; flush && w < q->num_writers && st == EVR_OK; w++)
+        st = q->writers[w]->flush(q->writers[w], err);
     return st;
 }
 
@@ -85,14 +87,14 @@ static void *writer_main(void *arg)
             if (!q->dirty) {
                 pthread_cond_wait(&q->cv, &q->mu);
             } else if (evr_host_seconds() >= due) {
-                run_batch(q, NULL, 1);   /* idle since a batch: make it durable now */
+                run_batch(q, NULL, 1); /* idle since a batch: make it durable now */
                 pthread_cond_broadcast(&q->cv);
             } else {
                 struct timespec ts = host_deadline(due);
                 pthread_cond_timedwait(&q->cv, &q->mu, &ts);
             }
         }
-        if (!q->count) break;   /* stop requested and nothing pending */
+        if (!q->count) break; /* stop requested and nothing pending */
         evr_event_vec *v = &q->slots[q->head];
         q->dirty = 1;
         run_batch(q, v, evr_host_seconds() >= q->last_flush + q->flush_seconds);
@@ -105,8 +107,8 @@ static void *writer_main(void *arg)
     return NULL;
 }
 
-evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, double flush_seconds,
-                                 evr_write_queue **out, evr_error *err)
+evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers,
+                                 double flush_seconds, evr_write_queue **out, evr_error *err)
 {
     evr_write_queue *q = calloc(1, sizeof *q);
     pthread_condattr_t ca;
@@ -119,12 +121,13 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     for (i = 0; i < num_writers; i++) q->writers[i] = writers[i];
     q->num_writers = num_writers;
     q->flush_seconds = flush_seconds;
-    q->last_flush = evr_host_seconds();   /* the writers' files are valid when opened */
+    q->last_flush = evr_host_seconds(); /* the writers' files are valid when opened */
     q->status = EVR_OK;
     pthread_mutex_init(&q->mu, NULL);
     ok = pthread_condattr_init(&ca) == 0;
     if (ok) {
-        ok = pthread_condattr_setclock(&ca, CLOCK_MONOTONIC) == 0 && pthread_cond_init(&q->cv, &ca) == 0;
+        ok = pthread_condattr_setclock(&ca, CLOCK_MONOTONIC) == 0 &&
+             pthread_cond_init(&q->cv, &ca) == 0;
         pthread_condattr_destroy(&ca);
     }
     if (ok && pthread_create(&q->thread, NULL, writer_main, q) != 0) {

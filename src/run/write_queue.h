@@ -17,13 +17,14 @@
 
 typedef struct evr_write_queue evr_write_queue;
 
-evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers, double flush_seconds,
-                                 evr_write_queue **out, evr_error *err);
+evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers,
+                                 double flush_seconds, evr_write_queue **out, evr_error *err);
 /* Queues the first n events of v for writing and returns (waits only while eight batches are
  * pending) without copying them: the queue takes v's buffer and gives v one of its own holding
  * the rest of v (v->data[n .. v->n)), which is usually short. Fails with the writer thread's
  * first error, if any. */
-evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n, evr_error *err);
+evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n,
+                                     evr_error *err);
 /* Waits until everything pushed is written (not necessarily flushed: the writers' finish()
  * completes the files); returns the first error, if any. */
 evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err);

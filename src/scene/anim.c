@@ -13,7 +13,7 @@
  * handled t before the first and after the last key. */
 static int curve_interval(const evr_curve *c, double t)
 {
-    int lo = 0, hi = c->num_keys - 1;   /* times[lo] <= t < times[hi] */
+    int lo = 0, hi = c->num_keys - 1; /* times[lo] <= t < times[hi] */
     while (hi - lo > 1) {
         int mid = lo + (hi - lo) / 2;
         if (c->times[mid] <= t) lo = mid;
@@ -28,7 +28,8 @@ static evr_v3 curve_v3(const evr_curve *c, double t)
     const float *v = c->values;
     int n = c->num_keys, i;
     if (n == 1 || t <= c->times[0]) return evr_v3_make(v[0], v[1], v[2]);
-    if (t >= c->times[n - 1]) return evr_v3_make(v[3 * (n - 1)], v[3 * (n - 1) + 1], v[3 * (n - 1) + 2]);
+    if (t >= c->times[n - 1])
+        return evr_v3_make(v[3 * (n - 1)], v[3 * (n - 1) + 1], v[3 * (n - 1) + 2]);
     i = curve_interval(c, t);
     {
         const float *a = v + 3 * i, *b = v + 3 * (i + 1);
@@ -36,7 +37,8 @@ static evr_v3 curve_v3(const evr_curve *c, double t)
         float f;
         /* a value held between two equal keys is held exactly (float lerp can be off in the last
          * bit, which would count as motion) */
-        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 3 * sizeof *a)) return evr_v3_make(a[0], a[1], a[2]);
+        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 3 * sizeof *a))
+            return evr_v3_make(a[0], a[1], a[2]);
         f = (float)((t - c->times[i]) / dt);
         return evr_v3_lerp(evr_v3_make(a[0], a[1], a[2]), evr_v3_make(b[0], b[1], b[2]), f);
     }
@@ -57,8 +59,10 @@ static evr_quat curve_quat(const evr_curve *c, double t)
         const float *a = v + 4 * i, *b = v + 4 * (i + 1);
         double dt = c->times[i + 1] - c->times[i];
         evr_quat qa = evr_quat_make(a[0], a[1], a[2], a[3]);
-        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 4 * sizeof *a)) return qa;   /* held exactly */
-        return evr_quat_slerp(qa, evr_quat_make(b[0], b[1], b[2], b[3]), (float)((t - c->times[i]) / dt));
+        if (c->interp == EVR_INTERP_STEP || dt <= 0.0 || !memcmp(a, b, 4 * sizeof *a))
+            return qa; /* held exactly */
+        return evr_quat_slerp(qa, evr_quat_make(b[0], b[1], b[2], b[3]),
+                              (float)((t - c->times[i]) / dt));
     }
 }
 
@@ -74,7 +78,9 @@ static evr_m34 trs_matrix(evr_v3 t, evr_quat q, evr_v3 s)
         m.m[i][1] = r[i][1] * s.y;
         m.m[i][2] = r[i][2] * s.z;
     }
-    m.m[0][3] = t.x; m.m[1][3] = t.y; m.m[2][3] = t.z;
+    m.m[0][3] = t.x;
+    m.m[1][3] = t.y;
+    m.m[2][3] = t.z;
     return m;
 }
 
@@ -153,14 +159,17 @@ static float probe_error(const evr_m34 *a, const evr_m34 *b, const evr_v3 *p, in
 
 /* Appends the key times of a node's curves and its ancestors' curves that lie strictly inside
  * (t0, t1): where a piecewise curve bends, the check must look. Returns the new count. */
-static int inner_key_times(const evr_scene *s, int node, double t0, double t1, double *out, int n, int cap)
+static int inner_key_times(const evr_scene *s, int node, double t0, double t1, double *out, int n,
+                           int cap)
 {
     int guard = 0;
     while (node >= 0 && node < s->num_nodes && guard++ <= s->num_nodes) {
         const evr_node *nd = &s->nodes[node];
         const evr_curve *cv[3];
         int c, k;
-        cv[0] = &nd->t_curve; cv[1] = &nd->r_curve; cv[2] = &nd->s_curve;
+        cv[0] = &nd->t_curve;
+        cv[1] = &nd->r_curve;
+        cv[2] = &nd->s_curve;
         for (c = 0; c < 3; c++) {
             for (k = 0; k < cv[c]->num_keys && n < cap; k++) {
                 double tk = cv[c]->times[k];
@@ -173,10 +182,7 @@ static int inner_key_times(const evr_scene *s, int node, double t0, double t1, d
 }
 
 /* Rotation step between two unit quaternions is below 120 degrees: |dot| > cos(60 degrees). */
-static int rotation_step_ok(evr_quat a, evr_quat b)
-{
-    return fabsf(evr_quat_dot(a, b)) > 0.5f;
-}
+static int rotation_step_ok(evr_quat a, evr_quat b) { return fabsf(evr_quat_dot(a, b)) > 0.5f; }
 
 #define EVR_MAX_INNER_TIMES 256
 
@@ -193,7 +199,8 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
         evr_m34 m0 = evr_node_world_at(s, node, t0);
         keys[0] = evr_motion_key_from_matrix(&m0);
     }
-    if (max_keys < 2 || node < 0 || node >= s->num_nodes || !(t1 > t0) || !evr_node_chain_animated(s, node))
+    if (max_keys < 2 || node < 0 || node >= s->num_nodes || !(t1 > t0) ||
+        !evr_node_chain_animated(s, node))
         return 1;
 
     /* Largest 2^k + 1 that fits. */
@@ -223,7 +230,8 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
         /* Shortest arcs: neighbouring quaternions in the same hemisphere. */
         for (i = 1; i < n; i++) {
             if (evr_quat_dot(keys[i - 1].rot, keys[i].rot) < 0.0f) {
-                keys[i].rot = evr_quat_make(-keys[i].rot.w, -keys[i].rot.x, -keys[i].rot.y, -keys[i].rot.z);
+                keys[i].rot =
+                    evr_quat_make(-keys[i].rot.w, -keys[i].rot.x, -keys[i].rot.y, -keys[i].rot.z);
             }
         }
         for (i = 1; i < n && ok; i++) ok = rotation_step_ok(keys[i - 1].rot, keys[i].rot);

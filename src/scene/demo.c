@@ -14,16 +14,14 @@ typedef struct {
 } demo_entry;
 
 static const demo_entry demos[] = {
-    {"eye", evr_demo_build_eye},
-    {"eye-drift", evr_demo_build_eye_drift},
-    {"square", evr_demo_build_square},
-    {"disk", evr_demo_build_disk},
-    {"cornell", evr_demo_build_cornell},
-    {"cornell-still", evr_demo_build_cornell_still},
+    {"eye", evr_demo_build_eye},         {"eye-drift", evr_demo_build_eye_drift},
+    {"square", evr_demo_build_square},   {"disk", evr_demo_build_disk},
+    {"cornell", evr_demo_build_cornell}, {"cornell-still", evr_demo_build_cornell_still},
     {"city", evr_demo_build_city},
 };
 
-static const char *const demo_names[] = {"eye", "eye-drift", "square", "disk", "cornell", "cornell-still", "city", NULL};
+static const char *const demo_names[] = {"eye",     "eye-drift",     "square", "disk",
+                                         "cornell", "cornell-still", "city",   NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 
@@ -38,8 +36,9 @@ evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *e
         if (name && strcmp(name, demos[i].name) == 0) break;
     if (i == sizeof demos / sizeof demos[0]) {
         size_t n = 0, k;
-        n += (size_t)snprintf(err->msg, sizeof err->msg, "unknown demo scene \"%s\"; the built-in scenes are:",
-                              name ? name : "(null)");
+        n += (size_t)snprintf(
+            err->msg, sizeof err->msg,
+            "unknown demo scene \"%s\"; the built-in scenes are:", name ? name : "(null)");
         for (k = 0; demo_names[k] && n < sizeof err->msg; k++)
             n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demo_names[k]);
         return EVR_ERR_ARG;
@@ -104,7 +103,8 @@ static int mesh_reserve(evr_demo_mesh *m, uint32_t nv, uint32_t ni)
     return 1;
 }
 
-uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u, double v)
+uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u,
+                              double v)
 {
     double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     uint32_t i = m->nv;
@@ -139,7 +139,7 @@ void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c
         lc += cr[k] * cr[k];
         ns += cr[k] * ((double)m->nrm[3 * a + k] + m->nrm[3 * b + k] + m->nrm[3 * c + k]);
     }
-    if (!(lc > 1e-12 * l1 * l2)) return;   /* degenerate (e.g. at the pole of a sphere) */
+    if (!(lc > 1e-12 * l1 * l2)) return; /* degenerate (e.g. at the pole of a sphere) */
     m->idx[m->ni++] = a;
     if (ns >= 0.0) {
         m->idx[m->ni++] = b;
@@ -185,7 +185,7 @@ void evr_demo_look_at(const double eye[3], const double target[3], const double 
     float r[3][3];
     evr_quat qq;
     int k;
-    for (k = 0; k < 3; k++) z[k] = eye[k] - target[k];    /* camera +Z points away from the target */
+    for (k = 0; k < 3; k++) z[k] = eye[k] - target[k]; /* camera +Z points away from the target */
     l = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
     for (k = 0; k < 3; k++) z[k] /= l;
     x[0] = up[1] * z[2] - up[2] * z[1];

@@ -21,39 +21,33 @@
 
 #include "scene/demo_scenes.h"
 
-#define CITY_SPACING 36.0      /* lot pitch (m) */
-#define CITY_FLOOR 3.5         /* storey height (m) */
-#define CITY_CELL 3.0          /* window pitch along a facade (m) */
+#define CITY_SPACING 36.0 /* lot pitch (m) */
+#define CITY_FLOOR 3.5    /* storey height (m) */
+#define CITY_CELL 3.0     /* window pitch along a facade (m) */
 #define CITY_TYPES 12
 #define CITY_DURATION 5.0
-#define CITY_KEYS 51           /* camera keys: every 0.1 s */
+#define CITY_KEYS 51 /* camera keys: every 0.1 s */
 
 typedef struct {
-    double wx, wz;             /* footprint (m) */
+    double wx, wz; /* footprint (m) */
     int floors;
-    double top_wx, top_wz;     /* stepped tower: the upper part's footprint (0: none) */
+    double top_wx, top_wz; /* stepped tower: the upper part's footprint (0: none) */
     int top_floors;
     float color[3];
 } building_type;
 
 static const building_type types[CITY_TYPES] = {
-    {12, 12, 3, 0, 0, 0, {0.62f, 0.55f, 0.47f}},
-    {18, 12, 4, 0, 0, 0, {0.55f, 0.33f, 0.27f}},
-    {15, 15, 6, 0, 0, 0, {0.70f, 0.68f, 0.62f}},
-    {21, 15, 5, 0, 0, 0, {0.45f, 0.47f, 0.50f}},
-    {15, 21, 9, 0, 0, 0, {0.66f, 0.60f, 0.50f}},
-    {18, 18, 12, 0, 0, 0, {0.38f, 0.42f, 0.48f}},
-    {12, 18, 8, 0, 0, 0, {0.72f, 0.66f, 0.56f}},
-    {21, 21, 10, 15, 15, 12, {0.50f, 0.52f, 0.55f}},
-    {18, 18, 6, 12, 12, 20, {0.60f, 0.62f, 0.66f}},
-    {21, 18, 14, 0, 0, 0, {0.58f, 0.40f, 0.32f}},
-    {15, 15, 16, 9, 9, 10, {0.42f, 0.46f, 0.52f}},
-    {21, 21, 8, 15, 12, 28, {0.68f, 0.70f, 0.74f}},
+    {12, 12, 3, 0, 0, 0, {0.62f, 0.55f, 0.47f}},    {18, 12, 4, 0, 0, 0, {0.55f, 0.33f, 0.27f}},
+    {15, 15, 6, 0, 0, 0, {0.70f, 0.68f, 0.62f}},    {21, 15, 5, 0, 0, 0, {0.45f, 0.47f, 0.50f}},
+    {15, 21, 9, 0, 0, 0, {0.66f, 0.60f, 0.50f}},    {18, 18, 12, 0, 0, 0, {0.38f, 0.42f, 0.48f}},
+    {12, 18, 8, 0, 0, 0, {0.72f, 0.66f, 0.56f}},    {21, 21, 10, 15, 15, 12, {0.50f, 0.52f, 0.55f}},
+    {18, 18, 6, 12, 12, 20, {0.60f, 0.62f, 0.66f}}, {21, 18, 14, 0, 0, 0, {0.58f, 0.40f, 0.32f}},
+    {15, 15, 16, 9, 9, 10, {0.42f, 0.46f, 0.52f}},  {21, 21, 8, 15, 12, 28, {0.68f, 0.70f, 0.74f}},
 };
 
 /* A tessellated rectangle: corner o, edges eu (cu cells) and ev (cv cells), normal n. */
-static void panel(evr_demo_mesh *m, const double o[3], const double eu[3], const double ev[3], int cu, int cv,
-                  const double n[3])
+static void panel(evr_demo_mesh *m, const double o[3], const double eu[3], const double ev[3],
+                  int cu, int cv, const double n[3])
 {
     uint32_t first = m->nv;
     int i, j, k;
@@ -100,12 +94,16 @@ static void facades(evr_demo_mesh *m, double wx, double wz, double y0, int floor
         int cols = (int)floor(len / CITY_CELL + 0.5);
         double a[3], t[3] = {0, 0, 0}, n[3] = {0, 0, 0}, up[3] = {0, h, 0};
         if (cols < 1) cols = 1;
-        if (along_x) {   /* the facades facing +z and -z */
-            a[0] = -sgn * wx / 2; a[1] = y0; a[2] = sgn * wz / 2;
+        if (along_x) { /* the facades facing +z and -z */
+            a[0] = -sgn * wx / 2;
+            a[1] = y0;
+            a[2] = sgn * wz / 2;
             t[0] = sgn * wx;
             n[2] = sgn;
-        } else {         /* facing +x and -x */
-            a[0] = sgn * wx / 2; a[1] = y0; a[2] = sgn * wz / 2;
+        } else { /* facing +x and -x */
+            a[0] = sgn * wx / 2;
+            a[1] = y0;
+            a[2] = sgn * wz / 2;
             t[2] = -sgn * wz;
             n[0] = sgn;
         }
@@ -113,9 +111,9 @@ static void facades(evr_demo_mesh *m, double wx, double wz, double y0, int floor
         /* window frames: a shallow box per cell */
         for (j = 0; j < floors; j++)
             for (i = 0; i < cols; i++) {
-                double lo[3], hi[3], c[3], hu = 0.5 * len / cols * 0.55, hv = 0.5 * CITY_FLOOR * 0.5;
-                for (k = 0; k < 3; k++)
-                    c[k] = a[k] + t[k] * (i + 0.5) / cols + n[k] * 0.1;
+                double lo[3], hi[3], c[3], hu = 0.5 * len / cols * 0.55,
+                                           hv = 0.5 * CITY_FLOOR * 0.5;
+                for (k = 0; k < 3; k++) c[k] = a[k] + t[k] * (i + 0.5) / cols + n[k] * 0.1;
                 c[1] = y0 + (j + 0.55) * CITY_FLOOR;
                 for (k = 0; k < 3; k++) {
                     double ext = fabs(t[k]) > 0 ? hu : k == 1 ? hv : 0.1;
@@ -142,11 +140,15 @@ static void roof(evr_demo_mesh *m, double wx, double wz, double y, int d)
     for (s = 0; s < 4; s++) {
         double plo[3], phi[3];
         if (s < 2) {
-            plo[0] = -wx / 2; phi[0] = wx / 2;
-            plo[2] = s ? wz / 2 - 0.3 : -wz / 2; phi[2] = plo[2] + 0.3;
+            plo[0] = -wx / 2;
+            phi[0] = wx / 2;
+            plo[2] = s ? wz / 2 - 0.3 : -wz / 2;
+            phi[2] = plo[2] + 0.3;
         } else {
-            plo[2] = -wz / 2 + 0.3; phi[2] = wz / 2 - 0.3;
-            plo[0] = s == 3 ? wx / 2 - 0.3 : -wx / 2; phi[0] = plo[0] + 0.3;
+            plo[2] = -wz / 2 + 0.3;
+            phi[2] = wz / 2 - 0.3;
+            plo[0] = s == 3 ? wx / 2 - 0.3 : -wx / 2;
+            phi[0] = plo[0] + 0.3;
         }
         plo[1] = y;
         phi[1] = y + 1.0;
@@ -244,7 +246,7 @@ void evr_demo_build_city_with(evr_gltf *g, int detail, int count)
     for (k = 0; k < count; k++) {
         uint32_t h = hash2(lots[k].i, lots[k].j);
         int type = (int)(h % CITY_TYPES), turn = (int)((h >> 8) & 3);
-        double a = 0.25 * 3.14159265358979 * turn;   /* half the quarter-turn angle */
+        double a = 0.25 * 3.14159265358979 * turn; /* half the quarter-turn angle */
         char name[32];
         int node;
         /* taller types more often near the centre */
@@ -270,7 +272,8 @@ void evr_demo_build_city_with(evr_gltf *g, int detail, int count)
         mat.base_color[2] = 0.21f;
         panel(&m, o, eu, ev, 1, 1, up);
         node = evr_gltf_node(g, "ground", -1);
-        evr_gltf_node_mesh(g, node, evr_demo_mesh_finish(g, &m, "ground", evr_gltf_add_material(g, &mat)));
+        evr_gltf_node_mesh(g, node,
+                           evr_demo_mesh_finish(g, &m, "ground", evr_gltf_add_material(g, &mat)));
     }
 
     /* a low sun from the south-west: illuminance pi gives a white surface facing it radiance 1 */
@@ -289,8 +292,8 @@ void evr_demo_build_city_with(evr_gltf *g, int detail, int count)
     {
         static const double yup[3] = {0, 1, 0};
         float times[CITY_KEYS], pos[3 * CITY_KEYS], rot[4 * CITY_KEYS];
-        int cam = evr_gltf_camera(g, "city_camera", (float)(50.0 * 3.14159265358979 / 180.0), 4.0f / 3.0f, 0.5f,
-                                  3000.0f);
+        int cam = evr_gltf_camera(g, "city_camera", (float)(50.0 * 3.14159265358979 / 180.0),
+                                  4.0f / 3.0f, 0.5f, 3000.0f);
         int node = evr_gltf_node(g, "city_camera", -1), anim;
         for (k = 0; k < CITY_KEYS; k++) {
             double tt = CITY_DURATION * k / (CITY_KEYS - 1), p[3], target[3];
@@ -298,7 +301,9 @@ void evr_demo_build_city_with(evr_gltf *g, int detail, int count)
             camera_at(tt, p, target);
             evr_demo_look_at(p, target, yup, q);
             /* keep neighbouring quaternions in one hemisphere */
-            if (k > 0 && q[0] * rot[4 * k - 4] + q[1] * rot[4 * k - 3] + q[2] * rot[4 * k - 2] + q[3] * rot[4 * k - 1] < 0)
+            if (k > 0 && q[0] * rot[4 * k - 4] + q[1] * rot[4 * k - 3] + q[2] * rot[4 * k - 2] +
+                                 q[3] * rot[4 * k - 1] <
+                             0)
                 for (t = 0; t < 4; t++) q[t] = -q[t];
             times[k] = (float)tt;
             for (t = 0; t < 3; t++) pos[3 * k + t] = (float)p[t];
@@ -308,12 +313,16 @@ void evr_demo_build_city_with(evr_gltf *g, int detail, int count)
         evr_gltf_node_rotation(g, node, rot[0], rot[1], rot[2], rot[3]);
         evr_gltf_node_camera(g, node, cam);
         anim = evr_gltf_animation(g, "fly");
-        evr_gltf_channel(g, anim, node, EVR_GLTF_TRANSLATION, times, pos, CITY_KEYS, EVR_GLTF_LINEAR);
+        evr_gltf_channel(g, anim, node, EVR_GLTF_TRANSLATION, times, pos, CITY_KEYS,
+                         EVR_GLTF_LINEAR);
         evr_gltf_channel(g, anim, node, EVR_GLTF_ROTATION, times, rot, CITY_KEYS, EVR_GLTF_LINEAR);
     }
 }
 
-void evr_demo_build_city(evr_gltf *g) { evr_demo_build_city_with(g, EVR_CITY_DETAIL, EVR_CITY_BUILDINGS); }
+void evr_demo_build_city(evr_gltf *g)
+{
+    evr_demo_build_city_with(g, EVR_CITY_DETAIL, EVR_CITY_BUILDINGS);
+}
 
 evr_status evr_demo_city_glb(int detail, int count, void **glb, size_t *size, evr_error *err)
 {
@@ -322,7 +331,8 @@ evr_status evr_demo_city_glb(int detail, int count, void **glb, size_t *size, ev
     *glb = NULL;
     *size = 0;
     if (detail < 1 || detail > 64 || count < 0 || count > 1000000) {
-        snprintf(err->msg, sizeof err->msg, "city: detail must be 1..64 and the building count 0..1000000 (got %d, %d)",
+        snprintf(err->msg, sizeof err->msg,
+                 "city: detail must be 1..64 and the building count 0..1000000 (got %d, %d)",
                  detail, count);
         evr_gltf_free(g);
         return EVR_ERR_ARG;

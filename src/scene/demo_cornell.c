@@ -12,7 +12,8 @@
 #include "scene/demo_scenes.h"
 
 /* An axis-aligned quad: centre c, half sizes along axes u and v (0 x, 1 y, 2 z), normal sign. */
-static void quad(evr_demo_mesh *m, const double c[3], int u, int v, double hu, double hv, const double n[3])
+static void quad(evr_demo_mesh *m, const double c[3], int u, int v, double hu, double hv,
+                 const double n[3])
 {
     uint32_t first = m->nv;
     int i, j;
@@ -27,8 +28,8 @@ static void quad(evr_demo_mesh *m, const double c[3], int u, int v, double hu, d
     evr_demo_mesh_triangle(m, first + 1, first + 2, first + 3);
 }
 
-static int wall(evr_gltf *g, const char *name, const double c[3], int u, int v, double hu, double hv,
-                const double n[3], int material)
+static int wall(evr_gltf *g, const char *name, const double c[3], int u, int v, double hu,
+                double hv, const double n[3], int material)
 {
     evr_demo_mesh m = {0};
     quad(&m, c, u, v, hu, hv, n);
@@ -77,7 +78,8 @@ static void build_cornell(evr_gltf *g, int moving)
     int white = material(g, "white", 0.725f, 0.71f, 0.68f, 0.0f);
     int red = material(g, "red", 0.63f, 0.065f, 0.05f, 0.0f);
     int green = material(g, "green", 0.14f, 0.45f, 0.091f, 0.0f);
-    int light = material(g, "light", 0.78f, 0.78f, 0.78f, 1.0f);   /* glTF caps emissive factors at 1 */
+    int light =
+        material(g, "light", 0.78f, 0.78f, 0.78f, 1.0f); /* glTF caps emissive factors at 1 */
     static const double floor_c[3] = {0, 0, 0}, floor_n[3] = {0, 1, 0};
     static const double ceil_c[3] = {0, 1, 0}, ceil_n[3] = {0, -1, 0};
     static const double back_c[3] = {0, 0.5, -0.5}, back_n[3] = {0, 0, 1};
@@ -89,7 +91,8 @@ static void build_cornell(evr_gltf *g, int moving)
     place(g, "back_wall", wall(g, "back_wall", back_c, 0, 1, 0.5, 0.5, back_n, white), 0, 0, 0);
     place(g, "left_wall", wall(g, "left_wall", left_c, 2, 1, 0.5, 0.5, left_n, red), 0, 0, 0);
     place(g, "right_wall", wall(g, "right_wall", right_c, 2, 1, 0.5, 0.5, right_n, green), 0, 0, 0);
-    place(g, "light_panel", wall(g, "light_panel", panel_c, 0, 2, 0.125, 0.125, ceil_n, light), 0, 0, 0);
+    place(g, "light_panel", wall(g, "light_panel", panel_c, 0, 2, 0.125, 0.125, ceil_n, light), 0,
+          0, 0);
 
     static const double tall_h[3] = {0.15, 0.3, 0.15}, short_h[3] = {0.15, 0.15, 0.15};
     int n_tall = evr_gltf_node(g, "tall_box", -1);
@@ -111,12 +114,14 @@ static void build_cornell(evr_gltf *g, int moving)
     evr_gltf_channel(g, anim, n_short, EVR_GLTF_TRANSLATION, times, pos, 3, EVR_GLTF_LINEAR);
 
     /* a point light just below the panel lights the room directly (shadows, colour of the walls) */
-    int lamp = evr_gltf_light(g, "ceiling_light", EVR_GLTF_POINT, NULL, 15.0f * 0.0625f, 0.0f, 0.0f);
+    int lamp =
+        evr_gltf_light(g, "ceiling_light", EVR_GLTF_POINT, NULL, 15.0f * 0.0625f, 0.0f, 0.0f);
     int n_lamp = evr_gltf_node(g, "ceiling_light", -1);
     evr_gltf_node_translation(g, n_lamp, 0.0f, 0.97f, 0.0f);
     evr_gltf_node_light(g, n_lamp, lamp);
 
-    int cam = evr_gltf_camera(g, "cornell_camera", (float)(2.0 * atan(0.5 / 1.4)), 1.0f, 0.05f, 100.0f);
+    int cam =
+        evr_gltf_camera(g, "cornell_camera", (float)(2.0 * atan(0.5 / 1.4)), 1.0f, 0.05f, 100.0f);
     int n_mount = evr_gltf_node(g, "cornell_camera_mount", -1);
     evr_gltf_node_translation(g, n_mount, 0.0f, 0.5f, 1.9f);
     int n_cam = evr_gltf_node(g, "cornell_camera", n_mount);

@@ -9,7 +9,7 @@
 #include "scene/demo_scenes.h"
 
 #define DISK_SECTORS 8
-#define DISK_SEGMENTS 32      /* arc segments per sector */
+#define DISK_SEGMENTS 32 /* arc segments per sector */
 #define DISK_RADIUS 0.5
 #define DISK_PI 3.14159265358979323846
 
@@ -75,7 +75,8 @@ void evr_demo_build_disk(evr_gltf *g)
     int n_b = evr_gltf_node(g, "black_sectors", n_disk);
     evr_gltf_node_mesh(g, n_b, mesh_b);
 
-    int cam = evr_gltf_camera(g, "disk_camera", (float)(2.0 * atan(0.7 / 2.0)), 4.0f / 3.0f, 0.05f, 100.0f);
+    int cam = evr_gltf_camera(g, "disk_camera", (float)(2.0 * atan(0.7 / 2.0)), 4.0f / 3.0f, 0.05f,
+                              100.0f);
     int n_mount = evr_gltf_node(g, "disk_camera_mount", -1);
     evr_gltf_node_translation(g, n_mount, 0.0f, 0.0f, 2.0f);
     int n_cam = evr_gltf_node(g, "disk_camera", n_mount);

@@ -69,64 +69,64 @@
 /* geometry, millimetres */
 #define EYE_R 12.0
 #define CORNEA_R 7.8
-#define CORNEA_C 6.7            /* centre of the corneal sphere on +Z: apex at 14.5 */
+#define CORNEA_C 6.7 /* centre of the corneal sphere on +Z: apex at 14.5 */
 #define CORNEA_PSI_MAX (72.0 * DEG)
-#define IRIS_TEX_HALF 7.5       /* the iris texture covers [-7.5, 7.5]^2 in x, y */
+#define IRIS_TEX_HALF 7.5 /* the iris texture covers [-7.5, 7.5]^2 in x, y */
 #define IRIS_R 5.75
 #define PUPIL_R 1.8
-#define LID_UP_R 14.8            /* lid radii at the middle ... */
+#define LID_UP_R 14.8 /* lid radii at the middle ... */
 #define LID_LO_R 15.1
-#define LID_UP_R_CORNER 12.4     /* ... and towards the corners, where the lids hug the eyeball */
+#define LID_UP_R_CORNER 12.4 /* ... and towards the corners, where the lids hug the eyeball */
 #define LID_LO_R_CORNER 12.7
-#define LID_TAPER_A 7.0          /* |x| where the taper starts and ends */
+#define LID_TAPER_A 7.0 /* |x| where the taper starts and ends */
 #define LID_TAPER_B 11.2
-#define LID_IN_R 12.2            /* inner edge of the margin band */
-#define LID_RHO_MIN 4.0          /* past the corners the lids go on as tubes of this radius */
+#define LID_IN_R 12.2   /* inner edge of the margin band */
+#define LID_RHO_MIN 4.0 /* past the corners the lids go on as tubes of this radius */
 #define LID_X_MAX 16.0
 #define LID_FAR (120.0 * DEG)
 #define MARGIN_UP 4.2
 #define MARGIN_LO (-5.6)
 #define CANTHUS_X 11.5
 #define CANTHUS_Y (-0.5)
-#define CANTHUS_TILT 0.04        /* the lateral (+X) canthus sits a little higher */
+#define CANTHUS_TILT 0.04 /* the lateral (+X) canthus sits a little higher */
 #define SKIN_Z 10.0
-#define SKIN_OVER_LID 0.25       /* the skin dome's radius over the lower lid's */
-#define SKIN_SINK 1.0            /* the face sinks this much towards the eye */
+#define SKIN_OVER_LID 0.25 /* the skin dome's radius over the lower lid's */
+#define SKIN_SINK 1.0      /* the face sinks this much towards the eye */
 #define SKIN_BLEND 5.0
 #define SKIN_RIM_BLEND 7.0
 #define SKIN_OUTER 35.0
-#define ORBIT_R 25.0             /* the socket: a bowl behind everything, a backstop for rays */
+#define ORBIT_R 25.0 /* the socket: a bowl behind everything, a backstop for rays */
 #define HOLE_HALF_W 11.9
 #define HOLE_UP 7.0
 #define HOLE_LO 6.5
 
 /* animation */
 #define ANIM_LENGTH 30.0
-#define EYE_PLAN_SEED 0x6579652d67617a65ull   /* the gaze plan's seed */
-#define FIX_MIN 0.180           /* fixation durations */
+#define EYE_PLAN_SEED 0x6579652d67617a65ull /* the gaze plan's seed */
+#define FIX_MIN 0.180                       /* fixation durations */
 #define FIX_MAX 0.450
-#define SACC_MIN_DEG 2.0        /* saccade amplitudes */
+#define SACC_MIN_DEG 2.0 /* saccade amplitudes */
 #define SACC_MAX_DEG 20.0
-#define GAZE_YAW_MAX 15.0       /* gaze limits */
+#define GAZE_YAW_MAX 15.0 /* gaze limits */
 #define GAZE_PITCH_MAX 12.0
-#define BLINK_FIX 2             /* the first blink happens during this fixation ... */
-#define BLINK_DELAY 0.040       /* ... this long after it starts (as all blinks) */
+#define BLINK_FIX 2       /* the first blink happens during this fixation ... */
+#define BLINK_DELAY 0.040 /* ... this long after it starts (as all blinks) */
 #define BLINK_CLOSE 0.100
 #define BLINK_HOLD 0.030
 #define BLINK_OPEN 0.170
 #define BLINK_LEN (BLINK_CLOSE + BLINK_HOLD + BLINK_OPEN)
-#define BLINK_AFTER_MIN 0.040   /* a blink's fixation goes on at least this long after it */
-#define BLINK_GAP_MIN 2.5       /* from one blink to the next fixation that may hold one */
+#define BLINK_AFTER_MIN 0.040 /* a blink's fixation goes on at least this long after it */
+#define BLINK_GAP_MIN 2.5     /* from one blink to the next fixation that may hold one */
 #define BLINK_GAP_MAX 4.45
-#define DENSE_KEY_STEP 0.002    /* key spacing in saccades and blinks ... */
-#define FIX_KEY_STEP 0.025      /* ... and in fixations with drift */
+#define DENSE_KEY_STEP 0.002 /* key spacing in saccades and blinks ... */
+#define FIX_KEY_STEP 0.025   /* ... and in fixations with drift */
 #define BLINK_UPPER_DEG 38.0
 #define BLINK_LOWER_DEG 2.5
 #define BLINK_EYE_DIP_DEG 2.0
 #define LID_FOLLOW_UP 0.7
 #define LID_FOLLOW_LO 0.3
-#define MAX_FIX 256             /* 84 are used */
-#define MAX_KEYS 8192           /* 2,892 are used without drift, 3,867 with */
+#define MAX_FIX 256   /* 84 are used */
+#define MAX_KEYS 8192 /* 2,892 are used without drift, 3,867 with */
 
 /* ---- deterministic noise and painting ---- */
 
@@ -140,7 +140,9 @@ static uint32_t hash_u32(uint32_t x)
     return x;
 }
 
-typedef struct { uint32_t s; } rng;
+typedef struct {
+    uint32_t s;
+} rng;
 
 static double rng_uniform(rng *r)
 {
@@ -152,7 +154,8 @@ static double rng_range(rng *r, double a, double b) { return a + (b - a) * rng_u
 
 static double lattice(int ix, int iy, uint32_t seed)
 {
-    return hash_u32((uint32_t)ix * 0x8da6b343u ^ hash_u32((uint32_t)iy * 0xd8163841u ^ seed * 0xcb1ab31fu)) /
+    return hash_u32((uint32_t)ix * 0x8da6b343u ^
+                    hash_u32((uint32_t)iy * 0xd8163841u ^ seed * 0xcb1ab31fu)) /
            4294967295.0;
 }
 
@@ -160,7 +163,10 @@ static double smooth01(double t) { return t * t * (3.0 - 2.0 * t); }
 
 static double clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
-static double smoothstep(double a, double b, double x) { return smooth01(clampd((x - a) / (b - a), 0.0, 1.0)); }
+static double smoothstep(double a, double b, double x)
+{
+    return smooth01(clampd((x - a) / (b - a), 0.0, 1.0));
+}
 
 /* Value noise in [0,1]; period > 0 wraps x with that integer period. */
 static double vnoise(double x, double y, uint32_t seed, int period)
@@ -202,7 +208,7 @@ static double fbm(double x, double y, uint32_t seed, int octaves, int period)
 /* An 8-bit sRGB image being painted, with a coverage mask for strokes. */
 typedef struct {
     int w, h, wrap_x;
-    double *rgb;      /* 0..255, 3 per pixel */
+    double *rgb; /* 0..255, 3 per pixel */
     float *mask;
 } image;
 
@@ -233,12 +239,14 @@ static void image_set(image *im, int x, int y, const double c[3])
 /* Adds a stroke from (xa,ya) to (xb,yb), radius r0 -> r1, opacity a0 -> a1, to the coverage mask
  * (the maximum is kept, so that overlapping pieces of one stroke do not build up); image_apply
  * then paints the mask in one colour. */
-static void image_stroke(image *im, double xa, double ya, double xb, double yb, double r0, double r1,
-                         double a0, double a1)
+static void image_stroke(image *im, double xa, double ya, double xb, double yb, double r0,
+                         double r1, double a0, double a1)
 {
     double len = hypot(xb - xa, yb - ya), rmax = r0 > r1 ? r0 : r1;
-    int xmin = (int)floor((xa < xb ? xa : xb) - rmax - 2), xmax = (int)ceil((xa > xb ? xa : xb) + rmax + 2);
-    int ymin = (int)floor((ya < yb ? ya : yb) - rmax - 2), ymax = (int)ceil((ya > yb ? ya : yb) + rmax + 2);
+    int xmin = (int)floor((xa < xb ? xa : xb) - rmax - 2),
+        xmax = (int)ceil((xa > xb ? xa : xb) + rmax + 2);
+    int ymin = (int)floor((ya < yb ? ya : yb) - rmax - 2),
+        ymax = (int)ceil((ya > yb ? ya : yb) + rmax + 2);
     int x, y;
     if (ymin < 0) ymin = 0;
     if (ymax > im->h - 1) ymax = im->h - 1;
@@ -251,7 +259,8 @@ static void image_stroke(image *im, double xa, double ya, double xb, double yb, 
             double px = x + 0.5, py = y + 0.5, t = 0.0, d, r, a, cov;
             int wx = im->wrap_x ? ((x % im->w) + im->w) % im->w : x;
             float *m;
-            if (len > 0.0) t = clampd(((px - xa) * (xb - xa) + (py - ya) * (yb - ya)) / (len * len), 0.0, 1.0);
+            if (len > 0.0)
+                t = clampd(((px - xa) * (xb - xa) + (py - ya) * (yb - ya)) / (len * len), 0.0, 1.0);
             d = hypot(px - (xa + t * (xb - xa)), py - (ya + t * (yb - ya)));
             r = r0 + (r1 - r0) * t;
             a = a0 + (a1 - a0) * t;
@@ -317,7 +326,8 @@ static int paint_sclera(evr_gltf *g)
         double th = (y + 0.5) / im.h * PI;
         for (x = 0; x < im.w; x++) {
             double u = (x + 0.5) / im.w, c[3], n = fbm(u * 16.0, th * 5.0, 7u, 4, 16) - 0.5;
-            double back = smoothstep(70.0 * DEG, 130.0 * DEG, th);   /* a little yellower at the back */
+            double back =
+                smoothstep(70.0 * DEG, 130.0 * DEG, th); /* a little yellower at the back */
             c[0] = sclera_srgb[0] * (1.0 + 0.05 * n);
             c[1] = sclera_srgb[1] * (1.0 + 0.05 * n - 0.04 * back);
             c[2] = sclera_srgb[2] * (1.0 + 0.05 * n - 0.10 * back);
@@ -328,18 +338,21 @@ static int paint_sclera(evr_gltf *g)
      * with a few side branches. */
     for (k = 0; k < 44; k++) {
         double px = rng_range(&r, 0.0, im.w), py = rng_range(&r, 72.0, 100.0) / 180.0 * im.h;
-        double stop = rng_range(&r, 44.0, 62.0) / 180.0 * im.h, dir = -PI / 2 + rng_range(&r, -0.5, 0.5);
+        double stop = rng_range(&r, 44.0, 62.0) / 180.0 * im.h,
+               dir = -PI / 2 + rng_range(&r, -0.5, 0.5);
         double w = rng_range(&r, 0.7, 1.3), a = rng_range(&r, 0.35, 0.6), start = py;
         int step = 0;
         while (py > stop && step < 400) {
-            double nx, ny, f = (start - py) / (start - stop), rr = w * (1.0 - 0.6 * f), aa = a * (1.0 - 0.7 * f);
+            double nx, ny, f = (start - py) / (start - stop), rr = w * (1.0 - 0.6 * f),
+                           aa = a * (1.0 - 0.7 * f);
             dir += rng_range(&r, -0.35, 0.35);
             dir = -PI / 2 + clampd(dir + PI / 2, -0.9, 0.9);
             nx = px + 2.0 * cos(dir);
             ny = py + 2.0 * sin(dir);
             image_stroke(&im, px, py, nx, ny, rr, rr, aa, aa);
-            if (rng_uniform(&r) < 0.04) {   /* a side branch */
-                double bx = nx, by = ny, bd = dir + (rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * rng_range(&r, 0.6, 1.1);
+            if (rng_uniform(&r) < 0.04) { /* a side branch */
+                double bx = nx, by = ny,
+                       bd = dir + (rng_uniform(&r) < 0.5 ? -1.0 : 1.0) * rng_range(&r, 0.6, 1.1);
                 int j;
                 for (j = 0; j < 14; j++) {
                     double cx = bx + 1.8 * cos(bd), cy = by + 1.8 * sin(bd);
@@ -385,7 +398,8 @@ static int paint_iris(evr_gltf *g)
         for (x = 0; x < im.w; x++) {
             double mx = ((x + 0.5) / im.w * 2.0 - 1.0) * IRIS_TEX_HALF;
             double my = (1.0 - (y + 0.5) / im.h * 2.0) * IRIS_TEX_HALF;
-            double rad = hypot(mx, my), ang = atan2(my, mx), t = (rad - PUPIL_R) / (IRIS_R - PUPIL_R);
+            double rad = hypot(mx, my), ang = atan2(my, mx),
+                   t = (rad - PUPIL_R) / (IRIS_R - PUPIL_R);
             double au = (ang + PI) / (2.0 * PI), c[3], f1, f2, coll, shade, sc[3];
             double tc = 0.34 + 0.035 * sin(11.0 * ang) + 0.02 * sin(23.0 * ang + 1.0);
             /* radial fibres: noise stretched along the radius, periodic in angle */
@@ -393,19 +407,23 @@ static int paint_iris(evr_gltf *g)
             f2 = vnoise(au * 260.0, t * 9.0, 47u, 260);
             mix3(c, inner, outer, smoothstep(tc - 0.05, tc + 0.25, t));
             shade = 0.78 + 0.45 * (f1 - 0.5) * 1.6 + 0.18 * (f2 - 0.5);
-            coll = exp(-pow((t - tc) / 0.035, 2.0));                   /* the collarette ridge */
+            coll = exp(-pow((t - tc) / 0.035, 2.0)); /* the collarette ridge */
             shade += 0.22 * coll;
-            shade -= 0.10 * exp(-pow((t - 0.74) / 0.012, 2.0)) * (vnoise(au * 40.0, 0.0, 5u, 40) > 0.4);
-            shade -= 0.10 * exp(-pow((t - 0.86) / 0.012, 2.0)) * (vnoise(au * 40.0, 3.0, 6u, 40) > 0.45);
-            for (k = 0; k < 36; k++) {                                  /* crypts */
+            shade -=
+                0.10 * exp(-pow((t - 0.74) / 0.012, 2.0)) * (vnoise(au * 40.0, 0.0, 5u, 40) > 0.4);
+            shade -=
+                0.10 * exp(-pow((t - 0.86) / 0.012, 2.0)) * (vnoise(au * 40.0, 3.0, 6u, 40) > 0.45);
+            for (k = 0; k < 36; k++) { /* crypts */
                 double da = remainder(ang - crypt_a[k], 2.0 * PI) / (0.05 * crypt_s[k]);
                 double dt = (t - crypt_t[k]) / (0.05 * crypt_s[k]);
                 shade -= 0.35 * exp(-(da * da + dt * dt));
             }
             for (k = 0; k < 3; k++) c[k] *= clampd(shade, 0.15, 1.6);
-            mix3(c, ruff, c, smoothstep(0.0, 0.06, t));                  /* pupillary ruff */
-            for (k = 0; k < 3; k++) c[k] *= 1.0 - 0.6 * smoothstep(IRIS_R - 0.9, IRIS_R - 0.05, rad);  /* limbal ring */
-            for (k = 0; k < 3; k++) sc[k] = sclera_srgb[k] * (1.0 + 0.04 * (fbm(mx * 1.5, my * 1.5, 9u, 3, 0) - 0.5));
+            mix3(c, ruff, c, smoothstep(0.0, 0.06, t)); /* pupillary ruff */
+            for (k = 0; k < 3; k++)
+                c[k] *= 1.0 - 0.6 * smoothstep(IRIS_R - 0.9, IRIS_R - 0.05, rad); /* limbal ring */
+            for (k = 0; k < 3; k++)
+                sc[k] = sclera_srgb[k] * (1.0 + 0.04 * (fbm(mx * 1.5, my * 1.5, 9u, 3, 0) - 0.5));
             mix3(c, c, sc, smoothstep(IRIS_R - 0.05, IRIS_R + 0.35, rad));
             mix3(c, pupil, c, smoothstep(PUPIL_R - 0.04, PUPIL_R + 0.04, rad));
             image_set(&im, x, y, c);
@@ -418,20 +436,23 @@ static int paint_iris(evr_gltf *g)
 
 static void skin_colour(double c[3], double x, double y, uint32_t seed)
 {
-    double low = fbm(x * 0.15, y * 0.15, seed, 3, 0) - 0.5, pores = vnoise(x * 4.0, y * 4.0, seed + 9u, 0) - 0.5;
+    double low = fbm(x * 0.15, y * 0.15, seed, 3, 0) - 0.5,
+           pores = vnoise(x * 4.0, y * 4.0, seed + 9u, 0) - 0.5;
     int k;
     for (k = 0; k < 3; k++) c[k] = skin_srgb[k] * (1.0 + 0.10 * low + 0.06 * pores);
-    c[0] *= 1.0 + 0.03 * low;   /* blotches are redder */
+    c[0] *= 1.0 + 0.03 * low; /* blotches are redder */
 }
 
 /* Lids: u along the lid (0..1 over x in [-16, 16] mm), v from the margin band (v < 0.05)
  * away from the margin. */
-static int paint_eyelid(evr_gltf *g, const char *name, uint32_t seed, int lashes, double len_lo, double len_hi)
+static int paint_eyelid(evr_gltf *g, const char *name, uint32_t seed, int lashes, double len_lo,
+                        double len_hi)
 {
     image im;
     rng r = {seed};
     int x, y, k, tex;
-    const double band[3] = {204.0, 124.0, 118.0}, lash[3] = {24.0, 19.0, 17.0}, crease[3] = {170.0, 118.0, 98.0};
+    const double band[3] = {204.0, 124.0, 118.0}, lash[3] = {24.0, 19.0, 17.0},
+                 crease[3] = {170.0, 118.0, 98.0};
     if (!image_init(&im, 512, 256, 0)) {
         image_free(&im);
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while painting a demo texture");
@@ -452,7 +473,8 @@ static int paint_eyelid(evr_gltf *g, const char *name, uint32_t seed, int lashes
     /* the lid crease, a soft darker fold */
     for (k = 0; k < 64; k++) {
         double u0 = 0.12 + 0.76 * k / 64.0, u1 = 0.12 + 0.76 * (k + 1) / 64.0;
-        double v0 = 0.42 + 0.10 * pow((u0 - 0.5) / 0.38, 2.0), v1 = 0.42 + 0.10 * pow((u1 - 0.5) / 0.38, 2.0);
+        double v0 = 0.42 + 0.10 * pow((u0 - 0.5) / 0.38, 2.0),
+               v1 = 0.42 + 0.10 * pow((u1 - 0.5) / 0.38, 2.0);
         double a = 0.35 * sin(PI * (u0 - 0.12) / 0.76);
         image_stroke(&im, u0 * im.w, v0 * im.h, u1 * im.w, v1 * im.h, 2.0, 2.0, a, a);
     }
@@ -470,8 +492,9 @@ static int paint_eyelid(evr_gltf *g, const char *name, uint32_t seed, int lashes
         for (j = 0; j < n; j++) {
             double f0 = (double)j / n, f1 = (double)(j + 1) / n;
             double nx = px + len / n * cos(dir), ny = py + len / n * sin(dir);
-            image_stroke(&im, px, py, nx, ny, 0.9 * (1.0 - 0.6 * f0), 0.9 * (1.0 - 0.6 * f1), 0.9, 0.75);
-            dir -= lean * 0.12;   /* curl outwards */
+            image_stroke(&im, px, py, nx, ny, 0.9 * (1.0 - 0.6 * f0), 0.9 * (1.0 - 0.6 * f1), 0.9,
+                         0.75);
+            dir -= lean * 0.12; /* curl outwards */
             px = nx;
             py = ny;
         }
@@ -497,20 +520,24 @@ static int paint_skin(evr_gltf *g)
     }
     for (y = 0; y < im.h; y++) {
         for (x = 0; x < im.w; x++) {
-            double mx = ((x + 0.5) / im.w * 2.0 - 1.0) * SKIN_OUTER, my = (1.0 - (y + 0.5) / im.h * 2.0) * SKIN_OUTER;
+            double mx = ((x + 0.5) / im.w * 2.0 - 1.0) * SKIN_OUTER,
+                   my = (1.0 - (y + 0.5) / im.h * 2.0) * SKIN_OUTER;
             double c[3];
             skin_colour(c, mx, my, 55u);
             image_set(&im, x, y, c);
         }
     }
     for (k = 0; k < 7; k++) {
-        double ang = rng_range(&r, -0.5, 0.5), r0 = rng_range(&r, 14.0, 16.0), r1 = r0 + rng_range(&r, 5.0, 9.0);
+        double ang = rng_range(&r, -0.5, 0.5), r0 = rng_range(&r, 14.0, 16.0),
+               r1 = r0 + rng_range(&r, 5.0, 9.0);
         int j;
         for (j = 0; j < 12; j++) {
             double ra = r0 + (r1 - r0) * j / 12.0, rb = r0 + (r1 - r0) * (j + 1) / 12.0;
             double aa = ang + 0.02 * sin(j * 1.3), ab = ang + 0.02 * sin((j + 1) * 1.3);
-            double xa = (ra * cos(aa) / SKIN_OUTER + 1.0) / 2.0 * im.w, ya = (1.0 - ra * sin(aa) / SKIN_OUTER) / 2.0 * im.h;
-            double xb = (rb * cos(ab) / SKIN_OUTER + 1.0) / 2.0 * im.w, yb = (1.0 - rb * sin(ab) / SKIN_OUTER) / 2.0 * im.h;
+            double xa = (ra * cos(aa) / SKIN_OUTER + 1.0) / 2.0 * im.w,
+                   ya = (1.0 - ra * sin(aa) / SKIN_OUTER) / 2.0 * im.h;
+            double xb = (rb * cos(ab) / SKIN_OUTER + 1.0) / 2.0 * im.w,
+                   yb = (1.0 - rb * sin(ab) / SKIN_OUTER) / 2.0 * im.h;
             double a = 0.45 * sin(PI * (j + 0.5) / 12.0);
             image_stroke(&im, xa, ya, xb, yb, 0.6, 0.6, a, a);
         }
@@ -523,7 +550,8 @@ static int paint_skin(evr_gltf *g)
 
 /* ---- geometry (built in millimetres, stored in metres) ---- */
 
-static uint32_t vert_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3], double u, double v)
+static uint32_t vert_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3], double u,
+                        double v)
 {
     double p[3];
     p[0] = x * MM;
@@ -544,7 +572,8 @@ static int build_sclera(evr_gltf *g, int material)
             n[0] = sin(th) * cos(ph);
             n[1] = sin(th) * sin(ph);
             n[2] = cos(th);
-            vert_mm(&m, EYE_R * n[0], EYE_R * n[1], EYE_R * n[2], n, (double)i / cols, (double)j / rows);
+            vert_mm(&m, EYE_R * n[0], EYE_R * n[1], EYE_R * n[2], n, (double)i / cols,
+                    (double)j / rows);
         }
     }
     evr_demo_mesh_grid(&m, 0, cols, rows);
@@ -638,7 +667,7 @@ static int build_lid(evr_gltf *g, int upper, int material)
             double phi = phm + s * (far - phm), p[3], n[3];
             double drho = (lid_rho(x + h, upper) - lid_rho(x - h, upper)) / (2.0 * h);
             lid_point(x, phi, upper, p);
-            n[0] = -drho;          /* normal of a surface of revolution about X */
+            n[0] = -drho; /* normal of a surface of revolution about X */
             n[1] = sin(phi);
             n[2] = cos(phi);
             vert_mm(&m, p[0], p[1], p[2], n, (double)i / cols, 0.05 + 0.95 * s);
@@ -668,7 +697,8 @@ static int build_lid(evr_gltf *g, int upper, int material)
             f = n[1] * cos(phm) - n[2] * sin(phm);
             if (f * (upper ? -1.0 : 1.0) < 0.0)
                 for (k = 0; k < 3; k++) n[k] = -n[k];
-            vert_mm(&m, p[0], p[1], p[2], n, (double)i / cols, 0.05 * (1.0 - (double)j / band_rows));
+            vert_mm(&m, p[0], p[1], p[2], n, (double)i / cols,
+                    0.05 * (1.0 - (double)j / band_rows));
         }
     }
     evr_demo_mesh_grid(&m, band_first, cols, band_rows);
@@ -684,20 +714,22 @@ static int build_lid(evr_gltf *g, int upper, int material)
 static double skin_dome(double x, double y)
 {
     double r = lid_radius(x, 0) + SKIN_OVER_LID, q = r * r - x * x - y * y, q0 = 4.0;
-    return q >= q0 ? sqrt(q) : sqrt(q0) + (q - q0) / (2.0 * sqrt(q0));   /* C1 past its edge */
+    return q >= q0 ? sqrt(q) : sqrt(q0) + (q - q0) / (2.0 * sqrt(q0)); /* C1 past its edge */
 }
 
 static void skin_point(double t, double s, double p[3])
 {
     double st = sin(t), hx = HOLE_HALF_W * cos(t), ox = SKIN_OUTER * cos(t), oy = SKIN_OUTER * st;
-    double hy = CANTHUS_Y + CANTHUS_TILT * hx + (st >= 0.0 ? HOLE_UP * pow(st, 2.2) : -HOLE_LO * pow(-st, 1.7));
+    double hy = CANTHUS_Y + CANTHUS_TILT * hx +
+                (st >= 0.0 ? HOLE_UP * pow(st, 2.2) : -HOLE_LO * pow(-st, 1.7));
     double f = pow(s, 1.6), x = hx + (ox - hx) * f, y = hy + (oy - hy) * f, dome = skin_dome(x, y);
     double face = SKIN_Z - SKIN_SINK * (1.0 - smoothstep(10.0, 18.0, hypot(x, y)));
     double w = smoothstep(0.0, SKIN_RIM_BLEND, f * hypot(ox - hx, oy - hy));
-    double target = skin_dome(hx, hy) + (smooth_max(face, dome, SKIN_BLEND) - skin_dome(hx, hy)) * w;
+    double target =
+        skin_dome(hx, hy) + (smooth_max(face, dome, SKIN_BLEND) - skin_dome(hx, hy)) * w;
     p[0] = x;
     p[1] = y;
-    p[2] = smooth_max(target, dome, 0.5);   /* never behind the dome, hence never behind a lid */
+    p[2] = smooth_max(target, dome, 0.5); /* never behind the dome, hence never behind a lid */
 }
 
 static int build_skin(evr_gltf *g, int material)
@@ -724,7 +756,8 @@ static int build_skin(evr_gltf *g, int material)
             n[2] = a[0] * c[1] - a[1] * c[0];
             if (n[2] < 0.0)
                 for (k = 0; k < 3; k++) n[k] = -n[k];
-            vert_mm(&m, p[0], p[1], p[2], n, 0.5 + p[0] / (2.0 * SKIN_OUTER), 0.5 - p[1] / (2.0 * SKIN_OUTER));
+            vert_mm(&m, p[0], p[1], p[2], n, 0.5 + p[0] / (2.0 * SKIN_OUTER),
+                    0.5 - p[1] / (2.0 * SKIN_OUTER));
         }
     }
     evr_demo_mesh_grid(&m, 0, cols, rows);
@@ -739,13 +772,14 @@ static int build_orbit(evr_gltf *g, int material)
     const int cols = 48, rows = 12;
     int i, j;
     for (j = 0; j <= rows; j++) {
-        double th = PI / 2 + PI / 2 * j / rows;   /* from the rim (z = 0) to the back pole */
+        double th = PI / 2 + PI / 2 * j / rows; /* from the rim (z = 0) to the back pole */
         for (i = 0; i <= cols; i++) {
             double ph = 2.0 * PI * i / cols, n[3];
-            n[0] = -sin(th) * cos(ph);            /* facing the centre */
+            n[0] = -sin(th) * cos(ph); /* facing the centre */
             n[1] = -sin(th) * sin(ph);
             n[2] = -cos(th);
-            vert_mm(&m, -ORBIT_R * n[0], -ORBIT_R * n[1], -ORBIT_R * n[2], n, (double)i / cols, (double)j / rows);
+            vert_mm(&m, -ORBIT_R * n[0], -ORBIT_R * n[1], -ORBIT_R * n[2], n, (double)i / cols,
+                    (double)j / rows);
         }
     }
     evr_demo_mesh_grid(&m, 0, cols, rows);
@@ -757,26 +791,27 @@ static int build_orbit(evr_gltf *g, int material)
 /* The gaze plan: the first ten fixations are written by hand (the original 3 s sequence, with its
  * blink in the third fixation); the rest, up to ANIM_LENGTH, is drawn from a fixed seed. */
 typedef struct {
-    double yaw, pitch;   /* degrees; yaw towards +X, pitch up */
-    double duration;     /* seconds; < 0: drawn like the generated ones */
+    double yaw, pitch; /* degrees; yaw towards +X, pitch up */
+    double duration;   /* seconds; < 0: drawn like the generated ones */
 } fixation_spec;
 
 static const fixation_spec plan_start[] = {
-    {0.0, 0.0, 0.280}, {10.0, 3.0, 0.240}, {-8.0, 1.0, 0.400}, {-6.0, 9.0, 0.200}, {-3.0, -9.0, 0.380},
-    {2.0, -6.0, 0.180}, {4.0, -4.0, 0.250}, {12.0, 2.0, 0.220}, {0.0, 0.0, 0.250}, {-2.0, 4.0, -1.0},
+    {0.0, 0.0, 0.280},   {10.0, 3.0, 0.240}, {-8.0, 1.0, 0.400}, {-6.0, 9.0, 0.200},
+    {-3.0, -9.0, 0.380}, {2.0, -6.0, 0.180}, {4.0, -4.0, 0.250}, {12.0, 2.0, 0.220},
+    {0.0, 0.0, 0.250},   {-2.0, 4.0, -1.0},
 };
 #define NUM_START ((int)(sizeof plan_start / sizeof plan_start[0]))
 
 typedef struct {
-    double yaw, pitch;   /* degrees */
-    double start, end;   /* seconds; saccade k runs from fix[k].end to fix[k + 1].start */
-    double blink;        /* start of the blink in this fixation, < 0 for none */
+    double yaw, pitch; /* degrees */
+    double start, end; /* seconds; saccade k runs from fix[k].end to fix[k + 1].start */
+    double blink;      /* start of the blink in this fixation, < 0 for none */
 } fixation;
 
 typedef struct {
     fixation fix[MAX_FIX];
     int num_fix, num_blinks;
-    int drift;           /* 1: slow fixational drift added everywhere ("eye-drift") */
+    int drift; /* 1: slow fixational drift added everywhere ("eye-drift") */
 } gaze_plan;
 
 /* splitmix64: a small deterministic generator, the same on every platform. */
@@ -795,7 +830,7 @@ static double plan_uniform(uint64_t *s, double a, double b)
 
 static double saccade_duration(double yaw0, double pitch0, double yaw1, double pitch1)
 {
-    return (2.2 * hypot(yaw1 - yaw0, pitch1 - pitch0) + 21.0) * 1e-3;   /* the main sequence */
+    return (2.2 * hypot(yaw1 - yaw0, pitch1 - pitch0) + 21.0) * 1e-3; /* the main sequence */
 }
 
 /* The next saccade's target: amplitude SACC_MIN_DEG..SACC_MAX_DEG (small ones more likely), a
@@ -804,13 +839,14 @@ static void next_target(uint64_t *s, double yaw, double pitch, double *ty, doubl
 {
     int tries;
     for (tries = 0; tries < 1000; tries++) {
-        double a = SACC_MIN_DEG + (SACC_MAX_DEG - SACC_MIN_DEG) * pow(plan_uniform(s, 0.0, 1.0), 1.5);
+        double a =
+            SACC_MIN_DEG + (SACC_MAX_DEG - SACC_MIN_DEG) * pow(plan_uniform(s, 0.0, 1.0), 1.5);
         double dir = plan_uniform(s, -PI, PI);
         *ty = yaw + a * cos(dir);
         *tp = pitch + a * sin(dir);
         if (fabs(*ty) <= GAZE_YAW_MAX && fabs(*tp) <= GAZE_PITCH_MAX) return;
     }
-    *ty = 0.0;   /* not reached in practice: back to the centre */
+    *ty = 0.0; /* not reached in practice: back to the centre */
     *tp = 0.0;
 }
 
@@ -845,7 +881,7 @@ static int make_plan(gaze_plan *p, int drift)
         if (k < NUM_START && plan_start[k].duration >= 0.0) dur = plan_start[k].duration;
         else if (blink) dur = need + plan_uniform(&s, 0.0, FIX_MAX - need);
         else dur = plan_uniform(&s, FIX_MIN, FIX_MAX);
-        if (k >= NUM_START && rest <= FIX_MAX) {   /* the last fixation runs to the end */
+        if (k >= NUM_START && rest <= FIX_MAX) { /* the last fixation runs to the end */
             f->end = ANIM_LENGTH;
             if (blink && rest >= need) {
                 f->blink = key_time(t + BLINK_DELAY);
@@ -860,7 +896,8 @@ static int make_plan(gaze_plan *p, int drift)
             next_target(&s, f->yaw, f->pitch, &ny, &np);
         }
         sacc = saccade_duration(f->yaw, f->pitch, ny, np);
-        if (dur > rest - sacc - FIX_MIN) dur = rest - sacc - FIX_MIN;   /* leave room for a last one */
+        if (dur > rest - sacc - FIX_MIN)
+            dur = rest - sacc - FIX_MIN; /* leave room for a last one */
         if (blink && dur >= need - 1e-9) {
             f->blink = key_time(t + BLINK_DELAY);
             p->num_blinks++;
@@ -915,11 +952,11 @@ static void gaze_at(const gaze_plan *p, double t, double *yaw, double *pitch, do
             break;
         }
     }
-    if (p->drift) {   /* slow drift, continuous across the whole sequence (peak speed ~0.55 deg/s) */
+    if (p->drift) { /* slow drift, continuous across the whole sequence (peak speed ~0.55 deg/s) */
         *yaw += 0.06 * sin(2.0 * PI * 0.83 * t + 0.3) + 0.02 * sin(2.0 * PI * 2.1 * t + 1.1);
         *pitch += 0.05 * sin(2.0 * PI * 0.61 * t + 2.0) + 0.02 * sin(2.0 * PI * 2.9 * t + 0.5);
     }
-    *pitch -= BLINK_EYE_DIP_DEG * b;   /* the eye dips during a blink */
+    *pitch -= BLINK_EYE_DIP_DEG * b; /* the eye dips during a blink */
     *closure = b;
 }
 
@@ -961,21 +998,23 @@ static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int 
         goto done;
     }
     if (!make_plan(plan, drift)) {
-        evr_gltf_fail(g, EVR_ERR_ARG, "eye animation: the gaze plan needs more than MAX_FIX fixations");
+        evr_gltf_fail(g, EVR_ERR_ARG,
+                      "eye animation: the gaze plan needs more than MAX_FIX fixations");
         goto done;
     }
     for (k = 0; k < plan->num_fix; k++) {
         const fixation *f = &plan->fix[k];
         n = add_times(t, n, f->start, f->end, drift ? FIX_KEY_STEP : 2.0 * ANIM_LENGTH);
         if (f->blink >= 0.0) n = add_times(t, n, f->blink, f->blink + BLINK_LEN, DENSE_KEY_STEP);
-        if (k + 1 < plan->num_fix) n = add_times(t, n, f->end, plan->fix[k + 1].start, DENSE_KEY_STEP);
+        if (k + 1 < plan->num_fix)
+            n = add_times(t, n, f->end, plan->fix[k + 1].start, DENSE_KEY_STEP);
     }
     if (n < 0) {
         evr_gltf_fail(g, EVR_ERR_ARG, "eye animation: more than MAX_KEYS keys");
         goto done;
     }
     qsort(t, (size_t)n, sizeof(double), cmp_double);
-    for (k = 0; k < n; k++) {           /* merge times closer than 0.4 ms (exact repeats at the ends) */
+    for (k = 0; k < n; k++) { /* merge times closer than 0.4 ms (exact repeats at the ends) */
         if (m > 0 && t[k] - t[m - 1] < 4e-4) continue;
         t[m++] = t[k];
     }
@@ -985,13 +1024,22 @@ static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int 
         gaze_at(plan, t[k], &yaw, &pitch, &b);
         times[k] = (float)t[k];
         quat_axis(0, 1, 0, yaw, &qy);
-        quat_axis(1, 0, 0, -pitch, &qx);   /* a positive turn about +X moves the front down */
+        quat_axis(1, 0, 0, -pitch, &qx); /* a positive turn about +X moves the front down */
         q = evr_quat_normalize(evr_quat_mul(qy, qx));
-        qe[4 * k] = q.x; qe[4 * k + 1] = q.y; qe[4 * k + 2] = q.z; qe[4 * k + 3] = q.w;
+        qe[4 * k] = q.x;
+        qe[4 * k + 1] = q.y;
+        qe[4 * k + 2] = q.z;
+        qe[4 * k + 3] = q.w;
         quat_axis(1, 0, 0, -LID_FOLLOW_UP * pitch + BLINK_UPPER_DEG * b, &q);
-        qu[4 * k] = q.x; qu[4 * k + 1] = q.y; qu[4 * k + 2] = q.z; qu[4 * k + 3] = q.w;
+        qu[4 * k] = q.x;
+        qu[4 * k + 1] = q.y;
+        qu[4 * k + 2] = q.z;
+        qu[4 * k + 3] = q.w;
         quat_axis(1, 0, 0, -LID_FOLLOW_LO * pitch - BLINK_LOWER_DEG * b, &q);
-        ql[4 * k] = q.x; ql[4 * k + 1] = q.y; ql[4 * k + 2] = q.z; ql[4 * k + 3] = q.w;
+        ql[4 * k] = q.x;
+        ql[4 * k + 1] = q.y;
+        ql[4 * k + 2] = q.z;
+        ql[4 * k + 3] = q.w;
     }
     /* rest pose: the pose at t = 0 */
     evr_gltf_node_rotation(g, eyeball, qe[0], qe[1], qe[2], qe[3]);
@@ -1027,12 +1075,15 @@ static void build_eye(evr_gltf *g, int drift)
                         up[3] = {0.0, 1.0, 0.0};
     float q[4];
     evr_gltf_material mat;
-    int m_sclera, m_iris, m_lid_up, m_lid_lo, m_skin, m_orbit, eyeball, node, upper, lower, mount, cam, led;
+    int m_sclera, m_iris, m_lid_up, m_lid_lo, m_skin, m_orbit, eyeball, node, upper, lower, mount,
+        cam, led;
 
     m_sclera = add_material(g, "sclera", paint_sclera(g), 0.35f);
     m_iris = add_material(g, "iris", paint_iris(g), 0.1f);
-    m_lid_up = add_material(g, "upper_eyelid", paint_eyelid(g, "upper_eyelid_texture", 4242u, 170, 22.0, 50.0), 0.6f);
-    m_lid_lo = add_material(g, "lower_eyelid", paint_eyelid(g, "lower_eyelid_texture", 4343u, 90, 10.0, 24.0), 0.6f);
+    m_lid_up = add_material(g, "upper_eyelid",
+                            paint_eyelid(g, "upper_eyelid_texture", 4242u, 170, 22.0, 50.0), 0.6f);
+    m_lid_lo = add_material(g, "lower_eyelid",
+                            paint_eyelid(g, "lower_eyelid_texture", 4343u, 90, 10.0, 24.0), 0.6f);
     m_skin = add_material(g, "skin", paint_skin(g), 0.6f);
     evr_gltf_material_init(&mat, "orbit");
     mat.base_color[0] = 0.25f;
@@ -1063,7 +1114,8 @@ static void build_eye(evr_gltf *g, int drift)
     evr_gltf_node_translation(g, mount, (float)cam_pos[0], (float)cam_pos[1], (float)cam_pos[2]);
     evr_demo_look_at(cam_pos, target, up, q);
     evr_gltf_node_rotation(g, mount, q[0], q[1], q[2], q[3]);
-    cam = evr_gltf_camera(g, "eye_camera", (float)(45.0 * DEG), 4.0f / 3.0f, 1.0f * (float)MM, 1.0f);
+    cam =
+        evr_gltf_camera(g, "eye_camera", (float)(45.0 * DEG), 4.0f / 3.0f, 1.0f * (float)MM, 1.0f);
     node = evr_gltf_node(g, "eye_camera", mount);
     evr_gltf_node_camera(g, node, cam);
 

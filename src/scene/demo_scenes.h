@@ -10,7 +10,7 @@
 
 /* Each adds its whole scene to an empty builder; failures are recorded in the builder. */
 void evr_demo_build_eye(evr_gltf *g);
-void evr_demo_build_eye_drift(evr_gltf *g);   /* the same with slow fixational drift */
+void evr_demo_build_eye_drift(evr_gltf *g); /* the same with slow fixational drift */
 void evr_demo_build_square(evr_gltf *g);
 void evr_demo_build_disk(evr_gltf *g);
 void evr_demo_build_cornell(evr_gltf *g);
@@ -27,10 +27,11 @@ typedef struct {
     float *pos, *nrm, *uv;
     uint32_t *idx;
     uint32_t nv, ni, cap_v, cap_i;
-    int failed;   /* out of memory: further additions are ignored */
+    int failed; /* out of memory: further additions are ignored */
 } evr_demo_mesh;
 
-uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u, double v);
+uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u,
+                              double v);
 /* Adds a triangle wound counter-clockwise around the mean of its vertex normals (so that the
  * geometric normal agrees with the shading normals); degenerate triangles are skipped. */
 void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c);

@@ -41,7 +41,7 @@
 #include "scene/demo_scenes.h"
 
 #define SQUARE_DARK 0.1f
-#define SQUARE_BRIGHT 0.738905609893065f   /* 0.1 * e^2 */
+#define SQUARE_BRIGHT 0.738905609893065f /* 0.1 * e^2 */
 
 static int add_quad(evr_gltf *g, const char *name, double half, int material)
 {
@@ -49,7 +49,7 @@ static int add_quad(evr_gltf *g, const char *name, double half, int material)
     static const double n[3] = {0.0, 0.0, 1.0};
     double p[3];
     int i, j;
-    for (j = 0; j < 2; j++) {          /* row 0 at the top: texture v = 0 */
+    for (j = 0; j < 2; j++) { /* row 0 at the top: texture v = 0 */
         for (i = 0; i < 2; i++) {
             p[0] = i ? half : -half;
             p[1] = j ? -half : half;

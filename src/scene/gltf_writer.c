@@ -37,7 +37,7 @@ typedef struct {
 typedef struct {
     char *name;
     sbuf channels, samplers;
-    int *targets;          /* node * 3 + path of each channel, to refuse duplicates */
+    int *targets; /* node * 3 + path of each channel, to refuse duplicates */
     int num_targets, cap_targets;
 } ganim;
 
@@ -65,7 +65,7 @@ static void fail(evr_gltf *g, evr_status st, const char *fmt, ...)
 {
     va_list ap;
     int n;
-    if (g->status != EVR_OK) return;   /* keep the first failure */
+    if (g->status != EVR_OK) return; /* keep the first failure */
     g->status = st;
     n = snprintf(g->msg, sizeof g->msg, "gltf: ");
     va_start(ap, fmt);
@@ -223,7 +223,10 @@ static int add_view(evr_gltf *g, const void *data, size_t n, int word, int targe
         size_t i;
         for (i = 0; i + 4 <= n; i += 4) {
             unsigned char *w = g->bin + off + i, t0 = w[0], t1 = w[1];
-            w[0] = w[3]; w[1] = w[2]; w[2] = t1; w[3] = t0;
+            w[0] = w[3];
+            w[1] = w[2];
+            w[2] = t1;
+            w[3] = t0;
         }
     }
     g->bin_n = off + n;
@@ -243,8 +246,9 @@ static int add_accessor(evr_gltf *g, int view, int component, uint32_t count, co
     int a;
     if (view < 0) return -1;
     a = sb_elem(g, &g->accessors);
-    sb_printf(g, &g->accessors, "{\"bufferView\":%d,\"componentType\":%d,\"count\":%lu,\"type\":\"%s\"",
-              view, component, (unsigned long)count, type);
+    sb_printf(g, &g->accessors,
+              "{\"bufferView\":%d,\"componentType\":%d,\"count\":%lu,\"type\":\"%s\"", view,
+              component, (unsigned long)count, type);
     if (min && max) {
         sb_cat(g, &g->accessors, ",\"min\":");
         sb_nums(g, &g->accessors, min, ncomp);
@@ -342,8 +346,8 @@ static int check_name(evr_gltf *g, const char *what, const char *name)
     return 1;
 }
 
-int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width, int height,
-                         int channels)
+int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width,
+                         int height, int channels)
 {
     void *png = NULL;
     size_t png_n = 0;
@@ -352,7 +356,8 @@ int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, i
     int view, img, tex;
     if (!check_name(g, "texture", name)) return -1;
     if (!pixels || (channels != 3 && channels != 4) || width <= 0 || height <= 0) {
-        fail(g, EVR_ERR_ARG, "texture \"%s\": bad image %dx%d with %d channels", name, width, height, channels);
+        fail(g, EVR_ERR_ARG, "texture \"%s\": bad image %dx%d with %d channels", name, width,
+             height, channels);
         return -1;
     }
     e.msg[0] = 0;
@@ -399,9 +404,10 @@ int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m)
     sbuf *b = &g->materials;
     int idx;
     if (!check_name(g, "material", m->name)) return -1;
-    if (!unit_range(m->base_color, 4) || !unit_range(&m->metallic, 1) || !unit_range(&m->roughness, 1) ||
-        !unit_range(m->emissive, 3)) {
-        fail(g, EVR_ERR_ARG, "material \"%s\": colour, metallic, roughness and emissive factors must lie in [0,1]",
+    if (!unit_range(m->base_color, 4) || !unit_range(&m->metallic, 1) ||
+        !unit_range(&m->roughness, 1) || !unit_range(m->emissive, 3)) {
+        fail(g, EVR_ERR_ARG,
+             "material \"%s\": colour, metallic, roughness and emissive factors must lie in [0,1]",
              m->name);
         return -1;
     }
@@ -414,7 +420,8 @@ int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m)
     sb_str(g, b, m->name);
     sb_cat(g, b, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
     sb_nums(g, b, m->base_color, 4);
-    if (m->base_texture >= 0) sb_printf(g, b, ",\"baseColorTexture\":{\"index\":%d}", m->base_texture);
+    if (m->base_texture >= 0)
+        sb_printf(g, b, ",\"baseColorTexture\":{\"index\":%d}", m->base_texture);
     sb_cat(g, b, ",\"metallicFactor\":");
     sb_num(g, b, m->metallic);
     sb_cat(g, b, ",\"roughnessFactor\":");
@@ -447,16 +454,18 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
     }
     for (i = 0; i < num_indices; i++) {
         if (indices[i] >= num_vertices) {
-            fail(g, EVR_ERR_ARG, "mesh \"%s\": index %lu out of range", name, (unsigned long)indices[i]);
+            fail(g, EVR_ERR_ARG, "mesh \"%s\": index %lu out of range", name,
+                 (unsigned long)indices[i]);
             return -1;
         }
     }
     apos = float_accessor(g, positions, num_vertices, 3, GLTF_ARRAY_BUFFER, 1);
     if (normals) anrm = float_accessor(g, normals, num_vertices, 3, GLTF_ARRAY_BUFFER, 0);
     if (texcoords) auv = float_accessor(g, texcoords, num_vertices, 2, GLTF_ARRAY_BUFFER, 0);
-    aidx = add_accessor(g, add_view(g, indices, (size_t)num_indices * sizeof(uint32_t), 1,
-                                    GLTF_ELEMENT_ARRAY_BUFFER),
-                        GLTF_UINT, num_indices, "SCALAR", NULL, NULL, 1);
+    aidx = add_accessor(
+        g,
+        add_view(g, indices, (size_t)num_indices * sizeof(uint32_t), 1, GLTF_ELEMENT_ARRAY_BUFFER),
+        GLTF_UINT, num_indices, "SCALAR", NULL, NULL, 1);
     if (g->status != EVR_OK) return -1;
     idx = sb_elem(g, b);
     sb_cat(g, b, "{\"name\":");
@@ -470,7 +479,8 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
     return g->status == EVR_OK ? idx : -1;
 }
 
-int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear, float zfar)
+int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear,
+                    float zfar)
 {
     sbuf *b = &g->cameras;
     int idx;
@@ -513,8 +523,10 @@ int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, cons
         fail(g, EVR_ERR_ARG, "light \"%s\": bad type, colour or intensity", name);
         return -1;
     }
-    if (type == EVR_GLTF_SPOT && !(inner_cone >= 0.0f && inner_cone < outer_cone && outer_cone <= 1.5707964f)) {
-        fail(g, EVR_ERR_ARG, "light \"%s\": spot cone angles need 0 <= inner < outer <= pi/2", name);
+    if (type == EVR_GLTF_SPOT &&
+        !(inner_cone >= 0.0f && inner_cone < outer_cone && outer_cone <= 1.5707964f)) {
+        fail(g, EVR_ERR_ARG, "light \"%s\": spot cone angles need 0 <= inner < outer <= pi/2",
+             name);
         return -1;
     }
     idx = sb_elem(g, b);
@@ -543,7 +555,8 @@ int evr_gltf_node(evr_gltf *g, const char *name, int parent)
         fail(g, EVR_ERR_ARG, "node \"%s\": no parent node %d", name, parent);
         return -1;
     }
-    if (!grow_int(g, (void **)&g->nodes, sizeof *g->nodes, g->num_nodes + 1, &g->cap_nodes)) return -1;
+    if (!grow_int(g, (void **)&g->nodes, sizeof *g->nodes, g->num_nodes + 1, &g->cap_nodes))
+        return -1;
     n = &g->nodes[g->num_nodes];
     memset(n, 0, sizeof *n);
     n->name = dup_str(g, name);
@@ -569,7 +582,9 @@ void evr_gltf_node_translation(evr_gltf *g, int node, float x, float y, float z)
 {
     gnode *n = node_ref(g, node);
     if (!n) return;
-    n->t[0] = x; n->t[1] = y; n->t[2] = z;
+    n->t[0] = x;
+    n->t[1] = y;
+    n->t[2] = z;
     n->has_t = 1;
 }
 
@@ -582,7 +597,10 @@ void evr_gltf_node_rotation(evr_gltf *g, int node, float x, float y, float z, fl
         fail(g, EVR_ERR_ARG, "node \"%s\": rotation is not a unit quaternion", n->name);
         return;
     }
-    n->r[0] = x / l; n->r[1] = y / l; n->r[2] = z / l; n->r[3] = w / l;
+    n->r[0] = x / l;
+    n->r[1] = y / l;
+    n->r[2] = z / l;
+    n->r[3] = w / l;
     n->has_r = 1;
 }
 
@@ -590,7 +608,9 @@ void evr_gltf_node_scale(evr_gltf *g, int node, float x, float y, float z)
 {
     gnode *n = node_ref(g, node);
     if (!n) return;
-    n->s[0] = x; n->s[1] = y; n->s[2] = z;
+    n->s[0] = x;
+    n->s[1] = y;
+    n->s[2] = z;
     n->has_s = 1;
 }
 
@@ -598,7 +618,8 @@ void evr_gltf_node_mesh(evr_gltf *g, int node, int mesh)
 {
     gnode *n = node_ref(g, node);
     if (!n) return;
-    if (mesh < 0 || mesh >= g->meshes.count) fail(g, EVR_ERR_ARG, "node \"%s\": no mesh %d", n->name, mesh);
+    if (mesh < 0 || mesh >= g->meshes.count)
+        fail(g, EVR_ERR_ARG, "node \"%s\": no mesh %d", n->name, mesh);
     else n->mesh = mesh;
 }
 
@@ -606,7 +627,8 @@ void evr_gltf_node_camera(evr_gltf *g, int node, int camera)
 {
     gnode *n = node_ref(g, node);
     if (!n) return;
-    if (camera < 0 || camera >= g->cameras.count) fail(g, EVR_ERR_ARG, "node \"%s\": no camera %d", n->name, camera);
+    if (camera < 0 || camera >= g->cameras.count)
+        fail(g, EVR_ERR_ARG, "node \"%s\": no camera %d", n->name, camera);
     else n->camera = camera;
 }
 
@@ -614,7 +636,8 @@ void evr_gltf_node_light(evr_gltf *g, int node, int light)
 {
     gnode *n = node_ref(g, node);
     if (!n) return;
-    if (light < 0 || light >= g->lights.count) fail(g, EVR_ERR_ARG, "node \"%s\": no light %d", n->name, light);
+    if (light < 0 || light >= g->lights.count)
+        fail(g, EVR_ERR_ARG, "node \"%s\": no light %d", n->name, light);
     else n->light = light;
 }
 
@@ -622,7 +645,8 @@ int evr_gltf_animation(evr_gltf *g, const char *name)
 {
     ganim *a;
     if (!check_name(g, "animation", name)) return -1;
-    if (!grow_int(g, (void **)&g->anims, sizeof *g->anims, g->num_anims + 1, &g->cap_anims)) return -1;
+    if (!grow_int(g, (void **)&g->anims, sizeof *g->anims, g->num_anims + 1, &g->cap_anims))
+        return -1;
     a = &g->anims[g->num_anims];
     memset(a, 0, sizeof *a);
     a->name = dup_str(g, name);
@@ -655,28 +679,32 @@ void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, 
     }
     for (i = 0; i < count; i++) {
         if (!(times[i] >= 0.0f) || !isfinite(times[i]) || (i > 0 && !(times[i] > times[i - 1]))) {
-            fail(g, EVR_ERR_ARG, "animation \"%s\": key times must be finite, >= 0 and increasing", a->name);
+            fail(g, EVR_ERR_ARG, "animation \"%s\": key times must be finite, >= 0 and increasing",
+                 a->name);
             return;
         }
         if (path == EVR_GLTF_ROTATION) {
             const float *q = values + 4 * (size_t)i;
             float l = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
             if (!(fabsf(l - 1.0f) < 1e-3f)) {
-                fail(g, EVR_ERR_ARG, "animation \"%s\": rotation key %d is not a unit quaternion", a->name, i);
+                fail(g, EVR_ERR_ARG, "animation \"%s\": rotation key %d is not a unit quaternion",
+                     a->name, i);
                 return;
             }
         }
     }
-    if (!grow_int(g, (void **)&a->targets, sizeof *a->targets, a->num_targets + 1, &a->cap_targets)) return;
+    if (!grow_int(g, (void **)&a->targets, sizeof *a->targets, a->num_targets + 1, &a->cap_targets))
+        return;
     a->targets[a->num_targets++] = target;
-    in = float_accessor(g, times, (uint32_t)count, 1, 0, 1);       /* input needs min/max */
+    in = float_accessor(g, times, (uint32_t)count, 1, 0, 1); /* input needs min/max */
     out = float_accessor(g, values, (uint32_t)count, ncomp, 0, 0);
     if (g->status != EVR_OK) return;
     s = sb_elem(g, &a->samplers);
     sb_printf(g, &a->samplers, "{\"input\":%d,\"output\":%d,\"interpolation\":\"%s\"}", in, out,
               interp == EVR_GLTF_STEP ? "STEP" : "LINEAR");
     sb_elem(g, &a->channels);
-    sb_printf(g, &a->channels, "{\"sampler\":%d,\"target\":{\"node\":%d,\"path\":\"%s\"}}", s, node, paths[path]);
+    sb_printf(g, &a->channels, "{\"sampler\":%d,\"target\":{\"node\":%d,\"path\":\"%s\"}}", s, node,
+              paths[path]);
 }
 
 /* ---- serialization ---- */
@@ -695,7 +723,7 @@ static void put_node(evr_gltf *g, sbuf *j, int i)
     int c, first = 1;
     sb_cat(g, j, "{\"name\":");
     sb_str(g, j, n->name);
-    for (c = i + 1; c < g->num_nodes; c++) {   /* children always come after their parent */
+    for (c = i + 1; c < g->num_nodes; c++) { /* children always come after their parent */
         if (g->nodes[c].parent != i) continue;
         sb_printf(g, j, first ? ",\"children\":[%d" : ",%d", c);
         first = 0;
@@ -715,7 +743,8 @@ static void put_node(evr_gltf *g, sbuf *j, int i)
         sb_cat(g, j, ",\"scale\":");
         sb_nums(g, j, n->s, 3);
     }
-    if (n->light >= 0) sb_printf(g, j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
+    if (n->light >= 0)
+        sb_printf(g, j, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", n->light);
     sb_cat(g, j, "}");
 }
 
@@ -736,7 +765,8 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
     *glb = NULL;
     *size = 0;
     for (i = 0; i < g->num_anims && g->status == EVR_OK; i++)
-        if (!g->anims[i].channels.count) fail(g, EVR_ERR_ARG, "animation \"%s\" has no channels", g->anims[i].name);
+        if (!g->anims[i].channels.count)
+            fail(g, EVR_ERR_ARG, "animation \"%s\" has no channels", g->anims[i].name);
     if (g->status != EVR_OK) return evr_gltf_status(g, err);
 
     sb_cat(g, &j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"evray gltf_writer\"}");
@@ -771,7 +801,8 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
     put_array(g, &j, "textures", &g->textures);
     put_array(g, &j, "images", &g->images);
     if (g->has_sampler)
-        sb_printf(g, &j, ",\"samplers\":[{\"magFilter\":%d,\"minFilter\":%d,\"wrapS\":%d,\"wrapT\":%d}]",
+        sb_printf(g, &j,
+                  ",\"samplers\":[{\"magFilter\":%d,\"minFilter\":%d,\"wrapS\":%d,\"wrapT\":%d}]",
                   GLTF_LINEAR, GLTF_LINEAR, GLTF_REPEAT, GLTF_REPEAT);
     put_array(g, &j, "cameras", &g->cameras);
     if (g->num_anims) {

@@ -32,7 +32,11 @@
 
 typedef struct evr_gltf evr_gltf;
 
-typedef enum { EVR_GLTF_POINT = 0, EVR_GLTF_SPOT = 1, EVR_GLTF_DIRECTIONAL = 2 } evr_gltf_light_type;
+typedef enum {
+    EVR_GLTF_POINT = 0,
+    EVR_GLTF_SPOT = 1,
+    EVR_GLTF_DIRECTIONAL = 2
+} evr_gltf_light_type;
 typedef enum { EVR_GLTF_TRANSLATION = 0, EVR_GLTF_ROTATION = 1, EVR_GLTF_SCALE = 2 } evr_gltf_path;
 typedef enum { EVR_GLTF_LINEAR = 0, EVR_GLTF_STEP = 1 } evr_gltf_interp;
 
@@ -40,9 +44,9 @@ typedef enum { EVR_GLTF_LINEAR = 0, EVR_GLTF_STEP = 1 } evr_gltf_interp;
 typedef struct {
     const char *name;
     float base_color[4];
-    int base_texture;          /* texture index from evr_gltf_texture_png, -1: none */
+    int base_texture; /* texture index from evr_gltf_texture_png, -1: none */
     float metallic, roughness;
-    float emissive[3];         /* linear RGB */
+    float emissive[3]; /* linear RGB */
     int double_sided;
 } evr_gltf_material;
 
@@ -53,8 +57,8 @@ void evr_gltf_free(evr_gltf *g);
 /* Encodes 8-bit pixels (rows top to bottom, sRGB-encoded colour; channels 3 or 4) as a PNG
  * stored in the BIN chunk, with an image, and a texture that samples it with linear filtering
  * and repeat wrapping. Returns the texture index. */
-int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width, int height,
-                         int channels);
+int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width,
+                         int height, int channels);
 
 /* Defaults: white, no texture, metallic 0, roughness 1, no emission, single-sided. */
 void evr_gltf_material_init(evr_gltf_material *m, const char *name);
@@ -67,7 +71,8 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
                   uint32_t num_indices, int material);
 
 /* Perspective camera; yfov in radians; aspect <= 0: not given; zfar <= 0: infinite. */
-int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear, float zfar);
+int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear,
+                    float zfar);
 
 /* KHR_lights_punctual light. color: linear RGB (NULL: white); intensity in candela (point,
  * spot) or lux (directional); cone half-angles in radians (spot only; 0 <= inner < outer <= pi/2). */
@@ -77,7 +82,7 @@ int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, cons
 /* A node; parent is an existing node index or -1 for a root of the scene. */
 int evr_gltf_node(evr_gltf *g, const char *name, int parent);
 void evr_gltf_node_translation(evr_gltf *g, int node, float x, float y, float z);
-void evr_gltf_node_rotation(evr_gltf *g, int node, float x, float y, float z, float w);  /* unit */
+void evr_gltf_node_rotation(evr_gltf *g, int node, float x, float y, float z, float w); /* unit */
 void evr_gltf_node_scale(evr_gltf *g, int node, float x, float y, float z);
 void evr_gltf_node_mesh(evr_gltf *g, int node, int mesh);
 void evr_gltf_node_camera(evr_gltf *g, int node, int camera);

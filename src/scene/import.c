@@ -80,7 +80,8 @@ void evr_import_copy_name(char *dst, size_t cap, const char *src)
 }
 
 /* Reads at most max bytes of a file (the whole file when max is 0). */
-evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size, evr_error *err)
+evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
+                                evr_error *err)
 {
     FILE *f = fopen(path, "rb");
     unsigned char *buf = NULL;
@@ -96,7 +97,11 @@ evr_status evr_import_read_file(const char *path, size_t max, unsigned char **da
             if (max && ncap > max) ncap = max;
             if (ncap == cap) break;
             nb = realloc(buf, ncap + 1);
-            if (!nb) { free(buf); fclose(f); return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading '%s'", path); }
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading '%s'", path);
+            }
             buf = nb;
             cap = ncap;
         }
@@ -107,7 +112,8 @@ evr_status evr_import_read_file(const char *path, size_t max, unsigned char **da
             if (ferror(f)) {
                 free(buf);
                 fclose(f);
-                return evr_import_fail(err, EVR_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
+                return evr_import_fail(err, EVR_ERR_IO, "cannot read '%s': %s", path,
+                                       strerror(errno));
             }
             break;
         }
@@ -149,7 +155,8 @@ static void read_format(const struct aiScene *ai, char *out, size_t cap)
     if (!ai->mMetaData) return;
     for (i = 0; i < ai->mMetaData->mNumProperties; i++) {
         const struct aiMetadataEntry *e = &ai->mMetaData->mValues[i];
-        if (!strcmp(ai->mMetaData->mKeys[i].data, "SourceAsset_Format") && e->mType == AI_AISTRING && e->mData) {
+        if (!strcmp(ai->mMetaData->mKeys[i].data, "SourceAsset_Format") &&
+            e->mType == AI_AISTRING && e->mData) {
             evr_import_copy_name(out, cap, ((const struct aiString *)e->mData)->data);
             return;
         }
@@ -178,8 +185,9 @@ static void importer_free(importer *im)
 
 /* Everything after Assimp: ai -> *out. `bytes` is the file or memory content (for the glTF
  * JSON), `dir` the folder for external textures. */
-static evr_status convert(const struct aiScene *ai, const char *source, const char *dir, const char *ext,
-                          const unsigned char *bytes, size_t nbytes, evr_scene **out, evr_error *err)
+static evr_status convert(const struct aiScene *ai, const char *source, const char *dir,
+                          const char *ext, const unsigned char *bytes, size_t nbytes,
+                          evr_scene **out, evr_error *err)
 {
     importer im;
     evr_scene *s;
@@ -197,7 +205,9 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     evr_import_copy_name(s->source, sizeof s->source, source);
     read_format(ai, s->format, sizeof s->format);
     if (s->format[0]) im.gltf = strstr(s->format, "glTF2") != NULL;
-    else im.gltf = ext_is(ext, "gltf") || ext_is(ext, "glb") || (nbytes >= 8 && !memcmp(bytes, "glTF", 4) && bytes[4] == 2);
+    else
+        im.gltf = ext_is(ext, "gltf") || ext_is(ext, "glb") ||
+                  (nbytes >= 8 && !memcmp(bytes, "glTF", 4) && bytes[4] == 2);
     if (im.gltf && bytes) {
         if ((st = evr_gltf_side_parse(bytes, nbytes, &im.side, err)) != EVR_OK) goto fail;
         im.have_side = 1;
@@ -206,14 +216,16 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     if ((st = evr_import_materials(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_meshes(&im, &tris)) != EVR_OK) goto fail;
     if (tris == 0) {
-        st = evr_import_fail(err, EVR_ERR_FORMAT, "'%s' has no triangles (points and lines are not rendered)", source);
+        st = evr_import_fail(err, EVR_ERR_FORMAT,
+                             "'%s' has no triangles (points and lines are not rendered)", source);
         goto fail;
     }
     if ((st = evr_import_nodes(&im)) != EVR_OK) goto fail;
     tris = 0;
     for (i = 0; i < s->num_instances; i++) tris += s->meshes[s->instances[i].mesh].num_triangles;
     if (tris == 0) {
-        st = evr_import_fail(err, EVR_ERR_FORMAT, "'%s' has meshes but no node places them", source);
+        st =
+            evr_import_fail(err, EVR_ERR_FORMAT, "'%s' has meshes but no node places them", source);
         goto fail;
     }
     if ((st = evr_import_animation(&im)) != EVR_OK) goto fail;
@@ -234,14 +246,18 @@ static evr_status import_error(evr_error *err, const char *source)
 {
     const char *why = aiGetErrorString();
     if (why && strstr(why, "No meshes remaining"))
-        return evr_import_fail(err, EVR_ERR_FORMAT, "'%s' has no triangles (points and lines are not rendered)", source);
-    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, why && why[0] ? why : "unknown Assimp error");
+        return evr_import_fail(err, EVR_ERR_FORMAT,
+                               "'%s' has no triangles (points and lines are not rendered)", source);
+    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source,
+                           why && why[0] ? why : "unknown Assimp error");
 }
 
 static struct aiPropertyStore *make_props(void)
 {
     struct aiPropertyStore *p = aiCreatePropertyStore();
-    if (p) aiSetImportPropertyInteger(p, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    if (p)
+        aiSetImportPropertyInteger(p, AI_CONFIG_PP_SBP_REMOVE,
+                                   aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     return p;
 }
 
@@ -260,14 +276,21 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
     *out = NULL;
     if (!path || !path[0]) return evr_import_fail(err, EVR_ERR_ARG, "no scene file given");
-    if (stat(path, &sb) != 0) return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path, strerror(errno));
-    if (S_ISDIR(sb.st_mode)) return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': it is a folder", path);
+    if (stat(path, &sb) != 0)
+        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
+                               strerror(errno));
+    if (S_ISDIR(sb.st_mode))
+        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': it is a folder",
+                               path);
     {
         FILE *f = fopen(path, "rb");
-        if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path, strerror(errno));
+        if (!f)
+            return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
+                                   strerror(errno));
         fclose(f);
     }
-    if (sb.st_size == 0) return evr_import_fail(err, EVR_ERR_FORMAT, "scene file '%s' is empty", path);
+    if (sb.st_size == 0)
+        return evr_import_fail(err, EVR_ERR_FORMAT, "scene file '%s' is empty", path);
 
     props = make_props();
     if (!props) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
@@ -283,7 +306,7 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
         memcpy(dir, path, n);
         dir[n] = 0;
     } else {
-        dir[0] = 0;   /* the current folder */
+        dir[0] = 0; /* the current folder */
     }
     {
         /* The glTF JSON for what Assimp drops (GLB: header and JSON chunk only). */
@@ -295,10 +318,14 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
             FILE *f = fopen(path, "rb");
             if (f) {
                 if (fread(head, 1, 20, f) == 20 && !memcmp(head, "glTF", 4))
-                    want = 20 + ((size_t)head[12] | (size_t)head[13] << 8 | (size_t)head[14] << 16 | (size_t)head[15] << 24);
+                    want = 20 + ((size_t)head[12] | (size_t)head[13] << 8 | (size_t)head[14] << 16 |
+                                 (size_t)head[15] << 24);
                 fclose(f);
             }
-            if ((st = evr_import_read_file(path, want, &bytes, &nbytes, err)) != EVR_OK) { aiReleaseImport(ai); return st; }
+            if ((st = evr_import_read_file(path, want, &bytes, &nbytes, err)) != EVR_OK) {
+                aiReleaseImport(ai);
+                return st;
+            }
         }
     }
     st = convert(ai, path, dir, ext, bytes, nbytes, out, err);
@@ -307,7 +334,8 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
     return st;
 }
 
-evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out, evr_error *err)
+evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out,
+                                 evr_error *err)
 {
     const struct aiScene *ai;
     struct aiPropertyStore *props;
@@ -318,11 +346,13 @@ evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
     *out = NULL;
     if (!data || size == 0) return evr_import_fail(err, EVR_ERR_ARG, "no scene data given");
-    if (size > UINT_MAX) return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
+    if (size > UINT_MAX)
+        return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
     if (!hint) hint = "";
     props = make_props();
     if (!props) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
-    ai = aiImportFileFromMemoryWithProperties((const char *)data, (unsigned)size, import_flags(), hint, props);
+    ai = aiImportFileFromMemoryWithProperties((const char *)data, (unsigned)size, import_flags(),
+                                              hint, props);
     aiReleasePropertyStore(props);
     snprintf(source, sizeof source, "<memory>.%s", hint);
     if (!ai) return import_error(err, source);
@@ -374,6 +404,7 @@ int evr_scene_find_camera(const evr_scene *s, const char *name)
     /* names longer than the stored 63 characters */
     for (i = 0; i < s->num_cameras; i++)
         if (strlen(name) >= sizeof s->cameras[i].name - 1 &&
-            !strncmp(s->cameras[i].name, name, sizeof s->cameras[i].name - 1)) return i;
+            !strncmp(s->cameras[i].name, name, sizeof s->cameras[i].name - 1))
+            return i;
     return -1;
 }

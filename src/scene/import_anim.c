@@ -39,19 +39,28 @@ static int make_curve(evr_curve *c, const void *keys, unsigned nkeys, int dim, d
     int sorted = 1;
     c->times = malloc((size_t)nkeys * sizeof(double));
     c->values = malloc((size_t)nkeys * (size_t)dim * sizeof(float));
-    if (!c->times || !c->values) { evr_import_curve_free(c); return 0; }
+    if (!c->times || !c->values) {
+        evr_import_curve_free(c);
+        return 0;
+    }
     c->num_keys = (int)nkeys;
     for (k = 0; k < nkeys; k++) {
         float *v = c->values + (size_t)k * (size_t)dim;
         if (dim == 3) {
             const struct aiVectorKey *key = (const struct aiVectorKey *)keys + k;
             c->times[k] = key->mTime / tps;
-            v[0] = key->mValue.x; v[1] = key->mValue.y; v[2] = key->mValue.z;
+            v[0] = key->mValue.x;
+            v[1] = key->mValue.y;
+            v[2] = key->mValue.z;
         } else {
             const struct aiQuatKey *key = (const struct aiQuatKey *)keys + k;
-            evr_quat q = evr_quat_normalize(evr_quat_make(key->mValue.w, key->mValue.x, key->mValue.y, key->mValue.z));
+            evr_quat q = evr_quat_normalize(
+                evr_quat_make(key->mValue.w, key->mValue.x, key->mValue.y, key->mValue.z));
             c->times[k] = key->mTime / tps;
-            v[0] = q.w; v[1] = q.x; v[2] = q.y; v[3] = q.z;
+            v[0] = q.w;
+            v[1] = q.x;
+            v[2] = q.y;
+            v[3] = q.z;
         }
         if (k && c->times[k] < c->times[k - 1]) sorted = 0;
     }
@@ -64,7 +73,9 @@ static int make_curve(evr_curve *c, const void *keys, unsigned nkeys, int dim, d
             for (d = 0; d < dim; d++) tmp[d] = c->values[(size_t)i * (size_t)dim + (size_t)d];
             for (j = i; j > 0 && c->times[j - 1] > t; j--) {
                 c->times[j] = c->times[j - 1];
-                for (d = 0; d < dim; d++) c->values[(size_t)j * (size_t)dim + (size_t)d] = c->values[(size_t)(j - 1) * (size_t)dim + (size_t)d];
+                for (d = 0; d < dim; d++)
+                    c->values[(size_t)j * (size_t)dim + (size_t)d] =
+                        c->values[(size_t)(j - 1) * (size_t)dim + (size_t)d];
             }
             c->times[j] = t;
             for (d = 0; d < dim; d++) c->values[(size_t)j * (size_t)dim + (size_t)d] = tmp[d];
@@ -91,28 +102,46 @@ evr_status evr_import_animation(importer *im)
             const struct aiNodeAnim *na = an->mChannels[ch];
             int ni = evr_import_find_node(im, na->mNodeName.data), kind;
             evr_node *n;
-            if (ni < 0) continue;   /* targets no node of the scene */
+            if (ni < 0) continue; /* targets no node of the scene */
             n = &s->nodes[ni];
             for (kind = 0; kind < 3; kind++) {
-                evr_curve *c = kind == PATH_T ? &n->t_curve : kind == PATH_R ? &n->r_curve : &n->s_curve;
-                unsigned nk = kind == PATH_T ? na->mNumPositionKeys : kind == PATH_R ? na->mNumRotationKeys : na->mNumScalingKeys;
-                const void *keys = kind == PATH_T ? (const void *)na->mPositionKeys
-                                 : kind == PATH_R ? (const void *)na->mRotationKeys : (const void *)na->mScalingKeys;
+                evr_curve *c = kind == PATH_T   ? &n->t_curve
+                               : kind == PATH_R ? &n->r_curve
+                                                : &n->s_curve;
+                unsigned nk = kind == PATH_T   ? na->mNumPositionKeys
+                              : kind == PATH_R ? na->mNumRotationKeys
+                                               : na->mNumScalingKeys;
+                const void *keys = kind == PATH_T   ? (const void *)na->mPositionKeys
+                                   : kind == PATH_R ? (const void *)na->mRotationKeys
+                                                    : (const void *)na->mScalingKeys;
                 int interp = GL_LINEAR;
                 float rest[4];
-                if (nk == 0 || !keys || c->num_keys > 0) continue;   /* first animation wins */
+                if (nk == 0 || !keys || c->num_keys > 0) continue; /* first animation wins */
                 if (im->have_side) {
                     /* quirk (e): keys of properties no glTF channel animates are synthesized */
-                    interp = evr_gltf_side_interp(&im->side, side_ok ? (int)a : -1, na->mNodeName.data, kind);
+                    interp = evr_gltf_side_interp(&im->side, side_ok ? (int)a : -1,
+                                                  na->mNodeName.data, kind);
                     if (interp < 0) continue;
                 }
                 if (!make_curve(c, keys, nk, kind == PATH_R ? 4 : 3, tps))
-                    return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading animations");
+                    return evr_import_fail(im->err, EVR_ERR_NOMEM,
+                                           "out of memory reading animations");
                 /* STEP from the JSON; CUBICSPLINE values (quirk (d)) are interpolated linearly */
                 c->interp = interp == GL_STEP ? EVR_INTERP_STEP : EVR_INTERP_LINEAR;
-                if (kind == PATH_T) { rest[0] = n->translation.x; rest[1] = n->translation.y; rest[2] = n->translation.z; }
-                else if (kind == PATH_S) { rest[0] = n->scale.x; rest[1] = n->scale.y; rest[2] = n->scale.z; }
-                else { rest[0] = n->rotation.w; rest[1] = n->rotation.x; rest[2] = n->rotation.y; rest[3] = n->rotation.z; }
+                if (kind == PATH_T) {
+                    rest[0] = n->translation.x;
+                    rest[1] = n->translation.y;
+                    rest[2] = n->translation.z;
+                } else if (kind == PATH_S) {
+                    rest[0] = n->scale.x;
+                    rest[1] = n->scale.y;
+                    rest[2] = n->scale.z;
+                } else {
+                    rest[0] = n->rotation.w;
+                    rest[1] = n->rotation.x;
+                    rest[2] = n->rotation.y;
+                    rest[3] = n->rotation.z;
+                }
                 if (curve_is_rest(c, rest, kind == PATH_R ? 4 : 3)) evr_import_curve_free(c);
             }
         }
@@ -121,16 +150,22 @@ evr_status evr_import_animation(importer *im)
         evr_node *n = &s->nodes[i];
         const evr_curve *cv[3];
         int k;
-        cv[0] = &n->t_curve; cv[1] = &n->r_curve; cv[2] = &n->s_curve;
+        cv[0] = &n->t_curve;
+        cv[1] = &n->r_curve;
+        cv[2] = &n->s_curve;
         for (k = 0; k < 3; k++) {
             if (cv[k]->num_keys <= 0) continue;
             n->animated = 1;
             any = 1;
             if (cv[k]->times[0] < t_min) t_min = cv[k]->times[0];
-            if (cv[k]->times[cv[k]->num_keys - 1] > t_max) t_max = cv[k]->times[cv[k]->num_keys - 1];
+            if (cv[k]->times[cv[k]->num_keys - 1] > t_max)
+                t_max = cv[k]->times[cv[k]->num_keys - 1];
         }
     }
-    if (any) { s->anim_start = t_min; s->anim_end = t_max; }
+    if (any) {
+        s->anim_start = t_min;
+        s->anim_end = t_max;
+    }
     /* glTF has no frame rate. FBX and BVH store keys in frames (ticks per second = frames per
      * second); Collada uses 1 tick per second, which says nothing. */
     if (!im->gltf && ai->mNumAnimations && ai->mAnimations[0]->mTicksPerSecond >= 10.0 &&

@@ -16,12 +16,22 @@ static evr_m34 look_matrix(evr_v3 pos, evr_v3 look, evr_v3 up)
     evr_v3 z = evr_v3_norm(evr_v3_scale(look, -1.0f)), x, y;
     if (evr_v3_len(z) == 0.0f) z = evr_v3_make(0, 0, 1);
     x = evr_v3_cross(up, z);
-    if (evr_v3_len(x) < 1e-6f) x = evr_v3_cross(fabsf(z.y) < 0.9f ? evr_v3_make(0, 1, 0) : evr_v3_make(1, 0, 0), z);
+    if (evr_v3_len(x) < 1e-6f)
+        x = evr_v3_cross(fabsf(z.y) < 0.9f ? evr_v3_make(0, 1, 0) : evr_v3_make(1, 0, 0), z);
     x = evr_v3_norm(x);
     y = evr_v3_cross(z, x);
-    m.m[0][0] = x.x; m.m[0][1] = y.x; m.m[0][2] = z.x; m.m[0][3] = pos.x;
-    m.m[1][0] = x.y; m.m[1][1] = y.y; m.m[1][2] = z.y; m.m[1][3] = pos.y;
-    m.m[2][0] = x.z; m.m[2][1] = y.z; m.m[2][2] = z.z; m.m[2][3] = pos.z;
+    m.m[0][0] = x.x;
+    m.m[0][1] = y.x;
+    m.m[0][2] = z.x;
+    m.m[0][3] = pos.x;
+    m.m[1][0] = x.y;
+    m.m[1][1] = y.y;
+    m.m[1][2] = z.y;
+    m.m[1][3] = pos.y;
+    m.m[2][0] = x.z;
+    m.m[2][1] = y.z;
+    m.m[2][2] = z.z;
+    m.m[2][3] = pos.z;
     return m;
 }
 
@@ -31,7 +41,8 @@ evr_status evr_import_cameras(importer *im)
     evr_scene *s = im->s;
     unsigned i;
     s->cameras = calloc((size_t)ai->mNumCameras + 1, sizeof *s->cameras);
-    if (!s->cameras) return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading cameras");
+    if (!s->cameras)
+        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading cameras");
     for (i = 0; i < ai->mNumCameras; i++) {
         const struct aiCamera *ac = ai->mCameras[i];
         evr_camera_desc *c = &s->cameras[s->num_cameras++];
@@ -42,7 +53,7 @@ evr_status evr_import_cameras(importer *im)
         c->aspect = ac->mAspect > 0.0f ? ac->mAspect : 0.0f;
         c->znear = ac->mClipPlaneNear > 0.0f ? ac->mClipPlaneNear : 0.01f;
         if (!(h > 0.0f)) {
-            c->yfov = (float)(EVR_PI_D / 4.0);   /* orthographic: not supported, 45 degrees */
+            c->yfov = (float)(EVR_PI_D / 4.0); /* orthographic: not supported, 45 degrees */
         } else if (im->gltf) {
             /* quirk (b): Assimp stored yfov * aspect */
             c->yfov = ac->mAspect > 0.0f ? h / ac->mAspect : h;
@@ -74,7 +85,8 @@ evr_status evr_import_cameras(importer *im)
         c->yfov = fov;
         c->aspect = 0.0f;
         c->znear = fmaxf(1e-4f * dist, 0.01f * (dist - r));
-        c->local = look_matrix(evr_v3_add(centre, evr_v3_make(0, 0, dist)), evr_v3_make(0, 0, -1), evr_v3_make(0, 1, 0));
+        c->local = look_matrix(evr_v3_add(centre, evr_v3_make(0, 0, dist)), evr_v3_make(0, 0, -1),
+                               evr_v3_make(0, 1, 0));
         c->automatic = 1;
     }
     return EVR_OK;

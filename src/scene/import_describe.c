@@ -24,14 +24,23 @@ static void sb_printf(strbuf *b, const char *fmt, ...)
         va_start(ap, fmt);
         n = vsnprintf(b->buf ? b->buf + b->len : NULL, b->buf ? room : 0, fmt, ap);
         va_end(ap);
-        if (n < 0) { b->failed = 1; return; }
-        if (b->buf && (size_t)n < room) { b->len += (size_t)n; return; }
+        if (n < 0) {
+            b->failed = 1;
+            return;
+        }
+        if (b->buf && (size_t)n < room) {
+            b->len += (size_t)n;
+            return;
+        }
         {
             size_t ncap = b->cap ? b->cap * 2 : 1024;
             char *nb;
             while (ncap < b->len + (size_t)n + 1) ncap *= 2;
             nb = realloc(b->buf, ncap);
-            if (!nb) { b->failed = 1; return; }
+            if (!nb) {
+                b->failed = 1;
+                return;
+            }
             b->buf = nb;
             b->cap = ncap;
         }
@@ -66,22 +75,25 @@ char *evr_scene_describe(const evr_scene *s)
     sb_printf(&b, "cameras: %d\n", s->num_cameras);
     for (i = 0; i < s->num_cameras; i++) {
         const evr_camera_desc *c = &s->cameras[i];
-        sb_printf(&b, "  [%d] \"%s\" node \"%s\", yfov %.2f deg", i, c->name, node_label(s, c->node),
-                  c->yfov * 180.0 / EVR_PI_D);
+        sb_printf(&b, "  [%d] \"%s\" node \"%s\", yfov %.2f deg", i, c->name,
+                  node_label(s, c->node), c->yfov * 180.0 / EVR_PI_D);
         if (c->aspect > 0.0f) sb_printf(&b, ", aspect %.4g", c->aspect);
-        sb_printf(&b, ", znear %.4g%s\n", c->znear, c->automatic ? ", automatic (the file has no camera)" : "");
+        sb_printf(&b, ", znear %.4g%s\n", c->znear,
+                  c->automatic ? ", automatic (the file has no camera)" : "");
     }
 
-    sb_printf(&b, "lights: %d%s\n", s->num_lights, s->default_light ? " (the file has none: default headlight added)" : "");
+    sb_printf(&b, "lights: %d%s\n", s->num_lights,
+              s->default_light ? " (the file has none: default headlight added)" : "");
     for (i = 0; i < s->num_lights; i++) {
         const evr_light *l = &s->lights[i];
         float k = fmaxf(l->color[0], fmaxf(l->color[1], l->color[2]));
         sb_printf(&b, "  [%d] \"%s\" %s, node \"%s\", colour (%.3g %.3g %.3g), intensity %.4g %s",
                   i, l->name, light_types[l->type <= 2 ? l->type : 0], node_label(s, l->node),
-                  k > 0 ? l->color[0] / k : 0.0, k > 0 ? l->color[1] / k : 0.0, k > 0 ? l->color[2] / k : 0.0,
-                  k, l->type == EVR_LIGHT_DIRECTIONAL ? "lx" : "cd");
+                  k > 0 ? l->color[0] / k : 0.0, k > 0 ? l->color[1] / k : 0.0,
+                  k > 0 ? l->color[2] / k : 0.0, k, l->type == EVR_LIGHT_DIRECTIONAL ? "lx" : "cd");
         if (l->type == EVR_LIGHT_SPOT)
-            sb_printf(&b, ", cone %.1f-%.1f deg (half angles)", l->inner_cone * 180.0 / EVR_PI_D, l->outer_cone * 180.0 / EVR_PI_D);
+            sb_printf(&b, ", cone %.1f-%.1f deg (half angles)", l->inner_cone * 180.0 / EVR_PI_D,
+                      l->outer_cone * 180.0 / EVR_PI_D);
         sb_printf(&b, "\n");
     }
 
@@ -112,20 +124,25 @@ char *evr_scene_describe(const evr_scene *s)
         tris += s->meshes[i].num_triangles;
         verts += s->meshes[i].num_vertices;
     }
-    for (i = 0; i < s->num_instances; i++) inst_tris += s->meshes[s->instances[i].mesh].num_triangles;
-    sb_printf(&b, "meshes: %d, %llu vertices, %llu triangles\n", s->num_meshes, (unsigned long long)verts, (unsigned long long)tris);
+    for (i = 0; i < s->num_instances; i++)
+        inst_tris += s->meshes[s->instances[i].mesh].num_triangles;
+    sb_printf(&b, "meshes: %d, %llu vertices, %llu triangles\n", s->num_meshes,
+              (unsigned long long)verts, (unsigned long long)tris);
     for (i = 0; i < s->num_meshes && i < max_list; i++) {
         const evr_mesh *m = &s->meshes[i];
-        sb_printf(&b, "  [%d] \"%s\": %u vertices, %u triangles, material \"%s\"\n", i, m->name, m->num_vertices,
-                  m->num_triangles, (m->material >= 0 && m->material < s->num_materials) ? s->materials[m->material].name : "?");
+        sb_printf(&b, "  [%d] \"%s\": %u vertices, %u triangles, material \"%s\"\n", i, m->name,
+                  m->num_vertices, m->num_triangles,
+                  (m->material >= 0 && m->material < s->num_materials)
+                      ? s->materials[m->material].name
+                      : "?");
     }
     if (s->num_meshes > max_list) sb_printf(&b, "  ... and %d more\n", s->num_meshes - max_list);
     sb_printf(&b, "instances: %d (%llu triangles in the scene), nodes: %d\n", s->num_instances,
               (unsigned long long)inst_tris, s->num_nodes);
     sb_printf(&b, "materials: %d, textures: %d\n", s->num_materials, s->num_textures);
     sb_printf(&b, "bounds (rest pose): (%.4g %.4g %.4g) to (%.4g %.4g %.4g), size %.4g\n",
-              s->bounds_min.x, s->bounds_min.y, s->bounds_min.z, s->bounds_max.x, s->bounds_max.y, s->bounds_max.z,
-              evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min)));
+              s->bounds_min.x, s->bounds_min.y, s->bounds_min.z, s->bounds_max.x, s->bounds_max.y,
+              s->bounds_max.z, evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min)));
     if (b.failed) {
         free(b.buf);
         return NULL;

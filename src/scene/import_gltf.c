@@ -34,7 +34,8 @@ static int side_channel_cmp(const void *pa, const void *pb)
 static int gltf_json_span(const unsigned char *data, size_t size, const char **json, size_t *len)
 {
     if (size >= 20 && !memcmp(data, "glTF", 4)) {
-        uint32_t clen = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
+        uint32_t clen = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 |
+                        (uint32_t)data[15] << 24;
         if (memcmp(data + 16, "JSON", 4) || (size_t)clen > size - 20) return 0;
         *json = (const char *)data + 20;
         *len = clen;
@@ -59,7 +60,8 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     root = evr_jdoc_parse(&d, json, jlen);
     if (root < 0 || evr_jdoc_type(&d, root) != EVR_JDOC_OBJECT) {
         st = d.failed ? evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON")
-                      : evr_import_fail(err, EVR_ERR_FORMAT, "glTF: cannot parse the JSON near byte %zu", d.pos);
+                      : evr_import_fail(err, EVR_ERR_FORMAT,
+                                        "glTF: cannot parse the JSON near byte %zu", d.pos);
         evr_jdoc_free(&d);
         return st;
     }
@@ -75,7 +77,8 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
     if (!g->node_names || !g->emissive_strength || !g->t_extras) goto nomem;
 
-    for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0; m = evr_jdoc_next(&d, m), i++) {
+    for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
+         m = evr_jdoc_next(&d, m), i++) {
         char buf[NAME_CAP];
         if (!evr_jdoc_string(&d, evr_jdoc_get(&d, m, "name"), buf, sizeof buf) || !buf[0])
             snprintf(buf, sizeof buf, "nodes[%d]", i);
@@ -83,14 +86,17 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         if (!g->node_names[i]) goto nomem;
         strcpy(g->node_names[i], buf);
     }
-    for (a = 0, i = g->num_anims ? evr_jdoc_first(&d, anims) : -1; i >= 0; i = evr_jdoc_next(&d, i), a++) {
+    for (a = 0, i = g->num_anims ? evr_jdoc_first(&d, anims) : -1; i >= 0;
+         i = evr_jdoc_next(&d, i), a++) {
         int samps = evr_jdoc_get(&d, i, "samplers"), nsamp = evr_jdoc_count(&d, samps), c, k;
         int chans = evr_jdoc_get(&d, i, "channels");
         free(samplers);
         samplers = malloc(((size_t)nsamp + 1) * sizeof *samplers);
         if (!samplers) goto nomem;
-        for (k = 0, c = nsamp ? evr_jdoc_first(&d, samps) : -1; c >= 0; c = evr_jdoc_next(&d, c)) samplers[k++] = c;
-        for (c = evr_jdoc_count(&d, chans) ? evr_jdoc_first(&d, chans) : -1; c >= 0; c = evr_jdoc_next(&d, c)) {
+        for (k = 0, c = nsamp ? evr_jdoc_first(&d, samps) : -1; c >= 0; c = evr_jdoc_next(&d, c))
+            samplers[k++] = c;
+        for (c = evr_jdoc_count(&d, chans) ? evr_jdoc_first(&d, chans) : -1; c >= 0;
+             c = evr_jdoc_next(&d, c)) {
             int tgt = evr_jdoc_get(&d, c, "target");
             double si = evr_jdoc_number(&d, evr_jdoc_get(&d, c, "sampler"), -1);
             double ni = evr_jdoc_number(&d, evr_jdoc_get(&d, tgt, "node"), -1);
@@ -100,10 +106,14 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
             if (!strcmp(path, "translation")) sc.path = PATH_T;
             else if (!strcmp(path, "rotation")) sc.path = PATH_R;
             else if (!strcmp(path, "scale")) sc.path = PATH_S;
-            else continue;   /* morph weights: not a transform */
+            else continue; /* morph weights: not a transform */
             if (!(si >= 0 && si < nsamp) || !(ni >= 0 && ni < g->num_nodes)) continue;
-            if (!evr_jdoc_string(&d, evr_jdoc_get(&d, samplers[(int)si], "interpolation"), interp, sizeof interp)) strcpy(interp, "LINEAR");
-            sc.interp = !strcmp(interp, "STEP") ? GL_STEP : !strcmp(interp, "CUBICSPLINE") ? GL_CUBIC : GL_LINEAR;
+            if (!evr_jdoc_string(&d, evr_jdoc_get(&d, samplers[(int)si], "interpolation"), interp,
+                                 sizeof interp))
+                strcpy(interp, "LINEAR");
+            sc.interp = !strcmp(interp, "STEP")          ? GL_STEP
+                        : !strcmp(interp, "CUBICSPLINE") ? GL_CUBIC
+                                                         : GL_LINEAR;
             sc.node = g->node_names[(int)ni];
             sc.anim = a;
             if (g->num_ch == cap) {
@@ -117,11 +127,17 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         }
     }
     if (g->num_ch) qsort(g->ch, (size_t)g->num_ch, sizeof *g->ch, side_channel_cmp);
-    for (i = 0, m = g->num_materials ? evr_jdoc_first(&d, mats) : -1; m >= 0; m = evr_jdoc_next(&d, m), i++) {
-        int es = evr_jdoc_get(&d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extensions"), "KHR_materials_emissive_strength"), "emissiveStrength");
+    for (i = 0, m = g->num_materials ? evr_jdoc_first(&d, mats) : -1; m >= 0;
+         m = evr_jdoc_next(&d, m), i++) {
+        int es = evr_jdoc_get(
+            &d,
+            evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extensions"), "KHR_materials_emissive_strength"),
+            "emissiveStrength");
         g->emissive_strength[i] = (float)evr_jdoc_number(&d, es, 1.0);
-        g->t_extras[2 * i] = (float)evr_jdoc_number(&d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_diffuse"), T_ABSENT);
-        g->t_extras[2 * i + 1] = (float)evr_jdoc_number(&d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_specular"), T_ABSENT);
+        g->t_extras[2 * i] = (float)evr_jdoc_number(
+            &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_diffuse"), T_ABSENT);
+        g->t_extras[2 * i + 1] = (float)evr_jdoc_number(
+            &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_specular"), T_ABSENT);
     }
     free(samplers);
     evr_jdoc_free(&d);
@@ -138,7 +154,7 @@ nomem:
 int evr_gltf_side_interp(const gltf_side *g, int anim, const char *name, int path)
 {
     int lo = 0, hi = g->num_ch, i;
-    while (lo < hi) {   /* first channel whose node name is >= name */
+    while (lo < hi) { /* first channel whose node name is >= name */
         int mid = lo + (hi - lo) / 2;
         if (strcmp(g->ch[mid].node, name) < 0) lo = mid + 1;
         else hi = mid;

@@ -33,24 +33,25 @@ enum { GL_LINEAR = 0, GL_STEP = 1, GL_CUBIC = 2 };
 
 /* One glTF animation channel that targets a node's translation, rotation or scale. */
 typedef struct {
-    const char *node;   /* the node's name as Assimp gives it (points into node_names) */
+    const char *node; /* the node's name as Assimp gives it (points into node_names) */
     int anim, path, interp;
 } side_channel;
 
 typedef struct {
     int num_nodes;
-    char **node_names;          /* as Assimp names them: the name, or "nodes[i]" when empty */
+    char **node_names; /* as Assimp names them: the name, or "nodes[i]" when empty */
     int num_anims;
-    side_channel *ch;           /* sorted by node name, animation, path */
+    side_channel *ch; /* sorted by node name, animation, path */
     int num_ch;
     int num_materials;
-    float *emissive_strength;   /* KHR_materials_emissive_strength, 1 when absent */
-    float *t_extras;            /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
+    float *emissive_strength; /* KHR_materials_emissive_strength, 1 when absent */
+    float *t_extras; /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
 } gltf_side;
 
 /* Reads the side information from a .gltf or a GLB (data: the file's bytes, a GLB's header and
  * JSON chunk at least). */
-evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g, evr_error *err);
+evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g,
+                               evr_error *err);
 void evr_gltf_side_free(gltf_side *g);
 /* The interpolation of the glTF channel (animation anim, node named `name`, path): GL_*, or -1
  * when the file has no such channel (Assimp synthesized the keys). anim < 0: any animation. */
@@ -59,7 +60,7 @@ int evr_gltf_side_interp(const gltf_side *g, int anim, const char *name, int pat
 /* ---- the importer's state while it converts one aiScene ---- */
 
 typedef struct {
-    const char *name;   /* Assimp's full name (evr names are cut at 63 characters) */
+    const char *name; /* Assimp's full name (evr names are cut at 63 characters) */
     int index;
 } name_index;
 
@@ -67,15 +68,15 @@ typedef struct {
     const struct aiScene *ai;
     evr_scene *s;
     evr_error *err;
-    char dir[512];            /* folder of the scene file with a trailing '/', "" for memory */
-    int gltf;                 /* Assimp's glTF 2.0 quirks apply */
+    char dir[512]; /* folder of the scene file with a trailing '/', "" for memory */
+    int gltf;      /* Assimp's glTF 2.0 quirks apply */
     int have_side;
     gltf_side side;
-    char **tex_keys;          /* per scene texture: what it was loaded from (to share it) */
+    char **tex_keys; /* per scene texture: what it was loaded from (to share it) */
     int tex_cap;
-    int *mat_uv;              /* per material: UV channel of its base colour texture */
-    const struct aiNode **ai_nodes;   /* per evr node */
-    name_index *by_name;              /* nodes sorted by Assimp name */
+    int *mat_uv;                    /* per material: UV channel of its base colour texture */
+    const struct aiNode **ai_nodes; /* per evr node */
+    name_index *by_name;            /* nodes sorted by Assimp name */
 } importer;
 
 /* ---- shared helpers (import.c) ---- */
@@ -84,7 +85,8 @@ typedef struct {
 evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...);
 void evr_import_copy_name(char *dst, size_t cap, const char *src);
 /* Reads at most max bytes of a file (the whole file when max is 0), 0-ended. */
-evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size, evr_error *err);
+evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
+                                evr_error *err);
 
 /* ---- the steps, in the order import.c runs them ---- */
 

@@ -22,21 +22,25 @@ evr_status evr_import_lights(importer *im)
         if (al->mType == aiLightSource_POINT) l->type = EVR_LIGHT_POINT;
         else if (al->mType == aiLightSource_SPOT) l->type = EVR_LIGHT_SPOT;
         else if (al->mType == aiLightSource_DIRECTIONAL) l->type = EVR_LIGHT_DIRECTIONAL;
-        else continue;   /* ambient and area lights: not punctual (the config has an ambient term) */
+        else continue; /* ambient and area lights: not punctual (the config has an ambient term) */
         s->num_lights++;
         evr_import_copy_name(l->name, sizeof l->name, al->mName.data);
         if (!l->name[0]) snprintf(l->name, sizeof l->name, "light%u", i);
         l->node = evr_import_find_node(im, al->mName.data);
         /* glTF: colour * intensity already */
-        l->color[0] = al->mColorDiffuse.r; l->color[1] = al->mColorDiffuse.g; l->color[2] = al->mColorDiffuse.b;
+        l->color[0] = al->mColorDiffuse.r;
+        l->color[1] = al->mColorDiffuse.g;
+        l->color[2] = al->mColorDiffuse.b;
         l->position = evr_v3_make(al->mPosition.x, al->mPosition.y, al->mPosition.z);
         l->direction = evr_v3_len(dir) > 0.0f ? evr_v3_norm(dir) : evr_v3_make(0, 0, -1);
         if (l->type == EVR_LIGHT_SPOT) {
-            float k = im->gltf ? 1.0f : 0.5f;   /* glTF gives half angles, the others full ones */
+            float k = im->gltf ? 1.0f : 0.5f; /* glTF gives half angles, the others full ones */
             l->inner_cone = al->mAngleInnerCone * k;
             l->outer_cone = al->mAngleOuterCone * k;
-            if (!(l->outer_cone > 0.0f) || l->outer_cone > (float)(EVR_PI_D / 2.0)) l->outer_cone = (float)(EVR_PI_D / 4.0);
-            if (!(l->inner_cone >= 0.0f) || l->inner_cone > l->outer_cone) l->inner_cone = l->outer_cone;
+            if (!(l->outer_cone > 0.0f) || l->outer_cone > (float)(EVR_PI_D / 2.0))
+                l->outer_cone = (float)(EVR_PI_D / 4.0);
+            if (!(l->inner_cone >= 0.0f) || l->inner_cone > l->outer_cone)
+                l->inner_cone = l->outer_cone;
         } else {
             l->inner_cone = l->outer_cone = (float)EVR_PI_D;
         }
@@ -47,7 +51,7 @@ evr_status evr_import_lights(importer *im)
          * surface facing it radiance 1. */
         const evr_camera_desc *c = &s->cameras[0];
         evr_light *l = &s->lights[s->num_lights++];
-        evr_v3 d = evr_v3_norm(evr_v3_make(0.25f, -0.25f, -1.0f));   /* camera space */
+        evr_v3 d = evr_v3_norm(evr_v3_make(0.25f, -0.25f, -1.0f)); /* camera space */
         strcpy(l->name, "headlight");
         l->type = EVR_LIGHT_DIRECTIONAL;
         l->node = c->node;

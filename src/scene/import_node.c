@@ -27,15 +27,25 @@ int evr_import_find_node(const importer *im, const char *name)
         if (strcmp(im->by_name[mid].name, name) < 0) lo = mid + 1;
         else hi = mid;
     }
-    return (lo < im->s->num_nodes && !strcmp(im->by_name[lo].name, name)) ? im->by_name[lo].index : -1;
+    return (lo < im->s->num_nodes && !strcmp(im->by_name[lo].name, name)) ? im->by_name[lo].index
+                                                                          : -1;
 }
 
 static evr_m34 m34_from_ai(const struct aiMatrix4x4 *a)
 {
     evr_m34 m;
-    m.m[0][0] = a->a1; m.m[0][1] = a->a2; m.m[0][2] = a->a3; m.m[0][3] = a->a4;
-    m.m[1][0] = a->b1; m.m[1][1] = a->b2; m.m[1][2] = a->b3; m.m[1][3] = a->b4;
-    m.m[2][0] = a->c1; m.m[2][1] = a->c2; m.m[2][2] = a->c3; m.m[2][3] = a->c4;
+    m.m[0][0] = a->a1;
+    m.m[0][1] = a->a2;
+    m.m[0][2] = a->a3;
+    m.m[0][3] = a->a4;
+    m.m[1][0] = a->b1;
+    m.m[1][1] = a->b2;
+    m.m[1][2] = a->b3;
+    m.m[1][3] = a->b4;
+    m.m[2][0] = a->c1;
+    m.m[2][1] = a->c2;
+    m.m[2][2] = a->c3;
+    m.m[2][3] = a->c4;
     return m;
 }
 
@@ -49,7 +59,8 @@ evr_status evr_import_nodes(importer *im)
     int sp = 0, cap = 0, count = 0, ninst = 0, i;
     unsigned c;
 
-    if (!ai->mRootNode) return evr_import_fail(im->err, EVR_ERR_FORMAT, "the scene has no node hierarchy");
+    if (!ai->mRootNode)
+        return evr_import_fail(im->err, EVR_ERR_FORMAT, "the scene has no node hierarchy");
     /* Count the nodes (iteratively: hierarchies can be deep). */
     cap = 64;
     stack = malloc((size_t)cap * sizeof *stack);
@@ -73,7 +84,12 @@ evr_status evr_import_nodes(importer *im)
             }
             stack[sp++] = n->mChildren[c];
         }
-        if (count > (1 << 26)) { free(stack); free(stack_parent); return evr_import_fail(im->err, EVR_ERR_FORMAT, "the node hierarchy is too large or cyclic"); }
+        if (count > (1 << 26)) {
+            free(stack);
+            free(stack_parent);
+            return evr_import_fail(im->err, EVR_ERR_FORMAT,
+                                   "the node hierarchy is too large or cyclic");
+        }
     }
 
     s->nodes = calloc((size_t)count, sizeof *s->nodes);
@@ -116,7 +132,8 @@ evr_status evr_import_nodes(importer *im)
     free(stack_parent);
 
     im->by_name = malloc((size_t)s->num_nodes * sizeof *im->by_name);
-    if (!im->by_name) return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading the node hierarchy");
+    if (!im->by_name)
+        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading the node hierarchy");
     for (i = 0; i < s->num_nodes; i++) {
         im->by_name[i].name = im->ai_nodes[i]->mName.data;
         im->by_name[i].index = i;
@@ -131,8 +148,12 @@ evr_status evr_import_nodes(importer *im)
             n->bounds_max = m->bounds_max;
             n->has_bounds = 1;
         } else {
-            n->bounds_min = evr_v3_make(fminf(n->bounds_min.x, m->bounds_min.x), fminf(n->bounds_min.y, m->bounds_min.y), fminf(n->bounds_min.z, m->bounds_min.z));
-            n->bounds_max = evr_v3_make(fmaxf(n->bounds_max.x, m->bounds_max.x), fmaxf(n->bounds_max.y, m->bounds_max.y), fmaxf(n->bounds_max.z, m->bounds_max.z));
+            n->bounds_min = evr_v3_make(fminf(n->bounds_min.x, m->bounds_min.x),
+                                        fminf(n->bounds_min.y, m->bounds_min.y),
+                                        fminf(n->bounds_min.z, m->bounds_min.z));
+            n->bounds_max = evr_v3_make(fmaxf(n->bounds_max.x, m->bounds_max.x),
+                                        fmaxf(n->bounds_max.y, m->bounds_max.y),
+                                        fmaxf(n->bounds_max.z, m->bounds_max.z));
         }
     }
     return EVR_OK;
@@ -156,7 +177,8 @@ static evr_m34 rest_world(const evr_scene *s, int node)
 void evr_import_bounds(evr_scene *s)
 {
     int i, c, any = 0;
-    evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY), hi = evr_v3_make(-INFINITY, -INFINITY, -INFINITY);
+    evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY),
+           hi = evr_v3_make(-INFINITY, -INFINITY, -INFINITY);
     for (i = 0; i < s->num_instances; i++) {
         const evr_mesh *m = &s->meshes[s->instances[i].mesh];
         evr_m34 w;

@@ -19,25 +19,37 @@ static float srgb_to_linear(float c)
 }
 
 /* Decodes an encoded image (PNG, JPEG, ...) into linear RGBA floats. */
-static evr_status decode_image(const unsigned char *data, size_t size, const char *what, evr_texture *t, evr_error *err)
+static evr_status decode_image(const unsigned char *data, size_t size, const char *what,
+                               evr_texture *t, evr_error *err)
 {
     int w = 0, h = 0, comp = 0;
     size_t i, n;
-    if (size > INT_MAX) return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: image too large", what);
+    if (size > INT_MAX)
+        return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: image too large", what);
     if (stbi_is_hdr_from_memory(data, (int)size)) {
         float *px = stbi_loadf_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px) return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)", what, stbi_failure_reason());
+        if (!px)
+            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
+                                   what, stbi_failure_reason());
         n = (size_t)w * (size_t)h;
         t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) { stbi_image_free(px); return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what); }
-        memcpy(t->rgba, px, n * 4 * sizeof(float));   /* HDR images are linear already */
+        if (!t->rgba) {
+            stbi_image_free(px);
+            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
+        }
+        memcpy(t->rgba, px, n * 4 * sizeof(float)); /* HDR images are linear already */
         stbi_image_free(px);
     } else if (stbi_is_16_bit_from_memory(data, (int)size)) {
         unsigned short *px = stbi_load_16_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px) return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)", what, stbi_failure_reason());
+        if (!px)
+            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
+                                   what, stbi_failure_reason());
         n = (size_t)w * (size_t)h;
         t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) { stbi_image_free(px); return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what); }
+        if (!t->rgba) {
+            stbi_image_free(px);
+            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
+        }
         for (i = 0; i < n * 4; i++) {
             float v = (float)px[i] / 65535.0f;
             t->rgba[i] = (i % 4 == 3) ? v : srgb_to_linear(v);
@@ -46,11 +58,16 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
     } else {
         float lut[256];
         unsigned char *px = stbi_load_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px) return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)", what, stbi_failure_reason());
+        if (!px)
+            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
+                                   what, stbi_failure_reason());
         for (i = 0; i < 256; i++) lut[i] = srgb_to_linear((float)i / 255.0f);
         n = (size_t)w * (size_t)h;
         t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) { stbi_image_free(px); return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what); }
+        if (!t->rgba) {
+            stbi_image_free(px);
+            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
+        }
         for (i = 0; i < n * 4; i++) t->rgba[i] = (i % 4 == 3) ? (float)px[i] / 255.0f : lut[px[i]];
         stbi_image_free(px);
     }
@@ -60,7 +77,8 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
 }
 
 /* An uncompressed embedded texture: aiTexel (b, g, r, a bytes), row 0 first. */
-static evr_status decode_texels(const struct aiTexture *tex, const char *what, evr_texture *t, evr_error *err)
+static evr_status decode_texels(const struct aiTexture *tex, const char *what, evr_texture *t,
+                                evr_error *err)
 {
     float lut[256];
     size_t i, n = (size_t)tex->mWidth * (size_t)tex->mHeight;
@@ -68,7 +86,8 @@ static evr_status decode_texels(const struct aiTexture *tex, const char *what, e
         return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: invalid embedded image", what);
     for (i = 0; i < 256; i++) lut[i] = srgb_to_linear((float)i / 255.0f);
     t->rgba = malloc(n * 4 * sizeof(float) + 1);
-    if (!t->rgba) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
+    if (!t->rgba)
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
     for (i = 0; i < n; i++) {
         const struct aiTexel *px = &tex->pcData[i];
         t->rgba[4 * i + 0] = lut[px->r];
@@ -90,7 +109,10 @@ static const char *short_name(const char *p)
 
 static int hex_digit(char c)
 {
-    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+    return c >= '0' && c <= '9'   ? c - '0'
+           : c >= 'a' && c <= 'f' ? c - 'a' + 10
+           : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                  : -1;
 }
 
 /* Replaces %XX escapes (URIs in glTF) in place; returns 1 if anything changed. */
@@ -126,13 +148,18 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         char *end;
         long k = strtol(ai_path + 1, &end, 10);
         if (*end || k < 0 || k >= (long)ai->mNumTextures)
-            return evr_import_fail(im->err, EVR_ERR_FORMAT, "material '%s': embedded texture '%s' does not exist", mat_name, ai_path);
+            return evr_import_fail(im->err, EVR_ERR_FORMAT,
+                                   "material '%s': embedded texture '%s' does not exist", mat_name,
+                                   ai_path);
         emb = (int)k;
     } else if (short_name(ai_path)[0]) {
         /* aiScene::GetEmbeddedTexture: match by file name without folders */
         for (i = 0; i < (int)ai->mNumTextures; i++) {
             const char *tn = short_name(ai->mTextures[i]->mFilename.data);
-            if (tn[0] && !strcmp(tn, short_name(ai_path))) { emb = i; break; }
+            if (tn[0] && !strcmp(tn, short_name(ai_path))) {
+                emb = i;
+                break;
+            }
         }
     }
     if (emb >= 0) {
@@ -157,14 +184,18 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         }
     }
     for (i = 0; i < s->num_textures; i++) {
-        if (!strcmp(im->tex_keys[i], key)) { *out = i; return EVR_OK; }
+        if (!strcmp(im->tex_keys[i], key)) {
+            *out = i;
+            return EVR_OK;
+        }
     }
     snprintf(what, sizeof what, "'%s' of material '%s'", ai_path, mat_name);
 
     if (emb >= 0) {
         const struct aiTexture *tex = ai->mTextures[emb];
         if (tex->mHeight == 0) {
-            if (!tex->pcData) return evr_import_fail(im->err, EVR_ERR_FORMAT, "texture %s: no image data", what);
+            if (!tex->pcData)
+                return evr_import_fail(im->err, EVR_ERR_FORMAT, "texture %s: no image data", what);
             st = decode_image((const unsigned char *)tex->pcData, tex->mWidth, what, &t, im->err);
         } else {
             st = decode_texels(tex, what, &t, im->err);
@@ -189,11 +220,17 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         if (nt) s->textures = nt;
         nk = nt ? realloc(im->tex_keys, (size_t)ncap * sizeof *nk) : NULL;
         if (nk) im->tex_keys = nk;
-        if (!nt || !nk) { free(t.rgba); return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures"); }
+        if (!nt || !nk) {
+            free(t.rgba);
+            return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
+        }
         im->tex_cap = ncap;
     }
     im->tex_keys[s->num_textures] = malloc(strlen(key) + 1);
-    if (!im->tex_keys[s->num_textures]) { free(t.rgba); return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures"); }
+    if (!im->tex_keys[s->num_textures]) {
+        free(t.rgba);
+        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
+    }
     strcpy(im->tex_keys[s->num_textures], key);
     s->textures[s->num_textures] = t;
     *out = s->num_textures++;
