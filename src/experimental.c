@@ -4,7 +4,7 @@
 #include "core/shading.h"
 #include "host_clock.h"
 #include "scene/scene.h"
-#include "still.h"
+#include "cpu/still.h"
 
 #include <stdio.h>
 #include <stdlib.h>

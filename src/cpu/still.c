@@ -1,7 +1,7 @@
 /* evray still: one image at one time. Its own Embree scene (every instance baked into world
  * space at that time, geometry id = scene instance), the event pipeline's direct shading through
  * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
-#include "still.h"
+#include "cpu/still.h"
 #include "host_clock.h"
 #include "cpu/cpu_gi.h"
 #include "cpu/workers.h"

@@ -3,8 +3,8 @@
  * brute-force path-traced indirect term, the reference for the photon estimate. The direct term
  * is the event pipeline's shading (src/core/shading.h) through the pixel centre; the indirect
  * term is added in linear RGB. Implementation: src/cpu/still.c (Embree, all cores). */
-#ifndef EVR_STILL_H
-#define EVR_STILL_H
+#ifndef EVR_CPU_STILL_H
+#define EVR_CPU_STILL_H
 
 #include <stdint.h>
 #include "evray.h"
