@@ -14,13 +14,14 @@ int cmd_convert(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            puts("usage: evray convert IN OUT [--quiet]\n\n"
-                 "Reads every event of IN and writes them, in the same order, to OUT; each file's format\n"
-                 "comes from its name: .h5/.hdf5 (DSEC layout), .txt, .npy, .dat (Prophesee DAT),\n"
-                 ".raw (Prophesee EVT 3.0, or EVT 2.0 for a name ending in evt2.raw; reading, the\n"
-                 "header says which). Width and height come from IN when it stores them, else from\n"
-                 "the largest x and y. What OUT's format cannot hold (a pixel or a time past its\n"
-                 "fields) is refused and OUT is not written.");
+            puts(
+                "usage: evray convert IN OUT [--quiet]\n\n"
+                "Reads every event of IN and writes them, in the same order, to OUT; each file's format\n"
+                "comes from its name: .h5/.hdf5 (DSEC layout), .txt, .npy, .dat (Prophesee DAT),\n"
+                ".raw (Prophesee EVT 3.0, or EVT 2.0 for a name ending in evt2.raw; reading, the\n"
+                "header says which). Width and height come from IN when it stores them, else from\n"
+                "the largest x and y. What OUT's format cannot hold (a pixel or a time past its\n"
+                "fields) is refused and OUT is not written.");
             return 0;
         }
         if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) quiet = 1;

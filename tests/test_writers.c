@@ -797,8 +797,8 @@ static void check_bad(const char *path, const char *why)
     if (!strstr(err.msg, why)) fprintf(stderr, "expected '%s' in: %s\n", why, err.msg);
 }
 
-static void test_camera_format(const char *dir, const char *file, open_fn open,
-                               const evr_event *ev, size_t n)
+static void test_camera_format(const char *dir, const char *file, open_fn open, const evr_event *ev,
+                               size_t n)
 {
     char path[512], tmp[600], partial[600];
     evr_writer_meta meta = {W, H, NULL, 0};

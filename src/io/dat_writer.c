@@ -13,8 +13,7 @@
 #define DAT_EVENT_SIZE 8
 
 typedef struct {
-    evr_event_writer base; /* first: the interface pointer is the writer pointer */
-    evr_raw_stream s;
+    evr_raw_stream s; /* first: the interface pointer is the writer pointer */
 } dat_writer;
 
 static evr_status dat_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
@@ -33,53 +32,16 @@ static evr_status dat_write(evr_event_writer *base, const evr_event *ev, size_t 
     return EVR_OK;
 }
 
-static evr_status dat_flush(evr_event_writer *base, evr_error *err)
-{
-    return evr_raw_stream_flush(&((dat_writer *)base)->s, err);
-}
-
-static evr_status dat_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
-{
-    dat_writer *w = (dat_writer *)base;
-    evr_status st = evr_raw_stream_finish(&w->s, err);
-    (void)duration_us;
-    free(w);
-    return st;
-}
-
-static void dat_abort(evr_event_writer *base)
-{
-    dat_writer *w = (dat_writer *)base;
-    evr_raw_stream_abort(&w->s);
-    free(w);
-}
-
 evr_status evr_dat_writer_open(const char *path, const evr_writer_meta *meta,
                                evr_event_writer **out, evr_error *err)
 {
     char header[512];
-    size_t len = evr_prophesee_header(header, sizeof header, NULL, NULL, meta->width,
-                                      meta->height);
-    dat_writer *w = calloc(1, sizeof *w);
-    evr_status st;
-    *out = NULL;
-    if (!w) {
-        snprintf(err->msg, sizeof err->msg, "dat writer: out of memory");
-        return EVR_ERR_NOMEM;
-    }
-    header[len++] = DAT_TYPE_CD;
+    size_t len = evr_prophesee_header(header, sizeof header, NULL, NULL, meta->width, meta->height);
+    header[len++] = DAT_TYPE_CD; /* the event type and size follow the header lines */
     header[len++] = DAT_EVENT_SIZE;
-    st = evr_raw_stream_open(&w->s, path, "dat writer", 1 << 14, DAT_MAX_T, header, len, err);
-    if (st != EVR_OK) {
-        free(w);
-        return st;
-    }
-    w->base.write = dat_write;
-    w->base.flush = dat_flush;
-    w->base.finish = dat_finish;
-    w->base.abort = dat_abort;
-    *out = &w->base;
-    return EVR_OK;
+    evr_status st = evr_raw_writer_open(sizeof(dat_writer), path, "dat writer", 1 << 14, DAT_MAX_T,
+                                        header, len, dat_write, out, err);
+    return st;
 }
 
 const evr_event_format evr_format_dat = {"dat", NULL, "events_td.dat", evr_dat_writer_open,

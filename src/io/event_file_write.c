@@ -40,10 +40,11 @@ evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int
     evr_status st;
     int count;
     if (!name) {
-        snprintf(err->msg, sizeof err->msg,
-                 "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .dat, .raw: EVT 3.0, "
-                 "or a name ending in evt2.raw: EVT 2.0)",
-                 path ? path : "(none)");
+        snprintf(
+            err->msg, sizeof err->msg,
+            "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .dat, .raw: EVT 3.0, "
+            "or a name ending in evt2.raw: EVT 2.0)",
+            path ? path : "(none)");
         return EVR_ERR_ARG;
     }
     formats = evr_event_formats(&count);

@@ -10,8 +10,7 @@
 #define EVT2_MAX_T ((INT64_C(1) << 34) - 1)
 
 typedef struct {
-    evr_event_writer base; /* first: the interface pointer is the writer pointer */
-    evr_raw_stream s;
+    evr_raw_stream s;  /* first: the interface pointer is the writer pointer */
     int64_t time_high; /* the last EV_TIME_HIGH written; -1: none yet */
 } evt2_writer;
 
@@ -36,53 +35,18 @@ static evr_status evt2_write(evr_event_writer *base, const evr_event *ev, size_t
     return EVR_OK;
 }
 
-static evr_status evt2_flush(evr_event_writer *base, evr_error *err)
-{
-    return evr_raw_stream_flush(&((evt2_writer *)base)->s, err);
-}
-
-static evr_status evt2_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
-{
-    evt2_writer *w = (evt2_writer *)base;
-    evr_status st = evr_raw_stream_finish(&w->s, err);
-    (void)duration_us;
-    free(w);
-    return st;
-}
-
-static void evt2_abort(evr_event_writer *base)
-{
-    evt2_writer *w = (evt2_writer *)base;
-    evr_raw_stream_abort(&w->s);
-    free(w);
-}
-
 evr_status evr_evt2_writer_open(const char *path, const evr_writer_meta *meta,
                                 evr_event_writer **out, evr_error *err)
 {
     char header[512];
-    size_t len = evr_prophesee_header(header, sizeof header, "2.0", "EVT2", meta->width,
-                                      meta->height);
-    evt2_writer *w = calloc(1, sizeof *w);
-    evr_status st;
-    *out = NULL;
-    if (!w) {
-        snprintf(err->msg, sizeof err->msg, "evt2 writer: out of memory");
-        return EVR_ERR_NOMEM;
-    }
-    st = evr_raw_stream_open(&w->s, path, "evt2 writer", 2048, EVT2_MAX_T, header, len, err);
-    if (st != EVR_OK) {
-        free(w);
-        return st;
-    }
-    w->time_high = -1;
-    w->base.write = evt2_write;
-    w->base.flush = evt2_flush;
-    w->base.finish = evt2_finish;
-    w->base.abort = evt2_abort;
-    *out = &w->base;
-    return EVR_OK;
+    size_t len =
+        evr_prophesee_header(header, sizeof header, "2.0", "EVT2", meta->width, meta->height);
+    evr_status st = evr_raw_writer_open(sizeof(evt2_writer), path, "evt2 writer", 2048, EVT2_MAX_T,
+                                        header, len, evt2_write, out, err);
+    if (st == EVR_OK) ((evt2_writer *)*out)->time_high = -1;
+    return st;
 }
 
-const evr_event_format evr_format_evt2 = {"evt2", NULL, "events_evt2.raw", evr_evt2_writer_open,
-                                          "Prophesee EVT 2.0 RAW (Metavision, expelliarmus, evlib)"};
+const evr_event_format evr_format_evt2 = {
+    "evt2", NULL, "events_evt2.raw", evr_evt2_writer_open,
+    "Prophesee EVT 2.0 RAW (Metavision, expelliarmus, evlib)"};

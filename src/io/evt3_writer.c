@@ -14,7 +14,8 @@
 #include <stdlib.h>
 
 #define EVT3_MAX_T ((INT64_C(1) << 36) - 1) /* 19 h: one TIME_HIGH word per 4096 us from 0 */
-#define EVT3_HIGH_STEP 1 /* time-high units between TIME_HIGH words: readers count wraps only on single steps */
+#define EVT3_HIGH_STEP \
+    1 /* time-high units between TIME_HIGH words: readers count wraps only on single steps */
 
 enum {
     EVT3_ADDR_Y = 0x0,
@@ -27,9 +28,8 @@ enum {
 };
 
 typedef struct {
-    evr_event_writer base; /* first: the interface pointer is the writer pointer */
-    evr_raw_stream s;
-    int64_t time_high;    /* t >> 12 of the last TIME_HIGH word (unwrapped); -1: none yet */
+    evr_raw_stream s;        /* first: the interface pointer is the writer pointer */
+    int64_t time_high;       /* t >> 12 of the last TIME_HIGH word (unwrapped); -1: none yet */
     int low, y, base_x, pol; /* the decoder's state; -1: not set */
 } evt3_writer;
 
@@ -106,53 +106,20 @@ static evr_status evt3_write(evr_event_writer *base, const evr_event *ev, size_t
     return EVR_OK;
 }
 
-static evr_status evt3_flush(evr_event_writer *base, evr_error *err)
-{
-    return evr_raw_stream_flush(&((evt3_writer *)base)->s, err);
-}
-
-static evr_status evt3_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
-{
-    evt3_writer *w = (evt3_writer *)base;
-    evr_status st = evr_raw_stream_finish(&w->s, err);
-    (void)duration_us;
-    free(w);
-    return st;
-}
-
-static void evt3_abort(evr_event_writer *base)
-{
-    evt3_writer *w = (evt3_writer *)base;
-    evr_raw_stream_abort(&w->s);
-    free(w);
-}
-
 evr_status evr_evt3_writer_open(const char *path, const evr_writer_meta *meta,
                                 evr_event_writer **out, evr_error *err)
 {
     char header[512];
-    size_t len = evr_prophesee_header(header, sizeof header, "3.0", "EVT3", meta->width,
-                                      meta->height);
-    evt3_writer *w = calloc(1, sizeof *w);
-    evr_status st;
-    *out = NULL;
-    if (!w) {
-        snprintf(err->msg, sizeof err->msg, "evt3 writer: out of memory");
-        return EVR_ERR_NOMEM;
+    size_t len =
+        evr_prophesee_header(header, sizeof header, "3.0", "EVT3", meta->width, meta->height);
+    evr_status st = evr_raw_writer_open(sizeof(evt3_writer), path, "evt3 writer", 2048, EVT3_MAX_T,
+                                        header, len, evt3_write, out, err);
+    if (st == EVR_OK) {
+        evt3_writer *w = (evt3_writer *)*out;
+        w->time_high = -1;
+        w->low = w->y = w->base_x = w->pol = -1;
     }
-    st = evr_raw_stream_open(&w->s, path, "evt3 writer", 2048, EVT3_MAX_T, header, len, err);
-    if (st != EVR_OK) {
-        free(w);
-        return st;
-    }
-    w->time_high = -1;
-    w->low = w->y = w->base_x = w->pol = -1;
-    w->base.write = evt3_write;
-    w->base.flush = evt3_flush;
-    w->base.finish = evt3_finish;
-    w->base.abort = evt3_abort;
-    *out = &w->base;
-    return EVR_OK;
+    return st;
 }
 
 const evr_event_format evr_format_evt3 = {"evt3", NULL, "events_evt3.raw", evr_evt3_writer_open,

@@ -63,9 +63,9 @@ static uint32_t le32(const unsigned char *p) { return le16(p) | le16(p + 2) << 1
 /* ---- header: lines starting with '%', up to "% end" or the first line without '%' ---- */
 
 typedef struct {
-    int evt;      /* 2 or 3 from "% evt 2.0" / "% format EVT2"; 0: none */
+    int evt; /* 2 or 3 from "% evt 2.0" / "% format EVT2"; 0: none */
     int width, height;
-    size_t end;   /* the first byte after the header */
+    size_t end; /* the first byte after the header */
     char encoding[32];
 } header_info;
 
@@ -121,8 +121,8 @@ static void parse_header(const unsigned char *data, size_t size, header_info *h)
 
 /* ---- EVT 2.0 ---- */
 
-static evr_status parse_evt2(const char *path, const unsigned char *d, size_t size,
-                             event_list *l, evr_error *err)
+static evr_status parse_evt2(const char *path, const unsigned char *d, size_t size, event_list *l,
+                             evr_error *err)
 {
     int64_t high = -1;
     if (size % 4) return fail(err, path, "truncated EVT 2.0 stream (not whole 32-bit words)", l);
@@ -131,7 +131,9 @@ static evr_status parse_evt2(const char *path, const unsigned char *d, size_t si
         switch (w >> 28) {
         case 0x0:
         case 0x1:
-            if (high < 0) return fail(err, path, "corrupt EVT 2.0 stream (CD event before the first time-high word)", l);
+            if (high < 0)
+                return fail(err, path,
+                            "corrupt EVT 2.0 stream (CD event before the first time-high word)", l);
             if (!push(l, high << 6 | (w >> 22 & 63), w >> 11 & 0x7ff, w & 0x7ff, (int)(w >> 28)))
                 return out_of_memory(err, path, l);
             break;
@@ -152,8 +154,8 @@ static evr_status parse_evt2(const char *path, const unsigned char *d, size_t si
 
 /* ---- EVT 3.0 ---- */
 
-static evr_status parse_evt3(const char *path, const unsigned char *d, size_t size,
-                             event_list *l, evr_error *err)
+static evr_status parse_evt3(const char *path, const unsigned char *d, size_t size, event_list *l,
+                             evr_error *err)
 {
     int64_t loops = 0;
     int high = -1, low = 0, y = -1, base_x = -1, pol = 0;
@@ -169,14 +171,15 @@ static evr_status parse_evt3(const char *path, const unsigned char *d, size_t si
             return fail(err, path, why, l);
         }
         if ((type == 0x4 || type == 0x5) && base_x < 0) {
-            snprintf(why, sizeof why, "corrupt EVT 3.0 stream (vector before its base x at byte %zu)",
-                     i);
+            snprintf(why, sizeof why,
+                     "corrupt EVT 3.0 stream (vector before its base x at byte %zu)", i);
             return fail(err, path, why, l);
         }
         switch (type) {
         case 0x0: y = (int)(v & 0x7ff); break;
         case 0x2:
-            if (!push(l, t, v & 0x7ff, (unsigned)y, (int)(v >> 11))) return out_of_memory(err, path, l);
+            if (!push(l, t, v & 0x7ff, (unsigned)y, (int)(v >> 11)))
+                return out_of_memory(err, path, l);
             break;
         case 0x3:
             base_x = (int)(v & 0x7ff);
@@ -222,7 +225,8 @@ evr_status evr_raw_parse(const char *path, const unsigned char *data, size_t siz
         if (h.encoding[0])
             snprintf(why, sizeof why, "unsupported RAW encoding '%s' (EVT 2.0 and 3.0 are read)",
                      h.encoding);
-        else snprintf(why, sizeof why, "not a Prophesee RAW file (no '%% evt' or '%% format' line)");
+        else
+            snprintf(why, sizeof why, "not a Prophesee RAW file (no '%% evt' or '%% format' line)");
         return fail(err, path, why, &l);
     }
     st = h.evt == 2 ? parse_evt2(path, data + h.end, size - h.end, &l, err)
@@ -246,9 +250,10 @@ evr_status evr_dat_parse(const char *path, const unsigned char *data, size_t siz
     const unsigned type = data[h.end], esize = data[h.end + 1];
     if ((type != 0x0C && type != 0x00) || esize != 8) {
         char why[112];
-        snprintf(why, sizeof why,
-                 "unsupported DAT events (type 0x%02X, size %u; CD events 0x0C of 8 bytes are read)",
-                 type, esize);
+        snprintf(
+            why, sizeof why,
+            "unsupported DAT events (type 0x%02X, size %u; CD events 0x0C of 8 bytes are read)",
+            type, esize);
         return fail(err, path, why, &l);
     }
     const unsigned char *d = data + h.end + 2;

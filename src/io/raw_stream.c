@@ -8,14 +8,13 @@
 
 #define RAW_BUFFER ((size_t)1 << 20)
 
+/* Frees the writer (the stream is its first member). */
 static void free_stream(evr_raw_stream *s)
 {
     free(s->path);
     free(s->tmp);
     free(s->buf);
-    s->path = s->tmp = NULL;
-    s->buf = NULL;
-    s->f = NULL;
+    free(s);
 }
 
 static evr_status cannot_write(const evr_raw_stream *s, evr_error *err)
@@ -31,26 +30,58 @@ static evr_status drain(evr_raw_stream *s, evr_error *err)
     return EVR_OK;
 }
 
-evr_status evr_raw_stream_open(evr_raw_stream *s, const char *path, const char *who, int max_xy,
-                               int64_t max_t, const char *header, size_t len, evr_error *err)
+static evr_status raw_flush(evr_event_writer *base, evr_error *err)
 {
-    memset(s, 0, sizeof *s);
-    s->who = who;
-    s->max_xy = max_xy;
-    s->max_t = max_t;
+    evr_raw_stream *s = (evr_raw_stream *)base;
+    evr_status st = drain(s, err);
+    if (st == EVR_OK && fflush(s->f) != 0) st = cannot_write(s, err);
+    return st;
+}
+
+static evr_status raw_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
+{
+    evr_raw_stream *s = (evr_raw_stream *)base;
+    evr_status st = drain(s, err);
+    (void)duration_us;
+    st = evr_file_commit(s->f, s->tmp, s->path, st, s->who, err);
+    free_stream(s);
+    return st;
+}
+
+static void raw_abort(evr_event_writer *base)
+{
+    evr_raw_stream *s = (evr_raw_stream *)base;
+    evr_file_discard(s->f, s->tmp);
+    free_stream(s);
+}
+
+evr_status evr_raw_writer_open(size_t size, const char *path, const char *who, int max_xy,
+                               int64_t max_t, const char *header, size_t len,
+                               evr_status (*write)(evr_event_writer *w, const evr_event *ev,
+                                                   size_t n, evr_error *err),
+                               evr_event_writer **out, evr_error *err)
+{
+    evr_raw_stream *s;
+    *out = NULL;
     if (!path || !*path) {
         snprintf(err->msg, sizeof err->msg, "%s: no path given", who);
         return EVR_ERR_ARG;
     }
-    s->path = strdup(path);
-    s->tmp = evr_file_tmp_name(path);
-    s->cap = RAW_BUFFER;
-    s->buf = malloc(s->cap);
-    if (!s->path || !s->tmp || !s->buf) {
-        free_stream(s);
+    s = calloc(1, size);
+    if (s) {
+        s->path = strdup(path);
+        s->tmp = evr_file_tmp_name(path);
+        s->cap = RAW_BUFFER;
+        s->buf = malloc(s->cap);
+    }
+    if (!s || !s->path || !s->tmp || !s->buf) {
+        if (s) free_stream(s);
         snprintf(err->msg, sizeof err->msg, "%s: out of memory", who);
         return EVR_ERR_NOMEM;
     }
+    s->who = who;
+    s->max_xy = max_xy;
+    s->max_t = max_t;
     s->f = evr_file_create(s->tmp, who, err);
     if (!s->f) {
         free_stream(s);
@@ -62,6 +93,11 @@ evr_status evr_raw_stream_open(evr_raw_stream *s, const char *path, const char *
         free_stream(s);
         return EVR_ERR_IO;
     }
+    s->base.write = write;
+    s->base.flush = raw_flush;
+    s->base.finish = raw_finish;
+    s->base.abort = raw_abort;
+    *out = &s->base;
     return EVR_OK;
 }
 
@@ -69,8 +105,8 @@ evr_status evr_raw_stream_check(evr_raw_stream *s, const evr_event *e, evr_error
 {
     if (s->have_last && e->t < s->last_t) {
         snprintf(err->msg, sizeof err->msg,
-                 "%s: events out of time order (%" PRId64 " us after %" PRId64 " us)", s->who,
-                 e->t, s->last_t);
+                 "%s: events out of time order (%" PRId64 " us after %" PRId64 " us)", s->who, e->t,
+                 s->last_t);
         return EVR_ERR_ARG;
     }
     if (e->x >= s->max_xy || e->y >= s->max_xy) {
@@ -93,27 +129,6 @@ evr_status evr_raw_stream_check(evr_raw_stream *s, const evr_event *e, evr_error
 evr_status evr_raw_stream_room(evr_raw_stream *s, size_t need, evr_error *err)
 {
     return s->cap - s->len >= need ? EVR_OK : drain(s, err);
-}
-
-evr_status evr_raw_stream_flush(evr_raw_stream *s, evr_error *err)
-{
-    evr_status st = drain(s, err);
-    if (st == EVR_OK && fflush(s->f) != 0) st = cannot_write(s, err);
-    return st;
-}
-
-evr_status evr_raw_stream_finish(evr_raw_stream *s, evr_error *err)
-{
-    evr_status st = drain(s, err);
-    st = evr_file_commit(s->f, s->tmp, s->path, st, s->who, err);
-    free_stream(s);
-    return st;
-}
-
-void evr_raw_stream_abort(evr_raw_stream *s)
-{
-    evr_file_discard(s->f, s->tmp);
-    free_stream(s);
 }
 
 size_t evr_prophesee_header(char *out, size_t cap, const char *evt, const char *format, int width,
