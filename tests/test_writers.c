@@ -1455,7 +1455,8 @@ static double now_s(void)
  * written and flushed (the worst case: the simulation flushes about once a second, write_queue.h;
  * kept so that the figures compare with earlier ones). 10 M events in optimized builds, 1 M
  * otherwise; EVR_H5_BENCH_EVENTS sets another count (0 skips). */
-static void bench_h5(const char *root)
+/* Writing speed of one writer on 10 M events (1 M in debug builds; EVR_H5_BENCH_EVENTS sets it). */
+static void bench_writer(const char *root, const char *name, open_fn open, const char *file)
 {
 #ifdef NDEBUG
     size_t n = 10000000;
@@ -1486,9 +1487,9 @@ static void bench_h5(const char *root)
         }
         last_t = ev[n - 1].t;
     }
-    snprintf(path, sizeof path, "%s/bench.h5", root);
+    snprintf(path, sizeof path, "%s/%s", root, file);
     t0 = now_s();
-    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &e_));
+    CHECK_OK(open(path, &meta, &w, &e_));
     for (size_t at = 0; w && at < n; at += seg) {
         CHECK_OK(w->write(w, ev + at, n - at < seg ? n - at : seg, &e_));
         CHECK_OK(w->flush(w, &e_));
@@ -1499,8 +1500,8 @@ static void bench_h5(const char *root)
         struct stat st;
         long long size = stat(path, &st) == 0 ? (long long)st.st_size : -1;
         printf(
-            "test_writers: hdf5 writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n",
-            n, t1 - t0, (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
+            "test_writers: %s writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n",
+            name, n, t1 - t0, (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
     }
     remove(path);
     free(ev);
@@ -1523,7 +1524,10 @@ int main(void)
     test_camera_formats(root);
     test_tonemap(root);
     test_event_frames(root);
-    bench_h5(root);
+    bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");
+    bench_writer(root, "evt2", evr_evt2_writer_open, "bench_evt2.raw");
+    bench_writer(root, "evt3", evr_evt3_writer_open, "bench_evt3.raw");
+    bench_writer(root, "dat", evr_dat_writer_open, "bench.dat");
     if (check_failures == 0) remove_tree(root);
     else fprintf(stderr, "test_writers: files kept in %s\n", root);
     (void)python_ok;
