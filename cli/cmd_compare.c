@@ -28,7 +28,7 @@ int cmd_compare(int argc, char **argv)
                 "Matches TEST's events one-to-one against REF's (same pixel, same polarity, |dt| <= tolerance,\n"
                 "in time order) and prints event counts and their ratio, precision, recall, F1, the median\n"
                 "and 95th percentile |dt| of matches and the correlation of per-pixel event counts.\n"
-                "Reads any format evray writes (.h5, .txt, .npy).");
+                "Reads any format evray writes (.h5, .txt, .npy, Prophesee .raw EVT 2.0/3.0 and .dat).");
             return 0;
         }
         if (!strcmp(a, "--json")) json = 1;

@@ -13,7 +13,7 @@ static int plot_usage(void)
 {
     puts(
         "usage: evray plot EVENTS [-o rate.png] [--bin-ms MS] [--heatmap heat.png] [--size WxH]\n\n"
-        "Reads an event file evray writes (.h5, .txt, .npy) and draws:\n"
+        "Reads an event file evray writes (.h5, .txt, .npy, Prophesee .raw and .dat) and draws:\n"
         "  -o FILE         the number of ON and OFF events per time bin, two lines against time\n"
         "                  (default rate.png); an asynchronous simulator gives a continuous curve,\n"
         "                  a frame-based one spikes at every frame\n"

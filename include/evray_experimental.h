@@ -34,11 +34,21 @@ double evr_seconds(void);
  *                are skipped.
  *   .npy         a 1-D structured array with integer fields t (us), x, y, p in any order and of
  *                any integer width, either byte order.
+ *   .raw         Prophesee EVT 2.0 or EVT 3.0 (named by the "% evt" / "% format" header line);
+ *                width and height from the header.
+ *   .dat         Prophesee DAT of CD events; width and height from the header.
  * Polarity is returned as 1 (p > 0) or 0 (p <= 0, so -1/1 files read too). Events keep the file's
  * order. *ev is malloc'ed (free() it; NULL when *n is 0). width/height are set to -1 when the
  * format does not store them; either pointer may be NULL. */
 evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height,
                            evr_error *err);
+
+/* Writes n events (sorted by time) to path in the format its name says: .h5/.hdf5, .txt, .npy,
+ * .dat (Prophesee DAT), a name ending in "evt2.raw" (Prophesee EVT 2.0) or any other .raw (EVT
+ * 3.0). width/height <= 0: taken from the largest x/y. Under a temporary name until complete, as
+ * the simulation's writers; what the format cannot hold is refused (EVR_ERR_ARG). */
+evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
+                            evr_error *err);
 
 /* ---- accuracy of an event stream against a reference (src/compare.c) ---- */
 /* One-to-one matching of events at the same pixel with the same polarity within a time

@@ -9,6 +9,7 @@ cmake --build build -j"$jobs"
 # CUDA code is built and compiled in the release build; the sanitizers check the host code
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DEVR_SANITIZE=ON -DEVR_CUDA=OFF
 cmake --build build-asan -j"$jobs"
+scripts/test-venv.sh build/venv
 echo "== release build =="
 (cd build && ctest --output-on-failure -j"$jobs")
 echo "== AddressSanitizer + UBSan build =="

@@ -1,4 +1,4 @@
-/* Event writers (HDF5, text, NPY), the event reader, the JSON builder and the preview images.
+/* Event writers (HDF5, text, NPY, Prophesee EVT 2.0, EVT 3.0, DAT), the event reader, the JSON builder and the preview images.
  * Python (h5py, numpy) reads the files as an independent check when it is installed. */
 #include <dirent.h>
 #include <stdint.h>
@@ -738,6 +738,199 @@ done:
     free(ref);
 }
 
+/* ---- Prophesee EVT 2.0, EVT 3.0 and DAT ---- */
+
+/* Sorted events over 22 s (more than one 2^24 us wrap of EVT 3.0) with runs of one timestamp,
+ * dense rows of one polarity (vector words), a repeated pixel and the largest addresses. */
+static evr_event *make_camera_events(size_t n)
+{
+    evr_event *ev = calloc(n, sizeof *ev);
+    uint64_t s = 777;
+    int64_t t = 3;
+    for (size_t i = 0; ev && i < n; i++) {
+        uint64_t r = rng_next(&s) % 100;
+        if (i > 0 && r < 25 && ev[i - 1].x + 3 < W) { /* the same row, a few columns on */
+            ev[i] = ev[i - 1];
+            ev[i].x = (uint16_t)(ev[i - 1].x + 1 + rng_next(&s) % 3);
+            continue;
+        }
+        if (i > 0 && r < 30) { /* the same timestamp elsewhere */
+            ev[i].t = t;
+        } else {
+            t += (int64_t)(rng_next(&s) % 9000);
+            ev[i].t = t;
+        }
+        ev[i].x = (uint16_t)(rng_next(&s) % W);
+        ev[i].y = (uint16_t)(rng_next(&s) % H);
+        ev[i].p = (int8_t)(rng_next(&s) & 1);
+        if (i % 997 == 5) { /* the same pixel twice at one time */
+            ev[i] = ev[i - 1];
+        }
+    }
+    if (n > 10) {
+        ev[n / 2].x = W - 1;
+        ev[n / 2].y = H - 1;
+    }
+    return ev;
+}
+
+static void write_file(const char *path, const char *text, size_t len)
+{
+    FILE *fp = fopen(path, "wb");
+    if (fp) {
+        fwrite(text, 1, len, fp);
+        fclose(fp);
+    }
+}
+
+/* A read that must fail with EVR_ERR_FORMAT and a message naming the file and saying why. */
+static void check_bad(const char *path, const char *why)
+{
+    evr_event *got = NULL;
+    size_t ngot = 0;
+    evr_error err;
+    err.msg[0] = 0;
+    CHECK(evr_events_read(path, &got, &ngot, NULL, NULL, &err) == EVR_ERR_FORMAT);
+    CHECK(got == NULL);
+    CHECK(strstr(err.msg, path) != NULL);
+    CHECK(strstr(err.msg, why) != NULL);
+    if (!strstr(err.msg, why)) fprintf(stderr, "expected '%s' in: %s\n", why, err.msg);
+}
+
+static void test_camera_format(const char *dir, const char *file, open_fn open, const evr_event *ev,
+                               size_t n)
+{
+    char path[512], tmp[600], partial[600];
+    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_event_writer *w = NULL;
+    evr_error err;
+    size_t at = 0;
+    evr_event *got = NULL;
+    size_t ngot = 0;
+    int width = 0, height = 0;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    snprintf(partial, sizeof partial, "%s/partial_%s", dir, file);
+    CHECK_OK(open(path, &meta, &w, &err));
+    if (!w) return;
+    for (int seg = 0; at < n; seg++) {
+        size_t len = (size_t)(seg * 397 + 11) % 1500;
+        if (len > n - at) len = n - at;
+        CHECK_OK(w->write(w, ev + at, len, &err));
+        CHECK_OK(w->flush(w, &err));
+        at += len;
+        if (seg == 3) { /* an interrupted run keeps every flushed event */
+            CHECK(copy_file(tmp, partial));
+            CHECK_OK(evr_events_read(partial, &got, &ngot, NULL, NULL, &err));
+            CHECK(ngot == at);
+            if (ngot == at) CHECK(same_events(got, ev, at));
+            free(got);
+            got = NULL;
+            remove(partial);
+        }
+    }
+    CHECK(!file_exists(path));
+    CHECK_OK(w->finish(w, ev[n - 1].t + 1, &err));
+    CHECK(file_exists(path) && !file_exists(tmp));
+    CHECK_OK(evr_events_read(path, &got, &ngot, &width, &height, &err));
+    CHECK(ngot == n);
+    if (ngot == n) CHECK(same_events(got, ev, n));
+    CHECK(width == W && height == H);
+    free(got);
+
+    /* a truncated file: one clear line, no events */
+    {
+        FILE *fp = fopen(path, "rb");
+        char *data = malloc(1 << 22);
+        size_t len = fp && data ? fread(data, 1, 1 << 22, fp) : 0;
+        if (fp) fclose(fp);
+        CHECK(len > 100);
+        if (len > 100) {
+            write_file(partial, data, len - 1);
+            check_bad(partial, "truncated");
+        }
+        free(data);
+        remove(partial);
+    }
+}
+
+/* what a format cannot hold is refused, with the value in the message */
+static void check_refused(const char *dir, const char *file, open_fn open, evr_event e,
+                          const char *what)
+{
+    char path[512];
+    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_event_writer *w = NULL;
+    evr_error err;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    CHECK_OK(open(path, &meta, &w, &err));
+    if (!w) return;
+    err.msg[0] = 0;
+    CHECK(w->write(w, &e, 1, &err) == EVR_ERR_ARG);
+    CHECK(strstr(err.msg, what) != NULL);
+    if (!strstr(err.msg, what)) fprintf(stderr, "expected '%s' in: %s\n", what, err.msg);
+    w->abort(w);
+    CHECK(!file_exists(path));
+}
+
+static void test_camera_formats(const char *root)
+{
+    const size_t n = 6000;
+    evr_event *ev = make_camera_events(n);
+    char dir[512], path[600];
+    evr_event e;
+    CHECK(ev != NULL);
+    if (!ev) return;
+    CHECK(ev[n - 1].t > (INT64_C(1) << 24)); /* spans an EVT 3.0 wrap */
+    snprintf(dir, sizeof dir, "%s/camera", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    test_camera_format(dir, "events_evt2.raw", evr_evt2_writer_open, ev, n);
+    test_camera_format(dir, "events_evt3.raw", evr_evt3_writer_open, ev, n);
+    test_camera_format(dir, "events_td.dat", evr_dat_writer_open, ev, n);
+    free(ev);
+
+    memset(&e, 0, sizeof e);
+    e.x = 2048;
+    check_refused(dir, "a_evt2.raw", evr_evt2_writer_open, e, "(2048, 0)");
+    check_refused(dir, "a_evt3.raw", evr_evt3_writer_open, e, "(2048, 0)");
+    e.x = 0;
+    e.y = 16384;
+    check_refused(dir, "a.dat", evr_dat_writer_open, e, "(0, 16384)");
+    e.y = 0;
+    e.t = INT64_C(1) << 32;
+    check_refused(dir, "a.dat", evr_dat_writer_open, e, "4294967296 us");
+    e.t = INT64_C(1) << 34;
+    check_refused(dir, "a_evt2.raw", evr_evt2_writer_open, e, "17179869184 us");
+
+    /* bad input: one clear line, no crash */
+    snprintf(path, sizeof path, "%s/bad.raw", dir);
+    write_file(path, "hello", 5);
+    check_bad(path, "not a Prophesee RAW file");
+    write_file(path, "", 0);
+    check_bad(path, "not a Prophesee RAW file");
+    write_file(path, "% date x\n% end\n\x01\x02", 17);
+    check_bad(path, "no '% evt' or '% format' line");
+    write_file(path, "% evt 2.1\n% end\n", 16);
+    check_bad(path, "unsupported RAW encoding 'evt 2.1'");
+    write_file(path, "% evt 2.0\n% end\n\x00\x00\x00\x80\x00\x00\x00\x30", 24);
+    check_bad(path, "unknown word type 0x3");
+    write_file(path, "% evt 2.0\n% end\n\x00\x00\x00\x10", 20);
+    check_bad(path, "before the first time-high word");
+    write_file(path, "% evt 3.0\n% end\n\x00\x80\x01\x20", 20);
+    check_bad(path, "before the first y word");
+    write_file(path, "% evt 3.0\n% end\n\x00\x80\x05\x00\x00\x90", 22);
+    check_bad(path, "unknown word type 0x9");
+    remove(path);
+    snprintf(path, sizeof path, "%s/bad.dat", dir);
+    write_file(path, "% Version 2\n% end\n\x10\x08", 20);
+    check_bad(path, "unsupported DAT events (type 0x10");
+    write_file(path, "% Version 2\n% end\n", 18);
+    check_bad(path, "truncated");
+    write_file(path, "\x0c\x08", 2);
+    check_bad(path, "not a Prophesee DAT file");
+    remove(path);
+}
+
 static void test_writers(const char *root, int *python_ok)
 {
     const size_t n = 5000;
@@ -1262,7 +1455,8 @@ static double now_s(void)
  * written and flushed (the worst case: the simulation flushes about once a second, write_queue.h;
  * kept so that the figures compare with earlier ones). 10 M events in optimized builds, 1 M
  * otherwise; EVR_H5_BENCH_EVENTS sets another count (0 skips). */
-static void bench_h5(const char *root)
+/* Writing speed of one writer on 10 M events (1 M in debug builds; EVR_H5_BENCH_EVENTS sets it). */
+static void bench_writer(const char *root, const char *name, open_fn open, const char *file)
 {
 #ifdef NDEBUG
     size_t n = 10000000;
@@ -1293,9 +1487,9 @@ static void bench_h5(const char *root)
         }
         last_t = ev[n - 1].t;
     }
-    snprintf(path, sizeof path, "%s/bench.h5", root);
+    snprintf(path, sizeof path, "%s/%s", root, file);
     t0 = now_s();
-    CHECK_OK(evr_h5_writer_open(path, &meta, &w, &e_));
+    CHECK_OK(open(path, &meta, &w, &e_));
     for (size_t at = 0; w && at < n; at += seg) {
         CHECK_OK(w->write(w, ev + at, n - at < seg ? n - at : seg, &e_));
         CHECK_OK(w->flush(w, &e_));
@@ -1306,8 +1500,8 @@ static void bench_h5(const char *root)
         struct stat st;
         long long size = stat(path, &st) == 0 ? (long long)st.st_size : -1;
         printf(
-            "test_writers: hdf5 writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n",
-            n, t1 - t0, (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
+            "test_writers: %s writer: %zu events in %.3f s: %.2f M events/s (%.2f bytes/event)\n",
+            name, n, t1 - t0, (double)n / (t1 - t0) * 1e-6, (double)size / (double)n);
     }
     remove(path);
     free(ev);
@@ -1327,9 +1521,13 @@ int main(void)
     test_chunk_stored_blocks();
     test_deflate_runs();
     test_writers(root, &python_ok);
+    test_camera_formats(root);
     test_tonemap(root);
     test_event_frames(root);
-    bench_h5(root);
+    bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");
+    bench_writer(root, "evt2", evr_evt2_writer_open, "bench_evt2.raw");
+    bench_writer(root, "evt3", evr_evt3_writer_open, "bench_evt3.raw");
+    bench_writer(root, "dat", evr_dat_writer_open, "bench.dat");
     if (check_failures == 0) remove_tree(root);
     else fprintf(stderr, "test_writers: files kept in %s\n", root);
     (void)python_ok;

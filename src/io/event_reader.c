@@ -1,4 +1,5 @@
 #include "io/event_reader.h"
+#include "io/prophesee_read.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -22,7 +23,7 @@ static int ext_is(const char *path, const char *ext)
 
 /* ---- whole-file read (text and NumPy) ---- */
 
-static evr_status slurp(const char *path, char **data, size_t *size, evr_error *err)
+evr_status evr_file_slurp(const char *path, char **data, size_t *size, evr_error *err)
 {
     FILE *f = fopen(path, "rb");
     char *buf = NULL;
@@ -126,7 +127,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
     char *data;
     size_t size, count = 0, cap = 0, line = 0;
     evr_event *out = NULL;
-    evr_status st = slurp(path, &data, &size, err);
+    evr_status st = evr_file_slurp(path, &data, &size, err);
     if (st != EVR_OK) return st;
     const char *s = data;
     while (*s) {
@@ -251,7 +252,7 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
     static const char names[4] = {'t', 'x', 'y', 'p'};
     evr_event *out = NULL;
     uint64_t count = 0;
-    evr_status st = slurp(path, &data, &size, err);
+    evr_status st = evr_file_slurp(path, &data, &size, err);
     const unsigned char *u = (const unsigned char *)data;
     const char *s;
 
@@ -645,9 +646,19 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
     if (ext_is(path, "h5") || ext_is(path, "hdf5")) return read_h5(path, ev, n, width, height, err);
     if (ext_is(path, "txt")) st = read_txt(path, ev, n, err);
     else if (ext_is(path, "npy")) st = read_npy(path, ev, n, err);
-    else {
+    else if (ext_is(path, "raw") || ext_is(path, "dat")) {
+        char *data;
+        size_t size;
+        st = evr_file_slurp(path, &data, &size, err);
+        if (st != EVR_OK) return st;
+        if (ext_is(path, "raw"))
+            st = evr_raw_parse(path, (const unsigned char *)data, size, ev, n, width, height, err);
+        else st = evr_dat_parse(path, (const unsigned char *)data, size, ev, n, width, height, err);
+        free(data);
+    } else {
         snprintf(err->msg, sizeof err->msg,
-                 "%s: unknown event file type (expected .h5, .hdf5, .txt or .npy)", path);
+                 "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .raw or .dat)",
+                 path);
         return EVR_ERR_ARG;
     }
     return st;

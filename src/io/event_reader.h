@@ -12,4 +12,7 @@
  * t >= i ms. *idx is malloc'ed (free() it). EVR_ERR_FORMAT when the file has no such index. */
 evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, evr_error *err);
 
+/* Reads a whole file into memory (*data is malloc'ed and 0-terminated; free() it). */
+evr_status evr_file_slurp(const char *path, char **data, size_t *size, evr_error *err);
+
 #endif

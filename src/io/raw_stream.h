@@ -1,0 +1,55 @@
+/* The part every binary event stream writer shares (Prophesee EVT 2.0, EVT 3.0, DAT): a file
+ * under its temporary name with a byte buffer in front, the checks of each event against what the
+ * format can hold, and the header lines Prophesee's tools read ("% key value", ending "% end"). */
+#ifndef EVR_IO_RAW_STREAM_H
+#define EVR_IO_RAW_STREAM_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include "evray.h"
+#include "io/event_writer.h"
+
+/* The first member of each such writer: the interface, then the stream. */
+typedef struct {
+    evr_event_writer base; /* first: the interface pointer is the writer pointer */
+    const char *who;       /* the writer, in messages */
+    char *path, *tmp;
+    FILE *f;
+    unsigned char *buf;
+    size_t len, cap;
+    int64_t last_t;
+    int have_last;
+    int max_xy;    /* x and y must stay below it */
+    int64_t max_t; /* t must not pass it */
+} evr_raw_stream;
+
+/* Allocates a writer of size bytes (a struct whose first member is an evr_raw_stream, the rest
+ * zeroed), creates path + ".tmp" holding header (len bytes), and gives it write and the stream's
+ * flush, finish and abort. */
+evr_status evr_raw_writer_open(size_t size, const char *path, const char *who, int max_xy,
+                               int64_t max_t, const char *header, size_t len,
+                               evr_status (*write)(evr_event_writer *w, const evr_event *ev,
+                                                   size_t n, evr_error *err),
+                               evr_event_writer **out, evr_error *err);
+/* Refuses an event out of time order, or one the format cannot hold, with one clear line. */
+evr_status evr_raw_stream_check(evr_raw_stream *s, const evr_event *e, evr_error *err);
+/* Room for at least need more bytes at s->buf + s->len (writing out what is buffered). */
+evr_status evr_raw_stream_room(evr_raw_stream *s, size_t need, evr_error *err);
+/* Prophesee's header lines for a width x height sensor: for RAW files evt is "2.0" or "3.0" and
+ * format "EVT2" or "EVT3"; for DAT files evt is NULL. Returns the length (0: no room). */
+size_t evr_prophesee_header(char *out, size_t cap, const char *evt, const char *format, int width,
+                            int height);
+
+/* Little-endian stores. */
+static inline void evr_put_le16(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)(v & 0xff);
+    p[1] = (unsigned char)((v >> 8) & 0xff);
+}
+static inline void evr_put_le32(unsigned char *p, uint32_t v)
+{
+    evr_put_le16(p, v & 0xffff);
+    evr_put_le16(p + 2, v >> 16);
+}
+
+#endif
