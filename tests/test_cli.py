@@ -98,4 +98,19 @@ expect_error(["render", glb, "-o", noout, "--format", "avi"], "unknown format", 
 expect_error(["render", glb, "--bogus"], "unknown option")
 expect_error(["info", os.path.join(tmp, "missing.gltf")], "info on a missing file")
 expect_error(["demo", "--scene", "nope", "--export", os.path.join(tmp, "x.glb")], "unknown demo")
+# evray convert picks the format by the registry's file name endings (the longest that fits):
+# npy -> each -> npy gives the same bytes, and the .raw files say which EVT version they hold
+run = os.path.join(tmp, "conv-run")
+T.run("demo", "--scene", "square", "--res", "32x32", "--duration", "0.2", "-o", run, "--format", "npy",
+      "--no-preview", "--quiet")
+npy = os.path.join(run, "events.npy")
+for name, header in (("c.h5", None), ("c.hdf5", None), ("c.txt", None), ("c.dat", b"% Height"),
+                     ("c_evt2.raw", b"% evt 2.0"), ("c.raw", b"% evt 3.0")):
+    mid, back = os.path.join(tmp, name), os.path.join(tmp, name + ".npy")
+    T.run("convert", npy, mid, "--quiet")
+    T.run("convert", mid, back, "--quiet")
+    T.check(open(back, "rb").read() == open(npy, "rb").read(), f"convert npy -> {name} -> npy: identical")
+    if header:
+        T.check(header in open(mid, "rb").read(200), f"convert to {name}: its header says {header!r}")
+expect_error(["convert", npy, os.path.join(tmp, "x.bin")], "convert to an unknown file type")
 T.finish("test_cli")

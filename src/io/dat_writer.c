@@ -44,5 +44,6 @@ evr_status evr_dat_writer_open(const char *path, const evr_writer_meta *meta,
     return st;
 }
 
-const evr_event_format evr_format_dat = {"dat", NULL, "events_td.dat", evr_dat_writer_open,
-                                         "Prophesee DAT of CD events (expelliarmus)"};
+const evr_event_format evr_format_dat = {
+    "dat", NULL, "events_td.dat", evr_dat_writer_open, "Prophesee DAT of CD events (expelliarmus)",
+    ".dat"};

@@ -17,41 +17,51 @@ static int ends_with(const char *s, const char *end)
     return 1;
 }
 
-/* The registry's name of the format a file name asks for; NULL: none. */
-static const char *format_of(const char *path)
+/* The registered format whose longest suffix ends the file name; NULL: none. */
+static const evr_event_format *format_of(const char *path)
 {
-    if (ends_with(path, ".h5") || ends_with(path, ".hdf5")) return "h5";
-    if (ends_with(path, ".txt")) return "txt";
-    if (ends_with(path, ".npy")) return "npy";
-    if (ends_with(path, ".dat")) return "dat";
-    if (ends_with(path, "evt2.raw")) return "evt2";
-    if (ends_with(path, ".raw")) return "evt3"; /* the IMX636 cameras' default */
-    return NULL;
+    int count;
+    const evr_event_format *const *formats = evr_event_formats(&count), *best = NULL;
+    size_t best_len = 0;
+    for (int i = 0; i < count; i++) {
+        const char *p = formats[i]->suffixes;
+        while (p && *p) {
+            char suffix[32];
+            size_t n = strcspn(p, " ");
+            if (n > 0 && n < sizeof suffix) {
+                memcpy(suffix, p, n);
+                suffix[n] = 0;
+                if (n > best_len && ends_with(path, suffix)) {
+                    best = formats[i];
+                    best_len = n;
+                }
+            }
+            p += n;
+            p += strspn(p, " ");
+        }
+    }
+    return best;
 }
 
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
                             evr_error *err)
 {
-    const char *name = path ? format_of(path) : NULL;
-    const evr_event_format *const *formats;
-    const evr_event_format *f = NULL;
+    const evr_event_format *f = path ? format_of(path) : NULL;
     evr_writer_meta meta;
     evr_event_writer *w = NULL;
     evr_status st;
-    int count;
-    if (!name) {
-        snprintf(
-            err->msg, sizeof err->msg,
-            "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .dat, .raw: EVT 3.0, "
-            "or a name ending in evt2.raw: EVT 2.0)",
-            path ? path : "(none)");
-        return EVR_ERR_ARG;
-    }
-    formats = evr_event_formats(&count);
-    for (int i = 0; i < count; i++)
-        if (!strcmp(formats[i]->name, name)) f = formats[i];
     if (!f) {
-        snprintf(err->msg, sizeof err->msg, "%s: format %s is not in this build", path, name);
+        char known[256] = "";
+        int count;
+        const evr_event_format *const *formats = evr_event_formats(&count);
+        for (int i = 0; i < count; i++) {
+            size_t len = strlen(known);
+            snprintf(known + len, sizeof known - len, "%s%s (%s)", i ? ", " : "",
+                     formats[i]->suffixes, formats[i]->name);
+        }
+        snprintf(err->msg, sizeof err->msg,
+                 "%s: unknown event file type (expected a name ending in %s)",
+                 path ? path : "(none)", known);
         return EVR_ERR_ARG;
     }
     memset(&meta, 0, sizeof meta);

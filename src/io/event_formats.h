@@ -14,7 +14,8 @@ typedef struct {
     const char *file;  /* its file in the run folder */
     evr_status (*open)(const char *path, const evr_writer_meta *meta, evr_event_writer **out,
                        evr_error *err);
-    const char *help; /* what the file is, in a few words */
+    const char *help;     /* what the file is, in a few words */
+    const char *suffixes; /* file name endings that ask for it (evray convert), space-separated */
 } evr_event_format;
 
 /* The formats, in bit order; *count is set to their number. */

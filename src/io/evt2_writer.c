@@ -47,6 +47,9 @@ evr_status evr_evt2_writer_open(const char *path, const evr_writer_meta *meta,
     return st;
 }
 
-const evr_event_format evr_format_evt2 = {
-    "evt2", NULL, "events_evt2.raw", evr_evt2_writer_open,
-    "Prophesee EVT 2.0 RAW (Metavision, expelliarmus, evlib)"};
+const evr_event_format evr_format_evt2 = {"evt2",
+                                          NULL,
+                                          "events_evt2.raw",
+                                          evr_evt2_writer_open,
+                                          "Prophesee EVT 2.0 RAW (Metavision, expelliarmus, evlib)",
+                                          "evt2.raw"};

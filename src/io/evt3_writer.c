@@ -122,5 +122,9 @@ evr_status evr_evt3_writer_open(const char *path, const evr_writer_meta *meta,
     return st;
 }
 
-const evr_event_format evr_format_evt3 = {"evt3", NULL, "events_evt3.raw", evr_evt3_writer_open,
-                                          "Prophesee EVT 3.0 RAW (Metavision, evlib, evt3)"};
+const evr_event_format evr_format_evt3 = {"evt3",
+                                          NULL,
+                                          "events_evt3.raw",
+                                          evr_evt3_writer_open,
+                                          "Prophesee EVT 3.0 RAW (Metavision, evlib, evt3)",
+                                          ".raw"};

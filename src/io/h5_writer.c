@@ -731,5 +731,6 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     return EVR_OK;
 }
 
-const evr_event_format evr_format_h5 = {"h5", "hdf5", "events.h5", evr_h5_writer_open,
-                                        "HDF5: events/x, y, t, p and ms_to_idx"};
+const evr_event_format evr_format_h5 = {
+    "h5",       "hdf5", "events.h5", evr_h5_writer_open, "HDF5: events/x, y, t, p and ms_to_idx",
+    ".h5 .hdf5"};

@@ -302,5 +302,5 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
     return EVR_OK;
 }
 
-const evr_event_format evr_format_npy = {"npy", NULL, "events.npy", evr_npy_writer_open,
-                                         "NumPy structured array (t, x, y, p)"};
+const evr_event_format evr_format_npy = {
+    "npy", NULL, "events.npy", evr_npy_writer_open, "NumPy structured array (t, x, y, p)", ".npy"};

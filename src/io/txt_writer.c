@@ -158,5 +158,5 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
     return EVR_OK;
 }
 
-const evr_event_format evr_format_txt = {"txt", NULL, "events.txt", evr_txt_writer_open,
-                                         "text, one event a line (t x y p)"};
+const evr_event_format evr_format_txt = {
+    "txt", NULL, "events.txt", evr_txt_writer_open, "text, one event a line (t x y p)", ".txt"};
