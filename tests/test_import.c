@@ -8,7 +8,10 @@
 #include <string.h>
 #include <unistd.h>
 #include "check.h"
+#include "io/png.h"
 #include "scene/scene.h"
+
+#include <stb/stb_image_write.h>
 
 #define DATA EVR_TEST_DATA "/import/"
 #define PI_D 3.14159265358979323846
@@ -481,8 +484,83 @@ static void test_bad_inputs(void)
     rmdir(dir);
 }
 
+/* ---- texture decoding: 16-bit PNG and Radiance HDR (8-bit PNG: test_lights_materials) ---- */
+
+/* lights.gltf in dir with its external checker.png replaced by the image in file; returns the
+ * decoded texture's first texels through rgba (16 floats), 0 when it does not load. */
+static int load_external_texture(const char *dir, const char *image, float rgba[16])
+{
+    char gltf[512], png[512];
+    size_t m = 0;
+    unsigned char *txt = read_bytes(DATA "lights.gltf", &m);
+    evr_scene *s = NULL;
+    evr_error err;
+    int ok = 0;
+    snprintf(gltf, sizeof gltf, "%s/lights.gltf", dir);
+    snprintf(png, sizeof png, "%s/checker.png", dir);
+    if (txt && write_bytes(gltf, txt, m) && rename(image, png) == 0 &&
+        evr_scene_load(gltf, &s, &err) == EVR_OK) {
+        for (int i = 0; i < s->num_materials; i++) {
+            const evr_material *e = &s->materials[i];
+            if (!strcmp(e->name, "external") && e->p.base_texture >= 0) {
+                const evr_texture *t = &s->textures[e->p.base_texture];
+                ok = t->width == 2 && t->height == 2;
+                if (ok) memcpy(rgba, t->rgba, 16 * sizeof(float));
+            }
+        }
+        evr_scene_release(s);
+    }
+    free(txt);
+    unlink(gltf);
+    unlink(png);
+    return ok;
+}
+
+static void test_texture_depths(void)
+{
+    char dir[] = "/tmp/evray_tex_XXXXXX", path[512];
+    float rgba[16];
+    evr_error err;
+    if (!mkdtemp(dir)) {
+        CHECK(!"mkdtemp");
+        return;
+    }
+    /* 16-bit: colour channels sRGB-encoded, alpha linear */
+    {
+        const uint16_t px[16] = {65535, 0, 32768, 16384, 0, 0, 0, 65535,
+                                 0,     0, 0,     65535, 0, 0, 0, 65535};
+        void *png = NULL;
+        size_t n = 0;
+        snprintf(path, sizeof path, "%s/img16", dir);
+        CHECK(evr_png_encode(px, 2, 2, 4, 16, &png, &n, &err) == EVR_OK);
+        CHECK(png && write_bytes(path, png, n));
+        free(png);
+        CHECK(load_external_texture(dir, path, rgba));
+        CHECK_NEAR(rgba[0], 1.0, 1e-6);
+        CHECK_NEAR(rgba[1], 0.0, 1e-6);
+        CHECK_NEAR(rgba[2], srgb(32768.0 / 65535.0), 1e-6);
+        CHECK_NEAR(rgba[3], 16384.0 / 65535.0, 1e-6);
+    }
+    /* Radiance HDR: linear already, values above 1 kept */
+    {
+        const float px[12] = {4.0f, 0.5f, 0.25f, 0.0f, 1.0f, 2.0f,
+                              0.0f, 0.0f, 0.0f,  1.0f, 1.0f, 1.0f};
+        snprintf(path, sizeof path, "%s/img.hdr", dir);
+        CHECK(stbi_write_hdr(path, 2, 2, 3, px) != 0);
+        CHECK(load_external_texture(dir, path, rgba));
+        CHECK_NEAR(rgba[0], 4.0, 1e-6);
+        CHECK_NEAR(rgba[1], 0.5, 1e-6);
+        CHECK_NEAR(rgba[2], 0.25, 1e-6);
+        CHECK_NEAR(rgba[3], 1.0, 1e-6);
+        CHECK_NEAR(rgba[5], 1.0, 1e-6);
+        CHECK_NEAR(rgba[6], 2.0, 1e-6);
+    }
+    rmdir(dir);
+}
+
 int main(void)
 {
+    test_texture_depths();
     test_gltf_cameras();
     test_lights_materials(DATA "lights.gltf", 0);
     test_lights_materials(DATA "lights.glb", 1);

@@ -18,59 +18,51 @@ static float srgb_to_linear(float c)
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
 
-/* Decodes an encoded image (PNG, JPEG, ...) into linear RGBA floats. */
+/* Decodes an encoded image (PNG, JPEG, ...) into linear RGBA floats: HDR images are linear
+ * already; 16- and 8-bit colour channels are sRGB-encoded, alpha is linear. */
 static evr_status decode_image(const unsigned char *data, size_t size, const char *what,
                                evr_texture *t, evr_error *err)
 {
+    enum { HDR, BITS16, BITS8 } kind;
     int w = 0, h = 0, comp = 0;
     size_t i, n;
+    void *px;
     if (size > INT_MAX)
         return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: image too large", what);
     if (stbi_is_hdr_from_memory(data, (int)size)) {
-        float *px = stbi_loadf_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px)
-            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
-                                   what, stbi_failure_reason());
-        n = (size_t)w * (size_t)h;
-        t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) {
-            stbi_image_free(px);
-            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
-        }
-        memcpy(t->rgba, px, n * 4 * sizeof(float)); /* HDR images are linear already */
-        stbi_image_free(px);
+        kind = HDR;
+        px = stbi_loadf_from_memory(data, (int)size, &w, &h, &comp, 4);
     } else if (stbi_is_16_bit_from_memory(data, (int)size)) {
-        unsigned short *px = stbi_load_16_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px)
-            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
-                                   what, stbi_failure_reason());
-        n = (size_t)w * (size_t)h;
-        t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) {
-            stbi_image_free(px);
-            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
-        }
+        kind = BITS16;
+        px = stbi_load_16_from_memory(data, (int)size, &w, &h, &comp, 4);
+    } else {
+        kind = BITS8;
+        px = stbi_load_from_memory(data, (int)size, &w, &h, &comp, 4);
+    }
+    if (!px)
+        return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
+                               what, stbi_failure_reason());
+    n = (size_t)w * (size_t)h;
+    t->rgba = malloc(n * 4 * sizeof(float));
+    if (!t->rgba) {
+        stbi_image_free(px);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
+    }
+    if (kind == HDR) {
+        memcpy(t->rgba, px, n * 4 * sizeof(float));
+    } else if (kind == BITS16) {
+        const unsigned short *p16 = px;
         for (i = 0; i < n * 4; i++) {
-            float v = (float)px[i] / 65535.0f;
+            float v = (float)p16[i] / 65535.0f;
             t->rgba[i] = (i % 4 == 3) ? v : srgb_to_linear(v);
         }
-        stbi_image_free(px);
     } else {
+        const unsigned char *p8 = px;
         float lut[256];
-        unsigned char *px = stbi_load_from_memory(data, (int)size, &w, &h, &comp, 4);
-        if (!px)
-            return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: cannot decode the image (%s)",
-                                   what, stbi_failure_reason());
         for (i = 0; i < 256; i++) lut[i] = srgb_to_linear((float)i / 255.0f);
-        n = (size_t)w * (size_t)h;
-        t->rgba = malloc(n * 4 * sizeof(float));
-        if (!t->rgba) {
-            stbi_image_free(px);
-            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
-        }
-        for (i = 0; i < n * 4; i++) t->rgba[i] = (i % 4 == 3) ? (float)px[i] / 255.0f : lut[px[i]];
-        stbi_image_free(px);
+        for (i = 0; i < n * 4; i++) t->rgba[i] = (i % 4 == 3) ? (float)p8[i] / 255.0f : lut[p8[i]];
     }
+    stbi_image_free(px);
     t->width = w;
     t->height = h;
     return EVR_OK;
