@@ -874,7 +874,7 @@ static void check_refused(const char *dir, const char *file, open_fn open, evr_e
     CHECK(!file_exists(path));
 }
 
-/* Writes ev[0 .. n) in batches of `batch` events (the first batch `first`) and returns the file's
+/* Writes ev[0 .. n) in batches of about `batch` events (the first about `first`) and returns the file's
  * bytes after its header lines (*len of them; NULL when it could not be written or read). */
 static unsigned char *write_in_batches(const char *path, open_fn open, const evr_event *ev,
                                        size_t n, size_t first, size_t batch, size_t *len)
@@ -892,9 +892,11 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     for (at = 0; at < n;) {
         size_t k = at == 0 ? first : batch;
         if (k > n - at) k = n - at;
+        /* EVT 3.0 vectors do not span writes: end each at a new timestamp, where none can */
+        while (at + k < n && ev[at + k].t == ev[at + k - 1].t) k++;
         CHECK_OK(w->write(w, ev + at, k, &err));
+        if (at == 0) CHECK_OK(w->flush(w, &err)); /* buffered bytes ahead of a large write */
         at += k;
-        if (at == first) CHECK_OK(w->flush(w, &err)); /* buffered bytes ahead of a large write */
     }
     CHECK_OK(w->finish(w, ev[n - 1].t + 1, &err));
     fp = fopen(path, "rb");
@@ -933,16 +935,22 @@ static void test_camera_parts(const char *root)
     } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1}, "(2048, 5)"},
              {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1}, "(5, 2048)"},
              {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0}, "4294967296 us"}};
-    const size_t n = 300000, small = EVR_PAR_PACK_MIN - 1;
+    const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
     evr_event *ev = calloc(n, sizeof *ev);
     uint64_t s = 4242;
     int64_t t = 0;
     char path[600];
     CHECK(ev != NULL);
     if (!ev) return;
-    /* runs of one time-high (64 us) word and jumps across several, parts starting in either */
+    /* runs of one time-high (64 us) word and jumps across several, parts starting in either;
+     * rows of events at one time (EVT 3.0 vector words), some longer than one word holds */
     for (size_t i = 0; i < n; i++) {
         uint64_t r = rng_next(&s) % 100;
+        if (i > 0 && r < 40 && ev[i - 1].x + 3 < W) {
+            ev[i] = ev[i - 1];
+            ev[i].x = (uint16_t)(ev[i - 1].x + 1 + rng_next(&s) % 3);
+            continue;
+        }
         t += r < 90 ? (int64_t)(r % 3) : (int64_t)(rng_next(&s) % 300);
         ev[i].t = t;
         ev[i].x = (uint16_t)(rng_next(&s) % W);
@@ -959,7 +967,10 @@ static void test_camera_parts(const char *root)
         snprintf(path, sizeof path, "%s/%s", root, f[k].file);
         serial = write_in_batches(path, f[k].open, ev, n, 1000, small, &len_serial);
         parts = write_in_batches(path, f[k].open, ev, n, 1000, 140000, &len_parts);
-        CHECK(serial && parts && len_serial == len_parts && len_serial > n * 4);
+        CHECK(serial && parts && len_serial == len_parts && len_serial > n);
+        if (len_serial != len_parts)
+            fprintf(stderr, "%s: %zu bytes in parts, %zu serially\n", f[k].file, len_parts,
+                    len_serial);
         if (serial && parts && len_serial == len_parts)
             CHECK(memcmp(serial, parts, len_serial) == 0);
         free(serial);

@@ -41,7 +41,7 @@ static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, 
 static evr_status dat_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     dat_writer *w = (dat_writer *)base;
-    const evr_par_packer parts = {measure_part, pack_part, w};
+    const evr_par_packer parts = {measure_part, pack_part, NULL, w};
     evr_status st;
     if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) return st;
     for (size_t i = 0; i < n; i++) {

@@ -63,7 +63,7 @@ static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, 
 static evr_status evt2_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     evt2_writer *w = (evt2_writer *)base;
-    const evr_par_packer parts = {measure_part, pack_part, w};
+    const evr_par_packer parts = {measure_part, pack_part, NULL, w};
     evr_status st;
     if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) {
         if (st == EVR_OK) w->time_high = EVT2_TIME_HIGH(ev[n - 1].t);

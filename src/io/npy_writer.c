@@ -124,7 +124,7 @@ static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, 
 static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err,
                           evr_status *st)
 {
-    const evr_par_packer parts = {measure_part, pack_part, NULL};
+    const evr_par_packer parts = {measure_part, pack_part, NULL, NULL};
     size_t bytes;
     evr_par_pack_result r;
     if ((*st = drain(w, err)) != EVR_OK) return 1;

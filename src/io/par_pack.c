@@ -17,7 +17,9 @@ typedef struct {
     int fd;
     off_t at;                    /* file offset of ev[0]'s bytes */
     int pass;                    /* 0: measure, 1: pack and write */
-    size_t size[PAR_PACK_PARTS]; /* each part's bytes */
+    size_t first[PAR_PACK_PARTS + 1]; /* part k: events [first[k], first[k + 1]) (cuts move
+                                         both ends alike, so the parts tile the events) */
+    size_t size[PAR_PACK_PARTS];      /* each part's bytes */
     size_t off[PAR_PACK_PARTS];  /* and where they start, in big and after at */
     int bad[PAR_PACK_PARTS];     /* a failed write */
 } pack_job;
@@ -43,12 +45,17 @@ static void pack_part(void *ctx, int k, int thread)
     pack_job *j = ctx;
     size_t a, b;
     (void)thread;
-    evr_par_share(j->n, PAR_PACK_PARTS, k, &a, &b);
-    if (a >= b) return;
     if (j->pass == 0) {
-        j->size[k] = j->p->measure(j->p->ctx, j->ev, a, b);
+        evr_par_share(j->n, PAR_PACK_PARTS, k, &a, &b);
+        if (j->p->cut && k > 0) a = j->p->cut(j->p->ctx, j->ev, j->n, a);
+        if (j->p->cut && b < j->n) b = j->p->cut(j->p->ctx, j->ev, j->n, b);
+        j->first[k] = a;
+        j->size[k] = a < b ? j->p->measure(j->p->ctx, j->ev, a, b) : 0;
         return;
     }
+    a = j->first[k];
+    b = j->first[k + 1];
+    if (a >= b) return;
     j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->off[k]);
     if (!write_at(j->fd, j->big + j->off[k], j->size[k], j->at + (off_t)j->off[k])) j->bad[k] = 1;
 }
@@ -66,6 +73,7 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     j.ev = ev;
     j.n = n;
     evr_par_pool_run(pk->pool, PAR_PACK_PARTS, pack_part, &j);
+    j.first[PAR_PACK_PARTS] = n;
     for (int k = 0; k < PAR_PACK_PARTS; k++) {
         if (j.size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
         j.off[k] = total;

@@ -23,6 +23,9 @@ typedef struct {
     /* Writes ev[a .. b) at out, exactly the bytes measure counted (the events before a are there
      * to read, for the state a part starts in). */
     void (*pack)(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out);
+    /* NULL, or the first index at or after `at` where a part may begin (n: none), for formats
+     * whose words span several events: parts are cut there. */
+    size_t (*cut)(const void *ctx, const evr_event *ev, size_t n, size_t at);
     const void *ctx;
 } evr_par_packer;
 
