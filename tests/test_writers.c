@@ -990,7 +990,8 @@ static void test_camera_parts(const char *root)
             err.msg[0] = 0;
             CHECK(w->write(w, bad, n, &err) == EVR_ERR_ARG);
             CHECK(strstr(err.msg, f[k].why) != NULL);
-            if (!strstr(err.msg, f[k].why)) fprintf(stderr, "expected '%s' in: %s\n", f[k].why, err.msg);
+            if (!strstr(err.msg, f[k].why))
+                fprintf(stderr, "expected '%s' in: %s\n", f[k].why, err.msg);
             w->abort(w);
         }
         CHECK(!file_exists(path));

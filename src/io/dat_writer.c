@@ -23,25 +23,30 @@ static void pack_event(unsigned char *p, const evr_event *e)
 }
 
 /* A part of a large write (io/par_pack.h): 8 bytes an event. */
-static size_t measure_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
-    const dat_writer *w = ctx;
-    for (size_t i = a; i < b; i++)
-        if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
-            return SIZE_MAX;
+    (void)ctx;
+    (void)ev;
     return (b - a) * DAT_EVENT_SIZE;
 }
 
-static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out)
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
 {
-    (void)ctx;
-    for (size_t i = a; i < b; i++, out += DAT_EVENT_SIZE) pack_event(out, &ev[i]);
+    const dat_writer *w = ctx;
+    (void)room;
+    for (size_t i = a; i < b; i++, out += DAT_EVENT_SIZE) {
+        if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
+            return SIZE_MAX;
+        pack_event(out, &ev[i]);
+    }
+    return (b - a) * DAT_EVENT_SIZE;
 }
 
 static evr_status dat_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     dat_writer *w = (dat_writer *)base;
-    const evr_par_packer parts = {measure_part, pack_part, NULL, w};
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
     evr_status st;
     if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) return st;
     for (size_t i = 0; i < n; i++) {

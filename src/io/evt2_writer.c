@@ -38,32 +38,32 @@ static int64_t part_time_high(const evt2_writer *w, const evr_event *ev, size_t 
 }
 
 /* A part of a large write (io/par_pack.h): a word an event, one more at each time-high change. */
-static size_t measure_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * 8;
+}
+
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
 {
     const evt2_writer *w = ctx;
     int64_t time_high = part_time_high(w, ev, a);
-    size_t words = b - a;
+    unsigned char *p = out;
+    (void)room;
     for (size_t i = a; i < b; i++) {
         if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
             return SIZE_MAX;
-        if (EVT2_TIME_HIGH(ev[i].t) != time_high) {
-            time_high = EVT2_TIME_HIGH(ev[i].t);
-            words++;
-        }
+        p += pack_event(p, &ev[i], &time_high);
     }
-    return words * 4;
-}
-
-static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out)
-{
-    int64_t time_high = part_time_high(ctx, ev, a);
-    for (size_t i = a; i < b; i++) out += pack_event(out, &ev[i], &time_high);
+    return (size_t)(p - out);
 }
 
 static evr_status evt2_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     evt2_writer *w = (evt2_writer *)base;
-    const evr_par_packer parts = {measure_part, pack_part, NULL, w};
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
     evr_status st;
     if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) {
         if (st == EVR_OK) w->time_high = EVT2_TIME_HIGH(ev[n - 1].t);

@@ -42,7 +42,8 @@ typedef struct {
 typedef struct {
     evt3_state *st;
     evr_raw_stream *s;  /* the serial path; NULL for a part */
-    unsigned char *out; /* a part's words; NULL: only counted */
+    unsigned char *out; /* a part's words */
+    size_t room;        /* and the bytes they may take */
     size_t bytes;       /* a part's bytes so far */
 } evt3_words;
 
@@ -54,10 +55,11 @@ static evr_status put(evt3_words *o, unsigned type, unsigned payload, evr_error 
         if (st != EVR_OK) return st;
         evr_put_le16(o->s->buf + o->s->len, word);
         o->s->len += 2;
-    } else if (o->out) {
+    } else {
+        if (o->room - o->bytes < 2) return EVR_ERR_NOMEM; /* the part goes serially */
         evr_put_le16(o->out + o->bytes, word);
+        o->bytes += 2;
     }
-    o->bytes += 2;
     /* readers differ in what other words do to the vector base (faery moves it with EVT_ADDR_X):
      * a vector continues from the base only right after a vector word */
     if (type != EVT3_VECT_BASE_X && type != EVT3_VECT_12 && type != EVT3_VECT_8) o->st->base_x = -1;
@@ -88,8 +90,8 @@ static evr_status put_time(evt3_words *o, int64_t t, evr_error *err)
  * further right. Where it may not, a vector run starts. */
 static int continues(const evr_event *ev, size_t j)
 {
-    return ev[j].t == ev[j - 1].t && ev[j].y == ev[j - 1].y &&
-           (ev[j].p > 0) == (ev[j - 1].p > 0) && ev[j].x > ev[j - 1].x;
+    return ev[j].t == ev[j - 1].t && ev[j].y == ev[j - 1].y && (ev[j].p > 0) == (ev[j - 1].p > 0) &&
+           ev[j].x > ev[j - 1].x;
 }
 
 /* The end of the run starting at ev[i] that one vector word can hold (ev[.. n) read). */
@@ -155,39 +157,39 @@ static evt3_state state_at(const evt3_writer *w, const evr_event *ev, size_t a)
     return s;
 }
 
-/* The words of ev[a .. b) (a part of a large write, io/par_pack.h) at out (NULL: counted). */
-static size_t put_part(const evt3_writer *w, const evr_event *ev, size_t a, size_t b,
-                       unsigned char *out)
-{
-    evt3_state s = state_at(w, ev, a);
-    evt3_words o = {&s, NULL, out, 0};
-    for (size_t i = a; i < b;) {
-        const size_t j = run_end(ev, i, b);
-        put_run(&o, ev, i, j, NULL);
-        i = j;
-    }
-    return o.bytes;
-}
-
-static size_t measure_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+/* A part of a large write (io/par_pack.h): at most 4 words a run besides the TIME_HIGH words,
+ * and these step from the part's first time high to its last (past which pack_part goes not). */
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
     const evt3_writer *w = ctx;
-    for (size_t i = a; i < b; i++)
-        if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
-            return SIZE_MAX;
-    return put_part(w, ev, a, b, NULL);
+    int64_t from = a > 0 ? ev[a - 1].t >> 12 : w->st.time_high;
+    int64_t to = ev[b - 1].t >> 12;
+    if (to > w->s.max_t >> 12) to = w->s.max_t >> 12;
+    if (from < 0) from = 0; /* and one word more, for time high 0 */
+    return (b - a) * 8 + 2 * (to > from ? (size_t)(to - from) + 1 : 1);
 }
 
-static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out)
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
 {
-    put_part(ctx, ev, a, b, out);
+    const evt3_writer *w = ctx;
+    evt3_state s = state_at(w, ev, a);
+    evt3_words o = {&s, NULL, out, room, 0};
+    for (size_t i = a, j; i < b; i = j) {
+        j = run_end(ev, i, b);
+        for (size_t k = i; k < j; k++)
+            if (!evr_raw_stream_fits(&w->s, &ev[k]) || (k > 0 && ev[k].t < ev[k - 1].t))
+                return SIZE_MAX;
+        if (put_run(&o, ev, i, j, NULL) != EVR_OK) return SIZE_MAX;
+    }
+    return o.bytes;
 }
 
 static evr_status evt3_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     evt3_writer *w = (evt3_writer *)base;
-    const evr_par_packer parts = {measure_part, pack_part, cut_part, w};
-    evt3_words o = {&w->st, &w->s, NULL, 0};
+    const evr_par_packer parts = {bound_part, pack_part, cut_part, w};
+    evt3_words o = {&w->st, &w->s, NULL, 0, 0};
     evr_status st;
     if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) {
         if (st == EVR_OK) w->st = state_at(w, ev, n);

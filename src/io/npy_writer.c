@@ -104,18 +104,23 @@ static void pack(unsigned char *r, const evr_event *e)
 }
 
 /* A part of a large write (io/par_pack.h): 13 bytes an event. */
-static size_t measure_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
     (void)ctx;
-    for (size_t i = a; i < b; i++)
-        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
+    (void)ev;
     return (b - a) * NPY_RECORD;
 }
 
-static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out)
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
 {
     (void)ctx;
-    for (size_t i = a; i < b; i++, out += NPY_RECORD) pack(out, &ev[i]);
+    (void)room;
+    for (size_t i = a; i < b; i++, out += NPY_RECORD) {
+        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
+        pack(out, &ev[i]);
+    }
+    return (b - a) * NPY_RECORD;
 }
 
 /* Writes ev[0 .. n) (n >= EVR_PAR_PACK_MIN, ev[0] not before the last event written) in parts
@@ -124,7 +129,7 @@ static void pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b, 
 static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err,
                           evr_status *st)
 {
-    const evr_par_packer parts = {measure_part, pack_part, NULL, NULL};
+    const evr_par_packer parts = {bound_part, pack_part, NULL, NULL};
     size_t bytes;
     evr_par_pack_result r;
     if ((*st = drain(w, err)) != EVR_OK) return 1;

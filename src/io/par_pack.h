@@ -16,13 +16,15 @@
 #define EVR_PAR_PACK_MIN ((size_t)1 << 15)
 
 typedef struct {
-    /* Checks ev[a .. b) (each against the event before it when there is one; ev[0] against what
-     * was written before is the caller's) and returns the bytes they take; SIZE_MAX when one of
-     * them cannot be written: the serial path then reports it at the first bad event. */
-    size_t (*measure)(const void *ctx, const evr_event *ev, size_t a, size_t b);
-    /* Writes ev[a .. b) at out, exactly the bytes measure counted (the events before a are there
-     * to read, for the state a part starts in). */
-    void (*pack)(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out);
+    /* At least the bytes ev[a .. b) can take, found cheaply (the events may be bad: see pack). */
+    size_t (*bound)(const void *ctx, const evr_event *ev, size_t a, size_t b);
+    /* Checks ev[a .. b) (each against the event before it when there is one; ev[0] against
+     * what was written before is the caller's) and packs them at out, within the bound; returns
+     * the bytes written, or SIZE_MAX when one of them cannot be written (or would pass the
+     * bound): the serial path then reports the first bad event. The events before a are there
+     * to read, for the state a part starts in. */
+    size_t (*pack)(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out,
+                   size_t room);
     /* NULL, or the first index at or after `at` where a part may begin (n: none), for formats
      * whose words span several events: parts are cut there. */
     size_t (*cut)(const void *ctx, const evr_event *ev, size_t n, size_t at);

@@ -20,8 +20,8 @@ typedef struct {
     size_t len, cap;
     int64_t last_t;
     int have_last;
-    int max_xy;    /* x and y must stay below it */
-    int64_t max_t; /* t must not pass it */
+    int max_xy;            /* x and y must stay below it */
+    int64_t max_t;         /* t must not pass it */
     evr_par_packing parts; /* large writes, packed in parts */
 } evr_raw_stream;
 
