@@ -21,6 +21,7 @@
 #include "io/event_writer.h"
 #include "io/json.h"
 #include "io/json_read.h"
+#include "io/par_pack.h"
 #include "io/preview.h"
 
 #define W 640
@@ -873,6 +874,132 @@ static void check_refused(const char *dir, const char *file, open_fn open, evr_e
     CHECK(!file_exists(path));
 }
 
+/* Writes ev[0 .. n) in batches of about `batch` events (the first about `first`) and returns the file's
+ * bytes after its header lines (*len of them; NULL when it could not be written or read). */
+static unsigned char *write_in_batches(const char *path, open_fn open, const evr_event *ev,
+                                       size_t n, size_t first, size_t batch, size_t *len)
+{
+    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_event_writer *w = NULL;
+    evr_error err;
+    unsigned char *data = NULL;
+    size_t size = 0, at;
+    FILE *fp;
+    const char *end;
+    *len = 0;
+    CHECK_OK(open(path, &meta, &w, &err));
+    if (!w) return NULL;
+    for (at = 0; at < n;) {
+        size_t k = at == 0 ? first : batch;
+        if (k > n - at) k = n - at;
+        /* EVT 3.0 vectors do not span writes: end each at a new timestamp, where none can */
+        while (at + k < n && ev[at + k].t == ev[at + k - 1].t) k++;
+        CHECK_OK(w->write(w, ev + at, k, &err));
+        if (at == 0) CHECK_OK(w->flush(w, &err)); /* buffered bytes ahead of a large write */
+        at += k;
+    }
+    CHECK_OK(w->finish(w, ev[n - 1].t + 1, &err));
+    fp = fopen(path, "rb");
+    if (fp && fseek(fp, 0, SEEK_END) == 0 && (size = (size_t)ftell(fp)) > 0 &&
+        fseek(fp, 0, SEEK_SET) == 0 && (data = malloc(size + 1)) != NULL &&
+        fread(data, 1, size, fp) != size) {
+        free(data);
+        data = NULL;
+    }
+    if (fp) fclose(fp);
+    CHECK(data != NULL);
+    if (!data) return NULL;
+    data[size] = 0;
+    end = strstr((const char *)data, "% end\n"); /* the header holds the date: skip it */
+    CHECK(end != NULL);
+    if (!end) {
+        free(data);
+        return NULL;
+    }
+    at = (size_t)(end - (const char *)data) + 6;
+    *len = size - at;
+    memmove(data, data + at, *len);
+    return data;
+}
+
+/* Large writes are packed in parallel parts (io/par_pack.h): the bytes must be those of the serial
+ * path (batches too small for parts), and a bad event deep in a large write is refused as the
+ * serial path refuses it. */
+static void test_camera_parts(const char *root)
+{
+    static const struct {
+        const char *file;
+        open_fn open;
+        evr_event bad; /* put in the middle of a large write */
+        const char *why;
+    } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1}, "(2048, 5)"},
+             {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1}, "(5, 2048)"},
+             {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0}, "4294967296 us"}};
+    const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
+    evr_event *ev = calloc(n, sizeof *ev);
+    uint64_t s = 4242;
+    int64_t t = 0;
+    char path[600];
+    CHECK(ev != NULL);
+    if (!ev) return;
+    /* runs of one time-high (64 us) word and jumps across several, parts starting in either;
+     * rows of events at one time (EVT 3.0 vector words), some longer than one word holds */
+    for (size_t i = 0; i < n; i++) {
+        uint64_t r = rng_next(&s) % 100;
+        if (i > 0 && r < 40 && ev[i - 1].x + 3 < W) {
+            ev[i] = ev[i - 1];
+            ev[i].x = (uint16_t)(ev[i - 1].x + 1 + rng_next(&s) % 3);
+            continue;
+        }
+        t += r < 90 ? (int64_t)(r % 3) : (int64_t)(rng_next(&s) % 300);
+        ev[i].t = t;
+        ev[i].x = (uint16_t)(rng_next(&s) % W);
+        ev[i].y = (uint16_t)(rng_next(&s) % H);
+        ev[i].p = (int8_t)(rng_next(&s) & 1);
+    }
+    for (size_t k = 0; k < sizeof f / sizeof f[0]; k++) {
+        size_t len_serial, len_parts;
+        unsigned char *serial, *parts;
+        evr_writer_meta meta = {W, H, NULL, 0};
+        evr_event_writer *w = NULL;
+        evr_error err;
+        evr_event *bad;
+        snprintf(path, sizeof path, "%s/%s", root, f[k].file);
+        serial = write_in_batches(path, f[k].open, ev, n, 1000, small, &len_serial);
+        parts = write_in_batches(path, f[k].open, ev, n, 1000, 140000, &len_parts);
+        CHECK(serial && parts && len_serial == len_parts && len_serial > n);
+        if (len_serial != len_parts)
+            fprintf(stderr, "%s: %zu bytes in parts, %zu serially\n", f[k].file, len_parts,
+                    len_serial);
+        if (serial && parts && len_serial == len_parts)
+            CHECK(memcmp(serial, parts, len_serial) == 0);
+        free(serial);
+        free(parts);
+        remove(path);
+
+        /* the first bad event is refused, the later ones (out of order, past the range) not seen */
+        bad = malloc(n * sizeof *bad);
+        CHECK(bad != NULL);
+        if (!bad) continue;
+        memcpy(bad, ev, n * sizeof *bad);
+        bad[200000] = f[k].bad;
+        bad[200000].t = f[k].bad.t == 7 ? bad[199999].t : f[k].bad.t;
+        bad[250000].t = 0;
+        CHECK_OK(f[k].open(path, &meta, &w, &err));
+        if (w) {
+            err.msg[0] = 0;
+            CHECK(w->write(w, bad, n, &err) == EVR_ERR_ARG);
+            CHECK(strstr(err.msg, f[k].why) != NULL);
+            if (!strstr(err.msg, f[k].why))
+                fprintf(stderr, "expected '%s' in: %s\n", f[k].why, err.msg);
+            w->abort(w);
+        }
+        CHECK(!file_exists(path));
+        free(bad);
+    }
+    free(ev);
+}
+
 static void test_camera_formats(const char *root)
 {
     const size_t n = 6000;
@@ -1522,6 +1649,7 @@ int main(void)
     test_deflate_runs();
     test_writers(root, &python_ok);
     test_camera_formats(root);
+    test_camera_parts(root);
     test_tonemap(root);
     test_event_frames(root);
     bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");

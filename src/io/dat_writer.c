@@ -16,17 +16,45 @@ typedef struct {
     evr_raw_stream s; /* first: the interface pointer is the writer pointer */
 } dat_writer;
 
+static void pack_event(unsigned char *p, const evr_event *e)
+{
+    evr_put_le32(p, (uint32_t)e->t);
+    evr_put_le32(p + 4, (uint32_t)(e->p > 0) << 28 | (uint32_t)e->y << 14 | (uint32_t)e->x);
+}
+
+/* A part of a large write (io/par_pack.h): 8 bytes an event. */
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * DAT_EVENT_SIZE;
+}
+
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
+{
+    const dat_writer *w = ctx;
+    (void)room;
+    for (size_t i = a; i < b; i++, out += DAT_EVENT_SIZE) {
+        if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
+            return SIZE_MAX;
+        pack_event(out, &ev[i]);
+    }
+    return (b - a) * DAT_EVENT_SIZE;
+}
+
 static evr_status dat_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     dat_writer *w = (dat_writer *)base;
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
+    evr_status st;
+    if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) return st;
     for (size_t i = 0; i < n; i++) {
         const evr_event *e = &ev[i];
-        evr_status st = evr_raw_stream_check(&w->s, e, err);
+        st = evr_raw_stream_check(&w->s, e, err);
         if (st == EVR_OK) st = evr_raw_stream_room(&w->s, DAT_EVENT_SIZE, err);
         if (st != EVR_OK) return st;
-        unsigned char *p = w->s.buf + w->s.len;
-        evr_put_le32(p, (uint32_t)e->t);
-        evr_put_le32(p + 4, (uint32_t)(e->p > 0) << 28 | (uint32_t)e->y << 14 | (uint32_t)e->x);
+        pack_event(w->s.buf + w->s.len, e);
         w->s.len += DAT_EVENT_SIZE;
     }
     return EVR_OK;

@@ -14,23 +14,67 @@ typedef struct {
     int64_t time_high; /* the last EV_TIME_HIGH written; -1: none yet */
 } evt2_writer;
 
+#define EVT2_TIME_HIGH(t) ((t) >> 6)
+
+/* The words of one event: an EV_TIME_HIGH word when the timestamp's upper bits differ from
+ * *time_high (updated), then the CD word. Returns the bytes written at p (4 or 8). */
+static size_t pack_event(unsigned char *p, const evr_event *e, int64_t *time_high)
+{
+    size_t at = 0;
+    if (EVT2_TIME_HIGH(e->t) != *time_high) {
+        *time_high = EVT2_TIME_HIGH(e->t);
+        evr_put_le32(p, UINT32_C(0x8) << 28 | (uint32_t)*time_high);
+        at = 4;
+    }
+    evr_put_le32(p + at, (uint32_t)(e->p > 0) << 28 | (uint32_t)(e->t & 63) << 22 |
+                             (uint32_t)e->x << 11 | (uint32_t)e->y);
+    return at + 4;
+}
+
+/* The time-high state part [a, ...) of a large write starts in: the event before it's. */
+static int64_t part_time_high(const evt2_writer *w, const evr_event *ev, size_t a)
+{
+    return a > 0 ? EVT2_TIME_HIGH(ev[a - 1].t) : w->time_high;
+}
+
+/* A part of a large write (io/par_pack.h): a word an event, one more at each time-high change. */
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * 8;
+}
+
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
+{
+    const evt2_writer *w = ctx;
+    int64_t time_high = part_time_high(w, ev, a);
+    unsigned char *p = out;
+    (void)room;
+    for (size_t i = a; i < b; i++) {
+        if (!evr_raw_stream_fits(&w->s, &ev[i]) || (i > 0 && ev[i].t < ev[i - 1].t))
+            return SIZE_MAX;
+        p += pack_event(p, &ev[i], &time_high);
+    }
+    return (size_t)(p - out);
+}
+
 static evr_status evt2_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     evt2_writer *w = (evt2_writer *)base;
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
+    evr_status st;
+    if (evr_raw_stream_write_parts(&w->s, &parts, ev, n, &st, err)) {
+        if (st == EVR_OK) w->time_high = EVT2_TIME_HIGH(ev[n - 1].t);
+        return st;
+    }
     for (size_t i = 0; i < n; i++) {
         const evr_event *e = &ev[i];
-        evr_status st = evr_raw_stream_check(&w->s, e, err);
+        st = evr_raw_stream_check(&w->s, e, err);
         if (st == EVR_OK) st = evr_raw_stream_room(&w->s, 8, err);
         if (st != EVR_OK) return st;
-        unsigned char *p = w->s.buf + w->s.len;
-        if (e->t >> 6 != w->time_high) {
-            w->time_high = e->t >> 6;
-            evr_put_le32(p, UINT32_C(0x8) << 28 | (uint32_t)w->time_high);
-            p += 4;
-        }
-        evr_put_le32(p, (uint32_t)(e->p > 0) << 28 | (uint32_t)(e->t & 63) << 22 |
-                            (uint32_t)e->x << 11 | (uint32_t)e->y);
-        w->s.len = (size_t)(p + 4 - w->s.buf);
+        w->s.len += pack_event(w->s.buf + w->s.len, e, &w->time_high);
     }
     return EVR_OK;
 }

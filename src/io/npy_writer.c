@@ -7,24 +7,16 @@
  * every event up to the last flush. */
 #include "io/event_formats.h"
 #include "io/file_commit.h"
-#include "par_pool.h"
+#include "io/par_pack.h"
 
-#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #define NPY_RECORD 13
 #define NPY_BUFFER_RECORDS (1u << 16)
 #define NPY_DESCR "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1')]"
-/* A write of this many events or more is checked, packed and written (pwrite at its offset) in
- * parts on a pool of NPY_THREADS: one thread packing and copying 2.84 GB into the page cache
- * kept the eye's 30 s waiting (H100 machine: writer busy 1.9-2.2 s, the loop waiting 0.7-1.0 s) */
-#define NPY_PAR_MIN (1u << 15)
-#define NPY_THREADS 4
-#define NPY_PARTS 16
 
 typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
@@ -36,9 +28,10 @@ typedef struct {
     size_t header_len; /* bytes before the first record */
     int64_t last_t;
     int have_last;
-    evr_par_pool *pool;
-    unsigned char *big; /* a large write's records */
-    size_t big_cap;     /* records big has room for */
+    /* large writes, packed in parts (io/par_pack.h): one thread packing and copying 2.84 GB into
+     * the page cache kept the eye's 30 s waiting (H100 machine: writer busy 1.9-2.2 s, the loop
+     * waiting 0.7-1.0 s) */
+    evr_par_packing parts;
 } npy_writer;
 
 /* Builds the whole header (magic, version, length, dict, padding, newline) for count records.
@@ -91,8 +84,7 @@ static evr_status drain(npy_writer *w, evr_error *err)
 
 static void free_writer(npy_writer *w)
 {
-    evr_par_pool_free(w->pool);
-    free(w->big);
+    evr_par_packing_free(&w->parts);
     free(w->path);
     free(w->tmp);
     free(w->buf);
@@ -111,88 +103,39 @@ static void pack(unsigned char *r, const evr_event *e)
     r[12] = e->p ? 1 : 0;
 }
 
-/* A large write in parts: pass 0 checks each event against the one before and packs it into big,
- * pass 1 writes each part's records at their place in the file. */
-typedef struct {
-    const evr_event *ev;
-    size_t n;
-    unsigned char *big;
-    int fd;
-    off_t at; /* file offset of ev[0]'s record */
-    int pass;
-    int bad[NPY_PARTS]; /* pass 0: an event out of order; pass 1: a failed write */
-} npy_job;
-
-static void npy_part(void *ctx, int k, int thread)
+/* A part of a large write (io/par_pack.h): 13 bytes an event. */
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
-    npy_job *j = ctx;
-    size_t a, b;
-    (void)thread;
-    evr_par_share(j->n, NPY_PARTS, k, &a, &b);
-    if (a >= b) return;
-    if (j->pass == 0) {
-        for (size_t i = a; i < b; i++) {
-            if (i > 0 && j->ev[i].t < j->ev[i - 1].t) {
-                j->bad[k] = 1;
-                return;
-            }
-            pack(j->big + i * NPY_RECORD, &j->ev[i]);
-        }
-        return;
-    }
-    const unsigned char *src = j->big + a * NPY_RECORD;
-    size_t left = (b - a) * NPY_RECORD;
-    off_t at = j->at + (off_t)(a * NPY_RECORD);
-    while (left > 0) {
-        const ssize_t wrote = pwrite(j->fd, src, left, at);
-        if (wrote <= 0) {
-            if (wrote < 0 && errno == EINTR) continue;
-            j->bad[k] = 1;
-            return;
-        }
-        src += wrote;
-        left -= (size_t)wrote;
-        at += wrote;
-    }
+    (void)ctx;
+    (void)ev;
+    return (b - a) * NPY_RECORD;
 }
 
-/* Writes ev[0 .. n) (n >= NPY_PAR_MIN, ev[0] not before the last event written) on the pool after
- * the buffered records (*st: how it went); returns 0, nothing written, when an event is out of
- * order or there is no room to pack them: the serial path then writes them or reports it. */
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
+{
+    (void)ctx;
+    (void)room;
+    for (size_t i = a; i < b; i++, out += NPY_RECORD) {
+        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
+        pack(out, &ev[i]);
+    }
+    return (b - a) * NPY_RECORD;
+}
+
+/* Writes ev[0 .. n) (n >= EVR_PAR_PACK_MIN, ev[0] not before the last event written) in parts
+ * after the buffered records (*st: how it went); returns 0, nothing written, when an event is
+ * out of order or there is no room to pack them: the serial path then writes them or reports it. */
 static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err,
                           evr_status *st)
 {
-    npy_job j;
-    *st = EVR_OK;
-    if (n > w->big_cap) {
-        unsigned char *p = realloc(w->big, n * NPY_RECORD);
-        if (!p) return 0; /* the serial path needs no room */
-        w->big = p;
-        w->big_cap = n;
-    }
-    memset(&j, 0, sizeof j);
-    j.ev = ev;
-    j.n = n;
-    j.big = w->big;
-    evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
-    for (int k = 0; k < NPY_PARTS; k++)
-        if (j.bad[k]) return 0;
+    const evr_par_packer parts = {bound_part, pack_part, NULL, NULL};
+    size_t bytes;
+    evr_par_pack_result r;
     if ((*st = drain(w, err)) != EVR_OK) return 1;
-    if (fflush(w->f) != 0) {
-        *st = cannot_write(w, err);
-        return 1;
-    }
-    j.fd = fileno(w->f);
-    j.at = (off_t)w->header_len + (off_t)(w->count * NPY_RECORD);
-    j.pass = 1;
-    evr_par_pool_run(w->pool, NPY_PARTS, npy_part, &j);
-    for (int k = 0; k < NPY_PARTS; k++)
-        if (j.bad[k]) {
-            *st = cannot_write(w, err);
-            return 1;
-        }
-    /* the stream goes on after the records written past it */
-    if (fseek(w->f, 0, SEEK_END) != 0) {
+    r = evr_par_pack_write(&w->parts, &parts, ev, n, w->f, &bytes);
+    if (r == EVR_PAR_PACK_SERIAL) return 0;
+    if (r == EVR_PAR_PACK_FAILED) {
         *st = cannot_write(w, err);
         return 1;
     }
@@ -205,7 +148,7 @@ static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_erro
 static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     npy_writer *w = (npy_writer *)base;
-    if (n >= NPY_PAR_MIN && !(w->have_last && ev[0].t < w->last_t)) {
+    if (n >= EVR_PAR_PACK_MIN && !(w->have_last && ev[0].t < w->last_t)) {
         evr_status st;
         if (write_parallel(w, ev, n, err, &st)) return st;
     }
@@ -275,9 +218,8 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
         w->path = strdup(path);
         w->tmp = evr_file_tmp_name(path);
         w->buf = malloc((size_t)NPY_BUFFER_RECORDS * NPY_RECORD);
-        w->pool = evr_par_pool_new(evr_par_threads(NPY_THREADS));
     }
-    if (!w || !w->path || !w->tmp || !w->buf || !w->pool) {
+    if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "npy writer: out of memory");
         return EVR_ERR_NOMEM;

@@ -14,6 +14,7 @@ static void free_stream(evr_raw_stream *s)
     free(s->path);
     free(s->tmp);
     free(s->buf);
+    evr_par_packing_free(&s->parts);
     free(s);
 }
 
@@ -124,6 +125,25 @@ evr_status evr_raw_stream_check(evr_raw_stream *s, const evr_event *e, evr_error
     s->last_t = e->t;
     s->have_last = 1;
     return EVR_OK;
+}
+
+int evr_raw_stream_write_parts(evr_raw_stream *s, const evr_par_packer *p, const evr_event *ev,
+                               size_t n, evr_status *st, evr_error *err)
+{
+    size_t bytes;
+    evr_par_pack_result r;
+    *st = EVR_OK;
+    if (n < EVR_PAR_PACK_MIN || (s->have_last && ev[0].t < s->last_t)) return 0;
+    if ((*st = drain(s, err)) != EVR_OK) return 1;
+    r = evr_par_pack_write(&s->parts, p, ev, n, s->f, &bytes);
+    if (r == EVR_PAR_PACK_SERIAL) return 0;
+    if (r == EVR_PAR_PACK_FAILED) {
+        *st = cannot_write(s, err);
+        return 1;
+    }
+    s->last_t = ev[n - 1].t;
+    s->have_last = 1;
+    return 1;
 }
 
 evr_status evr_raw_stream_room(evr_raw_stream *s, size_t need, evr_error *err)
