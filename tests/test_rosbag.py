@@ -3,7 +3,8 @@ build/venv, never the system Python), its types registered from the .msg text of
 from the bag's own definition. Every event must come back identical (x, y, t in us, polarity) to
 events.npy; each message on /dvs/events of type dvs_msgs/EventArray with the registered type's
 md5sum, the run's width and height, seq counting from 0, header.stamp and the record time its last
-event's time, and its events within one 30 Hz window. Skips (77) when the environment is missing or
+event's time, and its events within one 30 Hz window. evray's reader gives the same events
+(evray convert), and one line for a truncated bag. Skips (77) when the environment is missing or
 unusable."""
 import json
 import os
@@ -107,4 +108,20 @@ ok = all(m[0] == "/dvs/events" and m[1] == i and m[2] == m[8] and m[3] == m[8] a
 T.check(ok, "each message: seq from 0, stamp and record time its last event's, the run's size, "
         "one 30 Hz window")
 print(f"rosbags: events.bag: {len(ref)} events in {len(msgs)} messages, every event identical")
+
+# evray's own reader: npy -> bag -> npy gives the same events
+back = os.path.join(d, "back.npy")
+T.run("convert", os.path.join(run, "events.bag"), back, "--quiet")
+b = np.load(back)
+T.check(len(b) == len(ref) and all(np.array_equal(b[k], ref[k]) for k in "txyp"),
+        "evray convert events.bag -> npy: every event identical")
+
+# bad input through the program: one line, exit 1, no crash
+bad = os.path.join(d, "bad.bag")
+with open(os.path.join(run, "events.bag"), "rb") as f:
+    data = f.read()
+with open(bad, "wb") as f:
+    f.write(data[:-1])
+r = T.run("compare", bad, os.path.join(run, "events.npy"), expect=1)
+T.check("truncated" in r.stderr and len(r.stderr.strip().splitlines()) == 1, "a truncated bag: one line")
 T.finish("test_rosbag")
