@@ -90,35 +90,32 @@ typedef struct {
     uint64_t index_pos; /* where the next chunk (and now the tail) starts */
 } bag_writer;
 
-static void put(bytes *b, const void *data, size_t n)
+/* Room for n more bytes at b->p + b->len (NULL, and b->failed, when out of memory). */
+static unsigned char *reserve(bytes *b, size_t n)
 {
-    if (b->failed) return;
+    if (b->failed) return NULL;
     if (b->cap - b->len < n) {
         size_t cap = b->cap ? b->cap : 4096;
         while (cap - b->len < n) cap *= 2;
         unsigned char *p = realloc(b->p, cap);
         if (!p) {
             b->failed = 1;
-            return;
+            return NULL;
         }
         b->p = p;
         b->cap = cap;
     }
-    memcpy(b->p + b->len, data, n);
+    return b->p + b->len;
+}
+
+static void put(bytes *b, const void *data, size_t n)
+{
+    unsigned char *p = reserve(b, n);
+    if (!p) return;
+    memcpy(p, data, n);
     b->len += n;
 }
 
-static void put_u8(bytes *b, uint32_t v)
-{
-    unsigned char c = (unsigned char)v;
-    put(b, &c, 1);
-}
-static void put_u16(bytes *b, uint32_t v)
-{
-    unsigned char c[2];
-    evr_put_le16(c, v);
-    put(b, c, 2);
-}
 static void put_u32(bytes *b, uint32_t v)
 {
     unsigned char c[4];
@@ -355,13 +352,15 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
         }
         w->msg_win = win;
         w->msg_t = e->t;
+        unsigned char *p = reserve(&w->msg, EVENT_BYTES);
+        if (!p) return no_memory(w, err);
+        evr_put_le16(p, e->x);
+        evr_put_le16(p + 2, e->y);
+        evr_put_le32(p + 4, (uint32_t)(e->t / 1000000));
+        evr_put_le32(p + 8, (uint32_t)(e->t % 1000000 * 1000));
+        p[12] = e->p > 0;
+        w->msg.len += EVENT_BYTES;
         w->msg_n++;
-        put_u16(&w->msg, e->x);
-        put_u16(&w->msg, e->y);
-        put_u32(&w->msg, (uint32_t)(e->t / 1000000));
-        put_u32(&w->msg, (uint32_t)(e->t % 1000000 * 1000));
-        put_u8(&w->msg, e->p > 0);
-        if (w->msg.failed) return no_memory(w, err);
     }
     return EVR_OK;
 }
