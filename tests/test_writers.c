@@ -1,4 +1,4 @@
-/* Event writers (HDF5, text, NPY, Prophesee EVT 2.0, EVT 3.0, DAT), the event reader, the JSON builder and the preview images.
+/* Event writers (HDF5, text, NPY, Prophesee EVT 2.0, EVT 3.0, DAT, ROS1 bag), the event reader, the JSON builder and the preview images.
  * Python (h5py, numpy) reads the files as an independent check when it is installed. */
 #include <dirent.h>
 #include <stdint.h>
@@ -1058,6 +1058,86 @@ static void test_camera_formats(const char *root)
     remove(path);
 }
 
+/* ---- ROS1 bags ---- */
+
+/* Round trip through the bag writer and reader, flushing after every segment; a copy of the
+ * temporary file after a flush is a complete bag holding every finished message (the 30 Hz
+ * windows before the last event's). Then what the reader refuses. */
+static void test_rosbag(const char *root)
+{
+    const size_t n = 6000;
+    evr_event *ev = make_camera_events(n), *got = NULL, e;
+    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_event_writer *w = NULL;
+    char dir[512], path[600], tmp[700], partial[700];
+    size_t at = 0, ngot = 0;
+    int width = 0, height = 0;
+    CHECK(ev != NULL);
+    if (!ev) return;
+    snprintf(dir, sizeof dir, "%s/rosbag", root);
+    CHECK(mkdir(dir, 0700) == 0);
+    snprintf(path, sizeof path, "%s/events.bag", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    snprintf(partial, sizeof partial, "%s/partial.bag", dir);
+    CHECK_OK(evr_rosbag_writer_open(path, &meta, &w, &e_));
+    for (int seg = 0; w && at < n; seg++) {
+        size_t len = (size_t)(seg * 397 + 11) % 1500;
+        if (len > n - at) len = n - at;
+        CHECK_OK(w->write(w, ev + at, len, &e_));
+        CHECK_OK(w->flush(w, &e_));
+        at += len;
+        if (seg == 3) {
+            size_t done = 0;
+            while (done < at && ev[done].t * 30 / 1000000 < ev[at - 1].t * 30 / 1000000) done++;
+            CHECK(copy_file(tmp, partial));
+            CHECK_OK(evr_events_read(partial, &got, &ngot, NULL, NULL, &e_));
+            CHECK(ngot == done && done > 0);
+            if (ngot == done) CHECK(same_events(got, ev, done));
+            free(got);
+            got = NULL;
+            remove(partial);
+        }
+    }
+    CHECK(!file_exists(path));
+    if (w) CHECK_OK(w->finish(w, ev[n - 1].t + 1, &e_));
+    CHECK(file_exists(path) && !file_exists(tmp));
+    CHECK_OK(evr_events_read(path, &got, &ngot, &width, &height, &e_));
+    CHECK(ngot == n);
+    if (ngot == n) CHECK(same_events(got, ev, n));
+    CHECK(width == W && height == H);
+    free(got);
+    free(ev);
+
+    /* a truncated file, and one that is no bag: one clear line, no events */
+    {
+        FILE *fp = fopen(path, "rb");
+        char *data = malloc(1 << 22);
+        size_t len = fp && data ? fread(data, 1, 1 << 22, fp) : 0;
+        if (fp) fclose(fp);
+        CHECK(len > 5000);
+        if (len > 5000) {
+            write_file(partial, data, len - 1);
+            check_bad(partial, "truncated");
+            write_file(partial, data, 5000);
+            check_bad(partial, "truncated");
+            data[1] = 'X';
+            write_file(partial, data, len);
+            check_bad(partial, "not a ROS bag 2.0 file");
+        }
+        free(data);
+        write_file(partial, "#ROSBAG V2.0\n", 13);
+        check_bad(partial, "no dvs_msgs/EventArray connection");
+        remove(partial);
+    }
+
+    /* ROS time holds whole seconds below 2^32 */
+    memset(&e, 0, sizeof e);
+    e.t = (INT64_C(1) << 32) * 1000000;
+    check_refused(dir, "a.bag", evr_rosbag_writer_open, e, "4294967296000000 us");
+    remove(path);
+    rmdir(dir);
+}
+
 static void test_writers(const char *root, int *python_ok)
 {
     const size_t n = 5000;
@@ -1650,12 +1730,14 @@ int main(void)
     test_writers(root, &python_ok);
     test_camera_formats(root);
     test_camera_parts(root);
+    test_rosbag(root);
     test_tonemap(root);
     test_event_frames(root);
     bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");
     bench_writer(root, "evt2", evr_evt2_writer_open, "bench_evt2.raw");
     bench_writer(root, "evt3", evr_evt3_writer_open, "bench_evt3.raw");
     bench_writer(root, "dat", evr_dat_writer_open, "bench.dat");
+    bench_writer(root, "rosbag", evr_rosbag_writer_open, "bench.bag");
     if (check_failures == 0) remove_tree(root);
     else fprintf(stderr, "test_writers: files kept in %s\n", root);
     (void)python_ok;

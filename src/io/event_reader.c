@@ -1,5 +1,6 @@
 #include "io/event_reader.h"
 #include "io/prophesee_read.h"
+#include "io/rosbag_read.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -646,19 +647,23 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
     if (ext_is(path, "h5") || ext_is(path, "hdf5")) return read_h5(path, ev, n, width, height, err);
     if (ext_is(path, "txt")) st = read_txt(path, ev, n, err);
     else if (ext_is(path, "npy")) st = read_npy(path, ev, n, err);
-    else if (ext_is(path, "raw") || ext_is(path, "dat")) {
+    else if (ext_is(path, "raw") || ext_is(path, "dat") || ext_is(path, "bag")) {
         char *data;
         size_t size;
         st = evr_file_slurp(path, &data, &size, err);
         if (st != EVR_OK) return st;
         if (ext_is(path, "raw"))
             st = evr_raw_parse(path, (const unsigned char *)data, size, ev, n, width, height, err);
+        else if (ext_is(path, "bag"))
+            st = evr_rosbag_parse(path, (const unsigned char *)data, size, ev, n, width, height,
+                                  err);
         else st = evr_dat_parse(path, (const unsigned char *)data, size, ev, n, width, height, err);
         free(data);
     } else {
-        snprintf(err->msg, sizeof err->msg,
-                 "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .raw or .dat)",
-                 path);
+        snprintf(
+            err->msg, sizeof err->msg,
+            "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .raw, .dat or .bag)",
+            path);
         return EVR_ERR_ARG;
     }
     return st;

@@ -1,0 +1,177 @@
+#include "io/rosbag_read.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define BAG_MAGIC "#ROSBAG V2.0\n"
+#define EVENT_BYTES 13 /* uint16 x, uint16 y, time ts, bool polarity */
+
+typedef struct {
+    const unsigned char *p;
+    size_t n;
+} span;
+
+typedef struct {
+    int64_t conn;  /* the EventArray connection read; -1: none seen yet */
+    evr_event *ev; /* NULL: only counting */
+    size_t n;      /* events counted or stored */
+    int width, height;
+    const char *why; /* what is wrong, for the one line */
+} bag_reader;
+
+static uint32_t le32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* Takes n bytes off the front of s into out; 0 when s is shorter. */
+static int take(span *s, size_t n, span *out)
+{
+    if (s->n < n) return 0;
+    out->p = s->p;
+    out->n = n;
+    s->p += n;
+    s->n -= n;
+    return 1;
+}
+
+/* The next length-prefixed block (uint32 length, then the bytes). */
+static int take_block(span *s, span *out)
+{
+    span len;
+    return take(s, 4, &len) && take(s, le32(len.p), out);
+}
+
+/* The value of header field name ("name=value" blocks); 0 when absent or the header is corrupt. */
+static int field(span h, const char *name, span *value)
+{
+    size_t nl = strlen(name);
+    span f;
+    while (h.n) {
+        if (!take_block(&h, &f)) return 0;
+        if (f.n > nl && f.p[nl] == '=' && !memcmp(f.p, name, nl)) {
+            value->p = f.p + nl + 1;
+            value->n = f.n - nl - 1;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int field_u32(span h, const char *name, uint32_t *v)
+{
+    span f;
+    if (!field(h, name, &f) || f.n != 4) return 0;
+    *v = le32(f.p);
+    return 1;
+}
+
+static int field_is(span h, const char *name, const char *text)
+{
+    span f;
+    return field(h, name, &f) && f.n == strlen(text) && !memcmp(f.p, text, f.n);
+}
+
+/* One dvs_msgs/EventArray message: counts or stores its events. */
+static int message(bag_reader *r, span m)
+{
+    span head, frame, sizes, count, evs;
+    if (!take(&m, 12, &head) || !take_block(&m, &frame) || !take(&m, 8, &sizes) ||
+        !take(&m, 4, &count) || !take(&m, (size_t)le32(count.p) * EVENT_BYTES, &evs)) {
+        r->why = "truncated dvs_msgs/EventArray message";
+        return 0;
+    }
+    if (r->width < 0) {
+        r->height = (int)le32(sizes.p);
+        r->width = (int)le32(sizes.p + 4);
+    }
+    if (r->ev)
+        for (const unsigned char *p = evs.p; p < evs.p + evs.n; p += EVENT_BYTES) {
+            evr_event *e = &r->ev[r->n++];
+            memset(e, 0, sizeof *e);
+            e->x = (uint16_t)(p[0] | p[1] << 8);
+            e->y = (uint16_t)(p[2] | p[3] << 8);
+            e->t = (int64_t)le32(p + 4) * 1000000 + le32(p + 8) / 1000;
+            e->p = (int8_t)(p[12] ? 1 : 0);
+        }
+    else r->n += le32(count.p);
+    return 1;
+}
+
+/* The records of s (the file after its magic line, or a chunk's data). */
+static int records(bag_reader *r, span s, int in_chunk)
+{
+    span hdr, data, op;
+    uint32_t conn;
+    while (s.n) {
+        if (!take_block(&s, &hdr) || !take_block(&s, &data)) {
+            r->why = "truncated ROS bag (a record runs past the end)";
+            return 0;
+        }
+        if (!field(hdr, "op", &op) || op.n != 1) {
+            r->why = "corrupt ROS bag record header (no op field)";
+            return 0;
+        }
+        if (op.p[0] == 0x05 && !in_chunk) {
+            if (!field_is(hdr, "compression", "none")) {
+                r->why = "compressed ROS bag chunks are not read (run rosbag decompress first)";
+                return 0;
+            }
+            if (!records(r, data, 1)) return 0;
+        } else if (op.p[0] == 0x07 && r->conn < 0) {
+            if (!field_u32(hdr, "conn", &conn)) {
+                r->why = "corrupt ROS bag connection record (no conn field)";
+                return 0;
+            }
+            if (field_is(data, "type", "dvs_msgs/EventArray")) r->conn = conn;
+        } else if (op.p[0] == 0x02 && in_chunk) {
+            if (!field_u32(hdr, "conn", &conn)) {
+                r->why = "corrupt ROS bag message record (no conn field)";
+                return 0;
+            }
+            if (conn == r->conn && !message(r, data)) return 0;
+        }
+    }
+    return 1;
+}
+
+evr_status evr_rosbag_parse(const char *path, const unsigned char *data, size_t size,
+                            evr_event **ev, size_t *n, int *width, int *height, evr_error *err)
+{
+    bag_reader r;
+    span head;
+    size_t magic = strlen(BAG_MAGIC);
+    span all = {data, size};
+    memset(&r, 0, sizeof r);
+    r.conn = -1;
+    r.width = r.height = -1;
+    *ev = NULL;
+    *n = 0;
+    if (!take(&all, magic, &head) || memcmp(head.p, BAG_MAGIC, magic) != 0)
+        r.why = "not a ROS bag 2.0 file (no #ROSBAG V2.0 line)";
+    else if (records(&r, all, 0) && r.conn < 0)
+        r.why = "no dvs_msgs/EventArray connection in the ROS bag";
+    if (!r.why && r.n) {
+        /* Counted first: the events fill one allocation. */
+        r.ev = malloc(r.n * sizeof *r.ev);
+        if (!r.ev) {
+            snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
+            return EVR_ERR_NOMEM;
+        }
+        r.n = 0;
+        r.conn = -1;
+        records(&r, all, 0);
+    }
+    if (r.why) {
+        free(r.ev);
+        snprintf(err->msg, sizeof err->msg, "%s: %s", path, r.why);
+        return EVR_ERR_FORMAT;
+    }
+    *ev = r.ev;
+    *n = r.n;
+    if (width) *width = r.width;
+    if (height) *height = r.height;
+    return EVR_OK;
+}
