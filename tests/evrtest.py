@@ -12,6 +12,25 @@ EVRAY = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("EVRAY", "build/evr
 failures = []
 
 
+def oracle_python(modules):
+    """The Python of the oracle environment (build/venv, made by scripts/test-venv.sh) that can
+    import modules; exits 77 (CTest: skipped) with a clear line when there is none."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    # the environment beside the program, else the release build's (for build-asan)
+    candidates = [os.environ.get("EVR_VENV_PYTHON"),
+                  os.path.join(os.path.dirname(os.path.abspath(EVRAY)), "venv", "bin", "python"),
+                  os.path.join(root, "build", "venv", "bin", "python")]
+    python = next((c for c in candidates if c and os.path.exists(c)), candidates[1])
+    probe = subprocess.run([python, "-c", "import " + ", ".join(modules)], capture_output=True,
+                           text=True) if os.path.exists(python) else None
+    if probe is None or probe.returncode != 0:
+        why = "missing" if probe is None else "unusable: " + probe.stderr.strip().splitlines()[-1]
+        print(f"SKIP: the oracle environment {python} is {why} (run scripts/test-venv.sh; it "
+              "needs the package registry)")
+        sys.exit(77)
+    return python
+
+
 def check(cond, what):
     if not cond:
         failures.append(what)

@@ -13,19 +13,7 @@ import numpy as np
 
 import evrtest as T
 
-# the environment beside the program (build/venv), else the release build's (for build-asan)
-root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-candidates = [os.environ.get("EVR_VENV_PYTHON"),
-              os.path.join(os.path.dirname(os.path.abspath(T.EVRAY)), "venv", "bin", "python"),
-              os.path.join(root, "build", "venv", "bin", "python")]
-venv_python = next((c for c in candidates if c and os.path.exists(c)), candidates[1])
-probe = subprocess.run([venv_python, "-c", "import numpy, h5py, expelliarmus, evlib, evt3, faery"],
-                       capture_output=True, text=True) if os.path.exists(venv_python) else None
-if probe is None or probe.returncode != 0:
-    why = "missing" if probe is None else "unusable: " + probe.stderr.strip().splitlines()[-1]
-    print(f"SKIP: the oracle environment {venv_python} is {why} (run scripts/test-venv.sh; it "
-          "needs the package registry)")
-    sys.exit(77)
+venv_python = T.oracle_python(["numpy", "h5py", "expelliarmus", "evlib", "evt3", "faery"])
 
 # The readers, run in the virtual environment: one JSON line per (reader, file).
 ORACLES = r'''
