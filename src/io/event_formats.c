@@ -12,12 +12,12 @@ extern const evr_event_format evr_format_h5, evr_format_txt, evr_format_npy, evr
 
 /* Format i is configuration bit 1 << i: new formats go at the end. */
 static const evr_event_format *const formats[] = {
-    &evr_format_h5,   /* h5_writer.c */
-    &evr_format_txt,  /* txt_writer.c */
-    &evr_format_npy,  /* npy_writer.c */
-    &evr_format_evt2, /* evt2_writer.c */
-    &evr_format_evt3, /* evt3_writer.c */
-    &evr_format_dat,  /* dat_writer.c */
+    &evr_format_h5,     /* h5_writer.c */
+    &evr_format_txt,    /* txt_writer.c */
+    &evr_format_npy,    /* npy_writer.c */
+    &evr_format_evt2,   /* evt2_writer.c */
+    &evr_format_evt3,   /* evt3_writer.c */
+    &evr_format_dat,    /* dat_writer.c */
     &evr_format_rosbag, /* rosbag_writer.c */
 };
 
