@@ -1,6 +1,7 @@
 #include "io/event_reader.h"
 #include "io/prophesee_read.h"
 #include "io/rosbag_read.h"
+#include "io/byte_order.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -264,10 +265,10 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         goto done;
     }
     if (u[6] == 1) {
-        hlen = (size_t)u[8] | (size_t)u[9] << 8;
+        hlen = evr_get_le16(u + 8);
         start = 10;
     } else if ((u[6] == 2 || u[6] == 3) && size >= 12) {
-        hlen = (size_t)u[8] | (size_t)u[9] << 8 | (size_t)u[10] << 16 | (size_t)u[11] << 24;
+        hlen = evr_get_le32(u + 8);
         start = 12;
     } else {
         st = npy_bad(err, path, "unknown format version");

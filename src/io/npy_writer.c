@@ -6,6 +6,7 @@
  * flush() and at finish(): the temporary file of an interrupted run is a valid array holding
  * every event up to the last flush. */
 #include "io/event_formats.h"
+#include "io/byte_order.h"
 #include "io/file_commit.h"
 #include "io/par_pack.h"
 
@@ -94,12 +95,9 @@ static void free_writer(npy_writer *w)
 /* One record, little-endian whatever the host. */
 static void pack(unsigned char *r, const evr_event *e)
 {
-    const uint64_t t = (uint64_t)e->t;
-    for (int b = 0; b < 8; b++) r[b] = (unsigned char)(t >> (8 * b));
-    r[8] = (unsigned char)(e->x & 0xff);
-    r[9] = (unsigned char)(e->x >> 8);
-    r[10] = (unsigned char)(e->y & 0xff);
-    r[11] = (unsigned char)(e->y >> 8);
+    evr_put_le64(r, (uint64_t)e->t);
+    evr_put_le16(r + 8, e->x);
+    evr_put_le16(r + 10, e->y);
     r[12] = e->p ? 1 : 0;
 }
 

@@ -1,4 +1,5 @@
 #include "io/prophesee_read.h"
+#include "io/byte_order.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -56,9 +57,6 @@ static evr_status done(event_list *l, evr_event **ev, size_t *n)
     }
     return EVR_OK;
 }
-
-static uint32_t le16(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8; }
-static uint32_t le32(const unsigned char *p) { return le16(p) | le16(p + 2) << 16; }
 
 /* ---- header: lines starting with '%', up to "% end" or the first line without '%' ---- */
 
@@ -127,7 +125,7 @@ static evr_status parse_evt2(const char *path, const unsigned char *d, size_t si
     int64_t high = -1;
     if (size % 4) return fail(err, path, "truncated EVT 2.0 stream (not whole 32-bit words)", l);
     for (size_t i = 0; i < size; i += 4) {
-        uint32_t w = le32(d + i);
+        uint32_t w = evr_get_le32(d + i);
         switch (w >> 28) {
         case 0x0:
         case 0x1:
@@ -162,7 +160,7 @@ static evr_status parse_evt3(const char *path, const unsigned char *d, size_t si
     char why[112];
     if (size % 2) return fail(err, path, "truncated EVT 3.0 stream (not whole 16-bit words)", l);
     for (size_t i = 0; i < size; i += 2) {
-        uint32_t w = le16(d + i), type = w >> 12, v = w & 0xfff;
+        uint32_t w = evr_get_le16(d + i), type = w >> 12, v = w & 0xfff;
         int64_t t = (loops << 24) | (int64_t)(high < 0 ? 0 : high) << 12 | low;
         if ((type == 0x2 || type == 0x4 || type == 0x5) && (high < 0 || y < 0)) {
             snprintf(why, sizeof why,
@@ -260,8 +258,8 @@ evr_status evr_dat_parse(const char *path, const unsigned char *data, size_t siz
     size_t len = size - h.end - 2;
     if (len % 8) return fail(err, path, "truncated DAT file (not whole 8-byte events)", &l);
     for (size_t i = 0; i < len; i += 8) {
-        uint32_t a = le32(d + i + 4);
-        if (!push(&l, le32(d + i), a & 0x3fff, a >> 14 & 0x3fff, (int)(a >> 28)))
+        uint32_t a = evr_get_le32(d + i + 4);
+        if (!push(&l, evr_get_le32(d + i), a & 0x3fff, a >> 14 & 0x3fff, (int)(a >> 28)))
             return out_of_memory(err, path, &l);
     }
     if (width) *width = h.width;

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include "evray.h"
+#include "io/byte_order.h"
 #include "io/event_writer.h"
 #include "io/par_pack.h"
 
@@ -51,17 +52,5 @@ evr_status evr_raw_stream_room(evr_raw_stream *s, size_t need, evr_error *err);
  * format "EVT2" or "EVT3"; for DAT files evt is NULL. Returns the length (0: no room). */
 size_t evr_prophesee_header(char *out, size_t cap, const char *evt, const char *format, int width,
                             int height);
-
-/* Little-endian stores. */
-static inline void evr_put_le16(unsigned char *p, uint32_t v)
-{
-    p[0] = (unsigned char)(v & 0xff);
-    p[1] = (unsigned char)((v >> 8) & 0xff);
-}
-static inline void evr_put_le32(unsigned char *p, uint32_t v)
-{
-    evr_put_le16(p, v & 0xffff);
-    evr_put_le16(p + 2, v >> 16);
-}
 
 #endif

@@ -1,4 +1,5 @@
 #include "io/rosbag_read.h"
+#include "io/byte_order.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -21,11 +22,6 @@ typedef struct {
     const char *why; /* what is wrong, for the one line */
 } bag_reader;
 
-static uint32_t le32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
 /* Takes n bytes off the front of s into out; 0 when s is shorter. */
 static int take(span *s, size_t n, span *out)
 {
@@ -41,7 +37,7 @@ static int take(span *s, size_t n, span *out)
 static int take_block(span *s, span *out)
 {
     span len;
-    return take(s, 4, &len) && take(s, le32(len.p), out);
+    return take(s, 4, &len) && take(s, evr_get_le32(len.p), out);
 }
 
 /* The value of header field name ("name=value" blocks); 0 when absent or the header is corrupt. */
@@ -64,7 +60,7 @@ static int field_u32(span h, const char *name, uint32_t *v)
 {
     span f;
     if (!field(h, name, &f) || f.n != 4) return 0;
-    *v = le32(f.p);
+    *v = evr_get_le32(f.p);
     return 1;
 }
 
@@ -79,24 +75,24 @@ static int message(bag_reader *r, span m)
 {
     span head, frame, sizes, count, evs;
     if (!take(&m, 12, &head) || !take_block(&m, &frame) || !take(&m, 8, &sizes) ||
-        !take(&m, 4, &count) || !take(&m, (size_t)le32(count.p) * EVENT_BYTES, &evs)) {
+        !take(&m, 4, &count) || !take(&m, (size_t)evr_get_le32(count.p) * EVENT_BYTES, &evs)) {
         r->why = "truncated dvs_msgs/EventArray message";
         return 0;
     }
     if (r->width < 0) {
-        r->height = (int)le32(sizes.p);
-        r->width = (int)le32(sizes.p + 4);
+        r->height = (int)evr_get_le32(sizes.p);
+        r->width = (int)evr_get_le32(sizes.p + 4);
     }
     if (r->ev)
         for (const unsigned char *p = evs.p; p < evs.p + evs.n; p += EVENT_BYTES) {
             evr_event *e = &r->ev[r->n++];
             memset(e, 0, sizeof *e);
-            e->x = (uint16_t)(p[0] | p[1] << 8);
-            e->y = (uint16_t)(p[2] | p[3] << 8);
-            e->t = (int64_t)le32(p + 4) * 1000000 + le32(p + 8) / 1000;
+            e->x = (uint16_t)evr_get_le16(p);
+            e->y = (uint16_t)evr_get_le16(p + 2);
+            e->t = (int64_t)evr_get_le32(p + 4) * 1000000 + evr_get_le32(p + 8) / 1000;
             e->p = (int8_t)(p[12] ? 1 : 0);
         }
-    else r->n += le32(count.p);
+    else r->n += evr_get_le32(count.p);
     return 1;
 }
 

@@ -124,8 +124,9 @@ static void put_u32(bytes *b, uint32_t v)
 }
 static void put_u64(bytes *b, uint64_t v)
 {
-    put_u32(b, (uint32_t)v);
-    put_u32(b, (uint32_t)(v >> 32));
+    unsigned char c[8];
+    evr_put_le64(c, v);
+    put(b, c, 8);
 }
 
 /* A header field: field_len, then "name=value". */
@@ -151,8 +152,7 @@ static void field_u32(bytes *b, const char *name, uint32_t v)
 static void field_u64(bytes *b, const char *name, uint64_t v)
 {
     unsigned char c[8];
-    evr_put_le32(c, (uint32_t)v);
-    evr_put_le32(c + 4, (uint32_t)(v >> 32));
+    evr_put_le64(c, v);
     field(b, name, c, 8);
 }
 static void field_str(bytes *b, const char *name, const char *s) { field(b, name, s, strlen(s)); }
