@@ -10,12 +10,13 @@
 #include <assimp/scene.h>
 #include <stb/stb_image.h>
 
+#include "core/shading.h"
 #include "scene/import_internal.h"
 
-/* The exact sRGB electro-optical transfer function. */
-static float srgb_to_linear(float c)
+/* The linear values of the 256 sRGB-encoded 8-bit levels. */
+static void srgb8_table(float lut[256])
 {
-    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+    for (int i = 0; i < 256; i++) lut[i] = evr_srgb_to_linear((float)i / 255.0f);
 }
 
 /* Decodes an encoded image (PNG, JPEG, ...) into linear RGBA floats: HDR images are linear
@@ -54,12 +55,12 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
         const unsigned short *p16 = px;
         for (i = 0; i < n * 4; i++) {
             float v = (float)p16[i] / 65535.0f;
-            t->rgba[i] = (i % 4 == 3) ? v : srgb_to_linear(v);
+            t->rgba[i] = (i % 4 == 3) ? v : evr_srgb_to_linear(v);
         }
     } else {
         const unsigned char *p8 = px;
         float lut[256];
-        for (i = 0; i < 256; i++) lut[i] = srgb_to_linear((float)i / 255.0f);
+        srgb8_table(lut);
         for (i = 0; i < n * 4; i++) t->rgba[i] = (i % 4 == 3) ? (float)p8[i] / 255.0f : lut[p8[i]];
     }
     stbi_image_free(px);
@@ -76,7 +77,7 @@ static evr_status decode_texels(const struct aiTexture *tex, const char *what, e
     size_t i, n = (size_t)tex->mWidth * (size_t)tex->mHeight;
     if (!tex->pcData || tex->mWidth > INT_MAX || tex->mHeight > INT_MAX)
         return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: invalid embedded image", what);
-    for (i = 0; i < 256; i++) lut[i] = srgb_to_linear((float)i / 255.0f);
+    srgb8_table(lut);
     t->rgba = malloc(n * 4 * sizeof(float) + 1);
     if (!t->rgba)
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
