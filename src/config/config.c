@@ -189,8 +189,7 @@ static int choice_known(const evr_config_option *o, int v)
     return 0;
 }
 
-/* The names of a choice row's values, for a message: "auto, cpu, cuda". */
-static void choice_names(const evr_config_option *o, char *buf, size_t n)
+void evr_config_choice_names(const evr_config_option *o, char *buf, size_t n)
 {
     const evr_opt_choice *ch;
     size_t len = 0;
@@ -207,7 +206,7 @@ static evr_status check_range(const evr_config *c, const evr_config_option *o, e
     if (o->type == EVR_OPT_CHOICE) {
         int v = *(const int *)evr_config_field_const(c, o);
         if (choice_known(o, v)) return EVR_OK;
-        choice_names(o, names, sizeof names);
+        evr_config_choice_names(o, names, sizeof names);
         BAD("%s %d (%s)", o->what ? o->what : o->name, v, names);
     }
     if (!o->what) return EVR_OK;

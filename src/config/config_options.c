@@ -107,18 +107,13 @@ static evr_status set_choice(evr_config *c, const evr_config_option *o, const ch
 {
     const evr_opt_choice *ch;
     char names[128];
-    size_t len = 0;
     for (ch = o->choices; ch->name || ch->json; ch++) {
         if (!ch->name || strcmp(ch->name, v)) continue;
         if (ch->refuse) FAIL("%s", ch->refuse);
         *(int *)evr_config_field(c, o) = ch->value;
         return EVR_OK;
     }
-    names[0] = 0;
-    for (ch = o->choices; ch->name || ch->json; ch++)
-        if (ch->name && !ch->refuse && len < sizeof names)
-            len += (size_t)snprintf(names + len, sizeof names - len, "%s%s", len ? ", " : "",
-                                    ch->name);
+    evr_config_choice_names(o, names, sizeof names);
     FAIL("%s: unknown %s '%s' (%s)", o->flag, o->noun, v, names);
 }
 

@@ -88,6 +88,8 @@ const evr_config_option *evr_config_table(int *count);
 /* The field of row o in c (NULL for EVR_OPT_NONE). */
 void *evr_config_field(evr_config *c, const evr_config_option *o);
 const void *evr_config_field_const(const evr_config *c, const evr_config_option *o);
+/* The names a choice row accepts, for a message: "auto, cpu, cuda". */
+void evr_config_choice_names(const evr_config_option *o, char *buf, size_t n);
 
 /* Sensor presets (config.c): their names listed for a message ("ideal, davis346, ..." into buf,
  * returned), and the library's own copy of a preset's name (NULL: no such preset). */
