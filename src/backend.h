@@ -39,6 +39,11 @@ typedef struct {
     const evr_motion_key *keys;
     const int *track_offset, *track_count;
     int num_tracks, num_keys;
+    /* The deforming instances' vertices over the segment (host arrays, evr_render_host's
+     * deform order); deform_moved[d]: they change in the segment or since the last one */
+    const evr_deform_view *deforms;
+    const int *deform_moved;
+    int num_deforms;
     int camera_static;  /* the camera does not move in this segment */
     int want_intensity; /* return every pixel's intensity at the segment's end */
     /* Intensity frames wanted inside this segment: num_frames absolute times in [t0, t1] (t1 only
@@ -95,7 +100,9 @@ typedef struct {
     evr_texture_view *textures;
     evr_instance_view *instances;
     evr_light_view *lights;
-    float scene_size; /* diagonal of the rest-pose bounds */
+    int num_deforms;      /* instances that deform (evr_instance_view.deform) */
+    int *deform_instance; /* per deform: its scene instance */
+    float scene_size;     /* diagonal of the rest-pose bounds */
 } evr_render_host;
 
 evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,

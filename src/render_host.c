@@ -35,9 +35,23 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->textures[i].height = s->textures[i].height;
         h->textures[i].rgba = s->textures[i].rgba;
     }
+    h->deform_instance = calloc((size_t)s->num_instances + 1, sizeof *h->deform_instance);
+    if (!h->deform_instance) {
+        evr_render_host_free(h);
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return EVR_ERR_NOMEM;
+    }
     for (i = 0; i < s->num_instances; i++) {
+        const evr_mesh *m = &s->meshes[s->instances[i].mesh];
         h->instances[i].mesh = s->instances[i].mesh;
-        h->instances[i].track = s->instances[i].node;
+        /* Track i is node i; track num_nodes is the fixed world frame (identity). A skinned
+         * mesh's vertices are in world space: its node does not move it. */
+        h->instances[i].track = m->skin ? s->num_nodes : s->instances[i].node;
+        h->instances[i].deform = -1;
+        if (evr_instance_deforms(s, i)) {
+            h->instances[i].deform = h->num_deforms;
+            h->deform_instance[h->num_deforms++] = i;
+        }
     }
     for (i = 0; i < s->num_lights; i++) {
         const evr_light *l = &s->lights[i];
@@ -62,7 +76,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
     rs->lights = h->lights;
     rs->num_instances = s->num_instances;
     rs->num_lights = s->num_lights;
-    /* Track i is node i; track num_nodes is the fixed world frame (identity). */
+    rs->num_deforms = h->num_deforms;
     rs->camera_track = cam->node >= 0 ? cam->node : s->num_nodes;
     rs->camera_local = cam->local;
     rs->camera = evr_camera_intr_make(width, height, cam->yfov);
@@ -78,5 +92,6 @@ void evr_render_host_free(evr_render_host *h)
     free(h->textures);
     free(h->instances);
     free(h->lights);
+    free(h->deform_instance);
     memset(h, 0, sizeof *h);
 }

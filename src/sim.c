@@ -172,6 +172,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->par = evr_par_pool_new(evr_par_threads(8)); /* NULL: counted on this thread */
     if (!sim->node_used || !evr_skip_tracker_init(&sim->skip, ntracks) ||
         !evr_skip_tracker_parts(&sim->skip, s) ||
+        !evr_deform_tracker_init(&sim->deform, s, &sim->host) ||
         !(sim->skipped_per_segment =
               calloc((size_t)sim->num_segments, sizeof *sim->skipped_per_segment))) {
         evr_sim_release(sim);
@@ -255,13 +256,18 @@ static void plan_segment(void *user, int i, evr_planned_segment *out)
     out->num_keys = off;
     evr_skip_tracker_update(&sim->skip, out->keys, out->track_offset, out->track_count,
                             sim->host.scene_size);
+    out->failed =
+        !evr_deform_keys_make(&sim->deform, s, &sim->host, t0, t1, tol, EVR_MAX_KEYS, &out->deform);
     evr_render_scene rs = sim->host.rs;
     rs.keys = out->keys;
     rs.track_offset = out->track_offset;
     rs.track_count = out->track_count;
-    evr_skip_plan_build(&sim->skip, s, &rs, !sim->cfg.no_skip && !sim->setup.adaptive, &out->plan);
+    rs.deforms = out->deform.views;
+    const evr_deform_keys *dk = out->failed ? NULL : &out->deform;
+    evr_skip_plan_build(&sim->skip, s, &rs, dk, !sim->cfg.no_skip && !sim->setup.adaptive,
+                        &out->plan);
     if (sim->setup.adaptive)
-        evr_adapt_plan_build(&sim->skip, s, &rs, &sim->setup.adapt, t1 - t0, &out->adapt);
+        evr_adapt_plan_build(&sim->skip, s, &rs, dk, &sim->setup.adapt, t1 - t0, &out->adapt);
 }
 
 /* The sums of one part: branch-free in locals (ON and OFF alternate at random), about 10x faster
@@ -347,6 +353,13 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     const double tw = evr_host_seconds();
     const evr_planned_segment *pl = evr_planner_take(sim->planner, i);
     sim->time_plan_wait += evr_host_seconds() - tw;
+    if (pl->failed) {
+        evr_planner_release(sim->planner, i);
+        return nomem(err);
+    }
+    seg.deforms = pl->deform.views;
+    seg.deform_moved = pl->deform.moved;
+    seg.num_deforms = pl->deform.num_deforms;
     seg.keys = pl->keys;
     seg.track_offset = pl->track_offset;
     seg.track_count = pl->track_count;
@@ -495,6 +508,7 @@ void evr_sim_release(evr_sim *sim)
     evr_par_pool_free(sim->par);
     free(sim->node_used);
     evr_skip_tracker_free(&sim->skip);
+    evr_deform_tracker_free(&sim->deform);
     free(sim->skipped_per_segment);
     free(sim->config_json);
     evr_event_frame_release(&sim->preview);

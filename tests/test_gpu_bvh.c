@@ -857,6 +857,7 @@ static void test_watertight(int layout, int animated)
     memset(&top, 0, sizeof top);
     inst.mesh = 0;
     inst.track = 0;
+    inst.deform = -1;
     key = evr_motion_key_from_matrix(&id);
     rs.instances = &inst;
     rs.num_instances = 1;
@@ -974,6 +975,7 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         sinst[i].mesh = inst[i].mesh = i % 10 == 9 ? !sinst[i - 1].mesh : i % 3 == 0;
         sinst[i].node = node;
         inst[i].track = node;
+        inst[i].deform = -1;
         n_static += nodes[node].parent < 0 && !nodes[node].animated;
     }
     memset(&sc, 0, sizeof sc);

@@ -391,6 +391,7 @@ static void test_emission(void)
         mat.emissive[0] = 0.5f;
         in.mesh = 0;
         in.track = 0;
+        in.deform = -1;
         rs.meshes = &m;
         rs.materials = &mat;
         rs.instances = &in;
@@ -404,7 +405,7 @@ static void test_emission(void)
             float u[5];
             evr_photon_ray pr;
             for (k = 0; k < 5; k++) u[k] = evr_photon_rand(3, 2, j, k);
-            CHECK(evr_photon_emit_surface(&rs, &em, cdf, &xf, u, &pr));
+            CHECK(evr_photon_emit_surface(&rs, &em, cdf, &xf, 0.0f, u, &pr));
             CHECK(pr.from_light == 0);
             CHECK(pr.ray.org.z == 0.0f && pr.ray.org.x >= 0.0f && pr.ray.org.y >= 0.0f &&
                   pr.ray.org.x / 2.0f + pr.ray.org.y <= 1.0001f);
@@ -500,6 +501,7 @@ static void test_pass(void)
     }
     inst.mesh = 0;
     inst.track = 0;
+    inst.deform = -1;
     memset(&light, 0, sizeof light);
     light.type = 0;
     light.track = -1;

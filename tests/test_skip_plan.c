@@ -34,6 +34,7 @@ static void make_world(world *w, int num_instances, int moving_tracks)
     for (i = 0; i < num_instances; i++) {
         w->inst[i].mesh = 0;
         w->inst[i].track = i % moving_tracks;
+        w->inst[i].deform = -1;
     }
     for (i = 0; i <= moving_tracks; i++) {
         w->offset[i] = k;
@@ -61,7 +62,7 @@ static void plan_of(world *w, int moving_tracks, evr_skip_plan *pl)
     evr_skip_tracker t;
     CHECK(evr_skip_tracker_init(&t, moving_tracks + 1));
     evr_skip_tracker_update(&t, w->keys, w->offset, w->count, 1.0f);
-    evr_skip_plan_build(&t, &w->s, &w->rs, 1, pl);
+    evr_skip_plan_build(&t, &w->s, &w->rs, NULL, 1, pl);
     evr_skip_tracker_free(&t);
 }
 
@@ -131,6 +132,7 @@ static void test_parts(void)
     s.num_meshes = 1;
     inst.mesh = 0;
     inst.track = 0;
+    inst.deform = -1;
     rs.instances = &inst;
     rs.num_instances = 1;
     rs.keys = keys;
@@ -155,7 +157,7 @@ static void test_parts(void)
         keys[5] = evr_motion_key_from_matrix(
             &(evr_m34){{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}}); /* the camera's */
         evr_skip_tracker_update(&t, keys, offset, count, 1.0f);
-        evr_skip_plan_build(&t, &s, &rs, 1, &pl);
+        evr_skip_plan_build(&t, &s, &rs, NULL, 1, &pl);
         CHECK(pl.num_boxes == 1 && pl.part_first[1] - pl.part_first[0] > 1);
         int missed = 0;
         for (int n = 0; n < 20000; n++) {
@@ -251,7 +253,7 @@ int main(void)
         evr_skip_tracker_update(&t, w.keys, w.offset, w.count, 1.0f);
         CHECK(evr_motion_key_same(&w.keys[1],
                                   &w.keys[0])); /* the billionth: snapped to the key before */
-        evr_skip_plan_build(&t, &w.s, &w.rs, 1, &pl);
+        evr_skip_plan_build(&t, &w.s, &w.rs, NULL, 1, &pl);
         CHECK(pl.spans && pl.cache);
         CHECK(fabsf(pl.still_before - 1.99f / 5.0f) < 1e-6f &&
               fabsf(pl.still_after - 4.01f / 5.0f) < 1e-6f);
@@ -269,7 +271,7 @@ int main(void)
         CHECK(memcmp(&a, &b2, sizeof a) == 0 && memcmp(&c, &d, sizeof c) == 0 && e.m[0][3] > 0.0f &&
               e.m[0][3] < 1.0f);
         /* brute force: the same spans (its samples traced at the same times), nothing held */
-        evr_skip_plan_build(&t, &w.s, &w.rs, 0, &pl);
+        evr_skip_plan_build(&t, &w.s, &w.rs, NULL, 0, &pl);
         CHECK(pl.spans && !pl.cache && evr_skip_still_span(&pl, 0.1f) == 1 &&
               !evr_skip_held(&pl, 1, 1));
         evr_skip_tracker_free(&t);

@@ -137,11 +137,12 @@ EVR_HD static inline int evr_photon_emit_light(const evr_render_scene *rs, const
 
 /* Photon number j (of count) of an emissive instance: a triangle by area (u[0], which also picks
  * the side: both sides emit, as evr_surface_at's emission is two-sided), a point on it (u[1],
- * u[2]), a cosine-distributed direction (u[3], u[4]); flux = 2 pi Le * area / count.
+ * u[2]), a cosine-distributed direction (u[3], u[4]); flux = 2 pi Le * area / count. xf is the
+ * instance's transform at the photon's time f.
  * cdf: the instance's cumulative world-space triangle areas (cdf[ntri - 1] == area). */
 EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs,
                                                  const evr_photon_emitter *em, const float *cdf,
-                                                 const evr_m34 *xf, const float u[5],
+                                                 const evr_m34 *xf, float f, const float u[5],
                                                  evr_photon_ray *out)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[em->index].mesh];
@@ -156,12 +157,9 @@ EVR_HD static inline int evr_photon_emit_surface(const evr_render_scene *rs,
         else lo = mid + 1;
     }
     uint32_t i0 = m->indices[3 * lo], i1 = m->indices[3 * lo + 1], i2 = m->indices[3 * lo + 2];
-    evr_v3 p0 = evr_m34_point(
-        xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1], m->positions[3 * i0 + 2]));
-    evr_v3 p1 = evr_m34_point(
-        xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1], m->positions[3 * i1 + 2]));
-    evr_v3 p2 = evr_m34_point(
-        xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1], m->positions[3 * i2 + 2]));
+    evr_v3 p0 = evr_m34_point(xf, evr_rs_vertex(rs, em->index, m, i0, f));
+    evr_v3 p1 = evr_m34_point(xf, evr_rs_vertex(rs, em->index, m, i1, f));
+    evr_v3 p2 = evr_m34_point(xf, evr_rs_vertex(rs, em->index, m, i2, f));
     float su = sqrtf(u[1]), b1 = 1.0f - su, b2 = u[2] * su;
     evr_v3 e1 = evr_v3_sub(p1, p0), e2 = evr_v3_sub(p2, p0);
     evr_v3 n = evr_v3_scale(evr_v3_norm(evr_v3_cross(e1, e2)), side);

@@ -62,7 +62,7 @@ EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs,
             return 0;
     } else {
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[em->index].track), p->f);
-        if (!evr_photon_emit_surface(rs, em, cdf, &xf, u, &p->pr)) return 0;
+        if (!evr_photon_emit_surface(rs, em, cdf, &xf, p->f, u, &p->pr)) return 0;
     }
     p->bounce = 0;
     p->max_hits = p->pr.from_light ? pp->max_bounces + 1 : pp->max_bounces;

@@ -32,8 +32,19 @@ typedef struct {
 
 typedef struct {
     int mesh;
-    int track; /* motion track of the instance's node */
+    int track;  /* motion track of the instance's node (a skinned mesh: the world frame) */
+    int deform; /* index into evr_render_scene.deforms, -1: the mesh's own vertices */
 } evr_instance_view;
+
+/* A deforming instance's vertices over the current segment: num_keys >= 1 keys at uniform
+ * times 0, 1/(num_keys-1), ..., 1, each num_vertices positions and unit normals (3 floats each,
+ * key-major), in the instance's track space. A ray at time f sees every vertex linearly
+ * interpolated between the keys around f, as Embree's time steps do. */
+typedef struct {
+    int num_keys;
+    uint32_t num_vertices;
+    const float *positions, *normals;
+} evr_deform_view;
 
 typedef struct {
     const evr_mesh_view *meshes;
@@ -41,7 +52,8 @@ typedef struct {
     const evr_texture_view *textures;
     const evr_instance_view *instances;
     const evr_light_view *lights;
-    int num_instances, num_lights;
+    const evr_deform_view *deforms; /* of the current segment, like the keys */
+    int num_instances, num_lights, num_deforms;
     /* Motion of the current segment: track i has track_count[i] keys at keys + track_offset[i]. */
     const evr_motion_key *keys;
     const int *track_offset, *track_count;
@@ -58,6 +70,54 @@ EVR_HD static inline evr_motion_track evr_rs_track(const evr_render_scene *rs, i
     t.keys = rs->keys + rs->track_offset[i];
     t.n = rs->track_count[i];
     return t;
+}
+
+/* The key interval of time f over n keys: *a is the first key, the return value the fraction. */
+EVR_HD static inline float evr_key_interval(int n, float f, int *a)
+{
+    if (n <= 1) {
+        *a = 0;
+        return 0.0f;
+    }
+    float x = f * (float)(n - 1);
+    int i = (int)floorf(x);
+    if (i < 0) i = 0;
+    if (i > n - 2) i = n - 2;
+    *a = i;
+    return x - (float)i;
+}
+
+/* Vertex v of a deforming instance at time f (3 floats at base: positions or normals). Between
+ * equal keys the key itself, bit for bit, so that a still stretch stays still. */
+EVR_HD static inline evr_v3 evr_deform_lerp(const evr_deform_view *d, const float *base, uint32_t v,
+                                            float f)
+{
+    int a;
+    const float fr = evr_key_interval(d->num_keys, f, &a);
+    const float *p = base + ((size_t)a * d->num_vertices + v) * 3;
+    evr_v3 pa = evr_v3_make(p[0], p[1], p[2]);
+    if (d->num_keys <= 1) return pa;
+    const float *q = p + (size_t)d->num_vertices * 3;
+    if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return pa;
+    return evr_v3_make(p[0] + (q[0] - p[0]) * fr, p[1] + (q[1] - p[1]) * fr,
+                       p[2] + (q[2] - p[2]) * fr);
+}
+
+/* Position and normal (not unit between keys) of vertex v of mesh view m as instance inst shows
+ * it at time f. */
+EVR_HD static inline evr_v3 evr_rs_vertex(const evr_render_scene *rs, int inst,
+                                          const evr_mesh_view *m, uint32_t v, float f)
+{
+    const int d = rs->instances[inst].deform;
+    if (d >= 0) return evr_deform_lerp(&rs->deforms[d], rs->deforms[d].positions, v, f);
+    return evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1], m->positions[3 * v + 2]);
+}
+EVR_HD static inline evr_v3 evr_rs_normal(const evr_render_scene *rs, int inst,
+                                          const evr_mesh_view *m, uint32_t v, float f)
+{
+    const int d = rs->instances[inst].deform;
+    if (d >= 0) return evr_deform_lerp(&rs->deforms[d], rs->deforms[d].normals, v, f);
+    return evr_v3_make(m->normals[3 * v], m->normals[3 * v + 1], m->normals[3 * v + 2]);
 }
 
 /* Camera pose at normalized segment time f. */

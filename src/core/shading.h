@@ -24,18 +24,18 @@ EVR_HD static inline float evr_luminance(float r, float g, float b)
 }
 
 /* Fills the surface at barycentrics (u, v) of triangle prim of instance inst, whose transform at
- * the ray's time is xf; ray_dir is the incoming direction, t_hit the distance along it. */
+ * the ray's time f is xf; ray_dir is the incoming direction, t_hit the distance along it. */
 EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim,
-                                         float u, float v, const evr_m34 *xf, evr_ray ray,
+                                         float u, float v, const evr_m34 *xf, float f, evr_ray ray,
                                          float t_hit, evr_surface *s)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[inst].mesh];
     uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1],
              i2 = m->indices[3 * prim + 2];
     float w = 1.0f - u - v;
-    evr_v3 n0 = evr_v3_make(m->normals[3 * i0], m->normals[3 * i0 + 1], m->normals[3 * i0 + 2]);
-    evr_v3 n1 = evr_v3_make(m->normals[3 * i1], m->normals[3 * i1 + 1], m->normals[3 * i1 + 2]);
-    evr_v3 n2 = evr_v3_make(m->normals[3 * i2], m->normals[3 * i2 + 1], m->normals[3 * i2 + 2]);
+    evr_v3 n0 = evr_rs_normal(rs, inst, m, i0, f);
+    evr_v3 n1 = evr_rs_normal(rs, inst, m, i1, f);
+    evr_v3 n2 = evr_rs_normal(rs, inst, m, i2, f);
     evr_v3 n =
         evr_v3_add(evr_v3_add(evr_v3_scale(n0, w), evr_v3_scale(n1, u)), evr_v3_scale(n2, v));
     n = evr_m34_normal(xf, n);

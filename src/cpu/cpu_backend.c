@@ -147,7 +147,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
-        evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, ray[i],
+        evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, fs[i], ray[i],
                        rh.ray.tfar[i], &s[i]);
     }
     /* core/shade.h's steps light by light: each light's shadow rays as one packet */
@@ -579,13 +579,47 @@ static void *worker(void *arg)
     return NULL;
 }
 
+/* A deforming group's triangles take the segment's vertex keys as Embree time steps (which
+ * interpolate linearly between uniform steps, as evr_deform_lerp does). 0: out of memory. */
+static int update_deform(cpu_backend *b, int g, const evr_segment *seg)
+{
+    const int d = b->host.instances[b->groups.members[b->groups.group_first[g]]].deform;
+    const evr_deform_view *v = &seg->deforms[d];
+    RTCGeometry geom = rtcGetGeometry(b->group_scenes[g], 0);
+    rtcSetGeometryTimeStepCount(geom, (unsigned)v->num_keys);
+    for (int k = 0; k < v->num_keys; k++) {
+        float *vb = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)k,
+                                            RTC_FORMAT_FLOAT3, 3 * sizeof(float), v->num_vertices);
+        if (!vb) return 0;
+        memcpy(vb, v->positions + (size_t)k * 3 * v->num_vertices,
+               sizeof(float) * 3 * v->num_vertices);
+    }
+    rtcCommitGeometry(geom);
+    rtcCommitScene(b->group_scenes[g]);
+    rtcCommitGeometry(rtcGetGeometry(b->top, (unsigned)g)); /* its instance's bounds changed */
+    if (v->num_keys - 1 > b->time_grid) b->time_grid = v->num_keys - 1;
+    return 1;
+}
+
+/* Whether group g's transform follows its node's track every segment. */
+static int group_moves(const cpu_backend *b, int g)
+{
+    const int kind = b->groups.group_kind[g], node = b->groups.group_node[g];
+    return kind == EVR_GROUP_MOVING ||
+           (kind == EVR_GROUP_DEFORMING && node >= 0 && evr_node_chain_animated(b->scene, node));
+}
+
 static evr_status update_motion(cpu_backend *b, const evr_segment *seg, evr_error *err)
 {
     int g, k;
     b->time_grid = 1;
     for (g = 0; g < b->groups.num_groups; g++) {
         int track = b->groups.group_node[g]; /* a moving group's node is its track */
-        if (b->groups.group_kind[g] != EVR_GROUP_MOVING) continue; /* static: set once */
+        if (b->groups.group_kind[g] == EVR_GROUP_DEFORMING && !update_deform(b, g, seg)) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for a deforming mesh's vertices");
+            return EVR_ERR_NOMEM;
+        }
+        if (!group_moves(b, g)) continue; /* static: set once */
         int n = seg->track_count[track];
         if (n - 1 > b->time_grid)
             b->time_grid = n - 1; /* 2^k + 1 uniform keys: the finest grid holds the others */
@@ -621,6 +655,7 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->host.rs.keys = seg->keys;
     b->host.rs.track_offset = seg->track_offset;
     b->host.rs.track_count = seg->track_count;
+    b->host.rs.deforms = seg->deforms;
     if ((st = update_motion(b, seg, err)) != EVR_OK) return st;
     if (b->gi) { /* the segment's photons: still when nothing moved since the previous segment */
         if ((st = evr_cpu_gi_segment(&b->gi_state, &b->host.rs, seg->skip, b->setup.threads, base,
@@ -902,12 +937,15 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
         RTCGeometry g = rtcNewGeometry(b->device, RTC_GEOMETRY_TYPE_INSTANCE);
         if (!g) goto embree_fail;
         rtcSetGeometryInstancedScene(g, b->group_scenes[m]);
-        if (gr->group_kind[m] != EVR_GROUP_MOVING) { /* baked into world space (identity), or the
-                                                          node's fixed transform; no motion */
+        if (!group_moves(b, m)) { /* baked into world space (identity), or the node's fixed
+                                     transform; no motion */
+            const int kind = gr->group_kind[m];
             evr_m34 xf =
-                gr->group_kind[m] == EVR_GROUP_STATIC
+                kind == EVR_GROUP_STATIC
                     ? evr_node_world_at(s, s->instances[gr->members[gr->group_first[m]]].node,
                                         s->anim_start)
+                : kind == EVR_GROUP_DEFORMING && gr->group_node[m] >= 0
+                    ? evr_node_world_at(s, gr->group_node[m], s->anim_start)
                     : evr_m34_identity();
             rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &xf.m[0][0]);
             rtcCommitGeometry(g);

@@ -2,6 +2,7 @@
  * space at that time, geometry id = scene instance), the event pipeline's direct shading through
  * each pixel centre, and the indirect term from the photon buffer or from path tracing. */
 #include "cpu/still.h"
+#include "prep/deform_keys.h"
 #include "host_clock.h"
 #include "cpu/cpu_gi.h"
 #include "cpu/workers.h"
@@ -96,7 +97,7 @@ static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, evr_surface 
     evr_trace_hit h;
     if (!c->tr.closest(c->tr.user, ray, tnear, INFINITY, 0.0f, &h)) return 0;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), 0.0f);
-    evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, ray, h.t, s);
+    evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, 0.0f, ray, h.t, s);
     *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
     if (inst) *inst = h.inst;
     return 1;
@@ -227,6 +228,10 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
 {
     evr_render_host host;
     evr_motion_key *keys = NULL;
+    evr_deform_tracker dtrack;
+    evr_deform_keys dkeys;
+    memset(&dtrack, 0, sizeof dtrack);
+    memset(&dkeys, 0, sizeof dkeys);
     int *toff = NULL, *tcnt = NULL;
     RTCDevice dev = NULL;
     RTCScene sc = NULL;
@@ -302,6 +307,14 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     host.rs.keys = keys;
     host.rs.track_offset = toff;
     host.rs.track_count = tcnt;
+    /* deforming instances: their vertices at the time, one key each */
+    if (!evr_deform_tracker_init(&dtrack, s, &host) ||
+        !evr_deform_keys_make(&dtrack, s, &host, p->time, p->time, 1e-5f, 1, &dkeys)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for the deforming meshes");
+        st = EVR_ERR_NOMEM;
+        goto done;
+    }
+    host.rs.deforms = dkeys.views;
 
     dev = rtcNewDevice(NULL);
     if (!dev) {
@@ -328,8 +341,8 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
             break;
         }
         for (v = 0; v < m->num_vertices; v++) {
-            evr_v3 q = evr_m34_point(&xf, evr_v3_make(m->positions[3 * v], m->positions[3 * v + 1],
-                                                      m->positions[3 * v + 2]));
+            evr_v3 q = evr_m34_point(
+                &xf, evr_rs_vertex(&host.rs, i, &host.meshes[s->instances[i].mesh], v, 0.0f));
             vb[3 * v] = q.x;
             vb[3 * v + 1] = q.y;
             vb[3 * v + 2] = q.z;
@@ -437,6 +450,8 @@ done:
     free(keys);
     free(toff);
     free(tcnt);
+    evr_deform_keys_free(&dkeys);
+    evr_deform_tracker_free(&dtrack);
     free(c.row_used);
     free(c.row_hits);
     evr_render_host_free(&host);

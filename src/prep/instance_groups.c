@@ -50,13 +50,22 @@ int evr_instance_groups_build(const evr_scene *s, int grouped, evr_instance_grou
     for (i = 0; i < s->num_nodes; i++) node_group[i] = -1;
     for (i = 0; i < n; i++) {
         int m = s->instances[i].mesh;
-        if (m >= 0 && m < s->num_meshes && !evr_node_chain_animated(s, s->instances[i].node))
+        if (m >= 0 && m < s->num_meshes && !evr_instance_deforms(s, i) &&
+            !evr_node_chain_animated(s, s->instances[i].node))
             static_tris += s->meshes[m].num_triangles;
     }
     out->static_instanced = grouped && static_tris > evr_static_bake_limit();
     for (i = 0; i < n; i++) {
         int node = s->instances[i].node, moving = evr_node_chain_animated(s, node);
         int *grp = moving ? &node_group[node] : &out->static_group;
+        if (evr_instance_deforms(s, i)) { /* its own vertices every segment: a group of its own */
+            const int skinned = s->meshes[s->instances[i].mesh].skin != NULL;
+            out->instance_group[i] = out->num_groups;
+            out->group_kind[out->num_groups] = EVR_GROUP_DEFORMING;
+            out->group_node[out->num_groups++] =
+                !skinned && node >= 0 && node < s->num_nodes ? node : -1;
+            continue;
+        }
         if (!grouped || (!moving && out->static_instanced)) {
             /* a group of its own, in its node's space (none: the world) */
             out->instance_group[i] = out->num_groups;

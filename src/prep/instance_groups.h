@@ -6,7 +6,10 @@
  *   static  one never-moving instance in its node's space (the node's fixed transform), whose
  *           tree a backend shares among the instances of one mesh (a city of thousands of
  *           instances of a dozen buildings stores each building once);
- *   moving  the instances of one moving node, in that node's object space, moved by its track.
+ *   moving  the instances of one moving node, in that node's object space, moved by its track;
+ *   deforming  one instance whose mesh deforms (skin, morph targets), its vertices given per
+ *           segment (evr_deform_view) in its node's space, or in world space when skinned (node
+ *           -1), moved by the node's track when that node moves.
  * A ray that crosses overlapping instances (skin and orbit around an eyeball) then searches one
  * tree instead of one per instance. Groups are numbered in the order of their first member and
  * list their members in ascending order: the backends' trees, and so their hits, follow both. */
@@ -18,6 +21,7 @@
 #define EVR_GROUP_BAKED 0
 #define EVR_GROUP_STATIC 1
 #define EVR_GROUP_MOVING 2
+#define EVR_GROUP_DEFORMING 3
 
 typedef struct {
     int num_groups;

@@ -57,15 +57,9 @@ evr_status evr_photon_emitters_build(const evr_render_scene *rs, float f, evr_ph
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
         for (t = 0; t < m->num_triangles; t++) {
             uint32_t i0 = m->indices[3 * t], i1 = m->indices[3 * t + 1], i2 = m->indices[3 * t + 2];
-            evr_v3 p0 =
-                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i0], m->positions[3 * i0 + 1],
-                                               m->positions[3 * i0 + 2]));
-            evr_v3 p1 =
-                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i1], m->positions[3 * i1 + 1],
-                                               m->positions[3 * i1 + 2]));
-            evr_v3 p2 =
-                evr_m34_point(&xf, evr_v3_make(m->positions[3 * i2], m->positions[3 * i2 + 1],
-                                               m->positions[3 * i2 + 2]));
+            evr_v3 p0 = evr_m34_point(&xf, evr_rs_vertex(rs, i, m, i0, f));
+            evr_v3 p1 = evr_m34_point(&xf, evr_rs_vertex(rs, i, m, i1, f));
+            evr_v3 p2 = evr_m34_point(&xf, evr_rs_vertex(rs, i, m, i2, f));
             area += 0.5 * (double)evr_v3_len(evr_v3_cross(evr_v3_sub(p1, p0), evr_v3_sub(p2, p0)));
             em->cdf[em->cdf_n + (int)t] = (float)area;
         }

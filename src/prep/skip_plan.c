@@ -175,14 +175,42 @@ static void box_union(float lo[3], float hi[3], const float l2[3], const float h
     }
 }
 
+/* Instance i's box in its track's space: its mesh's, or for a deforming instance the box of its
+ * vertex keys over the segment and where they were at the previous segment's end. */
+static void local_box(const evr_scene *s, const evr_render_scene *rs, const evr_deform_keys *dk,
+                      int i, float lo[3], float hi[3])
+{
+    const int d = rs->instances[i].deform;
+    if (d >= 0 && dk && d < dk->num_deforms) {
+        memcpy(lo, dk->motion[d].lo, 3 * sizeof(float));
+        memcpy(hi, dk->motion[d].hi, 3 * sizeof(float));
+        return;
+    }
+    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
+    lo[0] = m->bounds_min.x;
+    lo[1] = m->bounds_min.y;
+    lo[2] = m->bounds_min.z;
+    hi[0] = m->bounds_max.x;
+    hi[1] = m->bounds_max.y;
+    hi[2] = m->bounds_max.z;
+}
+
+/* Whether instance i moves in the segment or since the last: its track or its vertices. */
+static int instance_moved(const evr_skip_tracker *t, const evr_render_scene *rs,
+                          const evr_deform_keys *dk, int i)
+{
+    const int d = rs->instances[i].deform;
+    return t->moved[rs->instances[i].track] ||
+           (d >= 0 && dk && d < dk->num_deforms && dk->moved[d]);
+}
+
 /* World box of instance i over the segment, and where it was at the previous segment's end. */
 static void instance_box(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
-                         int i, float blo[3], float bhi[3])
+                         const evr_deform_keys *dk, int i, float blo[3], float bhi[3])
 {
     const int tr = rs->instances[i].track;
-    const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
-    const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
-    const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
+    float lo[3], hi[3];
+    local_box(s, rs, dk, i, lo, hi);
     evr_swept_bounds(lo, hi, evr_rs_track(rs, tr), blo, bhi);
     if (t->prev_count[tr] > 0) {
         evr_motion_track prev;
@@ -309,9 +337,11 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
 static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i,
                       int leaves, evr_skip_plan *pl, int b, track_sweep *ts)
 {
-    const float(*parts)[6] = mesh_parts(t, s, rs->instances[i].mesh);
+    /* a deforming mesh's parts are not where its rest pose puts them: its whole box */
+    const float(*parts)[6] =
+        rs->instances[i].deform >= 0 ? NULL : mesh_parts(t, s, rs->instances[i].mesh);
     const int base = pl->part_first[b], per = EVR_SKIP_MESH_PARTS / leaves;
-    if (!parts) {
+    if (!parts) { /* no tree: the instance's box alone */
         pl->part_first[b + 1] = base;
         return;
     }
@@ -358,13 +388,28 @@ static void merge_by_track(evr_skip_plan *pl, int *box_track)
 /* The plan's still span: before the first and after the last change between consecutive keys of
  * any moving instance's track (with a hundredth of a key interval to spare, so that a time's
  * float key position never lands in the interval of a change). */
-static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t, evr_skip_plan *pl)
+static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t,
+                       const evr_deform_keys *dk, evr_skip_plan *pl)
 {
     int i, j;
     pl->still_before = 2.0f;
     pl->still_after = -1.0f;
     for (i = 0; i < rs->num_instances; i++) {
-        const int tr = rs->instances[i].track;
+        const int tr = rs->instances[i].track, d = rs->instances[i].deform;
+        if (d >= 0 && dk && d < dk->num_deforms && dk->moved[d]) {
+            const evr_deform_view *v = &dk->views[d];
+            const size_t per = 3 * (size_t)v->num_vertices;
+            for (j = 0; j + 1 < v->num_keys; j++) {
+                if (!memcmp(v->positions + j * per, v->positions + (j + 1) * per,
+                            per * sizeof(float)) &&
+                    !memcmp(v->normals + j * per, v->normals + (j + 1) * per, per * sizeof(float)))
+                    continue;
+                pl->still_before =
+                    fminf(pl->still_before, ((float)j - 0.01f) / (float)(v->num_keys - 1));
+                pl->still_after =
+                    fmaxf(pl->still_after, ((float)j + 1.01f) / (float)(v->num_keys - 1));
+            }
+        }
         if (!t->moved[tr]) continue;
         const evr_motion_track tk = evr_rs_track(rs, tr);
         for (j = 0; j + 1 < tk.n; j++) {
@@ -376,7 +421,7 @@ static void still_span(const evr_render_scene *rs, const evr_skip_tracker *t, ev
 }
 
 void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
-                         int enabled, evr_skip_plan *pl)
+                         const evr_deform_keys *dk, int enabled, evr_skip_plan *pl)
 {
     int i, tr, per_track = 0;
     int box_track[EVR_SKIP_MAX_BOXES];
@@ -393,15 +438,15 @@ void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_rend
     }
     /* still spans with and without skipping: brute force traces their samples at the same times */
     pl->spans = cache;
-    still_span(rs, t, pl);
+    still_span(rs, t, dk, pl);
     if (!enabled) return;
     /* a box per moving instance; once they are too many, a box per moving track */
     for (i = 0; i < rs->num_instances; i++) {
         float lo[3], hi[3];
         int b = pl->num_boxes;
         tr = rs->instances[i].track;
-        if (!t->moved[tr]) continue;
-        instance_box(t, s, rs, i, lo, hi);
+        if (!instance_moved(t, rs, dk, i)) continue;
+        instance_box(t, s, rs, dk, i, lo, hi);
         if (per_track)
             for (b = 0; b < pl->num_boxes && box_track[b] != tr; b++) {}
         if (b == EVR_SKIP_MAX_BOXES && !per_track) {
@@ -427,7 +472,7 @@ void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_rend
         track_sweep *ts = malloc(sizeof *ts);
         while (leaves > 1 && (2 * leaves - 1) * pl->num_boxes > EVR_SKIP_MAX_PARTS) leaves /= 2;
         for (int j = 0, nb = 0; ts && leaves > 1 && j < rs->num_instances; j++)
-            if (t->moved[rs->instances[j].track]) add_parts(t, s, rs, j, leaves, pl, nb++, ts);
+            if (instance_moved(t, rs, dk, j)) add_parts(t, s, rs, j, leaves, pl, nb++, ts);
         free(ts);
     }
     pl->cache = cache;
@@ -451,7 +496,8 @@ static float corner_move(const float lo[3], const float hi[3], const evr_motion_
 }
 
 void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
-                          const evr_adapt_params *ap, double seconds, evr_adapt_plan *pl)
+                          const evr_deform_keys *dk, const evr_adapt_params *ap, double seconds,
+                          evr_adapt_plan *pl)
 {
     int i, k;
     memset(pl, 0, sizeof *pl);
@@ -470,13 +516,12 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
     const float ty = rs->camera.tan_half_y, tx = ty * rs->camera.aspect;
     const float px_per_rad = 0.5f * (float)rs->camera.height / ty * (1.0f + tx * tx + ty * ty);
     for (i = 0; i < rs->num_instances; i++) {
-        int tr = rs->instances[i].track, b;
-        if (!t->moved[tr]) continue;
-        const evr_mesh *m = &s->meshes[rs->instances[i].mesh];
-        const float lo[3] = {m->bounds_min.x, m->bounds_min.y, m->bounds_min.z};
-        const float hi[3] = {m->bounds_max.x, m->bounds_max.y, m->bounds_max.z};
+        int tr = rs->instances[i].track, b, di = rs->instances[i].deform;
+        if (!instance_moved(t, rs, dk, i)) continue;
+        float lo[3], hi[3];
+        local_box(s, rs, dk, i, lo, hi);
         float blo[3], bhi[3], r2 = 0.0f, move = 0.0f, jump = 0.0f;
-        instance_box(t, s, rs, i, blo, bhi);
+        instance_box(t, s, rs, dk, i, blo, bhi);
         for (k = 0; k < 3; k++) { /* distance from the camera to the box */
             const float e = k == 0 ? eye.x : k == 1 ? eye.y : eye.z;
             const float d = e < blo[k] ? blo[k] - e : e > bhi[k] ? e - bhi[k] : 0.0f;
@@ -490,6 +535,22 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
         /* keys are close (< 120 degrees apart, 1e-5 of the scene from the curves): 1.25 covers
          * a point's arc between keys being longer than its chord */
         float speed = tk.n > 1 ? 1.25f * move * (float)(tk.n - 1) / (float)seconds : 0.0f;
+        if (di >= 0 && dk && di < dk->num_deforms) { /* and the vertices' own motion (a track
+                                                      * stretches it by at most its largest
+                                                      * column sum) */
+            const evr_deform_view *v = &dk->views[di];
+            float stretch = 0.0f;
+            for (k = 0; k < tk.n; k++) {
+                const evr_m34 mk = evr_motion_key_matrix(&tk.keys[k]);
+                for (int c = 0; c < 3; c++)
+                    stretch =
+                        fmaxf(stretch, fabsf(mk.m[0][c]) + fabsf(mk.m[1][c]) + fabsf(mk.m[2][c]));
+            }
+            if (v->num_keys > 1)
+                speed += 1.25f * stretch * dk->motion[di].move * (float)(v->num_keys - 1) /
+                         (float)seconds;
+            jump += stretch * dk->motion[di].jump;
+        }
         float jump_px = jump * px_per_rad / r;
         speed = r > 0.0f ? speed * px_per_rad / r : INFINITY;
         if (!(speed >= 0.0f)) speed = INFINITY;

@@ -6,6 +6,7 @@
 #include "backend.h"
 #include "core/skip.h"
 #include "core/adaptive.h"
+#include "prep/deform_keys.h"
 
 typedef struct {
     int num_tracks;
@@ -41,15 +42,17 @@ void evr_skip_tracker_update(evr_skip_tracker *t, evr_motion_key *keys, const in
                              const int *track_count, float scene_size);
 
 /* Fills the plan of the segment whose keys the tracker saw last: enabled 0 (--no-skip) gives a
- * plan that neither reuses nor caches. rs holds the segment's keys. */
+ * plan that neither reuses nor caches. rs holds the segment's keys, dk the deforming instances'
+ * (NULL: none). */
 void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
-                         int enabled, evr_skip_plan *pl);
+                         const evr_deform_keys *dk, int enabled, evr_skip_plan *pl);
 
 /* Fills the adaptive-sampling plan (core/adaptive.h) of the same segment: the swept bounds of
  * every instance that moves in it or changed since the previous one (all of them in one box past
  * EVR_SKIP_MAX_BOXES), each with a bound on its image speed; all_min when the camera or a light
  * moves. seconds: the segment's length. */
 void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
-                          const evr_adapt_params *ap, double seconds, evr_adapt_plan *pl);
+                          const evr_deform_keys *dk, const evr_adapt_params *ap, double seconds,
+                          evr_adapt_plan *pl);
 
 #endif

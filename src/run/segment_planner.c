@@ -116,6 +116,7 @@ void evr_planner_stop(evr_planner *p)
         free(p->slot[s].keys);
         free(p->slot[s].track_offset);
         free(p->slot[s].track_count);
+        evr_deform_keys_free(&p->slot[s].deform);
     }
     free(p);
 }

@@ -12,6 +12,7 @@
 #include "core/adaptive.h"
 #include "core/motion.h"
 #include "core/skip.h"
+#include "prep/deform_keys.h"
 
 #ifndef EVR_PLANNER_SLOTS
 #define EVR_PLANNER_SLOTS \
@@ -22,6 +23,8 @@ typedef struct {
     evr_motion_key *keys;            /* room for keys_cap keys */
     int *track_offset, *track_count; /* num_tracks each */
     int num_keys;
+    evr_deform_keys deform; /* the deforming instances' vertex keys */
+    int failed;             /* out of memory planning it */
     evr_skip_plan plan;
     evr_adapt_plan adapt;
 } evr_planned_segment;

@@ -370,6 +370,19 @@ void evr_scene_free_contents(evr_scene *s)
         free(s->meshes[i].normals);
         free(s->meshes[i].uvs);
         free(s->meshes[i].indices);
+        if (s->meshes[i].skin) {
+            free(s->meshes[i].skin->joint_nodes);
+            free(s->meshes[i].skin->inverse_bind);
+            free(s->meshes[i].skin->joints);
+            free(s->meshes[i].skin->weights);
+            free(s->meshes[i].skin);
+        }
+        if (s->meshes[i].morph) {
+            free(s->meshes[i].morph->d_positions);
+            free(s->meshes[i].morph->d_normals);
+            free(s->meshes[i].morph->default_weights);
+            free(s->meshes[i].morph);
+        }
     }
     free(s->meshes);
     for (i = 0; i < s->num_textures && s->textures; i++) free(s->textures[i].rgba);
@@ -378,6 +391,8 @@ void evr_scene_free_contents(evr_scene *s)
         evr_import_curve_free(&s->nodes[i].t_curve);
         evr_import_curve_free(&s->nodes[i].r_curve);
         evr_import_curve_free(&s->nodes[i].s_curve);
+        evr_import_curve_free(&s->nodes[i].w_curve);
+        free(s->nodes[i].weights);
     }
     free(s->nodes);
     free(s->materials);

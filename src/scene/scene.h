@@ -11,6 +11,26 @@
 #include "core/material.h"
 #include "evray.h"
 
+/* A mesh's skin (glTF skin, Assimp bones): a vertex's world position is
+ * sum_k weights[k] * (world(joint_nodes[j_k]) * inverse_bind[j_k]) * p over its influences, its
+ * instance's node transform ignored (the glTF rule; Assimp's bones are read the same way). */
+typedef struct {
+    int num_joints;
+    int *joint_nodes;      /* node of each joint */
+    evr_m34 *inverse_bind; /* per joint: mesh space to the joint's space at bind time */
+    int influences;        /* per vertex (a vertex with fewer has zero weights) */
+    uint16_t *joints;      /* influences per vertex: index into joint_nodes */
+    float *weights;        /* influences per vertex, summing to 1 */
+} evr_skin;
+
+/* A mesh's morph targets: p = p0 + sum_j w_j * d_positions[j]; normals likewise, then unit. */
+typedef struct {
+    int num_targets;
+    float *d_positions;     /* num_targets * num_vertices * 3 */
+    float *d_normals;       /* the same size, or NULL (normals follow the positions only) */
+    float *default_weights; /* num_targets: the mesh's weights where its node gives none */
+} evr_morph;
+
 typedef struct {
     char name[64];
     uint32_t num_vertices, num_triangles;
@@ -20,6 +40,8 @@ typedef struct {
     uint32_t *indices; /* 3 per triangle */
     int material;      /* index into scene materials */
     evr_v3 bounds_min, bounds_max; /* object-space bounds of the positions */
+    evr_skin *skin;                /* NULL: not skinned */
+    evr_morph *morph;              /* NULL: no morph targets */
 } evr_mesh;
 
 typedef struct {
@@ -34,8 +56,8 @@ typedef struct {
 
 typedef enum { EVR_INTERP_LINEAR = 0, EVR_INTERP_STEP = 1 } evr_interp;
 
-/* One animated property of a node: times in seconds, values 3 (translation, scale) or 4
- * (rotation, w x y z) floats per key. */
+/* One animated property of a node: times in seconds, values 3 (translation, scale), 4
+ * (rotation, w x y z) or the node's num_weights (morph weights) floats per key. */
 typedef struct {
     int num_keys;
     double *times;
@@ -51,7 +73,10 @@ typedef struct {
     evr_m34 rest_matrix; /* rest pose as a matrix (nodes given by a matrix keep it exactly) */
     int animated;        /* any curve present */
     evr_curve t_curve, r_curve, s_curve; /* num_keys == 0 when absent */
-    int has_bounds;                      /* 1 when the node places meshes */
+    int num_weights;   /* morph target weights of the meshes it places (0: none) */
+    float *weights;    /* rest weights (the node's, else its mesh's defaults), num_weights */
+    evr_curve w_curve; /* morph weights over time, num_weights values per key */
+    int has_bounds;    /* 1 when the node places meshes */
     evr_v3 bounds_min, bounds_max; /* union of the object-space bounds of the meshes it places */
 } evr_node;
 
@@ -106,6 +131,17 @@ evr_m34 evr_node_local_at(const evr_node *n, double t);
 evr_m34 evr_node_world_at(const evr_scene *s, int node, double t);
 /* 1 when the node or one of its ancestors has animation curves (0 for -1, no node). */
 int evr_node_chain_animated(const evr_scene *s, int node);
+
+/* Deformation (scene/deform.c). An instance deforms when its mesh has a skin or morph targets;
+ * evr_instance_deformed_at writes its vertices at time t: in world space for a skinned mesh (its
+ * node ignored), else in its node's space; normals unit (NULL: not wanted). */
+int evr_instance_deforms(const evr_scene *s, int instance);
+/* Whether the deformation can change over time: a joint's or the weights' curves. */
+int evr_instance_deform_animated(const evr_scene *s, int instance);
+int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *positions,
+                             float *normals); /* 0: out of memory */
+/* The morph weights of node n at time t into w (n->num_weights of them). */
+void evr_node_weights_at(const evr_node *n, double t, float *w);
 
 /* Motion keys of a node's world transform over [t0, t1]: the fewest uniformly spaced keys
  * (2^k + 1, at most max_keys) such that interpolating them matches the curves within tol
