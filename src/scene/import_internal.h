@@ -76,6 +76,8 @@ typedef struct {
     int tex_cap;
     int *mat_uv;                    /* per material: UV channel of its base colour texture */
     const struct aiNode **ai_nodes; /* per evr node */
+    unsigned char *clip_played;     /* per aiAnimation: 1 when its curves are imported (NULL:
+                                       every clip plays) */
     name_index *by_name;            /* nodes sorted by Assimp name */
 } importer;
 
