@@ -37,8 +37,8 @@ int cmd_info(int argc, char **argv)
         return 2;
     }
     /* quiet: the description says which clips play and why the others do not */
-    evr_scene *s = cli_load_scene(path, NULL, animation, 1, &r);
-    if (!s) return r;
+    evr_scene *s = cli_load_scene(path, NULL, animation, 1);
+    if (!s) return 1;
     char *text = evr_scene_describe(s);
     if (text) fputs(text, stdout);
     free(text);

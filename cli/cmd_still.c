@@ -401,11 +401,11 @@ int cmd_still(int argc, char **argv)
             return 2;
         }
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo, animation, quiet, &ar);
+    evr_scene *scene = cli_load_scene(scene_path, demo, animation, quiet);
     if (!scene) {
         free(ref);
         free(cmp);
-        return ar;
+        return 1;
     }
     evr_error err = {{0}};
     evr_still_image r;

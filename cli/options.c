@@ -71,8 +71,7 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
     return argv[*i];
 }
 
-evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet,
-                          int *exit_code)
+evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet)
 {
     evr_error err = {{0}};
     evr_scene *scene = NULL;
@@ -91,7 +90,6 @@ evr_scene *cli_load_scene(const char *path, const char *demo, const char *animat
     }
     if (st != EVR_OK) {
         cli_error("%s", err.msg);
-        *exit_code = st == EVR_ERR_ARG ? 2 : 1;
         return NULL;
     }
     const char *notice = evr_scene_notice(scene);
