@@ -12,10 +12,11 @@ int cmd_info(int argc, char **argv)
     int i, r;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            puts(
+            fputs(
                 "usage: evray info SCENE [--animation CLIP]\n\nDescribes a scene as evray imports it: cameras, lights, animation clips (each\n"
                 "one's duration, as --duration takes it, and whether it plays), animated nodes and\n"
-                "their time ranges, meshes, instances and triangles.\n\n" CLI_ANIMATION_HELP);
+                "their time ranges, meshes, instances and triangles.\n\n" CLI_ANIMATION_HELP,
+                stdout);
             return 0;
         }
         if ((r = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {

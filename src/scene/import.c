@@ -3,7 +3,8 @@
  * What we keep from Assimp: triangles (points and lines are dropped), the node hierarchy with
  * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials,
  * base colour textures (decoded with stb_image and linearized), punctual lights, perspective
- * cameras, and node animation curves converted to seconds.
+ * cameras, and the node animation curves of the clips that play (import_clips.c says which)
+ * converted to seconds.
  *
  * Assimp 5.2's glTF 2.0 importer has quirks that we correct here (the file counts as glTF 2.0
  * when Assimp's SourceAsset_Format metadata names the glTF2 importer, or failing that when the

@@ -123,32 +123,33 @@ static int append(char *line, size_t cap, size_t reserve, const char *text)
     return 1;
 }
 
-/* Appends the labels of the clips whose flag is set, comma-separated, and "and N more" for
- * those that do not fit. */
-static void append_labels(char *line, size_t cap, const evr_scene *s, const unsigned char *flag)
+/* The labels of the clips whose flag is set, comma-separated, into buf; "and N more" for those
+ * that do not fit. */
+static void list_labels(char *buf, size_t cap, const evr_scene *s, const unsigned char *flag)
 {
     int a, listed = 0, left = 0;
+    buf[0] = 0;
     for (a = 0; a < s->num_animations; a++) {
         char label[80], item[96];
         if (!flag[a]) continue;
         clip_label(label, sizeof label, s, a);
         snprintf(item, sizeof item, "%s%s", listed ? ", " : "", label);
-        if (!left && append(line, cap, 200, item)) listed++;
+        if (!left && append(buf, cap, 24, item)) listed++; /* room kept for "and N more" */
         else left++;
     }
     if (left) {
-        char more[48];
+        char more[24];
         snprintf(more, sizeof more, " and %d more", left);
-        append(line, cap, 0, more);
+        append(buf, cap, 0, more);
     }
 }
 
-/* The notice naming the clips the default rule leaves out, and what they share nodes with. */
+/* The notice naming the clips the default rule leaves out, and what they share nodes with
+ * (skipped and owners: one scratch flag per clip each). */
 static void make_notice(evr_scene *s, unsigned char *skipped, unsigned char *owners)
 {
     int a, nskip = 0, nown = 0;
-    char *line = s->notice;
-    size_t cap = sizeof s->notice;
+    char skip_list[256], owner_list[160];
     memset(skipped, 0, (size_t)s->num_animations);
     memset(owners, 0, (size_t)s->num_animations);
     for (a = 0; a < s->num_animations; a++) {
@@ -159,12 +160,13 @@ static void make_notice(evr_scene *s, unsigned char *skipped, unsigned char *own
         owners[s->clips[a].conflict] = 1;
     }
     if (!nskip) return;
-    snprintf(line, cap, "animation clip%s not played: ", nskip == 1 ? "" : "s");
-    append_labels(line, cap, s, skipped);
-    append(line, cap, 0, nskip == 1 ? " (it animates nodes that " : " (they animate nodes that ");
-    append_labels(line, cap, s, owners);
-    append(line, cap, 0, nown == 1 ? " animates)" : " animate)");
-    append(line, cap, 0, "; choose with --animation NAME|INDEX|all");
+    list_labels(skip_list, sizeof skip_list, s, skipped);
+    list_labels(owner_list, sizeof owner_list, s, owners);
+    snprintf(s->notice, sizeof s->notice,
+             "animation clip%s not played: %s (%s nodes that %s %s); choose with --animation "
+             "NAME|INDEX|all",
+             nskip == 1 ? "" : "s", skip_list, nskip == 1 ? "it animates" : "they animate",
+             owner_list, nown == 1 ? "animates" : "animate");
 }
 
 /* The clips as an error message lists them: "0 'walk', 1 'run'" (cut short with "..."). */
