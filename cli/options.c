@@ -80,5 +80,8 @@ evr_scene *cli_load_scene(const char *path, const char *demo)
         cli_error("%s", err.msg);
         return NULL;
     }
+    /* what evray does not render of the file, one line each (evray info lists them too) */
+    for (const char *w = evr_scene_warnings(scene), *nl; (nl = strchr(w, '\n')) != NULL; w = nl + 1)
+        fprintf(stderr, "evray: warning: %.*s\n", (int)(nl - w), w);
     return scene;
 }

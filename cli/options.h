@@ -21,7 +21,7 @@ int opt_is(const char *arg, const char *name);
 void cli_error(const char *fmt, ...);
 
 /* The scene file at path, else the built-in scene demo; NULL (after the error message) when it
- * cannot be loaded. */
+ * cannot be loaded. Prints the scene's warnings (evr_scene_warnings) on stderr. */
 evr_scene *cli_load_scene(const char *path, const char *demo);
 
 #endif
