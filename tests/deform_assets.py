@@ -24,11 +24,28 @@ lights; one scene listing every root node.
   bad_morph_count  morph_slide whose target POSITION accessor has 3 elements for 4 vertices.
   bad_weights_zero skin_slide with a vertex whose weights are all 0.
 
-Extra assets (not in the lead's list) for what the importer reads from the JSON:
+Extra assets (not in the lead's list), each pinning one of Assimp 5.2's quirks (import.c):
   morph_node_weights  morph_slide, no animation, mesh weights [0] but node weights [0.5]: the
                       node's weights win, the edge stays at x = 0.
-  morph_cubic         morph_slide with a CUBICSPLINE weights sampler (tangents 0): the values are
-                      0 and 1 at t = 0 and 1, evray interpolates them linearly and warns.
+  morph_cubic         morph_slide with a CUBICSPLINE weights sampler (tangents 2, 3 and 4, 5):
+                      the values are 0 and 1 at t = 0 and 1, evray interpolates them linearly and
+                      warns.
+  morph_step          morph_slide with a STEP sampler: the edge stays at x = -0.5 until t = 1.
+  morph_two_prims     a mesh of two primitives (two quads), two targets (the first with NORMAL
+                      deltas (0, 0.5, 0)), mesh weights [0.25, 0.5], node weights
+                      [0.75, 0.125], weights keyed (0, 0.1), (0.2, 0.3), (1, 0.9) at t = 0, 0.5, 1.
+  skin_no_ibm         skin_slide without inverseBindMatrices (glTF: identity; Assimp 5.2
+                      crashes on it); also written as skin_no_ibm.glb.
+  skin_unnormalized   the quad on [root, mover], static, weights (root, mover) per vertex
+                      (0.5, 1.5), (0.25, 0.25), (1, 1), (0, 3): normalized (0.25, 0.75),
+                      (0.5, 0.5), (0.5, 0.5), (0, 1).
+  skin_shared         skin_slide's mesh placed again by node quad2 with the skin "swapped"
+                      (joints [mover, root]): quad's right edge slides as in skin_slide, quad2's
+                      left edge (vertices 0, 3) is at x = -2 + t and its right edge still.
+  seam                the quad with a fifth vertex at vertex 1's position and normal but on joint
+                      root (vertex 1: mover) and with a zero morph target delta (vertex 1:
+                      (1, 0, 0)); mesh weights [1], static. JoinIdenticalVertices would merge
+                      the two.
 """
 import base64
 import json
@@ -140,8 +157,10 @@ def _morph_quad(target_deltas=None, node_weights=None, animate="LINEAR"):
         anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [0.0, 1.0])]
     elif animate == "CUBICSPLINE":
         # per key: in-tangent, value, out-tangent (one target each)
-        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [2.0, 0.0, 3.0, 4.0, 1.0, 5.0],
                                  "CUBICSPLINE")]
+    elif animate == "STEP":
+        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [0.0, 1.0], "STEP")]
     return g.document(nodes, [mesh], [0, 1], animations=anims)
 
 
@@ -157,13 +176,37 @@ def morph_cubic():
     return _morph_quad(animate="CUBICSPLINE")
 
 
+def morph_step():
+    return _morph_quad(animate="STEP")
+
+
+def morph_two_prims():
+    g = _Gltf()
+    prims = []
+    for shift in (0.0, 3.0):  # the second quad 3 units higher, its own accessors
+        attrs = {"POSITION": g.accessor(FLOAT, [(x, y + shift, z) for x, y, z in QUAD_POSITIONS],
+                                        minmax=True),
+                 "NORMAL": g.accessor(FLOAT, QUAD_NORMALS)}
+        t1 = {"POSITION": g.accessor(FLOAT, [(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 0, 0)],
+                                     minmax=True),
+              "NORMAL": g.accessor(FLOAT, [(0, 0.5, 0)] * 4)}
+        t2 = {"POSITION": g.accessor(FLOAT, [(0, 0, 0), (0, 1, 0), (0, 1, 0), (0, 0, 0)],
+                                     minmax=True)}
+        prims.append({"attributes": attrs, "indices": g.accessor(USHORT, QUAD_INDICES),
+                      "material": 0, "targets": [t1, t2]})
+    mesh = {"name": "pair", "primitives": prims, "weights": [0.25, 0.5]}
+    nodes = [_camera_node(), {"name": "pair", "mesh": 0, "weights": [0.75, 0.125]}]
+    anims = [_linear_channel(g, 1, "weights", [0.0, 0.5, 1.0], [0.0, 0.1, 0.2, 0.3, 1.0, 0.9])]
+    return g.document(nodes, [mesh], [0, 1], animations=anims)
+
+
 def bad_morph_count():
     return _morph_quad(target_deltas=[(0, 0, 0), (1, 0, 0), (1, 0, 0)])
 
 
 # ---- skins ----
 
-def _skin_quad(eight=False, bad_joint=False, ibm_count=None, zero_weights=False):
+def _skin_quad(eight=False, bad_joint=False, ibm_count=None, zero_weights=False, no_ibm=False):
     g = _Gltf()
     attrs = _quad_attributes(g)
     idx = g.accessor(USHORT, QUAD_INDICES)
@@ -201,6 +244,8 @@ def _skin_quad(eight=False, bad_joint=False, ibm_count=None, zero_weights=False)
         joints.append(4)
     ibm = [IDENTITY] * (num_joints if ibm_count is None else ibm_count)
     skins = [{"name": "quad_skin", "joints": joints, "inverseBindMatrices": g.accessor(FLOAT, ibm)}]
+    if no_ibm:
+        del skins[0]["inverseBindMatrices"]
     # one clip: every mover's translation (0,0,0) -> (1,0,0) over [0, 1]
     anim = _linear_channel(g, 3, "translation", [0.0, 1.0], [(0, 0, 0), (1, 0, 0)])
     anim["name"] = "slide"
@@ -218,6 +263,50 @@ def skin_slide():
 
 def skin_slide8():
     return _skin_quad(eight=True)
+
+
+def skin_no_ibm():
+    return _skin_quad(no_ibm=True)
+
+
+def skin_shared():
+    doc = _skin_quad()
+    doc["nodes"].append({"name": "quad2", "mesh": 0, "skin": 1})
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    doc["skins"].append({"name": "swapped", "joints": [3, 2],
+                         "inverseBindMatrices": doc["skins"][0]["inverseBindMatrices"]})
+    return doc
+
+
+def _static_skin(positions, indices, joints, weights, targets=None, mesh_weights=None):
+    """A static mesh on joints [root, mover] (nodes 2, 3), identity inverse bind matrices."""
+    g = _Gltf()
+    attrs = {"POSITION": g.accessor(FLOAT, positions, minmax=True),
+             "NORMAL": g.accessor(FLOAT, [(0, 0, 1)] * len(positions)),
+             "JOINTS_0": g.accessor(UBYTE, joints), "WEIGHTS_0": g.accessor(FLOAT, weights)}
+    prim = {"attributes": attrs, "indices": g.accessor(USHORT, indices), "material": 0}
+    mesh = {"name": "quad", "primitives": [prim]}
+    if targets:
+        prim["targets"] = [{"POSITION": g.accessor(FLOAT, t, minmax=True)} for t in targets]
+        mesh["weights"] = mesh_weights
+    nodes = [_camera_node(), {"name": "quad", "mesh": 0, "skin": 0}, {"name": "root"},
+             {"name": "mover"}]
+    skins = [{"joints": [2, 3], "inverseBindMatrices": g.accessor(FLOAT, [IDENTITY] * 2)}]
+    return g.document(nodes, [mesh], [0, 1, 2, 3], skins=skins)
+
+
+def skin_unnormalized():
+    return _static_skin(QUAD_POSITIONS, QUAD_INDICES, [(0, 1, 0, 0)] * 4,
+                        [(0.5, 1.5, 0, 0), (0.25, 0.25, 0, 0), (1, 1, 0, 0), (0, 3, 0, 0)])
+
+
+def seam():
+    pos = QUAD_POSITIONS + [QUAD_POSITIONS[1]]
+    return _static_skin(pos, [0, 1, 2, 0, 2, 3, 4, 2, 3],
+                        [(0, 0, 0, 0), (1, 0, 0, 0), (1, 0, 0, 0), (0, 0, 0, 0), (0, 0, 0, 0)],
+                        [(1, 0, 0, 0)] * 5,
+                        targets=[[(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 0, 0), (0, 0, 0)]],
+                        mesh_weights=[1])
 
 
 def bad_joint_index():
@@ -293,18 +382,37 @@ def bend_cylinder():
 
 ASSETS = {f.__name__: f for f in (morph_slide, skin_slide, skin_slide8, bend_cylinder,
                                   bad_joint_index, bad_ibm_count, bad_morph_count,
-                                  bad_weights_zero, morph_node_weights, morph_cubic)}
+                                  bad_weights_zero, morph_node_weights, morph_cubic, morph_step,
+                                  morph_two_prims, skin_no_ibm, skin_unnormalized, skin_shared,
+                                  seam)}
 BAD = ("bad_joint_index", "bad_ibm_count", "bad_morph_count", "bad_weights_zero")
+GLB_TOO = ("skin_no_ibm",)  # also written as NAME.glb
+
+
+def glb_bytes(doc):
+    """The document as a GLB: its one buffer becomes the BIN chunk."""
+    doc = json.loads(json.dumps(doc))
+    data = base64.b64decode(doc["buffers"][0].pop("uri").split(",", 1)[1])
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    data += b"\0" * (-len(data) % 4)
+    return (struct.pack("<4sII", b"glTF", 2, 28 + len(text) + len(data)) +
+            struct.pack("<I4s", len(text), b"JSON") + text +
+            struct.pack("<I4s", len(data), b"BIN\0") + data)
 
 
 def write_all(outdir):
-    """Writes every asset as outdir/NAME.gltf; returns {name: path}."""
+    """Writes every asset as outdir/NAME.gltf (and NAME.glb for GLB_TOO); returns {name: path}
+    of the .gltf files."""
     os.makedirs(outdir, exist_ok=True)
     paths = {}
     for name, make in ASSETS.items():
         paths[name] = os.path.join(outdir, name + ".gltf")
         with open(paths[name], "w") as f:
             json.dump(make(), f, indent=1)
+        if name in GLB_TOO:
+            with open(os.path.join(outdir, name + ".glb"), "wb") as f:
+                f.write(glb_bytes(make()))
     return paths
 
 

@@ -168,8 +168,13 @@ static int j_value(evr_jdoc *d, int depth)
     }
     {
         double num;
+        size_t start = d->pos;
         if (!j_number(d, &num)) return -1;
-        if ((idx = j_new(d, EVR_JDOC_NUMBER)) >= 0) d->v[idx].num = num;
+        if ((idx = j_new(d, EVR_JDOC_NUMBER)) >= 0) {
+            d->v[idx].num = num;
+            d->v[idx].off = start;
+            d->v[idx].len = d->pos - start;
+        }
         return idx;
     }
 }

@@ -33,8 +33,9 @@ typedef struct {
     unsigned char type;      /* EVR_JDOC_* */
     int first, next;         /* first child, next sibling; -1 for none */
     int count;               /* children */
-    size_t off, len;         /* strings: the raw (escaped) text between the quotes; arrays and
-                                objects: their text, brackets included (to edit it in place) */
+    size_t off, len;         /* strings: the raw (escaped) text between the quotes; numbers,
+                                arrays and objects: their text, brackets included (to edit a
+                                document's text in place) */
     size_t key_off, key_len; /* object members: the raw key */
     double num;              /* numbers; booleans 1 or 0 */
 } evr_jdoc_value;

@@ -53,8 +53,9 @@
  *      logs a warning and keeps the base positions (a target that does nothing);
  *      (k), (l) and (m) are errors naming the mesh, checked in the JSON and the buffers before
  *      Assimp reads the file (import_gltf_deform.c);
- *  (n) a mesh placed by nodes with different skins gets the bones of the last such node only
- *      (one aiMesh, one set of bones): a warning.
+ *  (n) a mesh placed by nodes with different skins (or with and without one) is one aiMesh with
+ *      the bones of the last such node only (the earlier bones leak): the patched copy of (j)
+ *      gives each further (mesh, skin) pair a copy of the mesh, referenced by its nodes.
  *  Assimp 5.2 does read JOINTS_1/WEIGHTS_1 (8 influences and more), sparse morph targets and
  *  unnamed joints (bones and nodes both named "nodes[i]"); it does not normalize the weights
  *  (we do, per vertex) and gives a bone without weights one of 0 on vertex 0 (ignored).
@@ -66,9 +67,12 @@
  * space to the bone's at bind time (glTF: the inverse bind matrix; Collada: the joint's inverse
  * bind matrix times the bind shape matrix; FBX: the inverse of the cluster's TransformLink
  * times its Transform), so a vertex's world position is sum_k w_k world(bone node) *
- * mOffsetMatrix * p with the mesh node's own transform ignored, the glTF rule. Morph targets
- * come through aiAnimMesh: absolute for every importer (Collada's normalized and relative
- * morphs alike), so deltas against the base mesh.
+ * mOffsetMatrix * p with the mesh node's own transform ignored, the glTF rule (tests/data/
+ * import/skin.dae pins the Collada case: bind shape matrix included, ticks in milliseconds as
+ * for glTF). Morph targets come through aiAnimMesh, absolute (deltas taken against the base
+ * mesh) unless aiMesh.mMethod is aiMorphingMethod_MORPH_RELATIVE (Collada's RELATIVE morph:
+ * the targets hold offsets; untested, Assimp 5.2 did not import our hand-written Collada morph
+ * controller).
  *
  * For other formats: mHorizontalFOV is documented as the half angle, but Assimp's importers
  * (Collada's xfov, FBX's FieldOfView) store the full horizontal angle, so we read it as the full
@@ -77,7 +81,7 @@
  *
  * This unit loads the file and runs the steps; each step is a unit of its own (the list is in
  * import_internal.h): (a), (d), (e) and STEP in import_anim.c, (b) and (c) in import_camera.c,
- * (f) to (h) and (n) in import_deform.c, (j) to (m) in import_gltf_deform.c, (i) here, the glTF
+ * (f) to (h) in import_deform.c, (j) to (n) in import_gltf_deform.c, (i) here, the glTF
  * JSON in import_gltf.c. What evray does not render of a file is a warning of the scene
  * (evr_scene_warnings), never a message printed here. */
 #include <errno.h>

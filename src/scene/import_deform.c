@@ -2,7 +2,7 @@
  * Assimp: bones (aiBone: the joint node's name, mOffsetMatrix the inverse bind matrix, the
  * weights), anim meshes (aiAnimMesh: absolute positions and normals, mWeight the default
  * weight) and morph channels (aiMeshMorphAnim), with the glTF JSON where Assimp 5.2 drops
- * something (quirks (f) to (n) in import.c). Weights are normalized per vertex; a vertex without
+ * something (quirks (f) to (h) in import.c). Weights are normalized per vertex; a vertex without
  * weight, a bone naming no node or an anim mesh of another size is an error naming the mesh. */
 #include <math.h>
 #include <stdlib.h>
@@ -110,7 +110,8 @@ fail:
 }
 
 /* Morph targets as deltas: Assimp keeps each target's absolute positions and normals (quirk
- * (g)). */
+ * (g)), except where the mesh says its targets are relative (Collada's RELATIVE morphs, whose
+ * target geometry holds the offsets). */
 static evr_status import_morph(importer *im, int mi)
 {
     const struct aiMesh *am = im->ai->mMeshes[mi];
@@ -119,6 +120,7 @@ static evr_status import_morph(importer *im, int mi)
     evr_morph *mo = calloc(1, sizeof *mo);
     unsigned t, v;
     int normals = 0;
+    const float keep = am->mMethod == aiMorphingMethod_MORPH_RELATIVE ? 0.0f : 1.0f;
     if (!mo) goto nomem;
     for (t = 0; t < nt; t++) {
         const struct aiAnimMesh *an = am->mAnimMeshes[t];
@@ -140,16 +142,16 @@ static evr_status import_morph(importer *im, int mi)
         float *dp = mo->d_positions + (size_t)t * nv * 3;
         mo->default_weights[t] = isfinite(an->mWeight) ? an->mWeight : 0.0f;
         for (v = 0; an->mVertices && v < nv; v++) {
-            dp[3 * v] = an->mVertices[v].x - am->mVertices[v].x;
-            dp[3 * v + 1] = an->mVertices[v].y - am->mVertices[v].y;
-            dp[3 * v + 2] = an->mVertices[v].z - am->mVertices[v].z;
+            dp[3 * v] = an->mVertices[v].x - keep * am->mVertices[v].x;
+            dp[3 * v + 1] = an->mVertices[v].y - keep * am->mVertices[v].y;
+            dp[3 * v + 2] = an->mVertices[v].z - keep * am->mVertices[v].z;
         }
         if (normals && an->mNormals) {
             float *dn = mo->d_normals + (size_t)t * nv * 3;
             for (v = 0; v < nv; v++) {
-                dn[3 * v] = an->mNormals[v].x - am->mNormals[v].x;
-                dn[3 * v + 1] = an->mNormals[v].y - am->mNormals[v].y;
-                dn[3 * v + 2] = an->mNormals[v].z - am->mNormals[v].z;
+                dn[3 * v] = an->mNormals[v].x - keep * am->mNormals[v].x;
+                dn[3 * v + 1] = an->mNormals[v].y - keep * am->mNormals[v].y;
+                dn[3 * v + 2] = an->mNormals[v].z - keep * am->mNormals[v].z;
             }
         }
     }
@@ -333,25 +335,6 @@ static evr_status weight_curves(importer *im)
     return EVR_OK;
 }
 
-/* Quirk (n): Assimp 5.2 keeps one set of bones per mesh, the last skinned node's, so a mesh
- * placed by nodes with different skins (or with and without one) is skinned one way for all. */
-static void warn_shared_skins(importer *im)
-{
-    const gltf_side *g = &im->side;
-    int i, j;
-    for (i = 0; i < g->num_nodes; i++) {
-        if (g->node_mesh[i] < 0) continue;
-        for (j = i + 1; j < g->num_nodes; j++)
-            if (g->node_mesh[j] == g->node_mesh[i] && g->node_skin[j] != g->node_skin[i]) {
-                evr_import_warn(im,
-                                "nodes '%s' and '%s' place one mesh with different skins: "
-                                "Assimp 5.2 keeps one skin per mesh, the last node's, for both",
-                                g->node_names[i], g->node_names[j]);
-                return;
-            }
-    }
-}
-
 evr_status evr_import_deform(importer *im)
 {
     const struct aiScene *ai = im->ai;
@@ -362,7 +345,5 @@ evr_status evr_import_deform(importer *im)
         if (ai->mMeshes[i]->mNumAnimMeshes && (st = import_morph(im, (int)i)) != EVR_OK) return st;
     }
     if ((st = node_weights(im)) != EVR_OK) return st;
-    if ((st = weight_curves(im)) != EVR_OK) return st;
-    if (im->have_side) warn_shared_skins(im);
-    return EVR_OK;
+    return weight_curves(im);
 }

@@ -1,6 +1,6 @@
 /* The glTF JSON read directly (the .gltf text or the GLB's JSON chunk), for what Assimp 5.2
  * drops or mangles: which channels exist and their interpolation (quirks (d), (e), (f) and STEP
- * in import.c), the nodes' morph weights and skins (quirks (h), (n)),
+ * in import.c), the nodes' morph weights (quirk (h)),
  * KHR_materials_emissive_strength and the materials' photon extras. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,8 +22,6 @@ void evr_gltf_side_free(gltf_side *g)
     for (i = 0; i < g->num_nodes && g->node_weights; i++) free(g->node_weights[i]);
     free(g->node_weights);
     free(g->node_num_weights);
-    free(g->node_mesh);
-    free(g->node_skin);
     memset(g, 0, sizeof *g);
 }
 
@@ -86,12 +84,10 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->emissive_strength = calloc((size_t)g->num_materials + 1, sizeof *g->emissive_strength);
     g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
-    g->node_mesh = malloc(((size_t)g->num_nodes + 1) * sizeof *g->node_mesh);
-    g->node_skin = malloc(((size_t)g->num_nodes + 1) * sizeof *g->node_skin);
     g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
     g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
-    if (!g->node_names || !g->emissive_strength || !g->t_extras || !g->node_mesh || !g->node_skin ||
-        !g->node_num_weights || !g->node_weights)
+    if (!g->node_names || !g->emissive_strength || !g->t_extras || !g->node_num_weights ||
+        !g->node_weights)
         goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
@@ -102,8 +98,6 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         g->node_names[i] = malloc(strlen(buf) + 1);
         if (!g->node_names[i]) goto nomem;
         strcpy(g->node_names[i], buf);
-        g->node_mesh[i] = evr_gltf_index(&d, evr_jdoc_get(&d, m, "mesh"));
-        g->node_skin[i] = evr_gltf_index(&d, evr_jdoc_get(&d, m, "skin"));
         {
             int w = evr_jdoc_get(&d, m, "weights"), e, k = 0;
             int nw = evr_jdoc_count(&d, w);

@@ -241,7 +241,7 @@ int evr_gltf_accessor_count(const gltf_data *g, int a, int *ncomp)
     int acc = evr_gltf_accessor(g, a);
     if (ncomp) *ncomp = acc < 0 ? 0 : type_components(g->d, acc);
     if (acc < 0) return -1;
-    return (int)evr_jdoc_number(g->d, evr_jdoc_get(g->d, acc, "count"), -1);
+    return evr_gltf_index(g->d, evr_jdoc_get(g->d, acc, "count"));
 }
 
 /* The bytes of bufferView `view` from byte `offset` on: *p and how many remain (*room); *stride
@@ -258,7 +258,10 @@ static evr_status view_bytes(gltf_data *g, int view, double offset, const unsign
     bi = evr_jdoc_number(d, evr_jdoc_get(d, v, "buffer"), -1);
     boff = evr_jdoc_number(d, evr_jdoc_get(d, v, "byteOffset"), 0);
     blen = evr_jdoc_number(d, evr_jdoc_get(d, v, "byteLength"), -1);
-    if (stride) *stride = (size_t)evr_jdoc_number(d, evr_jdoc_get(d, v, "byteStride"), 0);
+    if (stride) { /* absent: 0 (tightly packed) */
+        int bs = evr_gltf_index(d, evr_jdoc_get(d, v, "byteStride"));
+        *stride = bs > 0 ? (size_t)bs : 0;
+    }
     if (!(bi >= 0 && bi < g->num_buffers) || !(boff >= 0) || !(blen >= 0) || !(offset >= 0) ||
         offset > blen)
         return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: accessor %d's buffer view is invalid",
@@ -284,7 +287,7 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
     evr_status st;
     *out = NULL;
     if (acc < 0) return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: accessor %d is missing", a);
-    ctype = (int)evr_jdoc_number(d, evr_jdoc_get(d, acc, "componentType"), 0);
+    ctype = evr_gltf_index(d, evr_jdoc_get(d, acc, "componentType"));
     csize = component_size(ctype);
     nc = type_components(d, acc);
     norm = evr_jdoc_number(d, evr_jdoc_get(d, acc, "normalized"), 0) != 0;
@@ -297,7 +300,7 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
     elem = (size_t)nc * (size_t)csize;
     vals = calloc(n * (size_t)nc + 1, sizeof *vals);
     if (!vals) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading a glTF accessor");
-    view = (int)evr_jdoc_number(d, evr_jdoc_get(d, acc, "bufferView"), -1);
+    view = evr_gltf_index(d, evr_jdoc_get(d, acc, "bufferView"));
     if (view >= 0 && n > 0) { /* no view: zeros, then the sparse values */
         const unsigned char *p;
         size_t room, stride;
@@ -319,7 +322,7 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
     if (sparse >= 0) {
         int ind = evr_jdoc_get(d, sparse, "indices"), val = evr_jdoc_get(d, sparse, "values");
         double sc = evr_jdoc_number(d, evr_jdoc_get(d, sparse, "count"), -1);
-        int itype = (int)evr_jdoc_number(d, evr_jdoc_get(d, ind, "componentType"), 0);
+        int itype = evr_gltf_index(d, evr_jdoc_get(d, ind, "componentType"));
         int isize = component_size(itype);
         const unsigned char *pi, *pv;
         size_t ri, rv, k, m;
@@ -329,10 +332,10 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
             goto fail;
         }
         m = (size_t)sc;
-        if ((st = view_bytes(g, (int)evr_jdoc_number(d, evr_jdoc_get(d, ind, "bufferView"), -1),
+        if ((st = view_bytes(g, evr_gltf_index(d, evr_jdoc_get(d, ind, "bufferView")),
                              evr_jdoc_number(d, evr_jdoc_get(d, ind, "byteOffset"), 0), &pi, &ri,
                              NULL, a, err)) != EVR_OK ||
-            (st = view_bytes(g, (int)evr_jdoc_number(d, evr_jdoc_get(d, val, "bufferView"), -1),
+            (st = view_bytes(g, evr_gltf_index(d, evr_jdoc_get(d, val, "bufferView")),
                              evr_jdoc_number(d, evr_jdoc_get(d, val, "byteOffset"), 0), &pv, &rv,
                              NULL, a, err)) != EVR_OK)
             goto fail;

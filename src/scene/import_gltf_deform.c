@@ -1,9 +1,11 @@
 /* glTF skins and morph targets checked before Assimp 5.2 reads them (quirks (j) to (n) in
- * import.c). Assimp would crash on a skin without inverseBindMatrices, read past an accessor
- * with too few of them, drop a joint index out of range or a whole set of weights whose counts
- * differ, and replace a morph target of the wrong length by the base mesh: each is one error
- * here, naming the mesh, except the missing matrices, which glTF defines as identity: Assimp then
- * reads a copy of the file with an identity accessor added. */
+ * import.c). Assimp would read past an accessor with too few inverse bind matrices, drop a joint
+ * index out of range or a whole set of weights whose counts differ, and replace a morph target
+ * of the wrong length by the base mesh: each is one error here, naming the mesh. Two more are
+ * valid glTF that Assimp mishandles, so it reads a patched copy of the file instead: a skin
+ * without inverseBindMatrices (identity, by glTF's rule) crashes it, and a mesh placed by nodes
+ * with different skins would get the last node's bones only (the others leaked); the copy has
+ * an identity accessor added, and a copy of the mesh for each further skin. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -174,17 +176,50 @@ static int check_skin(checker *c, int skin, const char *ml, const char *sl, int 
     return nj;
 }
 
-/* ---- the identity patch ---- */
+/* ---- the patched copy ---- */
+
+/* Replace text[at, at + len) by `text` (len 0: insert). */
+typedef struct {
+    size_t at, len;
+    char *text;
+} edit;
 
 typedef struct {
-    size_t at;
-    char *text;
-} insertion;
+    edit *e;
+    int n, cap;
+} edits;
 
-static int insertion_cmp(const void *pa, const void *pb)
+static int edit_cmp(const void *pa, const void *pb)
 {
-    const insertion *a = pa, *b = pb;
+    const edit *a = pa, *b = pb;
     return (a->at > b->at) - (a->at < b->at);
+}
+
+/* Adds an edit taking ownership of text; 0 when memory ran out (text freed). */
+static int add_edit(edits *E, size_t at, size_t len, char *text)
+{
+    if (!text) return 0;
+    if (E->n == E->cap) {
+        int ncap = E->cap ? 2 * E->cap : 16;
+        edit *ne = realloc(E->e, (size_t)ncap * sizeof *ne);
+        if (!ne) {
+            free(text);
+            return 0;
+        }
+        E->e = ne;
+        E->cap = ncap;
+    }
+    E->e[E->n].at = at;
+    E->e[E->n].len = len;
+    E->e[E->n++].text = text;
+    return 1;
+}
+
+static void edits_free(edits *E)
+{
+    for (int i = 0; i < E->n; i++) free(E->e[i].text);
+    free(E->e);
+    memset(E, 0, sizeof *E);
 }
 
 static char *b64_encode(const unsigned char *p, size_t n)
@@ -211,79 +246,87 @@ static char *b64_encode(const unsigned char *p, size_t n)
     return out;
 }
 
-/* Text to add one element to the root array `key`: before its ']', or the whole member after
- * the root's '{' when the array is missing. */
-static int add_to_array(const evr_jdoc *d, int root, const char *key, const char *elem,
-                        insertion *ins)
+/* Appends elements (JSON text, comma-separated) to the root array `key`: before its ']', or as
+ * a whole member after the root's '{' when the array is missing. */
+static int append_to_array(edits *E, const evr_jdoc *d, int root, const char *key,
+                           const char *elems)
 {
     int arr = evr_jdoc_get(d, root, key);
-    size_t n = strlen(key) + strlen(elem) + 16;
-    ins->text = malloc(n);
-    if (!ins->text) return 0;
+    size_t n = strlen(key) + strlen(elems) + 16;
+    char *t = malloc(n);
+    if (!t) return 0;
     if (arr >= 0 && evr_jdoc_type(d, arr) == EVR_JDOC_ARRAY) {
-        ins->at = d->v[arr].off + d->v[arr].len - 1;
-        snprintf(ins->text, n, "%s%s", evr_jdoc_count(d, arr) ? "," : "", elem);
-    } else {
-        ins->at = d->v[root].off + 1;
-        snprintf(ins->text, n, "\"%s\":[%s],", key, elem);
+        snprintf(t, n, "%s%s", evr_jdoc_count(d, arr) ? "," : "", elems);
+        return add_edit(E, d->v[arr].off + d->v[arr].len - 1, 0, t);
     }
-    return 1;
+    snprintf(t, n, "\"%s\":[%s],", key, elems);
+    return add_edit(E, d->v[root].off + 1, 0, t);
 }
 
-/* The file with an accessor of `count` identity matrices added and given to the skins marked in
- * need[] as their inverseBindMatrices; a GLB keeps its BIN chunk (read from the file when the
- * bytes hold only the JSON). */
-static evr_status make_patch(const gltf_source *src, const evr_jdoc *d, int root, int skins,
-                             const unsigned char *need, int count, const char *json, size_t jlen,
-                             unsigned char **out, size_t *nout, evr_error *err)
+/* Gives the skins marked in need[] an accessor of `count` identity matrices as their
+ * inverseBindMatrices (quirk (j)). */
+static int add_identity(edits *E, const evr_jdoc *d, int root, const checker *c,
+                        const unsigned char *need, int count)
 {
-    int nskins = evr_jdoc_count(d, skins), i, s, nins = 0;
     int acc_index = evr_jdoc_count(d, evr_jdoc_get(d, root, "accessors"));
     int view_index = evr_jdoc_count(d, evr_jdoc_get(d, root, "bufferViews"));
     int buf_index = evr_jdoc_count(d, evr_jdoc_get(d, root, "buffers"));
-    insertion *ins = calloc((size_t)nskins + 4, sizeof *ins);
-    unsigned char *mats = malloc((size_t)count * 64), *file = NULL, *res = NULL;
+    unsigned char *mats = malloc((size_t)count * 64);
     char *b64 = NULL, *elem = NULL;
-    const unsigned char *rest = NULL;
-    size_t nrest = 0, nfile = 0, total, o, prev;
-    evr_status st = EVR_ERR_NOMEM;
-    int glb = src->nbytes >= 20 && !memcmp(src->bytes, "glTF", 4);
-
-    if (!ins || !mats) goto nomem;
-    for (i = 0; i < count; i++)
+    int ok = 0;
+    if (!mats) return 0;
+    for (int i = 0; i < count; i++)
         for (int k = 0; k < 16; k++) {
             float f = (k % 5 == 0) ? 1.0f : 0.0f; /* column-major identity */
             uint32_t u;
             memcpy(&u, &f, sizeof u);
             evr_put_le32(mats + (size_t)i * 64 + (size_t)k * 4, u);
         }
-    if (!(b64 = b64_encode(mats, (size_t)count * 64))) goto nomem;
-    if (!(elem = malloc(strlen(b64) + 128))) goto nomem;
-    for (i = 0, s = evr_jdoc_first(d, skins); s >= 0; s = evr_jdoc_next(d, s), i++) {
-        if (!need[i]) continue;
-        ins[nins].at = d->v[s].off + 1;
-        if (!(ins[nins].text = malloc(48))) goto nomem;
-        snprintf(ins[nins++].text, 48, "\"inverseBindMatrices\":%d,", acc_index);
+    if (!(b64 = b64_encode(mats, (size_t)count * 64)) || !(elem = malloc(strlen(b64) + 128)))
+        goto done;
+    for (int s = 0; s < c->num_skins; s++) {
+        char *t;
+        if (!need[s]) continue;
+        if (!(t = malloc(48))) goto done;
+        snprintf(t, 48, "\"inverseBindMatrices\":%d,", acc_index);
+        if (!add_edit(E, d->v[c->skin_v[s]].off + 1, 0, t)) goto done;
     }
     sprintf(elem, "{\"bufferView\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"MAT4\"}",
             view_index, count);
-    if (!add_to_array(d, root, "accessors", elem, &ins[nins++])) goto nomem;
+    if (!append_to_array(E, d, root, "accessors", elem)) goto done;
     sprintf(elem, "{\"buffer\":%d,\"byteLength\":%d}", buf_index, count * 64);
-    if (!add_to_array(d, root, "bufferViews", elem, &ins[nins++])) goto nomem;
+    if (!append_to_array(E, d, root, "bufferViews", elem)) goto done;
     sprintf(elem, "{\"byteLength\":%d,\"uri\":\"data:application/octet-stream;base64,%s\"}",
             count * 64, b64);
-    if (!add_to_array(d, root, "buffers", elem, &ins[nins++])) goto nomem;
-    qsort(ins, (size_t)nins, sizeof *ins, insertion_cmp);
+    ok = append_to_array(E, d, root, "buffers", elem);
+done:
+    free(mats);
+    free(b64);
+    free(elem);
+    return ok;
+}
 
+/* The file with the edits applied (sorted by place); a GLB keeps its BIN chunk (read from the
+ * file when the bytes hold only the JSON). */
+static evr_status apply_edits(const gltf_source *src, edits *E, const char *json, size_t jlen,
+                              unsigned char **out, size_t *nout, evr_error *err)
+{
+    unsigned char *file = NULL, *res;
+    const unsigned char *rest = NULL;
+    size_t nrest = 0, nfile = 0, total = jlen + 24, o, prev = 0;
+    int glb = src->nbytes >= 20 && !memcmp(src->bytes, "glTF", 4), i;
+    evr_status st;
+
+    qsort(E->e, (size_t)E->n, sizeof *E->e, edit_cmp);
     if (glb) { /* what follows the JSON chunk (the BIN chunk) */
         size_t end = 20 + (size_t)evr_get_le32(src->bytes + 12);
         size_t whole = evr_get_le32(src->bytes + 8); /* the GLB's length, from its header */
         if (src->nbytes < whole && src->path) {
-            if ((st = evr_import_read_file(src->path, 0, &file, &nfile, err)) != EVR_OK) goto done;
+            if ((st = evr_import_read_file(src->path, 0, &file, &nfile, err)) != EVR_OK) return st;
             if (nfile < end) {
-                st = evr_import_fail(err, EVR_ERR_FORMAT, "glTF: the GLB '%s' is cut short",
-                                     src->path);
-                goto done;
+                free(file);
+                return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: the GLB '%s' is cut short",
+                                       src->path);
             }
             rest = file + end;
             nrest = nfile - end;
@@ -292,18 +335,20 @@ static evr_status make_patch(const gltf_source *src, const evr_jdoc *d, int root
             nrest = src->nbytes - end;
         }
     }
-    total = jlen + nrest + 24;
-    for (i = 0; i < nins; i++) total += strlen(ins[i].text);
-    if (!(res = malloc(total + 4))) goto nomem;
+    total += nrest;
+    for (i = 0; i < E->n; i++) total += strlen(E->e[i].text);
+    if (!(res = malloc(total + 4))) {
+        free(file);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory patching the glTF");
+    }
     o = glb ? 20 : 0;
-    prev = 0;
-    for (i = 0; i < nins; i++) {
-        size_t n = strlen(ins[i].text);
-        memcpy(res + o, json + prev, ins[i].at - prev);
-        o += ins[i].at - prev;
-        memcpy(res + o, ins[i].text, n);
+    for (i = 0; i < E->n; i++) {
+        size_t n = strlen(E->e[i].text);
+        memcpy(res + o, json + prev, E->e[i].at - prev);
+        o += E->e[i].at - prev;
+        memcpy(res + o, E->e[i].text, n);
         o += n;
-        prev = ins[i].at;
+        prev = E->e[i].at + E->e[i].len;
     }
     memcpy(res + o, json + prev, jlen - prev);
     o += jlen - prev;
@@ -316,23 +361,17 @@ static evr_status make_patch(const gltf_source *src, const evr_jdoc *d, int root
         o += nrest;
         evr_put_le32(res + 8, (uint32_t)o);
     }
+    free(file);
     *out = res;
     *nout = o;
-    res = NULL;
-    st = EVR_OK;
-    goto done;
-nomem:
-    st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory patching the glTF");
-done:
-    for (i = 0; ins && i < nins; i++) free(ins[i].text);
-    free(ins);
-    free(mats);
-    free(b64);
-    free(elem);
-    free(file);
-    free(res);
-    return st;
+    return EVR_OK;
 }
+
+/* A mesh placed with another skin than its first node's (or with and without one) gets a copy
+ * of its own, per (mesh, skin) pair (quirk (n)): *index its index in the patched file. */
+typedef struct {
+    int mesh, skin, index;
+} mesh_copy;
 
 evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched, size_t *npatched,
                                  evr_error *err)
@@ -342,13 +381,16 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
     const char *json;
     size_t jlen;
     char version[16];
-    int root, n, ni = 0, m, max_patch = 0;
-    int *mesh_targets = NULL, *mesh_skin_checked = NULL;
+    int root, n, ni = 0, m, max_patch = 0, ncopies = 0;
+    int *mesh_targets = NULL, *mesh_skin_checked = NULL, *mesh_first_skin = NULL;
     unsigned char *need = NULL;
+    mesh_copy *copies = NULL;
+    edits E;
     evr_status st = EVR_OK;
 
     *patched = NULL;
     *npatched = 0;
+    memset(&E, 0, sizeof E);
     if (!evr_gltf_json_span(src->bytes, src->nbytes, &json, &jlen)) return EVR_OK;
     root = evr_jdoc_parse(&d, json, jlen);
     if (root < 0 || evr_jdoc_type(&d, root) != EVR_JDOC_OBJECT ||
@@ -375,22 +417,23 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
     c.skin_v = evr_jdoc_elements(&d, c.skins);
     mesh_targets = malloc(((size_t)c.num_meshes + 1) * sizeof *mesh_targets);
     mesh_skin_checked = malloc(((size_t)c.num_meshes + 1) * sizeof *mesh_skin_checked);
+    mesh_first_skin = malloc(((size_t)c.num_meshes + 1) * sizeof *mesh_first_skin);
+    copies = malloc(((size_t)evr_jdoc_count(&d, c.nodes) + 1) * sizeof *copies);
     need = calloc((size_t)c.num_skins + 1, 1);
-    if (!c.mesh_v || !c.skin_v || !mesh_targets || !mesh_skin_checked || !need) {
-        st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON");
-        goto done;
-    }
+    if (!c.mesh_v || !c.skin_v || !mesh_targets || !mesh_skin_checked || !mesh_first_skin ||
+        !copies || !need)
+        goto nomem;
     for (m = 0; m < c.num_meshes; m++) {
         char ml[128];
         label(&d, c.mesh_v[m], "mesh", m, ml, sizeof ml);
-        mesh_skin_checked[m] = -1;
+        mesh_skin_checked[m] = mesh_first_skin[m] = -2; /* -2: no node yet; -1: no skin */
         if ((mesh_targets[m] = check_mesh_targets(&c, c.mesh_v[m], ml)) < 0) {
             st = EVR_ERR_FORMAT;
             goto done;
         }
     }
     for (n = evr_jdoc_first(&d, c.nodes); n >= 0; n = evr_jdoc_next(&d, n), ni++) {
-        int s = index_of(&d, n, "skin"), nw, mv, sv, nj, no_ibm, p, pi = 0;
+        int s = index_of(&d, n, "skin"), nw, mv, sv, nj, no_ibm, p, pi = 0, k;
         char ml[128], nl[128], sl[128];
         m = index_of(&d, n, "mesh");
         if (m < 0 || m >= c.num_meshes) continue; /* Assimp reports a mesh that is not there */
@@ -404,13 +447,24 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
                                  nl, evr_jdoc_count(&d, nw), ml, mesh_targets[m]);
             goto done;
         }
-        if (evr_jdoc_get(&d, n, "skin") < 0) continue;
-        if (s < 0 || s >= c.num_skins) {
+        if (evr_jdoc_get(&d, n, "skin") >= 0 && (s < 0 || s >= c.num_skins)) {
             st = evr_import_fail(err, EVR_ERR_FORMAT,
                                  "glTF %s: its skin is not in the file's skins", nl);
             goto done;
         }
-        if (mesh_skin_checked[m] == s) continue; /* this mesh with this skin: checked */
+        if (mesh_first_skin[m] == -2) mesh_first_skin[m] = s;
+        else if (mesh_first_skin[m] != s) { /* quirk (n): this node gets a copy of the mesh */
+            int mn = evr_jdoc_get(&d, n, "mesh");
+            for (k = 0; k < ncopies && (copies[k].mesh != m || copies[k].skin != s); k++) continue;
+            if (k == ncopies) {
+                copies[k].mesh = m;
+                copies[k].skin = s;
+                copies[k].index = c.num_meshes + ncopies++;
+            }
+            if (!add_edit(&E, d.v[mn].off, d.v[mn].len, malloc(16))) goto nomem;
+            snprintf(E.e[E.n - 1].text, 16, "%d", copies[k].index);
+        }
+        if (s < 0 || mesh_skin_checked[m] == s) continue; /* unskinned, or checked */
         mesh_skin_checked[m] = s;
         sv = c.skin_v[s];
         label(&d, sv, "skin", s, sl, sizeof sl);
@@ -426,12 +480,36 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
              p = evr_jdoc_next(&d, p), pi++)
             if ((st = check_skin_weights(&c, p, pi, nj, ml, sl)) != EVR_OK) goto done;
     }
-    if (max_patch > 0)
-        st =
-            make_patch(src, &d, root, c.skins, need, max_patch, json, jlen, patched, npatched, err);
+    if (max_patch > 0 && !add_identity(&E, &d, root, &c, need, max_patch)) goto nomem;
+    if (ncopies) { /* the copies, in their order, after the file's meshes */
+        size_t len = 0, o = 0;
+        char *all;
+        int k;
+        for (k = 0; k < ncopies; k++) len += d.v[c.mesh_v[copies[k].mesh]].len + 1;
+        if (!(all = malloc(len + 1))) goto nomem;
+        for (k = 0; k < ncopies; k++) {
+            const evr_jdoc_value *v = &d.v[c.mesh_v[copies[k].mesh]];
+            if (k) all[o++] = ',';
+            memcpy(all + o, json + v->off, v->len);
+            o += v->len;
+        }
+        all[o] = 0;
+        if (!append_to_array(&E, &d, root, "meshes", all)) {
+            free(all);
+            goto nomem;
+        }
+        free(all);
+    }
+    if (E.n) st = apply_edits(src, &E, json, jlen, patched, npatched, err);
+    goto done;
+nomem:
+    st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON");
 done:
+    edits_free(&E);
     free(mesh_targets);
     free(mesh_skin_checked);
+    free(mesh_first_skin);
+    free(copies);
     free(need);
     free(c.mesh_v);
     free(c.skin_v);

@@ -52,9 +52,8 @@ typedef struct {
     int num_materials;
     float *emissive_strength; /* KHR_materials_emissive_strength, 1 when absent */
     float *t_extras; /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
-    int *node_mesh, *node_skin; /* per node: its mesh and skin index, -1 when none */
-    int *node_num_weights;      /* per node: the morph weights it gives (node.weights), 0: none */
-    float **node_weights;       /* per node: those weights, or NULL */
+    int *node_num_weights; /* per node: the morph weights it gives (node.weights), 0: none */
+    float **node_weights;  /* per node: those weights, or NULL */
 } gltf_side;
 
 /* A glTF index (a non-negative integer number), or -1. */
@@ -107,9 +106,10 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
 /* ---- glTF skins and morph targets before Assimp (import_gltf_deform.c) ---- */
 
 /* Checks what Assimp 5.2 would misread or crash on (quirks (j) to (n) in import.c): one error
- * naming the mesh. When a used skin has no inverseBindMatrices, *patched is a copy of the file
- * with identity matrices added, for Assimp to read instead (free()); else NULL. A document that
- * is not glTF 2.0 JSON passes unchecked (Assimp reports it). */
+ * naming the mesh. When a used skin has no inverseBindMatrices or a mesh is placed with two
+ * skins, *patched is a copy of the file for Assimp to read instead (identity matrices added, a
+ * copy of the mesh per further skin; free()); else NULL. A document that is not glTF 2.0 JSON
+ * passes unchecked (Assimp reports it). */
 evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched, size_t *npatched,
                                  evr_error *err);
 
