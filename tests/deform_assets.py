@@ -380,6 +380,72 @@ def bend_cylinder():
     return g.document(nodes, [mesh], [0, 1, 2], skins=skins, animations=anims)
 
 
+def _arm_part(g, x0, x1, rings, segments, shift, skin_weights):
+    """A tube from x0 to x1 (rings x segments, no caps) moved by -shift in x; skin_weights(x) gives
+    j1's weight, or None for no skin attributes. Returns the primitive."""
+    pos, nrm, idx, joints, weights = [], [], [], [], []
+    for i in range(rings):
+        x = x0 + (x1 - x0) * i / (rings - 1)
+        for j in range(segments):
+            a = 2 * math.pi * j / segments
+            pos.append((x - shift, 0.3 * math.cos(a), 0.3 * math.sin(a)))
+            nrm.append((0.0, math.cos(a), math.sin(a)))
+            if skin_weights:
+                w1 = skin_weights(x)
+                joints.append((0, 1, 0, 0))
+                weights.append((1.0 - w1, w1, 0.0, 0.0))
+    for i in range(rings - 1):
+        for j in range(segments):
+            a, b = i * segments + j, i * segments + (j + 1) % segments
+            idx += [a, b, b + segments, a, b + segments, a + segments]
+    attrs = {"POSITION": g.accessor(FLOAT, pos, minmax=True), "NORMAL": g.accessor(FLOAT, nrm)}
+    if skin_weights:
+        attrs["JOINTS_0"] = g.accessor(UBYTE, joints)
+        attrs["WEIGHTS_0"] = g.accessor(FLOAT, weights)
+    return {"attributes": attrs, "indices": g.accessor(UINT, idx), "material": 0}
+
+
+def bench_arm(skinned=True, rings=401, segments=64):
+    """For measuring what deformation costs: a grey tube (radius 0.3, x in [0, 2]) lit by a point
+    light, its half beyond x = 1 turning 90 degrees about +Z over 1 s around (1, 0, 0). skinned:
+    one mesh on joints j0, j1 (the bend over x in [0.95, 1.05]); else its rigid twin, the same
+    triangles as two meshes, the outer one on the turning node. 2 (rings - 1) segments
+    triangles either way."""
+    g = _Gltf()
+    rot = []
+    for deg in (0, 45, 90):
+        h = math.radians(deg) / 2
+        rot.append((0.0, 0.0, math.sin(h), math.cos(h)))
+    half = rings // 2 + 1
+    if skinned:
+        prim = _arm_part(g, 0.0, 2.0, rings, segments, 0.0,
+                         lambda x: min(1.0, max(0.0, (x - 0.95) / 0.1)))
+        meshes = [{"name": "arm", "primitives": [prim]}]
+        nodes = [_camera_node((1, 0.8, 6)), {"name": "arm", "mesh": 0, "skin": 0},
+                 {"name": "j0", "children": [3]}, {"name": "j1", "translation": [1, 0, 0]}]
+        ibm = [IDENTITY, (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1)]
+        skins = [{"joints": [2, 3], "inverseBindMatrices": g.accessor(FLOAT, ibm)}]
+        roots = [0, 1, 2, 4]
+    else:
+        inner = _arm_part(g, 0.0, 1.0, half, segments, 0.0, None)
+        outer = _arm_part(g, 1.0, 2.0, rings - half + 1, segments, 1.0, None)
+        meshes = [{"name": "upper", "primitives": [inner]}, {"name": "fore", "primitives": [outer]}]
+        nodes = [_camera_node((1, 0.8, 6)), {"name": "upper", "mesh": 0},
+                 {"name": "j0", "children": [3]}, {"name": "j1", "translation": [1, 0, 0], "mesh": 1}]
+        skins = None
+        roots = [0, 1, 2, 4]
+    nodes.append({"name": "light", "translation": [1, 3, 4],
+                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    anims = [_linear_channel(g, 3, "rotation", [0.0, 0.5, 1.0], rot)]
+    doc = g.document(nodes, meshes, roots, skins=skins, animations=anims)
+    doc["materials"] = [{"name": "grey", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.6, 0.6, 0.6, 1], "metallicFactor": 0, "roughnessFactor": 1}}]
+    doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"type": "point", "color": [1, 1, 1], "intensity": 60}]}}
+    return doc
+
+
 ASSETS = {f.__name__: f for f in (morph_slide, skin_slide, skin_slide8, bend_cylinder,
                                   bad_joint_index, bad_ibm_count, bad_morph_count,
                                   bad_weights_zero, morph_node_weights, morph_cubic, morph_step,
@@ -417,7 +483,15 @@ def write_all(outdir):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit("usage: deform_assets.py OUTDIR")
-    for path in write_all(sys.argv[1]).values():
-        print(path)
+    if len(sys.argv) == 3 and sys.argv[1] == "--bench":  # the benchmark pair (docs/benchmarks.md)
+        os.makedirs(sys.argv[2], exist_ok=True)
+        for name, skinned in (("bench_arm_skinned", True), ("bench_arm_rigid", False)):
+            path = os.path.join(sys.argv[2], name + ".gltf")
+            with open(path, "w") as f:
+                json.dump(bench_arm(skinned), f)
+            print(path)
+    elif len(sys.argv) == 2:
+        for path in write_all(sys.argv[1]).values():
+            print(path)
+    else:
+        sys.exit("usage: deform_assets.py OUTDIR | --bench OUTDIR")
