@@ -121,6 +121,16 @@ uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double 
     return i;
 }
 
+uint32_t evr_demo_mesh_vertex_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3],
+                                 double u, double v)
+{
+    double p[3];
+    p[0] = x * 0.001;
+    p[1] = y * 0.001;
+    p[2] = z * 0.001;
+    return evr_demo_mesh_vertex(m, p, n, u, v);
+}
+
 void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c)
 {
     double e1[3], e2[3], cr[3], ns = 0.0, l1 = 0.0, l2 = 0.0, lc = 0.0;

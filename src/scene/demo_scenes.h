@@ -32,6 +32,9 @@ typedef struct {
 
 uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u,
                               double v);
+/* The same with the position given in millimetres (stored in metres). */
+uint32_t evr_demo_mesh_vertex_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3],
+                                 double u, double v);
 /* Adds a triangle wound counter-clockwise around the mean of its vertex normals (so that the
  * geometric normal agrees with the shading normals); degenerate triangles are skipped. */
 void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c);
