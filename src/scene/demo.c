@@ -17,11 +17,11 @@ static const demo_entry demos[] = {
     {"eye", evr_demo_build_eye},         {"eye-drift", evr_demo_build_eye_drift},
     {"square", evr_demo_build_square},   {"disk", evr_demo_build_disk},
     {"cornell", evr_demo_build_cornell}, {"cornell-still", evr_demo_build_cornell_still},
-    {"city", evr_demo_build_city},
+    {"city", evr_demo_build_city},       {"blink", evr_demo_build_blink},
 };
 
-static const char *const demo_names[] = {"eye",     "eye-drift",     "square", "disk",
-                                         "cornell", "cornell-still", "city",   NULL};
+static const char *const demo_names[] = {"eye",           "eye-drift", "square", "disk", "cornell",
+                                         "cornell-still", "city",      "blink",  NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 
