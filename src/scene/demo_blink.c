@@ -35,7 +35,7 @@
  *                (demo_eye_parts.h), so the lids rest in [0, 0.40], [0.70, 1.45], [1.63, 2.50]
  *                and [2.80, 3.6] with bit-identical keys. Weight keys every 2 ms in blinks.
  *                The finger beckons twice (1.8 s each): joint angles about their X axis (towards
- *                the palm) 20 f(t), 65 f(t - 0.06) and 45 f(t - 0.12) degrees for MCP, PIP and
+ *                the palm) 10 f(t), 55 f(t - 0.06) and 35 f(t - 0.12) degrees for MCP, PIP and
  *                DIP, f(t) = (1 - cos(2 pi t / 1.8)) / 2; rotation keys every 1/60 s. */
 #include <math.h>
 #include <stdlib.h>
@@ -67,7 +67,7 @@
 #define FINGER_TIP_RINGS 12
 
 static const double joint_y[3] = {0.0, 28.0, 48.0};
-static const double joint_max_deg[3] = {20.0, 65.0, 45.0};
+static const double joint_max_deg[3] = {10.0, 55.0, 35.0};
 static const double joint_lag[3] = {0.0, 0.06, 0.12};
 
 typedef struct {
@@ -324,17 +324,17 @@ static int paint_finger(evr_gltf *g)
         }
     }
     evr_demo_image_apply(&im, ridge);
-    /* the nail on the back, from y = 51 to the tip, and its pale free edge */
-    evr_demo_image_stroke(&im, PX(1.0), PY(52.5), PX(1.0), PY(FINGER_TIP - 1.0), 0.09 * im.w,
-                          0.08 * im.w, 0.95, 0.95);
-    evr_demo_image_stroke(&im, PX(0.0), PY(52.5), PX(0.0), PY(FINGER_TIP - 1.0), 0.09 * im.w,
-                          0.08 * im.w, 0.95, 0.95);
-    evr_demo_image_apply(&im, nail);
-    evr_demo_image_stroke(&im, PX(1.0), PY(FINGER_TIP - 2.0), PX(1.0), PY(FINGER_TIP), 0.08 * im.w,
-                          0.07 * im.w, 0.9, 0.9);
-    evr_demo_image_stroke(&im, PX(0.0), PY(FINGER_TIP - 2.0), PX(0.0), PY(FINGER_TIP), 0.08 * im.w,
-                          0.07 * im.w, 0.9, 0.9);
-    evr_demo_image_apply(&im, nail_edge);
+    /* the nail on the back: 9.6 wide from a rounded base at y = 51 to a pale free edge */
+    for (y = 0; y < im.h; y++) {
+        double ymm = FINGER_BASE + (1.0 - (y + 0.5) / im.h) * len;
+        for (x = 0; x < im.w; x++) {
+            double u = (x + 0.5) / im.w, du = (u < 0.5 ? u : 1.0 - u) * around, e = du / 4.8;
+            double *px = im.rgb + 3 * ((size_t)y * (size_t)im.w + (size_t)x);
+            if (e >= 1.0 || ymm < 51.0 + 2.0 * e * e) continue;
+            for (k = 0; k < 3; k++)
+                px[k] = ymm > FINGER_TIP - 1.5 + 0.8 * e * e ? nail_edge[k] : nail[k];
+        }
+    }
 #undef PX
 #undef PY
     tex = evr_demo_image_texture(g, &im, "finger_texture");
