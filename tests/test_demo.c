@@ -1,6 +1,7 @@
 /* The built-in scenes: each is a valid GLB (header, chunk layout) that Assimp imports, from
  * memory and from a file, with the expected meshes, materials, textures, camera, lights and
- * animation; and it loads through evr_demo_load. */
+ * animation (the blink scene's bones and morph targets too); and it loads through
+ * evr_demo_load. */
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -143,6 +144,22 @@ static const expectation expected[] = {
      5.0,
      40000,
      80000},
+    {"blink", /* the eye's parts, lids deformed by morph targets, a skinned finger */
+     {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", "finger", NULL},
+     {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "finger", "orbit", NULL},
+     6,
+     "finger",
+     "blink_camera",
+     16.0f / 9.0f,
+     0.001f,
+     {0.012, 0.0, 0.130},
+     {0.012, 0.0, 0.0},
+     "lamp",
+     aiLightSource_POINT,
+     {"finger_mcp", "finger_pip", "finger_dip", NULL},
+     3.6,
+     40000,
+     45000},
 };
 
 static uint32_t rd_u32(const unsigned char *p)
@@ -318,6 +335,60 @@ static void check_scene(const struct aiScene *s, const expectation *e, int full)
     }
 }
 
+static const struct aiMesh *find_mesh(const struct aiScene *s, const char *name)
+{
+    unsigned i;
+    for (i = 0; i < s->mNumMeshes; i++)
+        if (strcmp(s->mMeshes[i]->mName.data, name) == 0) return s->mMeshes[i];
+    return NULL;
+}
+
+/* The blink scene's deformers as Assimp reads them: the finger's three bones (each vertex on at
+ * most two, weights summing to 1), the lids' morph targets (2 and 1) and their weight channels,
+ * keyed 0 at both ends (the animation loops). */
+static void check_blink_deformers(const struct aiScene *s)
+{
+    const struct aiMesh *finger = find_mesh(s, "finger"), *up = find_mesh(s, "upper_lid"),
+                        *lo = find_mesh(s, "lower_lid");
+    unsigned i, k;
+    CHECK(finger && up && lo);
+    if (!finger || !up || !lo) return;
+    CHECK(finger->mNumBones == 3);
+    if (finger->mNumBones == 3) {
+        double *sum = calloc(finger->mNumVertices, sizeof *sum);
+        unsigned *count = calloc(finger->mNumVertices, sizeof *count);
+        static const char *const bones[3] = {"finger_mcp", "finger_pip", "finger_dip"};
+        CHECK(sum && count);
+        for (i = 0; sum && count && i < 3; i++) {
+            const struct aiBone *b = finger->mBones[i];
+            int known = 0;
+            for (k = 0; k < 3; k++) known |= strcmp(b->mName.data, bones[k]) == 0;
+            CHECK(known);
+            for (k = 0; k < b->mNumWeights; k++) {
+                sum[b->mWeights[k].mVertexId] += b->mWeights[k].mWeight;
+                count[b->mWeights[k].mVertexId] += b->mWeights[k].mWeight > 0.0f;
+            }
+        }
+        for (i = 0; sum && count && i < finger->mNumVertices; i++) {
+            CHECK_NEAR(sum[i], 1.0, 1e-5);
+            CHECK(count[i] >= 1 && count[i] <= 2);
+        }
+        free(sum);
+        free(count);
+    }
+    CHECK(up->mNumAnimMeshes == 2 && lo->mNumAnimMeshes == 1);
+    CHECK(s->mNumAnimations == 1 && s->mAnimations[0]->mNumMorphMeshChannels == 2);
+    for (i = 0; s->mNumAnimations == 1 && i < s->mAnimations[0]->mNumMorphMeshChannels; i++) {
+        const struct aiMeshMorphAnim *c = s->mAnimations[0]->mMorphMeshChannels[i];
+        CHECK(c->mNumKeys > 100);
+        if (c->mNumKeys < 2) continue;
+        for (k = 0; k < c->mKeys[0].mNumValuesAndWeights; k++) {
+            CHECK(c->mKeys[0].mWeights[k] == 0.0);
+            CHECK(c->mKeys[c->mNumKeys - 1].mWeights[k] == 0.0);
+        }
+    }
+}
+
 /* Facts of the square scene that tests elsewhere derive analytic results from. */
 static void check_square_numbers(const struct aiScene *s)
 {
@@ -392,6 +463,7 @@ int main(void)
         if (!s) fprintf(stderr, "%s: Assimp: %s\n", e->name, aiGetErrorString());
         check_scene(s, e, 1);
         if (s && strcmp(e->name, "square") == 0) check_square_numbers(s);
+        if (s && strcmp(e->name, "blink") == 0) check_blink_deformers(s);
         aiReleaseImport(s);
 
         /* the same through a file, as `evray demo --export` writes it */

@@ -17,11 +17,11 @@ static const demo_entry demos[] = {
     {"eye", evr_demo_build_eye},         {"eye-drift", evr_demo_build_eye_drift},
     {"square", evr_demo_build_square},   {"disk", evr_demo_build_disk},
     {"cornell", evr_demo_build_cornell}, {"cornell-still", evr_demo_build_cornell_still},
-    {"city", evr_demo_build_city},
+    {"city", evr_demo_build_city},       {"blink", evr_demo_build_blink},
 };
 
-static const char *const demo_names[] = {"eye",     "eye-drift",     "square", "disk",
-                                         "cornell", "cornell-still", "city",   NULL};
+static const char *const demo_names[] = {"eye",           "eye-drift", "square", "disk", "cornell",
+                                         "cornell-still", "city",      "blink",  NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 
@@ -119,6 +119,16 @@ uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double 
     m->uv[2 * i + 1] = (float)v;
     m->nv++;
     return i;
+}
+
+uint32_t evr_demo_mesh_vertex_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3],
+                                 double u, double v)
+{
+    double p[3];
+    p[0] = x * 0.001;
+    p[1] = y * 0.001;
+    p[2] = z * 0.001;
+    return evr_demo_mesh_vertex(m, p, n, u, v);
 }
 
 void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c)

@@ -1,4 +1,4 @@
-/* The built-in scenes, each generated as a glTF document (demo_eye.c, demo_square.c), and the
+/* The built-in scenes, each generated as a glTF document (demo_eye.c, demo_blink.c, ...), and the
  * small mesh-building helpers they share (demo.c). Internal to the library. */
 #ifndef EVR_SCENE_DEMO_SCENES_H
 #define EVR_SCENE_DEMO_SCENES_H
@@ -16,6 +16,7 @@ void evr_demo_build_disk(evr_gltf *g);
 void evr_demo_build_cornell(evr_gltf *g);
 void evr_demo_build_cornell_still(evr_gltf *g);
 void evr_demo_build_city(evr_gltf *g);
+void evr_demo_build_blink(evr_gltf *g); /* morph-target lids and a skinned finger */
 
 /* The city (demo_city.c) at a tessellation detail and a building count: EVR_CITY_DETAIL,
  * EVR_CITY_BUILDINGS and evr_demo_city_load are in evray_experimental.h. */
@@ -32,6 +33,9 @@ typedef struct {
 
 uint32_t evr_demo_mesh_vertex(evr_demo_mesh *m, const double p[3], const double n[3], double u,
                               double v);
+/* The same with the position given in millimetres (stored in metres). */
+uint32_t evr_demo_mesh_vertex_mm(evr_demo_mesh *m, double x, double y, double z, const double n[3],
+                                 double u, double v);
 /* Adds a triangle wound counter-clockwise around the mean of its vertex normals (so that the
  * geometric normal agrees with the shading normals); degenerate triangles are skipped. */
 void evr_demo_mesh_triangle(evr_demo_mesh *m, uint32_t a, uint32_t b, uint32_t c);

@@ -1,7 +1,9 @@
 /* glTF 2.0 builder and GLB serializer. Objects that nothing refers back to (meshes, materials,
- * cameras, lights, images, accessors, buffer views) are written to their JSON arrays as soon as
- * they are added; nodes and animations are kept as structs because later calls change them
- * (children, channels), and are written by evr_gltf_glb. */
+ * skins, cameras, lights, images, accessors, buffer views) are written to their JSON arrays as
+ * soon as they are added; nodes and animations are kept as structs because later calls change
+ * them (children, skin, weights, channels), and are written by evr_gltf_glb, which first checks
+ * what only the whole document shows (a skinned mesh's node has a skin that covers its joints,
+ * node weights and weight channels match their mesh's targets). */
 #include "scene/gltf_writer.h"
 
 #include <math.h>
@@ -14,6 +16,8 @@
 
 #define GLTF_FLOAT 5126
 #define GLTF_UINT 5125
+#define GLTF_UBYTE 5121
+#define GLTF_USHORT 5123
 #define GLTF_ARRAY_BUFFER 34962
 #define GLTF_ELEMENT_ARRAY_BUFFER 34963
 #define GLTF_LINEAR 9729
@@ -31,13 +35,26 @@ typedef struct {
     int parent;
     float t[3], r[4], s[3];
     int has_t, has_r, has_s;
-    int mesh, camera, light;
+    int mesh, camera, light, skin;
+    float *weights; /* num_weights morph weights, or NULL */
+    int num_weights;
 } gnode;
+
+/* What a node's skin, weights and weight channels are checked against. */
+typedef struct {
+    int num_targets;
+    int max_joint; /* largest joint index of a non-zero weight; -1: not skinned */
+} gmesh;
+
+typedef struct {
+    int node, path;
+    int values; /* floats per key */
+} gtarget;
 
 typedef struct {
     char *name;
     sbuf channels, samplers;
-    int *targets; /* node * 3 + path of each channel, to refuse duplicates */
+    gtarget *targets; /* one per channel, to refuse duplicates */
     int num_targets, cap_targets;
 } ganim;
 
@@ -47,8 +64,12 @@ struct evr_gltf {
     char *scene_name;
     unsigned char *bin;
     size_t bin_n, bin_cap;
-    sbuf accessors, views, meshes, materials, textures, images, cameras, lights;
+    sbuf accessors, views, meshes, materials, textures, images, cameras, lights, skins;
     int has_sampler;
+    gmesh *mesh_info;  /* one per mesh */
+    int *skin_joints;  /* joint count of each skin */
+    int cap_mesh_info; /* (meshes.count and skins.count are the counts) */
+    int cap_skin_joints;
     gnode *nodes;
     int num_nodes, cap_nodes;
     ganim *anims;
@@ -259,11 +280,12 @@ static int add_accessor(evr_gltf *g, int view, int component, uint32_t count, co
     return g->status == EVR_OK ? a : -1;
 }
 
+/* ncomp 1 to 4 (SCALAR to VEC4) or 16 (MAT4). */
 static int float_accessor(evr_gltf *g, const float *v, uint32_t count, int ncomp, int target,
                           int with_bounds)
 {
     static const char *const types[5] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
-    float mn[4] = {0, 0, 0, 0}, mx[4] = {0, 0, 0, 0};
+    float mn[16] = {0}, mx[16] = {0};
     uint32_t i;
     int c;
     for (i = 0; i < count; i++) {
@@ -278,8 +300,8 @@ static int float_accessor(evr_gltf *g, const float *v, uint32_t count, int ncomp
         }
     }
     return add_accessor(g, add_view(g, v, (size_t)count * (size_t)ncomp * sizeof(float), 1, target),
-                        GLTF_FLOAT, count, types[ncomp], with_bounds ? mn : NULL,
-                        with_bounds ? mx : NULL, ncomp);
+                        GLTF_FLOAT, count, ncomp == 16 ? "MAT4" : types[ncomp],
+                        with_bounds ? mn : NULL, with_bounds ? mx : NULL, ncomp);
 }
 
 /* ---- public API ---- */
@@ -313,7 +335,13 @@ void evr_gltf_free(evr_gltf *g)
     sb_free(&g->images);
     sb_free(&g->cameras);
     sb_free(&g->lights);
-    for (i = 0; i < g->num_nodes; i++) free(g->nodes[i].name);
+    sb_free(&g->skins);
+    free(g->mesh_info);
+    free(g->skin_joints);
+    for (i = 0; i < g->num_nodes; i++) {
+        free(g->nodes[i].name);
+        free(g->nodes[i].weights);
+    }
     free(g->nodes);
     for (i = 0; i < g->num_anims; i++) {
         free(g->anims[i].name);
@@ -440,43 +468,265 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
                   const float *texcoords, uint32_t num_vertices, const uint32_t *indices,
                   uint32_t num_indices, int material)
 {
+    evr_gltf_mesh_desc d;
+    evr_gltf_mesh_desc_init(&d, name);
+    d.positions = positions;
+    d.normals = normals;
+    d.texcoords = texcoords;
+    d.num_vertices = num_vertices;
+    d.indices = indices;
+    d.num_indices = num_indices;
+    d.material = material;
+    return evr_gltf_add_mesh(g, &d);
+}
+
+void evr_gltf_mesh_desc_init(evr_gltf_mesh_desc *d, const char *name)
+{
+    memset(d, 0, sizeof *d);
+    d->name = name;
+    d->material = -1;
+}
+
+/* Checks JOINTS_0 / WEIGHTS_0 as glTF requires them and finds the largest joint index that
+ * carries weight. */
+static int check_skin_attributes(evr_gltf *g, const evr_gltf_mesh_desc *d, int *max_joint)
+{
+    uint32_t v;
+    int k, j;
+    *max_joint = -1;
+    for (v = 0; v < d->num_vertices; v++) {
+        const uint16_t *jv = d->joints + 4 * (size_t)v;
+        const float *wv = d->weights + 4 * (size_t)v;
+        double sum = 0.0;
+        for (k = 0; k < 4; k++) {
+            if (!(wv[k] >= 0.0f) || !isfinite(wv[k])) {
+                fail(g, EVR_ERR_ARG, "mesh \"%s\": vertex %lu has a negative or non-finite weight",
+                     d->name, (unsigned long)v);
+                return 0;
+            }
+            if (wv[k] == 0.0f) continue;
+            sum += wv[k];
+            for (j = 0; j < k; j++) {
+                if (jv[j] == jv[k] && wv[j] > 0.0f) {
+                    fail(g, EVR_ERR_ARG, "mesh \"%s\": vertex %lu gives joint %u two weights",
+                         d->name, (unsigned long)v, (unsigned)jv[k]);
+                    return 0;
+                }
+            }
+            if (jv[k] > *max_joint) *max_joint = jv[k];
+        }
+        if (!(fabs(sum - 1.0) <= 1e-5)) {
+            fail(g, EVR_ERR_ARG, "mesh \"%s\": the weights of vertex %lu sum to %g, not 1", d->name,
+                 (unsigned long)v, sum);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* JOINTS_0: unsigned bytes or little-endian unsigned shorts, 0 where the weight is 0. */
+static int joints_accessor(evr_gltf *g, const evr_gltf_mesh_desc *d, int max_joint)
+{
+    const int wide = max_joint > 255;
+    const size_t n = 4 * (size_t)d->num_vertices, size = n * (wide ? 2 : 1);
+    unsigned char *bytes = malloc(size);
+    size_t i;
+    int a;
+    if (!bytes) {
+        fail(g, EVR_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    for (i = 0; i < n; i++) {
+        unsigned j = d->weights[i] > 0.0f ? d->joints[i] : 0u;
+        if (wide) {
+            bytes[2 * i] = (unsigned char)(j & 0xff);
+            bytes[2 * i + 1] = (unsigned char)(j >> 8);
+        } else {
+            bytes[i] = (unsigned char)j;
+        }
+    }
+    a = add_accessor(g, add_view(g, bytes, size, 0, GLTF_ARRAY_BUFFER),
+                     wide ? GLTF_USHORT : GLTF_UBYTE, d->num_vertices, "VEC4", NULL, NULL, 4);
+    free(bytes);
+    return a;
+}
+
+int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d)
+{
+    const char *name = d->name;
     sbuf *b = &g->meshes;
-    int apos, anrm = -1, auv = -1, aidx, idx;
+    const uint32_t nv = d->num_vertices;
+    const size_t tstride = 3 * (size_t)nv;
+    int apos, anrm = -1, auv = -1, aidx, ajoints = -1, aweights = -1, idx, max_joint = -1, t;
+    int *acc_t = NULL; /* per target: POSITION accessor, then NORMAL accessor (or -1) */
     uint32_t i;
     if (!check_name(g, "mesh", name)) return -1;
-    if (!positions || !indices || num_vertices == 0 || num_indices == 0 || num_indices % 3 != 0) {
+    if (!d->positions || !d->indices || nv == 0 || d->num_indices == 0 || d->num_indices % 3 != 0) {
         fail(g, EVR_ERR_ARG, "mesh \"%s\": needs positions and a multiple of 3 indices", name);
         return -1;
     }
-    if (material < -1 || material >= g->materials.count) {
-        fail(g, EVR_ERR_ARG, "mesh \"%s\": no material %d", name, material);
+    if (d->material < -1 || d->material >= g->materials.count) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": no material %d", name, d->material);
         return -1;
     }
-    for (i = 0; i < num_indices; i++) {
-        if (indices[i] >= num_vertices) {
+    for (i = 0; i < d->num_indices; i++) {
+        if (d->indices[i] >= nv) {
             fail(g, EVR_ERR_ARG, "mesh \"%s\": index %lu out of range", name,
-                 (unsigned long)indices[i]);
+                 (unsigned long)d->indices[i]);
             return -1;
         }
     }
-    apos = float_accessor(g, positions, num_vertices, 3, GLTF_ARRAY_BUFFER, 1);
-    if (normals) anrm = float_accessor(g, normals, num_vertices, 3, GLTF_ARRAY_BUFFER, 0);
-    if (texcoords) auv = float_accessor(g, texcoords, num_vertices, 2, GLTF_ARRAY_BUFFER, 0);
-    aidx = add_accessor(
-        g,
-        add_view(g, indices, (size_t)num_indices * sizeof(uint32_t), 1, GLTF_ELEMENT_ARRAY_BUFFER),
-        GLTF_UINT, num_indices, "SCALAR", NULL, NULL, 1);
-    if (g->status != EVR_OK) return -1;
+    if (!d->joints != !d->weights) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": a skin needs both joints and weights", name);
+        return -1;
+    }
+    if (d->joints && !check_skin_attributes(g, d, &max_joint)) return -1;
+    if (d->num_targets < 0 || (d->num_targets > 0 && !d->target_positions) ||
+        (d->num_targets == 0 &&
+         (d->target_positions || d->target_normals || d->default_weights || d->target_names))) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": morph targets need num_targets and target_positions",
+             name);
+        return -1;
+    }
+    for (t = 0; t < d->num_targets; t++) {
+        if ((d->default_weights && !isfinite(d->default_weights[t])) ||
+            (d->target_names && !check_name(g, "morph target", d->target_names[t]))) {
+            fail(g, EVR_ERR_ARG, "mesh \"%s\": bad default weight or name of target %d", name, t);
+            return -1;
+        }
+    }
+    if (!grow_int(g, (void **)&g->mesh_info, sizeof *g->mesh_info, b->count + 1, &g->cap_mesh_info))
+        return -1;
+    if (d->num_targets > 0 && !(acc_t = malloc(sizeof(int) * 2 * (size_t)d->num_targets))) {
+        fail(g, EVR_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+
+    apos = float_accessor(g, d->positions, nv, 3, GLTF_ARRAY_BUFFER, 1);
+    if (d->normals) anrm = float_accessor(g, d->normals, nv, 3, GLTF_ARRAY_BUFFER, 0);
+    if (d->texcoords) auv = float_accessor(g, d->texcoords, nv, 2, GLTF_ARRAY_BUFFER, 0);
+    if (d->joints) {
+        ajoints = joints_accessor(g, d, max_joint);
+        aweights = float_accessor(g, d->weights, nv, 4, GLTF_ARRAY_BUFFER, 0);
+    }
+    for (t = 0; t < d->num_targets; t++) { /* a target's POSITION needs min and max */
+        acc_t[2 * t] = float_accessor(g, d->target_positions + (size_t)t * tstride, nv, 3,
+                                      GLTF_ARRAY_BUFFER, 1);
+        acc_t[2 * t + 1] = d->target_normals
+                               ? float_accessor(g, d->target_normals + (size_t)t * tstride, nv, 3,
+                                                GLTF_ARRAY_BUFFER, 0)
+                               : -1;
+    }
+    aidx = add_accessor(g,
+                        add_view(g, d->indices, (size_t)d->num_indices * sizeof(uint32_t), 1,
+                                 GLTF_ELEMENT_ARRAY_BUFFER),
+                        GLTF_UINT, d->num_indices, "SCALAR", NULL, NULL, 1);
+    if (g->status != EVR_OK) {
+        free(acc_t);
+        return -1;
+    }
     idx = sb_elem(g, b);
     sb_cat(g, b, "{\"name\":");
     sb_str(g, b, name);
     sb_printf(g, b, ",\"primitives\":[{\"attributes\":{\"POSITION\":%d", apos);
     if (anrm >= 0) sb_printf(g, b, ",\"NORMAL\":%d", anrm);
     if (auv >= 0) sb_printf(g, b, ",\"TEXCOORD_0\":%d", auv);
+    if (ajoints >= 0) sb_printf(g, b, ",\"JOINTS_0\":%d,\"WEIGHTS_0\":%d", ajoints, aweights);
     sb_printf(g, b, "},\"indices\":%d", aidx);
-    if (material >= 0) sb_printf(g, b, ",\"material\":%d", material);
-    sb_cat(g, b, ",\"mode\":4}]}");
-    return g->status == EVR_OK ? idx : -1;
+    if (d->material >= 0) sb_printf(g, b, ",\"material\":%d", d->material);
+    sb_cat(g, b, ",\"mode\":4");
+    for (t = 0; t < d->num_targets; t++) {
+        sb_printf(g, b, "%s{\"POSITION\":%d", t ? "," : ",\"targets\":[", acc_t[2 * t]);
+        if (acc_t[2 * t + 1] >= 0) sb_printf(g, b, ",\"NORMAL\":%d", acc_t[2 * t + 1]);
+        sb_cat(g, b, t + 1 == d->num_targets ? "}]" : "}");
+    }
+    sb_cat(g, b, "}]");
+    if (d->default_weights) {
+        sb_cat(g, b, ",\"weights\":");
+        sb_nums(g, b, d->default_weights, d->num_targets);
+    }
+    for (t = 0; d->target_names && t < d->num_targets; t++) {
+        sb_cat(g, b, t ? "," : ",\"extras\":{\"targetNames\":[");
+        sb_str(g, b, d->target_names[t]);
+        if (t + 1 == d->num_targets) sb_cat(g, b, "]}");
+    }
+    sb_cat(g, b, "}");
+    free(acc_t);
+    if (g->status != EVR_OK) return -1;
+    g->mesh_info[idx].num_targets = d->num_targets;
+    g->mesh_info[idx].max_joint = d->joints ? max_joint : -1;
+    return idx;
+}
+
+/* Whether node a is node n or one of its ancestors. */
+static int is_ancestor_or_self(const evr_gltf *g, int a, int n)
+{
+    for (; n >= 0; n = g->nodes[n].parent)
+        if (n == a) return 1;
+    return 0;
+}
+
+int evr_gltf_skin(evr_gltf *g, const char *name, const int *joints, int num_joints,
+                  const float *inverse_bind, int skeleton)
+{
+    sbuf *b = &g->skins;
+    int i, k, root, aibm = -1, idx;
+    if (!check_name(g, "skin", name)) return -1;
+    if (!joints || num_joints < 1 || skeleton < -1 || skeleton >= g->num_nodes) {
+        fail(g, EVR_ERR_ARG, "skin \"%s\": needs joints (and skeleton -1 or a node)", name);
+        return -1;
+    }
+    for (i = 0; i < num_joints; i++) {
+        if (joints[i] < 0 || joints[i] >= g->num_nodes) {
+            fail(g, EVR_ERR_ARG, "skin \"%s\": joint %d is no node", name, i);
+            return -1;
+        }
+        for (k = 0; k < i; k++) {
+            if (joints[k] == joints[i]) {
+                fail(g, EVR_ERR_ARG, "skin \"%s\": node \"%s\" is two joints", name,
+                     g->nodes[joints[i]].name);
+                return -1;
+            }
+        }
+    }
+    /* the closest common root: the nearest ancestor-or-self of the first joint above them all */
+    for (root = joints[0]; root >= 0; root = g->nodes[root].parent) {
+        for (i = 1; i < num_joints && is_ancestor_or_self(g, root, joints[i]); i++) continue;
+        if (i == num_joints) break;
+    }
+    if (root < 0) {
+        fail(g, EVR_ERR_ARG, "skin \"%s\": the joints have no common root node", name);
+        return -1;
+    }
+    if (skeleton >= 0 && !is_ancestor_or_self(g, skeleton, root)) {
+        fail(g, EVR_ERR_ARG, "skin \"%s\": skeleton \"%s\" is not above the joints' common root",
+             name, g->nodes[skeleton].name);
+        return -1;
+    }
+    for (i = 0; inverse_bind && i < num_joints; i++) {
+        const float *m = inverse_bind + 16 * (size_t)i; /* column-major: row 3 at 3, 7, 11, 15 */
+        if (m[3] != 0.0f || m[7] != 0.0f || m[11] != 0.0f || m[15] != 1.0f) {
+            fail(g, EVR_ERR_ARG, "skin \"%s\": inverse bind matrix %d: last row is not 0 0 0 1",
+                 name, i);
+            return -1;
+        }
+    }
+    if (!grow_int(g, (void **)&g->skin_joints, sizeof *g->skin_joints, b->count + 1,
+                  &g->cap_skin_joints))
+        return -1;
+    if (inverse_bind) aibm = float_accessor(g, inverse_bind, (uint32_t)num_joints, 16, 0, 0);
+    if (g->status != EVR_OK) return -1;
+    idx = sb_elem(g, b);
+    sb_cat(g, b, "{\"name\":");
+    sb_str(g, b, name);
+    if (aibm >= 0) sb_printf(g, b, ",\"inverseBindMatrices\":%d", aibm);
+    for (i = 0; i < num_joints; i++) sb_printf(g, b, i ? ",%d" : ",\"joints\":[%d", joints[i]);
+    sb_cat(g, b, "]");
+    if (skeleton >= 0) sb_printf(g, b, ",\"skeleton\":%d", skeleton);
+    sb_cat(g, b, "}");
+    if (g->status != EVR_OK) return -1;
+    g->skin_joints[idx] = num_joints;
+    return idx;
 }
 
 int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear,
@@ -562,7 +812,7 @@ int evr_gltf_node(evr_gltf *g, const char *name, int parent)
     n->name = dup_str(g, name);
     if (!n->name) return -1;
     n->parent = parent;
-    n->mesh = n->camera = n->light = -1;
+    n->mesh = n->camera = n->light = n->skin = -1;
     n->r[3] = 1.0f;
     n->s[0] = n->s[1] = n->s[2] = 1.0f;
     return g->num_nodes++;
@@ -641,6 +891,41 @@ void evr_gltf_node_light(evr_gltf *g, int node, int light)
     else n->light = light;
 }
 
+void evr_gltf_node_skin(evr_gltf *g, int node, int skin)
+{
+    gnode *n = node_ref(g, node);
+    if (!n) return;
+    if (skin < 0 || skin >= g->skins.count)
+        fail(g, EVR_ERR_ARG, "node \"%s\": no skin %d", n->name, skin);
+    else n->skin = skin;
+}
+
+void evr_gltf_node_weights(evr_gltf *g, int node, const float *weights, int count)
+{
+    gnode *n = node_ref(g, node);
+    float *w;
+    int i;
+    if (!n) return;
+    if (!weights || count < 1) {
+        fail(g, EVR_ERR_ARG, "node \"%s\": no weights", n->name);
+        return;
+    }
+    for (i = 0; i < count; i++) {
+        if (!isfinite(weights[i])) {
+            fail(g, EVR_ERR_ARG, "node \"%s\": non-finite weight", n->name);
+            return;
+        }
+    }
+    if (!(w = malloc(sizeof *w * (size_t)count))) {
+        fail(g, EVR_ERR_NOMEM, "out of memory");
+        return;
+    }
+    memcpy(w, weights, sizeof *w * (size_t)count);
+    free(n->weights);
+    n->weights = w;
+    n->num_weights = count;
+}
+
 int evr_gltf_animation(evr_gltf *g, const char *name)
 {
     ganim *a;
@@ -657,21 +942,31 @@ int evr_gltf_animation(evr_gltf *g, const char *name)
 void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, const float *times,
                       const float *values, int count, evr_gltf_interp interp)
 {
-    static const char *const paths[3] = {"translation", "rotation", "scale"};
+    static const char *const paths[4] = {"translation", "rotation", "scale", "weights"};
     ganim *a;
-    int ncomp, i, in, out, s, target;
+    gtarget *tg;
+    int ncomp, i, in, out, s;
     if (g->status != EVR_OK) return;
     if (animation < 0 || animation >= g->num_anims || node < 0 || node >= g->num_nodes ||
-        (int)path < 0 || (int)path > 2 || (interp != EVR_GLTF_LINEAR && interp != EVR_GLTF_STEP) ||
+        (int)path < 0 || (int)path > 3 || (interp != EVR_GLTF_LINEAR && interp != EVR_GLTF_STEP) ||
         !times || !values || count < 1) {
         fail(g, EVR_ERR_ARG, "channel: bad animation, node, path, interpolation or keys");
         return;
     }
     a = &g->anims[animation];
-    ncomp = path == EVR_GLTF_ROTATION ? 4 : 3;
-    target = node * 3 + (int)path;
+    if (path == EVR_GLTF_WEIGHTS) { /* one value per morph target of the node's mesh */
+        const int mesh = g->nodes[node].mesh;
+        ncomp = mesh >= 0 ? g->mesh_info[mesh].num_targets : 0;
+        if (ncomp < 1) {
+            fail(g, EVR_ERR_ARG, "animation \"%s\": node \"%s\" has no mesh with morph targets",
+                 a->name, g->nodes[node].name);
+            return;
+        }
+    } else {
+        ncomp = path == EVR_GLTF_ROTATION ? 4 : 3;
+    }
     for (i = 0; i < a->num_targets; i++) {
-        if (a->targets[i] == target) {
+        if (a->targets[i].node == node && a->targets[i].path == (int)path) {
             fail(g, EVR_ERR_ARG, "animation \"%s\": node \"%s\" has two %s channels", a->name,
                  g->nodes[node].name, paths[path]);
             return;
@@ -695,9 +990,15 @@ void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, 
     }
     if (!grow_int(g, (void **)&a->targets, sizeof *a->targets, a->num_targets + 1, &a->cap_targets))
         return;
-    a->targets[a->num_targets++] = target;
+    tg = &a->targets[a->num_targets++];
+    tg->node = node;
+    tg->path = (int)path;
+    tg->values = ncomp;
     in = float_accessor(g, times, (uint32_t)count, 1, 0, 1); /* input needs min/max */
-    out = float_accessor(g, values, (uint32_t)count, ncomp, 0, 0);
+    /* weights: SCALAR, the keys' values end to end (count x targets) */
+    out = path == EVR_GLTF_WEIGHTS
+              ? float_accessor(g, values, (uint32_t)count * (uint32_t)ncomp, 1, 0, 0)
+              : float_accessor(g, values, (uint32_t)count, ncomp, 0, 0);
     if (g->status != EVR_OK) return;
     s = sb_elem(g, &a->samplers);
     sb_printf(g, &a->samplers, "{\"input\":%d,\"output\":%d,\"interpolation\":\"%s\"}", in, out,
@@ -730,6 +1031,11 @@ static void put_node(evr_gltf *g, sbuf *j, int i)
     }
     if (!first) sb_cat(g, j, "]");
     if (n->mesh >= 0) sb_printf(g, j, ",\"mesh\":%d", n->mesh);
+    if (n->skin >= 0) sb_printf(g, j, ",\"skin\":%d", n->skin);
+    if (n->weights) {
+        sb_cat(g, j, ",\"weights\":");
+        sb_nums(g, j, n->weights, n->num_weights);
+    }
     if (n->camera >= 0) sb_printf(g, j, ",\"camera\":%d", n->camera);
     if (n->has_t) {
         sb_cat(g, j, ",\"translation\":");
@@ -756,6 +1062,38 @@ static void put_u32(unsigned char *p, uint32_t v)
     p[3] = (unsigned char)((v >> 24) & 0xff);
 }
 
+/* What only the whole document shows: skins, node weights and weight channels against the meshes
+ * their nodes place. */
+static void check_deform(evr_gltf *g)
+{
+    int i, k;
+    for (i = 0; i < g->num_nodes && g->status == EVR_OK; i++) {
+        const gnode *n = &g->nodes[i];
+        const gmesh *m = n->mesh >= 0 ? &g->mesh_info[n->mesh] : NULL;
+        if (n->skin >= 0 && (!m || m->max_joint < 0))
+            fail(g, EVR_ERR_ARG, "node \"%s\" has a skin but no skinned mesh", n->name);
+        else if (n->skin < 0 && m && m->max_joint >= 0)
+            fail(g, EVR_ERR_ARG, "node \"%s\": its mesh is skinned, the node needs a skin",
+                 n->name);
+        else if (n->skin >= 0 && m->max_joint >= g->skin_joints[n->skin])
+            fail(g, EVR_ERR_ARG, "node \"%s\": its mesh uses joint %d, its skin has %d", n->name,
+                 m->max_joint, g->skin_joints[n->skin]);
+        else if (n->weights && (!m || m->num_targets != n->num_weights))
+            fail(g, EVR_ERR_ARG, "node \"%s\": %d weights for %d morph targets", n->name,
+                 n->num_weights, m ? m->num_targets : 0);
+    }
+    for (i = 0; i < g->num_anims && g->status == EVR_OK; i++) {
+        for (k = 0; k < g->anims[i].num_targets; k++) {
+            const gtarget *t = &g->anims[i].targets[k];
+            const gnode *n = &g->nodes[t->node];
+            if (t->path == EVR_GLTF_WEIGHTS && g->mesh_info[n->mesh].num_targets != t->values)
+                fail(g, EVR_ERR_ARG,
+                     "animation \"%s\": node \"%s\" changed its mesh after its weights channel",
+                     g->anims[i].name, n->name);
+        }
+    }
+}
+
 evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
 {
     sbuf j = {NULL, 0, 0, 0};
@@ -767,6 +1105,7 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
     for (i = 0; i < g->num_anims && g->status == EVR_OK; i++)
         if (!g->anims[i].channels.count)
             fail(g, EVR_ERR_ARG, "animation \"%s\" has no channels", g->anims[i].name);
+    check_deform(g);
     if (g->status != EVR_OK) return evr_gltf_status(g, err);
 
     sb_cat(g, &j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"evray gltf_writer\"}");
@@ -797,6 +1136,7 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
         sb_cat(g, &j, "]");
     }
     put_array(g, &j, "meshes", &g->meshes);
+    put_array(g, &j, "skins", &g->skins);
     put_array(g, &j, "materials", &g->materials);
     put_array(g, &j, "textures", &g->textures);
     put_array(g, &j, "images", &g->images);

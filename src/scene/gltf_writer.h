@@ -37,7 +37,12 @@ typedef enum {
     EVR_GLTF_SPOT = 1,
     EVR_GLTF_DIRECTIONAL = 2
 } evr_gltf_light_type;
-typedef enum { EVR_GLTF_TRANSLATION = 0, EVR_GLTF_ROTATION = 1, EVR_GLTF_SCALE = 2 } evr_gltf_path;
+typedef enum {
+    EVR_GLTF_TRANSLATION = 0,
+    EVR_GLTF_ROTATION = 1,
+    EVR_GLTF_SCALE = 2,
+    EVR_GLTF_WEIGHTS = 3 /* morph target weights */
+} evr_gltf_path;
 typedef enum { EVR_GLTF_LINEAR = 0, EVR_GLTF_STEP = 1 } evr_gltf_interp;
 
 /* A metallic-roughness material; base_color is linear RGBA, multiplied by the texture. */
@@ -70,6 +75,44 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
                   const float *texcoords, uint32_t num_vertices, const uint32_t *indices,
                   uint32_t num_indices, int material);
 
+/* One triangle primitive that may deform: evr_gltf_mesh's arrays, and
+ *   skin         joints and weights (JOINTS_0, WEIGHTS_0), 4 per vertex: indices into the joints
+ *                of the skin that the mesh's node gives (evr_gltf_node_skin), and weights >= 0
+ *                summing to 1 (within 1e-5), a joint at most once with a non-zero weight; both
+ *                NULL: not skinned. Joints are stored as unsigned bytes when every index of a
+ *                non-zero weight is below 256, else as unsigned shorts; a joint whose weight is 0
+ *                is stored as 0 (as glTF recommends).
+ *   morph        num_targets targets, each a displacement of every vertex position
+ *   targets      (target_positions: 3 floats per vertex, target after target) and optionally of
+ *                every normal (target_normals, the same layout, or NULL); default_weights: the
+ *                mesh's weights (num_targets of them, or NULL: zeros); target_names: num_targets
+ *                names or NULL (written as mesh.extras.targetNames, the common convention).
+ * Morph targets apply before the skin (glTF's order). */
+typedef struct {
+    const char *name;
+    const float *positions, *normals, *texcoords;
+    uint32_t num_vertices;
+    const uint32_t *indices;
+    uint32_t num_indices;
+    int material; /* -1: none */
+    const uint16_t *joints;
+    const float *weights;
+    int num_targets;
+    const float *target_positions, *target_normals, *default_weights;
+    const char *const *target_names;
+} evr_gltf_mesh_desc;
+
+/* Defaults: nothing given, no material, not skinned, no morph targets. */
+void evr_gltf_mesh_desc_init(evr_gltf_mesh_desc *d, const char *name);
+int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d);
+
+/* A skin: joints are existing node indices, distinct, with a common root node (glTF's rule);
+ * inverse_bind holds 16 floats per joint (4x4, column-major as glTF stores them, last row
+ * 0 0 0 1) taking the mesh's coordinates into the joint's space at bind time, or NULL
+ * (identities); skeleton is the joints' closest common root or one of its ancestors, or -1. */
+int evr_gltf_skin(evr_gltf *g, const char *name, const int *joints, int num_joints,
+                  const float *inverse_bind, int skeleton);
+
 /* Perspective camera; yfov in radians; aspect <= 0: not given; zfar <= 0: infinite. */
 int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, float znear,
                     float zfar);
@@ -87,9 +130,17 @@ void evr_gltf_node_scale(evr_gltf *g, int node, float x, float y, float z);
 void evr_gltf_node_mesh(evr_gltf *g, int node, int mesh);
 void evr_gltf_node_camera(evr_gltf *g, int node, int camera);
 void evr_gltf_node_light(evr_gltf *g, int node, int light);
+/* Skins the node's mesh, which must be skinned (evr_gltf_mesh_desc.joints) with joint indices
+ * below the skin's joint count; glTF ignores the transform of a skinned mesh's node (the joints
+ * place it), so leave it at the identity. A skinned mesh's node needs a skin. */
+void evr_gltf_node_skin(evr_gltf *g, int node, int skin);
+/* The node's morph weights, one per target of its mesh; without them the mesh's default
+ * weights apply. */
+void evr_gltf_node_weights(evr_gltf *g, int node, const float *weights, int count);
 
 /* An animation, then its channels: one sampler each, count keys with strictly increasing times
- * (seconds, >= 0) and values 3 (translation, scale) or 4 (rotation x y z w) floats per key. */
+ * (seconds, >= 0) and values 3 (translation, scale), 4 (rotation x y z w) or, for weights, one
+ * per morph target of the node's mesh (set before the channel) floats per key. */
 int evr_gltf_animation(evr_gltf *g, const char *name);
 void evr_gltf_channel(evr_gltf *g, int animation, int node, evr_gltf_path path, const float *times,
                       const float *values, int count, evr_gltf_interp interp);
