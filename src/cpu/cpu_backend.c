@@ -38,6 +38,7 @@ typedef struct {
      * by the node's motion keys. */
     evr_instance_groups groups;
     RTCScene *group_scenes;
+    int *deform_keys_set; /* per group: the keys a deforming group's vertices have (0: none) */
     RTCScene top;
     int time_grid; /* the segment's motion keys split it into this many equal intervals (1: none moves) */
     int gi;        /* global illumination on */
@@ -585,7 +586,12 @@ static int update_deform(cpu_backend *b, int g, const evr_segment *seg)
 {
     const int d = b->host.instances[b->groups.members[b->groups.group_first[g]]].deform;
     const evr_deform_view *v = &seg->deforms[d];
+    if (v->num_keys - 1 > b->time_grid) b->time_grid = v->num_keys - 1;
+    /* one key, the same bits as the one it has: nothing to rebuild */
+    if (b->deform_keys_set[g] == 1 && v->num_keys == 1 && !seg->deform_moved[d]) return 1;
+    b->deform_keys_set[g] = v->num_keys;
     RTCGeometry geom = rtcGetGeometry(b->group_scenes[g], 0);
+    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
     rtcSetGeometryTimeStepCount(geom, (unsigned)v->num_keys);
     for (int k = 0; k < v->num_keys; k++) {
         float *vb = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)k,
@@ -597,7 +603,6 @@ static int update_deform(cpu_backend *b, int g, const evr_segment *seg)
     rtcCommitGeometry(geom);
     rtcCommitScene(b->group_scenes[g]);
     rtcCommitGeometry(rtcGetGeometry(b->top, (unsigned)g)); /* its instance's bounds changed */
-    if (v->num_keys - 1 > b->time_grid) b->time_grid = v->num_keys - 1;
     return 1;
 }
 
@@ -775,6 +780,7 @@ static void cpu_release(evr_backend *base)
             if (b->group_scenes[i]) rtcReleaseScene(b->group_scenes[i]);
     }
     free(b->group_scenes);
+    free(b->deform_keys_set);
     evr_instance_groups_free(&b->groups);
     if (b->device) rtcReleaseDevice(b->device);
     if (b->tile_events) {
@@ -838,7 +844,8 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
         return 0;
     }
     b->group_scenes = calloc((size_t)gr->num_groups + 1, sizeof *b->group_scenes);
-    if (!b->group_scenes) ok = 0;
+    b->deform_keys_set = calloc((size_t)gr->num_groups + 1, sizeof *b->deform_keys_set);
+    if (!b->group_scenes || !b->deform_keys_set) ok = 0;
     for (g = 0; ok && g < gr->num_groups; g++) {
         RTCScene sc;
         if (gr->group_kind[g] ==
@@ -866,7 +873,10 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
             break;
         }
         b->group_scenes[g] = sc;
-        rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+        /* a deforming group is rebuilt every segment it moves: a quicker build */
+        const int dynamic = gr->group_kind[g] == EVR_GROUP_DEFORMING;
+        if (dynamic) rtcSetSceneFlags(sc, RTC_SCENE_FLAG_DYNAMIC);
+        rtcSetSceneBuildQuality(sc, dynamic ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
         for (j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[gr->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
