@@ -80,7 +80,6 @@ def check_file(tmp, side):
     t = ev["t"] * 1e-6
     n = len(ev)
     phases = side["phases"]
-    print(f"{NAME}: {name}: {n} events")
     T.check(n >= MIN_EVENTS_PHASE * len(phases), f"{name}: events where the mesh moves ({n})")
     if n == 0:
         return
@@ -94,6 +93,7 @@ def check_file(tmp, side):
 
     # where: nothing in the background
     bg = int(np.sum(~inside(ev, side["object_box"], PAD)))
+    print(f"{NAME}: {name}: {n} events, {early} before the motion, {late} after, {bg} in the background")
     T.check(bg <= OUTSIDE_SHARE * n, f"{name}: no events outside the object's box {side['object_box']} ({bg})")
 
     for ph in phases:
@@ -119,6 +119,8 @@ def check_file(tmp, side):
         T.check(int(still_only.sum()) >= 100,
                 f"{label}: the still region the test watches is large enough ({int(still_only.sum())} px)")
         quiet = int(np.sum(still_only[e["y"].astype(int), e["x"].astype(int)]))
+        print(f"{NAME}: {label}: {k} events, {first} in its first half, {int(np.sum(moving))} in the "
+              f"moving box, {quiet} in the still part ({int(still_only.sum())} px)")
         T.check(quiet <= OUTSIDE_SHARE * k, f"{label}: no events in the part that stays still ({quiet} of {k})")
 
 
