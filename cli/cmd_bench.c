@@ -516,7 +516,7 @@ static int bench_usage(void)
         "memory, and the share of the wall time spent rendering, sorting, copying and writing\n"
         "(writing runs on its own thread, overlapping rendering).\n"
         "Render options are those of evray render (--res, --samples-per-frame, --duration,\n"
-        "--backend, --format, --no-skip, ...). With change-driven sampling (the default) the row\n"
+        "--backend, --format, --no-skip, --animation, ...). With change-driven sampling (the default) the row\n"
         "also gives the share of pixel-segments skipped, the samples actually traced and the\n"
         "equivalent samples/s (samples brute force takes / wall time; samples/s is that figure).\n"
         "With --sampling adaptive, samples are those taken (every one traced): the row adds\n"
@@ -562,7 +562,8 @@ int cmd_bench(int argc, char **argv)
 {
     evr_config cfg;
     render_options ro;
-    const char *scene_path = NULL, *demo = "eye", *suite = NULL, *sweep = NULL, *v;
+    const char *scene_path = NULL, *demo = "eye", *suite = NULL, *sweep = NULL, *v,
+               *animation = NULL;
     int json = 0, keep = 0, i, r, set_res = 0, set_spf = 0, set_fps = 0, set_dur = 0, max_w = 1280,
         max_h = 720;
     int set_scene = 0, vs_brute = 0;
@@ -585,6 +586,11 @@ int cmd_bench(int argc, char **argv)
         else if (opt_is(a, "--scene")) {
             set_scene = 1;
             if (!(demo = opt_value(argc, argv, &i, "--scene"))) {
+                render_options_free(&ro);
+                return 2;
+            }
+        } else if ((r = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {
+            if (r < 0) {
                 render_options_free(&ro);
                 return 2;
             }
@@ -650,8 +656,8 @@ int cmd_bench(int argc, char **argv)
             cli_error("--suite: unknown suite '%s' (seed)", suite);
             return 2;
         }
-        if (scene_path || set_scene) {
-            cli_error("--suite seed runs the eye scene; drop --scene/SCENE");
+        if (scene_path || set_scene || animation) {
+            cli_error("--suite seed runs the eye scene; drop --scene/SCENE/--animation");
             return 2;
         }
         if (set_spf || set_fps) {
@@ -673,8 +679,9 @@ int cmd_bench(int argc, char **argv)
             cli_error("--sweep: unknown kind '%s' (res, samples, triangles, instances)", sweep);
             return 2;
         }
-        if (city_sweep && (scene_path || set_scene)) {
-            cli_error("--sweep %s grows the city scene itself; drop --scene/SCENE", sweep);
+        if (city_sweep && (scene_path || set_scene || animation)) {
+            cli_error("--sweep %s grows the city scene itself; drop --scene/SCENE/--animation",
+                      sweep);
             return 2;
         }
         if (!strcmp(sweep, "res") && set_res) {
@@ -692,7 +699,8 @@ int cmd_bench(int argc, char **argv)
         cfg.out_dir = NULL;
         return run_city_sweep(&cfg, sweep, dir, max_detail, max_buildings);
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo);
+    /* the row goes to stdout; the loader's notice (clips left out) to stderr */
+    evr_scene *scene = cli_load_scene(scene_path, demo, animation, 0);
     if (!scene) return 1;
     int rc;
     if (suite) {

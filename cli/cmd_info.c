@@ -1,5 +1,6 @@
 #include "commands.h"
 #include "evray.h"
+#include "options.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,14 +8,20 @@
 
 int cmd_info(int argc, char **argv)
 {
-    const char *path = NULL;
-    int i;
+    const char *path = NULL, *animation = NULL;
+    int i, r;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            puts(
-                "usage: evray info SCENE\n\nDescribes a scene as evray imports it: cameras, lights, animations and\n"
-                "their time ranges, meshes, instances and triangles.");
+            fputs(
+                "usage: evray info SCENE [--animation CLIP]\n\nDescribes a scene as evray imports it: cameras, lights, animation clips (each\n"
+                "one's duration, as --duration takes it, and whether it plays), animated nodes and\n"
+                "their time ranges, meshes, instances and triangles.\n\n" CLI_ANIMATION_HELP,
+                stdout);
             return 0;
+        }
+        if ((r = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {
+            if (r < 0) return 2;
+            continue;
         }
         if (argv[i][0] == '-') {
             fprintf(stderr, "evray: error: info: unknown option '%s'\n", argv[i]);
@@ -30,12 +37,9 @@ int cmd_info(int argc, char **argv)
         fprintf(stderr, "evray: error: info needs a scene file (evray info SCENE)\n");
         return 2;
     }
-    evr_scene *s = NULL;
-    evr_error err = {{0}};
-    if (evr_scene_load(path, &s, &err) != EVR_OK) {
-        fprintf(stderr, "evray: error: %s\n", err.msg);
-        return 1;
-    }
+    /* quiet: the description says which clips play and why the others do not */
+    evr_scene *s = cli_load_scene(path, NULL, animation, 1);
+    if (!s) return 1;
     char *text = evr_scene_describe(s);
     if (text) fputs(text, stdout);
     free(text);

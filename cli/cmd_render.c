@@ -54,7 +54,8 @@ static void help(void)
           "\n"
           "Renders SCENE over time with every pixel sampling at its own times and writes the\n"
           "time-sorted DVS events, previews and run.json into the run folder.\n"
-          "\n",
+          "\n"
+          "scene:\n" CLI_ANIMATION_HELP,
           stdout);
     if (options) fputs(options, stdout); /* made from the configuration table */
     free(options);
@@ -64,7 +65,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
 {
     evr_config cfg;
     render_options ro;
-    const char *scene_path = NULL;
+    const char *scene_path = NULL, *animation = NULL;
     int quiet, i, r;
     evr_config_defaults(&cfg);
     if (!render_options_init(&ro, &cfg, 0, argc)) return 1;
@@ -74,6 +75,10 @@ int cmd_render(int argc, char **argv, const char *default_demo)
             help();
             render_options_free(&ro);
             return 0;
+        } else if ((r = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {
+            if (r > 0) continue;
+            render_options_free(&ro);
+            return 2;
         } else if ((r = parse_render_option(argc, argv, &i, &ro)) < 0) {
             render_options_free(&ro);
             return 2;
@@ -100,7 +105,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         return 2;
     }
 
-    evr_scene *scene = cli_load_scene(scene_path, default_demo);
+    evr_scene *scene = cli_load_scene(scene_path, default_demo, animation, quiet);
     if (!scene) return 1;
     evr_error err = {{0}};
     evr_status st;

@@ -26,6 +26,9 @@ static void help(void)
         "  --time T               seconds into the animation (default 0)\n"
         "  --res WxH              resolution (default 256x256)\n"
         "  --camera NAME          camera of the scene (default: the first)\n"
+        "  --animation CLIP       animation clips that play: a clip's name or 0-based index alone,\n"
+        "                         or all (default: clips that animate disjoint nodes play\n"
+        "                         together, the later of two sharing a node does not)\n"
         "  --gi MODE              none (default: direct light only), photon (image-space photon\n"
         "                         mapping) or path (brute-force path tracing: the reference)\n"
         "  --spp N                path: paths per pixel (default 64)\n"
@@ -202,9 +205,9 @@ int cmd_still(int argc, char **argv)
     evr_still_params p;
     const char *scene_path = NULL, *demo = NULL, *out = NULL, *pfm = NULL, *ref_path = NULL,
                *region = NULL, *v;
-    const char *cmp_path = NULL;
+    const char *cmp_path = NULL, *animation = NULL;
     float exposure = 1.0f;
-    int quiet = 0, i;
+    int quiet = 0, i, ar;
     evr_still_defaults(&p);
 #define VAL(name)                                             \
     do {                                                      \
@@ -250,6 +253,8 @@ int cmd_still(int argc, char **argv)
         } else if (opt_is(a, "--camera")) {
             VAL("--camera");
             p.camera = v;
+        } else if ((ar = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {
+            if (ar < 0) return 2;
         } else if (opt_is(a, "--gi")) {
             VAL("--gi");
             if (!strcmp(v, "none")) p.gi = EVR_GI_NONE;
@@ -396,7 +401,7 @@ int cmd_still(int argc, char **argv)
             return 2;
         }
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo);
+    evr_scene *scene = cli_load_scene(scene_path, demo, animation, quiet);
     if (!scene) {
         free(ref);
         free(cmp);

@@ -71,14 +71,35 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
     return argv[*i];
 }
 
-evr_scene *cli_load_scene(const char *path, const char *demo)
+evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet)
 {
     evr_error err = {{0}};
     evr_scene *scene = NULL;
-    evr_status st = path ? evr_scene_load(path, &scene, &err) : evr_demo_load(demo, &scene, &err);
+    evr_load_options opts;
+    evr_status st;
+    evr_load_options_defaults(&opts);
+    opts.animation = animation;
+    if (path) {
+        st = evr_scene_load_with(path, &opts, &scene, &err);
+    } else { /* a built-in scene goes through the same importer, from memory */
+        void *glb = NULL;
+        size_t n = 0;
+        st = evr_demo_glb(demo, &glb, &n, &err);
+        if (st == EVR_OK) st = evr_scene_load_memory_with(glb, n, "glb", &opts, &scene, &err);
+        free(glb);
+    }
     if (st != EVR_OK) {
         cli_error("%s", err.msg);
         return NULL;
     }
+    const char *notice = evr_scene_notice(scene);
+    if (notice && !quiet) fprintf(stderr, "evray: note: %s\n", notice);
     return scene;
+}
+
+int cli_is_animation_option(int argc, char **argv, int *i, const char **animation)
+{
+    if (!opt_is(argv[*i], "--animation")) return 0;
+    *animation = opt_value(argc, argv, i, "--animation");
+    return *animation ? 1 : -1;
 }

@@ -20,8 +20,18 @@ int opt_is(const char *arg, const char *name);
 
 void cli_error(const char *fmt, ...);
 
-/* The scene file at path, else the built-in scene demo; NULL (after the error message) when it
- * cannot be loaded. */
-evr_scene *cli_load_scene(const char *path, const char *demo);
+/* The scene file at path, else the built-in scene demo, with --animation's choice (NULL: the
+ * default rule); prints the loader's notice unless quiet. NULL (after the error message) when
+ * it cannot be loaded, a clip the file does not have included. */
+evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet);
+/* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when
+ * argv[*i] is another argument, -1 after an error message. */
+int cli_is_animation_option(int argc, char **argv, int *i, const char **animation);
+/* The help line of --animation, for every command that loads a scene. */
+#define CLI_ANIMATION_HELP                                                                     \
+    "  --animation CLIP           animation clips that play: a clip's name or 0-based index\n" \
+    "                             alone, or all (default: clips that animate disjoint nodes\n" \
+    "                             play together, the later of two sharing a node does not;\n"  \
+    "                             evray info SCENE lists them)\n"
 
 #endif

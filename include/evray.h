@@ -41,11 +41,47 @@ typedef struct {
 /* ---- scenes ---- */
 typedef struct evr_scene evr_scene;
 
-/* Loads any format Assimp reads (glTF 2.0 .gltf/.glb first of all). */
+/* Loads any format Assimp reads (glTF 2.0 .gltf/.glb first of all), with the default load
+ * options (evr_load_options_defaults). */
 evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err);
 /* Loads from memory; hint is the file extension ("glb", "gltf", "obj", ...). */
 evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out,
                                  evr_error *err);
+
+/* How a scene is loaded. Make one with evr_load_options_defaults and change the fields you need;
+ * size works as evr_config's does (fields are only ever added at the end; a size the library
+ * does not know is refused with EVR_ERR_ARG). Strings are read during the load, not kept.
+ *
+ * animation: which of the file's animation clips play. Every played clip runs from time 0 with
+ * its keys at the times the file gives them.
+ *   NULL or "" (the default): clips that animate disjoint sets of nodes play together. Clips are
+ *     taken in file order, and a clip is taken when it animates no node that an already taken
+ *     clip animates; the others do not play, and evr_scene_notice names them. A clip animates
+ *     the nodes its transform channels name, and those its morph-weight and mesh channels name
+ *     (a node of that name, else the nodes that place a mesh of that name). So one clip per
+ *     object (as Blender exports) all play, and of walk/run/idle clips of one character only the
+ *     first plays.
+ *   "all": every clip plays; where two clips animate the same property, the first one's keys
+ *     are used.
+ *   a clip's name, else its 0-based index in the file ("2"): that clip alone. "all" is always
+ *     the keyword (name such a clip by index). A name or index the file does not have fails
+ *     with EVR_ERR_ARG and a message listing the clips. */
+typedef struct {
+    size_t size; /* sizeof(evr_load_options) as the caller sees it: set by the defaults */
+    const char *animation;
+} evr_load_options;
+
+void evr_load_options_init(evr_load_options *o, size_t size);
+#define evr_load_options_defaults(o) evr_load_options_init((o), sizeof(evr_load_options))
+/* evr_scene_load and evr_scene_load_memory with options (NULL: the defaults). */
+evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, evr_scene **out,
+                               evr_error *err);
+evr_status evr_scene_load_memory_with(const void *data, size_t size, const char *hint,
+                                      const evr_load_options *opts, evr_scene **out,
+                                      evr_error *err);
+/* One line the loader has for the user (e.g. the animation clips that do not play by the
+ * default rule), or NULL when it has nothing to say. Valid while the scene lives. */
+const char *evr_scene_notice(const evr_scene *s);
 /* Names of the built-in scenes, NULL-terminated. */
 const char *const *evr_demo_names(void);
 /* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
@@ -54,7 +90,8 @@ evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *e
 evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err);
 void evr_scene_release(evr_scene *s);
 
-/* A human-readable description (cameras, lights, animations and time ranges, meshes, triangles);
+/* A human-readable description (cameras, lights, animation clips and whether each plays,
+ * animations and time ranges, meshes, triangles);
  * free the returned string with free(). */
 char *evr_scene_describe(const evr_scene *s);
 

@@ -46,7 +46,7 @@ struct evr_sim {
     struct evr_par_pool *par; /* threads for the passes over a segment's events (par_pool.h) */
     int *node_used;
     evr_skip_tracker skip;
-    evr_deform_tracker deform; /* the planner thread's, like skip */
+    evr_deform_tracker deform;     /* the planner thread's, like skip */
     uint32_t *skipped_per_segment; /* pixels that traced nothing, per segment */
     /* events */
     evr_event_vec pending, scratch;

@@ -165,6 +165,69 @@ def quad_gltf(path, with_triangles=True, animated=False):
         json.dump(g, f)
 
 
+def clips_gltf(path, clips):
+    """Two lit grey quads facing +Z, "a" at x = -1.2 and "b" at x = +1.2 (0.8 wide), seen by a
+    camera at z = 6, and animation clips: clips is a list of (name, channels), each channel
+    (node name, path, key times, flat values) with path translation or scale."""
+    blob = b""
+    views, accessors = [], []
+
+    def accessor(fmt_count, values, typ, extra=None):
+        nonlocal blob
+        data = struct.pack("<%d%s" % (len(values), fmt_count), *values)
+        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+        blob += data + b"\0" * (-len(data) % 4)
+        a = {"bufferView": len(views) - 1, "componentType": 5126 if fmt_count == "f" else 5123,
+             "count": len(values) // {"SCALAR": 1, "VEC3": 3}[typ], "type": typ}
+        a.update(extra or {})
+        accessors.append(a)
+        return len(accessors) - 1
+
+    pos = accessor("f", [-0.4, -0.4, 0, 0.4, -0.4, 0, 0.4, 0.4, 0, -0.4, 0.4, 0], "VEC3",
+                   {"min": [-0.4, -0.4, 0], "max": [0.4, 0.4, 0]})
+    idx = accessor("H", [0, 1, 2, 0, 2, 3], "SCALAR")
+    names = {"a": 1, "b": 2}
+    animations = []
+    for name, channels in clips:
+        samplers, chans = [], []
+        for node, prop, times, values in channels:
+            t = accessor("f", times, "SCALAR", {"min": [min(times)], "max": [max(times)]})
+            samplers.append({"input": t, "output": accessor("f", values, "VEC3"), "interpolation": "LINEAR"})
+            chans.append({"sampler": len(samplers) - 1, "target": {"node": names[node], "path": prop}})
+        animations.append({"name": name, "samplers": samplers, "channels": chans})
+    g = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 6]},
+                  {"name": "a", "mesh": 0, "translation": [-1.2, 0, 0]},
+                  {"name": "b", "mesh": 0, "translation": [1.2, 0, 0]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+        "bufferViews": views,
+        "accessors": accessors,
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],
+        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": pos}, "indices": idx, "material": 0}]}],
+        "animations": animations,
+    }
+    with open(path, "w") as f:
+        json.dump(g, f)
+
+
+def read_pfm(path):
+    """A PFM image (evray still writes them): width, height and the RGB floats in the file's
+    order, rows bottom to top."""
+    with open(path, "rb") as f:
+        data = f.read()
+    head = data.split(b"\n", 3)
+    check(head[0] == b"PF", f"{path}: PFM magic")
+    w, h = map(int, head[1].split())
+    check(float(head[2]) < 0, f"{path}: little-endian scale")
+    px = struct.unpack(f"<{w * h * 3}f", head[3][: w * h * 12])
+    return w, h, px
+
+
 def square_crossings(ev, w, h, c_on, c_off):
     """The built-in 'square' scene's events against its analytic crossings (tests/test_square.py
     derives them): the pixels checked, how many of them have the wrong number of ON or OFF events,

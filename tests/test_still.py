@@ -3,22 +3,10 @@ box at a tiny size, PFM output, the comparison, material extras, and bad input."
 import json
 import os
 import re
-import struct
 
 import evrtest as T
 
 tmp = T.tmpdir()
-
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    head = data.split(b"\n", 3)
-    T.check(head[0] == b"PF", f"{path}: PFM magic")
-    w, h = map(int, head[1].split())
-    T.check(float(head[2]) < 0, f"{path}: little-endian scale")
-    px = struct.unpack(f"<{w * h * 3}f", head[3][: w * h * 12])
-    return w, h, px
 
 
 def mean_lum(px):
@@ -40,7 +28,7 @@ for gi in ("none", "photon", "path"):
     p = T.run("still", "--scene", "cornell", "--res", "32x32", "--gi", gi, "--spp", "8", "--threads", "2",
               "-o", png, "--pfm", pfm)
     T.check(os.path.getsize(png) > 100, f"{gi}: PNG written")
-    w, h, px = read_pfm(pfm)
+    w, h, px = T.read_pfm(pfm)
     T.check((w, h) == (32, 32), f"{gi}: PFM is 32x32")
     imgs[gi] = px
     if gi == "photon":
@@ -61,12 +49,12 @@ T.check(rg(imgs["photon"], 4, 30) > rg(imgs["none"], 4, 30) * 1.02 or rg(imgs["p
 # the kernel over the whole disk instead of the surface the camera sees: darker or equal on average
 nd = os.path.join(tmp, "nodisk.pfm")
 T.run("still", "--scene", "cornell", "--res", "32x32", "--gi", "photon", "--no-gather-area", "-o", nd)
-T.check(d < mean_lum(read_pfm(nd)[2]) <= ph * 1.001, "--no-gather-area: indirect light, no more than with the view")
+T.check(d < mean_lum(T.read_pfm(nd)[2]) <= ph * 1.001, "--no-gather-area: indirect light, no more than with the view")
 
 # determinism: the same photons twice give the same image
 again = os.path.join(tmp, "photon2.pfm")
 T.run("still", "--scene", "cornell", "--res", "32x32", "--gi", "photon", "--threads", "1", "-o", again)
-T.check(read_pfm(again)[2] == imgs["photon"], "photon image identical for 1 and 2 threads")
+T.check(T.read_pfm(again)[2] == imgs["photon"], "photon image identical for 1 and 2 threads")
 
 # the comparison against a reference
 p = T.run("still", "--scene", "cornell", "--res", "32x32", "--gi", "photon", "-o", os.path.join(tmp, "c.png"),
@@ -99,8 +87,8 @@ T.run("still", good, "--res", "16x16", "--gi", "photon", "-o", os.path.join(tmp,
 t0, t1, t2 = (os.path.join(tmp, f"t{k}.pfm") for k in range(3))
 for t, f in ((0, t0), (2, t1), (1, t2)):
     T.run("still", "--scene", "cornell", "--res", "32x32", "--gi", "photon", "--time", t, "-o", f)
-T.check(read_pfm(t0)[2] == read_pfm(t1)[2], "same scene at two times: identical photon images")
-T.check(read_pfm(t0)[2] != read_pfm(t2)[2], "the box moved: a different image")
+T.check(T.read_pfm(t0)[2] == T.read_pfm(t1)[2], "same scene at two times: identical photon images")
+T.check(T.read_pfm(t0)[2] != T.read_pfm(t2)[2], "the box moved: a different image")
 bad = os.path.join(tmp, "bad.gltf")
 quad_with_extras(bad, {"t_diffuse": 0.8, "t_specular": 0.3})
 expect_error(["still", bad, "--res", "16x16", "-o", os.path.join(tmp, "bad.png")], "t_diffuse > t_specular", 1)

@@ -216,6 +216,11 @@ static char *run_json(const evr_sim *sim)
     evr_json_integer(&j, sc->num_lights);
     evr_json_key(&j, "animation_end");
     evr_json_number(&j, sc->anim_end);
+    evr_json_key(&j, "clips_played"); /* the file's clips that played (names, "" unnamed) */
+    evr_json_begin_array(&j);
+    for (i = 0; i < sc->num_animations; i++)
+        if (sc->clips[i].played) evr_json_string(&j, sc->clips[i].name);
+    evr_json_end_array(&j);
     evr_json_end_object(&j);
     evr_json_key(&j, "outputs");
     evr_json_begin_array(&j);

@@ -3,7 +3,8 @@
  * What we keep from Assimp: triangles (points and lines are dropped), the node hierarchy with
  * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials,
  * base colour textures (decoded with stb_image and linearized), punctual lights, perspective
- * cameras, and node animation curves converted to seconds.
+ * cameras, and the node animation curves of the clips that play (import_clips.c says which)
+ * converted to seconds.
  *
  * Assimp 5.2's glTF 2.0 importer has quirks that we correct here (the file counts as glTF 2.0
  * when Assimp's SourceAsset_Format metadata names the glTF2 importer, or failing that when the
@@ -53,6 +54,9 @@
 #include <assimp/config.h>
 
 #include "scene/import_internal.h"
+
+/* The first evr_load_options (size and animation): the smallest size a caller may pass. */
+#define EVR_LOAD_OPTIONS_FIRST_SIZE (offsetof(evr_load_options, animation) + sizeof(const char *))
 
 /* Fills err with one line (newlines from library messages become spaces) and returns st. */
 evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...)
@@ -180,14 +184,15 @@ static void importer_free(importer *im)
     free(im->mat_uv);
     free((void *)im->ai_nodes);
     free(im->by_name);
+    free(im->clip_played);
     evr_gltf_side_free(&im->side);
 }
 
 /* Everything after Assimp: ai -> *out. `bytes` is the file or memory content (for the glTF
- * JSON), `dir` the folder for external textures. */
+ * JSON), `dir` the folder for external textures, `opts` the caller's (current) options. */
 static evr_status convert(const struct aiScene *ai, const char *source, const char *dir,
                           const char *ext, const unsigned char *bytes, size_t nbytes,
-                          evr_scene **out, evr_error *err)
+                          const evr_load_options *opts, evr_scene **out, evr_error *err)
 {
     importer im;
     evr_scene *s;
@@ -228,6 +233,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
             evr_import_fail(err, EVR_ERR_FORMAT, "'%s' has meshes but no node places them", source);
         goto fail;
     }
+    if ((st = evr_import_clips(&im, opts->animation)) != EVR_OK) goto fail;
     if ((st = evr_import_animation(&im)) != EVR_OK) goto fail;
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
@@ -261,9 +267,48 @@ static struct aiPropertyStore *make_props(void)
     return p;
 }
 
+/* The options as this library's evr_load_options, whatever the caller's size (NULL: defaults). */
+static evr_status current_options(const evr_load_options *o, evr_load_options *cur, evr_error *err)
+{
+    evr_load_options_defaults(cur);
+    if (!o) return EVR_OK;
+    if (o->size < EVR_LOAD_OPTIONS_FIRST_SIZE || o->size > sizeof *cur)
+        return evr_import_fail(
+            err, EVR_ERR_ARG,
+            "evr_load_options of %zu bytes is not one this evray (%zu bytes) knows: make it with evr_load_options_defaults",
+            o->size, sizeof *cur);
+    memcpy(cur, o, o->size);
+    cur->size = sizeof *cur;
+    return EVR_OK;
+}
+
+void evr_load_options_init(evr_load_options *o, size_t size)
+{
+    evr_load_options d;
+    memset(&d, 0, sizeof d);
+    d.size = sizeof d;
+    d.animation = NULL; /* the default rule */
+    if (!o || size < sizeof(size_t)) return;
+    if (size <= sizeof d) { /* an older caller: its own fields only */
+        memcpy(o, &d, size);
+    } else { /* a newer caller: ours, and a size it will be refused with */
+        memcpy(o, &d, sizeof d);
+    }
+    o->size = size;
+}
+
+const char *evr_scene_notice(const evr_scene *s) { return s && s->notice[0] ? s->notice : NULL; }
+
 evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
 {
+    return evr_scene_load_with(path, NULL, out, err);
+}
+
+evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, evr_scene **out,
+                               evr_error *err)
+{
     struct stat sb;
+    evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
     unsigned char *bytes = NULL;
@@ -275,6 +320,7 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
     *out = NULL;
+    if ((st = current_options(opts, &o, err)) != EVR_OK) return st;
     if (!path || !path[0]) return evr_import_fail(err, EVR_ERR_ARG, "no scene file given");
     if (stat(path, &sb) != 0)
         return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
@@ -328,7 +374,7 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
             }
         }
     }
-    st = convert(ai, path, dir, ext, bytes, nbytes, out, err);
+    st = convert(ai, path, dir, ext, bytes, nbytes, &o, out, err);
     free(bytes);
     aiReleaseImport(ai);
     return st;
@@ -337,6 +383,13 @@ evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
 evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint, evr_scene **out,
                                  evr_error *err)
 {
+    return evr_scene_load_memory_with(data, size, hint, NULL, out, err);
+}
+
+evr_status evr_scene_load_memory_with(const void *data, size_t size, const char *hint,
+                                      const evr_load_options *opts, evr_scene **out, evr_error *err)
+{
+    evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
     char source[64];
@@ -345,6 +398,7 @@ evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
     *out = NULL;
+    if ((st = current_options(opts, &o, err)) != EVR_OK) return st;
     if (!data || size == 0) return evr_import_fail(err, EVR_ERR_ARG, "no scene data given");
     if (size > UINT_MAX)
         return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
@@ -356,7 +410,7 @@ evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint
     aiReleasePropertyStore(props);
     snprintf(source, sizeof source, "<memory>.%s", hint);
     if (!ai) return import_error(err, source);
-    st = convert(ai, source, "", hint, (const unsigned char *)data, size, out, err);
+    st = convert(ai, source, "", hint, (const unsigned char *)data, size, &o, out, err);
     aiReleaseImport(ai);
     return st;
 }
@@ -399,6 +453,7 @@ void evr_scene_free_contents(evr_scene *s)
     free(s->instances);
     free(s->lights);
     free(s->cameras);
+    free(s->clips);
     memset(s, 0, sizeof *s);
 }
 

@@ -1,5 +1,6 @@
-/* Node animation curves in seconds (quirk (a) in import.c), with what the glTF JSON says of
- * each channel (quirks (d), (e) and STEP): synthesized and rest-only curves dropped. */
+/* Node animation curves of the played clips (import_clips.c) in seconds (quirk (a) in
+ * import.c), with what the glTF JSON says of each channel (quirks (d), (e) and STEP):
+ * synthesized and rest-only curves dropped. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,6 +85,20 @@ static int make_curve(evr_curve *c, const void *keys, unsigned nkeys, int dim, d
     return 1;
 }
 
+double evr_import_ticks_per_second(const struct aiAnimation *an)
+{
+    /* quirk (a): glTF keys are in milliseconds, mTicksPerSecond = 1000 */
+    return an->mTicksPerSecond > 0.0 ? an->mTicksPerSecond : 25.0;
+}
+
+int evr_import_channel_interp(const importer *im, unsigned a, const char *node, int path)
+{
+    int side_ok = im->have_side && im->side.num_anims == (int)im->ai->mNumAnimations;
+    if (!im->have_side) return GL_LINEAR;
+    /* quirk (e): keys of properties no glTF channel animates are synthesized */
+    return evr_gltf_side_interp(&im->side, side_ok ? (int)a : -1, node, path);
+}
+
 evr_status evr_import_animation(importer *im)
 {
     const struct aiScene *ai = im->ai;
@@ -91,13 +106,11 @@ evr_status evr_import_animation(importer *im)
     unsigned a, ch;
     int i, any = 0;
     double t_min = INFINITY, t_max = -INFINITY;
-    int side_ok = im->have_side && im->side.num_anims == (int)ai->mNumAnimations;
 
-    s->num_animations = (int)ai->mNumAnimations;
     for (a = 0; a < ai->mNumAnimations; a++) {
         const struct aiAnimation *an = ai->mAnimations[a];
-        /* quirk (a): glTF keys are in milliseconds, mTicksPerSecond = 1000 */
-        double tps = an->mTicksPerSecond > 0.0 ? an->mTicksPerSecond : 25.0;
+        double tps = evr_import_ticks_per_second(an);
+        if (!evr_import_clip_played(im, a)) continue;
         for (ch = 0; ch < an->mNumChannels; ch++) {
             const struct aiNodeAnim *na = an->mChannels[ch];
             int ni = evr_import_find_node(im, na->mNodeName.data), kind;
@@ -114,15 +127,11 @@ evr_status evr_import_animation(importer *im)
                 const void *keys = kind == PATH_T   ? (const void *)na->mPositionKeys
                                    : kind == PATH_R ? (const void *)na->mRotationKeys
                                                     : (const void *)na->mScalingKeys;
-                int interp = GL_LINEAR;
+                int interp;
                 float rest[4];
                 if (nk == 0 || !keys || c->num_keys > 0) continue; /* first animation wins */
-                if (im->have_side) {
-                    /* quirk (e): keys of properties no glTF channel animates are synthesized */
-                    interp = evr_gltf_side_interp(&im->side, side_ok ? (int)a : -1,
-                                                  na->mNodeName.data, kind);
-                    if (interp < 0) continue;
-                }
+                interp = evr_import_channel_interp(im, a, na->mNodeName.data, kind);
+                if (interp < 0) continue; /* synthesized */
                 if (!make_curve(c, keys, nk, kind == PATH_R ? 4 : 3, tps))
                     return evr_import_fail(im->err, EVR_ERR_NOMEM,
                                            "out of memory reading animations");
@@ -162,14 +171,24 @@ evr_status evr_import_animation(importer *im)
                 t_max = cv[k]->times[cv[k]->num_keys - 1];
         }
     }
+    /* The played clips run to their last key, also where their last curves were dropped (they
+     * hold the rest value): a clip as long as `evray info` says it is. */
+    for (a = 0; a < (unsigned)s->num_animations && s->clips; a++) {
+        const evr_clip *c = &s->clips[a];
+        if (!c->played || c->num_nodes == 0) continue;
+        if (c->start < t_min) t_min = c->start;
+        if (c->end > t_max) t_max = c->end;
+        any = 1;
+    }
     if (any) {
         s->anim_start = t_min;
         s->anim_end = t_max;
     }
     /* glTF has no frame rate. FBX and BVH store keys in frames (ticks per second = frames per
-     * second); Collada uses 1 tick per second, which says nothing. */
-    if (!im->gltf && ai->mNumAnimations && ai->mAnimations[0]->mTicksPerSecond >= 10.0 &&
-        ai->mAnimations[0]->mTicksPerSecond <= 240.0)
-        s->frame_rate = ai->mAnimations[0]->mTicksPerSecond;
+     * second); Collada uses 1 tick per second, which says nothing. The first played clip's. */
+    for (a = 0; a < ai->mNumAnimations && !evr_import_clip_played(im, a); a++) continue;
+    if (!im->gltf && a < ai->mNumAnimations && ai->mAnimations[a]->mTicksPerSecond >= 10.0 &&
+        ai->mAnimations[a]->mTicksPerSecond <= 240.0)
+        s->frame_rate = ai->mAnimations[a]->mTicksPerSecond;
     return EVR_OK;
 }

@@ -59,6 +59,50 @@ static void describe_curve(strbuf *b, const char *what, const evr_curve *c)
               c->interp == EVR_INTERP_STEP ? "step" : "linear");
 }
 
+/* The shortest %g text that reads back as exactly v: a clip's duration given as printed to
+ * `evray render --duration` is the clip's end, not a rounding of it. */
+static void exact_number(char *buf, size_t cap, double v)
+{
+    int digits;
+    for (digits = 1; digits < 17; digits++) {
+        snprintf(buf, cap, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v) return;
+    }
+    snprintf(buf, cap, "%.17g", v);
+}
+
+static void describe_clips(strbuf *b, const evr_scene *s, int max_list)
+{
+    int a, played = 0;
+    for (a = 0; a < s->num_animations; a++) played += s->clips[a].played;
+    sb_printf(b, "clips: %d, %d play%s", s->num_animations, played, played == 1 ? "s" : "");
+    if (s->clip_choice == EVR_CLIPS_ALL)
+        sb_printf(b, " (--animation all: where two animate a property, the first one's keys)");
+    else if (s->clip_choice == EVR_CLIPS_ONE) sb_printf(b, " (chosen with --animation)");
+    else if (played < s->num_animations)
+        sb_printf(b, " (by default a clip plays unless it animates a node that an earlier played "
+                     "clip animates; --animation NAME|INDEX|all chooses)");
+    sb_printf(b, "\n");
+    for (a = 0; a < s->num_animations && a < max_list; a++) {
+        const evr_clip *c = &s->clips[a];
+        char end[32], start[32];
+        exact_number(end, sizeof end, c->end);
+        exact_number(start, sizeof start, c->start);
+        if (c->name[0]) sb_printf(b, "  [%d] \"%s\": ", a, c->name);
+        else sb_printf(b, "  [%d] (unnamed): ", a);
+        /* played clips run from time 0: the duration that plays one to its end is its end */
+        sb_printf(b, "duration %s s (keys %s s to %s s), %d animated node%s, ", end, start, end,
+                  c->num_nodes, c->num_nodes == 1 ? "" : "s");
+        if (c->played) sb_printf(b, "plays\n");
+        else if (c->conflict >= 0)
+            sb_printf(b, "not played: it animates a node that [%d] \"%s\" animates\n", c->conflict,
+                      s->clips[c->conflict].name);
+        else sb_printf(b, "not played: not chosen\n");
+    }
+    if (s->num_animations > max_list)
+        sb_printf(b, "  ... and %d more\n", s->num_animations - max_list);
+}
+
 char *evr_scene_describe(const evr_scene *s)
 {
     strbuf b;
@@ -97,11 +141,11 @@ char *evr_scene_describe(const evr_scene *s)
         sb_printf(&b, "\n");
     }
 
+    if (s->num_animations) describe_clips(&b, s, max_list);
     for (i = 0; i < s->num_nodes; i++) animated += s->nodes[i].animated;
     if (animated) {
         int listed = 0;
-        sb_printf(&b, "animation: %.4g s to %.4g s, %d clip%s played together, %d animated node%s",
-                  s->anim_start, s->anim_end, s->num_animations, s->num_animations == 1 ? "" : "s",
+        sb_printf(&b, "animation: %.4g s to %.4g s, %d animated node%s", s->anim_start, s->anim_end,
                   animated, animated == 1 ? "" : "s");
         if (s->frame_rate > 0) sb_printf(&b, ", %.4g frames/s", s->frame_rate);
         sb_printf(&b, "\n");
@@ -116,6 +160,8 @@ char *evr_scene_describe(const evr_scene *s)
             sb_printf(&b, "\n");
         }
         if (animated > listed) sb_printf(&b, "  ... and %d more\n", animated - listed);
+    } else if (s->anim_end > s->anim_start) { /* played clips whose curves hold the rest pose */
+        sb_printf(&b, "animation: %.4g s to %.4g s, no node moves\n", s->anim_start, s->anim_end);
     } else {
         sb_printf(&b, "animation: none (static scene)\n");
     }

@@ -7,6 +7,7 @@
  *   import_texture.c   base colour textures: finding, decoding and linearizing them
  *   import_mesh.c      materials and triangle meshes
  *   import_node.c      the node hierarchy, instances and rest-pose bounds
+ *   import_clips.c     which animation clips play (the default rule or the caller's choice)
  *   import_anim.c      animation curves
  *   import_camera.c    cameras (or one framing the scene)
  *   import_light.c     punctual lights (or a headlight)
@@ -21,6 +22,7 @@
 
 struct aiScene;
 struct aiNode;
+struct aiAnimation;
 
 #define EVR_PI_D 3.14159265358979323846
 
@@ -101,6 +103,17 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
 evr_status evr_import_nodes(importer *im);
 /* The first node (in depth-first order) with Assimp name `name`, or -1. */
 int evr_import_find_node(const importer *im, const char *name);
+/* Which clips play: s->clips, s->clip_choice, im->clip_played and s->notice from `choice`
+ * (evr_load_options.animation). Runs after the nodes and before any curve is imported. */
+evr_status evr_import_clips(importer *im, const char *choice);
+/* 1 when the curves of aiAnimation a are imported (every importer of curves asks this). */
+int evr_import_clip_played(const importer *im, unsigned a);
+/* Ticks per second of a clip's key times (quirk (a) in import.c): mTicksPerSecond, 25 when 0. */
+double evr_import_ticks_per_second(const struct aiAnimation *an);
+/* The interpolation (GL_*) of clip a's channel for node's property path (PATH_*): what the glTF
+ * JSON says, GL_LINEAR without it, or -1 when Assimp synthesized those keys (quirk (e)). */
+int evr_import_channel_interp(const importer *im, unsigned a, const char *node, int path);
+/* Curves of the played clips (evr_import_clip_played). */
 evr_status evr_import_animation(importer *im);
 void evr_import_curve_free(evr_curve *c);
 /* The scene's world bounds at rest pose. */

@@ -108,10 +108,31 @@ typedef struct {
     int automatic; /* 1 when framed automatically (scene had no camera) */
 } evr_camera_desc;
 
+/* One animation clip of the file (an aiAnimation) and whether it plays (scene/import_clips.c has
+ * the rule). Every played clip starts at time 0: its keys keep the times the file gives them. */
+typedef struct {
+    char name[64];
+    double start, end; /* its first and last key, seconds (0, 0 without keys on the scene) */
+    int num_nodes;     /* nodes it animates: transforms, morph weights or mesh channels */
+    int played;        /* 1 when its curves are imported */
+    int conflict;      /* not played by the default rule: the first played clip that animates one
+                          of its nodes; -1 otherwise */
+} evr_clip;
+
+/* How the played clips were chosen (evr_load_options.animation). */
+typedef enum {
+    EVR_CLIPS_DEFAULT = 0, /* the default rule */
+    EVR_CLIPS_ALL = 1,     /* "all": every clip, the first clip winning where two animate a curve */
+    EVR_CLIPS_ONE = 2      /* one clip by name or index */
+} evr_clip_choice;
+
 struct evr_scene {
     char source[512];
     char format[32];    /* the Assimp importer that read it, e.g. "glTF2 Importer" */
-    int num_animations; /* animation clips in the file; all play together from time 0 */
+    int num_animations; /* animation clips in the file (clips: one per clip) */
+    evr_clip *clips;
+    evr_clip_choice clip_choice;
+    char notice[512]; /* one line for the user (evr_scene_notice), "" when nothing to say */
     int num_meshes, num_materials, num_textures, num_nodes, num_instances, num_lights, num_cameras;
     evr_mesh *meshes;
     evr_material *materials;
@@ -121,7 +142,7 @@ struct evr_scene {
     evr_light *lights;
     evr_camera_desc *cameras;    /* all cameras of the file; at least one after import */
     int default_light;           /* 1 when the scene had no light and one was added */
-    double anim_start, anim_end; /* time range covered by the animation curves (0,0 if static) */
+    double anim_start, anim_end; /* time range of the played clips' curves (0,0 if static) */
     double frame_rate;           /* frames per second of the animation when the file says, else 0 */
     evr_v3 bounds_min, bounds_max; /* world bounds at rest pose */
 };

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the small scene files that tests/test_import.c and tests/test_anim.c load.
+"""Writes the small scene files that tests/test_import.c, tests/test_anim.c and tests/test_clips.c load.
 
 Run from anywhere: python3 tests/data/import/make_data.py (it writes next to itself). The files
 are committed; this script documents what they hold and regenerates them. Standard library only.
@@ -231,7 +231,43 @@ def lines():
     write("lines.gltf", g.finish())
 
 
+# ---- clips.gltf: clips that share nodes and clips that do not (src/scene/import_clips.c) -------
+def clips():
+    g = Gltf()
+    pos, idx = cube(g)
+    up = g.floats([0, 1, 0] * 8, "VEC3")  # a morph target lifting the whole cube by 1
+    anims = []
+
+    def clip(name, channels):
+        samplers, chans = [], []
+        for nd, path, times, values in channels:
+            typ = {"rotation": "VEC4", "weights": "SCALAR"}.get(path, "VEC3")
+            samplers.append({"input": g.floats(times, "SCALAR"), "output": g.floats(values, typ)})
+            chans.append({"sampler": len(samplers) - 1, "target": {"node": nd, "path": path}})
+        a = {"samplers": samplers, "channels": chans}
+        if name is not None:
+            a["name"] = name
+        anims.append(a)
+
+    clip("walk", [(0, "translation", [0, 1], [0, 0, 0, 2, 0, 0])])     # a: +X, 1 s
+    clip("run", [(0, "translation", [0, 0.5], [0, 0, 0, 0, 3, 0]),      # a: +Y and taller, 0.5 s
+                 (0, "scale", [0, 0.5], [1, 1, 1, 1, 2, 1])])
+    clip("wave", [(1, "rotation", [0, 1.3], qaxis([0, 0, 1], 0) + qaxis([0, 0, 1], 90))])  # b alone
+    clip("blink", [(0, "weights", [0, 0.8], [0, 1])])                   # a's morph weight
+    clip(None, [(2, "translation", [0.25, 0.75], [0, 0, 5, 0, 0, 6])])  # c alone, unnamed
+    g.d.update({"scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+                "nodes": [{"name": "a", "mesh": 0}, {"name": "b", "mesh": 1, "translation": [3, 0, 0]},
+                          {"name": "c", "mesh": 1, "translation": [0, 0, 5]}],
+                "meshes": [{"name": "morph_cube", "weights": [0],
+                            "primitives": [{"attributes": {"POSITION": pos}, "indices": idx,
+                                            "targets": [{"POSITION": up}]}]},
+                           {"name": "cube", "primitives": [{"attributes": {"POSITION": pos}, "indices": idx}]}],
+                "animations": anims})
+    write("clips.gltf", g.finish())
+
+
 anim()
+clips()
 lights(False)
 lights(True)
 plain()
