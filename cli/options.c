@@ -92,8 +92,12 @@ evr_scene *cli_load_scene(const char *path, const char *demo, const char *animat
         cli_error("%s", err.msg);
         return NULL;
     }
+    if (quiet == CLI_LOAD_DESCRIBED) return scene; /* evray info lists both */
     const char *notice = evr_scene_notice(scene);
     if (notice && !quiet) fprintf(stderr, "evray: note: %s\n", notice);
+    /* what evray does not render of the file, one line each, even when quiet */
+    for (const char *w = evr_scene_warnings(scene), *nl; (nl = strchr(w, '\n')) != NULL; w = nl + 1)
+        fprintf(stderr, "evray: warning: %.*s\n", (int)(nl - w), w);
     return scene;
 }
 

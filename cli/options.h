@@ -21,9 +21,12 @@ int opt_is(const char *arg, const char *name);
 void cli_error(const char *fmt, ...);
 
 /* The scene file at path, else the built-in scene demo, with --animation's choice (NULL: the
- * default rule); prints the loader's notice unless quiet. NULL (after the error message) when
- * it cannot be loaded, a clip the file does not have included. */
+ * default rule); prints the loader's notice unless quiet, and the scene's warnings
+ * (evr_scene_warnings) always, on stderr. NULL (after the error message) when it cannot be
+ * loaded, a clip the file does not have included. */
 evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet);
+/* cli_load_scene's quiet for a caller that prints the notice and the warnings itself */
+#define CLI_LOAD_DESCRIBED (-1)
 /* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when
  * argv[*i] is another argument, -1 after an error message. */
 int cli_is_animation_option(int argc, char **argv, int *i, const char **animation);

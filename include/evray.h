@@ -91,9 +91,12 @@ evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err);
 void evr_scene_release(evr_scene *s);
 
 /* A human-readable description (cameras, lights, animation clips and whether each plays,
- * animations and time ranges, meshes, triangles);
- * free the returned string with free(). */
+ * animations and time ranges, meshes, triangles, skins and morph targets, warnings); free the
+ * returned string with free(). */
 char *evr_scene_describe(const evr_scene *s);
+/* What evray does not render of the file as it is (e.g. CUBICSPLINE morph weights, interpolated
+ * linearly): one warning per line, each ending in a newline; "" when there is none. */
+const char *evr_scene_warnings(const evr_scene *s);
 
 /* ---- simulation ---- */
 /* Event output formats as bits of evr_config.formats: format i of the registry

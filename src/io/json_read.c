@@ -94,10 +94,12 @@ static int j_container(evr_jdoc *d, int depth, int is_obj)
 {
     int self = j_new(d, is_obj ? EVR_JDOC_OBJECT : EVR_JDOC_ARRAY), last = -1;
     if (self < 0) return -1;
+    d->v[self].off = d->pos;
     d->pos++; /* '{' or '[' */
     j_ws(d);
     if (d->pos < d->len && d->text[d->pos] == (is_obj ? '}' : ']')) {
         d->pos++;
+        d->v[self].len = d->pos - d->v[self].off;
         return self;
     }
     for (;;) {
@@ -127,6 +129,7 @@ static int j_container(evr_jdoc *d, int depth, int is_obj)
         }
         if (d->text[d->pos] == (is_obj ? '}' : ']')) {
             d->pos++;
+            d->v[self].len = d->pos - d->v[self].off;
             return self;
         }
         return -1;
@@ -165,8 +168,13 @@ static int j_value(evr_jdoc *d, int depth)
     }
     {
         double num;
+        size_t start = d->pos;
         if (!j_number(d, &num)) return -1;
-        if ((idx = j_new(d, EVR_JDOC_NUMBER)) >= 0) d->v[idx].num = num;
+        if ((idx = j_new(d, EVR_JDOC_NUMBER)) >= 0) {
+            d->v[idx].num = num;
+            d->v[idx].off = start;
+            d->v[idx].len = d->pos - start;
+        }
         return idx;
     }
 }
@@ -304,6 +312,15 @@ int evr_jdoc_next(const evr_jdoc *d, int c) { return c >= 0 ? d->v[c].next : -1;
 int evr_jdoc_count(const evr_jdoc *d, int arr)
 {
     return (arr >= 0 && d->v[arr].type == EVR_JDOC_ARRAY) ? d->v[arr].count : 0;
+}
+
+int *evr_jdoc_elements(const evr_jdoc *d, int arr)
+{
+    int n = evr_jdoc_count(d, arr), i = 0, c;
+    int *out = malloc(sizeof *out * ((size_t)n + 1));
+    if (!out) return NULL;
+    for (c = n ? evr_jdoc_first(d, arr) : -1; c >= 0; c = evr_jdoc_next(d, c)) out[i++] = c;
+    return out;
 }
 
 double evr_jdoc_number(const evr_jdoc *d, int v, double def)

@@ -33,7 +33,9 @@ typedef struct {
     unsigned char type;      /* EVR_JDOC_* */
     int first, next;         /* first child, next sibling; -1 for none */
     int count;               /* children */
-    size_t off, len;         /* strings: the raw (escaped) text between the quotes */
+    size_t off, len;         /* strings: the raw (escaped) text between the quotes; numbers,
+                                arrays and objects: their text, brackets included (to edit a
+                                document's text in place) */
     size_t key_off, key_len; /* object members: the raw key */
     double num;              /* numbers; booleans 1 or 0 */
 } evr_jdoc_value;
@@ -60,6 +62,9 @@ int evr_jdoc_first(const evr_jdoc *d, int v);
 int evr_jdoc_next(const evr_jdoc *d, int c);
 /* The elements of array arr, 0 when it is not an array. */
 int evr_jdoc_count(const evr_jdoc *d, int arr);
+/* The elements of array arr in order, for indexing (evr_jdoc_count of them; free()); NULL when
+ * memory ran out. */
+int *evr_jdoc_elements(const evr_jdoc *d, int arr);
 /* The number v, or def when v is not a number. */
 double evr_jdoc_number(const evr_jdoc *d, int v, double def);
 /* String v decoded (escapes, \u with surrogate pairs) into out (truncated, 0-ended): 1, or 0 and

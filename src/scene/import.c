@@ -28,9 +28,52 @@
  *      the glTF2 importer ignores the sampler's mode except for CUBICSPLINE's stride), so STEP
  *      samplers arrive as plain keys. We read each channel's interpolation from the glTF JSON
  *      (the .gltf text or the GLB JSON chunk) and mark those curves STEP.
+ *  (f) morph weight animation: one aiMeshMorphAnim per animated node, named exactly as the node
+ *      (no suffix), its keys' mTime in milliseconds like (a), each key giving every target's
+ *      index (mValues) and weight (mWeights); no interpolation field, so STEP comes from the JSON
+ *      as above, and CUBICSPLINE keeps each key's value and drops both tangents: interpolated
+ *      linearly, with a warning. Other importers name channels "node*N" or by mesh: a channel
+ *      is matched to the node of its name, else of its name before '*', else to the nodes
+ *      placing meshes of its name;
+ *  (g) aiAnimMesh.mVertices / mNormals hold a target's ABSOLUTE positions and normals (base +
+ *      delta; normals only when the target and the mesh have them), aiAnimMesh.mWeight the
+ *      mesh's default weight: deltas are taken against the aiMesh;
+ *  (h) node.weights (a node's own morph weights, which override mesh.weights) are dropped:
+ *      read from the JSON;
+ *  (i) aiProcess_JoinIdenticalVertices compares positions, normals and UVs only: two vertices
+ *      that differ in their joint weights or morph targets are merged (the merged vertex gets
+ *      both bones' weights and the first one's targets). It is applied (aiApplyPostProcessing)
+ *      only to scenes without bones or anim meshes; their vertices stay as the file has them;
+ *  (j) a skin without inverseBindMatrices (glTF: identity matrices) crashes Assimp (a null
+ *      dereference): Assimp reads a copy of the file with an accessor of identity matrices
+ *      added (import_gltf_deform.c), served under the file's name by import_memfile.c;
+ *  (k) inverseBindMatrices with fewer matrices than joints: Assimp reads past the accessor;
+ *  (l) a JOINTS_n index >= the number of joints: Assimp drops that influence silently; JOINTS_n
+ *      and WEIGHTS_n of different lengths: it drops all weights of the primitive;
+ *  (m) a morph target attribute with more or fewer elements than the mesh has vertices: Assimp
+ *      logs a warning and keeps the base positions (a target that does nothing);
+ *      (k), (l) and (m) are errors naming the mesh, checked in the JSON and the buffers before
+ *      Assimp reads the file (import_gltf_deform.c);
+ *  (n) a mesh placed by nodes with different skins (or with and without one) is one aiMesh with
+ *      the bones of the last such node only (the earlier bones leak): the patched copy of (j)
+ *      gives each further (mesh, skin) pair a copy of the mesh, referenced by its nodes.
+ *  Assimp 5.2 does read JOINTS_1/WEIGHTS_1 (8 influences and more), sparse morph targets and
+ *  unnamed joints (bones and nodes both named "nodes[i]"); it does not normalize the weights
+ *  (we do, per vertex) and gives a bone without weights one of 0 on vertex 0 (ignored).
  *  Also from the JSON: KHR_materials_emissive_strength, which Assimp 5.2 does not import.
  *  Lights: for glTF, aiLight.mColorDiffuse already holds colour * intensity (candela for point
  *      and spot, lux for directional), and the spot cone angles are glTF's half angles.
+ *
+ * Skins of every format come through the same aiBone path: mOffsetMatrix maps the mesh's
+ * space to the bone's at bind time (glTF: the inverse bind matrix; Collada: the joint's inverse
+ * bind matrix times the bind shape matrix; FBX: the inverse of the cluster's TransformLink
+ * times its Transform), so a vertex's world position is sum_k w_k world(bone node) *
+ * mOffsetMatrix * p with the mesh node's own transform ignored, the glTF rule (tests/data/
+ * import/skin.dae pins the Collada case: bind shape matrix included, ticks in milliseconds as
+ * for glTF). Morph targets come through aiAnimMesh, absolute (deltas taken against the base
+ * mesh) unless aiMesh.mMethod is aiMorphingMethod_MORPH_RELATIVE (Collada's RELATIVE morph:
+ * the targets hold offsets; untested, Assimp 5.2 did not import our hand-written Collada morph
+ * controller).
  *
  * For other formats: mHorizontalFOV is documented as the half angle, but Assimp's importers
  * (Collada's xfov, FBX's FieldOfView) store the full horizontal angle, so we read it as the full
@@ -39,7 +82,9 @@
  *
  * This unit loads the file and runs the steps; each step is a unit of its own (the list is in
  * import_internal.h): (a), (d), (e) and STEP in import_anim.c, (b) and (c) in import_camera.c,
- * the glTF JSON in import_gltf.c. */
+ * (f) to (h) in import_deform.c, (j) to (n) in import_gltf_deform.c, (i) here, the glTF
+ * JSON in import_gltf.c. What evray does not render of a file is a warning of the scene
+ * (evr_scene_warnings), never a message printed here. */
 #include <errno.h>
 #include <limits.h>
 #include <stdarg.h>
@@ -53,6 +98,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/config.h>
 
+#include "io/byte_order.h"
 #include "scene/import_internal.h"
 
 /* The first evr_load_options (size and animation): the smallest size a caller may pass. */
@@ -74,6 +120,30 @@ evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...)
     }
     return st;
 }
+
+void evr_import_warn(importer *im, const char *fmt, ...)
+{
+    evr_scene *s = im->s;
+    char line[256], *p;
+    size_t have = s->warnings ? strlen(s->warnings) : 0, n;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line - 1, fmt, ap);
+    va_end(ap);
+    for (p = line; *p; p++)
+        if (*p == '\n' || *p == '\r' || *p == '\t') *p = ' ';
+    n = strlen(line);
+    line[n++] = '\n';
+    line[n] = 0;
+    if (s->warnings && strstr(s->warnings, line)) return; /* said already */
+    if (s->num_warnings++ >= EVR_MAX_WARNINGS) return;
+    p = realloc(s->warnings, have + n + 1);
+    if (!p) return; /* a warning lost to memory: the import itself goes on */
+    memcpy(p + have, line, n + 1);
+    s->warnings = p;
+}
+
+const char *evr_scene_warnings(const evr_scene *s) { return s && s->warnings ? s->warnings : ""; }
 
 void evr_import_copy_name(char *dst, size_t cap, const char *src)
 {
@@ -170,9 +240,22 @@ static void read_format(const struct aiScene *ai, char *out, size_t cap)
 static unsigned import_flags(void)
 {
     /* FlipUVs: Assimp stores v upwards (it flips glTF's v); flipped back, v = 0 is the image's
-     * first row, as stb_image returns it and as glTF defines it. */
-    return aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
-           aiProcess_SortByPType | aiProcess_ValidateDataStructure | aiProcess_FlipUVs;
+     * first row, as stb_image returns it and as glTF defines it. JoinIdenticalVertices comes
+     * after, in join_vertices (quirk (i)). */
+    return aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_SortByPType |
+           aiProcess_ValidateDataStructure | aiProcess_FlipUVs;
+}
+
+/* Quirk (i): identical vertices joined, unless a mesh has bones or morph targets (which the
+ * join ignores). Assimp runs JoinIdenticalVertices after the import's other steps either way, so
+ * a scene without them comes out as from one pass with every flag. NULL: Assimp failed (and
+ * released the scene). */
+static const struct aiScene *join_vertices(const struct aiScene *ai)
+{
+    unsigned i;
+    for (i = 0; i < ai->mNumMeshes; i++)
+        if (ai->mMeshes[i]->mNumBones || ai->mMeshes[i]->mNumAnimMeshes) return ai;
+    return aiApplyPostProcessing(ai, aiProcess_JoinIdenticalVertices);
 }
 
 static void importer_free(importer *im)
@@ -235,6 +318,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     }
     if ((st = evr_import_clips(&im, opts->animation)) != EVR_OK) goto fail;
     if ((st = evr_import_animation(&im)) != EVR_OK) goto fail;
+    if ((st = evr_import_deform(&im)) != EVR_OK) goto fail;
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_lights(&im)) != EVR_OK) goto fail;
@@ -299,6 +383,34 @@ void evr_load_options_init(evr_load_options *o, size_t size)
 
 const char *evr_scene_notice(const evr_scene *s) { return s && s->notice[0] ? s->notice : NULL; }
 
+/* 1 when the bytes may be glTF 2.0: a GLB, or JSON text (after any byte order mark). */
+static int may_be_gltf(const unsigned char *b, size_t n, const char *ext)
+{
+    size_t i = (n >= 3 && b[0] == 0xEF && b[1] == 0xBB && b[2] == 0xBF) ? 3 : 0;
+    if (n >= 8 && !memcmp(b, "glTF", 4)) return 1;
+    if (ext_is(ext, "gltf") || ext_is(ext, "glb")) return 1;
+    while (i < n && (b[i] == ' ' || b[i] == '\t' || b[i] == '\n' || b[i] == '\r')) i++;
+    return i < n && b[i] == '{';
+}
+
+/* The bytes of a file that may be glTF (a GLB's header and JSON chunk only, a .gltf whole):
+ * *bytes stays NULL for any other file. */
+static evr_status read_gltf_json(const char *path, const char *ext, unsigned char **bytes,
+                                 size_t *nbytes, evr_error *err)
+{
+    unsigned char head[64];
+    size_t got, want = 0;
+    FILE *f = fopen(path, "rb");
+    *bytes = NULL;
+    *nbytes = 0;
+    if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    got = fread(head, 1, sizeof head, f);
+    fclose(f);
+    if (!may_be_gltf(head, got, ext)) return EVR_OK;
+    if (got >= 20 && !memcmp(head, "glTF", 4)) want = 20 + (size_t)evr_get_le32(head + 12);
+    return evr_import_read_file(path, want, bytes, nbytes, err);
+}
+
 evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
 {
     return evr_scene_load_with(path, NULL, out, err);
@@ -311,8 +423,9 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
-    unsigned char *bytes = NULL;
-    size_t nbytes = 0;
+    struct aiFileIO *io = NULL;
+    unsigned char *bytes = NULL, *patched = NULL;
+    size_t nbytes = 0, npatched = 0;
     char dir[512];
     const char *ext, *slash;
     evr_status st;
@@ -338,12 +451,6 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     if (sb.st_size == 0)
         return evr_import_fail(err, EVR_ERR_FORMAT, "scene file '%s' is empty", path);
 
-    props = make_props();
-    if (!props) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
-    ai = aiImportFileExWithProperties(path, import_flags(), NULL, props);
-    aiReleasePropertyStore(props);
-    if (!ai) return import_error(err, path);
-
     ext = file_extension(path);
     slash = strrchr(path, '/');
     if (slash) {
@@ -354,25 +461,41 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     } else {
         dir[0] = 0; /* the current folder */
     }
-    {
-        /* The glTF JSON for what Assimp drops (GLB: header and JSON chunk only). */
-        char fmt[32];
-        read_format(ai, fmt, sizeof fmt);
-        if (fmt[0] ? strstr(fmt, "glTF2") != NULL : (ext_is(ext, "gltf") || ext_is(ext, "glb"))) {
-            unsigned char head[20];
-            size_t want = 0;
-            FILE *f = fopen(path, "rb");
-            if (f) {
-                if (fread(head, 1, 20, f) == 20 && !memcmp(head, "glTF", 4))
-                    want = 20 + ((size_t)head[12] | (size_t)head[13] << 8 | (size_t)head[14] << 16 |
-                                 (size_t)head[15] << 24);
-                fclose(f);
-            }
-            if ((st = evr_import_read_file(path, want, &bytes, &nbytes, err)) != EVR_OK) {
-                aiReleaseImport(ai);
-                return st;
-            }
+    /* The glTF JSON before Assimp reads the file: skins and morph targets are checked first
+     * (quirks (j) to (m)), and what Assimp drops is read from it after. */
+    if ((st = read_gltf_json(path, ext, &bytes, &nbytes, err)) != EVR_OK) return st;
+    if (bytes) {
+        gltf_source src;
+        src.bytes = bytes;
+        src.nbytes = nbytes;
+        src.path = path;
+        src.dir = dir;
+        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
+            free(bytes);
+            return st;
         }
+        if (patched && !(io = evr_memfile_io_new(path, patched, npatched))) {
+            free(bytes);
+            free(patched);
+            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
+        }
+    }
+
+    props = make_props();
+    if (!props) {
+        free(bytes);
+        free(patched);
+        evr_memfile_io_free(io);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
+    }
+    ai = aiImportFileExWithProperties(path, import_flags(), io, props);
+    aiReleasePropertyStore(props);
+    evr_memfile_io_free(io);
+    free(patched);
+    if (ai) ai = join_vertices(ai);
+    if (!ai) {
+        free(bytes);
+        return import_error(err, path);
     }
     st = convert(ai, path, dir, ext, bytes, nbytes, &o, out, err);
     free(bytes);
@@ -392,6 +515,8 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
+    unsigned char *patched = NULL;
+    size_t npatched = 0;
     char source[64];
     evr_status st;
 
@@ -403,11 +528,25 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (size > UINT_MAX)
         return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
     if (!hint) hint = "";
+    if (may_be_gltf(data, size, hint)) { /* as for a file (quirks (j) to (m)) */
+        gltf_source src;
+        src.bytes = data;
+        src.nbytes = size;
+        src.path = NULL;
+        src.dir = NULL;
+        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) return st;
+    }
     props = make_props();
-    if (!props) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
-    ai = aiImportFileFromMemoryWithProperties((const char *)data, (unsigned)size, import_flags(),
-                                              hint, props);
+    if (!props) {
+        free(patched);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
+    }
+    ai = aiImportFileFromMemoryWithProperties(patched ? (const char *)patched : (const char *)data,
+                                              patched ? (unsigned)npatched : (unsigned)size,
+                                              import_flags(), hint, props);
     aiReleasePropertyStore(props);
+    free(patched);
+    if (ai) ai = join_vertices(ai);
     snprintf(source, sizeof source, "<memory>.%s", hint);
     if (!ai) return import_error(err, source);
     st = convert(ai, source, "", hint, (const unsigned char *)data, size, &o, out, err);
@@ -454,6 +593,7 @@ void evr_scene_free_contents(evr_scene *s)
     free(s->lights);
     free(s->cameras);
     free(s->clips);
+    free(s->warnings);
     memset(s, 0, sizeof *s);
 }
 

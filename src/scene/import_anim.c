@@ -33,6 +33,24 @@ void evr_import_curve_free(evr_curve *c)
     memset(c, 0, sizeof *c);
 }
 
+void evr_import_curve_sort(evr_curve *c, int dim)
+{
+    /* insertion sort by adjacent swaps (keys are nearly always sorted already) */
+    int i, j, d;
+    for (i = 1; i < c->num_keys; i++)
+        for (j = i; j > 0 && c->times[j - 1] > c->times[j]; j--) {
+            float *a = c->values + (size_t)(j - 1) * (size_t)dim, *b = a + dim;
+            double t = c->times[j];
+            c->times[j] = c->times[j - 1];
+            c->times[j - 1] = t;
+            for (d = 0; d < dim; d++) {
+                float v = a[d];
+                a[d] = b[d];
+                b[d] = v;
+            }
+        }
+}
+
 /* Copies one kind of keys (dim 3: aiVectorKey, 4: aiQuatKey) into a curve in seconds. */
 static int make_curve(evr_curve *c, const void *keys, unsigned nkeys, int dim, double tps)
 {
@@ -65,23 +83,7 @@ static int make_curve(evr_curve *c, const void *keys, unsigned nkeys, int dim, d
         }
         if (k && c->times[k] < c->times[k - 1]) sorted = 0;
     }
-    if (!sorted) {
-        /* insertion sort by time (keys are nearly always sorted already) */
-        int i, j, d;
-        for (i = 1; i < c->num_keys; i++) {
-            double t = c->times[i];
-            float tmp[4];
-            for (d = 0; d < dim; d++) tmp[d] = c->values[(size_t)i * (size_t)dim + (size_t)d];
-            for (j = i; j > 0 && c->times[j - 1] > t; j--) {
-                c->times[j] = c->times[j - 1];
-                for (d = 0; d < dim; d++)
-                    c->values[(size_t)j * (size_t)dim + (size_t)d] =
-                        c->values[(size_t)(j - 1) * (size_t)dim + (size_t)d];
-            }
-            c->times[j] = t;
-            for (d = 0; d < dim; d++) c->values[(size_t)j * (size_t)dim + (size_t)d] = tmp[d];
-        }
-    }
+    if (!sorted) evr_import_curve_sort(c, dim);
     return 1;
 }
 

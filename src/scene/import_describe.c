@@ -103,6 +103,65 @@ static void describe_clips(strbuf *b, const evr_scene *s, int max_list)
         sb_printf(b, "  ... and %d more\n", s->num_animations - max_list);
 }
 
+/* Each skinned mesh: its joints (the first few by node name) and influences per vertex. */
+static void describe_skins(strbuf *b, const evr_scene *s, int max_list)
+{
+    int i, n = 0, listed = 0;
+    for (i = 0; i < s->num_meshes; i++) n += s->meshes[i].skin != NULL;
+    if (!n) return;
+    sb_printf(b, "skins: %d\n", n);
+    for (i = 0; i < s->num_meshes && listed < max_list; i++) {
+        const evr_skin *sk = s->meshes[i].skin;
+        int j;
+        if (!sk) continue;
+        listed++;
+        sb_printf(b, "  [%d] \"%s\": %d joint%s (", i, s->meshes[i].name, sk->num_joints,
+                  sk->num_joints == 1 ? "" : "s");
+        for (j = 0; j < sk->num_joints && j < 8; j++)
+            sb_printf(b, "%s\"%s\"", j ? ", " : "", node_label(s, sk->joint_nodes[j]));
+        sb_printf(b, "%s), %d influence%s per vertex\n", sk->num_joints > 8 ? ", ..." : "",
+                  sk->influences, sk->influences == 1 ? "" : "s");
+    }
+    if (n > listed) sb_printf(b, "  ... and %d more\n", n - listed);
+}
+
+/* Each mesh with morph targets: how many, whether normals move with them, and for each node
+ * placing it, its weights at rest and their channel. */
+static void describe_morphs(strbuf *b, const evr_scene *s, int max_list)
+{
+    int i, k, n = 0, listed = 0;
+    for (i = 0; i < s->num_meshes; i++) n += s->meshes[i].morph != NULL;
+    if (!n) return;
+    sb_printf(b, "morph targets: %d mesh%s\n", n, n == 1 ? "" : "es");
+    for (i = 0; i < s->num_meshes && listed < max_list; i++) {
+        const evr_morph *mo = s->meshes[i].morph;
+        if (!mo) continue;
+        listed++;
+        sb_printf(b, "  [%d] \"%s\": %d target%s, %s\n", i, s->meshes[i].name, mo->num_targets,
+                  mo->num_targets == 1 ? "" : "s",
+                  mo->d_normals ? "normal deltas" : "no normal deltas (normals follow positions)");
+        for (k = 0; k < s->num_instances; k++) {
+            const evr_node *nd;
+            const evr_curve *c;
+            int j;
+            if (s->instances[k].mesh != i) continue;
+            nd = &s->nodes[s->instances[k].node];
+            c = &nd->w_curve;
+            sb_printf(b, "    node \"%s\": weights (", nd->name);
+            for (j = 0; j < nd->num_weights && j < 8; j++)
+                sb_printf(b, "%s%.4g", j ? " " : "", nd->weights[j]);
+            sb_printf(b, "%s)", nd->num_weights > 8 ? " ..." : "");
+            if (c->num_keys > 0)
+                sb_printf(b, ", channel %d key%s %s, %.4g s to %.4g s\n", c->num_keys,
+                          c->num_keys == 1 ? "" : "s",
+                          c->interp == EVR_INTERP_STEP ? "step" : "linear", c->times[0],
+                          c->times[c->num_keys - 1]);
+            else sb_printf(b, ", no channel\n");
+        }
+    }
+    if (n > listed) sb_printf(b, "  ... and %d more\n", n - listed);
+}
+
 char *evr_scene_describe(const evr_scene *s)
 {
     strbuf b;
@@ -142,7 +201,8 @@ char *evr_scene_describe(const evr_scene *s)
     }
 
     if (s->num_animations) describe_clips(&b, s, max_list);
-    for (i = 0; i < s->num_nodes; i++) animated += s->nodes[i].animated;
+    for (i = 0; i < s->num_nodes; i++)
+        animated += s->nodes[i].animated || s->nodes[i].w_curve.num_keys > 0;
     if (animated) {
         int listed = 0;
         sb_printf(&b, "animation: %.4g s to %.4g s, %d animated node%s", s->anim_start, s->anim_end,
@@ -151,12 +211,13 @@ char *evr_scene_describe(const evr_scene *s)
         sb_printf(&b, "\n");
         for (i = 0; i < s->num_nodes && listed < max_list; i++) {
             const evr_node *n = &s->nodes[i];
-            if (!n->animated) continue;
+            if (!n->animated && n->w_curve.num_keys <= 0) continue;
             listed++;
             sb_printf(&b, "  \"%s\":", n->name);
             describe_curve(&b, "translation", &n->t_curve);
             describe_curve(&b, "rotation", &n->r_curve);
             describe_curve(&b, "scale", &n->s_curve);
+            describe_curve(&b, "morph weights", &n->w_curve);
             sb_printf(&b, "\n");
         }
         if (animated > listed) sb_printf(&b, "  ... and %d more\n", animated - listed);
@@ -183,12 +244,22 @@ char *evr_scene_describe(const evr_scene *s)
                       : "?");
     }
     if (s->num_meshes > max_list) sb_printf(&b, "  ... and %d more\n", s->num_meshes - max_list);
+    describe_skins(&b, s, max_list);
+    describe_morphs(&b, s, max_list);
     sb_printf(&b, "instances: %d (%llu triangles in the scene), nodes: %d\n", s->num_instances,
               (unsigned long long)inst_tris, s->num_nodes);
     sb_printf(&b, "materials: %d, textures: %d\n", s->num_materials, s->num_textures);
     sb_printf(&b, "bounds (rest pose): (%.4g %.4g %.4g) to (%.4g %.4g %.4g), size %.4g\n",
               s->bounds_min.x, s->bounds_min.y, s->bounds_min.z, s->bounds_max.x, s->bounds_max.y,
               s->bounds_max.z, evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min)));
+    if (s->num_warnings) {
+        const char *w = evr_scene_warnings(s), *nl;
+        sb_printf(&b, "warnings: %d\n", s->num_warnings);
+        for (; (nl = strchr(w, '\n')) != NULL; w = nl + 1)
+            sb_printf(&b, "  %.*s\n", (int)(nl - w), w);
+        if (s->num_warnings > EVR_MAX_WARNINGS)
+            sb_printf(&b, "  ... and %d more\n", s->num_warnings - EVR_MAX_WARNINGS);
+    }
     if (b.failed) {
         free(b.buf);
         return NULL;

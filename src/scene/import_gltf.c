@@ -1,6 +1,7 @@
 /* The glTF JSON read directly (the .gltf text or the GLB's JSON chunk), for what Assimp 5.2
- * drops or mangles: which channels exist and their interpolation (quirks (d), (e) and STEP in
- * import.c), KHR_materials_emissive_strength and the materials' photon extras. */
+ * drops or mangles: which channels exist and their interpolation (quirks (d), (e), (f) and STEP
+ * in import.c), the nodes' morph weights (quirk (h)),
+ * KHR_materials_emissive_strength and the materials' photon extras. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +19,9 @@ void evr_gltf_side_free(gltf_side *g)
     free(g->ch);
     free(g->emissive_strength);
     free(g->t_extras);
+    for (i = 0; i < g->num_nodes && g->node_weights; i++) free(g->node_weights[i]);
+    free(g->node_weights);
+    free(g->node_num_weights);
     memset(g, 0, sizeof *g);
 }
 
@@ -30,8 +34,13 @@ static int side_channel_cmp(const void *pa, const void *pb)
     return a->path - b->path;
 }
 
-/* The JSON text of a .gltf or of a GLB's first chunk. */
-static int gltf_json_span(const unsigned char *data, size_t size, const char **json, size_t *len)
+int evr_gltf_index(const evr_jdoc *d, int v)
+{
+    double x = evr_jdoc_number(d, v, -1);
+    return x >= 0 && x < 2147483647.0 && x == (int)x ? (int)x : -1;
+}
+
+int evr_gltf_json_span(const unsigned char *data, size_t size, const char **json, size_t *len)
 {
     if (size >= 20 && !memcmp(data, "glTF", 4)) {
         uint32_t clen = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 |
@@ -55,7 +64,7 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     size_t jlen;
     evr_status st = EVR_OK;
     memset(g, 0, sizeof *g);
-    if (!gltf_json_span(data, size, &json, &jlen))
+    if (!evr_gltf_json_span(data, size, &json, &jlen))
         return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: the GLB has no JSON chunk");
     root = evr_jdoc_parse(&d, json, jlen);
     if (root < 0 || evr_jdoc_type(&d, root) != EVR_JDOC_OBJECT) {
@@ -75,7 +84,11 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->emissive_strength = calloc((size_t)g->num_materials + 1, sizeof *g->emissive_strength);
     g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
-    if (!g->node_names || !g->emissive_strength || !g->t_extras) goto nomem;
+    g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
+    g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
+    if (!g->node_names || !g->emissive_strength || !g->t_extras || !g->node_num_weights ||
+        !g->node_weights)
+        goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
          m = evr_jdoc_next(&d, m), i++) {
@@ -85,6 +98,16 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         g->node_names[i] = malloc(strlen(buf) + 1);
         if (!g->node_names[i]) goto nomem;
         strcpy(g->node_names[i], buf);
+        {
+            int w = evr_jdoc_get(&d, m, "weights"), e, k = 0;
+            int nw = evr_jdoc_count(&d, w);
+            if (nw > 0) {
+                if (!(g->node_weights[i] = malloc((size_t)nw * sizeof(float)))) goto nomem;
+                for (e = evr_jdoc_first(&d, w); e >= 0; e = evr_jdoc_next(&d, e))
+                    g->node_weights[i][k++] = (float)evr_jdoc_number(&d, e, 0.0);
+                g->node_num_weights[i] = nw;
+            }
+        }
     }
     for (a = 0, i = g->num_anims ? evr_jdoc_first(&d, anims) : -1; i >= 0;
          i = evr_jdoc_next(&d, i), a++) {
@@ -106,7 +129,8 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
             if (!strcmp(path, "translation")) sc.path = PATH_T;
             else if (!strcmp(path, "rotation")) sc.path = PATH_R;
             else if (!strcmp(path, "scale")) sc.path = PATH_S;
-            else continue; /* morph weights: not a transform */
+            else if (!strcmp(path, "weights")) sc.path = PATH_W;
+            else continue;
             if (!(si >= 0 && si < nsamp) || !(ni >= 0 && ni < g->num_nodes)) continue;
             if (!evr_jdoc_string(&d, evr_jdoc_get(&d, samplers[(int)si], "interpolation"), interp,
                                  sizeof interp))
@@ -149,8 +173,6 @@ nomem:
     return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON");
 }
 
-/* The interpolation of the glTF channel (animation anim, node named `name`, path): GL_*, or -1
- * when the file has no such channel (Assimp synthesized the keys). anim < 0: any animation. */
 int evr_gltf_side_interp(const gltf_side *g, int anim, const char *name, int path)
 {
     int lo = 0, hi = g->num_ch, i;

@@ -4,11 +4,15 @@
  *
  *   import.c           loading a file or memory through Assimp, the order of the steps, release
  *   import_gltf.c      the glTF JSON read directly, for what Assimp drops
+ *   import_gltf_data.c glTF buffers and accessors read directly (data: URIs, files, GLB BIN)
+ *   import_gltf_deform.c  glTF skins and morph targets checked before Assimp reads them
+ *   import_memfile.c   an aiFileIO that serves Assimp a patched copy of the scene file
  *   import_texture.c   base colour textures: finding, decoding and linearizing them
  *   import_mesh.c      materials and triangle meshes
  *   import_node.c      the node hierarchy, instances and rest-pose bounds
  *   import_clips.c     which animation clips play (the default rule or the caller's choice)
  *   import_anim.c      animation curves
+ *   import_deform.c    skins, morph targets, morph weights and their curves
  *   import_camera.c    cameras (or one framing the scene)
  *   import_light.c     punctual lights (or a headlight)
  *   import_describe.c  what `evray info` prints */
@@ -18,6 +22,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "io/json_read.h"
 #include "scene/scene.h"
 
 struct aiScene;
@@ -28,12 +33,13 @@ struct aiAnimation;
 
 /* ---- glTF side information: what Assimp 5.2 drops (import_gltf.c) ---- */
 
-enum { PATH_T = 0, PATH_R = 1, PATH_S = 2 };
+enum { PATH_T = 0, PATH_R = 1, PATH_S = 2, PATH_W = 3 };
 enum { GL_LINEAR = 0, GL_STEP = 1, GL_CUBIC = 2 };
 
 #define T_ABSENT -1e30f
 
-/* One glTF animation channel that targets a node's translation, rotation or scale. */
+/* One glTF animation channel that targets a node's translation, rotation, scale or morph
+ * weights. */
 typedef struct {
     const char *node; /* the node's name as Assimp gives it (points into node_names) */
     int anim, path, interp;
@@ -48,8 +54,14 @@ typedef struct {
     int num_materials;
     float *emissive_strength; /* KHR_materials_emissive_strength, 1 when absent */
     float *t_extras; /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
+    int *node_num_weights; /* per node: the morph weights it gives (node.weights), 0: none */
+    float **node_weights;  /* per node: those weights, or NULL */
 } gltf_side;
 
+/* A glTF index (a non-negative integer number), or -1. */
+int evr_gltf_index(const evr_jdoc *d, int v);
+/* The JSON text of a .gltf or of a GLB's first chunk: 0 when a GLB has none. */
+int evr_gltf_json_span(const unsigned char *data, size_t size, const char **json, size_t *len);
 /* Reads the side information from a .gltf or a GLB (data: the file's bytes, a GLB's header and
  * JSON chunk at least). */
 evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g,
@@ -58,6 +70,59 @@ void evr_gltf_side_free(gltf_side *g);
 /* The interpolation of the glTF channel (animation anim, node named `name`, path): GL_*, or -1
  * when the file has no such channel (Assimp synthesized the keys). anim < 0: any animation. */
 int evr_gltf_side_interp(const gltf_side *g, int anim, const char *name, int path);
+
+/* ---- glTF binary data (import_gltf_data.c) ---- */
+
+/* Where a glTF's data is: its bytes (a .gltf's text, or a GLB: whole, or its header and JSON
+ * chunk only, the BIN chunk then read from path), and the folder of relative URIs. */
+typedef struct {
+    const unsigned char *bytes;
+    size_t nbytes;
+    const char *path; /* the file, NULL for memory */
+    const char *dir;  /* folder with a trailing '/' ("" the current one); NULL: none (memory) */
+} gltf_source;
+
+/* Accessors of one parsed glTF document; buffers are loaded when first read. */
+typedef struct {
+    const evr_jdoc *d;
+    const gltf_source *src;
+    int accessors; /* the JSON array */
+    int num_accessors, num_views, num_buffers;
+    int *acc_v, *view_v, *buf_v; /* the JSON value of each accessor, view and buffer */
+    unsigned char **buf;         /* per buffer: its bytes once loaded */
+    size_t *buf_len;
+} gltf_data;
+
+evr_status evr_gltf_data_init(gltf_data *g, const evr_jdoc *d, int root, const gltf_source *src,
+                              evr_error *err);
+void evr_gltf_data_free(gltf_data *g);
+/* The JSON value of accessor a, or -1. */
+int evr_gltf_accessor(const gltf_data *g, int a);
+/* Accessor a's element count (-1 when there is no such accessor) and components per element. */
+int evr_gltf_accessor_count(const gltf_data *g, int a, int *ncomp);
+/* Reads accessor a (SCALAR to VEC4; strides, normalized integers and sparse values applied)
+ * into *out, count * ncomp doubles (free()). */
+evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count, int *ncomp,
+                                  evr_error *err);
+
+/* ---- glTF skins and morph targets before Assimp (import_gltf_deform.c) ---- */
+
+/* Checks what Assimp 5.2 would misread or crash on (quirks (j) to (n) in import.c): one error
+ * naming the mesh. When a used skin has no inverseBindMatrices or a mesh is placed with two
+ * skins, *patched is a copy of the file for Assimp to read instead (identity matrices added, a
+ * copy of the mesh per further skin; free()); else NULL. A document that is not glTF 2.0 JSON
+ * passes unchecked (Assimp reports it). */
+evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched, size_t *npatched,
+                                 evr_error *err);
+
+/* ---- serving Assimp a patched file (import_memfile.c) ---- */
+
+struct aiFileIO;
+/* An aiFileIO that gives Assimp `bytes` (which must outlive the import) for the file `path` and
+ * opens every other file (the buffers and textures beside it) from disk; NULL when out of
+ * memory. */
+struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes, size_t n);
+void evr_memfile_io_free(struct aiFileIO *io);
 
 /* ---- the importer's state while it converts one aiScene ---- */
 
@@ -88,6 +153,11 @@ typedef struct {
 /* Fills err with one line (newlines from library messages become spaces) and returns st. */
 evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...);
 void evr_import_copy_name(char *dst, size_t cap, const char *src);
+/* One warning line (what evray does not render of the file) added to the scene's list. */
+void evr_import_warn(importer *im, const char *fmt, ...);
+/* An Assimp matrix as evr_m34 (its last row dropped). */
+struct aiMatrix4x4;
+evr_m34 evr_import_m34(const struct aiMatrix4x4 *a);
 /* Reads at most max bytes of a file (the whole file when max is 0), 0-ended. */
 evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
                                 evr_error *err);
@@ -114,8 +184,15 @@ double evr_import_ticks_per_second(const struct aiAnimation *an);
  * JSON says, GL_LINEAR without it, or -1 when Assimp synthesized those keys (quirk (e)). */
 int evr_import_channel_interp(const importer *im, unsigned a, const char *node, int path);
 /* Curves of the played clips (evr_import_clip_played). */
+/* How many nodes have Assimp name `name`. */
+int evr_import_name_count(const importer *im, const char *name);
 evr_status evr_import_animation(importer *im);
 void evr_import_curve_free(evr_curve *c);
+/* Sorts a curve's keys by time (stable; dim values per key). */
+void evr_import_curve_sort(evr_curve *c, int dim);
+/* Skins and morph targets of the meshes, the nodes' morph weights and their curves (after
+ * evr_import_animation: it widens the animation's time range). */
+evr_status evr_import_deform(importer *im);
 /* The scene's world bounds at rest pose. */
 void evr_import_bounds(evr_scene *s);
 evr_status evr_import_cameras(importer *im);

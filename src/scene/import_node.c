@@ -16,22 +16,39 @@ static int name_index_cmp(const void *pa, const void *pb)
     return c ? c : (a->index > b->index) - (a->index < b->index);
 }
 
-/* The first node (in depth-first order) with Assimp name `name`, or -1. Assimp attaches
- * animation channels, cameras and lights to nodes by name. */
-int evr_import_find_node(const importer *im, const char *name)
+/* The position in by_name of the first node named `name` (where it would be when none is). */
+static int first_by_name(const importer *im, const char *name)
 {
     int lo = 0, hi = im->s->num_nodes;
-    if (!im->by_name) return -1;
     while (lo < hi) {
         int mid = lo + (hi - lo) / 2;
         if (strcmp(im->by_name[mid].name, name) < 0) lo = mid + 1;
         else hi = mid;
     }
-    return (lo < im->s->num_nodes && !strcmp(im->by_name[lo].name, name)) ? im->by_name[lo].index
+    return lo;
+}
+
+/* The first node (in depth-first order) with Assimp name `name`, or -1. Assimp attaches
+ * animation channels, bones, cameras and lights to nodes by name. */
+int evr_import_find_node(const importer *im, const char *name)
+{
+    int at;
+    if (!im->by_name) return -1;
+    at = first_by_name(im, name);
+    return (at < im->s->num_nodes && !strcmp(im->by_name[at].name, name)) ? im->by_name[at].index
                                                                           : -1;
 }
 
-static evr_m34 m34_from_ai(const struct aiMatrix4x4 *a)
+int evr_import_name_count(const importer *im, const char *name)
+{
+    int at, n = 0;
+    if (!im->by_name) return 0;
+    at = first_by_name(im, name);
+    while (at + n < im->s->num_nodes && !strcmp(im->by_name[at + n].name, name)) n++;
+    return n;
+}
+
+evr_m34 evr_import_m34(const struct aiMatrix4x4 *a)
 {
     evr_m34 m;
     m.m[0][0] = a->a1;
@@ -111,7 +128,7 @@ evr_status evr_import_nodes(importer *im)
         im->ai_nodes[self] = an;
         evr_import_copy_name(n->name, sizeof n->name, an->mName.data);
         n->parent = parent;
-        n->rest_matrix = m34_from_ai(&an->mTransformation);
+        n->rest_matrix = evr_import_m34(&an->mTransformation);
         aiDecomposeMatrix(&an->mTransformation, &sc, &q, &pos);
         n->translation = evr_v3_make(pos.x, pos.y, pos.z);
         n->scale = evr_v3_make(sc.x, sc.y, sc.z);
@@ -174,6 +191,28 @@ static evr_m34 rest_world(const evr_scene *s, int node)
     return m;
 }
 
+/* A deforming instance's world bounds at the animation's start (a skinned mesh's rest
+ * positions mean nothing without its joints: the mesh node's transform is ignored); 0 when
+ * memory ran out. */
+static int deformed_bounds(const evr_scene *s, int inst, evr_v3 *lo, evr_v3 *hi)
+{
+    const evr_mesh *m = &s->meshes[s->instances[inst].mesh];
+    float *p = malloc(sizeof(float) * 3 * (size_t)m->num_vertices + 1);
+    evr_m34 w = m->skin ? evr_m34_identity() : rest_world(s, s->instances[inst].node);
+    uint32_t v;
+    if (!p || !evr_instance_deformed_at(s, inst, s->anim_start, p, NULL)) {
+        free(p);
+        return 0;
+    }
+    for (v = 0; v < m->num_vertices; v++) {
+        evr_v3 q = evr_m34_point(&w, evr_v3_make(p[3 * v], p[3 * v + 1], p[3 * v + 2]));
+        *lo = evr_v3_make(fminf(lo->x, q.x), fminf(lo->y, q.y), fminf(lo->z, q.z));
+        *hi = evr_v3_make(fmaxf(hi->x, q.x), fmaxf(hi->y, q.y), fmaxf(hi->z, q.z));
+    }
+    free(p);
+    return 1;
+}
+
 void evr_import_bounds(evr_scene *s)
 {
     int i, c, any = 0;
@@ -183,6 +222,8 @@ void evr_import_bounds(evr_scene *s)
         const evr_mesh *m = &s->meshes[s->instances[i].mesh];
         evr_m34 w;
         if (!m->num_triangles) continue;
+        any = 1;
+        if (evr_instance_deforms(s, i) && deformed_bounds(s, i, &lo, &hi)) continue;
         w = rest_world(s, s->instances[i].node);
         for (c = 0; c < 8; c++) {
             evr_v3 p = evr_v3_make((c & 1) ? m->bounds_max.x : m->bounds_min.x,
@@ -191,7 +232,6 @@ void evr_import_bounds(evr_scene *s)
             p = evr_m34_point(&w, p);
             lo = evr_v3_make(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
             hi = evr_v3_make(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
-            any = 1;
         }
     }
     if (!any) lo = hi = evr_v3_make(0, 0, 0);

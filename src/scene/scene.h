@@ -145,7 +145,11 @@ struct evr_scene {
     double anim_start, anim_end; /* time range of the played clips' curves (0,0 if static) */
     double frame_rate;           /* frames per second of the animation when the file says, else 0 */
     evr_v3 bounds_min, bounds_max; /* world bounds at rest pose */
+    char *warnings;   /* what evray does not render of the file: lines ending in '\n', or NULL */
+    int num_warnings; /* how many there were (the text keeps the first EVR_MAX_WARNINGS) */
 };
+
+#define EVR_MAX_WARNINGS 16
 
 /* Animation evaluation (scene/anim.c). */
 evr_m34 evr_node_local_at(const evr_node *n, double t);
