@@ -10,6 +10,7 @@ cmake --build build -j"$jobs"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DEVR_SANITIZE=ON -DEVR_CUDA=OFF
 cmake --build build-asan -j"$jobs"
 scripts/test-venv.sh build/venv
+scripts/test-blender.sh
 echo "== release build =="
 (cd build && ctest --output-on-failure -j"$jobs")
 echo "== AddressSanitizer + UBSan build =="
