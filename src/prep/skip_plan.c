@@ -27,6 +27,8 @@ void evr_skip_tracker_free(evr_skip_tracker *t)
     free(t->last_count);
     for (int i = 0; t->mesh_parts && i < t->num_meshes; i++) free(t->mesh_parts[i]);
     free(t->mesh_parts);
+    for (int i = 0; t->tri_order && i < t->num_meshes; i++) free(t->tri_order[i]);
+    free(t->tri_order);
     memset(t, 0, sizeof *t);
 }
 
@@ -34,7 +36,8 @@ int evr_skip_tracker_parts(evr_skip_tracker *t, const evr_scene *s)
 {
     t->num_meshes = s->num_meshes;
     t->mesh_parts = calloc((size_t)(s->num_meshes ? s->num_meshes : 1), sizeof *t->mesh_parts);
-    return t->mesh_parts != NULL;
+    t->tri_order = calloc((size_t)(s->num_meshes ? s->num_meshes : 1), sizeof *t->tri_order);
+    return t->mesh_parts != NULL && t->tri_order != NULL;
 }
 
 typedef struct {
@@ -122,6 +125,71 @@ static const float (*mesh_parts(evr_skip_tracker *t, const evr_scene *s, int i))
         t->mesh_parts[i] = out;
     }
     return (const float(*)[6])t->mesh_parts[i];
+}
+
+/* The leaves split_parts makes of k[first .. first + n): leaf l holds k[bounds[l] ..
+ * bounds[l + 1]) (the same recursion, without the sorting). */
+static void leaf_bounds(uint32_t first, uint32_t n, int depth, uint32_t *bounds)
+{
+    const uint32_t leaves = (uint32_t)1 << depth;
+    if (depth == 0 || n <= 1) {
+        bounds[0] = first;
+        for (uint32_t i = 1; i <= leaves; i++) bounds[i] = first + n;
+        return;
+    }
+    leaf_bounds(first, n / 2, depth - 1, bounds);
+    leaf_bounds(first + n / 2, n - n / 2, depth - 1, bounds + leaves / 2);
+}
+
+/* The parts of a deforming mesh i: its triangles in split_parts' order (split at rest) and each
+ * leaf's first; their boxes are made every segment from the vertex keys (deform_part_boxes). */
+static int deform_parts(evr_skip_tracker *t, const evr_scene *s, int i)
+{
+    if (!t->tri_order || i < 0 || i >= t->num_meshes) return 0;
+    if (t->tri_order[i]) return 1;
+    const evr_mesh *m = &s->meshes[i];
+    float(*scratch)[6] = malloc(sizeof *scratch * EVR_SKIP_MESH_PARTS);
+    keyed_tri *k = malloc(sizeof *k * (m->num_triangles ? m->num_triangles : 1));
+    uint32_t *order = malloc(sizeof *order * (m->num_triangles ? m->num_triangles : 1) +
+                             sizeof *order * (EVR_SKIP_MESH_PARTS + 1));
+    if (!scratch || !k || !order) {
+        free(scratch);
+        free(k);
+        free(order);
+        return 0;
+    }
+    for (uint32_t j = 0; j < m->num_triangles; j++) k[j].tri = j;
+    int depth = 0;
+    while ((1 << depth) < EVR_SKIP_MESH_PARTS) depth++;
+    split_parts(m, k, m->num_triangles, depth, scratch);
+    for (uint32_t j = 0; j < m->num_triangles; j++) order[j] = k[j].tri;
+    leaf_bounds(0, m->num_triangles, depth, order + m->num_triangles);
+    free(scratch);
+    free(k);
+    t->tri_order[i] = order;
+    return 1;
+}
+
+/* Each part's box over every key of the segment (in the instance's track space). */
+static void deform_part_boxes(const evr_skip_tracker *t, const evr_scene *s, int mesh,
+                              const evr_deform_view *v, float (*out)[6])
+{
+    const evr_mesh *m = &s->meshes[mesh];
+    const uint32_t *order = t->tri_order[mesh], *first = order + m->num_triangles;
+    for (int l = 0; l < EVR_SKIP_MESH_PARTS; l++) {
+        empty_box(out[l]);
+        for (uint32_t j = first[l]; j < first[l + 1]; j++)
+            for (int c = 0; c < 3; c++) {
+                const uint32_t vi = m->indices[3 * order[j] + c];
+                for (int k = 0; k < v->num_keys; k++) {
+                    const float *p = v->positions + ((size_t)k * v->num_vertices + vi) * 3;
+                    for (int a = 0; a < 3; a++) {
+                        out[l][a] = fminf(out[l][a], p[a]);
+                        out[l][a + 3] = fmaxf(out[l][a + 3], p[a]);
+                    }
+                }
+            }
+    }
 }
 
 static int close_to(float a, float b, float tol) { return fabsf(a - b) <= tol; }
@@ -334,12 +402,18 @@ static void sweep_box(const track_sweep *ts, const float lo[3], const float hi[3
  * children. Where the part was before the segment does not matter here: a pixel's cache is
  * clean only if its rays met nothing that moved in its own segment, so it holds the static
  * scene's answer, and it holds now when its rays meet nothing where things are now. */
-static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs, int i,
-                      int leaves, evr_skip_plan *pl, int b, track_sweep *ts)
+static void add_parts(evr_skip_tracker *t, const evr_scene *s, const evr_render_scene *rs,
+                      const evr_deform_keys *dk, int i, int leaves, evr_skip_plan *pl, int b,
+                      track_sweep *ts, float (*deformed)[6])
 {
-    /* a deforming mesh's parts are not where its rest pose puts them: its whole box */
-    const float(*parts)[6] =
-        rs->instances[i].deform >= 0 ? NULL : mesh_parts(t, s, rs->instances[i].mesh);
+    /* a deforming mesh's parts: the same triangles, boxed where the segment's keys put them */
+    const int d = rs->instances[i].deform, mesh = rs->instances[i].mesh;
+    const float(*parts)[6] = NULL;
+    if (d < 0) parts = mesh_parts(t, s, mesh);
+    else if (dk && d < dk->num_deforms && deformed && deform_parts(t, s, mesh)) {
+        deform_part_boxes(t, s, mesh, &dk->views[d], deformed);
+        parts = (const float(*)[6])deformed;
+    }
     const int base = pl->part_first[b], per = EVR_SKIP_MESH_PARTS / leaves;
     if (!parts) { /* no tree: the instance's box alone */
         pl->part_first[b + 1] = base;
@@ -470,9 +544,13 @@ void evr_skip_plan_build(evr_skip_tracker *t, const evr_scene *s, const evr_rend
     if (!per_track && pl->num_boxes > 0 && t->mesh_parts) {
         int leaves = EVR_SKIP_MESH_PARTS;
         track_sweep *ts = malloc(sizeof *ts);
+        float(*deformed)[6] =
+            dk && dk->num_deforms ? malloc(sizeof *deformed * EVR_SKIP_MESH_PARTS) : NULL;
         while (leaves > 1 && (2 * leaves - 1) * pl->num_boxes > EVR_SKIP_MAX_PARTS) leaves /= 2;
         for (int j = 0, nb = 0; ts && leaves > 1 && j < rs->num_instances; j++)
-            if (instance_moved(t, rs, dk, j)) add_parts(t, s, rs, j, leaves, pl, nb++, ts);
+            if (instance_moved(t, rs, dk, j))
+                add_parts(t, s, rs, dk, j, leaves, pl, nb++, ts, deformed);
+        free(deformed);
         free(ts);
     }
     pl->cache = cache;

@@ -21,6 +21,9 @@ typedef struct {
      * first moves */
     int num_meshes;
     float (**mesh_parts)[6];
+    /* a deforming mesh's parts (boxed anew every segment from its keys): per mesh NULL or its
+     * triangles in the parts' order followed by EVR_SKIP_MESH_PARTS + 1 part starts */
+    uint32_t **tri_order;
 } evr_skip_tracker;
 
 /* Parts a moving mesh is bounded by at most: its triangles split eight times at the median of
