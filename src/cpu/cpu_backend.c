@@ -9,6 +9,7 @@
 #include "core/skip.h"
 #include "cpu/workers.h"
 #include "cpu/cpu_gi.h"
+#include "cpu/deform_geometry.h"
 #include "prep/instance_groups.h"
 
 #include <embree3/rtcore.h>
@@ -38,7 +39,8 @@ typedef struct {
      * by the node's motion keys. */
     evr_instance_groups groups;
     RTCScene *group_scenes;
-    int *deform_keys_set; /* per group: the keys a deforming group's vertices have (0: none) */
+    int *deform_keys_set;    /* per group: the keys a deforming group's vertices have (0: none) */
+    evr_cpu_deform *deforms; /* per group: a deforming group's triangles and current keys */
     RTCScene top;
     int time_grid; /* the segment's motion keys split it into this many equal intervals (1: none moves) */
     int gi;        /* global illumination on */
@@ -580,27 +582,18 @@ static void *worker(void *arg)
     return NULL;
 }
 
-/* A deforming group's triangles take the segment's vertex keys as Embree time steps (which
- * interpolate linearly between uniform steps, as evr_deform_lerp does). 0: out of memory. */
+/* A deforming group's triangles take the segment's vertex keys (cpu/deform_geometry.h): its tree
+ * is rebuilt over their boxes when they changed. 0: out of memory. */
 static int update_deform(cpu_backend *b, int g, const evr_segment *seg)
 {
     const int d = b->host.instances[b->groups.members[b->groups.group_first[g]]].deform;
     const evr_deform_view *v = &seg->deforms[d];
     if (v->num_keys - 1 > b->time_grid) b->time_grid = v->num_keys - 1;
-    /* one key, the same bits as the one it has: nothing to rebuild */
+    b->deforms[g].view = *v; /* the keys' arrays of this segment, whatever happens below */
+    /* one key, the same bits as the one it has: the tree holds */
     if (b->deform_keys_set[g] == 1 && v->num_keys == 1 && !seg->deform_moved[d]) return 1;
     b->deform_keys_set[g] = v->num_keys;
-    RTCGeometry geom = rtcGetGeometry(b->group_scenes[g], 0);
-    rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_MEDIUM);
-    rtcSetGeometryTimeStepCount(geom, (unsigned)v->num_keys);
-    for (int k = 0; k < v->num_keys; k++) {
-        float *vb = rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, (unsigned)k,
-                                            RTC_FORMAT_FLOAT3, 3 * sizeof(float), v->num_vertices);
-        if (!vb) return 0;
-        memcpy(vb, v->positions + (size_t)k * 3 * v->num_vertices,
-               sizeof(float) * 3 * v->num_vertices);
-    }
-    rtcCommitGeometry(geom);
+    rtcCommitGeometry(rtcGetGeometry(b->group_scenes[g], 0));
     rtcCommitScene(b->group_scenes[g]);
     rtcCommitGeometry(rtcGetGeometry(b->top, (unsigned)g)); /* its instance's bounds changed */
     return 1;
@@ -781,6 +774,7 @@ static void cpu_release(evr_backend *base)
     }
     free(b->group_scenes);
     free(b->deform_keys_set);
+    free(b->deforms);
     evr_instance_groups_free(&b->groups);
     if (b->device) rtcReleaseDevice(b->device);
     if (b->tile_events) {
@@ -845,7 +839,8 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
     }
     b->group_scenes = calloc((size_t)gr->num_groups + 1, sizeof *b->group_scenes);
     b->deform_keys_set = calloc((size_t)gr->num_groups + 1, sizeof *b->deform_keys_set);
-    if (!b->group_scenes || !b->deform_keys_set) ok = 0;
+    b->deforms = calloc((size_t)gr->num_groups + 1, sizeof *b->deforms);
+    if (!b->group_scenes || !b->deform_keys_set || !b->deforms) ok = 0;
     for (g = 0; ok && g < gr->num_groups; g++) {
         RTCScene sc;
         if (gr->group_kind[g] ==
@@ -873,10 +868,29 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
             break;
         }
         b->group_scenes[g] = sc;
-        /* a deforming group is rebuilt every segment it moves: a quicker build */
-        const int dynamic = gr->group_kind[g] == EVR_GROUP_DEFORMING;
-        if (dynamic) rtcSetSceneFlags(sc, RTC_SCENE_FLAG_DYNAMIC);
-        rtcSetSceneBuildQuality(sc, dynamic ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+        if (gr->group_kind[g] == EVR_GROUP_DEFORMING) { /* rebuilt every segment it moves */
+            const evr_mesh *m = &s->meshes[s->instances[gr->members[gr->group_first[g]]].mesh];
+            evr_cpu_deform *d = &b->deforms[g];
+            RTCGeometry geom;
+            d->indices = m->indices;
+            d->num_triangles = m->num_triangles;
+            d->view.num_keys = 1; /* the rest pose until the first segment's keys */
+            d->view.num_vertices = m->num_vertices;
+            d->view.positions = m->positions;
+            d->view.normals = m->normals;
+            rtcSetSceneFlags(sc, RTC_SCENE_FLAG_DYNAMIC);
+            rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_MEDIUM);
+            if (!(geom = evr_cpu_deform_geometry_new(b->device, d))) {
+                ok = 0;
+                break;
+            }
+            rtcCommitGeometry(geom);
+            rtcAttachGeometryByID(sc, geom, 0);
+            rtcReleaseGeometry(geom);
+            rtcCommitScene(sc);
+            continue;
+        }
+        rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
         for (j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[gr->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);

@@ -1,0 +1,122 @@
+/* Deforming triangles as Embree user geometry (see deform_geometry.h). */
+#include "cpu/deform_geometry.h"
+#include "core/ray_triangle.h"
+
+#include <math.h>
+
+/* Embree's packets of N rays in SOA layout (rtcore_ray.h; its accessors are C++ only): a ray's
+ * fields, then a hit's, each N wide. */
+enum { RAY_ORG = 0, RAY_TNEAR = 3, RAY_DIR = 4, RAY_TIME = 7, RAY_TFAR = 8, RAY_FIELDS = 12 };
+enum { HIT_NG = 0, HIT_U = 3, HIT_V = 4, HIT_PRIM = 5, HIT_GEOM = 6, HIT_INST = 7 };
+static float *ray_field(struct RTCRayN *ray, unsigned n, unsigned field, unsigned i)
+{
+    return (float *)ray + (size_t)field * n + i;
+}
+static float *hit_float(struct RTCHitN *hit, unsigned n, unsigned field, unsigned i)
+{
+    return (float *)hit + (size_t)field * n + i;
+}
+static unsigned *hit_uint(struct RTCHitN *hit, unsigned n, unsigned field, unsigned i)
+{
+    return (unsigned *)hit + (size_t)field * n + i;
+}
+
+static void corners(const evr_cpu_deform *d, unsigned prim, float f, evr_v3 *a, evr_v3 *b,
+                    evr_v3 *c)
+{
+    const uint32_t *ix = d->indices + 3 * (size_t)prim;
+    *a = evr_deform_lerp(&d->view, d->view.positions, ix[0], f);
+    *b = evr_deform_lerp(&d->view, d->view.positions, ix[1], f);
+    *c = evr_deform_lerp(&d->view, d->view.positions, ix[2], f);
+}
+
+/* A triangle's box over every key: linear interpolation between keys stays inside it. */
+static void bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const evr_cpu_deform *d = args->geometryUserPtr;
+    const evr_deform_view *v = &d->view;
+    const uint32_t *ix = d->indices + 3 * (size_t)args->primID;
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int k = 0; k < v->num_keys; k++)
+        for (int c = 0; c < 3; c++) {
+            const float *p = v->positions + ((size_t)k * v->num_vertices + ix[c]) * 3;
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fminf(lo[a], p[a]);
+                hi[a] = fmaxf(hi[a], p[a]);
+            }
+        }
+    struct RTCBounds *o = args->bounds_o;
+    o->lower_x = lo[0];
+    o->lower_y = lo[1];
+    o->lower_z = lo[2];
+    o->upper_x = hi[0];
+    o->upper_y = hi[1];
+    o->upper_z = hi[2];
+}
+
+static int ray_hits(const evr_cpu_deform *d, unsigned prim, struct RTCRayN *ray, unsigned n,
+                    unsigned i, float *t, float *u, float *v, evr_v3 *ng)
+{
+    const evr_v3 org =
+        evr_v3_make(*ray_field(ray, n, RAY_ORG, i), *ray_field(ray, n, RAY_ORG + 1, i),
+                    *ray_field(ray, n, RAY_ORG + 2, i));
+    const evr_v3 dir =
+        evr_v3_make(*ray_field(ray, n, RAY_DIR, i), *ray_field(ray, n, RAY_DIR + 1, i),
+                    *ray_field(ray, n, RAY_DIR + 2, i));
+    evr_v3 a, b, c;
+    corners(d, prim, *ray_field(ray, n, RAY_TIME, i), &a, &b, &c);
+    const evr_tri_ray r = evr_tri_ray_make(org, dir);
+    if (!evr_tri_hit(&r, a, b, c, *ray_field(ray, n, RAY_TNEAR, i), *ray_field(ray, n, RAY_TFAR, i),
+                     t, u, v))
+        return 0;
+    *ng = evr_v3_cross(evr_v3_sub(b, a), evr_v3_sub(c, a));
+    return 1;
+}
+
+static void intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    const evr_cpu_deform *d = args->geometryUserPtr;
+    const unsigned n = args->N;
+    struct RTCRayN *ray = (struct RTCRayN *)args->rayhit;
+    struct RTCHitN *hit = (struct RTCHitN *)((float *)args->rayhit + (size_t)RAY_FIELDS * n);
+    for (unsigned i = 0; i < n; i++) {
+        float t, u, v;
+        evr_v3 ng;
+        if (args->valid[i] == 0 || !ray_hits(d, args->primID, ray, n, i, &t, &u, &v, &ng)) continue;
+        *ray_field(ray, n, RAY_TFAR, i) = t;
+        *hit_float(hit, n, HIT_NG, i) = ng.x;
+        *hit_float(hit, n, HIT_NG + 1, i) = ng.y;
+        *hit_float(hit, n, HIT_NG + 2, i) = ng.z;
+        *hit_float(hit, n, HIT_U, i) = u;
+        *hit_float(hit, n, HIT_V, i) = v;
+        *hit_uint(hit, n, HIT_PRIM, i) = args->primID;
+        *hit_uint(hit, n, HIT_GEOM, i) = args->geomID;
+        for (unsigned l = 0; l < RTC_MAX_INSTANCE_LEVEL_COUNT; l++)
+            *hit_uint(hit, n, HIT_INST + l, i) = args->context->instID[l];
+    }
+}
+
+static void occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    const evr_cpu_deform *d = args->geometryUserPtr;
+    for (unsigned i = 0; i < args->N; i++) {
+        float t, u, v;
+        evr_v3 ng;
+        if (args->valid[i] != 0 &&
+            ray_hits(d, args->primID, args->ray, args->N, i, &t, &u, &v, &ng))
+            *ray_field(args->ray, args->N, RAY_TFAR, i) = -INFINITY;
+    }
+}
+
+RTCGeometry evr_cpu_deform_geometry_new(RTCDevice dev, evr_cpu_deform *d)
+{
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_USER);
+    if (!g) return NULL;
+    rtcSetGeometryUserPrimitiveCount(g, d->num_triangles);
+    rtcSetGeometryUserData(g, d);
+    rtcSetGeometryBoundsFunction(g, bounds, NULL);
+    rtcSetGeometryIntersectFunction(g, intersect);
+    rtcSetGeometryOccludedFunction(g, occluded);
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_MEDIUM);
+    return g;
+}
