@@ -17,6 +17,9 @@ export PATH="$PATH:/usr/local/cuda/bin"
 python3 tests/test_cuda.py "$E" > "$OUT/test_cuda.log" 2>&1; echo "test_cuda exit $?" >> "$OUT/test_cuda.log"
 python3 tests/test_skip.py "$E" > "$OUT/test_skip.log" 2>&1; echo "test_skip exit $?" >> "$OUT/test_skip.log"
 python3 tests/test_bench.py "$E" > "$OUT/test_bench.log" 2>&1; echo "test_bench exit $?" >> "$OUT/test_bench.log"
+# deforming meshes: analytic edges and the blink scene, on the GPU (--backend auto picks it)
+python3 tests/test_deform.py "$E" > "$OUT/test_deform.log" 2>&1; echo "test_deform exit $?" >> "$OUT/test_deform.log"
+python3 tests/test_blink.py "$E" > "$OUT/test_blink.log" 2>&1; echo "test_blink exit $?" >> "$OUT/test_blink.log"
 # memcheck over segments that skip (the eye in a fixation) and that trace (a saccade), ideal and davis346
 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.5 \
     --start 0.9 -o "$OUT/cs-eye" --no-preview -q > "$OUT/sanitizer.log" 2>&1; echo "memcheck exit $?" >> "$OUT/sanitizer.log"
@@ -24,6 +27,11 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --bac
     --sensor davis346 --start 0.9 -o "$OUT/cs-eye2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck davis346 exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x64 --duration 0.1 \
     -o "$OUT/cs-sq" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck exit $?" >> "$OUT/sanitizer.log"
+# deforming meshes: per-segment vertex keys and trees (morph-target lids, a skinned finger)
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene blink --backend cuda --res 96x54 \
+    --duration 0.6 -o "$OUT/cs-blink" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck blink exit $?" >> "$OUT/sanitizer.log"
+compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene blink --backend cuda --res 64x36 \
+    --duration 0.5 -o "$OUT/cs-blink2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck blink exit $?" >> "$OUT/sanitizer.log"
 # global illumination on the GPU (photon pass, sort, gathers)
 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --backend cuda --res 96x72 \
     --duration 0.3 -o "$OUT/cs-gi" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck gi exit $?" >> "$OUT/sanitizer.log"
