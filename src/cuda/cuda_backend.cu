@@ -338,6 +338,11 @@ extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_
                                            const evr_run_setup *setup, evr_backend **out,
                                            evr_error *err)
 {
+    if (h->num_deforms > 0) { /* auto falls back to the CPU with this as its notice */
+        snprintf(err->msg, sizeof err->msg,
+                 "the CUDA backend does not render deforming meshes (skins, morph targets) yet");
+        return EVR_ERR_BACKEND;
+    }
     cuda_backend *b = new (std::nothrow) cuda_backend();
     if (!b) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
