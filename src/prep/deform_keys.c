@@ -1,5 +1,6 @@
 /* Per-segment vertex keys of the deforming instances (see deform_keys.h). */
 #include "prep/deform_keys.h"
+#include "par_pool.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -93,6 +94,7 @@ int evr_deform_tracker_init(evr_deform_tracker *t, const evr_scene *s, const evr
     memset(t, 0, sizeof *t);
     t->num_deforms = h->num_deforms;
     if (!h->num_deforms) return 1;
+    t->pool = evr_par_pool_new(evr_par_threads(EVR_DEFORM_PARTS)); /* NULL: on this thread */
     t->last = calloc((size_t)h->num_deforms, sizeof *t->last);
     t->last_box = calloc((size_t)h->num_deforms, sizeof *t->last_box);
     if (!t->last || !t->last_box) return 0;
@@ -109,6 +111,7 @@ void evr_deform_tracker_free(evr_deform_tracker *t)
     free(t->last);
     free(t->last_box);
     free(t->scratch);
+    evr_par_pool_free(t->pool);
     memset(t, 0, sizeof *t);
 }
 
@@ -121,10 +124,45 @@ void evr_deform_keys_free(evr_deform_keys *k)
     memset(k, 0, sizeof *k);
 }
 
-/* Evaluates instance inst at time t into key slot (positions then normals, 6 nv floats). */
-static int eval_at(const evr_scene *s, int inst, double t, float *slot, uint32_t nv)
+/* One evaluation cut into parts for the tracker's pool. */
+typedef struct {
+    const evr_scene *s;
+    int inst, parts;
+    double t;
+    float *slot;
+    uint32_t nv;
+    int failed[EVR_DEFORM_PARTS];
+} eval_job;
+
+static void eval_part(void *ctx, int part, int thread)
 {
-    return evr_instance_deformed_at(s, inst, t, slot, slot + 3 * (size_t)nv);
+    eval_job *j = ctx;
+    size_t a, b;
+    (void)thread;
+    evr_par_share(j->nv, j->parts, part, &a, &b);
+    j->failed[part] = !evr_instance_deformed_range(j->s, j->inst, j->t, (uint32_t)a, (uint32_t)b,
+                                                   j->slot, j->slot + 3 * (size_t)j->nv);
+}
+
+/* Evaluates instance inst at time t into key slot (positions then normals, 6 nv floats), on the
+ * tracker's threads when the mesh is large enough to pay for them. */
+static int eval_at(evr_deform_tracker *t, const evr_scene *s, int inst, double time, float *slot,
+                   uint32_t nv)
+{
+    const int threads = evr_par_pool_threads(t->pool);
+    if (!t->pool || threads < 2 || nv < 8192)
+        return evr_instance_deformed_at(s, inst, time, slot, slot + 3 * (size_t)nv);
+    eval_job j;
+    j.s = s;
+    j.inst = inst;
+    j.t = time;
+    j.slot = slot;
+    j.nv = nv;
+    j.parts = threads < EVR_DEFORM_PARTS ? threads : EVR_DEFORM_PARTS;
+    evr_par_pool_run(t->pool, j.parts, eval_part, &j);
+    for (int k = 0; k < j.parts; k++)
+        if (j.failed[k]) return 0;
+    return 1;
 }
 
 /* Fits the keys of deform d into work (key-major, 6 nv floats a key); returns the count, 0 when
@@ -136,9 +174,9 @@ static int fit_keys(evr_deform_tracker *t, const evr_scene *s, int inst, double 
     double inner[INNER_MAX];
     const int ninner = inner_times(s, inst, t0, t1, inner);
     const double span = t1 - t0;
-    if (!grow(work, work_cap, 2 * per) || !eval_at(s, inst, t0, *work, nv)) return 0;
+    if (!grow(work, work_cap, 2 * per) || !eval_at(t, s, inst, t0, *work, nv)) return 0;
     if (!(span > 0.0) || cap < 2 || !evr_instance_deform_animated(s, inst)) return 1;
-    if (!eval_at(s, inst, t1, *work + per, nv)) return 0;
+    if (!eval_at(t, s, inst, t1, *work + per, nv)) return 0;
     int n = 2;
     for (;;) {
         /* the midpoints of every interval: the keys added if the check fails */
@@ -146,7 +184,7 @@ static int fit_keys(evr_deform_tracker *t, const evr_scene *s, int inst, double 
         int ok = 1;
         for (int i = 0; i + 1 < n; i++) {
             float *mid = t->scratch + (size_t)i * per;
-            if (!eval_at(s, inst, t0 + span * ((double)i + 0.5) / (double)(n - 1), mid, nv))
+            if (!eval_at(t, s, inst, t0 + span * ((double)i + 0.5) / (double)(n - 1), mid, nv))
                 return 0;
             if (ok && lerp_error(mid, *work + (size_t)i * per, *work + (size_t)(i + 1) * per, 0.5f,
                                  nv) > limit)
@@ -157,7 +195,7 @@ static int fit_keys(evr_deform_tracker *t, const evr_scene *s, int inst, double 
             const double f = (inner[k] - t0) / span * (double)(n - 1);
             int i = (int)floor(f);
             if (i > n - 2) i = n - 2;
-            if (!eval_at(s, inst, inner[k], probe, nv)) return 0;
+            if (!eval_at(t, s, inst, inner[k], probe, nv)) return 0;
             if (lerp_error(probe, *work + (size_t)i * per, *work + (size_t)(i + 1) * per,
                            (float)(f - i), nv) > limit)
                 ok = 0;
@@ -167,11 +205,11 @@ static int fit_keys(evr_deform_tracker *t, const evr_scene *s, int inst, double 
             float still_tol = limit * 1e-3f;
             int still = max_move(*work, *work + per, nv) <= still_tol;
             for (int q = 1; q < 4 && still; q++) {
-                if (!eval_at(s, inst, t0 + span * 0.25 * q, t->scratch, nv)) return 0;
+                if (!eval_at(t, s, inst, t0 + span * 0.25 * q, t->scratch, nv)) return 0;
                 still = max_move(*work, t->scratch, nv) <= still_tol;
             }
             for (int k = 0; k < ninner && still; k++) {
-                if (!eval_at(s, inst, inner[k], t->scratch, nv)) return 0;
+                if (!eval_at(t, s, inst, inner[k], t->scratch, nv)) return 0;
                 still = max_move(*work, t->scratch, nv) <= still_tol;
             }
             if (still) return 1;
@@ -179,7 +217,7 @@ static int fit_keys(evr_deform_tracker *t, const evr_scene *s, int inst, double 
         if (ok || n >= cap) return n;
         if (ok == 0 && !grow(work, work_cap, (size_t)(2 * n - 1) * per)) return 0;
         if (ok == 0 && ninner) { /* the probe overwrote the first midpoint */
-            if (!eval_at(s, inst, t0 + span * 0.5 / (double)(n - 1), t->scratch, nv)) return 0;
+            if (!eval_at(t, s, inst, t0 + span * 0.5 / (double)(n - 1), t->scratch, nv)) return 0;
         }
         for (int i = n - 1; i >= 1; i--)
             memmove(*work + (size_t)(2 * i) * per, *work + (size_t)i * per, per * sizeof(float));

@@ -26,8 +26,12 @@ typedef struct {
     size_t cap;  /* floats data holds */
 } evr_deform_keys;
 
+/* Threads one evaluation of a large mesh is spread over, at most. */
+#define EVR_DEFORM_PARTS 16
+
 /* The tracker's memory of the previous segment, on the planner's thread. */
 typedef struct {
+    struct evr_par_pool *pool; /* threads for evaluating large meshes (NULL: none) */
     int num_deforms;
     int have_prev;
     float **last; /* per deform: positions and normals of the last key seen */

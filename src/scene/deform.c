@@ -76,11 +76,18 @@ static void joint_matrices(const evr_scene *s, const evr_skin *sk, double t, evr
 int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *positions,
                              float *normals)
 {
+    return evr_instance_deformed_range(
+        s, instance, t, 0, s->meshes[s->instances[instance].mesh].num_vertices, positions, normals);
+}
+
+int evr_instance_deformed_range(const evr_scene *s, int instance, double t, uint32_t first,
+                                uint32_t end, float *positions, float *normals)
+{
     const evr_instance *in = &s->instances[instance];
     const evr_mesh *m = &s->meshes[in->mesh];
-    const size_t nv = m->num_vertices;
-    memcpy(positions, m->positions, sizeof(float) * 3 * nv);
-    if (normals) memcpy(normals, m->normals, sizeof(float) * 3 * nv);
+    const size_t v0 = first, nv = end; /* vertices [v0, nv) */
+    memcpy(positions + 3 * v0, m->positions + 3 * v0, sizeof(float) * 3 * (nv - v0));
+    if (normals) memcpy(normals + 3 * v0, m->normals + 3 * v0, sizeof(float) * 3 * (nv - v0));
     if (m->morph && in->node >= 0 && in->node < s->num_nodes) {
         const evr_morph *mo = m->morph;
         const evr_node *n = &s->nodes[in->node];
@@ -102,11 +109,12 @@ int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *
             }
             for (int j = 0; j < mo->num_targets; j++) {
                 if (w[j] == 0.0f) continue;
-                const float *dp = mo->d_positions + (size_t)j * 3 * nv;
-                for (size_t k = 0; k < 3 * nv; k++) positions[k] += w[j] * dp[k];
+                const size_t all = m->num_vertices;
+                const float *dp = mo->d_positions + (size_t)j * 3 * all;
+                for (size_t k = 3 * v0; k < 3 * nv; k++) positions[k] += w[j] * dp[k];
                 if (normals && mo->d_normals) {
-                    const float *dn = mo->d_normals + (size_t)j * 3 * nv;
-                    for (size_t k = 0; k < 3 * nv; k++) normals[k] += w[j] * dn[k];
+                    const float *dn = mo->d_normals + (size_t)j * 3 * all;
+                    for (size_t k = 3 * v0; k < 3 * nv; k++) normals[k] += w[j] * dn[k];
                 }
             }
             if (w != wstack) free(w);
@@ -117,7 +125,7 @@ int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *
         evr_m34 jstack[64], *jm = jstack;
         if (sk->num_joints > 64 && !(jm = malloc(sizeof *jm * (size_t)sk->num_joints))) return 0;
         joint_matrices(s, sk, t, jm);
-        for (size_t v = 0; v < nv; v++) {
+        for (size_t v = v0; v < nv; v++) {
             evr_m34 b;
             memset(&b, 0, sizeof b);
             for (int k = 0; k < sk->influences; k++) {
@@ -143,7 +151,7 @@ int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *
         }
         if (jm != jstack) free(jm);
     } else if (normals && m->morph) {
-        for (size_t v = 0; v < nv; v++) {
+        for (size_t v = v0; v < nv; v++) {
             float *nn = normals + 3 * v;
             const evr_v3 r = evr_v3_norm(evr_v3_make(nn[0], nn[1], nn[2]));
             nn[0] = r.x;

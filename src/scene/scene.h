@@ -165,6 +165,10 @@ int evr_instance_deforms(const evr_scene *s, int instance);
 int evr_instance_deform_animated(const evr_scene *s, int instance);
 int evr_instance_deformed_at(const evr_scene *s, int instance, double t, float *positions,
                              float *normals); /* 0: out of memory */
+/* The same for vertices [first, end) only (positions and normals still indexed by vertex), for
+ * evaluating one instance on several threads. */
+int evr_instance_deformed_range(const evr_scene *s, int instance, double t, uint32_t first,
+                                uint32_t end, float *positions, float *normals);
 /* The morph weights of node n at time t into w (n->num_weights of them). */
 void evr_node_weights_at(const evr_node *n, double t, float *w);
 
