@@ -228,6 +228,22 @@ def read_pfm(path):
     return w, h, px
 
 
+def deform_assets(tmp):
+    """The deforming test scenes (skins and morph targets) that tests/deform_assets.py writes
+    into a folder under tmp (`deform_assets.py DIR`), those `evray info` reads: their paths,
+    sorted; none where that writer is missing or fails, or the importer reads none of them (the
+    tests' deforming cases then do not run)."""
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "deform_assets.py")
+    if not os.path.exists(script):
+        return []
+    out = os.path.join(tmp, "deform-assets")
+    os.makedirs(out, exist_ok=True)
+    if subprocess.run([sys.executable, script, out], capture_output=True, text=True).returncode != 0:
+        return []
+    paths = sorted(os.path.join(out, f) for f in os.listdir(out) if f.endswith((".gltf", ".glb")))
+    return [p for p in paths if run("info", p, expect=None).returncode == 0]
+
+
 def square_crossings(ev, w, h, c_on, c_off):
     """The built-in 'square' scene's events against its analytic crossings (tests/test_square.py
     derives them): the pixels checked, how many of them have the wrong number of ON or OFF events,

@@ -12,14 +12,22 @@
  *   - occlusion (evr_trace_any) agrees with rtcOccluded1 in the same way;
  *   - the top level's per-segment group boxes hold the group at every time of the segment
  *     (also for synthetic tracks with large rotations, scaling and skew);
- *   - no ray leaks through a closed mesh, not even when aimed exactly at its vertices.
- * Prints traversal speed next to Embree's, for information. */
+ *   - no ray leaks through a closed mesh, not even when aimed exactly at its vertices;
+ *   - deforming meshes (morph targets on a moving and on a still node, a skin): their trees,
+ *     made per segment from the vertex keys, agree with Embree's time steps (the CPU backend's
+ *     way) at many ray times; a segment whose vertices hold still keeps its trees bit for bit;
+ *     the top level's boxes hold every vertex at every time;
+ *   - the rigid scenes' structures are what they were before deforming meshes (eye: node and
+ *     triangle counts; Debian 12's Embree 3.13.5).
+ * Prints traversal speed next to Embree's, and the deforming trees' build time, for
+ * information. */
 #include "check.h"
 #include "backend.h"
 #include "cpu/cpu_gi.h"
 #include "core/rng.h"
 #include "cuda/gpu_bvh.h"
 #include "cuda/gpu_traverse.h"
+#include "prep/deform_keys.h"
 #include "prep/swept_bounds.h"
 #include "scene/scene.h"
 
@@ -98,7 +106,9 @@ typedef struct {
     int num_groups;
     RTCScene *group_scenes;
     int *group_track, *group_first, *members;
-    int *group_instanced; /* 1: a static instance of its mesh's scene (past the bake limit) */
+    int *group_instanced; /* 1: a static instance of its mesh's scene (past the bake limit), or
+                             a deforming mesh on a node that never moves: its node's transform */
+    int *group_deform;    /* a deforming mesh's group: its deform view, -1: none */
 } reference;
 
 static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition *q)
@@ -150,9 +160,35 @@ static int node_never_moves(const evr_scene *s, int node)
     return 1;
 }
 
+/* A deforming mesh's vertex keys as the geometry's time steps (cpu_backend.c's update_deform). */
+static void add_deform_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m,
+                                const evr_deform_view *v)
+{
+    int k;
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), m->num_triangles);
+    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    rtcSetGeometryTimeStepCount(g, (unsigned)v->num_keys);
+    for (k = 0; k < v->num_keys; k++) {
+        float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, (unsigned)k,
+                                            RTC_FORMAT_FLOAT3, 3 * sizeof(float), v->num_vertices);
+        memcpy(vb, v->positions + (size_t)k * 3 * v->num_vertices,
+               sizeof(float) * 3 * v->num_vertices);
+    }
+    memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc, g, 0);
+    rtcReleaseGeometry(g);
+}
+
 /* instance_static: the static instances are not baked but each a group of its own, an instance
- * of its mesh's scene with its node's transform (the CPU backend past EVR_STATIC_BAKE_LIMIT) */
-static void reference_build(reference *r, const evr_scene *s, const motion *mo, int instance_static)
+ * of its mesh's scene with its node's transform (the CPU backend past EVR_STATIC_BAKE_LIMIT).
+ * rs: the segment's deforming meshes' vertex keys (NULL: the scene has none): each such mesh a
+ * group of its own (prep/instance_groups.h), in its node's space (a skin: world space), its
+ * keys as time steps. */
+static void reference_build(reference *r, const evr_scene *s, const motion *mo, int instance_static,
+                            const evr_render_scene *rs)
 {
     int n = s->num_instances, i, j, g, k;
     int *group_of = malloc(sizeof(int) * ((size_t)n + 1));
@@ -162,15 +198,26 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo, 
     r->group_first = calloc((size_t)n + 2, sizeof(int));
     r->members = malloc(sizeof(int) * ((size_t)n + 1));
     r->group_instanced = calloc((size_t)n + 1, sizeof(int));
+    r->group_deform = malloc(sizeof(int) * ((size_t)n + 1));
+    for (i = 0; i < n; i++) r->group_deform[i] = -1;
     for (i = 0; i < n; i++) {
         int node = s->instances[i].node, track = node_never_moves(s, node) ? -1 : node;
+        if (rs && rs->instances[i].deform >= 0) { /* as the CPU backend's group_moves */
+            const int skinned = s->meshes[s->instances[i].mesh].skin != NULL;
+            r->group_deform[r->num_groups] = rs->instances[i].deform;
+            r->group_track[r->num_groups] = skinned ? -1 : track;
+            r->group_instanced[r->num_groups] = !skinned && track < 0;
+            group_of[i] = r->num_groups++;
+            continue;
+        }
         if (track < 0 && instance_static) {
             r->group_instanced[r->num_groups] = 1;
             r->group_track[r->num_groups] = -1;
             group_of[i] = r->num_groups++;
             continue;
         }
-        for (g = 0; g < r->num_groups && (r->group_track[g] != track || r->group_instanced[g]);
+        for (g = 0; g < r->num_groups && (r->group_track[g] != track || r->group_instanced[g] ||
+                                          r->group_deform[g] >= 0);
              g++) {}
         if (g == r->num_groups) r->group_track[r->num_groups++] = track;
         group_of[i] = g;
@@ -187,6 +234,13 @@ static void reference_build(reference *r, const evr_scene *s, const motion *mo, 
         RTCScene sc = rtcNewScene(r->dev);
         r->group_scenes[g] = sc;
         rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+        if (r->group_deform[g] >= 0) {
+            add_deform_geometry(r->dev, sc,
+                                &s->meshes[s->instances[r->members[r->group_first[g]]].mesh],
+                                &rs->deforms[r->group_deform[g]]);
+            rtcCommitScene(sc);
+            continue;
+        }
         for (j = r->group_first[g]; j < r->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[r->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
@@ -232,6 +286,7 @@ static void reference_free(reference *r)
     free(r->group_scenes);
     free(r->group_track);
     free(r->group_instanced);
+    free(r->group_deform);
     free(r->group_first);
     free(r->members);
     rtcReleaseDevice(r->dev);
@@ -280,6 +335,24 @@ typedef struct {
 
 static float rnd(uint64_t *c) { return evr_uniform(evr_hash4(0x627668ull, (*c)++, 0, 0)); }
 
+/* Vertex vi of instance i in world space at time f: the mesh's (meshes[...]) or, deforming, the
+ * segment's vertex keys interpolated (rs->deforms), moved by the instance's track. */
+static evr_v3 world_vertex(const evr_mesh *meshes, const evr_render_scene *rs, int i, uint32_t vi,
+                           float f)
+{
+    const evr_instance_view *iv = &rs->instances[i];
+    const evr_m34 xf = evr_motion_eval(evr_rs_track(rs, iv->track), f);
+    evr_v3 p;
+    if (iv->deform >= 0) {
+        const evr_deform_view *d = &rs->deforms[iv->deform];
+        p = evr_deform_lerp(d, d->positions, vi, f);
+    } else {
+        const float *q = meshes[iv->mesh].positions + 3 * (size_t)vi;
+        p = evr_v3_make(q[0], q[1], q[2]);
+    }
+    return evr_m34_point(&xf, p);
+}
+
 /* A random point on a random instance's surface at time f, in world space, and the surface's
  * (geometric) normal there. */
 static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, float f, uint64_t *c,
@@ -291,16 +364,11 @@ static evr_v3 surface_point(const evr_scene *s, const evr_render_scene *rs, floa
         uint32_t t;
         float a, b;
         evr_v3 p[3];
-        evr_m34 xf;
         int k;
         if (!m->num_triangles) continue;
         t = (uint32_t)(rnd(c) * (float)m->num_triangles) % m->num_triangles;
-        xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
-        for (k = 0; k < 3; k++) {
-            uint32_t vi = m->indices[3 * t + (uint32_t)k];
-            p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1],
-                                                  m->positions[3 * vi + 2]));
-        }
+        for (k = 0; k < 3; k++)
+            p[k] = world_vertex(s->meshes, rs, i, m->indices[3 * t + (uint32_t)k], f);
         *normal = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
         if (evr_v3_dot(*normal, *normal) == 0.0f) continue; /* a degenerate triangle */
         a = rnd(c);
@@ -410,14 +478,11 @@ static float edge_distance(const evr_gpu_hit *h)
 static float hit_cosine(const judge *j, const evr_gpu_hit *h, evr_ray ray, float f)
 {
     const evr_mesh *m = &j->meshes[j->rs->instances[h->instance].mesh];
-    evr_m34 xf = evr_motion_eval(evr_rs_track(j->rs, j->rs->instances[h->instance].track), f);
     evr_v3 p[3], n;
     int k;
-    for (k = 0; k < 3; k++) {
-        uint32_t vi = m->indices[3 * h->prim + (uint32_t)k];
-        p[k] = evr_m34_point(&xf, evr_v3_make(m->positions[3 * vi], m->positions[3 * vi + 1],
-                                              m->positions[3 * vi + 2]));
-    }
+    for (k = 0; k < 3; k++)
+        p[k] =
+            world_vertex(j->meshes, j->rs, h->instance, m->indices[3 * h->prim + (uint32_t)k], f);
     n = evr_v3_norm(evr_v3_cross(evr_v3_sub(p[1], p[0]), evr_v3_sub(p[2], p[0])));
     return fabsf(evr_v3_dot(n, evr_v3_norm(ray.dir)));
 }
@@ -611,7 +676,8 @@ static long check_box_holds(const float box[6], const float *lo, const float *hi
     return bad;
 }
 
-/* The top level's boxes hold every group at every time of the segment. */
+/* The top level's boxes hold every group at every time of the segment (a deforming group: every
+ * vertex of its mesh, interpolated and moved, at sampled times). */
 static long check_group_boxes(const evr_gpu_bvh *b, const evr_gpu_top *top,
                               const evr_render_scene *rs, int samples, uint64_t *c)
 {
@@ -619,6 +685,19 @@ static long check_group_boxes(const evr_gpu_bvh *b, const evr_gpu_top *top,
     int g, k;
     for (g = 0; g < b->num_groups; g++) {
         const float *box = b->group_bounds + 6 * g, *lo = top->group_bounds + 6 * g, *hi = lo + 3;
+        if (b->group_deform[g] >= 0) {
+            const int i = b->members[b->group_first[g]];
+            const evr_deform_view *d = &rs->deforms[rs->instances[i].deform];
+            for (k = 0; k <= samples / 100; k++) {
+                const float f = k < samples / 200 ? (float)k / (float)(samples / 200) : rnd(c);
+                const evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[i].track), f);
+                uint32_t v;
+                for (v = 0; v < d->num_vertices; v++)
+                    if (!inside(evr_m34_point(&xf, evr_deform_lerp(d, d->positions, v, f)), lo, hi))
+                        bad++;
+            }
+            continue;
+        }
         if (b->group_root[g] < 0) continue;
         if (b->group_node[g] < 0) { /* static: world space already */
             for (k = 0; k < 3; k++)
@@ -866,8 +945,8 @@ static void test_watertight(int layout, int animated)
     rs.track_count = &cnt;
     CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
     CHECK(bvh.num_groups == 1 && bvh.group_node[0] == (animated ? 0 : -1));
-    CHECK_OK(evr_gpu_top_build(&bvh, &rs, &top, &e_));
-    evr_gpu_scene_view_host(&bvh, &top, &view);
+    CHECK_OK(evr_gpu_top_build(&bvh, NULL, &rs, &top, &e_));
+    evr_gpu_scene_view_host(&bvh, NULL, &top, &view);
     for (k = 0; k < 60000 / RAY_SCALE; k++) {
         evr_ray r;
         evr_gpu_hit h;
@@ -994,8 +1073,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     mo.keys = keys;
     mo.offset = off;
     mo.count = cnt;
-    reference_build(&ref, &sc, &mo, 0);
-    reference_build(&ref_inst, &sc, &mo, 1);
+    reference_build(&ref, &sc, &mo, 0, NULL);
+    reference_build(&ref_inst, &sc, &mo, 1, NULL);
 
     for (i = 0; i < n_rays; i++) {
         evr_v3 d;
@@ -1048,8 +1127,8 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
             CHECK(!bvh.grouped && bvh.num_groups == n_inst && bvh.static_group < 0 &&
                   bvh.num_trees == 2);
         }
-        CHECK_OK(evr_gpu_top_build(&bvh, &rs, &top, &e_));
-        evr_gpu_scene_view_host(&bvh, &top, &view);
+        CHECK_OK(evr_gpu_top_build(&bvh, NULL, &rs, &top, &e_));
+        evr_gpu_scene_view_host(&bvh, NULL, &top, &view);
         bad = check_group_boxes(&bvh, &top, &rs, 200, &c);
         CHECK(bad == 0);
         snprintf(what, sizeof what, "instances/%s", layout_name(layout));
@@ -1092,9 +1171,157 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
     free(rays);
 }
 
+/* ---- refitted and rebuilt deforming trees ---- */
+
+/* A sheet whose vertices move by three segments of keys: its first tree is built, then its
+ * vertices scatter (a refit of the sheet's topology would be far worse than a new tree: built
+ * again), then they move a little (refitted). Every segment, rays at random times find what a
+ * search of every triangle (interpolated, the same watertight test) finds. */
+static void test_deform_refit(int layout)
+{
+    evr_mesh mesh;
+    evr_morph morph;
+    evr_node node;
+    evr_instance sinst = {0, 0};
+    evr_scene sc;
+    evr_mesh_view mv;
+    evr_instance_view iv;
+    evr_deform_view dv;
+    evr_render_scene rs;
+    evr_motion_key key;
+    evr_gpu_bvh bvh;
+    evr_gpu_deform d;
+    evr_gpu_top top;
+    evr_gpu_scene_view view;
+    evr_m34 id = evr_m34_identity();
+    int off = 0, cnt = 1, seg, moved = 1, bad = 0, hits = 0;
+    uint64_t c = 99;
+    uint32_t v, nv;
+    float *keys;
+    make_sheet(16, &mesh);
+    nv = mesh.num_vertices;
+    keys = malloc(sizeof(float) * 3 * nv * 2);
+    memset(&morph, 0, sizeof morph);
+    mesh.morph = &morph; /* deforms (the keys are made here) */
+    memset(&node, 0, sizeof node);
+    node.parent = -1;
+    node.rest_matrix = id;
+    memset(&sc, 0, sizeof sc);
+    sc.num_meshes = 1;
+    sc.meshes = &mesh;
+    sc.num_nodes = 1;
+    sc.nodes = &node;
+    sc.num_instances = 1;
+    sc.instances = &sinst;
+    mv.positions = mesh.positions;
+    mv.normals = mesh.normals;
+    mv.uvs = NULL;
+    mv.indices = mesh.indices;
+    mv.num_triangles = mesh.num_triangles;
+    mv.material = 0;
+    iv.mesh = 0;
+    iv.track = 0;
+    iv.deform = 0;
+    dv.num_vertices = nv;
+    dv.positions = keys;
+    dv.normals = keys;
+    key = evr_motion_key_from_matrix(&id);
+    memset(&rs, 0, sizeof rs);
+    rs.meshes = &mv;
+    rs.instances = &iv;
+    rs.num_instances = 1;
+    rs.deforms = &dv;
+    rs.num_deforms = 1;
+    rs.keys = &key;
+    rs.track_offset = &off;
+    rs.track_count = &cnt;
+    memset(&d, 0, sizeof d);
+    memset(&top, 0, sizeof top);
+    CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+    CHECK(bvh.num_deforming == 1 && bvh.num_trees == 0);
+    for (seg = 0; seg < 3; seg++) {
+        int i;
+        /* keys: the sheet; the sheet to scattered points; those moved a little */
+        memcpy(keys, mesh.positions, sizeof(float) * 3 * nv);
+        dv.num_keys = seg ? 2 : 1;
+        for (v = 0; v < nv && seg; v++)
+            for (i = 0; i < 3; i++) {
+                float *p = keys + 3 * (nv + v) + i;
+                *p = 2.0f * evr_uniform(evr_hash4(0x5ca7ull, v, (uint64_t)i, 0)) - 1.0f;
+                if (seg == 2) {
+                    keys[3 * v + (uint32_t)i] = *p;
+                    *p += 0.05f * (rnd(&c) - 0.5f);
+                }
+            }
+        CHECK_OK(evr_gpu_deform_update(&bvh, &rs, &moved, &d, &e_));
+        printf(
+            "deforming tree, %s, segment %d: built %d, refitted %d, cost %.3g of its built %.3g\n",
+            layout_name(layout), seg, d.rebuilt, d.refitted, d.trees[0].cost,
+            d.trees[0].built_cost);
+        CHECK(d.rebuilt == (seg < 2) && d.refitted == (seg == 2));
+        CHECK_OK(evr_gpu_top_build(&bvh, &d, &rs, &top, &e_));
+        evr_gpu_scene_view_host(&bvh, &d, &top, &view);
+        for (i = 0; i < 4000 / RAY_SCALE; i++) {
+            evr_v3 o = evr_v3_make(3.0f * rnd(&c) - 1.5f, 3.0f * rnd(&c) - 1.5f, 2.0f),
+                   to = evr_v3_make(2.0f * rnd(&c) - 1.0f, 2.0f * rnd(&c) - 1.0f,
+                                    2.0f * rnd(&c) - 1.0f);
+            evr_ray ray;
+            evr__tray tr;
+            evr_gpu_hit h;
+            float f = rnd(&c), best = INFINITY;
+            uint32_t t, best_prim = 0;
+            int a;
+            ray.org = o;
+            ray.dir = evr_v3_norm(evr_v3_sub(to, o));
+            evr__tray_init(&tr, ray.org, ray.dir);
+            for (t = 0; t < mesh.num_triangles; t++) { /* every triangle, at time f */
+                evr_gpu_tri tri;
+                float *p[3] = {tri.v0, tri.v1, tri.v2}, tt, uu, vv;
+                for (a = 0; a < 3; a++) {
+                    evr_v3 q =
+                        evr_deform_lerp(&dv, dv.positions, mesh.indices[3 * t + (uint32_t)a], f);
+                    p[a][0] = q.x;
+                    p[a][1] = q.y;
+                    p[a][2] = q.z;
+                }
+                if (evr__tri(&tr, &tri, 0.0f, best, &tt, &uu, &vv) && tt < best) {
+                    best = tt;
+                    best_prim = t;
+                }
+            }
+            /* the same distance (the same arithmetic); another triangle only at a tie */
+            if (evr_trace_closest(&view, &rs, ray, INFINITY, f, &h) != (best < INFINITY)) bad++;
+            else if (best < INFINITY && (h.instance != 0 || h.t != best)) bad++;
+            else if (best < INFINITY && h.prim != best_prim) {
+                evr_gpu_tri tri;
+                float *p[3] = {tri.v0, tri.v1, tri.v2}, tt, uu, vv;
+                for (a = 0; a < 3; a++) {
+                    evr_v3 q = evr_deform_lerp(&dv, dv.positions,
+                                               mesh.indices[3 * h.prim + (uint32_t)a], f);
+                    p[a][0] = q.x;
+                    p[a][1] = q.y;
+                    p[a][2] = q.z;
+                }
+                if (!evr__tri(&tr, &tri, 0.0f, INFINITY, &tt, &uu, &vv) || tt != best) bad++;
+            }
+            hits += best < INFINITY;
+        }
+    }
+    printf("deforming tree, %s: %d of the rays' hits differ from a search of every triangle "
+           "(%d hits)\n",
+           layout_name(layout), bad, hits);
+    CHECK(bad == 0 && hits > 0);
+    evr_gpu_top_free(&top);
+    evr_gpu_deform_free(&d);
+    evr_gpu_bvh_free(&bvh);
+    free(keys);
+    free_mesh(&mesh);
+}
+
 /* ---- one scene segment ---- */
 
-/* The groups of a BVH, as "node: mesh mesh | ..." ("static" for the static group). */
+/* The groups of a BVH, as "node: mesh mesh | ..." ("static" for the static group, "skinned" for a
+ * skinned mesh's, in world space). */
 static void describe_groups(const evr_scene *s, const evr_gpu_bvh *b, char *out, size_t size)
 {
     size_t len = 0;
@@ -1102,32 +1329,69 @@ static void describe_groups(const evr_scene *s, const evr_gpu_bvh *b, char *out,
     out[0] = 0;
     for (g = 0; g < b->num_groups && len < size; g++) {
         len += (size_t)snprintf(out + len, size - len, "%s%s:", g ? " | " : "",
-                                b->group_node[g] < 0 ? "static" : s->nodes[b->group_node[g]].name);
+                                b->group_node[g] >= 0     ? s->nodes[b->group_node[g]].name
+                                : b->group_deform[g] >= 0 ? "skinned"
+                                                          : "static");
         for (k = b->group_first[g]; k < b->group_first[g + 1] && len < size; k++)
             len += (size_t)snprintf(out + len, size - len, " %s",
                                     s->meshes[s->instances[b->members[k]].mesh].name);
     }
 }
 
-/* A scene's bottom level is built once per layout (its groups as expect_groups says, when not
- * NULL); every segment rebuilds the top level in place (as the backend does) and is checked
- * against an Embree scene with that segment's keys. */
-static void test_scene(const char *name, const char *expect_groups, const double *t0s, int nseg,
-                       int n_cam, int n_shadow, int n_random, totals *tot)
+/* What test_scene checks beyond the comparison (each may be NULL/0). */
+typedef struct {
+    const char *groups;     /* the groups, as describe_groups writes them */
+    const uint32_t *counts; /* nodes and triangle references, CW8 then BVH4 */
+    int still_segments;     /* segments whose deforming meshes all hold still, at least */
+    int refits, rebuilds;   /* deforming trees refitted, and built again (after the first
+                               segment), at least (both layouts) */
+} scene_expect;
+
+/* FNV-1a of a deforming trees' packed arrays (to tell a kept tree from a rebuilt one). */
+static uint64_t deform_hash(const evr_gpu_deform *d)
 {
-    evr_scene *s = NULL;
+    const unsigned char *p[3];
+    size_t n[3], i;
+    uint64_t h = 1469598103934665603ull;
+    int k;
+    p[0] = (const unsigned char *)d->nodes4;
+    n[0] = d->nodes4 ? d->num_nodes * sizeof *d->nodes4 : 0;
+    p[1] = (const unsigned char *)d->nodes8;
+    n[1] = d->nodes8 ? d->num_nodes * sizeof *d->nodes8 : 0;
+    p[2] = (const unsigned char *)d->tris;
+    n[2] = d->num_tris * sizeof *d->tris;
+    for (k = 0; k < 3; k++)
+        for (i = 0; i < n[k]; i++) {
+            h ^= p[k][i];
+            h *= 1099511628211ull;
+        }
+    return h;
+}
+
+/* A scene's bottom level is built once per layout (its groups and sizes as ex says); every
+ * segment rebuilds the top level in place (as the backend does), and the trees of the deforming
+ * meshes from the segment's vertex keys (prep/deform_keys.c, segments in order), and is checked
+ * against an Embree scene with that segment's keys. */
+static void test_scene(const char *name, const evr_scene *s, const scene_expect *ex,
+                       const double *t0s, int nseg, int n_cam, int n_shadow, int n_random,
+                       totals *tot)
+{
     evr_render_host host;
     evr_error err;
     evr_gpu_bvh bvh[2];
     evr_gpu_top top[2];
+    evr_gpu_deform dtrees[2];
+    evr_deform_tracker tracker;
+    evr_deform_keys dkeys;
     const int layouts[2] = {EVR_GPU_LAYOUT_CW8, EVR_GPU_LAYOUT_BVH4};
-    int li, i, seg, n = n_cam + n_shadow + n_random;
+    int li, i, seg, n = n_cam + n_shadow + n_random, still_segments = 0, refits = 0, rebuilds = 0;
     unsigned ntri = 0;
     uint64_t c = 3;
 
-    CHECK_OK(evr_demo_load(name, &s, &err));
-    if (!s) return;
     CHECK_OK(evr_render_host_init(&host, s, 0, 640, 480, 0.02f, &err));
+    memset(&dkeys, 0, sizeof dkeys);
+    memset(dtrees, 0, sizeof dtrees);
+    CHECK(evr_deform_tracker_init(&tracker, s, &host));
     for (i = 0; i < s->num_meshes; i++) ntri += s->meshes[i].num_triangles;
     for (li = 0; li < 2; li++) {
         double tb = now();
@@ -1140,8 +1404,13 @@ static void test_scene(const char *name, const char *expect_groups, const double
             layouts[li] == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4),
             bvh[li].num_tris, ntri, bvh[li].max_stack, 1e3 * (now() - tb));
         describe_groups(s, &bvh[li], groups, sizeof groups);
-        printf("  %d groups (%d trees): %s\n", bvh[li].num_groups, bvh[li].num_trees, groups);
-        if (expect_groups) CHECK(strcmp(groups, expect_groups) == 0);
+        printf("  %d groups (%d trees, %d deforming): %s\n", bvh[li].num_groups, bvh[li].num_trees,
+               bvh[li].num_deforming, groups);
+        if (ex && ex->groups) CHECK(strcmp(groups, ex->groups) == 0);
+        if (ex && ex->counts)
+            CHECK(bvh[li].num_nodes == ex->counts[2 * li] &&
+                  bvh[li].num_tris == ex->counts[2 * li + 1]);
+        CHECK(bvh[li].num_deforming == host.num_deforms);
     }
 
     for (seg = 0; seg < nseg; seg++) {
@@ -1149,14 +1418,20 @@ static void test_scene(const char *name, const char *expect_groups, const double
         motion mo;
         reference ref;
         test_ray *rays;
-        int *kind, moving = 0;
+        int *kind, moving = 0, moved = 0;
         judge j;
         motion_compute(s, 0, t0, t1, &mo);
         host.rs.keys = mo.keys;
         host.rs.track_offset = mo.offset;
         host.rs.track_count = mo.count;
+        if (host.num_deforms) {
+            CHECK(evr_deform_keys_make(&tracker, s, &host, t0, t1, 1e-5f, MAX_KEYS, &dkeys));
+            host.rs.deforms = dkeys.views;
+            for (i = 0; i < host.num_deforms; i++) moved += dkeys.moved[i];
+            still_segments += moved == 0;
+        }
         for (i = 0; i < s->num_instances; i++) moving += mo.count[host.rs.instances[i].track] > 1;
-        reference_build(&ref, s, &mo, 0);
+        reference_build(&ref, s, &mo, 0, host.num_deforms ? &host.rs : NULL);
         CHECK(same_groups(s, &bvh[0], &ref) && same_groups(s, &bvh[1], &ref));
         rays = make_rays(s, &host.rs, n_cam, n_shadow, n_random, 0x5eedull + (uint64_t)(t0 * 1000));
         kind = malloc(sizeof(int) * (size_t)n);
@@ -1165,8 +1440,9 @@ static void test_scene(const char *name, const char *expect_groups, const double
         j.meshes = s->meshes;
         j.rs = &host.rs;
         j.delta = 1e-6f * host.scene_size;
-        printf("%s, segment %.4f .. %.4f s: %d instances (%d moving), %d rays\n", name, t0, t1,
-               s->num_instances, moving, n);
+        printf("%s, segment %.4f .. %.4f s: %d instances (%d moving, %d deforming, %d of them "
+               "moved), %d rays\n",
+               name, t0, t1, s->num_instances, moving, host.num_deforms, moved, n);
 
         for (li = 0; li < 2; li++) {
             evr_gpu_scene_view view;
@@ -1176,8 +1452,33 @@ static void test_scene(const char *name, const char *expect_groups, const double
             long bad = 0, well = 0, well_bad = 0, all_bad = 0;
             int k;
             memset(&ty, 0, sizeof ty);
-            CHECK_OK(evr_gpu_top_build(&bvh[li], &host.rs, &top[li], &err));
-            evr_gpu_scene_view_host(&bvh[li], &top[li], &view);
+            if (host.num_deforms) {
+                const unsigned long long gen = dtrees[li].gen;
+                const uint64_t before = deform_hash(&dtrees[li]);
+                double td = now();
+                CHECK_OK(evr_gpu_deform_update(&bvh[li], &host.rs, dkeys.moved, &dtrees[li], &err));
+                printf("  layout %s: deforming trees: %d built, %d refitted in %.2f ms, %u nodes, "
+                       "%u triangles, stack %d; cost (refitted / built):",
+                       layout_name(layouts[li]), dtrees[li].rebuilt, dtrees[li].refitted,
+                       1e3 * (now() - td), dtrees[li].num_nodes, dtrees[li].num_tris,
+                       dtrees[li].max_stack);
+                for (k = 0; k < dtrees[li].num; k++)
+                    printf(" %.3g", dtrees[li].trees[k].cost / dtrees[li].trees[k].built_cost);
+                printf("\n");
+                /* every moved mesh's tree made again (the first segment: built); while all
+                 * hold still the trees stay the bits */
+                CHECK(dtrees[li].rebuilt + dtrees[li].refitted ==
+                      (seg == 0 ? host.num_deforms : moved));
+                if (seg == 0) CHECK(dtrees[li].rebuilt == host.num_deforms);
+                refits += dtrees[li].refitted;
+                rebuilds += seg ? dtrees[li].rebuilt : 0;
+                if (seg > 0 && moved == 0)
+                    CHECK(dtrees[li].gen == gen && deform_hash(&dtrees[li]) == before);
+            }
+            CHECK_OK(evr_gpu_top_build(&bvh[li], host.num_deforms ? &dtrees[li] : NULL, &host.rs,
+                                       &top[li], &err));
+            evr_gpu_scene_view_host(&bvh[li], host.num_deforms ? &dtrees[li] : NULL, &top[li],
+                                    &view);
             printf("  layout %s: top level %u nodes, %u groups, stack %d of %d, built in %.3f ms\n",
                    layout_name(layouts[li]), top[li].num_nodes, top[li].num_insts,
                    top[li].stack_need, EVR_GPU_STACK_SIZE, 1e3 * (now() - tt));
@@ -1214,12 +1515,243 @@ static void test_scene(const char *name, const char *expect_groups, const double
         reference_free(&ref);
         motion_free(&mo);
     }
+    if (ex)
+        CHECK(still_segments >= ex->still_segments && refits >= ex->refits &&
+              rebuilds >= ex->rebuilds);
     for (li = 0; li < 2; li++) {
+        evr_gpu_deform_free(&dtrees[li]);
         evr_gpu_top_free(&top[li]);
         evr_gpu_bvh_free(&bvh[li]);
     }
+    evr_deform_keys_free(&dkeys);
+    evr_deform_tracker_free(&tracker);
     evr_render_host_free(&host);
+}
+
+static void test_demo(const char *name, const scene_expect *ex, const double *t0s, int nseg,
+                      int n_cam, int n_shadow, int n_random, totals *tot)
+{
+    evr_scene *s = NULL;
+    evr_error err;
+    CHECK_OK(evr_demo_load(name, &s, &err));
+    if (!s) return;
+    test_scene(name, s, ex, t0s, nseg, n_cam, n_shadow, n_random, tot);
     evr_scene_release(s);
+}
+
+/* ---- a scene of deforming meshes ---- */
+
+static evr_m34 trs(evr_v3 t, float sx, float sy, float sz)
+{
+    evr_m34 m = evr_m34_identity();
+    m.m[0][0] = sx;
+    m.m[1][1] = sy;
+    m.m[2][2] = sz;
+    m.m[0][3] = t.x;
+    m.m[1][3] = t.y;
+    m.m[2][3] = t.z;
+    return m;
+}
+
+static void rest_node(evr_node *n, const char *name, int parent, evr_v3 t, float sx, float sy,
+                      float sz)
+{
+    memset(n, 0, sizeof *n);
+    snprintf(n->name, sizeof n->name, "%s", name);
+    n->parent = parent;
+    n->translation = t;
+    n->scale = evr_v3_make(sx, sy, sz);
+    n->rotation = evr_quat_make(1, 0, 0, 0);
+    n->rest_matrix = trs(t, sx, sy, sz);
+}
+
+static void set_curve(evr_curve *c, int n, double *times, float *values)
+{
+    c->num_keys = n;
+    c->times = times;
+    c->values = values;
+    c->interp = EVR_INTERP_LINEAR;
+}
+
+/* An open tube along x from 0 to len (rings x sides vertices), radius r, radial normals. */
+static void make_tube(int rings, int sides, float len, float r, evr_mesh *mesh)
+{
+    int nv = rings * sides, nt = 2 * (rings - 1) * sides, i, k, ti = 0;
+    float *pos = malloc(sizeof(float) * 3 * (size_t)nv),
+          *nrm = malloc(sizeof(float) * 3 * (size_t)nv);
+    uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (size_t)nt);
+    for (i = 0; i < rings; i++)
+        for (k = 0; k < sides; k++) {
+            const float a = 6.2831853f * (float)k / (float)sides,
+                        x = len * (float)i / (float)(rings - 1);
+            float *p = pos + 3 * (i * sides + k), *q = nrm + 3 * (i * sides + k);
+            p[0] = x;
+            p[1] = r * cosf(a);
+            p[2] = r * sinf(a);
+            q[0] = 0.0f;
+            q[1] = cosf(a);
+            q[2] = sinf(a);
+        }
+    for (i = 0; i + 1 < rings; i++)
+        for (k = 0; k < sides; k++) {
+            const uint32_t a = (uint32_t)(i * sides + k),
+                           b = (uint32_t)(i * sides + (k + 1) % sides);
+            const uint32_t c2 = a + (uint32_t)sides, d = b + (uint32_t)sides;
+            idx[3 * ti] = a;
+            idx[3 * ti + 1] = b;
+            idx[3 * ti + 2] = d;
+            ti++;
+            idx[3 * ti] = a;
+            idx[3 * ti + 1] = d;
+            idx[3 * ti + 2] = c2;
+            ti++;
+        }
+    memset(mesh, 0, sizeof *mesh);
+    mesh->num_vertices = (uint32_t)nv;
+    mesh->num_triangles = (uint32_t)nt;
+    mesh->positions = pos;
+    mesh->normals = nrm;
+    mesh->indices = idx;
+    mesh->bounds_min = evr_v3_make(0.0f, -r, -r);
+    mesh->bounds_max = evr_v3_make(len, r, r);
+}
+
+/* Morph targets, a skin, a rigid mover and a still floor, timed so that the segments below
+ * see them move, bend at a curve's key, and hold still:
+ *   node 1 "blob-a"  morph targets (weights ramp to 1 by t = 1, back to 0.3 by 1.5, then held)
+ *                    on a node that moves: a deforming group moved by its track;
+ *   node 2 "blob-b"  the same mesh on a node that never moves (weights ramp over 0.5 .. 1.5);
+ *   nodes 3, 4       a shoulder and an elbow that turns 90 degrees about z by t = 1.2;
+ *   node 5 "arm"     the skinned tube (its node's transform ignored: 5 units up);
+ *   node 6 "ball"    a rigid sphere that moves; node 7 "floor" a still sheet. */
+typedef struct {
+    evr_scene s;
+    evr_mesh meshes[4];
+    evr_node nodes[8];
+    evr_instance inst[5];
+    evr_camera_desc cam;
+    evr_morph morph;
+    evr_skin skin;
+    evr_m34 inv_bind[2];
+    float *d_pos, def_w[2], rest_w[2];
+} deform_scene;
+
+static double ta_times[2] = {0.0, 2.0}, wa_times[3] = {0.0, 1.0, 1.5}, wb_times[2] = {0.5, 1.5},
+              elbow_times[2] = {0.0, 1.2}, ball_times[2] = {0.0, 2.0};
+static float ta_values[6] = {-2.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f},
+             wa_values[6] = {0.0f, 0.0f, 1.0f, 0.5f, 0.3f, 1.0f},
+             wb_values[4] = {0.0f, 1.0f, 1.0f, 0.0f},
+             elbow_values[8] = {1.0f, 0.0f, 0.0f, 0.0f, 0.70710678f, 0.0f, 0.0f, 0.70710678f},
+             ball_values[6] = {0.0f, 2.5f, 1.0f, 0.0f, -2.5f, 1.0f};
+
+static void deform_scene_make(deform_scene *d)
+{
+    evr_scene *s = &d->s;
+    evr_mesh *blob = &d->meshes[1], *arm = &d->meshes[2];
+    uint32_t v;
+    int k;
+    memset(d, 0, sizeof *d);
+    make_sheet(8, &d->meshes[0]);
+    for (v = 0; v < d->meshes[0].num_vertices; v++) d->meshes[0].normals[3 * v + 2] = 1.0f;
+    make_sphere(20, blob);
+    memcpy(blob->normals, blob->positions, sizeof(float) * 3 * blob->num_vertices);
+    /* target 0 bulges +x, target 1 shears z by y */
+    d->d_pos = calloc(2 * 3 * (size_t)blob->num_vertices, sizeof(float));
+    for (v = 0; v < blob->num_vertices; v++) {
+        const float *p = blob->positions + 3 * v;
+        d->d_pos[3 * v] = p[0] > 0.0f ? 0.8f * p[0] * p[0] : 0.0f;
+        d->d_pos[3 * (blob->num_vertices + v) + 2] = 0.6f * sinf(2.0f * p[0]) * p[1];
+    }
+    d->morph.num_targets = 2;
+    d->morph.d_positions = d->d_pos;
+    d->morph.default_weights = d->def_w;
+    blob->morph = &d->morph;
+    make_tube(25, 12, 3.0f, 0.3f, arm);
+    d->skin.num_joints = 2;
+    d->skin.joint_nodes = malloc(2 * sizeof(int));
+    d->skin.joint_nodes[0] = 3;
+    d->skin.joint_nodes[1] = 4;
+    d->inv_bind[0] = evr_m34_identity();
+    d->inv_bind[1] = trs(evr_v3_make(-1.5f, 0.0f, 0.0f), 1.0f, 1.0f, 1.0f);
+    d->skin.inverse_bind = d->inv_bind;
+    d->skin.influences = 2;
+    d->skin.joints = malloc(sizeof(uint16_t) * 2 * arm->num_vertices);
+    d->skin.weights = malloc(sizeof(float) * 2 * arm->num_vertices);
+    for (v = 0; v < arm->num_vertices; v++) { /* blended over 1 <= x <= 2 */
+        float w = arm->positions[3 * v] - 1.0f;
+        w = w < 0.0f ? 0.0f : w > 1.0f ? 1.0f : w;
+        d->skin.joints[2 * v] = 0;
+        d->skin.joints[2 * v + 1] = 1;
+        d->skin.weights[2 * v] = 1.0f - w;
+        d->skin.weights[2 * v + 1] = w;
+    }
+    arm->skin = &d->skin;
+    make_sphere(4, &d->meshes[3]);
+    memcpy(d->meshes[3].normals, d->meshes[3].positions,
+           sizeof(float) * 3 * d->meshes[3].num_vertices);
+    for (k = 0; k < 4; k++)
+        snprintf(d->meshes[k].name, sizeof d->meshes[k].name, "%s",
+                 k == 0   ? "floor"
+                 : k == 1 ? "blob"
+                 : k == 2 ? "arm"
+                          : "ball");
+
+    rest_node(&d->nodes[0], "root", -1, evr_v3_make(0, 0, 0), 1, 1, 1);
+    rest_node(&d->nodes[1], "blob-a", -1, evr_v3_make(-2, 0, 0), 1, 1, 1);
+    set_curve(&d->nodes[1].t_curve, 2, ta_times, ta_values);
+    set_curve(&d->nodes[1].w_curve, 3, wa_times, wa_values);
+    d->nodes[1].animated = 1;
+    rest_node(&d->nodes[2], "blob-b", -1, evr_v3_make(2.5f, -1.0f, 0.5f), 1, 1, 1);
+    set_curve(&d->nodes[2].w_curve, 2, wb_times, wb_values);
+    rest_node(&d->nodes[3], "shoulder", -1, evr_v3_make(-1.0f, -2.5f, 0.5f), 1, 1, 1);
+    rest_node(&d->nodes[4], "elbow", 3, evr_v3_make(1.5f, 0, 0), 1, 1, 1);
+    set_curve(&d->nodes[4].r_curve, 2, elbow_times, elbow_values);
+    d->nodes[4].animated = 1;
+    rest_node(&d->nodes[5], "arm", -1, evr_v3_make(0, 0, 5), 1, 1, 1);
+    rest_node(&d->nodes[6], "ball", -1, evr_v3_make(0, 2.5f, 1), 0.5f, 0.5f, 0.5f);
+    set_curve(&d->nodes[6].t_curve, 2, ball_times, ball_values);
+    d->nodes[6].animated = 1;
+    rest_node(&d->nodes[7], "floor", -1, evr_v3_make(0, 0, -1.5f), 5, 5, 1);
+    for (k = 1; k <= 2; k++) {
+        d->nodes[k].num_weights = 2;
+        d->nodes[k].weights = d->rest_w;
+    }
+    d->inst[0].mesh = 0; /* floor */
+    d->inst[0].node = 7;
+    d->inst[1].mesh = 1;
+    d->inst[1].node = 1;
+    d->inst[2].mesh = 3; /* the ball between the deforming meshes */
+    d->inst[2].node = 6;
+    d->inst[3].mesh = 2;
+    d->inst[3].node = 5;
+    d->inst[4].mesh = 1;
+    d->inst[4].node = 2;
+    d->cam.node = -1;
+    d->cam.yfov = 0.9f;
+    d->cam.local = trs(evr_v3_make(0, 0, 9), 1, 1, 1);
+    snprintf(d->cam.name, sizeof d->cam.name, "camera");
+    s->num_meshes = 4;
+    s->meshes = d->meshes;
+    s->num_nodes = 8;
+    s->nodes = d->nodes;
+    s->num_instances = 5;
+    s->instances = d->inst;
+    s->num_cameras = 1;
+    s->cameras = &d->cam;
+    s->anim_start = 0.0;
+    s->anim_end = 2.0;
+    s->bounds_min = evr_v3_make(-5, -5, -2);
+    s->bounds_max = evr_v3_make(5, 5, 3);
+}
+
+static void deform_scene_free(deform_scene *d)
+{
+    int k;
+    for (k = 0; k < 4; k++) free_mesh(&d->meshes[k]);
+    free(d->d_pos);
+    free(d->skin.joint_nodes);
+    free(d->skin.joints);
+    free(d->skin.weights);
 }
 
 int main(void)
@@ -1233,6 +1765,8 @@ int main(void)
     test_watertight(EVR_GPU_LAYOUT_BVH4, 0);
     test_watertight(EVR_GPU_LAYOUT_CW8, 1);
     test_watertight(EVR_GPU_LAYOUT_BVH4, 1);
+    test_deform_refit(EVR_GPU_LAYOUT_CW8);
+    test_deform_refit(EVR_GPU_LAYOUT_BVH4);
     printf("(%.1f s)\n", now() - t);
     test_many_instances(600, 20000 / RAY_SCALE,
                         &tot); /* Embree takes ~1.5 ms per quaternion-motion instance */
@@ -1242,13 +1776,28 @@ int main(void)
         static const double eye_t0[2] = {1.0, 0.72}, square_t0[1] = {0.5};
         /* grouped as the CPU backend groups: skin and orbit never move; sclera and cornea are on
          * nodes of their own under the animated "eyeball" node, so each is a group */
-        test_scene(
-            "eye",
+        /* and as built before deforming meshes: the same nodes and triangle references */
+        static const uint32_t eye_counts[4] = {5561, 35867, 8455, 35095};
+        scene_expect eye = {
             "sclera: sclera | cornea: cornea | upper_lid: upper_lid | lower_lid: lower_lid | static: skin orbit",
-            eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE, &tot);
+            eye_counts, 0, 0, 0};
+        /* deforming: moving (blob-a, the elbow), across the weight curve's key at 1.0, then
+         * the weights and the elbow held (from 1.5 on): the last two segments hold still */
+        static const double deform_t0[4] = {0.3, 0.98, 1.6, 1.6 + 1.0 / 30.0};
+        scene_expect deforming = {"static: floor | blob-a: blob | ball: ball | skinned: arm | "
+                                  "blob-b: blob",
+                                  NULL, 1, 1, 0};
+        deform_scene ds;
+        test_demo("eye", &eye, eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE,
+                  &tot);
         printf("(%.1f s)\n", now() - t);
-        test_scene("square", NULL, square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE,
-                   10000 / RAY_SCALE, &tot);
+        test_demo("square", NULL, square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE,
+                  10000 / RAY_SCALE, &tot);
+        printf("(%.1f s)\n", now() - t);
+        deform_scene_make(&ds);
+        test_scene("deforming", &ds.s, &deforming, deform_t0, 4, 20000 / RAY_SCALE,
+                   10000 / RAY_SCALE, 10000 / RAY_SCALE, &tot);
+        deform_scene_free(&ds);
         printf("(%.1f s)\n", now() - t);
     }
     /* each ray is asked twice (closest and occlusion): rates are per question */

@@ -1,7 +1,8 @@
 """Change-driven sampling gives exactly the events of brute force (--no-skip): every built-in scene
-and the moving square, ideal sensor and the davis346 noise model, on the CPU and (where a GPU is
-usable) on CUDA; and it really skips: run.json accounts for the samples traced and the pixels
-skipped per segment."""
+and the moving square, ideal sensor and the davis346 noise model, the deforming test scenes
+(skins and morph targets, tests/deform_assets.py, where the importer reads them), on the CPU and
+(where a GPU is usable) on CUDA; and it really skips: run.json accounts for the samples traced
+and the pixels skipped per segment."""
 import os
 
 import evrtest as T
@@ -23,12 +24,19 @@ cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4
 # with a limit on the photons per estimate
 cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8"]))
+# the deforming meshes (a path: a scene file): a still stretch keeps its vertices and (on CUDA) its
+# tree bit for bit, so pixels that see it skip exactly
+for asset in T.deform_assets(tmp):
+    cases.append((asset, ["--res", "64x48", "--duration", "1.0"]))
+    cases.append((asset, ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
+    cases.append((asset, ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}
+        source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)
         for mode in ("skip", "brute"):
-            d = os.path.join(tmp, f"{backend}-{scene}-{case}-{mode}")
-            T.run("demo", "--scene", scene, "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
+            d = os.path.join(tmp, f"{backend}-{os.path.basename(scene)}-{case}-{mode}")
+            T.run(*source, "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
                   "--seed", "3", *extra, *(["--no-skip"] if mode == "brute" else []))
             runs[mode] = (open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d))
         (ev_s, js), (ev_b, jb) = runs["skip"], runs["brute"]

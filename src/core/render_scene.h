@@ -87,13 +87,13 @@ EVR_HD static inline float evr_key_interval(int n, float f, int *a)
     return x - (float)i;
 }
 
-/* Vertex v of a deforming instance at time f (3 floats at base: positions or normals). Between
- * equal keys the key itself, bit for bit, so that a still stretch stays still. */
-EVR_HD static inline evr_v3 evr_deform_lerp(const evr_deform_view *d, const float *base, uint32_t v,
-                                            float f)
+/* Vertex v of a deforming instance in key interval a at fraction fr (evr_key_interval of the
+ * time: what a ray traversal works out once for all the vertices it reads); 3 floats at base:
+ * positions or normals. Between equal keys the key itself, bit for bit, so that a still stretch
+ * stays still. */
+EVR_HD static inline evr_v3 evr_deform_lerp_in(const evr_deform_view *d, const float *base,
+                                               uint32_t v, int a, float fr)
 {
-    int a;
-    const float fr = evr_key_interval(d->num_keys, f, &a);
     const float *p = base + ((size_t)a * d->num_vertices + v) * 3;
     evr_v3 pa = evr_v3_make(p[0], p[1], p[2]);
     if (d->num_keys <= 1) return pa;
@@ -101,6 +101,15 @@ EVR_HD static inline evr_v3 evr_deform_lerp(const evr_deform_view *d, const floa
     if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return pa;
     return evr_v3_make(p[0] + (q[0] - p[0]) * fr, p[1] + (q[1] - p[1]) * fr,
                        p[2] + (q[2] - p[2]) * fr);
+}
+
+/* Vertex v of a deforming instance at time f (evr_deform_lerp_in). */
+EVR_HD static inline evr_v3 evr_deform_lerp(const evr_deform_view *d, const float *base, uint32_t v,
+                                            float f)
+{
+    int a;
+    const float fr = evr_key_interval(d->num_keys, f, &a);
+    return evr_deform_lerp_in(d, base, v, a, fr);
 }
 
 /* Position and normal (not unit between keys) of vertex v of mesh view m as instance inst shows

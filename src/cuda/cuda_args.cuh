@@ -6,6 +6,7 @@
 #define EVR_CUDA_CUDA_ARGS_CUH
 
 #include <cuda_runtime.h>
+#include <type_traits>
 
 extern "C" {
 #include "backend.h"
@@ -36,12 +37,30 @@ static inline unsigned tiled_threads(int w, int h)
     return (unsigned)((w + TILE_W - 1) / TILE_W) * (unsigned)((h + TILE_H - 1) / TILE_H) * 32u;
 }
 
-/* The kernels' compile-time variant of a run: its node layout (EVR_GPU_LAYOUT_*), the sensor
- * model (1) or the ideal one (0), global illumination. */
+/* The kernels' compile-time variant of a run: its traversal layout (the node layout,
+ * EVR_GPU_LAYOUT_*, with EVR_GPU_TRACE_DEFORMING where the scene has deforming meshes: the
+ * kernels of a scene without them are the code they were before), the sensor model (1) or the
+ * ideal one (0), global illumination. */
 struct kernel_variant {
     int layout;
     bool sensor, gi;
 };
+
+/* Calls f with a traversal layout (kernel_variant.layout) as a compile-time constant:
+ * f(std::integral_constant<int, LAYOUT>{}). */
+template <typename F> static inline void with_layout(int layout, F f)
+{
+    const int deforming = layout & EVR_GPU_TRACE_DEFORMING;
+    if ((layout & ~EVR_GPU_TRACE_DEFORMING) == EVR_GPU_LAYOUT_CW8) {
+        if (deforming)
+            f(std::integral_constant<int, EVR_GPU_LAYOUT_CW8 | EVR_GPU_TRACE_DEFORMING>{});
+        else f(std::integral_constant<int, EVR_GPU_LAYOUT_CW8>{});
+    } else {
+        if (deforming)
+            f(std::integral_constant<int, EVR_GPU_LAYOUT_BVH4 | EVR_GPU_TRACE_DEFORMING>{});
+        else f(std::integral_constant<int, EVR_GPU_LAYOUT_BVH4>{});
+    }
+}
 
 /* The segment's counters (kernel_args.counters, slot.d_counters): 64-bit counters the kernels
  * add to, the render kernels' first, then the photon pass's; CTR_KEY_RANGE counts events outside

@@ -1,7 +1,8 @@
 /* CUDA backend: the same simulation as the CPU backend on an NVIDIA GPU.
  *
  * Per segment: the host builds the top-level BVH over the instances (bounds over the whole
- * segment) and uploads it with the motion keys; one kernel runs every pixel's samples of the
+ * segment) and the trees of the deforming meshes whose vertices moved, and uploads them with the
+ * motion keys and the deforming meshes' vertex keys; one kernel runs every pixel's samples of the
  * segment (one thread per pixel, its samples in a loop): camera ray, our own BVH traversal with
  * motion transforms (cuda/gpu_traverse.h), shading and the pixel model from src/core, the very
  * functions the CPU backend runs. Events are appended with warp-aggregated atomics as 64-bit
@@ -148,6 +149,16 @@ static void cuda_release(evr_backend *base)
         sl->d_top4.release();
         sl->d_top8.release();
         sl->d_insts.release();
+        sl->h_dverts.release();
+        sl->d_dverts.release();
+        sl->h_dviews.release();
+        sl->d_dviews.release();
+        sl->h_dnodes4.release();
+        sl->h_dnodes8.release();
+        sl->h_dtris.release();
+        sl->d_dnodes4.release();
+        sl->d_dnodes8.release();
+        sl->d_dtris.release();
         sl->d_keys_ev.release();
         sl->d_keys_sorted.release();
         sl->d_sort_temp.release();
@@ -227,6 +238,7 @@ static void cuda_release(evr_backend *base)
     gi_deferred_release(b);
     evr_photon_emitters_free(&b->em);
     if (b->render) cudaStreamDestroy(b->render);
+    evr_gpu_deform_free(&b->deform);
     evr_gpu_bvh_free(&b->bvh);
     evr_event_vec_free(&b->scratch);
     delete b;
@@ -338,11 +350,6 @@ extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_
                                            const evr_run_setup *setup, evr_backend **out,
                                            evr_error *err)
 {
-    if (h->num_deforms > 0) { /* auto falls back to the CPU with this as its notice */
-        snprintf(err->msg, sizeof err->msg,
-                 "the CUDA backend does not render deforming meshes (skins, morph targets) yet");
-        return EVR_ERR_BACKEND;
-    }
     cuda_backend *b = new (std::nothrow) cuda_backend();
     if (!b) {
         snprintf(err->msg, sizeof err->msg, "out of memory");

@@ -387,9 +387,9 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
             photon_reuse_kernel<<<pgrid, BLOCK, 0, rs>>>(a, p);
             CK(cudaGetLastError());
         }
-        if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
-            photon_kernel<EVR_GPU_LAYOUT_CW8><<<pgrid, BLOCK, 0, rs>>>(a, p);
-        else photon_kernel<EVR_GPU_LAYOUT_BVH4><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        with_layout(run_variant(b).layout, [&](auto l) {
+            photon_kernel<decltype(l)::value><<<pgrid, BLOCK, 0, rs>>>(a, p);
+        });
         CK(cudaGetLastError());
         /* the cell in the high bits (up to 2^end - 1), the photon key in the low 32 */
         int end_bit = 33;
@@ -406,9 +406,9 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
                                                      b->d_pending.p, *out, sl->d_counters.p);
         CK(cudaGetLastError());
     }
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
-        photon_view_kernel<EVR_GPU_LAYOUT_CW8><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
-    else photon_view_kernel<EVR_GPU_LAYOUT_BVH4><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    with_layout(run_variant(b).layout, [&](auto l) {
+        photon_view_kernel<decltype(l)::value><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
+    });
     CK(cudaGetLastError());
     sl->gi_passes++;
     return EVR_OK;

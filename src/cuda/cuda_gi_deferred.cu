@@ -358,9 +358,8 @@ evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const
                               unsigned grid, evr_error *err)
 {
     cudaStream_t rs = b->render;
-    if (b->bvh.layout == EVR_GPU_LAYOUT_CW8)
-        gi_trace_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, rs>>>(a, d);
-    else gi_trace_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, rs>>>(a, d);
+    with_layout(run_variant(b).layout,
+                [&](auto l) { gi_trace_kernel<decltype(l)::value><<<grid, BLOCK, 0, rs>>>(a, d); });
     CK(cudaGetLastError());
     if (b->gp.max_photons <= 0) {
         if (b->d_gi_ends[0].p) { /* what the changed cells add to the pixels' last gathers */

@@ -187,6 +187,71 @@ static evr_status start_ready_copies(cuda_backend *b, evr_error *err)
     return start_copy(b, sl, n, err);
 }
 
+/* The segment's deforming meshes to the slot, on the render stream through its pinned staging
+ * (its last copies from there finished before its previous segment was collected): every view's
+ * vertex keys and the views of them with device pointers, and the deforming groups' trees where
+ * the slot does not hold their generation yet (while every mesh holds still, each slot gets them
+ * once). */
+static evr_status upload_deform(cuda_backend *b, slot *sl, const evr_segment *seg, evr_error *err)
+{
+    const evr_gpu_deform *d = &b->deform;
+    const int nd = seg->num_deforms;
+    cudaStream_t rs = b->render;
+    sl->num_deforms = nd;
+    if (nd <= 0) return EVR_OK;
+    size_t nf = 0;
+    for (int k = 0; k < nd; k++)
+        nf += 6 * (size_t)seg->deforms[k].num_keys * (size_t)seg->deforms[k].num_vertices;
+    CK(sl->h_dverts.reserve(nf + 1));
+    CK(sl->d_dverts.reserve(nf + 1));
+    CK(sl->h_dviews.reserve((size_t)nd));
+    CK(sl->d_dviews.reserve((size_t)nd));
+    size_t at = 0;
+    for (int k = 0; k < nd; k++) {
+        const evr_deform_view *v = &seg->deforms[k];
+        const size_t n = 3 * (size_t)v->num_keys * (size_t)v->num_vertices;
+        evr_deform_view *dv = &sl->h_dviews.p[k];
+        *dv = *v;
+        memcpy(sl->h_dverts.p + at, v->positions, n * sizeof(float));
+        dv->positions = sl->d_dverts.p + at;
+        at += n;
+        memcpy(sl->h_dverts.p + at, v->normals, n * sizeof(float));
+        dv->normals = sl->d_dverts.p + at;
+        at += n;
+    }
+    CK(cudaMemcpyAsync(sl->d_dverts.p, sl->h_dverts.p, at * sizeof(float), cudaMemcpyHostToDevice,
+                       rs));
+    CK(cudaMemcpyAsync(sl->d_dviews.p, sl->h_dviews.p, (size_t)nd * sizeof(evr_deform_view),
+                       cudaMemcpyHostToDevice, rs));
+    if (sl->dgen == d->gen) return EVR_OK;
+    sl->dgen = 0; /* until the copies below are queued */
+    if (d->nodes8 && d->num_nodes) {
+        CK(sl->h_dnodes8.reserve(d->num_nodes));
+        CK(sl->d_dnodes8.reserve(d->num_nodes));
+        memcpy(sl->h_dnodes8.p, d->nodes8, d->num_nodes * sizeof(evr_gpu_node8));
+        CK(cudaMemcpyAsync(sl->d_dnodes8.p, sl->h_dnodes8.p, d->num_nodes * sizeof(evr_gpu_node8),
+                           cudaMemcpyHostToDevice, rs));
+    }
+    if (d->nodes4 && d->num_nodes) {
+        CK(sl->h_dnodes4.reserve(d->num_nodes));
+        CK(sl->d_dnodes4.reserve(d->num_nodes));
+        memcpy(sl->h_dnodes4.p, d->nodes4, d->num_nodes * sizeof(evr_gpu_node4));
+        CK(cudaMemcpyAsync(sl->d_dnodes4.p, sl->h_dnodes4.p, d->num_nodes * sizeof(evr_gpu_node4),
+                           cudaMemcpyHostToDevice, rs));
+    }
+    if (d->num_tris) {
+        CK(sl->h_dtris.reserve(d->num_tris));
+        CK(sl->d_dtris.reserve(d->num_tris));
+        memcpy(sl->h_dtris.p, d->tris, d->num_tris * sizeof(evr_gpu_dtri));
+        CK(cudaMemcpyAsync(sl->d_dtris.p, sl->h_dtris.p, d->num_tris * sizeof(evr_gpu_dtri),
+                           cudaMemcpyHostToDevice, rs));
+    }
+    sl->num_dnodes = d->num_nodes;
+    sl->num_dtris = d->num_tris;
+    sl->dgen = d->gen;
+    return EVR_OK;
+}
+
 evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err)
 {
     cuda_backend *b = (cuda_backend *)base;
@@ -253,12 +318,27 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     memcpy(sl->h_tracks.p, seg->track_offset, (size_t)seg->num_tracks * sizeof(int));
     memcpy(sl->h_tracks.p + seg->num_tracks, seg->track_count,
            (size_t)seg->num_tracks * sizeof(int));
-    /* top level over the instances, bounds over the whole segment */
+    /* the deforming groups' trees (those that moved built again), the top level over the
+     * groups, bounds over the whole segment; hrs (host pointers) is also what the photon pass's
+     * emitter table reads */
     evr_render_scene hrs = b->host.rs;
     hrs.keys = sl->h_keys.p;
     hrs.track_offset = sl->h_tracks.p;
     hrs.track_count = sl->h_tracks.p + seg->num_tracks;
-    if ((st = evr_gpu_top_build(&b->bvh, &hrs, &sl->top, err)) != EVR_OK) return st;
+    hrs.deforms = seg->deforms;
+    hrs.num_deforms = seg->num_deforms;
+    if (seg->num_deforms != b->host.num_deforms) {
+        snprintf(err->msg, sizeof err->msg,
+                 "internal error: %d deforming meshes' vertex keys for a scene of %d",
+                 seg->num_deforms, b->host.num_deforms);
+        return EVR_ERR_BACKEND;
+    }
+    const evr_gpu_deform *dtrees = b->bvh.num_deforming ? &b->deform : NULL;
+    if (dtrees &&
+        (st = evr_gpu_deform_update(&b->bvh, &hrs, seg->deform_moved, &b->deform, err)) != EVR_OK)
+        return st;
+    if ((st = evr_gpu_top_build(&b->bvh, dtrees, &hrs, &sl->top, err)) != EVR_OK) return st;
+    if ((st = upload_deform(b, sl, seg, err)) != EVR_OK) return st;
     CK(sl->d_keys.reserve((size_t)seg->num_keys));
     CK(sl->d_tracks.reserve(2 * (size_t)seg->num_tracks));
     CK(sl->d_insts.reserve(sl->top.num_insts + 1));
@@ -290,7 +370,7 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
             b->static_gen++;
             kernel_args a = make_args(b, sl);
             const unsigned grid = (unsigned)((npix + BLOCK - 1) / BLOCK);
-            cuda_launch_static_hits(a, b->bvh.layout, b->d_static.p, grid, b->render);
+            cuda_launch_static_hits(a, run_variant(b).layout, b->d_static.p, grid, b->render);
             CK(cudaGetLastError());
             b->static_cam = *cam;
         }

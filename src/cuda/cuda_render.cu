@@ -277,16 +277,15 @@ template <int L, typename F> static void with_variant_of(bool sensor, bool gi, F
 }
 template <typename F> static void with_variant(kernel_variant v, F f)
 {
-    if (v.layout == EVR_GPU_LAYOUT_CW8) with_variant_of<EVR_GPU_LAYOUT_CW8>(v.sensor, v.gi, f);
-    else with_variant_of<EVR_GPU_LAYOUT_BVH4>(v.sensor, v.gi, f);
+    with_layout(v.layout, [&](auto l) { with_variant_of<decltype(l)::value>(v.sensor, v.gi, f); });
 }
 
 void cuda_launch_static_hits(const kernel_args &a, int layout, gpu_static_hit *out, unsigned grid,
                              cudaStream_t s)
 {
-    if (layout == EVR_GPU_LAYOUT_CW8)
-        static_hits_kernel<EVR_GPU_LAYOUT_CW8><<<grid, BLOCK, 0, s>>>(a, out);
-    else static_hits_kernel<EVR_GPU_LAYOUT_BVH4><<<grid, BLOCK, 0, s>>>(a, out);
+    with_layout(layout, [&](auto l) {
+        static_hits_kernel<decltype(l)::value><<<grid, BLOCK, 0, s>>>(a, out);
+    });
 }
 
 void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, bool ideal, unsigned grid,

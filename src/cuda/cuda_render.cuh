@@ -5,7 +5,8 @@
 
 #include "cuda/cuda_args.cuh"
 
-/* Every pixel's camera ray against the static group alone (the camera holds still). */
+/* Every pixel's camera ray against the static group alone (the camera holds still); layout:
+ * kernel_variant.layout. */
 void cuda_launch_static_hits(const kernel_args &a, int layout, gpu_static_hit *out, unsigned grid,
                              cudaStream_t s);
 /* Change-driven sampling's first pass: the pixels that keep their intensity; lists the others. */

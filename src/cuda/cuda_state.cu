@@ -37,6 +37,8 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     a.rs.textures = b->d_textures.p;
     a.rs.instances = b->d_instances.p;
     a.rs.lights = b->d_lights.p;
+    a.rs.deforms = sl->num_deforms ? sl->d_dviews.p : NULL;
+    a.rs.num_deforms = sl->num_deforms;
     a.rs.keys = sl->d_keys.p;
     a.rs.track_offset = sl->d_tracks.p;
     a.rs.track_count = sl->d_tracks.p + sl->num_tracks;
@@ -51,6 +53,11 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     a.view.num_tris = b->bvh.num_tris;
     a.view.num_top_nodes = sl->top.num_nodes;
     a.view.num_insts = sl->top.num_insts;
+    a.view.dnodes4 = sl->d_dnodes4.p;
+    a.view.dnodes8 = sl->d_dnodes8.p;
+    a.view.dtris = sl->d_dtris.p;
+    a.view.num_dnodes = sl->num_dnodes;
+    a.view.num_dtris = sl->num_dtris;
     a.state_in = b->d_state[sl->index % NRING].p;
     a.state_out = b->d_state[(sl->index + 1) % NRING].p;
     a.phase = b->d_phase.p;
@@ -86,12 +93,10 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     return a;
 }
 
-/* Calls f with the kernel variant of the run as compile-time constants: f(variant<LAYOUT, SENSOR, GI>{}). */
-
 kernel_variant run_variant(const cuda_backend *b)
 {
     kernel_variant v;
-    v.layout = b->bvh.layout;
+    v.layout = b->bvh.layout | (b->bvh.num_deforming ? EVR_GPU_TRACE_DEFORMING : 0);
     v.sensor = !evr_pixel_params_ideal(&b->setup.pixel);
     v.gi = b->gi != 0;
     return v;
@@ -111,7 +116,9 @@ uint64_t device_bytes(const cuda_backend *b)
              bytes(sl->d_sort_temp) + bytes(sl->d_count) + bytes(sl->d_counters) +
              bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) +
              bytes(sl->d_frames) + bytes(sl->d_sat) + bytes(sl->d_ch_before) +
-             bytes(sl->d_ch_base) + bytes(sl->d_ch_x) + bytes(sl->d_em) + bytes(sl->d_cdf);
+             bytes(sl->d_ch_base) + bytes(sl->d_ch_x) + bytes(sl->d_em) + bytes(sl->d_cdf) +
+             bytes(sl->d_dverts) + bytes(sl->d_dviews) + bytes(sl->d_dnodes4) +
+             bytes(sl->d_dnodes8) + bytes(sl->d_dtris);
     }
     for (int i = 0; i < NRING; i++)
         n += bytes(b->gi_ring[i].slots) + bytes(b->gi_ring[i].count) + bytes(b->gi_ring[i].gbuf);

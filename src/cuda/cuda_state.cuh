@@ -39,6 +39,22 @@ struct slot {
     dbuf<evr_gpu_node4> d_top4;
     dbuf<evr_gpu_node8> d_top8;
     dbuf<evr_gpu_inst> d_insts;
+    /* the deforming instances: the segment's vertex keys (every view's positions and normals)
+     * and views of them, and the deforming groups' trees (cuda_backend.deform's packed arrays,
+     * copied when their generation dgen is not the backend's) */
+    int num_deforms;
+    hbuf<float> h_dverts;
+    dbuf<float> d_dverts;
+    hbuf<evr_deform_view> h_dviews;
+    dbuf<evr_deform_view> d_dviews;
+    unsigned long long dgen; /* 0: none copied */
+    uint32_t num_dnodes, num_dtris;
+    hbuf<evr_gpu_node4> h_dnodes4;
+    hbuf<evr_gpu_node8> h_dnodes8;
+    hbuf<evr_gpu_dtri> h_dtris;
+    dbuf<evr_gpu_node4> d_dnodes4;
+    dbuf<evr_gpu_node8> d_dnodes8;
+    dbuf<evr_gpu_dtri> d_dtris;
     dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
     dbuf<unsigned char> d_sort_temp;
     dbuf<unsigned int> d_count;          /* indexed by launch_count */
@@ -101,6 +117,7 @@ struct cuda_backend {
     evr_render_host host;
     evr_run_setup setup;
     evr_gpu_bvh bvh;
+    evr_gpu_deform deform; /* the deforming groups' trees of the last submitted segment (host) */
     int device;
     char device_name[256];
     /* scene on the device */

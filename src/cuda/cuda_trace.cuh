@@ -7,16 +7,20 @@
 #include "cuda/gpu_traverse.h"
 
 /* One traversal body for primary and shadow rays, not inlined: a kernel with four inlined copies
- * (two queries, two node layouts) stalled on instruction-cache misses (measured with ncu). */
+ * (two queries, two node layouts) stalled on instruction-cache misses (measured with ncu).
+ * LAYOUT: the node layout, with EVR_GPU_TRACE_DEFORMING where the scene has deforming groups. */
 template <int LAYOUT>
 __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_render_scene *rs,
                                       evr_ray ray, float tnear, float tfar, float f, int any,
                                       evr_gpu_hit *hit, int groups = EVR_GROUPS_ALL)
 {
+    /* the dispatch of evr__trace, here with the template's constants (through evr__trace the
+     * BVH4 kernels' registers came out otherwise) */
+    const int deform = (LAYOUT & EVR_GPU_TRACE_DEFORMING) != 0;
     if (view->num_top_nodes == 0) return 0;
-    if (LAYOUT == EVR_GPU_LAYOUT_CW8)
-        return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit, groups);
-    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit, groups);
+    if ((LAYOUT & ~EVR_GPU_TRACE_DEFORMING) == EVR_GPU_LAYOUT_CW8)
+        return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit, groups, deform);
+    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit, groups, deform);
 }
 
 /* A warp-aggregated append: every lane of the warp calls it; the lanes with `want` get

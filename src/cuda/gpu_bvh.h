@@ -3,16 +3,30 @@
  *
  * Two levels over the groups of instances that both backends use (prep/instance_groups.h: the
  * never-moving instances baked into world space, or past the bake limit each in its node's
- * space with one tree per mesh; the instances of each moving node in that node's object space).
+ * space with one tree per mesh; the instances of each moving node in that node's object space;
+ * each deforming instance on its own).
  *   bottom  one BVH per group, built once per run by Embree's rtcBuildBVH (SAH with spatial
  *           splits, RTC_BUILD_QUALITY_HIGH) and flattened into wide nodes; every group's nodes
  *           and triangles live in one node array and one triangle array. Moving groups whose
  *           members are consecutive scene instances with the same sequence of meshes (many
  *           instances of one mesh, each on its own node) share one BVH.
+ *   deforming  a deforming group's vertices change from segment to segment (evr_deform_view:
+ *           vertex keys over the segment): its BVH is made for a segment (evr_gpu_deform: built
+ *           once, then refitted, built again when refits have made it much worse), over boxes
+ *           that hold each triangle at every key (the interpolation between two keys stays
+ *           inside their union), so a ray at any time of the segment finds it; its
+ *           triangles (evr_gpu_dtri) carry vertex indices, and the traversal interpolates the
+ *           vertices at the ray's time (evr_deform_lerp_in, as shading does). Made again only
+ *           when the vertices moved: while they hold still the tree stays the same bits, so the
+ *           same rays meet the same triangles in the same order (change-driven sampling). The
+ *           trees of all deforming groups are packed into arrays of their own, one copy per
+ *           segment in flight on the device. A scene without deforming meshes is searched by the
+ *           code that searched it before them (gpu_traverse.h).
  *   top     one BVH over the groups, rebuilt on the host for every segment (Embree's binned
  *           SAH, one group per leaf); a moving group's box encloses its object-space box moved
  *           by its track's motion keys over the WHOLE segment (a proven bound, not samples
- *           only), so a ray at any time inside the segment finds every group it can hit. The
+ *           only), so a ray at any time inside the segment finds every group it can hit; a
+ *           deforming group's object-space box is that of its vertex keys. The
  *           traversal searches a node's groups in a fixed order, set at the build: smallest box
  *           first, so that their hits shorten the ray before the large groups around them.
  * Each triangle carries its scene instance (relative to its group's first member in a BVH that
@@ -57,6 +71,9 @@ extern "C" {
 #ifndef EVR_GPU_LAYOUT_DEFAULT
 #define EVR_GPU_LAYOUT_DEFAULT EVR_GPU_LAYOUT_CW8
 #endif
+/* Or'ed into a traversal's layout (the CUDA backend's kernels' LAYOUT): the scene has deforming
+ * groups (gpu_traverse.h: a search without them is the code it was before them). */
+#define EVR_GPU_TRACE_DEFORMING 0x10
 /* Or'ed into evr_gpu_bvh_build's layout: no grouping, every instance a group of its own in its
  * node's object space (the trees of one mesh shared), as before grouping; for comparisons. */
 #define EVR_GPU_BVH_UNGROUPED 0x100
@@ -106,10 +123,19 @@ typedef struct {
     uint32_t pad;
 } evr_gpu_tri;
 
+/* A deforming group's triangle in leaf order, 16 bytes: its vertices' indices into the group's
+ * evr_deform_view (interpolated at the ray's time) and its index in the mesh; its instance is the
+ * group's one member (evr_gpu_inst.instance_base). */
+typedef struct {
+    EVR_ALIGN16 uint32_t v[3];
+    uint32_t prim;
+} evr_gpu_dtri;
+
 /* A group in the top level's leaf order, 64 bytes. */
 typedef struct {
     EVR_ALIGN16 evr_m34 inv; /* world to group space; valid when moving == 0 */
-    int32_t root;            /* root node of the group's bottom-level BVH */
+    int32_t root;            /* root node of the group's bottom-level BVH; a deforming group's:
+                                -1 - its root in the deforming trees (dnodes) */
     int32_t track;           /* motion track (evr_render_scene), -1 in world space (static) */
     int32_t instance_base;   /* added to a triangle's instance: the scene instance index */
     int32_t moving;          /* 1: the transform changes in the segment, evaluate per ray */
@@ -125,6 +151,12 @@ typedef struct {
     const evr_gpu_node8 *top8;
     const evr_gpu_inst *insts;
     uint32_t num_nodes, num_tris, num_top_nodes, num_insts; /* num_top_nodes 0: nothing to hit */
+    /* the deforming groups' trees of the segment (evr_gpu_deform's packed arrays; num_dtris 0:
+     * no deforming group to search) */
+    const evr_gpu_node4 *dnodes4;
+    const evr_gpu_node8 *dnodes8;
+    const evr_gpu_dtri *dtris;
+    uint32_t num_dnodes, num_dtris;
 } evr_gpu_scene_view;
 
 /* ---- host side ---- */
@@ -139,13 +171,17 @@ typedef struct {
     int static_group;     /* index of the baked static group, -1: none */
     int static_instanced; /* 1: the static instances were past the bake limit: each is a group
                                   of its own in its node's space, the trees shared by mesh */
+    int *group_kind;      /* per group: EVR_GROUP_* (prep/instance_groups.h) */
     int *group_node;      /* per group: the node whose object space it is in and whose track
-                                  moves it, -1: world space (the static group) */
+                                  moves it, -1: world space (the static group, a skinned mesh) */
     int *group_first;     /* per group + 1: its members are members[group_first[g] ..
                                   group_first[g + 1]), scene instance indices, ascending */
     int *members;
     int *instance_group; /* per scene instance: its group */
-    int32_t *group_root; /* per group: root node, -1 for a group without usable triangles */
+    int32_t *group_root; /* per group: root node, -1 for a group without usable triangles (and
+                                  for a deforming group: its tree is evr_gpu_deform's) */
+    int *group_deform;   /* per group: its index among the deforming groups, -1: none */
+    int num_deforming;   /* deforming groups */
     int32_t *group_instance_base; /* per group: evr_gpu_inst.instance_base */
     int *group_stack;             /* per group: stack entries its traversal needs at most */
     float *group_bounds;          /* per group: box of its triangles in its space, lo xyz hi xyz */
@@ -158,6 +194,41 @@ typedef struct {
     uint32_t num_tris; /* triangle references (>= the meshes' triangles with splits) */
     void *device;      /* the Embree device (RTCDevice) its builds use */
 } evr_gpu_bvh;
+
+/* One deforming group's tree (node and item indices from 0, its root at node 0). */
+typedef struct {
+    evr_gpu_node4 *nodes4;
+    evr_gpu_node8 *nodes8;
+    uint32_t num_nodes, cap_nodes;
+    evr_gpu_dtri *tris;
+    uint32_t num_tris, cap_tris;
+    int stack;         /* traversal stack it needs */
+    float bounds[6];   /* box of its triangles at every key of the segment it was built for, in
+                        its group's space, lo xyz hi xyz */
+    int built;         /* 0: not yet built */
+    double built_cost; /* its surface area cost when built (relative to the root's area) */
+    double cost;       /* and now, refitted to the segment's keys */
+} evr_gpu_dtree;
+
+/* The deforming groups' trees for the current segment (host). Zero it before the first update;
+ * updates reuse its memory. */
+typedef struct {
+    int layout;
+    int num;              /* deforming groups (evr_gpu_bvh.num_deforming) */
+    evr_gpu_dtree *trees; /* per deforming group */
+    /* every tree packed, node and item indices relocated: what evr_gpu_scene_view's dnodes4,
+     * dnodes8 and dtris hold */
+    evr_gpu_node4 *nodes4;
+    evr_gpu_node8 *nodes8;
+    uint32_t num_nodes, cap_nodes;
+    evr_gpu_dtri *tris;
+    uint32_t num_tris, cap_tris;
+    int32_t *root;          /* per deforming group: its root in the packed nodes, -1: nothing */
+    int max_stack;          /* largest of the trees' stacks */
+    int rebuilt, refitted;  /* trees the last update built, and refitted */
+    unsigned long long gen; /* counts the updates that changed the packed arrays */
+    void *scratch;          /* the builder's inputs (private) */
+} evr_gpu_deform;
 
 /* Top level of one segment. Zero it before the first build; later builds reuse its memory. */
 typedef struct {
@@ -180,15 +251,27 @@ typedef struct {
 evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err);
 void evr_gpu_bvh_free(evr_gpu_bvh *b);
 
+/* Makes the deforming groups' trees for the segment whose vertex keys rs->deforms holds (host
+ * views, rs->num_deforms of them; rs->meshes and rs->instances for the triangles): a group whose
+ * vertices moved (moved[k] of its deform view k, evr_segment.deform_moved; NULL: all moved) gets
+ * its tree refitted to each triangle's box at every key, or built (Embree's binned SAH) where it
+ * has none yet or a refit made it much worse; the others keep theirs, bit for bit. Segments in
+ * order. On failure d is left empty. */
+evr_status evr_gpu_deform_update(const evr_gpu_bvh *b, const evr_render_scene *rs, const int *moved,
+                                 evr_gpu_deform *d, evr_error *err);
+void evr_gpu_deform_free(evr_gpu_deform *d);
+
 /* Builds the top level for the segment whose motion keys rs holds (rs->num_instances, equal to
  * the scene's; rs->instances[i].track, the same for every member of a moving group; rs->keys,
- * rs->track_offset, rs->track_count). */
-evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top,
-                             evr_error *err);
+ * rs->track_offset, rs->track_count) and whose deforming groups' trees d holds (updated for
+ * this segment; NULL where b has no deforming groups). */
+evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_gpu_deform *d,
+                             const evr_render_scene *rs, evr_gpu_top *top, evr_error *err);
 void evr_gpu_top_free(evr_gpu_top *top);
 
-/* A view of host arrays, for host traversal. */
-void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_top *top, evr_gpu_scene_view *v);
+/* A view of host arrays, for host traversal (d: NULL where b has no deforming groups). */
+void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_deform *d, const evr_gpu_top *top,
+                             evr_gpu_scene_view *v);
 
 #ifdef __cplusplus
 }

@@ -1,5 +1,6 @@
 /* Host side of the GPU acceleration structure (see gpu_bvh.h): a tree per group of instances
- * (gpu_bvh_tree.c builds and flattens each) and the top level over the groups. */
+ * (gpu_bvh_tree.c builds and flattens each; the deforming groups' per segment, gpu_bvh_deform.c)
+ * and the top level over the groups. */
 #include "cuda/gpu_bvh_internal.h"
 #include "prep/instance_groups.h"
 #include "prep/swept_bounds.h"
@@ -16,11 +17,13 @@
 void evr_gpu_bvh_free(evr_gpu_bvh *b)
 {
     if (!b) return;
+    free(b->group_kind);
     free(b->group_node);
     free(b->group_first);
     free(b->members);
     free(b->instance_group);
     free(b->group_root);
+    free(b->group_deform);
     free(b->group_instance_base);
     free(b->group_stack);
     free(b->group_bounds);
@@ -38,7 +41,7 @@ void evr_gpu_bvh_free(evr_gpu_bvh *b)
 static int consecutive(const evr_gpu_bvh *b, int g)
 {
     int first = b->group_first[g], last = b->group_first[g + 1] - 1;
-    return b->group_node[g] >= 0 && last >= first &&
+    return b->group_node[g] >= 0 && b->group_kind[g] != EVR_GROUP_DEFORMING && last >= first &&
            b->members[last] - b->members[first] == last - first;
 }
 
@@ -208,18 +211,20 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         out->num_groups = groups.num_groups;
         out->static_group = groups.static_group;
         out->static_instanced = groups.static_instanced;
+        out->group_kind = groups.group_kind;
         out->group_node = groups.group_node;
         out->group_first = groups.group_first;
         out->members = groups.members;
         out->instance_group = groups.instance_group;
-        free(groups.group_kind);
     }
     out->group_root = malloc(sizeof(int32_t) * ((size_t)n + 1));
+    out->group_deform = malloc(sizeof(int) * ((size_t)n + 1));
     out->group_instance_base = calloc((size_t)n + 1, sizeof(int32_t));
     out->group_stack = calloc((size_t)n + 1, sizeof(int));
     out->group_bounds = malloc(sizeof(float) * 6 * ((size_t)n + 1));
-    if (!out->group_node || !out->group_first || !out->members || !out->instance_group ||
-        !out->group_root || !out->group_instance_base || !out->group_stack || !out->group_bounds) {
+    if (!out->group_kind || !out->group_node || !out->group_first || !out->members ||
+        !out->instance_group || !out->group_root || !out->group_deform ||
+        !out->group_instance_base || !out->group_stack || !out->group_bounds) {
         evr_gpu_bvh_free(out);
         return fail(err, EVR_ERR_NOMEM, "out of memory for the GPU BVH", NULL);
     }
@@ -248,6 +253,15 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         int j, need;
         split_source split;
         out->group_root[g] = -1;
+        out->group_deform[g] = -1;
+        if (out->group_kind[g] == EVR_GROUP_DEFORMING) {
+            /* its tree is made per segment (evr_gpu_deform_update); its one member is its
+             * triangles' instance */
+            out->group_deform[g] = out->num_deforming++;
+            out->group_instance_base[g] = out->members[out->group_first[g]];
+            for (j = 0; j < 6; j++) out->group_bounds[6 * g + j] = j < 3 ? INFINITY : -INFINITY;
+            continue;
+        }
         if (consecutive(out, g)) {
             size_t h = (size_t)mesh_signature(s, out, g) & table_mask;
             base = out->members[out->group_first[g]];
@@ -331,10 +345,10 @@ void evr_gpu_top_free(evr_gpu_top *top)
     memset(top, 0, sizeof *top);
 }
 
-evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, evr_gpu_top *top,
-                             evr_error *err)
+evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_gpu_deform *d,
+                             const evr_render_scene *rs, evr_gpu_top *top, evr_error *err)
 {
-    int ng = b->num_groups, g, k, need;
+    int ng = b->num_groups, g, k, need, bottom_stack = b->max_stack;
     size_t count = 0;
     evr_gpu_inst *src = NULL;
     struct RTCBuildPrimitive *prims = NULL;
@@ -351,6 +365,11 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     if (rs->num_instances != b->num_scene_instances)
         return fail(err, EVR_ERR_ARG,
                     "the render scene's instances are not those the GPU BVH was built for", NULL);
+    if (b->num_deforming && (!d || d->num != b->num_deforming || d->layout != b->layout))
+        return fail(err, EVR_ERR_ARG,
+                    "internal error: the deforming groups' trees are not those of the GPU BVH",
+                    NULL);
+    if (d && d->max_stack > bottom_stack) bottom_stack = d->max_stack;
     if (ng > top->cap_groups || !top->group_bounds) {
         float *gb = realloc(top->group_bounds, sizeof(float) * 6 * ((size_t)ng + 1));
         if (!gb) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
@@ -366,7 +385,9 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
         return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
     }
     for (g = 0; g < ng; g++) {
-        const float *gb = b->group_bounds + 6 * g;
+        const int dk = b->group_deform[g]; /* a deforming group: its tree in d */
+        const float *gb = dk >= 0 ? d->trees[dk].bounds : b->group_bounds + 6 * g;
+        const int32_t group_root = dk >= 0 ? d->root[dk] : b->group_root[g];
         float *ib = top->group_bounds + 6 * g, lo[3], hi[3];
         evr_gpu_inst *in = &src[count];
         int ok = 1;
@@ -374,11 +395,11 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
             ib[k] = INFINITY;
             ib[k + 3] = -INFINITY;
         }
-        if (b->group_root[g] < 0) continue;
+        if (group_root < 0) continue;
         memset(in, 0, sizeof *in);
-        in->root = b->group_root[g];
+        in->root = dk >= 0 ? -1 - group_root : group_root;
         in->instance_base = b->group_instance_base[g];
-        if (b->group_node[g] < 0) { /* world space (the static group) */
+        if (b->group_node[g] < 0 && dk < 0) { /* world space (the static group) */
             for (k = 0; k < 3; k++) {
                 lo[k] = gb[k];
                 hi[k] = gb[k + 3];
@@ -386,7 +407,10 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
             in->track = -1;
             in->moving = 0;
             in->inv = evr_m34_identity();
-        } else { /* every member is on the group's node: the first one's track is the group's */
+        } else {
+            /* every member is on the group's node: the first one's track is the group's (a
+             * skinned mesh's, in world space, is the fixed world frame's: never track -1, which
+             * would make it part of the static hits of a still camera) */
             int track = rs->instances[b->members[b->group_first[g]]].track;
             evr_motion_track tr = evr_rs_track(rs, track);
             evr_swept_bounds(gb, gb + 3, tr, lo, hi);
@@ -445,7 +469,7 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     if (st != EVR_OK) return st;
     need = evr_gpu_tree_stack_need(&c, 0, c.num_nodes);
     if (need < 0) return fail(err, EVR_ERR_NOMEM, "out of memory for the top-level BVH", NULL);
-    need += b->max_stack;
+    need += bottom_stack;
     if (need >= EVR_GPU_STACK_SIZE)
         return fail(err, EVR_ERR_BACKEND, "the scene's BVH is too deep for the traversal stack",
                     NULL);
@@ -455,7 +479,8 @@ evr_status evr_gpu_top_build(const evr_gpu_bvh *b, const evr_render_scene *rs, e
     return EVR_OK;
 }
 
-void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_top *top, evr_gpu_scene_view *v)
+void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_deform *d, const evr_gpu_top *top,
+                             evr_gpu_scene_view *v)
 {
     memset(v, 0, sizeof *v);
     v->layout = b->layout;
@@ -469,4 +494,11 @@ void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_top *top, evr_g
     v->insts = top->insts;
     v->num_top_nodes = top->num_nodes;
     v->num_insts = top->num_insts;
+    if (d) {
+        v->dnodes4 = d->nodes4;
+        v->dnodes8 = d->nodes8;
+        v->dtris = d->tris;
+        v->num_dnodes = d->num_nodes;
+        v->num_dtris = d->num_tris;
+    }
 }

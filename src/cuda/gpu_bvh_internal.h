@@ -24,16 +24,19 @@ typedef struct {
 
 typedef struct {
     int layout;
-    int instances; /* items are instances (top level), else triangles */
+    int instances; /* items are instances (top level), */
+    int deforming; /* or a deforming group's vertex-indexed triangles, else triangles */
     /* outputs, grown as needed (and kept across top-level builds) */
     evr_gpu_node4 *n4;
     evr_gpu_node8 *n8;
     uint32_t num_nodes, cap_nodes;
     evr_gpu_tri *tris;
+    evr_gpu_dtri *dtris;
     evr_gpu_inst *insts;
     uint32_t num_items, cap_items;
     /* item sources, by primID */
     const float *tri9;            /* a group's triangles, 9 floats each */
+    const uint32_t *tri_vidx;     /* a deforming group's triangles, 3 vertex indices each */
     const uint32_t *tri_prim;     /* their indices in their meshes */
     const int32_t *tri_inst;      /* their instance fields */
     const evr_gpu_inst *inst_src; /* the top level's groups */
@@ -62,5 +65,13 @@ evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimiti
 /* Worst-case stack entries of the traversal of the tree in nodes [first, end) rooted at first
  * (children always come after their parent); -1 when out of memory. */
 int evr_gpu_tree_stack_need(const flat_ctx *c, uint32_t first, uint32_t end);
+/* Refits the tree in nodes [0, num_nodes) (root 0, children after their parent, every item in
+ * one leaf: no spatial splits) to new item boxes (item_box: lo xyz hi xyz per item): each child
+ * box made again bottom up, CW8's quantized again; node_box: room for 6 floats per node (the
+ * root's box first). *cost: its surface area heuristic (the nodes' areas and each leaf's area
+ * times its items, over the root's area), to tell when a refitted tree has become much worse
+ * than a new one. 0: a CW8 node's boxes cannot be quantized (build it again). */
+int evr_gpu_tree_refit(int layout, evr_gpu_node4 *n4, evr_gpu_node8 *n8, uint32_t num_nodes,
+                       const float *item_box, float *node_box, double *cost);
 
 #endif

@@ -1,6 +1,7 @@
 /* Embree's rtcBuildBVH run through our callbacks (a tree of temporary nodes in memory Embree
  * owns and frees with the RTCBVH), then flattened into the node layout the traversal reads
- * (gpu_bvh.h: BVH4 or compressed CW8), with the traversal stack each tree needs. */
+ * (gpu_bvh.h: BVH4 or compressed CW8), with the traversal stack each tree needs; and a flattened
+ * tree refitted to new item boxes (the deforming meshes'). */
 #include "cuda/gpu_bvh_internal.h"
 
 #include <float.h>
@@ -212,6 +213,8 @@ static int emit_items(flat_ctx *c, const build_leaf *l, uint32_t *first)
         uint32_t cap = c->cap_items;
         if (c->instances) {
             if (!grow((void **)&c->insts, &cap, need, sizeof *c->insts)) return 0;
+        } else if (c->deforming) {
+            if (!grow((void **)&c->dtris, &cap, need, sizeof *c->dtris)) return 0;
         } else {
             if (!grow((void **)&c->tris, &cap, need, sizeof *c->tris)) return 0;
         }
@@ -222,6 +225,10 @@ static int emit_items(flat_ctx *c, const build_leaf *l, uint32_t *first)
         uint32_t p = l->prim[i];
         if (c->instances) {
             c->insts[c->num_items + i] = c->inst_src[p];
+        } else if (c->deforming) {
+            evr_gpu_dtri *t = &c->dtris[c->num_items + i];
+            memcpy(t->v, c->tri_vidx + 3 * (size_t)p, sizeof t->v);
+            t->prim = c->tri_prim[p];
         } else {
             evr_gpu_tri *t = &c->tris[c->num_items + i];
             const float *v = c->tri9 + 9 * (size_t)p;
@@ -542,6 +549,83 @@ int evr_gpu_tree_stack_need(const flat_ctx *c, uint32_t first, uint32_t end)
     r = need[0];
     free(need);
     return r;
+}
+
+/* ---- refitting ---- */
+
+static void box_empty(float b[6])
+{
+    b[0] = b[1] = b[2] = INFINITY;
+    b[3] = b[4] = b[5] = -INFINITY;
+}
+
+static void box_add(float b[6], const float *o)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        b[a] = min_f(b[a], o[a]);
+        b[a + 3] = max_f(b[a + 3], o[a + 3]);
+    }
+}
+
+/* The box of items [first, first + n) and their share of the cost (n times its area). */
+static void leaf_box(const float *item_box, uint32_t first, uint32_t n, float b[6], double *cost)
+{
+    uint32_t i;
+    box_empty(b);
+    for (i = 0; i < n; i++) box_add(b, item_box + 6 * (size_t)(first + i));
+    *cost += (double)n * half_area(b);
+}
+
+int evr_gpu_tree_refit(int layout, evr_gpu_node4 *n4, evr_gpu_node8 *n8, uint32_t num_nodes,
+                       const float *item_box, float *node_box, double *cost)
+{
+    uint32_t i;
+    double sum = 0.0;
+    int s, k;
+    for (i = num_nodes; i-- > 0;) { /* children come after their parent */
+        float *nb = node_box + 6 * (size_t)i;
+        box_empty(nb);
+        if (layout == EVR_GPU_LAYOUT_CW8) {
+            evr_gpu_node8 *nd = &n8[i];
+            float box[8][6];
+            int slot_kid[8];
+            for (s = 0; s < 8; s++) {
+                const unsigned m = nd->meta[s];
+                slot_kid[s] = -1;
+                if (!m) continue;
+                if ((m & 31u) >= 24u) { /* an inner child: after the inner ones of lower slots */
+                    const uint32_t c =
+                        nd->child_base + (uint32_t)__builtin_popcount(nd->imask & ((1u << s) - 1u));
+                    memcpy(box[s], node_box + 6 * (size_t)c, sizeof box[s]);
+                } else { /* a leaf: (0x1, 0x3, 0x7 for 1, 2, 3 items) << 5 | offset */
+                    leaf_box(item_box, nd->item_base + (m & 31u),
+                             (uint32_t)__builtin_popcount(m >> 5), box[s], &sum);
+                }
+                slot_kid[s] = s;
+                box_add(nb, box[s]);
+            }
+            if (!quantize_node8(nd, box, slot_kid, nb)) return 0;
+        } else {
+            evr_gpu_node4 *nd = &n4[i];
+            for (k = 0; k < 4; k++) {
+                float b[6];
+                if (nd->child[k] < 0) continue;
+                if (nd->count[k]) leaf_box(item_box, (uint32_t)nd->child[k], nd->count[k], b, &sum);
+                else memcpy(b, node_box + 6 * (size_t)nd->child[k], sizeof b);
+                nd->lo_x[k] = b[0];
+                nd->lo_y[k] = b[1];
+                nd->lo_z[k] = b[2];
+                nd->hi_x[k] = b[3];
+                nd->hi_y[k] = b[4];
+                nd->hi_z[k] = b[5];
+                box_add(nb, b);
+            }
+        }
+        sum += half_area(nb);
+    }
+    *cost = num_nodes && half_area(node_box) > 0.0f ? sum / (double)half_area(node_box) : 0.0;
+    return 1;
 }
 
 struct RTCBuildPrimitive *evr_gpu_tree_prims(size_t n)

@@ -14,7 +14,17 @@
  * Each moving group's transform is evaluated at the ray's time exactly as the CPU backend does
  * (evr_motion_eval of its track), inverted, and the ray moved into group space without
  * normalizing its direction, so t stays the world parameter (the static group's space is the
- * world: an identity transform, exact in float). Triangles are intersected with the
+ * world: an identity transform, exact in float). A deforming group's triangles get their
+ * vertices at the ray's time from the segment's vertex keys (evr_deform_lerp_in, what shading
+ * reads too); a top-level leaf is a deforming group when its root is negative. Whether a scene
+ * has deforming groups at all is a constant of the search (`deform`; on the device a bit of the
+ * kernel's LAYOUT, EVR_GPU_TRACE_DEFORMING): without them the search is the very code it was
+ * before deforming meshes, instruction for instruction (nvdisasm, sm_90). Any trace of them in
+ * that code changed the eye's render kernel's registers and spills (a branch per group entered,
+ * a call to a search of their own inside or after this one, even passing a triangle's vertices
+ * by pointer instead of the record); so the CUDA kernels come in both kinds, and the deforming
+ * kind checks each group it enters. One source serves both, inlined with the constants folded
+ * (EVR__ALWAYS_INLINE). Triangles are intersected with the
  * watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge or vertex
  * hits at least one of the triangles. Its edge functions must be evaluated without fused
  * multiply-adds (exactly antisymmetric): on the device through __fmul_rn/__fsub_rn, on the host
@@ -57,6 +67,14 @@ typedef struct {
 #define EVR__NODE8_UNROLL EVR__PRAGMA_UNROLL(EVR_NODE8_UNROLL)
 #else
 #define EVR__NODE8_UNROLL
+#endif
+
+/* The searches are inlined into each caller with what says deforming or not a constant (see the
+ * top). */
+#ifdef __CUDACC__
+#define EVR__ALWAYS_INLINE __forceinline__
+#else
+#define EVR__ALWAYS_INLINE inline __attribute__((always_inline))
 #endif
 
 /* 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24 */
@@ -250,6 +268,54 @@ typedef struct {
     float u, v;
 } evr__tri_hit;
 
+/* A deforming group's triangles and where their vertices are at the ray's time: the group's
+ * deform view and the key interval of the time (evr_key_interval), found once per search. */
+typedef struct {
+    const evr_gpu_dtri *tris;
+    evr_deform_view view;
+    int a;    /* key interval */
+    float fr; /* and the fraction in it */
+} evr__deform_src;
+
+/* Leaf item i against the ray: a rigid triangle of tris, or with ds a deforming one. */
+EVR_HD static EVR__ALWAYS_INLINE int evr__leaf_tri(const evr_gpu_tri *tris,
+                                                   const evr__deform_src *ds, uint32_t i,
+                                                   const evr__tray *r, float tnear, float tfar,
+                                                   float *t, float *u, float *v)
+{
+    if (ds) { /* the same test of a record of its vertices at the ray's time */
+        const evr_gpu_dtri *d = &ds->tris[i];
+        evr_gpu_tri at;
+        float *p[3];
+        int k;
+        p[0] = at.v0;
+        p[1] = at.v1;
+        p[2] = at.v2;
+        for (k = 0; k < 3; k++) {
+            const evr_v3 q =
+                evr_deform_lerp_in(&ds->view, ds->view.positions, d->v[k], ds->a, ds->fr);
+            p[k][0] = q.x;
+            p[k][1] = q.y;
+            p[k][2] = q.z;
+        }
+        return evr__tri(r, &at, tnear, tfar, t, u, v);
+    }
+    return evr__tri(r, &tris[i], tnear, tfar, t, u, v);
+}
+
+/* The triangle and instance fields of a leaf item that was hit (read only then). */
+EVR_HD static EVR__ALWAYS_INLINE void
+evr__leaf_hit(const evr_gpu_tri *tris, const evr__deform_src *ds, uint32_t i, evr__tri_hit *th)
+{
+    if (ds) {
+        th->prim = ds->tris[i].prim;
+        th->inst = 0; /* the group's one instance */
+        return;
+    }
+    th->prim = tris[i].prim;
+    th->inst = tris[i].instance;
+}
+
 /* ---- BVH4 ---- */
 
 #define EVR__CSWAP(i, j)      \
@@ -291,11 +357,13 @@ EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r,
     EVR__CSWAP(1, 2);
 }
 
-/* Nearest (any != 0: first) triangle of one mesh in (tnear, *tfar]; shrinks *tfar. Uses the
- * stack above sp0. */
-EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris, int root,
-                                    const evr__tray *r, float tnear, float *tfar, int any,
-                                    evr__stack_entry *stack, int sp0, evr__tri_hit *th)
+/* Nearest (any != 0: first) triangle of one group in (tnear, *tfar]; shrinks *tfar. Uses the
+ * stack above sp0. The triangles are tris, or with ds a deforming group's. */
+EVR_HD static EVR__ALWAYS_INLINE int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris,
+                                                int root, const evr__tray *r, float tnear,
+                                                float *tfar, int any, evr__stack_entry *stack,
+                                                int sp0, evr__tri_hit *th,
+                                                const evr__deform_src *ds)
 {
     int node = root, sp = sp0, found = 0;
     for (;;) {
@@ -306,12 +374,11 @@ EVR_HD static inline int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tr
         EVR__UNROLL
         for (i = 0; i < 4; i++) {
             for (k = 0; k < lc[i]; k++) {
-                const evr_gpu_tri *tri = &tris[(uint32_t)lf[i] + k];
+                const uint32_t item = (uint32_t)lf[i] + k;
                 float t, u, v;
-                if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+                if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar) {
                     *tfar = t;
-                    th->prim = tri->prim;
-                    th->inst = tri->instance;
+                    evr__leaf_hit(tris, ds, item, th);
                     th->u = u;
                     th->v = v;
                     found = 1;
@@ -426,9 +493,12 @@ EVR_HD static inline uint32_t evr__group_next(uint32_t *base, uint32_t *hits, co
     return index;
 }
 
-EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root,
-                                    const evr__tray *r, float tnear, float *tfar, int any,
-                                    evr__stack_entry *stack, int sp0, evr__tri_hit *th)
+/* As evr__blas4, for CW8 nodes. */
+EVR_HD static EVR__ALWAYS_INLINE int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris,
+                                                int root, const evr__tray *r, float tnear,
+                                                float *tfar, int any, evr__stack_entry *stack,
+                                                int sp0, evr__tri_hit *th,
+                                                const evr__deform_src *ds)
 {
     uint32_t ng_base = (uint32_t)root, ng_hits = 0x80000000u, tg_base = 0, tg_hits = 0;
     int sp = sp0, found = 0;
@@ -443,13 +513,12 @@ EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tr
         }
         while (tg_hits) {
             int bit = evr__msb(tg_hits);
-            const evr_gpu_tri *tri = &tris[tg_base + (uint32_t)bit];
+            const uint32_t item = tg_base + (uint32_t)bit;
             float t, u, v;
             tg_hits &= ~(1u << bit);
-            if (evr__tri(r, tri, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+            if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar) {
                 *tfar = t;
-                th->prim = tri->prim;
-                th->inst = tri->instance;
+                evr__leaf_hit(tris, ds, item, th);
                 th->u = u;
                 th->v = v;
                 found = 1;
@@ -469,11 +538,12 @@ EVR_HD static inline int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tr
 /* ---- groups ---- */
 
 /* Searches one group with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
- * and fills hit (when not NULL). */
-EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs,
-                                       const evr_gpu_inst *in, evr_v3 o, evr_v3 d, float f,
-                                       float tnear, float *tfar, int any, evr__stack_entry *stack,
-                                       int sp, evr_gpu_hit *hit)
+ * and fills hit (when not NULL). deform (a constant where inlined): the group may be a deforming
+ * one (root < 0: its tree in the deforming arrays, its vertices the segment's keys at time f). */
+EVR_HD static EVR__ALWAYS_INLINE int
+evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
+              evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
+              evr__stack_entry *stack, int sp, evr_gpu_hit *hit, int deform)
 {
     evr_m34 inv;
     evr_v3 oo, od;
@@ -493,9 +563,24 @@ EVR_HD static inline int evr__instance(const evr_gpu_scene_view *v, const evr_re
     th.prim = 0;
     th.inst = 0;
     th.u = th.v = 0.0f;
-    if (v->layout == EVR_GPU_LAYOUT_CW8)
-        found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
-    else found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th);
+    if (deform && in->root < 0) {
+        evr__deform_src ds;
+        ds.tris = v->dtris;
+        ds.view = rs->deforms[rs->instances[in->instance_base].deform];
+        ds.fr = evr_key_interval(ds.view.num_keys, f, &ds.a);
+        if (v->layout == EVR_GPU_LAYOUT_CW8)
+            found = evr__blas8(v->dnodes8, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
+                               &th, &ds);
+        else
+            found = evr__blas4(v->dnodes4, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
+                               &th, &ds);
+    } else if (v->layout == EVR_GPU_LAYOUT_CW8) {
+        found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th,
+                           (const evr__deform_src *)0);
+    } else {
+        found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th,
+                           (const evr__deform_src *)0);
+    }
     if (found && hit) {
         hit->t = *tfar;
         hit->u = th.u;
@@ -519,9 +604,11 @@ EVR_HD static inline int evr__group_skipped(const evr_gpu_inst *in, int groups)
                                          : 0;
 }
 
-EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_render_scene *rs,
-                                     evr_ray ray, float tnear, float tfar, float f, int any,
-                                     evr_gpu_hit *hit, int groups)
+/* Top-level search; deform (a constant where inlined): some groups may be deforming ones. */
+EVR_HD static EVR__ALWAYS_INLINE int evr__trace4(const evr_gpu_scene_view *v,
+                                                 const evr_render_scene *rs, evr_ray ray,
+                                                 float tnear, float tfar, float f, int any,
+                                                 evr_gpu_hit *hit, int groups, int deform)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -536,7 +623,7 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
             for (k = 0; k < lc[i]; k++) {
                 if (evr__group_skipped(&v->insts[(uint32_t)lf[i] + k], groups)) continue;
                 if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear,
-                                  &tfar, any, stack, sp, hit)) {
+                                  &tfar, any, stack, sp, hit, deform)) {
                     found = 1;
                     if (any) return 1;
                 }
@@ -566,9 +653,10 @@ EVR_HD static inline int evr__trace4(const evr_gpu_scene_view *v, const evr_rend
     return found;
 }
 
-EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_render_scene *rs,
-                                     evr_ray ray, float tnear, float tfar, float f, int any,
-                                     evr_gpu_hit *hit, int groups)
+EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
+                                                 const evr_render_scene *rs, evr_ray ray,
+                                                 float tnear, float tfar, float f, int any,
+                                                 evr_gpu_hit *hit, int groups, int deform)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -589,7 +677,7 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
             tg_hits &= ~(1u << bit);
             if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
             if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear,
-                              &tfar, any, stack, sp, hit)) {
+                              &tfar, any, stack, sp, hit, deform)) {
                 found = 1;
                 if (any) return 1;
             }
@@ -604,6 +692,19 @@ EVR_HD static inline int evr__trace8(const evr_gpu_scene_view *v, const evr_rend
     return found;
 }
 
+/* Nearest (any != 0: first) hit among some groups (EVR_GROUPS_*) in (tnear, tfar] at time f, in
+ * node layout `layout`; deform: the scene has deforming groups (the host's queries below; the
+ * CUDA kernels' gpu_trace makes the same choice with its template's constants). */
+EVR_HD static EVR__ALWAYS_INLINE int
+evr__trace(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
+           float tfar, float f, int any, evr_gpu_hit *hit, int groups, int layout, int deform)
+{
+    if (v->num_top_nodes == 0) return 0;
+    if (layout == EVR_GPU_LAYOUT_CW8)
+        return evr__trace8(v, rs, ray, tnear, tfar, f, any, hit, groups, deform);
+    return evr__trace4(v, rs, ray, tnear, tfar, f, any, hit, groups, deform);
+}
+
 /* The nearest hit among some groups only (EVR_GROUPS_*), nearer than tmax (ties go to tmax).
  * The nearest hit of all groups is the static group's unless the others have one nearer (what
  * a camera ray's static hit, kept per pixel while the camera holds still, saves). */
@@ -611,10 +712,7 @@ EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v,
                                                   const evr_render_scene *rs, evr_ray ray,
                                                   float tmax, float f, int groups, evr_gpu_hit *hit)
 {
-    if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8)
-        return evr__trace8(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
-    return evr__trace4(v, rs, ray, 0.0f, tmax, f, 0, hit, groups);
+    return evr__trace(v, rs, ray, 0.0f, tmax, f, 0, hit, groups, v->layout, v->num_dtris != 0);
 }
 
 /* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
@@ -628,10 +726,8 @@ EVR_HD static inline int evr_trace_closest(const evr_gpu_scene_view *v, const ev
 EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_render_scene *rs,
                                        evr_ray ray, float tnear, float tfar, float f)
 {
-    if (v->num_top_nodes == 0) return 0;
-    if (v->layout == EVR_GPU_LAYOUT_CW8)
-        return evr__trace8(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
-    return evr__trace4(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL);
+    return evr__trace(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL, v->layout,
+                      v->num_dtris != 0);
 }
 
 #endif
