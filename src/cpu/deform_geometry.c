@@ -40,9 +40,9 @@ static void bounds(const struct RTCBoundsFunctionArguments *args)
     for (int k = 0; k < v->num_keys; k++)
         for (int c = 0; c < 3; c++) {
             const float *p = v->positions + ((size_t)k * v->num_vertices + ix[c]) * 3;
-            for (int a = 0; a < 3; a++) {
-                lo[a] = fminf(lo[a], p[a]);
-                hi[a] = fmaxf(hi[a], p[a]);
+            for (int a = 0; a < 3; a++) { /* finite: no libm call for NaN rules */
+                lo[a] = p[a] < lo[a] ? p[a] : lo[a];
+                hi[a] = p[a] > hi[a] ? p[a] : hi[a];
             }
         }
     struct RTCBounds *o = args->bounds_o;

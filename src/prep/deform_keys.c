@@ -71,9 +71,9 @@ static int close_arrays(const float *a, const float *b, size_t n, float tol)
 static void box_of(const float *p, uint32_t nv, float box[6])
 {
     for (size_t i = 0; i < 3 * (size_t)nv; i += 3)
-        for (int c = 0; c < 3; c++) {
-            box[c] = fminf(box[c], p[i + c]);
-            box[3 + c] = fmaxf(box[3 + c], p[i + c]);
+        for (int c = 0; c < 3; c++) { /* a NaN vertex widens nothing; no libm call */
+            box[c] = p[i + c] < box[c] ? p[i + c] : box[c];
+            box[3 + c] = p[i + c] > box[3 + c] ? p[i + c] : box[3 + c];
         }
 }
 
@@ -111,6 +111,7 @@ void evr_deform_tracker_free(evr_deform_tracker *t)
     free(t->last);
     free(t->last_box);
     free(t->scratch);
+    free(t->work);
     evr_par_pool_free(t->pool);
     memset(t, 0, sizeof *t);
 }
@@ -250,14 +251,13 @@ int evr_deform_keys_make(evr_deform_tracker *t, const evr_scene *s, const evr_re
     size_t used = 0;
     size_t *offset = malloc(sizeof *offset * ((size_t)nd + 1));
     int *count = malloc(sizeof *count * ((size_t)nd + 1));
-    float *work = NULL;
-    size_t work_cap = 0;
     if (!offset || !count) goto nomem;
     for (int d = 0; d < nd; d++) {
         const int inst = h->deform_instance[d];
         const uint32_t nv = s->meshes[s->instances[inst].mesh].num_vertices;
         const size_t per = 6 * (size_t)nv;
-        int n = fit_keys(t, s, inst, t0, t1, limit, cap, nv, &work, &work_cap);
+        int n = fit_keys(t, s, inst, t0, t1, limit, cap, nv, &t->work, &t->work_cap);
+        float *work = t->work;
         if (n < 1) goto nomem;
         /* a key as close to the one before is that key (a still stretch is still bit for
          * bit); a segment that holds the previous segment's last pose keeps it exactly */
@@ -309,12 +309,10 @@ int evr_deform_keys_make(evr_deform_tracker *t, const evr_scene *s, const evr_re
         out->views[d].normals = out->data + offset[d] + (size_t)count[d] * 3 * nv;
     }
     t->have_prev = 1;
-    free(work);
     free(offset);
     free(count);
     return 1;
 nomem:
-    free(work);
     free(offset);
     free(count);
     return 0;

@@ -38,6 +38,8 @@ typedef struct {
     float (*last_box)[6];
     float *scratch; /* evaluations between keys */
     size_t scratch_cap;
+    float *work; /* the keys being fitted */
+    size_t work_cap;
 } evr_deform_tracker;
 
 /* 0: out of memory. */

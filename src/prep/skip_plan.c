@@ -183,9 +183,9 @@ static void deform_part_boxes(const evr_skip_tracker *t, const evr_scene *s, int
                 const uint32_t vi = m->indices[3 * order[j] + c];
                 for (int k = 0; k < v->num_keys; k++) {
                     const float *p = v->positions + ((size_t)k * v->num_vertices + vi) * 3;
-                    for (int a = 0; a < 3; a++) {
-                        out[l][a] = fminf(out[l][a], p[a]);
-                        out[l][a + 3] = fmaxf(out[l][a + 3], p[a]);
+                    for (int a = 0; a < 3; a++) { /* finite: no libm call for NaN rules */
+                        out[l][a] = p[a] < out[l][a] ? p[a] : out[l][a];
+                        out[l][a + 3] = p[a] > out[l][a + 3] ? p[a] : out[l][a + 3];
                     }
                 }
             }
