@@ -33,7 +33,7 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
          # the sensor model with global illumination (the sensor kernel's GI variant)
          ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"])]
 # the deforming meshes: a scene file (a path) instead of a built-in scene; vertices per ray
-# from the segment's keys (the CPU's Embree time steps, the GPU's own trees per segment)
+# from the segment's keys (the CPU's Embree user geometry, the GPU's own trees per segment)
 for asset in T.deform_assets(tmp):
     cases.append((asset, ["--res", "160x120", "--duration", "1.0"]))
     cases.append((asset, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))

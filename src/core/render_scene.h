@@ -39,7 +39,7 @@ typedef struct {
 /* A deforming instance's vertices over the current segment: num_keys >= 1 keys at uniform
  * times 0, 1/(num_keys-1), ..., 1, each num_vertices positions and unit normals (3 floats each,
  * key-major), in the instance's track space. A ray at time f sees every vertex linearly
- * interpolated between the keys around f, as Embree's time steps do. */
+ * interpolated between the keys around f (evr_deform_lerp, on both backends). */
 typedef struct {
     int num_keys;
     uint32_t num_vertices;
