@@ -169,18 +169,7 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
                        pos + 3 * (size_t)mesh->indices[3 * t + (size_t)v], 3 * sizeof(float));
             gt->prim[n] = (uint32_t)t;
             gt->inst[n] = (int32_t)i - base;
-            pr->lower_x = lo[0];
-            pr->lower_y = lo[1];
-            pr->lower_z = lo[2];
-            pr->upper_x = hi[0];
-            pr->upper_y = hi[1];
-            pr->upper_z = hi[2];
-            pr->geomID = 0;
-            pr->primID = (unsigned)n;
-            for (k = 0; k < 3; k++) {
-                box[k] = fminf(box[k], lo[k]);
-                box[k + 3] = fmaxf(box[k + 3], hi[k]);
-            }
+            evr_gpu_prim_set(pr, n, lo, hi, box);
             n++;
         }
     }

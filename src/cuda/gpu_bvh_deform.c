@@ -165,18 +165,7 @@ static evr_status build_tree(RTCDevice dev, int layout, const evr_render_scene *
         }
         if (!ok) continue;
         sc->prim[n] = (uint32_t)tri;
-        pr->lower_x = lo[0];
-        pr->lower_y = lo[1];
-        pr->lower_z = lo[2];
-        pr->upper_x = hi[0];
-        pr->upper_y = hi[1];
-        pr->upper_z = hi[2];
-        pr->geomID = 0;
-        pr->primID = (unsigned)n;
-        for (a = 0; a < 3; a++) {
-            box[a] = fminf(box[a], lo[a]);
-            box[a + 3] = fmaxf(box[a + 3], hi[a]);
-        }
+        evr_gpu_prim_set(pr, n, lo, hi, box);
         n++;
     }
     if (n == 0) return EVR_OK; /* nothing to hit */

@@ -3,6 +3,7 @@
 #ifndef EVR_CUDA_GPU_BVH_INTERNAL_H
 #define EVR_CUDA_GPU_BVH_INTERNAL_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -53,6 +54,24 @@ static inline evr_status fail(evr_error *err, evr_status st, const char *what, c
         snprintf(err->msg, sizeof err->msg, "%s%s%s", what, detail ? ": " : "",
                  detail ? detail : "");
     return st;
+}
+
+/* Fills build primitive pr (item id, box lo..hi) and widens the tree's box by it. */
+static inline void evr_gpu_prim_set(struct RTCBuildPrimitive *pr, size_t id, const float lo[3],
+                                    const float hi[3], float box[6])
+{
+    pr->lower_x = lo[0];
+    pr->lower_y = lo[1];
+    pr->lower_z = lo[2];
+    pr->upper_x = hi[0];
+    pr->upper_y = hi[1];
+    pr->upper_z = hi[2];
+    pr->geomID = 0;
+    pr->primID = (unsigned)id;
+    for (int k = 0; k < 3; k++) {
+        box[k] = fminf(box[k], lo[k]);
+        box[k + 3] = fmaxf(box[k + 3], hi[k]);
+    }
 }
 
 /* Room for n build primitives, aligned as Embree wants them. */

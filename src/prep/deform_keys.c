@@ -94,7 +94,6 @@ int evr_deform_tracker_init(evr_deform_tracker *t, const evr_scene *s, const evr
     memset(t, 0, sizeof *t);
     t->num_deforms = h->num_deforms;
     if (!h->num_deforms) return 1;
-    t->pool = evr_par_pool_new(evr_par_threads(EVR_DEFORM_PARTS)); /* NULL: on this thread */
     t->last = calloc((size_t)h->num_deforms, sizeof *t->last);
     t->last_box = calloc((size_t)h->num_deforms, sizeof *t->last_box);
     if (!t->last || !t->last_box) return 0;
@@ -150,6 +149,10 @@ static void eval_part(void *ctx, int part, int thread)
 static int eval_at(evr_deform_tracker *t, const evr_scene *s, int inst, double time, float *slot,
                    uint32_t nv)
 {
+    if (nv >= 8192 && !t->pool && !t->pool_tried) { /* started for the first large mesh */
+        t->pool_tried = 1;
+        t->pool = evr_par_pool_new(evr_par_threads(EVR_DEFORM_PARTS)); /* NULL: on this thread */
+    }
     const int threads = evr_par_pool_threads(t->pool);
     if (!t->pool || threads < 2 || nv < 8192)
         return evr_instance_deformed_at(s, inst, time, slot, slot + 3 * (size_t)nv);

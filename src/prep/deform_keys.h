@@ -31,7 +31,8 @@ typedef struct {
 
 /* The tracker's memory of the previous segment, on the planner's thread. */
 typedef struct {
-    struct evr_par_pool *pool; /* threads for evaluating large meshes (NULL: none) */
+    struct evr_par_pool *pool; /* threads for evaluating large meshes (NULL: none yet) */
+    int pool_tried;            /* the pool was asked for (once) */
     int num_deforms;
     int have_prev;
     float **last; /* per deform: positions and normals of the last key seen */
