@@ -262,9 +262,76 @@ static void test_skin_bend(void)
     evr_deform_tracker_free(&t);
 }
 
+/* A mesh of 8,192 vertices or more is evaluated in parts on the tracker's threads: its keys are
+ * the same floats as one evaluation on this thread (a sheet of 100 x 100 vertices on the morph
+ * target's slide). */
+static void test_large_threaded(void)
+{
+    enum { SIDE = 100, NV = SIDE * SIDE };
+    float *pos = malloc(sizeof(float) * 3 * NV), *nrm = malloc(sizeof(float) * 3 * NV);
+    float *dpos = malloc(sizeof(float) * 3 * NV), *truth = malloc(sizeof(float) * 6 * NV);
+    uint32_t idx[6] = {0, 1, SIDE + 1, 0, SIDE + 1, SIDE};
+    float defw[1] = {0}, restw[1] = {0}, values[2] = {0.0f, 1.0f};
+    double times[2] = {0.0, 1.0};
+    evr_scene s;
+    evr_node node;
+    evr_mesh mesh;
+    evr_morph morph;
+    evr_instance inst = {0, 0};
+    int dinst[1];
+    evr_render_host h;
+    evr_deform_tracker t;
+    evr_deform_keys k;
+    CHECK(pos && nrm && dpos && truth);
+    if (!pos || !nrm || !dpos || !truth) return;
+    for (int v = 0; v < NV; v++) {
+        const float x = (float)(v % SIDE) / SIDE, y = (float)(v / SIDE) / SIDE;
+        pos[3 * v] = x, pos[3 * v + 1] = y, pos[3 * v + 2] = -1.0f;
+        nrm[3 * v] = 0.0f, nrm[3 * v + 1] = 0.0f, nrm[3 * v + 2] = 1.0f;
+        dpos[3 * v] = x * x, dpos[3 * v + 1] = 0.5f * y, dpos[3 * v + 2] = 0.0f;
+    }
+    memset(&s, 0, sizeof s);
+    rest_node(&node, "sheet", -1);
+    node.num_weights = 1;
+    node.weights = restw;
+    node.w_curve.num_keys = 2;
+    node.w_curve.times = times;
+    node.w_curve.values = values;
+    set_mesh(&mesh, pos, nrm, NV, idx, 2);
+    morph.num_targets = 1;
+    morph.d_positions = dpos;
+    morph.d_normals = NULL;
+    morph.default_weights = defw;
+    mesh.morph = &morph;
+    s.nodes = &node;
+    s.num_nodes = 1;
+    s.meshes = &mesh;
+    s.num_meshes = 1;
+    s.instances = &inst;
+    s.num_instances = 1;
+    host_of(&s, &h, dinst);
+    memset(&k, 0, sizeof k);
+    CHECK(evr_deform_tracker_init(&t, &s, &h));
+    CHECK(evr_deform_keys_make(&t, &s, &h, 0.25, 0.5, TOL, EVR_MAX_KEYS, &k));
+    const evr_deform_view *v = &k.views[0];
+    for (int key = 0; key < v->num_keys; key++) {
+        const double at = 0.25 + 0.25 * key / (v->num_keys > 1 ? v->num_keys - 1 : 1);
+        CHECK(evr_instance_deformed_at(&s, 0, at, truth, truth + 3 * NV));
+        CHECK(!memcmp(v->positions + (size_t)key * 3 * NV, truth, sizeof(float) * 3 * NV));
+        CHECK(!memcmp(v->normals + (size_t)key * 3 * NV, truth + 3 * NV, sizeof(float) * 3 * NV));
+    }
+    evr_deform_keys_free(&k);
+    evr_deform_tracker_free(&t);
+    free(pos);
+    free(nrm);
+    free(dpos);
+    free(truth);
+}
+
 int main(void)
 {
     test_morph_slide();
     test_skin_bend();
+    test_large_threaded();
     return check_report("test_deform_keys");
 }
