@@ -25,6 +25,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->meshes[i].positions = m->positions;
         h->meshes[i].normals = m->normals;
         h->meshes[i].uvs = m->uvs;
+        h->meshes[i].tangents = m->tangents;
         h->meshes[i].indices = m->indices;
         h->meshes[i].num_triangles = m->num_triangles;
         h->meshes[i].material = m->material;
@@ -33,6 +34,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
     for (i = 0; i < s->num_textures; i++) {
         h->textures[i].width = s->textures[i].width;
         h->textures[i].height = s->textures[i].height;
+        h->textures[i].levels = s->textures[i].levels > 0 ? s->textures[i].levels : 1;
         h->textures[i].rgba = s->textures[i].rgba;
     }
     h->deform_instance = calloc((size_t)s->num_instances + 1, sizeof *h->deform_instance);
@@ -62,6 +64,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->lights[i].dir = evr_v3_norm(l->direction);
         h->lights[i].cos_inner = cosf(l->inner_cone);
         h->lights[i].cos_outer = cosf(l->outer_cone);
+        h->lights[i].radius = l->type == EVR_LIGHT_DIRECTIONAL ? 0.0f : l->radius;
     }
     evr_v3 ext = evr_v3_sub(s->bounds_max, s->bounds_min);
     h->scene_size = evr_v3_len(ext);

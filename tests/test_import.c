@@ -269,14 +269,14 @@ static void test_lights_materials(const char *path, int glb)
         CHECK_NEAR(e2->p.metallic, 0.0, 1e-6);
         /* two textures: the embedded image, and the external file shared by two materials */
         CHECK(s->num_textures == 2);
-        CHECK(m->p.base_texture >= 0 && e1->p.base_texture >= 0);
-        CHECK(e1->p.base_texture == e2->p.base_texture);
-        CHECK(m->p.base_texture != e1->p.base_texture);
-        if (s->num_textures == 2 && m->p.base_texture >= 0 && e1->p.base_texture >= 0) {
+        CHECK(m->p.tex[EVR_TEX_BASE].index >= 0 && e1->p.tex[EVR_TEX_BASE].index >= 0);
+        CHECK(e1->p.tex[EVR_TEX_BASE].index == e2->p.tex[EVR_TEX_BASE].index);
+        CHECK(m->p.tex[EVR_TEX_BASE].index != e1->p.tex[EVR_TEX_BASE].index);
+        if (s->num_textures == 2 && m->p.tex[EVR_TEX_BASE].index >= 0 && e1->p.tex[EVR_TEX_BASE].index >= 0) {
             int k;
             for (k = 0; k < 2; k++) {
                 const evr_texture *t =
-                    &s->textures[k == 0 ? m->p.base_texture : e1->p.base_texture];
+                    &s->textures[k == 0 ? m->p.tex[EVR_TEX_BASE].index : e1->p.tex[EVR_TEX_BASE].index];
                 CHECK(t->width == 2 && t->height == 2);
                 if (t->width != 2 || t->height != 2) continue;
                 /* row 0 is the image's first (top) row: red, then (0, 128, 255) */
@@ -502,8 +502,8 @@ static int load_external_texture(const char *dir, const char *image, float rgba[
         evr_scene_load(gltf, &s, &err) == EVR_OK) {
         for (int i = 0; i < s->num_materials; i++) {
             const evr_material *e = &s->materials[i];
-            if (!strcmp(e->name, "external") && e->p.base_texture >= 0) {
-                const evr_texture *t = &s->textures[e->p.base_texture];
+            if (!strcmp(e->name, "external") && e->p.tex[EVR_TEX_BASE].index >= 0) {
+                const evr_texture *t = &s->textures[e->p.tex[EVR_TEX_BASE].index];
                 ok = t->width == 2 && t->height == 2;
                 if (ok) memcpy(rgba, t->rgba, 16 * sizeof(float));
             }

@@ -491,10 +491,8 @@ static void test_pass(void)
     mesh.normals = box_nrm;
     mesh.indices = box_idx;
     mesh.num_triangles = 12;
-    memset(&mat, 0, sizeof mat);
+    evr_material_defaults(&mat);
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = rho;
-    mat.base_color[3] = 1.0f;
-    mat.base_texture = -1;
     {
         float c3[3] = {rho, rho, rho};
         evr_photon_material_map(c3, 0.0f, 1.0f, &mat.t_diffuse, &mat.t_specular);

@@ -21,18 +21,52 @@
 
 #define EVR_PI 3.14159265358979f
 
+/* A texture as a material uses it: which texture, the KHR_texture_transform of its uv (identity
+ * when absent), and the slot's scale (normalTexture.scale, occlusionTexture.strength, else 1). */
+typedef struct {
+    int index;   /* into the textures, -1: none */
+    float xf[6]; /* uv' = (xf[0] u + xf[1] v + xf[2], xf[3] u + xf[4] v + xf[5]) */
+    float scale;
+} evr_texture_ref;
+
+/* The textures a glTF material may give. Base colour and emissive are sRGB-encoded in their
+ * files and held linear; the others hold data and are never linearized (import_texture.c). */
+enum {
+    EVR_TEX_BASE = 0,           /* base colour (rgb) and alpha (a) */
+    EVR_TEX_METALLIC_ROUGHNESS, /* roughness in g, metallic in b */
+    EVR_TEX_NORMAL,             /* tangent-space normal, rgb in [0,1] -> [-1,1] */
+    EVR_TEX_OCCLUSION,          /* ambient occlusion in r */
+    EVR_TEX_EMISSIVE,           /* emissive colour (rgb) */
+    EVR_TEX_TRANSMISSION,       /* KHR_materials_transmission: r */
+    EVR_TEX_COUNT
+};
+
+enum { EVR_ALPHA_OPAQUE = 0, EVR_ALPHA_MASK = 1, EVR_ALPHA_BLEND = 2 };
+
 /* What a material is: the scene holds one per material (scene/scene.h), the backends read them
- * (evr_render_scene.materials). A new model adds its parameters here, its defaults to
- * evr_material_defaults and its reading to the import (scene/import_mesh.c). */
+ * (evr_render_scene.materials): glTF 2.0 metallic-roughness with the KHR_materials extensions
+ * evray renders. A new parameter goes here, its default in evr_material_defaults below and its
+ * reading in scene/import_mesh.c. */
 struct evr_material_params {
     float base_color[4]; /* linear RGBA factor */
-    int base_texture;    /* index into the textures (sRGB-encoded source), -1: none */
-    float emissive[3];   /* linear RGB, radiance units */
+    float emissive[3];   /* linear RGB, radiance units: emissiveFactor times emissive_strength */
     /* the photon pass's thresholds, 0 <= t_diffuse <= t_specular <= 1: from the material's
-     * extras "t_diffuse" and "t_specular" when the glTF gives them, else from base colour,
-     * metallic and roughness (evr_photon_material_map) */
+     * extras "t_diffuse" and "t_specular" when the glTF gives them, else from the BSDF
+     * (evr_photon_material_map) */
     float t_diffuse, t_specular;
-    float metallic, roughness;
+    float metallic, roughness; /* factors (perceptual roughness; GGX alpha = roughness^2) */
+    int alpha_mode;            /* EVR_ALPHA_* */
+    float alpha_cutoff;        /* MASK: alpha below it is a hole */
+    int double_sided;          /* 0: back faces are culled for camera and secondary rays */
+    int unlit;                 /* KHR_materials_unlit: radiance = base colour */
+    float transmission;        /* KHR_materials_transmission factor */
+    float ior;                 /* KHR_materials_ior (1.5) */
+    float specular;            /* KHR_materials_specular factor (1) */
+    float specular_color[3];   /* KHR_materials_specular colour factor (1, 1, 1) */
+    float thickness;           /* KHR_materials_volume: 0 thin-walled */
+    float attenuation_distance; /* KHR_materials_volume: INFINITY none */
+    float attenuation_color[3];
+    evr_texture_ref tex[EVR_TEX_COUNT];
 };
 
 /* A surface point as shading sees it: its shading frame (position, normal) and the hit's
@@ -74,11 +108,11 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
     s->albedo[0] = mat->base_color[0];
     s->albedo[1] = mat->base_color[1];
     s->albedo[2] = mat->base_color[2];
-    if (mat->base_texture >= 0 && m->uvs) {
+    if (mat->tex[EVR_TEX_BASE].index >= 0 && m->uvs) {
         float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
         float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
         float tex[4];
-        evr_texture_bilinear(&rs->textures[mat->base_texture], tu, tv, tex);
+        evr_texture_bilinear(&rs->textures[mat->tex[EVR_TEX_BASE].index], tu, tv, tex);
         s->albedo[0] *= tex[0];
         s->albedo[1] *= tex[1];
         s->albedo[2] *= tex[2];
@@ -140,14 +174,36 @@ EVR_HD static inline void evr_photon_material_map(const float base_color[3], flo
     *t_specular = *t_diffuse + r * (1.0f - m);
 }
 
-/* A material before the file says anything of it: white, untextured, rough dielectric. */
+/* A texture slot with nothing in it. */
+static inline void evr_texture_ref_none(evr_texture_ref *t)
+{
+    t->index = -1;
+    t->xf[0] = 1.0f, t->xf[1] = 0.0f, t->xf[2] = 0.0f;
+    t->xf[3] = 0.0f, t->xf[4] = 1.0f, t->xf[5] = 0.0f;
+    t->scale = 1.0f;
+}
+
+/* A material before the file says anything of it: the glTF defaults (white, untextured,
+ * metallic 1 and roughness 1 in the spec; evray keeps metallic 0 for a material that gives no
+ * pbrMetallicRoughness, as Assimp reports it), opaque, single-sided, IOR 1.5. */
 static inline void evr_material_defaults(evr_material_params *m)
 {
     m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
-    m->base_texture = -1;
     m->emissive[0] = m->emissive[1] = m->emissive[2] = 0.0f;
     m->metallic = 0.0f;
     m->roughness = 1.0f;
+    m->alpha_mode = EVR_ALPHA_OPAQUE;
+    m->alpha_cutoff = 0.5f;
+    m->double_sided = 0;
+    m->unlit = 0;
+    m->transmission = 0.0f;
+    m->ior = 1.5f;
+    m->specular = 1.0f;
+    m->specular_color[0] = m->specular_color[1] = m->specular_color[2] = 1.0f;
+    m->thickness = 0.0f;
+    m->attenuation_distance = INFINITY;
+    m->attenuation_color[0] = m->attenuation_color[1] = m->attenuation_color[2] = 1.0f;
+    for (int i = 0; i < EVR_TEX_COUNT; i++) evr_texture_ref_none(&m->tex[i]);
     evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse,
                             &m->t_specular);
 }

@@ -9,6 +9,7 @@
 
 typedef struct {
     const float *positions, *normals, *uvs; /* uvs may be NULL */
+    const float *tangents; /* 4 per vertex (xyz unit, w the bitangent's sign), or NULL */
     const uint32_t *indices;
     uint32_t num_triangles;
     int material;
@@ -17,9 +18,11 @@ typedef struct {
 /* A material's parameters, defined with the model that reads them in core/material.h. */
 typedef struct evr_material_params evr_material_params;
 
+/* A texture and its mip levels: level 0 is width x height texels, level k+1 halves level k
+ * (rounded down, at least 1) and follows it in rgba; 4 floats per texel, rows from v = 0. */
 typedef struct {
-    int width, height;
-    const float *rgba; /* linear, 4 floats per texel */
+    int width, height, levels; /* levels >= 1 */
+    const float *rgba;
 } evr_texture_view;
 
 typedef struct {
@@ -28,6 +31,7 @@ typedef struct {
     float color[3];
     evr_v3 pos, dir; /* in the track's space */
     float cos_inner, cos_outer;
+    float radius; /* point and spot: the emitting sphere's radius (0: a point) */
 } evr_light_view;
 
 typedef struct {

@@ -562,6 +562,7 @@ void evr_scene_free_contents(evr_scene *s)
         free(s->meshes[i].positions);
         free(s->meshes[i].normals);
         free(s->meshes[i].uvs);
+        free(s->meshes[i].tangents);
         free(s->meshes[i].indices);
         if (s->meshes[i].skin) {
             free(s->meshes[i].skin->joint_nodes);

@@ -133,7 +133,7 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
     char key[1100], what[1200];
     int emb = -1, i;
     evr_status st;
-    evr_texture t;
+    evr_texture t = {0};
 
     memset(&t, 0, sizeof t);
     *out = -1;

@@ -37,6 +37,7 @@ typedef struct {
     float *positions;  /* 3 per vertex, object space */
     float *normals;    /* 3 per vertex, unit; never NULL (generated from faces when missing) */
     float *uvs;        /* 2 per vertex, or NULL */
+    float *tangents;   /* 4 per vertex (xyz unit, w = +-1 the bitangent's sign), or NULL */
     uint32_t *indices; /* 3 per triangle */
     int material;      /* index into scene materials */
     evr_v3 bounds_min, bounds_max; /* object-space bounds of the positions */
@@ -51,7 +52,8 @@ typedef struct {
 
 typedef struct {
     int width, height;
-    float *rgba; /* linear (sRGB decoded), 4 floats per texel, row 0 at v = 0 */
+    float *rgba; /* 4 floats per texel, row 0 at v = 0: linear (colour slots sRGB-decoded) */
+    int levels;  /* mip levels in rgba after level 0 (evr_texture_view's layout); 1: level 0 */
 } evr_texture;
 
 typedef enum { EVR_INTERP_LINEAR = 0, EVR_INTERP_STEP = 1 } evr_interp;
@@ -95,6 +97,7 @@ typedef struct {
     evr_v3 position;  /* in node space */
     evr_v3 direction; /* in node space, the way light travels (spot, directional) */
     float inner_cone, outer_cone; /* spot: half angles in radians */
+    float radius; /* point and spot: radius of the emitting sphere (extras "radius"), 0: a point */
 } evr_light;
 
 typedef struct {
