@@ -99,6 +99,14 @@ EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float 
             (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
 }
 
+/* The uv a texture slot samples at mesh uv (u, v): its KHR_texture_transform applied. */
+EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, float v, float *tu,
+                                         float *tv)
+{
+    *tu = t->xf[0] * u + t->xf[1] * v + t->xf[2];
+    *tv = t->xf[3] * u + t->xf[4] * v + t->xf[5];
+}
+
 /* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m. */
 EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m,
                                           uint32_t i0, uint32_t i1, uint32_t i2, float w, float u,
