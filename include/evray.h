@@ -182,6 +182,8 @@ typedef struct {
     int gather_window;   /* the gather window's half size at most, pixels */
     int photon_layers;   /* photons each pixel of the buffer holds */
     int gi_bounces;      /* indirect bounces of a photon */
+    /* shading: reflections and refractions a camera ray may take (core/path.h) */
+    int max_bounces;
 } evr_config;
 
 /* Fills c with the defaults (the ideal sensor at 346x260, docs/sensors.md) and sets c->size.

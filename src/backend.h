@@ -103,6 +103,7 @@ typedef struct {
     int num_deforms;      /* instances that deform (evr_instance_view.deform) */
     int *deform_instance; /* per deform: its scene instance */
     float scene_size;     /* diagonal of the rest-pose bounds */
+    float *bsdf_table;    /* core/bsdf.h's albedo table */
 } evr_render_host;
 
 evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,

@@ -15,7 +15,9 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
     h->textures = calloc((size_t)s->num_textures + 1, sizeof *h->textures);
     h->instances = calloc((size_t)s->num_instances + 1, sizeof *h->instances);
     h->lights = calloc((size_t)s->num_lights + 1, sizeof *h->lights);
-    if (!h->meshes || !h->materials || !h->textures || !h->instances || !h->lights) {
+    h->bsdf_table = malloc(2 * EVR_BSDF_MU * EVR_BSDF_ROUGH * sizeof *h->bsdf_table);
+    if (!h->meshes || !h->materials || !h->textures || !h->instances || !h->lights ||
+        !h->bsdf_table) {
         evr_render_host_free(h);
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;
@@ -30,7 +32,12 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->meshes[i].num_triangles = m->num_triangles;
         h->meshes[i].material = m->material;
     }
-    for (i = 0; i < s->num_materials; i++) h->materials[i] = s->materials[i].p;
+    for (i = 0; i < s->num_materials; i++) {
+        const evr_material_params *p = &s->materials[i].p;
+        h->materials[i] = *p;
+        if (p->transmission > 0.0f || p->alpha_mode == EVR_ALPHA_BLEND) h->rs.translucent = 1;
+    }
+    evr_bsdf_table_fill(h->bsdf_table, 1024);
     for (i = 0; i < s->num_textures; i++) {
         h->textures[i].width = s->textures[i].width;
         h->textures[i].height = s->textures[i].height;
@@ -85,6 +92,8 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
     rs->camera = evr_camera_intr_make(width, height, cam->yfov);
     rs->ambient = ambient;
     rs->ray_eps = 1e-5f * h->scene_size;
+    rs->bsdf_table = h->bsdf_table;
+    rs->max_bounces = 4;
     return EVR_OK;
 }
 
@@ -96,5 +105,6 @@ void evr_render_host_free(evr_render_host *h)
     free(h->instances);
     free(h->lights);
     free(h->deform_instance);
+    free(h->bsdf_table);
     memset(h, 0, sizeof *h);
 }

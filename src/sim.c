@@ -129,6 +129,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         free(sim);
         return st;
     }
+    sim->host.rs.max_bounces = c->max_bounces;
     sim->setup.width = c->width;
     sim->setup.height = c->height;
     sim->setup.samples_per_frame = c->samples_per_frame;

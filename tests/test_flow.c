@@ -51,6 +51,14 @@ static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, 
     return o->blocked;
 }
 
+/* Not called: the scenes here hold nothing translucent (shadow rays use evr_occluded). */
+static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f,
+                              evr_hit *h)
+{
+    (void)o, (void)r, (void)tnear, (void)tfar, (void)f, (void)h;
+    return 0;
+}
+
 /* The loop as the backends wrote it before it moved to core: begin, next until none, end. */
 static int reference_events(evr_pixel_state *st, const evr_pixel_params *p, int sensor, float t,
                             float in, double t0, int x, int y, ev_t *out)
@@ -167,16 +175,39 @@ static void test_adapt_machine(void)
     }
 }
 
-/* One point light straight above a white patch: E = I / d^2 at normal incidence. */
+/* A surface of material mat at the origin, normal n, seen along wo: its record as
+ * evr_material_at leaves it. */
+static void flow_surface(const evr_render_scene *rs, const evr_material_params *mat, evr_v3 n,
+                         evr_v3 wo, evr_surface *s)
+{
+    memset(s, 0, sizeof *s);
+    s->p = evr_v3_make(0, 0, 0);
+    s->n = s->nv = n;
+    s->front = 1;
+    for (int c = 0; c < 3; c++) s->albedo[c] = mat->base_color[c];
+    s->rough = mat->roughness;
+    s->alpha = mat->roughness * mat->roughness;
+    s->opacity = s->occlusion = 1.0f;
+    s->eta = 1.0f / mat->ior;
+    evr_material_view(rs, mat, wo, s);
+}
+
+/* One point light straight above a grey patch with no specular layer (KHR_materials_specular
+ * factor 0: Lambert): E = I / d^2 at normal incidence. */
 static void test_shade_hit(void)
 {
     evr_render_scene rs;
     evr_light_view light;
+    evr_material_params mat;
     evr_surface s;
     struct evr_occlusion o;
     const evr_v3 wo = evr_v3_make(0, 0, 1);
     unsigned rays = 0;
+    evr_material_defaults(&mat);
+    mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = 0.5f;
+    mat.specular = 0.0f;
     memset(&rs, 0, sizeof rs);
+    rs.materials = &mat;
     memset(&light, 0, sizeof light);
     memset(&o, 0, sizeof o);
     light.type = 0;
@@ -187,10 +218,7 @@ static void test_shade_hit(void)
     rs.num_lights = 1;
     rs.ambient = 0.1f;
     rs.ray_eps = 1e-3f;
-    s.p = evr_v3_make(0, 0, 0);
-    s.n = evr_v3_make(0, 0, 1);
-    s.albedo[0] = s.albedo[1] = s.albedo[2] = 0.5f;
-    s.emissive[0] = s.emissive[1] = s.emissive[2] = 0.0f;
+    flow_surface(&rs, &mat, evr_v3_make(0, 0, 1), wo, &s);
     const float lit = evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays);
     CHECK_NEAR(lit, 0.5 * (0.1 + 2.0 / EVR_PI), 1e-5);
     CHECK(rays == 1 && o.calls == 1);
@@ -200,7 +228,7 @@ static void test_shade_hit(void)
     o.blocked = 1;
     CHECK_NEAR(evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays), 0.5 * 0.1, 1e-6);
     /* the light behind the surface: no shadow ray */
-    s.n = evr_v3_make(0, 0, -1);
+    flow_surface(&rs, &mat, evr_v3_make(0, 0, -1), wo, &s);
     o.calls = 0;
     CHECK_NEAR(evr_shade_hit(&rs, &s, wo, 0.0f, &o, &rays), 0.5 * 0.1, 1e-6);
     CHECK(o.calls == 0);
@@ -208,7 +236,7 @@ static void test_shade_hit(void)
     {
         evr_light_ray lr;
         float acc[3] = {0.0f, 0.0f, 0.0f};
-        s.n = evr_v3_make(0, 0.6f, 0.8f);
+        flow_surface(&rs, &mat, evr_v3_make(0, 0.6f, 0.8f), wo, &s);
         o.blocked = 0;
         CHECK(evr_shade_light_ray(&rs, 0, 0.0f, &s, &lr));
         evr_shade_add_light(&s, wo, &lr, acc);

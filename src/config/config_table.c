@@ -855,6 +855,19 @@ static const evr_config_option table[] = {
      .help = "ambient light as a fraction of the base colour (default 0.02)",
      .json = "ambient",
      .json_rank = 28},
+    {.name = "max_bounces",
+     .type = EVR_OPT_INT,
+     .offset = F(max_bounces),
+     .def = 4,
+     .lo = 0,
+     .hi = 16,
+     .what = "--max-bounces must be between 0 and 16",
+     .flag = "--max-bounces",
+     .section = "shading",
+     .label = "--max-bounces N",
+     .help = "reflections and refractions a camera ray may take (default 4)",
+     .json = "max_bounces",
+     .json_rank = 47},
 };
 
 const evr_config_option *evr_config_table(int *count)

@@ -18,6 +18,7 @@
 #define EVR_CORE_MATERIAL_H
 
 #include "core/render_scene.h"
+#include "core/bsdf.h"
 
 #define EVR_PI 3.14159265358979f
 
@@ -54,28 +55,44 @@ struct evr_material_params {
      * extras "t_diffuse" and "t_specular" when the glTF gives them, else from the BSDF
      * (evr_photon_material_map) */
     float t_diffuse, t_specular;
-    float metallic, roughness; /* factors (perceptual roughness; GGX alpha = roughness^2) */
-    int alpha_mode;            /* EVR_ALPHA_* */
-    float alpha_cutoff;        /* MASK: alpha below it is a hole */
-    int double_sided;          /* 0: back faces are culled for camera and secondary rays */
-    int unlit;                 /* KHR_materials_unlit: radiance = base colour */
-    float transmission;        /* KHR_materials_transmission factor */
-    float ior;                 /* KHR_materials_ior (1.5) */
-    float specular;            /* KHR_materials_specular factor (1) */
-    float specular_color[3];   /* KHR_materials_specular colour factor (1, 1, 1) */
-    float thickness;           /* KHR_materials_volume: 0 thin-walled */
+    float metallic, roughness;  /* factors (perceptual roughness; GGX alpha = roughness^2) */
+    int alpha_mode;             /* EVR_ALPHA_* */
+    float alpha_cutoff;         /* MASK: alpha below it is a hole */
+    int double_sided;           /* 0: back faces are culled for camera and secondary rays */
+    int unlit;                  /* KHR_materials_unlit: radiance = base colour */
+    float transmission;         /* KHR_materials_transmission factor */
+    float ior;                  /* KHR_materials_ior (1.5) */
+    float specular;             /* KHR_materials_specular factor (1) */
+    float specular_color[3];    /* KHR_materials_specular colour factor (1, 1, 1) */
+    float thickness;            /* KHR_materials_volume: 0 thin-walled */
     float attenuation_distance; /* KHR_materials_volume: INFINITY none */
     float attenuation_color[3];
     evr_texture_ref tex[EVR_TEX_COUNT];
 };
 
-/* A surface point as shading sees it: its shading frame (position, normal) and the hit's
- * material record (the material evaluated there, textures applied). */
+/* A surface point as shading sees it: its shading frame and the hit's material record (the
+ * material evaluated there, textures applied, the BSDF's view-dependent weights for the
+ * direction it is seen from). */
 typedef struct {
-    evr_v3 p; /* world position */
-    evr_v3 n; /* world shading normal, facing the incoming ray */
-    float albedo[3];
-    float emissive[3];
+    evr_v3 p;             /* world position */
+    evr_v3 n;             /* world shading normal (normal map applied), facing the incoming ray */
+    evr_v3 nv;            /* the interpolated vertex normal, facing the incoming ray */
+    float albedo[3];      /* base colour: factor times texture */
+    float emissive[3];    /* emitted radiance */
+    float diffuse[3];     /* the diffuse base's reflectance: what the specular layer leaves */
+    float f0[3], f90;     /* the specular lobe's Fresnel at normal and grazing incidence */
+    float comp[3];        /* the lobe's multiple-scattering compensation (1: none) */
+    float spec_albedo[3]; /* the specular lobe's directional albedo seen from the viewer */
+    float transmit[3];    /* the share transmitted through the surface (transmission) */
+    float metallic;
+    float rough, alpha;      /* perceptual roughness and GGX alpha */
+    float opacity;           /* BLEND: coverage (base alpha); 1 otherwise */
+    float occlusion;         /* ambient occlusion (1: none) */
+    float eta;               /* ratio of IORs outside / inside for a ray entering (1 / ior) */
+    const float *bsdf_table; /* core/bsdf.h's table (NULL: single scattering only) */
+    int material;
+    int unlit;
+    int front; /* the ray met the face the vertex normals point out of */
 } evr_surface;
 
 /* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
@@ -107,27 +124,140 @@ EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, floa
     *tv = t->xf[3] * u + t->xf[4] * v + t->xf[5];
 }
 
-/* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m. */
+/* Texture slot t at mesh uv (u, v); 0 when the slot is empty (out untouched). */
+EVR_HD static inline int evr_material_texture(const evr_render_scene *rs, const evr_texture_ref *t,
+                                              float u, float v, float out[4])
+{
+    if (t->index < 0) return 0;
+    float tu, tv;
+    evr_texture_uv(t, u, v, &tu, &tv);
+    evr_texture_bilinear(&rs->textures[t->index], tu, tv, out);
+    return 1;
+}
+
+/* Opacity of material mat at mesh uv (u, v) (uv_ok 0: the mesh has none): base alpha. */
+EVR_HD static inline float evr_material_alpha(const evr_render_scene *rs,
+                                              const evr_material_params *mat, int uv_ok, float u,
+                                              float v)
+{
+    float a = mat->base_color[3], tex[4];
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], u, v, tex)) a *= tex[3];
+    return a;
+}
+
+/* The view-dependent weights of s seen along wo (unit, on the side of s->n): the specular
+ * lobe's albedo from the table (core/bsdf.h), the diffuse base scaled by what the dielectric
+ * layer leaves, the transmitted share. Called once the frame and the parameters are set. */
+EVR_HD static inline void evr_material_view(const evr_render_scene *rs,
+                                            const evr_material_params *mat, evr_v3 wo,
+                                            evr_surface *s)
+{
+    const float mu = fmaxf(evr_v3_dot(s->n, wo), 1e-4f);
+    float ta = 1.0f, tb = 0.0f;
+    s->bsdf_table = rs->bsdf_table;
+    if (rs->bsdf_table) evr_bsdf_table_ab(rs->bsdf_table, mu, s->rough, &ta, &tb);
+    const float e1 = fmaxf(ta + tb, 1e-3f);
+    /* the dielectric layer: f0 from the IOR and KHR_materials_specular, f90 its factor */
+    const float r = (mat->ior - 1.0f) / (mat->ior + 1.0f);
+    const float m = s->metallic;
+    const float tr = mat->transmission;
+    for (int c = 0; c < 3; c++) {
+        const float f0d = fminf(r * r * mat->specular_color[c], 1.0f) * mat->specular;
+        const float f90d = mat->specular;
+        const float compd = 1.0f + f0d * (1.0f / e1 - 1.0f);
+        const float ed = fminf((f0d * ta + f90d * tb) * compd, 1.0f);
+        s->f0[c] = f0d + (s->albedo[c] - f0d) * m;
+        s->comp[c] = 1.0f + s->f0[c] * (1.0f / e1 - 1.0f);
+        s->diffuse[c] = (1.0f - m) * (1.0f - tr) * s->albedo[c] * (1.0f - ed);
+        s->transmit[c] = (1.0f - m) * tr * s->albedo[c] * (1.0f - ed);
+    }
+    s->f90 = mat->specular + (1.0f - mat->specular) * m;
+    for (int c = 0; c < 3; c++)
+        s->spec_albedo[c] = fminf((s->f0[c] * ta + s->f90 * tb) * s->comp[c], 1.0f);
+}
+
+/* Perceptual roughness below which a surface reflects (and refracts) along one ray: a mirror
+ * or near-mirror, whose reflected scene the ambient term cannot stand for. */
+#define EVR_MIRROR_ROUGHNESS 0.2f
+
+/* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m,
+ * seen along wo. The caller has set s->p, s->nv (the vertex normal facing the ray, unit) and
+ * s->front; tw is the interpolated tangent in world space (xyz, not unit) and tsign its
+ * bitangent sign, used when the material has a normal texture and the mesh tangents. */
 EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m,
                                           uint32_t i0, uint32_t i1, uint32_t i2, float w, float u,
-                                          float v, evr_surface *s)
+                                          float v, evr_v3 tw, float tsign, evr_v3 wo,
+                                          evr_surface *s)
 {
     const evr_material_params *mat = &rs->materials[m->material];
+    const int uv_ok = m->uvs != 0;
+    float tu = 0.0f, tv = 0.0f, tex[4];
+    if (uv_ok) {
+        tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
+        tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
+    }
+    s->material = m->material;
+    s->unlit = mat->unlit;
     s->albedo[0] = mat->base_color[0];
     s->albedo[1] = mat->base_color[1];
     s->albedo[2] = mat->base_color[2];
-    if (mat->tex[EVR_TEX_BASE].index >= 0 && m->uvs) {
-        float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
-        float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
-        float tex[4];
-        evr_texture_bilinear(&rs->textures[mat->tex[EVR_TEX_BASE].index], tu, tv, tex);
+    s->opacity = mat->alpha_mode == EVR_ALPHA_BLEND ? mat->base_color[3] : 1.0f;
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], tu, tv, tex)) {
         s->albedo[0] *= tex[0];
         s->albedo[1] *= tex[1];
         s->albedo[2] *= tex[2];
+        if (mat->alpha_mode == EVR_ALPHA_BLEND) s->opacity *= tex[3];
     }
     s->emissive[0] = mat->emissive[0];
     s->emissive[1] = mat->emissive[1];
     s->emissive[2] = mat->emissive[2];
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_EMISSIVE], tu, tv, tex)) {
+        s->emissive[0] *= tex[0];
+        s->emissive[1] *= tex[1];
+        s->emissive[2] *= tex[2];
+    }
+    s->metallic = fminf(fmaxf(mat->metallic, 0.0f), 1.0f);
+    s->rough = fminf(fmaxf(mat->roughness, 0.0f), 1.0f);
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_METALLIC_ROUGHNESS], tu, tv, tex)) {
+        s->rough *= tex[1];
+        s->metallic *= tex[2];
+    }
+    s->alpha = fmaxf(s->rough * s->rough, EVR_GGX_ALPHA_MIN);
+    s->occlusion = 1.0f;
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_OCCLUSION], tu, tv, tex))
+        s->occlusion = 1.0f + mat->tex[EVR_TEX_OCCLUSION].scale * (tex[0] - 1.0f);
+    s->eta = 1.0f / fmaxf(mat->ior, 1.0f);
+    s->n = s->nv;
+    /* normal map: the tangent frame Gram-Schmidt orthogonalized against the vertex normal as the
+     * ray sees it (a back face's normal is flipped, its bitangent with it) */
+    if (uv_ok && m->tangents && evr_material_texture(rs, &mat->tex[EVR_TEX_NORMAL], tu, tv, tex)) {
+        const float ns = mat->tex[EVR_TEX_NORMAL].scale;
+        evr_v3 t = evr_v3_sub(tw, evr_v3_scale(s->nv, evr_v3_dot(tw, s->nv)));
+        const float tl = evr_v3_len(t);
+        if (tl > 1e-12f) {
+            t = evr_v3_scale(t, 1.0f / tl);
+            const float side = s->front ? 1.0f : -1.0f;
+            const evr_v3 b = evr_v3_scale(evr_v3_cross(s->nv, t), tsign * side);
+            const float x = (2.0f * tex[0] - 1.0f) * ns, y = (2.0f * tex[1] - 1.0f) * ns,
+                        z = 2.0f * tex[2] - 1.0f;
+            evr_v3 n = evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)),
+                                  evr_v3_scale(s->nv, z));
+            const float nl = evr_v3_len(n);
+            if (nl > 1e-12f) {
+                n = evr_v3_scale(n, 1.0f / nl);
+                /* a mapped normal facing away from the viewer is bent back to the horizon */
+                const float c = evr_v3_dot(n, wo);
+                if (c < 1e-3f) n = evr_v3_norm(evr_v3_add(n, evr_v3_scale(wo, 1e-3f - c)));
+                s->n = n;
+            }
+        }
+    }
+    float tr = mat->transmission;
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_TRANSMISSION], tu, tv, tex))
+        tr *= tex[0];
+    evr_material_params eff = *mat;
+    eff.transmission = tr;
+    evr_material_view(rs, &eff, wo, s);
 }
 
 /* Radiance s emits towards wo (both sides emit). */
@@ -141,29 +271,75 @@ EVR_HD static inline void evr_material_emission(const evr_surface *s, evr_v3 wo,
 
 /* ---- direct light: the BSDF for a light direction ---- */
 
-/* Adds one unshadowed light's contribution at s, seen along wo, arriving along wi with
- * irradiance e_rgb (on a surface facing it), to acc. Lambert: acc sums irradiance times cosine;
- * the BSDF's albedo / pi is applied once, in evr_material_radiance. */
-EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo, evr_v3 wi,
-                                                 const float e_rgb[3], float acc[3])
+/* The GGX alpha with which s reflects a light whose sphere subtends the half-angle `spread`
+ * (radius over distance): a mirror's reflection of the sphere spans that angle, its half
+ * vectors half of it, so the lobe widens by spread / 2. */
+EVR_HD static inline float evr_material_light_alpha(const evr_surface *s, float spread)
 {
-    (void)wo;
-    float c = evr_v3_dot(s->n, wi);
-    if (c <= 0.0f) return;
-    acc[0] += e_rgb[0] * c;
-    acc[1] += e_rgb[1] * c;
-    acc[2] += e_rgb[2] * c;
+    return fminf(s->alpha + 0.5f * spread, 1.0f);
+}
+
+/* Adds one unshadowed light's contribution at s, seen along wo, arriving along wi with
+ * irradiance e_rgb (on a surface facing it) from a sphere of angular radius spread, to acc:
+ * the BSDF times the cosine times the irradiance (radiance, RGB). */
+EVR_HD static inline void evr_material_add_light(const evr_surface *s, evr_v3 wo, evr_v3 wi,
+                                                 const float e_rgb[3], float spread, float acc[3])
+{
+    if (s->unlit) return;
+    const float nl = evr_v3_dot(s->n, wi);
+    if (nl <= 0.0f) return;
+    const float nv = fmaxf(evr_v3_dot(s->n, wo), 1e-4f);
+    const evr_v3 h = evr_v3_norm(evr_v3_add(wi, wo));
+    const float nh = fmaxf(evr_v3_dot(s->n, h), 0.0f), vh = fmaxf(evr_v3_dot(wo, h), 0.0f);
+    const float a = evr_material_light_alpha(s, spread);
+    const float dv = evr_ggx_d(a, nh) * evr_smith_v(a, nl, nv), fw = evr_schlick_w(vh);
+    float e1w = 0.0f; /* the widened lobe's own compensation keeps its energy */
+    if (a > s->alpha && s->bsdf_table) {
+        float ta, tb;
+        evr_bsdf_table_ab(s->bsdf_table, nv, sqrtf(a), &ta, &tb);
+        e1w = fmaxf(ta + tb, 1e-3f);
+    }
+    for (int c = 0; c < 3; c++) {
+        const float f = s->f0[c] + (s->f90 - s->f0[c]) * fw;
+        const float comp = e1w > 0.0f ? 1.0f + s->f0[c] * (1.0f / e1w - 1.0f) : s->comp[c];
+        const float brdf = s->diffuse[c] * (1.0f / EVR_PI) + dv * f * comp;
+        acc[c] += e_rgb[c] * nl * brdf;
+    }
 }
 
 /* Radiance leaving s towards wo (RGB) from the lights' sum acc (evr_material_add_light), the
- * ambient irradiance (a fraction of pi) and its emission. */
+ * ambient environment (uniform radiance `ambient`, which the camera does not see directly but
+ * surfaces reflect) and emission. The ambient light the specular lobe reflects is left out
+ * when the caller traces the reflection as a ray (reflect_traced), and the ambient light
+ * transmitted when it traces the refraction (transmit_traced). BLEND's coverage is the
+ * caller's (evr_surface.opacity). An unlit surface shows its base colour. */
 EVR_HD static inline void evr_material_radiance(const evr_surface *s, evr_v3 wo, const float acc[3],
-                                                float ambient, float rgb[3])
+                                                float ambient, int reflect_traced,
+                                                int transmit_traced, float rgb[3])
 {
     (void)wo;
-    rgb[0] = s->albedo[0] * (ambient + acc[0] / EVR_PI) + s->emissive[0];
-    rgb[1] = s->albedo[1] * (ambient + acc[1] / EVR_PI) + s->emissive[1];
-    rgb[2] = s->albedo[2] * (ambient + acc[2] / EVR_PI) + s->emissive[2];
+    for (int c = 0; c < 3; c++) {
+        if (s->unlit) {
+            rgb[c] = s->albedo[c];
+            continue;
+        }
+        float env = s->diffuse[c] * s->occlusion;
+        if (!reflect_traced) env += s->spec_albedo[c] * s->occlusion;
+        if (!transmit_traced) env += s->transmit[c];
+        rgb[c] = acc[c] + ambient * env + s->emissive[c];
+    }
+}
+
+/* Whether s reflects along one mirror ray (smooth enough, and reflecting anything). */
+EVR_HD static inline int evr_material_mirror(const evr_surface *s)
+{
+    return !s->unlit && s->rough < EVR_MIRROR_ROUGHNESS;
+}
+
+/* Whether s transmits anything (the refraction is always traced as one ray). */
+EVR_HD static inline int evr_material_transmits(const evr_surface *s)
+{
+    return !s->unlit && (s->transmit[0] > 0.0f || s->transmit[1] > 0.0f || s->transmit[2] > 0.0f);
 }
 
 /* ---- indirect light: photon thresholds, decisions and bounce directions ---- */

@@ -66,6 +66,9 @@ typedef struct {
     evr_camera_intr camera;
     float ambient; /* ambient irradiance as a fraction of pi (radiance = albedo * ambient) */
     float ray_eps; /* offset for secondary rays, scaled to the scene */
+    const float *bsdf_table; /* core/bsdf.h's albedo table (NULL: single scattering only) */
+    int max_bounces;         /* reflections and refractions a camera ray may take */
+    int translucent;         /* some material transmits or blends: shadow rays pass them */
 } evr_render_scene;
 
 EVR_HD static inline evr_motion_track evr_rs_track(const evr_render_scene *rs, int i)

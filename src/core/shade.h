@@ -10,9 +10,10 @@
 
 /* One light's share at a hit: where it comes from and what it brings, and its shadow ray. */
 typedef struct {
-    evr_v3 wi;   /* towards the light */
-    float e[3];  /* irradiance on a surface facing it */
-    evr_ray ray; /* the shadow ray, free over [tnear, tfar) when the light is visible */
+    evr_v3 wi;    /* towards the light */
+    float e[3];   /* irradiance on a surface facing it */
+    float spread; /* the light's angular radius seen from the surface (0: a point) */
+    evr_ray ray;  /* the shadow ray, free over [tnear, tfar) when the light is visible */
     float tnear, tfar;
 } evr_light_ray;
 
@@ -21,8 +22,11 @@ EVR_HD static inline int evr_shade_light_ray(const evr_render_scene *rs, int l, 
                                              const evr_surface *s, evr_light_ray *lr)
 {
     float dist;
+    lr->spread = 0.0f;
+    if (s->unlit) return 0;
     if (!evr_light_incident(rs, &rs->lights[l], f, s->p, &lr->wi, &dist, lr->e)) return 0;
-    if (evr_v3_dot(lr->wi, s->n) <= 0.0f) return 0;
+    if (evr_v3_dot(lr->wi, s->n) <= 0.0f || evr_v3_dot(lr->wi, s->nv) <= 0.0f) return 0;
+    lr->spread = rs->lights[l].radius > 0.0f ? fminf(rs->lights[l].radius / dist, 1.0f) : 0.0f;
     lr->ray.org = s->p;
     lr->ray.dir = lr->wi;
     lr->tnear = evr_shadow_tnear(s, lr->wi, rs->ray_eps);
@@ -34,7 +38,7 @@ EVR_HD static inline int evr_shade_light_ray(const evr_render_scene *rs, int l, 
 EVR_HD static inline void evr_shade_add_light(const evr_surface *s, evr_v3 wo,
                                               const evr_light_ray *lr, float acc[3])
 {
-    evr_material_add_light(s, wo, lr->wi, lr->e, acc);
+    evr_material_add_light(s, wo, lr->wi, lr->e, lr->spread, acc);
 }
 
 /* Sensor intensity of s seen along wo from the lights' sum acc, plus ambient and emission. */

@@ -39,10 +39,21 @@ EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, u
     evr_v3 n =
         evr_v3_add(evr_v3_add(evr_v3_scale(n0, w), evr_v3_scale(n1, u)), evr_v3_scale(n2, v));
     n = evr_m34_normal(xf, n);
-    if (evr_v3_dot(n, ray.dir) > 0.0f) n = evr_v3_scale(n, -1.0f); /* two-sided */
-    s->n = n;
+    s->front = evr_v3_dot(n, ray.dir) <= 0.0f;
+    if (!s->front) n = evr_v3_scale(n, -1.0f); /* two-sided */
+    s->nv = n;
     s->p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
-    evr_material_at(rs, m, i0, i1, i2, w, u, v, s);
+    evr_v3 tw = evr_v3_make(0.0f, 0.0f, 0.0f);
+    float tsign = 1.0f;
+    if (m->tangents) {
+        const float *t0 = m->tangents + 4 * i0, *t1 = m->tangents + 4 * i1,
+                    *t2 = m->tangents + 4 * i2;
+        tw = evr_m34_vector(xf, evr_v3_make(w * t0[0] + u * t1[0] + v * t2[0],
+                                            w * t0[1] + u * t1[1] + v * t2[1],
+                                            w * t0[2] + u * t1[2] + v * t2[2]));
+        tsign = t0[3] < 0.0f ? -1.0f : 1.0f;
+    }
+    evr_material_at(rs, m, i0, i1, i2, w, u, v, tw, tsign, evr_v3_scale(ray.dir, -1.0f), s);
 }
 
 /* Light arriving at p from light l at normalized segment time f: direction towards the light,
@@ -83,12 +94,12 @@ EVR_HD static inline int evr_light_incident(const evr_render_scene *rs, const ev
 }
 
 /* Sensor intensity of s seen along wo: the luminance of its radiance (evr_material_radiance)
- * from the lights' sum acc (evr_material_add_light). */
+ * from the lights' sum acc (evr_material_add_light), with no reflection or refraction traced. */
 EVR_HD static inline float evr_surface_intensity(const evr_surface *s, evr_v3 wo,
                                                  const float acc[3], float ambient)
 {
     float rgb[3];
-    evr_material_radiance(s, wo, acc, ambient, rgb);
+    evr_material_radiance(s, wo, acc, ambient, 0, 0, rgb);
     return evr_luminance(rgb[0], rgb[1], rgb[2]);
 }
 
@@ -97,7 +108,7 @@ EVR_HD static inline float evr_surface_intensity(const evr_surface *s, evr_v3 wo
  * offset along the normal would shift that line sideways and misjudge shadows near edges). */
 EVR_HD static inline float evr_shadow_tnear(const evr_surface *s, evr_v3 wi, float eps)
 {
-    return eps / fmaxf(evr_v3_dot(s->n, wi), 0.05f);
+    return eps / fmaxf(evr_v3_dot(s->nv, wi), 0.05f);
 }
 
 #endif

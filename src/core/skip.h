@@ -161,23 +161,35 @@ EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const ev
 }
 
 /* The pixel's cache as stored in its state: the distance of its last traced sample's hit
- * (INFINITY: none) when clean, negative when not. */
+ * (INFINITY: none) when clean, negative when not. EVR_SKIP_DEEP: clean, but its path went on
+ * past the primary hit (core/path.h: a reflection, refraction or blended layer), whose rays
+ * the cache does not keep: it may be reused only in a segment where nothing moves. */
 #define EVR_SKIP_DIRTY (-1.0f)
+#define EVR_SKIP_DEEP (-2.0f)
+
+/* Whether a cache value is clean (reusable under the rules above). */
+EVR_HD static inline int evr_skip_clean(float cache_dist)
+{
+    return cache_dist >= 0.0f || cache_dist == EVR_SKIP_DEEP;
+}
 
 /* 1 when a pixel whose camera ray is `ray` keeps its last intensity for the whole segment. */
 EVR_HD static inline int evr_skip_pixel(const evr_render_scene *rs, const evr_skip_plan *pl,
                                         int started, float cache_dist, evr_ray ray)
 {
+    if (cache_dist == EVR_SKIP_DEEP) return pl->reuse && started && pl->num_boxes == 0;
     return pl->reuse && started && cache_dist >= 0.0f &&
            !evr_skip_rays_meet(rs, pl, ray, cache_dist);
 }
 
-/* The cache a traced pixel keeps: its last sample's hit distance if clean, else EVR_SKIP_DIRTY. */
+/* The cache a traced pixel keeps: its last sample's hit distance if clean, else EVR_SKIP_DIRTY;
+ * deep: the sample's path went past the primary hit (EVR_SKIP_DEEP when nothing moves). */
 EVR_HD static inline float evr_skip_cache_after_trace(const evr_render_scene *rs,
                                                       const evr_skip_plan *pl, evr_ray ray,
-                                                      float t_hit)
+                                                      float t_hit, int deep)
 {
     if (!pl->cache) return EVR_SKIP_DIRTY;
+    if (deep) return pl->num_boxes == 0 ? EVR_SKIP_DEEP : EVR_SKIP_DIRTY;
     const float d = t_hit < 1e29f ? t_hit : INFINITY;
     return evr_skip_rays_meet(rs, pl, ray, d) ? EVR_SKIP_DIRTY : d;
 }

@@ -5,7 +5,7 @@
 #include "core/rng.h"
 #include "core/adaptive.h"
 #include "core/pixel_flow.h"
-#include "core/shade.h"
+#include "core/shade_hit.h"
 #include "core/skip.h"
 #include "cpu/workers.h"
 #include "cpu/cpu_gi.h"
@@ -96,6 +96,37 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
     q->translation_z = k->trans.z;
 }
 
+/* core/path.h's ray queries, one ray at a time (a path's rays after the primary hit, and
+ * shadow rays through translucent surfaces): Embree at the sample's trace time. */
+struct evr_occlusion {
+    const cpu_backend *b;
+    float trace_time; /* evr_skip_trace_time of the sample */
+};
+
+static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f)
+{
+    (void)f;
+    return evr_embree_occluded1(o->b->top, r, tnear, tfar, o->trace_time);
+}
+
+static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f,
+                              evr_hit *h)
+{
+    evr_trace_hit th;
+    (void)f;
+    if (!evr_embree_closest1(o->b->top, o->b->groups.members, o->b->groups.group_first, r, tnear,
+                             tfar, o->trace_time, &th))
+        return 0;
+    h->t = th.t;
+    h->u = th.u;
+    h->v = th.v;
+    h->prim = th.prim;
+    h->inst = th.inst;
+    return 1;
+}
+
+#include "core/path.h"
+
 /* Intensity of eight samples at once (neighbouring pixels of a row, each at its own time):
  * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
  * shared shading of src/core lane by lane. Counts the rays it traces; t_hit gets each primary
@@ -104,7 +135,7 @@ static void to_embree(const evr_motion_key *k, struct RTCQuaternionDecomposition
 #define PACKET 8
 static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
                                    const int *ys, const float *fs, const int *valid, float *out,
-                                   float *t_hit, float *direct, unsigned long long *rays)
+                                   float *t_hit, float *direct, int *deep, unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -153,8 +184,16 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, fs[i], ray[i],
                        rh.ray.tfar[i], &s[i]);
     }
-    /* core/shade.h's steps light by light: each light's shadow rays as one packet */
-    for (l = 0; l < rs->num_lights; l++) {
+    /* core/shade.h's steps light by light: each light's shadow rays as one packet (through
+     * translucent surfaces: one ray at a time, evr_shade_direct_sum) */
+    for (i = 0; rs->translucent && i < PACKET; i++) {
+        struct evr_occlusion o = {b, rh.ray.time[i]};
+        unsigned r1 = 0;
+        if (!hit[i]) continue;
+        evr_shade_direct_sum(rs, &s[i], evr_v3_scale(ray[i].dir, -1.0f), fs[i], &o, &r1, acc[i]);
+        *rays += r1;
+    }
+    for (l = 0; !rs->translucent && l < rs->num_lights; l++) {
         evr_light_ray lr[PACKET];
         int any = 0;
         for (i = 0; i < PACKET; i++) {
@@ -187,7 +226,12 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
             if (b->gi && valid[i] && t_hit) evr_cpu_gi_missed(&b->gi_state, xs[i], ys[i]);
             continue;
         }
-        out[i] = evr_shade_intensity(rs, &s[i], evr_v3_scale(ray[i].dir, -1.0f), acc[i]);
+        struct evr_occlusion o = {b, rh.ray.time[i]};
+        unsigned r1 = 0;
+        int dp = 0;
+        out[i] = evr_path_intensity(rs, &s[i], ray[i].dir, acc[i], &o, fs[i], &r1, &dp);
+        *rays += r1;
+        if (deep) deep[i] = dp;
         if (direct) direct[i] = out[i];
         if (b->gi)
             out[i] += evr_cpu_gi_indirect(&b->gi_state, rs, inst_of[i], &s[i], ray[i].org, xs[i],
@@ -202,7 +246,7 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
 {
     int ys[PACKET], i;
     for (i = 0; i < PACKET; i++) ys[i] = y;
-    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, NULL, rays);
+    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, NULL, NULL, rays);
 }
 
 static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
@@ -247,6 +291,7 @@ typedef struct {
     evr_pixel_params pp;      /* its thresholds, leak and noise (a fixed pattern) */
     evr_ray ray;              /* its centre ray (the camera at the segment's start) */
     float phi, t_last, t_hit; /* sample phase; time of its last sample; last hit distance */
+    int deep;                 /* its last traced sample's path went past the primary hit */
     float direct;             /* GI: its last traced sample's direct light */
     int last_span;            /* the still span (evr_skip_still_span) of its last traced sample */
     int x, y;
@@ -340,6 +385,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
         for (c = 0; c < ntr; c += PACKET) {
             int xs[PACKET], ys[PACKET], valid[PACKET];
             float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
+            int deep[PACKET];
             tile_pixel *q[PACKET];
             for (i = 0; i < PACKET; i++) {
                 valid[i] = c + i < ntr;
@@ -350,11 +396,12 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
                 fs[i] = fk[j];
             }
             sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid,
-                                   intensity, t_hit, direct, rays);
+                                   intensity, t_hit, direct, deep, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 (*traced)++;
                 q[i]->t_hit = t_hit[i];
+                q[i]->deep = deep[i];
                 q[i]->direct = direct[i];
                 pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i],
                              out);
@@ -364,8 +411,8 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     if (!settle) return;
     for (j = 0; j < count; j++) {
         tile_pixel *q = &px[list[j]];
-        float cd = evr_skip_cache_after_trace(rs, seg->skip, q->ray, q->t_hit);
-        if (cd >= 0.0f) { /* settled: the same triangles at every sample */
+        float cd = evr_skip_cache_after_trace(rs, seg->skip, q->ray, q->t_hit, q->deep);
+        if (evr_skip_clean(cd)) { /* settled: the same triangles at every sample */
             q->st->cache_dist = cd;
             keep_samples(b, q, ideal, k1, n, dt, out);
             q->t_hit = -1.0f; /* its cache is set */
@@ -411,6 +458,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
                     q->phi = b->phase[(size_t)y * (size_t)w + (size_t)x];
                     q->t_last = (((float)(n - 1) + q->phi) / (float)n) * dt;
                     q->t_hit = INFINITY;
+                    q->deep = 0;
                     q->last_span = -1;
                     if (ideal) q->pp = b->setup.pixel;
                     else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
@@ -437,7 +485,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
     for (i = 0; i < count; i++) {
         tile_pixel *q = &px[list[i]];
         if (q->t_hit >= 0.0f)
-            q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit);
+            q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit, q->deep);
         evr_pixel_end_segment(q->st, dt);
     }
     render_frames(b, x0, y0, x1, y1);
@@ -529,7 +577,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 fs[i] = tnext[js[i]] / dt;
             }
             sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid,
-                                   intensity, t_hit, NULL, rays);
+                                   intensity, t_hit, NULL, NULL, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 const int jj = js[i];

@@ -80,6 +80,19 @@ static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, 
     return o->tr->occluded(o->tr->user, r, tnear, tfar, f);
 }
 
+static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f,
+                              evr_hit *h)
+{
+    evr_trace_hit th;
+    if (!o->tr->closest(o->tr->user, r, tnear, tfar, f, &th)) return 0;
+    h->t = th.t;
+    h->u = th.u;
+    h->v = th.v;
+    h->prim = th.prim;
+    h->inst = th.inst;
+    return 1;
+}
+
 /* The lights' sum acc at surface s seen along wo, shadow rays included (evr_shade_direct_sum):
  * the event pipeline's direct term one ray at a time. */
 static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, float acc[3])
@@ -139,13 +152,13 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
         r.org = s.p;
         r.dir = wo;
         if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), &y, &my, NULL)) return;
-        float acc[3], em[3], kd = evr_material_diffuse_k(my);
+        float acc[3], em[3];
         const evr_v3 back = evr_v3_scale(wo, -1.0f);
-        direct_lights(c, &y, back, acc);
+        direct_lights(c, &y, back, acc); /* the BSDF's direct light, RGB radiance */
         evr_material_emission(&y, back, em);
-        out[0] += beta[0] * (em[0] + y.albedo[0] * kd * acc[0]);
-        out[1] += beta[1] * (em[1] + y.albedo[1] * kd * acc[1]);
-        out[2] += beta[2] * (em[2] + y.albedo[2] * kd * acc[2]);
+        out[0] += beta[0] * (em[0] + acc[0]);
+        out[1] += beta[1] * (em[1] + acc[1]);
+        out[2] += beta[2] * (em[2] + acc[2]);
         s = y;
         m = my;
         dir_in = wo;
@@ -173,7 +186,7 @@ static void shade_row(shade_ctx *c, int y)
         o->instance[i] = inst;
         const evr_v3 wo = evr_v3_scale(ray.dir, -1.0f);
         direct_lights(c, &s, wo, acc);
-        evr_material_radiance(&s, wo, acc, rs->ambient, dir);
+        evr_material_radiance(&s, wo, acc, rs->ambient, 0, 0, dir);
         for (k = 0; k < 3; k++) rgb[k] = dir[k];
         if (p->gi == EVR_GI_PHOTON) {
             float e[3], ind[3];

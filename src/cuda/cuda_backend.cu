@@ -110,6 +110,9 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
     CK(cudaMemcpy(b->d_materials.p, b->host.materials,
                   ((size_t)s->num_materials + 1) * sizeof(evr_material_params),
                   cudaMemcpyHostToDevice));
+    CK(b->d_bsdf_table.reserve(2 * EVR_BSDF_MU * EVR_BSDF_ROUGH));
+    CK(cudaMemcpy(b->d_bsdf_table.p, b->host.bsdf_table,
+                  2 * EVR_BSDF_MU * EVR_BSDF_ROUGH * sizeof(float), cudaMemcpyHostToDevice));
     CK(b->d_instances.reserve((size_t)s->num_instances + 1));
     CK(cudaMemcpy(b->d_instances.p, b->host.instances,
                   ((size_t)s->num_instances + 1) * sizeof(evr_instance_view),
@@ -203,6 +206,7 @@ static void cuda_release(evr_backend *base)
     b->d_indices.release();
     b->d_meshes.release();
     b->d_materials.release();
+    b->d_bsdf_table.release();
     b->d_textures.release();
     b->d_texels.release();
     b->d_instances.release();

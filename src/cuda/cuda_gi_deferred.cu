@@ -46,6 +46,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     const evr_ray ray0 =
         evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     float direct = 0.0f; /* the last traced sample's, and its request */
+    int deep = 0;        /* the last traced sample's path went past its primary hit */
     unsigned r = GI_NO_REQUEST;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
@@ -62,8 +63,8 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             int inst = 0;
             evr_v3 org;
             if (gpu_sample_direct<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit,
-                                          a.coherence ? t_hit : INFINITY, &direct, &s, &inst,
-                                          &org)) {
+                                          a.coherence ? t_hit : INFINITY, &direct, &s, &inst, &org,
+                                          &deep)) {
                 gpu_gather_point(&a.rs, inst, &s, org, &g);
                 if (gi_memo_take(&memo, inst, &g)) r = memo.req;
                 else want = true;
@@ -93,8 +94,8 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
         }
         if (k == 0 && tracing) {
             /* settle, as render_kernel: the first sample's rays meet nothing that moves */
-            const float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
-            if (c >= 0.0f) {
+            const float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit, deep);
+            if (evr_skip_clean(c)) {
                 tracing = false;
                 cache = c;
             }
@@ -103,7 +104,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     const unsigned at = warp_append(&d.count[REQ_NEW_PIXELS], made_new);
     if (made_new) d.newpix[at] = i;
     if (active) {
-        if (tracing) cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
+        if (tracing) cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit, deep);
         d.cache_dist[i] = cache;
         d.traced[i] = entries;
     }

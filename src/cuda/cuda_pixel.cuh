@@ -38,12 +38,46 @@ EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float 
 #endif
 }
 
+/* core/path.h's closest-hit query for the rays after the primary hit, the same traversal. */
+EVR_HD static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
+                                     float f, evr_hit *h)
+{
+#ifdef __CUDA_ARCH__
+    const int deforming = EVR_GPU_TRACE_DEFORMING;
+    int found;
+    if (o->layout == EVR_GPU_LAYOUT_CW8)
+        found = gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 0, o->hit);
+    else if (o->layout == (EVR_GPU_LAYOUT_CW8 | deforming))
+        found = gpu_trace<EVR_GPU_LAYOUT_CW8 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
+                                                          0, o->hit);
+    else if (o->layout == (EVR_GPU_LAYOUT_BVH4 | deforming))
+        found = gpu_trace<EVR_GPU_LAYOUT_BVH4 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar,
+                                                           f, 0, o->hit);
+    else
+        found =
+            gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 0, o->hit);
+    if (!found) return 0;
+    h->t = o->hit->t;
+    h->u = o->hit->u;
+    h->v = o->hit->v;
+    h->prim = o->hit->prim;
+    h->inst = o->hit->instance;
+    return 1;
+#else
+    (void)o, (void)r, (void)tnear, (void)tfar, (void)f, (void)h;
+    return 0;
+#endif
+}
+
+#include "core/path.h"
+
 /* Direct light of one sample, as sample_intensity in cpu/cpu_backend.c, with our traversal; 0 on a
  * miss (returns false), else the surface met, its instance and the ray's origin for the gather. */
 template <int LAYOUT>
 __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *pose, int x, int y,
                                          float f, unsigned *rays, float *t_hit, float hint,
-                                         float *direct, evr_surface *s, int *inst, evr_v3 *cam_org)
+                                         float *direct, evr_surface *s, int *inst, evr_v3 *cam_org,
+                                         int *deep)
 {
     const evr_render_scene *rs = &a.rs;
     evr_ray ray = evr_camera_ray(&rs->camera, pose, (float)x + 0.5f, (float)y + 0.5f);
@@ -51,6 +85,7 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     (*rays)++;
     *t_hit = INFINITY;
     *direct = 0.0f;
+    *deep = 0;
     /* temporal coherence: the pixel's last hit distance (hint) bounds the search first; the
      * closest hit below that bound is the closest hit, and finding none, the ray is traced again
      * unbounded: the same hit either way */
@@ -84,7 +119,11 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     occ.a = &a;
     occ.layout = LAYOUT;
     occ.hit = &hit;
-    *direct = evr_shade_hit(rs, s, evr_v3_scale(ray.dir, -1.0f), f, &occ, rays);
+    float acc[3];
+    int dp = 0;
+    evr_shade_direct_sum(rs, s, evr_v3_scale(ray.dir, -1.0f), f, &occ, rays, acc);
+    *direct = evr_path_intensity(rs, s, ray.dir, acc, &occ, f, rays, &dp);
+    *deep = dp;
     return true;
 }
 
@@ -93,14 +132,18 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
 template <int LAYOUT, int GI>
 __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f,
                                    unsigned *rays, float *t_hit, gi_memo *memo,
-                                   float hint = INFINITY, float *direct = nullptr)
+                                   float hint = INFINITY, float *direct = nullptr,
+                                   int *deep = nullptr)
 {
     evr_surface s;
     int inst = 0;
     evr_v3 org;
     float out;
-    if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org))
+    int dp = 0;
+    if (deep) *deep = 0;
+    if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org, &dp))
         return 0.0f;
+    if (deep) *deep = dp;
     if (direct) *direct = out;
     if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, f, memo);
     return out;

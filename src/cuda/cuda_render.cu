@@ -62,9 +62,10 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
                                       a.gi->end.margin, a.gi->window, x, y)) {
             skip = false;
             /* as the trace kernel would settle it: its hit the cached one, the cache kept */
-            cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray, st.cache_dist);
-            indirect_only =
-                d.requests && a.gi->ends_in && a.gi->ends_in[pix].g.dist >= 0.0f && cache >= 0.0f;
+            cache = evr_skip_cache_after_trace(&a.rs, a.plan, ray, st.cache_dist,
+                                               st.cache_dist == EVR_SKIP_DEEP);
+            indirect_only = d.requests && a.gi->ends_in && a.gi->ends_in[pix].g.dist >= 0.0f &&
+                            evr_skip_clean(cache);
         }
     }
     const unsigned at = warp_append(a.list_count, active && !skip);
@@ -116,6 +117,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     unsigned rays = 0, traced = 0;
     float t_hit = INFINITY, direct = 0.0f;
+    int deep = 0; /* the last traced sample's path went past its primary hit */
     bool tracing = active;
     gi_memo memo;
     memo.valid = false;
@@ -130,7 +132,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
         if (tracing && !evr_skip_held(a.plan, span, last_span)) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo,
-                                               a.coherence ? t_hit : INFINITY, &direct);
+                                               a.coherence ? t_hit : INFINITY, &direct, &deep);
             traced++;
             last_span = span;
         } else if (
@@ -143,15 +145,15 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
         if (k == 0 && tracing) {
             /* settle: the first sample's rays meet nothing that moves in the segment, so every
              * sample sees the same triangles: keep its intensity (GI: its direct light) */
-            float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
-            if (c >= 0.0f) {
+            float c = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit, deep);
+            if (evr_skip_clean(c)) {
                 tracing = false;
                 st.cache_dist = c;
             }
         }
     }
     if (active) {
-        if (tracing) st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit);
+        if (tracing) st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit, deep);
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
     }

@@ -34,6 +34,7 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     a.rs = b->host.rs;
     a.rs.meshes = b->d_meshes.p;
     a.rs.materials = b->d_materials.p;
+    a.rs.bsdf_table = b->d_bsdf_table.p;
     a.rs.textures = b->d_textures.p;
     a.rs.instances = b->d_instances.p;
     a.rs.lights = b->d_lights.p;
@@ -105,9 +106,10 @@ kernel_variant run_variant(const cuda_backend *b)
 uint64_t device_bytes(const cuda_backend *b)
 {
     uint64_t n = bytes(b->d_floats) + bytes(b->d_indices) + bytes(b->d_meshes) +
-                 bytes(b->d_materials) + bytes(b->d_textures) + bytes(b->d_texels) +
-                 bytes(b->d_instances) + bytes(b->d_lights) + bytes(b->d_nodes4) +
-                 bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) + bytes(b->d_sensor);
+                 bytes(b->d_materials) + bytes(b->d_bsdf_table) + bytes(b->d_textures) +
+                 bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
+                 bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) +
+                 bytes(b->d_sensor);
     for (int i = 0; i < NRING; i++) n += bytes(b->d_state[i]) + bytes(b->d_next[i]);
     for (int i = 0; i < NSLOT; i++) {
         const slot *sl = &b->slots[i];

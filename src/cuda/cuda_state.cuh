@@ -125,6 +125,7 @@ struct cuda_backend {
     dbuf<uint32_t> d_indices;
     dbuf<evr_mesh_view> d_meshes;
     dbuf<evr_material_params> d_materials;
+    dbuf<float> d_bsdf_table; /* core/bsdf.h's albedo table */
     dbuf<evr_texture_view> d_textures;
     dbuf<float> d_texels;
     dbuf<evr_instance_view> d_instances;

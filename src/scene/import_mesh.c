@@ -89,7 +89,8 @@ evr_status evr_import_materials(importer *im)
                 !str.data[0])
                 continue;
             {
-                evr_status st = evr_import_texture(im, str.data, m->name, &m->p.tex[EVR_TEX_BASE].index);
+                evr_status st =
+                    evr_import_texture(im, str.data, m->name, &m->p.tex[EVR_TEX_BASE].index);
                 if (st != EVR_OK) return st;
             }
             im->mat_uv[i] = (int)uv;
