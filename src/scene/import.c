@@ -264,6 +264,7 @@ static void importer_free(importer *im)
     if (im->tex_keys)
         for (i = 0; i < im->s->num_textures; i++) free(im->tex_keys[i]);
     free(im->tex_keys);
+    free(im->tex_srgb);
     free(im->mat_uv);
     free((void *)im->ai_nodes);
     free(im->by_name);
@@ -272,10 +273,12 @@ static void importer_free(importer *im)
 }
 
 /* Everything after Assimp: ai -> *out. `bytes` is the file or memory content (for the glTF
- * JSON), `dir` the folder for external textures, `opts` the caller's (current) options. */
-static evr_status convert(const struct aiScene *ai, const char *source, const char *dir,
-                          const char *ext, const unsigned char *bytes, size_t nbytes,
-                          const evr_load_options *opts, evr_scene **out, evr_error *err)
+ * JSON), `path` the file (NULL: memory), `dir` the folder for external textures, `opts` the
+ * caller's (current) options. */
+static evr_status convert(const struct aiScene *ai, const char *source, const char *path,
+                          const char *dir, const char *ext, const unsigned char *bytes,
+                          size_t nbytes, const evr_load_options *opts, evr_scene **out,
+                          evr_error *err)
 {
     importer im;
     evr_scene *s;
@@ -299,6 +302,10 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     if (im.gltf && bytes) {
         if ((st = evr_gltf_side_parse(bytes, nbytes, &im.side, err)) != EVR_OK) goto fail;
         im.have_side = 1;
+        im.src.bytes = bytes;
+        im.src.nbytes = nbytes;
+        im.src.path = path;
+        im.src.dir = path ? dir : NULL;
     }
 
     if ((st = evr_import_materials(&im)) != EVR_OK) goto fail;
@@ -470,7 +477,8 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         src.nbytes = nbytes;
         src.path = path;
         src.dir = dir;
-        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
+        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
+            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
             free(bytes);
             return st;
         }
@@ -497,7 +505,7 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         free(bytes);
         return import_error(err, path);
     }
-    st = convert(ai, path, dir, ext, bytes, nbytes, &o, out, err);
+    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, out, err);
     free(bytes);
     aiReleaseImport(ai);
     return st;
@@ -534,7 +542,9 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         src.nbytes = size;
         src.path = NULL;
         src.dir = NULL;
-        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) return st;
+        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
+            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK)
+            return st;
     }
     props = make_props();
     if (!props) {
@@ -549,7 +559,7 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (ai) ai = join_vertices(ai);
     snprintf(source, sizeof source, "<memory>.%s", hint);
     if (!ai) return import_error(err, source);
-    st = convert(ai, source, "", hint, (const unsigned char *)data, size, &o, out, err);
+    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, out, err);
     aiReleaseImport(ai);
     return st;
 }
