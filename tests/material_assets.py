@@ -70,6 +70,8 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
   normal_plane_mirrored  the same without TANGENT and with u mirrored (u = 0.5 - x): the
                      generated tangent is (-1, 0, 0) with w = -1, the shading normal
                      (-0.36, 0.48, 0.8) (red tilt flips, green keeps pointing up).
+  normal_plane_mirrored_tangents  normal_plane_mirrored with TANGENT (-1, 0, 0, -1) given: the
+                     same frame read from the file (w = -1).
   normal_sphere      UV sphere "ball" (radius 0.4, centre (0, 0, -1.5), 24 segments x 12 rings,
                      u = longitude / 2pi increasing eastwards (with +x at u = 0.25, seen from +z
                      at u = 0.5... see the code), v = 0 at the north pole +Y) without TANGENT,
@@ -413,6 +415,12 @@ def normal_plane_mirrored(outdir):
     return g.write(outdir, "normal_plane_mirrored")
 
 
+def normal_plane_mirrored_tangents(outdir):
+    g = Gltf()
+    _quad(g, "quad", _bumpy(g), mirrored=True, tangents=[(-1, 0, 0, -1)] * 4)
+    return g.write(outdir, "normal_plane_mirrored_tangents")
+
+
 def sphere(radius=0.4, segments=24, rings=12):
     """A UV sphere about the origin: u = segment / segments (longitude phi = 2 pi u, the vertex
     at (r sin(theta) sin(phi), r cos(theta), r sin(theta) cos(phi))... so u grows eastwards seen
@@ -489,7 +497,7 @@ def bad_texture(outdir):
 
 ASSETS = [slots, colour_spaces, texture_transform, alpha_mask_card, alpha_blend_card,
           transmission_slab, emissive_texture, normal_plane_tangents, normal_plane,
-          normal_plane_mirrored, normal_sphere, unsupported, bad_ior, bad_factor, bad_cutoff,
+          normal_plane_mirrored, normal_plane_mirrored_tangents, normal_sphere, unsupported, bad_ior, bad_factor, bad_cutoff,
           bad_texture]
 
 

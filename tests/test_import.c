@@ -272,11 +272,12 @@ static void test_lights_materials(const char *path, int glb)
         CHECK(m->p.tex[EVR_TEX_BASE].index >= 0 && e1->p.tex[EVR_TEX_BASE].index >= 0);
         CHECK(e1->p.tex[EVR_TEX_BASE].index == e2->p.tex[EVR_TEX_BASE].index);
         CHECK(m->p.tex[EVR_TEX_BASE].index != e1->p.tex[EVR_TEX_BASE].index);
-        if (s->num_textures == 2 && m->p.tex[EVR_TEX_BASE].index >= 0 && e1->p.tex[EVR_TEX_BASE].index >= 0) {
+        if (s->num_textures == 2 && m->p.tex[EVR_TEX_BASE].index >= 0 &&
+            e1->p.tex[EVR_TEX_BASE].index >= 0) {
             int k;
             for (k = 0; k < 2; k++) {
-                const evr_texture *t =
-                    &s->textures[k == 0 ? m->p.tex[EVR_TEX_BASE].index : e1->p.tex[EVR_TEX_BASE].index];
+                const evr_texture *t = &s->textures[k == 0 ? m->p.tex[EVR_TEX_BASE].index
+                                                           : e1->p.tex[EVR_TEX_BASE].index];
                 CHECK(t->width == 2 && t->height == 2);
                 if (t->width != 2 || t->height != 2) continue;
                 /* row 0 is the image's first (top) row: red, then (0, 128, 255) */
