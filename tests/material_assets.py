@@ -45,18 +45,22 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
   alpha_blend_card   quad, material "veil": BLEND, baseColorFactor (0.2, 0.4, 0.8, 0.5), untextured;
                      behind it (z = -2, x, y in [-1, 1]) an opaque white emissive backdrop
                      "backdrop" (material "white_glow": base (0,0,0), emissive (1,1,1)).
-  transmission_slab  a box "slab" 2 x 2 x 0.2 (x, y in [-1, 1], z in [-1.2, -1.0]) turned 30
-                     degrees about +Y (node rotation), material "glass": transmission 1,
+  transmission_slab  a box "slab" 2 x 2 x 0.2 (x, y in [-1, 1], z in [-1.2, -1.0] before the
+                     turn) turned 30 degrees about +Y about its centre (0, 0, -1.1) (node
+                     translation and rotation), material "glass": transmission 1,
                      KHR_materials_ior 1.5, KHR_materials_volume thicknessFactor 0.2,
                      attenuationDistance 2, attenuationColor (0.9, 0.8, 0.7),
                      KHR_materials_specular specularFactor 0.5, specularColorFactor
                      (1, 0.9, 0.8), metallic 0, roughness 0, doubleSided false. Behind it at z = -3
-                     two emissive quads: "left" (x in [-3, 0], black, emissive 0) and "right"
-                     (x in [0, 3], emissive 1): a vertical edge at x = 0. A ray along -Z through
-                     the slab is shifted sideways by d = t sin(a) (1 - cos(a) / sqrt(n^2 -
-                     sin^2(a))) with t = 0.2, a = 30 deg, n = 1.5 (d = 0.03876 perpendicular to the
-                     ray, towards -x: the edge seen through the slab appears at x = +0.03876/cos... 
-                     measured along the plane z = -3 the offset is d / cos(0) = 0.03876 to +x).
+                     two quads: "left" (x in [-3, 0], material "dark": black, emissive 0) and
+                     "right" (x in [0, 3], material "lit": black base, emissive 1): a vertical edge at x = 0. The slab's normal is
+                     (sin 30, 0, cos 30); a ray crossing it at incidence angle a leaves it parallel
+                     to itself, shifted perpendicular to itself by t sin(a) (1 - cos(a) /
+                     sqrt(n^2 - sin^2(a))), t = 0.2, n = 1.5, towards -x (it bends towards the
+                     inner normal). For the central ray (along -Z, a = 30 deg) that is 0.038763:
+                     seen through the slab, the edge appears at x = +0.038763 on the backdrop
+                     (the ray aimed there lands on x = 0), about 0.74 degrees right of the image
+                     centre's column; other rays: the same formula with their own incidence angle.
   emissive_texture   quad, material "glow_checker": base (0,0,0,1), emissiveFactor (1, 1, 1),
                      KHR_materials_emissive_strength 5, emissiveTexture "checker" (4x4 cells of
                      0.25 x 0.25: white where (column + row) is even, the top-left cell white):
@@ -72,9 +76,10 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
                      (-0.36, 0.48, 0.8) (red tilt flips, green keeps pointing up).
   normal_plane_mirrored_tangents  normal_plane_mirrored with TANGENT (-1, 0, 0, -1) given: the
                      same frame read from the file (w = -1).
-  normal_sphere      UV sphere "ball" (radius 0.4, centre (0, 0, -1.5), 24 segments x 12 rings,
-                     u = longitude / 2pi increasing eastwards (with +x at u = 0.25, seen from +z
-                     at u = 0.5... see the code), v = 0 at the north pole +Y) without TANGENT,
+  normal_sphere      UV sphere "ball" (radius 0.4, centre (0, 0, -1.5), 24 segments x 12 rings;
+                     the normal at (u, v) is (sin(th) sin(ph), cos(th), sin(th) cos(ph)) with
+                     ph = 2 pi u, th = pi v: u = 0 faces +z (the camera), u = 0.25 faces +x,
+                     v = 0 at the north pole +Y) without TANGENT,
                      material "bumpy" as above: generated tangents are unit, orthogonal to the
                      normals, along the direction of increasing u, w = +1.
   unsupported        quad, material "coated" with KHR_materials_clearcoat and
@@ -422,10 +427,9 @@ def normal_plane_mirrored_tangents(outdir):
 
 
 def sphere(radius=0.4, segments=24, rings=12):
-    """A UV sphere about the origin: u = segment / segments (longitude phi = 2 pi u, the vertex
-    at (r sin(theta) sin(phi), r cos(theta), r sin(theta) cos(phi))... so u grows eastwards seen
-    from above, +z at u = 0), v = ring / rings (0 at the north pole +Y). The seam column is
-    duplicated (u = 0 and 1)."""
+    """A UV sphere about the origin: u = segment / segments, v = ring / rings, the vertex at
+    r (sin(th) sin(ph), cos(th), sin(th) cos(ph)) with ph = 2 pi u, th = pi v (u = 0 faces +z,
+    v = 0 is the north pole +Y). The seam column is duplicated (u = 0 and 1)."""
     pos, nrm, uv, idx = [], [], [], []
     for j in range(rings + 1):
         th = math.pi * j / rings
