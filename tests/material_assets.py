@@ -82,6 +82,10 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
                      v = 0 at the north pole +Y) without TANGENT,
                      material "bumpy" as above: generated tangents are unit, orthogonal to the
                      normals, along the direction of increasing u, w = +1.
+  normal_warped      normal_sphere's sphere with warped uvs (u + 0.15 sin(2 pi v),
+                     v + 0.1 sin(2 pi u)): tangents no longer follow the parallels (the same mesh,
+                     warped_sphere(), is what tests/test_tangents_blender.c compares with
+                     Blender's MikkTSpace).
   unsupported        quad, material "coated" with KHR_materials_clearcoat and
                      KHR_materials_sheen (not rendered: one warning each), material "volume_tex"
                      (second quad 2 units behind) with KHR_materials_volume thicknessTexture and
@@ -457,6 +461,21 @@ def normal_sphere(outdir):
     return g.write(outdir, "normal_sphere")
 
 
+def warped_sphere():
+    """sphere() with its uvs warped: (u + 0.15 sin(2 pi v), v + 0.1 sin(2 pi u))."""
+    pos, nrm, uv, idx = sphere()
+    uv = [(u + 0.15 * math.sin(2 * math.pi * v), v + 0.1 * math.sin(2 * math.pi * u))
+          for u, v in uv]
+    return pos, nrm, uv, idx
+
+
+def normal_warped(outdir):
+    g = Gltf()
+    pos, nrm, uv, idx = warped_sphere()
+    g.mesh("ball", pos, nrm, uv, idx, _bumpy(g), translation=(0, 0, -1.5))
+    return g.write(outdir, "normal_warped")
+
+
 def unsupported(outdir):
     g = Gltf()
     coated = g.material({"name": "coated", "extensions": {
@@ -501,7 +520,8 @@ def bad_texture(outdir):
 
 ASSETS = [slots, colour_spaces, texture_transform, alpha_mask_card, alpha_blend_card,
           transmission_slab, emissive_texture, normal_plane_tangents, normal_plane,
-          normal_plane_mirrored, normal_plane_mirrored_tangents, normal_sphere, unsupported, bad_ior, bad_factor, bad_cutoff,
+          normal_plane_mirrored, normal_plane_mirrored_tangents, normal_sphere,
+          normal_warped, unsupported, bad_ior, bad_factor, bad_cutoff,
           bad_texture]
 
 
