@@ -90,8 +90,10 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
                      KHR_materials_sheen (not rendered: one warning each), material "volume_tex"
                      (second quad 2 units behind) with KHR_materials_volume thicknessTexture and
                      KHR_materials_specular specularTexture and specularColorTexture (ignored:
-                     warnings); extensionsUsed also lists KHR_materials_iridescence (unused by
-                     any material: one warning for the file).
+                     warnings); material "clamped" (third quad "far", 4 units behind) whose base
+                     colour texture's sampler is CLAMP_TO_EDGE (evray repeats: a warning);
+                     extensionsUsed also lists KHR_materials_iridescence (unused by any
+                     material: one warning for the file).
   bad_ior            quad, material "bad_ior": KHR_materials_ior ior 0.5 (an error: ior must be 0
                      or >= 1).
   bad_factor         quad, material "bad_factor": metallicFactor -0.5 (an error).
@@ -158,6 +160,7 @@ class Gltf:
         self.data = bytearray()
         self.views, self.accessors = [], []
         self.images, self.textures, self.image_index = [], [], {}
+        self.samplers = []
         self.materials, self.meshes = [], []
         self.nodes = [{"name": "camera", "camera": 0},
                       {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}}]
@@ -187,6 +190,15 @@ class Gltf:
             self.textures.append({"source": len(self.images) - 1})
             self.image_index[image] = len(self.textures) - 1
         return self.image_index[image]
+
+    def clamped_texture(self, image):
+        """A second texture of a named image, sampled with CLAMP_TO_EDGE in u and v."""
+        self.texture(image)
+        if not self.samplers:
+            self.samplers.append({"wrapS": 33071, "wrapT": 33071})
+        self.textures.append({"source": self.textures[self.image_index[image]]["source"],
+                              "sampler": 0})
+        return len(self.textures) - 1
 
     def material(self, mat):
         for ext in mat.get("extensions", {}):
@@ -239,6 +251,8 @@ class Gltf:
         if self.images:
             doc["images"] = self.images
             doc["textures"] = self.textures
+        if self.samplers:
+            doc["samplers"] = self.samplers
         path = os.path.join(outdir, name + ".gltf")
         with open(path, "w") as f:
             json.dump(doc, f, indent=1)
@@ -486,9 +500,13 @@ def unsupported(outdir):
         "KHR_materials_volume": {"thicknessFactor": 0.1, "thicknessTexture": _tex(g, "grey")},
         "KHR_materials_specular": {"specularTexture": _tex(g, "grey"),
                                    "specularColorTexture": _tex(g, "quadrants")}}})
+    clamped = g.material({"name": "clamped", "pbrMetallicRoughness": {
+        "baseColorTexture": {"index": g.clamped_texture("quadrants")}}})
     _quad(g, "quad", coated)
     pos, nrm, uv, idx = _rect(-1, 1, -1, 1, -3.0)
     g.mesh("back", pos, nrm, uv, idx, vol)
+    pos, nrm, uv, idx = _rect(-2, 2, -2, 2, -5.0)
+    g.mesh("far", pos, nrm, uv, idx, clamped)
     return g.write(outdir, "unsupported", extra_used=["KHR_materials_iridescence"])
 
 

@@ -311,7 +311,9 @@ static void test_warnings_and_errors(void)
     evr_scene *s = load("unsupported");
     if (s) {
         const char *w = evr_scene_warnings(s);
-        CHECK(s->num_warnings == 6);
+        CHECK(s->num_warnings == 7);
+        CHECK(strstr(w, "material 'clamped': texture 2's sampler clamps or mirrors (wrapS 33071, "
+                        "wrapT 33071): evray repeats") != NULL);
         CHECK(strstr(w, "material 'coated': KHR_materials_clearcoat is not rendered") != NULL);
         CHECK(strstr(w, "material 'coated': KHR_materials_sheen is not rendered") != NULL);
         CHECK(strstr(w, "material 'volume_tex': KHR_materials_volume thicknessTexture") != NULL);

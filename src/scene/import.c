@@ -1,8 +1,9 @@
 /* Scene import through Assimp's C API, into the flattened evr_scene model (scene.h).
  *
  * What we keep from Assimp: triangles (points and lines are dropped), the node hierarchy with
- * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials,
- * base colour textures (decoded with stb_image and linearized), punctual lights, perspective
+ * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials
+ * with their textures (decoded with stb_image; colour slots sRGB-decoded, data slots as they
+ * are) and the mesh tangents normal maps need, punctual lights, perspective
  * cameras, and the node animation curves of the clips that play (import_clips.c says which)
  * converted to seconds.
  *
@@ -60,7 +61,10 @@
  *  Assimp 5.2 does read JOINTS_1/WEIGHTS_1 (8 influences and more), sparse morph targets and
  *  unnamed joints (bones and nodes both named "nodes[i]"); it does not normalize the weights
  *  (we do, per vertex) and gives a bone without weights one of 0 on vertex 0 (ignored).
- *  Also from the JSON: KHR_materials_emissive_strength, which Assimp 5.2 does not import.
+ *  Also from the JSON: every material property (import_gltf_material.c): Assimp 5.2 drops
+ *      KHR_materials_emissive_strength and _specular, rewrites KHR_texture_transform for its
+ *      flipped v and ignores its texCoord, and fails on a texture index out of range without
+ *      naming the material (checked before Assimp reads the file, like (k) to (m)).
  *  Lights: for glTF, aiLight.mColorDiffuse already holds colour * intensity (candela for point
  *      and spot, lux for directional), and the spot cone angles are glTF's half angles.
  *

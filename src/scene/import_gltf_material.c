@@ -33,9 +33,9 @@ static const char *const read_ext[] = {"KHR_texture_transform", "KHR_lights_punc
 
 typedef struct {
     const evr_jdoc *d;
-    int num_textures, num_images;
-    int *tex_v, *img_v; /* the JSON value of each texture and image */
-    const char *name;   /* the material's, for messages */
+    int num_textures, num_images, num_samplers;
+    int *tex_v, *img_v, *smp_v; /* the JSON value of each texture, image and sampler */
+    const char *name;           /* the material's, for messages */
     evr_error *err;
     importer *im;  /* NULL: checking only (no textures loaded, no warnings) */
     gltf_data *gd; /* the buffers, for images in buffer views */
@@ -165,6 +165,16 @@ static evr_status load(reader *r, int index, int slot, evr_texture_ref *ref)
         return bad(r, "texture %d's image %d does not exist (the file has %d)", index, src,
                    r->num_images);
     if (!r->im) return EVR_OK;
+    {
+        /* evray's lookups repeat (core/material.h): other wrap modes would be drawn wrong */
+        int sm = evr_gltf_index(d, evr_jdoc_get(d, tv, "sampler"));
+        int smv = sm >= 0 && sm < r->num_samplers ? r->smp_v[sm] : -1;
+        double ws = evr_jdoc_number(d, evr_jdoc_get(d, smv, "wrapS"), 10497);
+        double wt = evr_jdoc_number(d, evr_jdoc_get(d, smv, "wrapT"), 10497);
+        if (ws != 10497 || wt != 10497)
+            warn(r, "texture %d's sampler clamps or mirrors (wrapS %g, wrapT %g): evray repeats",
+                 index, ws, wt);
+    }
     st = evr_gltf_image_source(r->gd, r->img_v[src], &bytes, &n, path, sizeof path, r->err);
     if (st != EVR_OK) return st;
     if (bytes) {
@@ -408,7 +418,9 @@ static evr_status parse(const gltf_source *src, evr_jdoc *d, int *root, reader *
     r->num_images = evr_jdoc_count(d, evr_jdoc_get(d, *root, "images"));
     r->tex_v = evr_jdoc_elements(d, evr_jdoc_get(d, *root, "textures"));
     r->img_v = evr_jdoc_elements(d, evr_jdoc_get(d, *root, "images"));
-    if (!r->tex_v || !r->img_v)
+    r->num_samplers = evr_jdoc_count(d, evr_jdoc_get(d, *root, "samplers"));
+    r->smp_v = evr_jdoc_elements(d, evr_jdoc_get(d, *root, "samplers"));
+    if (!r->tex_v || !r->img_v || !r->smp_v)
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON");
     return EVR_OK;
 }
@@ -417,6 +429,7 @@ static void reader_free(reader *r, evr_jdoc *d)
 {
     free(r->tex_v);
     free(r->img_v);
+    free(r->smp_v);
     evr_jdoc_free(d);
 }
 
