@@ -460,7 +460,7 @@ evr_status evr_gltf_material_check(const gltf_source *src, evr_error *err)
     return st;
 }
 
-evr_status evr_gltf_materials_read(importer *im)
+evr_status evr_gltf_materials_read(importer *im, int *count)
 {
     evr_jdoc d;
     reader r;
@@ -478,6 +478,7 @@ evr_status evr_gltf_materials_read(importer *im)
         r.name = mat->name;
         st = read_material(&r, m, &mat->p, &im->mat_uv[i]);
     }
+    *count = i;
     if (st == EVR_OK && root >= 0) warn_file_extensions(im, &d, root);
     if (root >= 0) evr_gltf_data_free(&gd);
     reader_free(&r, &d);

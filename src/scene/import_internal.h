@@ -186,8 +186,9 @@ evr_status evr_import_texture_image(importer *im, const char *key, const unsigne
  * passes unchecked. */
 evr_status evr_gltf_material_check(const gltf_source *src, evr_error *err);
 /* glTF: the materials of im->src's JSON (every property, textures loaded) into im->s->materials
- * [0 .. the JSON's count), warnings for what evray does not render; im->mat_uv set. */
-evr_status evr_gltf_materials_read(importer *im);
+ * [0 .. *count), warnings for what evray does not render; im->mat_uv set. *count 0 when the
+ * document is not glTF 2.0 JSON. */
+evr_status evr_gltf_materials_read(importer *im, int *count);
 /* Tangents of mesh m (tangents.c): MikkTSpace's definition from its uvs (glTF's v, pointing down
  * the image) and normals; m->tangents allocated. 0 when out of memory. */
 int evr_mesh_generate_tangents(evr_mesh *m);

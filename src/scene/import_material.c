@@ -165,10 +165,9 @@ evr_status evr_import_materials(importer *im)
         else snprintf(m->name, sizeof m->name, "material%u", i);
     }
     /* glTF: the JSON's materials (Assimp's first ones, in the same order) */
-    if (im->gltf && im->have_side && im->src.bytes) {
-        if ((st = evr_gltf_materials_read(im)) != EVR_OK) return st;
-        from_json = im->side.num_materials;
-    }
+    if (im->gltf && im->have_side && im->src.bytes &&
+        (st = evr_gltf_materials_read(im, &from_json)) != EVR_OK)
+        return st;
     for (i = (unsigned)from_json; i < ai->mNumMaterials; i++)
         if ((st = assimp_material(im, ai->mMaterials[i], &s->materials[i], &im->mat_uv[i])) !=
             EVR_OK)
