@@ -1,7 +1,7 @@
 /* glTF materials read from the JSON, not through Assimp. Assimp 5.2 drops
- * KHR_materials_emissive_strength, _volume's attenuation, _specular and the texture transform's
- * texCoord, rewrites KHR_texture_transform for its own flipped v, and fails on a texture index
- * out of range without naming the material (docs/assimp-quirks.md). Every property is read here:
+ * KHR_materials_emissive_strength, _specular and the texture transform's texCoord, rewrites
+ * KHR_texture_transform for its own flipped v, and fails on a texture index out of range without
+ * naming the material (docs/assimp-quirks.md). Every property is read here:
  * metallic-roughness factors and textures, normal (scale), occlusion (strength), emissive (times
  * KHR_materials_emissive_strength), alpha mode and cutoff, double-sidedness, KHR_materials_unlit,
  * _transmission, _ior, _volume, _specular, KHR_texture_transform, and the photon extras.
