@@ -1,8 +1,9 @@
 /* Scene import through Assimp's C API, into the flattened evr_scene model (scene.h).
  *
  * What we keep from Assimp: triangles (points and lines are dropped), the node hierarchy with
- * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials,
- * base colour textures (decoded with stb_image and linearized), punctual lights, perspective
+ * each node's rest transform, one instance per (node, mesh) pair, metallic-roughness materials
+ * with their textures (decoded with stb_image; colour slots sRGB-decoded, data slots as they
+ * are) and the mesh tangents normal maps need, punctual lights, perspective
  * cameras, and the node animation curves of the clips that play (import_clips.c says which)
  * converted to seconds.
  *
@@ -60,7 +61,10 @@
  *  Assimp 5.2 does read JOINTS_1/WEIGHTS_1 (8 influences and more), sparse morph targets and
  *  unnamed joints (bones and nodes both named "nodes[i]"); it does not normalize the weights
  *  (we do, per vertex) and gives a bone without weights one of 0 on vertex 0 (ignored).
- *  Also from the JSON: KHR_materials_emissive_strength, which Assimp 5.2 does not import.
+ *  Also from the JSON: every material property (import_gltf_material.c): Assimp 5.2 drops
+ *      KHR_materials_emissive_strength and _specular, rewrites KHR_texture_transform for its
+ *      flipped v and ignores its texCoord, and fails on a texture index out of range without
+ *      naming the material (checked before Assimp reads the file, like (k) to (m)).
  *  Lights: for glTF, aiLight.mColorDiffuse already holds colour * intensity (candela for point
  *      and spot, lux for directional), and the spot cone angles are glTF's half angles.
  *
@@ -264,6 +268,7 @@ static void importer_free(importer *im)
     if (im->tex_keys)
         for (i = 0; i < im->s->num_textures; i++) free(im->tex_keys[i]);
     free(im->tex_keys);
+    free(im->tex_srgb);
     free(im->mat_uv);
     free((void *)im->ai_nodes);
     free(im->by_name);
@@ -272,10 +277,12 @@ static void importer_free(importer *im)
 }
 
 /* Everything after Assimp: ai -> *out. `bytes` is the file or memory content (for the glTF
- * JSON), `dir` the folder for external textures, `opts` the caller's (current) options. */
-static evr_status convert(const struct aiScene *ai, const char *source, const char *dir,
-                          const char *ext, const unsigned char *bytes, size_t nbytes,
-                          const evr_load_options *opts, evr_scene **out, evr_error *err)
+ * JSON), `path` the file (NULL: memory), `dir` the folder for external textures, `opts` the
+ * caller's (current) options. */
+static evr_status convert(const struct aiScene *ai, const char *source, const char *path,
+                          const char *dir, const char *ext, const unsigned char *bytes,
+                          size_t nbytes, const evr_load_options *opts, evr_scene **out,
+                          evr_error *err)
 {
     importer im;
     evr_scene *s;
@@ -299,6 +306,10 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     if (im.gltf && bytes) {
         if ((st = evr_gltf_side_parse(bytes, nbytes, &im.side, err)) != EVR_OK) goto fail;
         im.have_side = 1;
+        im.src.bytes = bytes;
+        im.src.nbytes = nbytes;
+        im.src.path = path;
+        im.src.dir = path ? dir : NULL;
     }
 
     if ((st = evr_import_materials(&im)) != EVR_OK) goto fail;
@@ -470,7 +481,8 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         src.nbytes = nbytes;
         src.path = path;
         src.dir = dir;
-        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
+        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
+            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
             free(bytes);
             return st;
         }
@@ -497,7 +509,7 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         free(bytes);
         return import_error(err, path);
     }
-    st = convert(ai, path, dir, ext, bytes, nbytes, &o, out, err);
+    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, out, err);
     free(bytes);
     aiReleaseImport(ai);
     return st;
@@ -534,7 +546,9 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         src.nbytes = size;
         src.path = NULL;
         src.dir = NULL;
-        if ((st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) return st;
+        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
+            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK)
+            return st;
     }
     props = make_props();
     if (!props) {
@@ -549,7 +563,7 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (ai) ai = join_vertices(ai);
     snprintf(source, sizeof source, "<memory>.%s", hint);
     if (!ai) return import_error(err, source);
-    st = convert(ai, source, "", hint, (const unsigned char *)data, size, &o, out, err);
+    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, out, err);
     aiReleaseImport(ai);
     return st;
 }

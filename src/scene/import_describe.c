@@ -162,6 +162,54 @@ static void describe_morphs(strbuf *b, const evr_scene *s, int max_list)
     if (n > listed) sb_printf(b, "  ... and %d more\n", n - listed);
 }
 
+/* Each material's model in one line: factors, textures, alpha, transmission and the rest that
+ * differs from the defaults. */
+static void describe_materials(strbuf *b, const evr_scene *s, int max_list)
+{
+    static const char *slot_names[EVR_TEX_COUNT] = {
+        "base", "metallic-roughness", "normal", "occlusion", "emissive", "transmission"};
+    int i, k, listed = 0;
+    for (i = 0; i < s->num_materials && listed < max_list; i++, listed++) {
+        const evr_material_params *p = &s->materials[i].p;
+        const char *sep = ", textures: ";
+        sb_printf(b, "  [%d] \"%s\": base (%.3g %.3g %.3g", i, s->materials[i].name,
+                  p->base_color[0], p->base_color[1], p->base_color[2]);
+        if (p->base_color[3] != 1.0f) sb_printf(b, " alpha %.3g", p->base_color[3]);
+        sb_printf(b, "), metal %.3g rough %.3g", p->metallic, p->roughness);
+        for (k = 0; k < EVR_TEX_COUNT; k++) {
+            const evr_texture_ref *t = &p->tex[k];
+            int moved = t->xf[0] != 1.0f || t->xf[1] != 0.0f || t->xf[2] != 0.0f ||
+                        t->xf[3] != 0.0f || t->xf[4] != 1.0f || t->xf[5] != 0.0f;
+            if (t->index < 0) continue;
+            sb_printf(b, "%s%s", sep, slot_names[k]);
+            if ((k == EVR_TEX_NORMAL || k == EVR_TEX_OCCLUSION) && t->scale != 1.0f)
+                sb_printf(b, " %.3g", t->scale);
+            if (moved) sb_printf(b, " (transformed)");
+            sep = ", ";
+        }
+        if (p->emissive[0] != 0.0f || p->emissive[1] != 0.0f || p->emissive[2] != 0.0f)
+            sb_printf(b, "; emissive (%.3g %.3g %.3g)", p->emissive[0], p->emissive[1],
+                      p->emissive[2]);
+        if (p->alpha_mode == EVR_ALPHA_MASK) sb_printf(b, "; alpha mask %.3g", p->alpha_cutoff);
+        else if (p->alpha_mode == EVR_ALPHA_BLEND) sb_printf(b, "; alpha blend");
+        if (p->transmission > 0.0f || p->tex[EVR_TEX_TRANSMISSION].index >= 0)
+            sb_printf(b, "; transmission %.3g", p->transmission);
+        if (p->ior != 1.5f || p->transmission > 0.0f) sb_printf(b, "; ior %.4g", p->ior);
+        if (p->thickness > 0.0f || isfinite(p->attenuation_distance))
+            sb_printf(b, "; volume thickness %.3g attenuation %.3g (%.3g %.3g %.3g)", p->thickness,
+                      p->attenuation_distance, p->attenuation_color[0], p->attenuation_color[1],
+                      p->attenuation_color[2]);
+        if (p->specular != 1.0f || p->specular_color[0] != 1.0f || p->specular_color[1] != 1.0f ||
+            p->specular_color[2] != 1.0f)
+            sb_printf(b, "; specular %.3g (%.3g %.3g %.3g)", p->specular, p->specular_color[0],
+                      p->specular_color[1], p->specular_color[2]);
+        if (p->unlit) sb_printf(b, "; unlit");
+        if (p->double_sided) sb_printf(b, "; double-sided");
+        sb_printf(b, "\n");
+    }
+    if (s->num_materials > listed) sb_printf(b, "  ... and %d more\n", s->num_materials - listed);
+}
+
 char *evr_scene_describe(const evr_scene *s)
 {
     strbuf b;
@@ -249,6 +297,7 @@ char *evr_scene_describe(const evr_scene *s)
     sb_printf(&b, "instances: %d (%llu triangles in the scene), nodes: %d\n", s->num_instances,
               (unsigned long long)inst_tris, s->num_nodes);
     sb_printf(&b, "materials: %d, textures: %d\n", s->num_materials, s->num_textures);
+    describe_materials(&b, s, max_list);
     sb_printf(&b, "bounds (rest pose): (%.4g %.4g %.4g) to (%.4g %.4g %.4g), size %.4g\n",
               s->bounds_min.x, s->bounds_min.y, s->bounds_min.z, s->bounds_max.x, s->bounds_max.y,
               s->bounds_max.z, evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min)));

@@ -1,7 +1,7 @@
 /* The glTF JSON read directly (the .gltf text or the GLB's JSON chunk), for what Assimp 5.2
  * drops or mangles: which channels exist and their interpolation (quirks (d), (e), (f) and STEP
- * in import.c), the nodes' morph weights (quirk (h)),
- * KHR_materials_emissive_strength and the materials' photon extras. */
+ * in import.c) and the nodes' morph weights (quirk (h)). The materials are read from the JSON
+ * in import_gltf_material.c. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,8 +17,6 @@ void evr_gltf_side_free(gltf_side *g)
     for (i = 0; i < g->num_nodes && g->node_names; i++) free(g->node_names[i]);
     free(g->node_names);
     free(g->ch);
-    free(g->emissive_strength);
-    free(g->t_extras);
     for (i = 0; i < g->num_nodes && g->node_weights; i++) free(g->node_weights[i]);
     free(g->node_weights);
     free(g->node_num_weights);
@@ -58,7 +56,7 @@ int evr_gltf_json_span(const unsigned char *data, size_t size, const char **json
 evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g, evr_error *err)
 {
     evr_jdoc d;
-    int root, nodes, anims, mats, i, a, m, cap = 0;
+    int root, nodes, anims, i, a, m, cap = 0;
     int *samplers = NULL;
     const char *json;
     size_t jlen;
@@ -77,18 +75,13 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
 
     nodes = evr_jdoc_get(&d, root, "nodes");
     anims = evr_jdoc_get(&d, root, "animations");
-    mats = evr_jdoc_get(&d, root, "materials");
     g->num_nodes = evr_jdoc_count(&d, nodes);
     g->num_anims = evr_jdoc_count(&d, anims);
-    g->num_materials = evr_jdoc_count(&d, mats);
+    g->num_materials = evr_jdoc_count(&d, evr_jdoc_get(&d, root, "materials"));
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
-    g->emissive_strength = calloc((size_t)g->num_materials + 1, sizeof *g->emissive_strength);
-    g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
     g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
     g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
-    if (!g->node_names || !g->emissive_strength || !g->t_extras || !g->node_num_weights ||
-        !g->node_weights)
-        goto nomem;
+    if (!g->node_names || !g->node_num_weights || !g->node_weights) goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
          m = evr_jdoc_next(&d, m), i++) {
@@ -151,18 +144,6 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         }
     }
     if (g->num_ch) qsort(g->ch, (size_t)g->num_ch, sizeof *g->ch, side_channel_cmp);
-    for (i = 0, m = g->num_materials ? evr_jdoc_first(&d, mats) : -1; m >= 0;
-         m = evr_jdoc_next(&d, m), i++) {
-        int es = evr_jdoc_get(
-            &d,
-            evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extensions"), "KHR_materials_emissive_strength"),
-            "emissiveStrength");
-        g->emissive_strength[i] = (float)evr_jdoc_number(&d, es, 1.0);
-        g->t_extras[2 * i] = (float)evr_jdoc_number(
-            &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_diffuse"), T_ABSENT);
-        g->t_extras[2 * i + 1] = (float)evr_jdoc_number(
-            &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_specular"), T_ABSENT);
-    }
     free(samplers);
     evr_jdoc_free(&d);
     return EVR_OK;

@@ -364,3 +364,51 @@ fail:
     free(vals);
     return st;
 }
+
+evr_status evr_gltf_image_source(gltf_data *g, int img, unsigned char **data, size_t *n, char *path,
+                                 size_t cap, evr_error *err)
+{
+    const evr_jdoc *d = g->d;
+    int uri = evr_jdoc_get(d, img, "uri"),
+        view = evr_gltf_index(d, evr_jdoc_get(d, img, "bufferView"));
+    evr_status st = EVR_OK;
+    *data = NULL;
+    *n = 0;
+    path[0] = 0;
+    if (uri >= 0) {
+        size_t len = d->v[uri].len + 1;
+        char *text = malloc(len);
+        if (!text) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading glTF images");
+        evr_jdoc_string(d, uri, text, len);
+        if (!strncmp(text, "data:", 5)) {
+            const char *comma = strchr(text, ',');
+            if (!comma || !strstr(text, ";base64,"))
+                st = evr_import_fail(err, EVR_ERR_FORMAT,
+                                     "glTF: an image's data: URI is not base64");
+            else if (!(*data = b64_decode(comma + 1, strlen(comma + 1), n)))
+                st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading glTF images");
+        } else {
+            char name[1024];
+            uri_decode(text, name, sizeof name);
+            /* a scene in memory: relative to the current folder, as Assimp would look */
+            snprintf(path, cap, "%s%s", g->src->dir && name[0] != '/' ? g->src->dir : "", name);
+        }
+        free(text);
+        return st;
+    }
+    if (view >= 0) {
+        const unsigned char *p;
+        size_t room;
+        int v = view < g->num_views ? g->view_v[view] : -1;
+        if (v < 0)
+            return evr_import_fail(err, EVR_ERR_FORMAT,
+                                   "glTF: an image's buffer view %d is missing", view);
+        if ((st = view_bytes(g, view, 0, &p, &room, NULL, -1, err)) != EVR_OK) return st;
+        if (!(*data = malloc(room + 1)))
+            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading glTF images");
+        memcpy(*data, p, room);
+        *n = room;
+        return EVR_OK;
+    }
+    return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: an image has neither uri nor bufferView");
+}

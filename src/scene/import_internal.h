@@ -7,8 +7,10 @@
  *   import_gltf_data.c glTF buffers and accessors read directly (data: URIs, files, GLB BIN)
  *   import_gltf_deform.c  glTF skins and morph targets checked before Assimp reads them
  *   import_memfile.c   an aiFileIO that serves Assimp a patched copy of the scene file
- *   import_texture.c   base colour textures: finding, decoding and linearizing them
- *   import_mesh.c      materials and triangle meshes
+ *   import_texture.c   textures: finding, decoding (sRGB for colour, as is for data), sharing
+ *   import_material.c  materials as Assimp gives them (every format but glTF)
+ *   import_gltf_material.c  glTF materials read from the JSON (checked before Assimp reads it)
+ *   import_mesh.c      triangle meshes (and their tangents: tangents.c)
  *   import_node.c      the node hierarchy, instances and rest-pose bounds
  *   import_clips.c     which animation clips play (the default rule or the caller's choice)
  *   import_anim.c      animation curves
@@ -52,8 +54,6 @@ typedef struct {
     side_channel *ch; /* sorted by node name, animation, path */
     int num_ch;
     int num_materials;
-    float *emissive_strength; /* KHR_materials_emissive_strength, 1 when absent */
-    float *t_extras; /* per material: extras.t_diffuse, extras.t_specular (T_ABSENT when absent) */
     int *node_num_weights; /* per node: the morph weights it gives (node.weights), 0: none */
     float **node_weights;  /* per node: those weights, or NULL */
 } gltf_side;
@@ -100,6 +100,10 @@ void evr_gltf_data_free(gltf_data *g);
 int evr_gltf_accessor(const gltf_data *g, int a);
 /* Accessor a's element count (-1 when there is no such accessor) and components per element. */
 int evr_gltf_accessor_count(const gltf_data *g, int a, int *ncomp);
+/* Image value img's encoded bytes: *data (free()) for a data: URI or a buffer view; else *data
+ * NULL and path the file (dir + its decoded uri). */
+evr_status evr_gltf_image_source(gltf_data *g, int img, unsigned char **data, size_t *n, char *path,
+                                 size_t cap, evr_error *err);
 /* Reads accessor a (SCALAR to VEC4; strides, normalized integers and sparse values applied)
  * into *out, count * ncomp doubles (free()). */
 evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count, int *ncomp,
@@ -139,9 +143,11 @@ typedef struct {
     int gltf;      /* Assimp's glTF 2.0 quirks apply */
     int have_side;
     gltf_side side;
+    gltf_source src; /* the glTF's bytes (bytes NULL: not glTF) */
     char **tex_keys; /* per scene texture: what it was loaded from (to share it) */
+    int *tex_srgb;   /* per scene texture: 1 when sRGB-decoded (a colour slot) */
     int tex_cap;
-    int *mat_uv;                    /* per material: UV channel of its base colour texture */
+    int *mat_uv; /* per material: the UV channel its textures use (the base colour's) */
     const struct aiNode **ai_nodes; /* per evr node */
     unsigned char *clip_played;     /* per aiAnimation: 1 when its curves are imported (NULL:
                                        every clip plays) */
@@ -167,8 +173,25 @@ evr_status evr_import_read_file(const char *path, size_t max, unsigned char **da
 /* Materials (with their textures) and then meshes: a mesh's UVs are its material's channel. */
 evr_status evr_import_materials(importer *im);
 evr_status evr_import_meshes(importer *im, uint64_t *total_tris);
-/* Loads (or shares) the texture Assimp names ai_path for material mat_name: *out its index. */
-evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat_name, int *out);
+/* Loads (or shares) the texture Assimp names ai_path for material mat_name, sRGB-decoded when
+ * srgb (a colour slot): *out its index. */
+evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat_name, int srgb,
+                              int *out);
+/* The same for an encoded image's bytes shared under key (data NULL: the file key), `what`
+ * naming it in messages. */
+evr_status evr_import_texture_image(importer *im, const char *key, const unsigned char *data,
+                                    size_t n, const char *what, int srgb, int *out);
+/* glTF: checks every material of the JSON (bad values, texture indices out of range) before
+ * Assimp reads the file: one error naming the material. A document that is not glTF 2.0 JSON
+ * passes unchecked. */
+evr_status evr_gltf_material_check(const gltf_source *src, evr_error *err);
+/* glTF: the materials of im->src's JSON (every property, textures loaded) into im->s->materials
+ * [0 .. *count), warnings for what evray does not render; im->mat_uv set. *count 0 when the
+ * document is not glTF 2.0 JSON. */
+evr_status evr_gltf_materials_read(importer *im, int *count);
+/* Tangents of mesh m (tangents.c): MikkTSpace's definition from its uvs (glTF's v, pointing down
+ * the image) and normals; m->tangents allocated. 0 when out of memory. */
+int evr_mesh_generate_tangents(evr_mesh *m);
 /* Flattens the node tree depth-first (parents before children) and makes the instances. */
 evr_status evr_import_nodes(importer *im);
 /* The first node (in depth-first order) with Assimp name `name`, or -1. */

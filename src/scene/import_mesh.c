@@ -1,5 +1,6 @@
-/* Materials (metallic-roughness factors, emission, the photon thresholds, the base colour
- * texture) and triangle meshes (positions, unit normals, the material's UV channel). */
+/* Triangle meshes: positions, unit normals, the material's uv channel, and tangents for a
+ * material with a normal texture (the file's, else generated: tangents.c). Materials are read
+ * before (import_material.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,96 +9,49 @@
 #include <assimp/scene.h>
 #include <assimp/material.h>
 
-#include "core/photon.h"
 #include "scene/import_internal.h"
 
-evr_status evr_import_materials(importer *im)
+/* Tangents for a mesh whose material has a normal texture: the file's (Assimp's mTangents and
+ * mBitangents; w is the sign of the bitangent against cross(normal, tangent)), made orthogonal to
+ * the normal, else generated from the uvs. A skinned or morphed mesh keeps its rest tangents (the
+ * shading makes them orthogonal to the deformed normal). Without uvs: none, and a warning. */
+static evr_status mesh_tangents(importer *im, const struct aiMesh *am, evr_mesh *m)
 {
-    const struct aiScene *ai = im->ai;
-    evr_scene *s = im->s;
-    unsigned i;
-    int n = ai->mNumMaterials ? (int)ai->mNumMaterials : 1; /* at least a default one */
-
-    s->materials = calloc((size_t)n, sizeof *s->materials);
-    im->mat_uv = calloc((size_t)n, sizeof *im->mat_uv);
-    if (!s->materials || !im->mat_uv)
-        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading materials");
-    s->num_materials = n;
-    for (i = 0; i < (unsigned)n; i++) {
-        evr_material_defaults(&s->materials[i].p);
+    uint32_t v;
+    int usable = am->mTangents && am->mBitangents;
+    if (!m->uvs) {
+        evr_import_warn(im, "mesh '%s': its material's normal texture needs uvs (not rendered)",
+                        m->name);
+        return EVR_OK;
     }
-    for (i = 0; i < ai->mNumMaterials; i++) {
-        const struct aiMaterial *am = ai->mMaterials[i];
-        evr_material *m = &s->materials[i];
-        struct aiString str;
-        struct aiColor4D c;
-        ai_real f;
-        unsigned int one = 1, uv = 0;
-        int tt;
-        static const enum aiTextureType kinds[2] = {aiTextureType_BASE_COLOR,
-                                                    aiTextureType_DIFFUSE};
-
-        if (aiGetMaterialString(am, AI_MATKEY_NAME, &str) == aiReturn_SUCCESS)
-            evr_import_copy_name(m->name, sizeof m->name, str.data);
-        else snprintf(m->name, sizeof m->name, "material%u", i);
-        if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS ||
-            aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS) {
-            m->p.base_color[0] = c.r;
-            m->p.base_color[1] = c.g;
-            m->p.base_color[2] = c.b;
-            m->p.base_color[3] = c.a;
-        }
-        if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS) {
-            float k = 1.0f;
-            one = 1;
-            if (aiGetMaterialFloatArray(am, AI_MATKEY_EMISSIVE_INTENSITY, &f, &one) ==
-                aiReturn_SUCCESS)
-                k = (float)f;
-            else if (im->have_side && (int)i < im->side.num_materials)
-                k = im->side.emissive_strength[i];
-            m->p.emissive[0] = c.r * k;
-            m->p.emissive[1] = c.g * k;
-            m->p.emissive[2] = c.b * k;
-        }
-        one = 1;
-        if (aiGetMaterialFloatArray(am, AI_MATKEY_METALLIC_FACTOR, &f, &one) == aiReturn_SUCCESS)
-            m->p.metallic = (float)f;
-        one = 1;
-        if (aiGetMaterialFloatArray(am, AI_MATKEY_ROUGHNESS_FACTOR, &f, &one) == aiReturn_SUCCESS)
-            m->p.roughness = (float)f;
-        evr_photon_material_map(m->p.base_color, m->p.metallic, m->p.roughness, &m->p.t_diffuse,
-                                &m->p.t_specular);
-        if (im->have_side && (int)i < im->side.num_materials &&
-            (im->side.t_extras[2 * i] != T_ABSENT || im->side.t_extras[2 * i + 1] != T_ABSENT)) {
-            float td = im->side.t_extras[2 * i], ts = im->side.t_extras[2 * i + 1];
-            if (td == T_ABSENT) td = m->p.t_diffuse;
-            if (ts == T_ABSENT) ts = td > m->p.t_specular ? td : m->p.t_specular;
-            if (!(td >= 0.0f && td <= ts && ts <= 1.0f))
-                return evr_import_fail(
-                    im->err, EVR_ERR_FORMAT,
-                    "material '%s': extras need 0 <= t_diffuse <= t_specular <= 1 (got %g, %g)",
-                    m->name, (double)td, (double)ts);
-            m->p.t_diffuse = td;
-            m->p.t_specular = ts;
-        }
-
-        for (tt = 0; tt < 2; tt++) {
-            if (aiGetMaterialTextureCount(am, kinds[tt]) == 0) continue;
-            uv = 0;
-            if (aiGetMaterialTexture(am, kinds[tt], 0, &str, NULL, &uv, NULL, NULL, NULL, NULL) !=
-                    aiReturn_SUCCESS ||
-                !str.data[0])
-                continue;
-            {
-                evr_status st =
-                    evr_import_texture(im, str.data, m->name, &m->p.tex[EVR_TEX_BASE].index);
-                if (st != EVR_OK) return st;
+    if (usable) {
+        m->tangents = malloc((size_t)m->num_vertices * 4 * sizeof(float) + 1);
+        if (!m->tangents)
+            return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading tangents");
+        for (v = 0; v < m->num_vertices && usable; v++) {
+            evr_v3 n = evr_v3_make(m->normals[3 * v], m->normals[3 * v + 1], m->normals[3 * v + 2]);
+            evr_v3 t = evr_v3_make(am->mTangents[v].x, am->mTangents[v].y, am->mTangents[v].z);
+            evr_v3 b =
+                evr_v3_make(am->mBitangents[v].x, am->mBitangents[v].y, am->mBitangents[v].z);
+            float l;
+            t = evr_v3_sub(t, evr_v3_scale(n, evr_v3_dot(n, t)));
+            l = evr_v3_len(t);
+            if (!(l > 1e-12f) || !isfinite(l)) {
+                usable = 0; /* a degenerate tangent: generate them all instead */
+                break;
             }
-            im->mat_uv[i] = (int)uv;
-            break;
+            t = evr_v3_scale(t, 1.0f / l);
+            m->tangents[4 * v] = t.x;
+            m->tangents[4 * v + 1] = t.y;
+            m->tangents[4 * v + 2] = t.z;
+            m->tangents[4 * v + 3] = evr_v3_dot(evr_v3_cross(n, t), b) < 0.0f ? -1.0f : 1.0f;
         }
+        if (usable) return EVR_OK;
+        free(m->tangents);
+        m->tangents = NULL;
     }
-    if (!ai->mNumMaterials) strcpy(s->materials[0].name, "default");
+    if (!evr_mesh_generate_tangents(m))
+        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory generating tangents");
     return EVR_OK;
 }
 
@@ -219,6 +173,10 @@ evr_status evr_import_meshes(importer *im, uint64_t *total_tris)
                 m->uvs[2 * v] = am->mTextureCoords[uvch][v].x;
                 m->uvs[2 * v + 1] = am->mTextureCoords[uvch][v].y;
             }
+        }
+        if (s->materials[m->material].p.tex[EVR_TEX_NORMAL].index >= 0) {
+            evr_status st = mesh_tangents(im, am, m);
+            if (st != EVR_OK) return st;
         }
         *total_tris += ntri;
     }

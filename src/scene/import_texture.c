@@ -1,5 +1,8 @@
-/* Base colour textures: found beside the scene file or embedded in it, decoded with stb_image
- * and linearized to RGBA floats, each file loaded once however many materials use it. */
+/* Textures: found beside the scene file or embedded in it (Assimp's names), or given as bytes (a
+ * glTF image read from the JSON, import_gltf_material.c), decoded with stb_image to RGBA floats.
+ * Colour textures (base colour, emissive) are sRGB-decoded; data textures (metallic-roughness,
+ * normal, occlusion, transmission) keep their values (v / 255). Each image is loaded once per
+ * colour space however many materials use it: one image used both ways is decoded twice. */
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -13,15 +16,17 @@
 #include "core/shading.h"
 #include "scene/import_internal.h"
 
-/* The linear values of the 256 sRGB-encoded 8-bit levels. */
-static void srgb8_table(float lut[256])
+/* The values of the 256 8-bit levels: sRGB-decoded, or i / 255 for data. */
+static void level8_table(float lut[256], int srgb)
 {
-    for (int i = 0; i < 256; i++) lut[i] = evr_srgb_to_linear((float)i / 255.0f);
+    for (int i = 0; i < 256; i++)
+        lut[i] = srgb ? evr_srgb_to_linear((float)i / 255.0f) : (float)i / 255.0f;
 }
 
-/* Decodes an encoded image (PNG, JPEG, ...) into linear RGBA floats: HDR images are linear
- * already; 16- and 8-bit colour channels are sRGB-encoded, alpha is linear. */
-static evr_status decode_image(const unsigned char *data, size_t size, const char *what,
+/* Decodes an encoded image (PNG, JPEG, ...) into RGBA floats: HDR images are linear already;
+ * 16- and 8-bit colour channels are sRGB-decoded when srgb, else scaled to [0, 1]; alpha is
+ * linear. */
+static evr_status decode_image(const unsigned char *data, size_t size, const char *what, int srgb,
                                evr_texture *t, evr_error *err)
 {
     enum { HDR, BITS16, BITS8 } kind;
@@ -55,12 +60,12 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
         const unsigned short *p16 = px;
         for (i = 0; i < n * 4; i++) {
             float v = (float)p16[i] / 65535.0f;
-            t->rgba[i] = (i % 4 == 3) ? v : evr_srgb_to_linear(v);
+            t->rgba[i] = (i % 4 == 3 || !srgb) ? v : evr_srgb_to_linear(v);
         }
     } else {
         const unsigned char *p8 = px;
         float lut[256];
-        srgb8_table(lut);
+        level8_table(lut, srgb);
         for (i = 0; i < n * 4; i++) t->rgba[i] = (i % 4 == 3) ? (float)p8[i] / 255.0f : lut[p8[i]];
     }
     stbi_image_free(px);
@@ -70,14 +75,14 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
 }
 
 /* An uncompressed embedded texture: aiTexel (b, g, r, a bytes), row 0 first. */
-static evr_status decode_texels(const struct aiTexture *tex, const char *what, evr_texture *t,
-                                evr_error *err)
+static evr_status decode_texels(const struct aiTexture *tex, const char *what, int srgb,
+                                evr_texture *t, evr_error *err)
 {
     float lut[256];
     size_t i, n = (size_t)tex->mWidth * (size_t)tex->mHeight;
     if (!tex->pcData || tex->mWidth > INT_MAX || tex->mHeight > INT_MAX)
         return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: invalid embedded image", what);
-    srgb8_table(lut);
+    level8_table(lut, srgb);
     t->rgba = malloc(n * 4 * sizeof(float) + 1);
     if (!t->rgba)
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory decoding texture %s", what);
@@ -126,14 +131,83 @@ static int percent_decode(char *s)
     return changed;
 }
 
-evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat_name, int *out)
+/* The texture already loaded from key in this colour space, or -1. */
+static int find_texture(const importer *im, const char *key, int srgb)
+{
+    for (int i = 0; i < im->s->num_textures; i++)
+        if (im->tex_srgb[i] == srgb && !strcmp(im->tex_keys[i], key)) return i;
+    return -1;
+}
+
+/* Appends t (owned from here on) as the scene's next texture, loaded from key. */
+static evr_status add_texture(importer *im, const char *key, int srgb, evr_texture *t, int *out)
 {
     evr_scene *s = im->s;
+    if (s->num_textures == im->tex_cap) {
+        int ncap = im->tex_cap ? im->tex_cap * 2 : 8;
+        evr_texture *nt = realloc(s->textures, (size_t)ncap * sizeof *nt);
+        char **nk = NULL;
+        int *ns = NULL;
+        if (nt) s->textures = nt;
+        if (nt && (nk = realloc(im->tex_keys, (size_t)ncap * sizeof *nk))) im->tex_keys = nk;
+        if (nk && (ns = realloc(im->tex_srgb, (size_t)ncap * sizeof *ns))) im->tex_srgb = ns;
+        if (!ns) {
+            free(t->rgba);
+            return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
+        }
+        im->tex_cap = ncap;
+    }
+    im->tex_keys[s->num_textures] = malloc(strlen(key) + 1);
+    if (!im->tex_keys[s->num_textures]) {
+        free(t->rgba);
+        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
+    }
+    strcpy(im->tex_keys[s->num_textures], key);
+    im->tex_srgb[s->num_textures] = srgb;
+    t->levels = 1;
+    s->textures[s->num_textures] = *t;
+    *out = s->num_textures++;
+    return EVR_OK;
+}
+
+/* A file's texture: decoded once per colour space. */
+static evr_status load_file(importer *im, const char *key, const char *what, int srgb, int *out)
+{
+    unsigned char *data = NULL;
+    size_t size = 0;
+    evr_texture t;
+    evr_status st;
+    evr_error e;
+    memset(&t, 0, sizeof t);
+    if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
+    st = evr_import_read_file(key, 0, &data, &size, &e);
+    if (st != EVR_OK) return evr_import_fail(im->err, st, "texture %s: %s", what, e.msg);
+    st = decode_image(data, size, what, srgb, &t, im->err);
+    free(data);
+    if (st != EVR_OK) return st;
+    return add_texture(im, key, srgb, &t, out);
+}
+
+evr_status evr_import_texture_image(importer *im, const char *key, const unsigned char *data,
+                                    size_t n, const char *what, int srgb, int *out)
+{
+    evr_texture t;
+    evr_status st;
+    memset(&t, 0, sizeof t);
+    if (!data) return load_file(im, key, what, srgb, out);
+    if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
+    if ((st = decode_image(data, n, what, srgb, &t, im->err)) != EVR_OK) return st;
+    return add_texture(im, key, srgb, &t, out);
+}
+
+evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat_name, int srgb,
+                              int *out)
+{
     const struct aiScene *ai = im->ai;
     char key[1100], what[1200];
     int emb = -1, i;
     evr_status st;
-    evr_texture t = {0};
+    evr_texture t;
 
     memset(&t, 0, sizeof t);
     *out = -1;
@@ -176,56 +250,20 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
             }
         }
     }
-    for (i = 0; i < s->num_textures; i++) {
-        if (!strcmp(im->tex_keys[i], key)) {
-            *out = i;
-            return EVR_OK;
-        }
-    }
     snprintf(what, sizeof what, "'%s' of material '%s'", ai_path, mat_name);
-
-    if (emb >= 0) {
+    if (emb < 0) return load_file(im, key, what, srgb, out);
+    if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
+    {
         const struct aiTexture *tex = ai->mTextures[emb];
         if (tex->mHeight == 0) {
             if (!tex->pcData)
                 return evr_import_fail(im->err, EVR_ERR_FORMAT, "texture %s: no image data", what);
-            st = decode_image((const unsigned char *)tex->pcData, tex->mWidth, what, &t, im->err);
+            st = decode_image((const unsigned char *)tex->pcData, tex->mWidth, what, srgb, &t,
+                              im->err);
         } else {
-            st = decode_texels(tex, what, &t, im->err);
+            st = decode_texels(tex, what, srgb, &t, im->err);
         }
-    } else {
-        unsigned char *data = NULL;
-        size_t size = 0;
-        {
-            evr_error e;
-            st = evr_import_read_file(key, 0, &data, &size, &e);
-            if (st != EVR_OK) return evr_import_fail(im->err, st, "texture %s: %s", what, e.msg);
-        }
-        st = decode_image(data, size, what, &t, im->err);
-        free(data);
     }
     if (st != EVR_OK) return st;
-
-    if (s->num_textures == im->tex_cap) {
-        int ncap = im->tex_cap ? im->tex_cap * 2 : 8;
-        evr_texture *nt = realloc(s->textures, (size_t)ncap * sizeof *nt);
-        char **nk;
-        if (nt) s->textures = nt;
-        nk = nt ? realloc(im->tex_keys, (size_t)ncap * sizeof *nk) : NULL;
-        if (nk) im->tex_keys = nk;
-        if (!nt || !nk) {
-            free(t.rgba);
-            return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
-        }
-        im->tex_cap = ncap;
-    }
-    im->tex_keys[s->num_textures] = malloc(strlen(key) + 1);
-    if (!im->tex_keys[s->num_textures]) {
-        free(t.rgba);
-        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory loading textures");
-    }
-    strcpy(im->tex_keys[s->num_textures], key);
-    s->textures[s->num_textures] = t;
-    *out = s->num_textures++;
-    return EVR_OK;
+    return add_texture(im, key, srgb, &t, out);
 }
