@@ -54,16 +54,16 @@ struct evr_material_params {
      * extras "t_diffuse" and "t_specular" when the glTF gives them, else from the BSDF
      * (evr_photon_material_map) */
     float t_diffuse, t_specular;
-    float metallic, roughness; /* factors (perceptual roughness; GGX alpha = roughness^2) */
-    int alpha_mode;            /* EVR_ALPHA_* */
-    float alpha_cutoff;        /* MASK: alpha below it is a hole */
-    int double_sided;          /* 0: back faces are culled for camera and secondary rays */
-    int unlit;                 /* KHR_materials_unlit: radiance = base colour */
-    float transmission;        /* KHR_materials_transmission factor */
-    float ior;                 /* KHR_materials_ior (1.5) */
-    float specular;            /* KHR_materials_specular factor (1) */
-    float specular_color[3];   /* KHR_materials_specular colour factor (1, 1, 1) */
-    float thickness;           /* KHR_materials_volume: 0 thin-walled */
+    float metallic, roughness;  /* factors (perceptual roughness; GGX alpha = roughness^2) */
+    int alpha_mode;             /* EVR_ALPHA_* */
+    float alpha_cutoff;         /* MASK: alpha below it is a hole */
+    int double_sided;           /* 0: back faces are culled for camera and secondary rays */
+    int unlit;                  /* KHR_materials_unlit: radiance = base colour */
+    float transmission;         /* KHR_materials_transmission factor */
+    float ior;                  /* KHR_materials_ior (1.5) */
+    float specular;             /* KHR_materials_specular factor (1) */
+    float specular_color[3];    /* KHR_materials_specular colour factor (1, 1, 1) */
+    float thickness;            /* KHR_materials_volume: 0 thin-walled */
     float attenuation_distance; /* KHR_materials_volume: INFINITY none */
     float attenuation_color[3];
     evr_texture_ref tex[EVR_TEX_COUNT];
@@ -76,7 +76,13 @@ typedef struct {
     evr_v3 n; /* world shading normal, facing the incoming ray */
     float albedo[3];
     float emissive[3];
+    /* the ray's footprint at the hit in uv units, as log2 of its width (evr_texture_lod; a
+     * texture's level: evr_texture_level); EVR_TEX_LOD_SHARPEST: level 0 */
+    float tex_lod;
 } evr_surface;
+
+/* A footprint of no width: every texture's level 0. */
+#define EVR_TEX_LOD_SHARPEST (-100.0f)
 
 /* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
 EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v,
@@ -99,6 +105,63 @@ EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float 
             (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
 }
 
+/* ---- textures filtered by the ray's footprint: mip levels (core/render_scene.h's layout) ---- */
+
+/* Trilinear lookup: bilinear (evr_texture_bilinear, repeat wrapping) in levels floor(lod) and
+ * floor(lod) + 1, blended by lod's fraction; lod is clamped to [0, t->levels - 1] (lod 0 is
+ * evr_texture_bilinear of level 0 exactly). */
+EVR_HD static inline void evr_texture_sample(const evr_texture_view *t, float u, float v, float lod,
+                                             float out[4])
+{
+    const float l = fminf(fmaxf(lod, 0.0f), (float)(t->levels - 1));
+    const int k = (int)floorf(l);
+    const float a = l - (float)k;
+    evr_texture_view lv = evr_texture_level_view(t, k);
+    evr_texture_bilinear(&lv, u, v, out);
+    if (a > 0.0f) { /* k + 1 < levels: the next level follows this one */
+        float o1[4];
+        lv.rgba += 4 * (long)lv.width * lv.height;
+        lv.width = evr_mip_size(t->width, k + 1);
+        lv.height = evr_mip_size(t->height, k + 1);
+        evr_texture_bilinear(&lv, u, v, o1);
+        for (int c = 0; c < 4; c++) out[c] = out[c] * (1.0f - a) + o1[c] * a;
+    }
+}
+
+/* The footprint of a ray cone at a hit in uv units, as log2 of its width: the cone's width there
+ * (world units) stretched by 1 / |cos| of the angle between the ray and the triangle's normal,
+ * times the triangle's uv per world length, sqrt(uv_area / world_area) (the ray-cone level of
+ * detail of Akenine-Moller et al., "Texture Level of Detail Strategies for Real-Time Ray
+ * Tracing", Ray Tracing Gems, ch. 20, with the texture's size left to evr_texture_level). The
+ * areas may both be doubled. EVR_TEX_LOD_SHARPEST for a cone of no width or a degenerate
+ * triangle. */
+EVR_HD static inline float evr_texture_lod(float cone_width, float cos_theta, float world_area,
+                                           float uv_area)
+{
+    if (!(cone_width > 0.0f) || !(world_area > 0.0f) || !(uv_area > 0.0f))
+        return EVR_TEX_LOD_SHARPEST;
+    const float c = fmaxf(fabsf(cos_theta), 1e-4f); /* grazing: the coarsest level anyway */
+    return fmaxf(log2f(cone_width / c * sqrtf(uv_area / world_area)), EVR_TEX_LOD_SHARPEST);
+}
+
+/* The level of texture t, used by slot r, for a footprint of lod_uv (evr_texture_lod): its
+ * texels per uv unit, sqrt(width * height), times the slot's uv transform's scale,
+ * sqrt(|det|) of its 2 x 2 part, added in log2. */
+EVR_HD static inline float evr_texture_level(const evr_texture_view *t, const evr_texture_ref *r,
+                                             float lod_uv)
+{
+    const float det = fabsf(r->xf[0] * r->xf[4] - r->xf[1] * r->xf[3]);
+    return lod_uv + 0.5f * log2f((float)t->width * (float)t->height * fmaxf(det, 1e-30f));
+}
+
+/* Whether material mat samples any texture. */
+EVR_HD static inline int evr_material_textured(const evr_material_params *mat)
+{
+    for (int i = 0; i < EVR_TEX_COUNT; i++)
+        if (mat->tex[i].index >= 0) return 1;
+    return 0;
+}
+
 /* The uv a texture slot samples at mesh uv (u, v): its KHR_texture_transform applied. */
 EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, float v, float *tu,
                                          float *tv)
@@ -107,7 +170,8 @@ EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, floa
     *tv = t->xf[3] * u + t->xf[4] * v + t->xf[5];
 }
 
-/* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m. */
+/* The material record of s at barycentrics (w, u, v) of the triangle (i0, i1, i2) of mesh m;
+ * textures are filtered by the footprint s->tex_lod (evr_surface_at sets it first). */
 EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_mesh_view *m,
                                           uint32_t i0, uint32_t i1, uint32_t i2, float w, float u,
                                           float v, evr_surface *s)
@@ -120,7 +184,9 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
         float tu = w * m->uvs[2 * i0] + u * m->uvs[2 * i1] + v * m->uvs[2 * i2];
         float tv = w * m->uvs[2 * i0 + 1] + u * m->uvs[2 * i1 + 1] + v * m->uvs[2 * i2 + 1];
         float tex[4];
-        evr_texture_bilinear(&rs->textures[mat->tex[EVR_TEX_BASE].index], tu, tv, tex);
+        const evr_texture_view *t = &rs->textures[mat->tex[EVR_TEX_BASE].index];
+        evr_texture_sample(t, tu, tv, evr_texture_level(t, &mat->tex[EVR_TEX_BASE], s->tex_lod),
+                           tex);
         s->albedo[0] *= tex[0];
         s->albedo[1] *= tex[1];
         s->albedo[2] *= tex[2];

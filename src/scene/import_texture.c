@@ -1,5 +1,6 @@
 /* Base colour textures: found beside the scene file or embedded in it, decoded with stb_image
- * and linearized to RGBA floats, each file loaded once however many materials use it. */
+ * and linearized to RGBA floats, their mip levels appended (texture_mips.c), each file loaded
+ * once however many materials use it. */
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -12,6 +13,7 @@
 
 #include "core/shading.h"
 #include "scene/import_internal.h"
+#include "scene/texture_mips.h"
 
 /* The linear values of the 256 sRGB-encoded 8-bit levels. */
 static void srgb8_table(float lut[256])
@@ -205,6 +207,11 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         free(data);
     }
     if (st != EVR_OK) return st;
+    st = evr_texture_build_mips(&t, im->err);
+    if (st != EVR_OK) {
+        free(t.rgba);
+        return st;
+    }
 
     if (s->num_textures == im->tex_cap) {
         int ncap = im->tex_cap ? im->tex_cap * 2 : 8;
