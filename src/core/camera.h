@@ -25,6 +25,14 @@ EVR_HD static inline evr_camera_intr evr_camera_intr_make(int width, int height,
     return c;
 }
 
+/* The angle one pixel subtends at the image centre (radians): the spread angle of the ray cone
+ * through a pixel, whose width at distance t is about spread * t (core/material.h's
+ * evr_texture_lod). */
+EVR_HD static inline float evr_camera_pixel_spread(const evr_camera_intr *c)
+{
+    return atanf(2.0f * c->tan_half_y / (float)c->height);
+}
+
 /* Ray through image position (px, py) in pixels (pixel x's centre is x + 0.5). */
 EVR_HD static inline evr_ray evr_camera_ray(const evr_camera_intr *c, const evr_m34 *pose, float px,
                                             float py)

@@ -93,7 +93,13 @@ typedef struct {
     int material;
     int unlit;
     int front; /* the ray met the face the vertex normals point out of */
+    /* the ray's footprint at the hit in uv units, as log2 of its width (evr_texture_lod; a
+     * texture's level: evr_texture_level); EVR_TEX_LOD_SHARPEST: level 0 */
+    float tex_lod;
 } evr_surface;
+
+/* A footprint of no width: every texture's level 0. */
+#define EVR_TEX_LOD_SHARPEST (-100.0f)
 
 /* Bilinear texture lookup with repeat wrapping; glTF uv (0,0) is the image's top-left. */
 EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float u, float v,
@@ -116,6 +122,63 @@ EVR_HD static inline void evr_texture_bilinear(const evr_texture_view *t, float 
             (p00[c] * (1 - ax) + p10[c] * ax) * (1 - ay) + (p01[c] * (1 - ax) + p11[c] * ax) * ay;
 }
 
+/* ---- textures filtered by the ray's footprint: mip levels (core/render_scene.h's layout) ---- */
+
+/* Trilinear lookup: bilinear (evr_texture_bilinear, repeat wrapping) in levels floor(lod) and
+ * floor(lod) + 1, blended by lod's fraction; lod is clamped to [0, t->levels - 1] (lod 0 is
+ * evr_texture_bilinear of level 0 exactly). */
+EVR_HD static inline void evr_texture_sample(const evr_texture_view *t, float u, float v, float lod,
+                                             float out[4])
+{
+    const float l = fminf(fmaxf(lod, 0.0f), (float)(t->levels - 1));
+    const int k = (int)floorf(l);
+    const float a = l - (float)k;
+    evr_texture_view lv = evr_texture_level_view(t, k);
+    evr_texture_bilinear(&lv, u, v, out);
+    if (a > 0.0f) { /* k + 1 < levels: the next level follows this one */
+        float o1[4];
+        lv.rgba += 4 * (long)lv.width * lv.height;
+        lv.width = evr_mip_size(t->width, k + 1);
+        lv.height = evr_mip_size(t->height, k + 1);
+        evr_texture_bilinear(&lv, u, v, o1);
+        for (int c = 0; c < 4; c++) out[c] = out[c] * (1.0f - a) + o1[c] * a;
+    }
+}
+
+/* The footprint of a ray cone at a hit in uv units, as log2 of its width: the cone's width there
+ * (world units) stretched by 1 / |cos| of the angle between the ray and the triangle's normal,
+ * times the triangle's uv per world length, sqrt(uv_area / world_area) (the ray-cone level of
+ * detail of Akenine-Moller et al., "Texture Level of Detail Strategies for Real-Time Ray
+ * Tracing", Ray Tracing Gems, ch. 20, with the texture's size left to evr_texture_level). The
+ * areas may both be doubled. EVR_TEX_LOD_SHARPEST for a cone of no width or a degenerate
+ * triangle. */
+EVR_HD static inline float evr_texture_lod(float cone_width, float cos_theta, float world_area,
+                                           float uv_area)
+{
+    if (!(cone_width > 0.0f) || !(world_area > 0.0f) || !(uv_area > 0.0f))
+        return EVR_TEX_LOD_SHARPEST;
+    const float c = fmaxf(fabsf(cos_theta), 1e-4f); /* grazing: the coarsest level anyway */
+    return fmaxf(log2f(cone_width / c * sqrtf(uv_area / world_area)), EVR_TEX_LOD_SHARPEST);
+}
+
+/* The level of texture t, used by slot r, for a footprint of lod_uv (evr_texture_lod): its
+ * texels per uv unit, sqrt(width * height), times the slot's uv transform's scale,
+ * sqrt(|det|) of its 2 x 2 part, added in log2. */
+EVR_HD static inline float evr_texture_level(const evr_texture_view *t, const evr_texture_ref *r,
+                                             float lod_uv)
+{
+    const float det = fabsf(r->xf[0] * r->xf[4] - r->xf[1] * r->xf[3]);
+    return lod_uv + 0.5f * log2f((float)t->width * (float)t->height * fmaxf(det, 1e-30f));
+}
+
+/* Whether material mat samples any texture. */
+EVR_HD static inline int evr_material_textured(const evr_material_params *mat)
+{
+    for (int i = 0; i < EVR_TEX_COUNT; i++)
+        if (mat->tex[i].index >= 0) return 1;
+    return 0;
+}
+
 /* The uv a texture slot samples at mesh uv (u, v): its KHR_texture_transform applied. */
 EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, float v, float *tu,
                                          float *tv)
@@ -124,14 +187,16 @@ EVR_HD static inline void evr_texture_uv(const evr_texture_ref *t, float u, floa
     *tv = t->xf[3] * u + t->xf[4] * v + t->xf[5];
 }
 
-/* Texture slot t at mesh uv (u, v); 0 when the slot is empty (out untouched). */
+/* Texture slot t at mesh uv (u, v), filtered for the footprint lod (evr_surface.tex_lod); 0
+ * when the slot is empty (out untouched). */
 EVR_HD static inline int evr_material_texture(const evr_render_scene *rs, const evr_texture_ref *t,
-                                              float u, float v, float out[4])
+                                              float u, float v, float lod, float out[4])
 {
     if (t->index < 0) return 0;
     float tu, tv;
+    const evr_texture_view *tex = &rs->textures[t->index];
     evr_texture_uv(t, u, v, &tu, &tv);
-    evr_texture_bilinear(&rs->textures[t->index], tu, tv, out);
+    evr_texture_sample(tex, tu, tv, evr_texture_level(tex, t, lod), out);
     return 1;
 }
 
@@ -141,7 +206,8 @@ EVR_HD static inline float evr_material_alpha(const evr_render_scene *rs,
                                               float v)
 {
     float a = mat->base_color[3], tex[4];
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], u, v, tex)) a *= tex[3];
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], u, v, EVR_TEX_LOD_SHARPEST, tex))
+        a *= tex[3];
     return a;
 }
 
@@ -202,7 +268,7 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
     s->albedo[1] = mat->base_color[1];
     s->albedo[2] = mat->base_color[2];
     s->opacity = mat->alpha_mode == EVR_ALPHA_BLEND ? mat->base_color[3] : 1.0f;
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], tu, tv, tex)) {
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_BASE], tu, tv, s->tex_lod, tex)) {
         s->albedo[0] *= tex[0];
         s->albedo[1] *= tex[1];
         s->albedo[2] *= tex[2];
@@ -211,26 +277,28 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
     s->emissive[0] = mat->emissive[0];
     s->emissive[1] = mat->emissive[1];
     s->emissive[2] = mat->emissive[2];
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_EMISSIVE], tu, tv, tex)) {
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_EMISSIVE], tu, tv, s->tex_lod, tex)) {
         s->emissive[0] *= tex[0];
         s->emissive[1] *= tex[1];
         s->emissive[2] *= tex[2];
     }
     s->metallic = fminf(fmaxf(mat->metallic, 0.0f), 1.0f);
     s->rough = fminf(fmaxf(mat->roughness, 0.0f), 1.0f);
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_METALLIC_ROUGHNESS], tu, tv, tex)) {
+    if (uv_ok &&
+        evr_material_texture(rs, &mat->tex[EVR_TEX_METALLIC_ROUGHNESS], tu, tv, s->tex_lod, tex)) {
         s->rough *= tex[1];
         s->metallic *= tex[2];
     }
     s->alpha = fmaxf(s->rough * s->rough, EVR_GGX_ALPHA_MIN);
     s->occlusion = 1.0f;
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_OCCLUSION], tu, tv, tex))
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_OCCLUSION], tu, tv, s->tex_lod, tex))
         s->occlusion = 1.0f + mat->tex[EVR_TEX_OCCLUSION].scale * (tex[0] - 1.0f);
     s->eta = 1.0f / fmaxf(mat->ior, 1.0f);
     s->n = s->nv;
     /* normal map: the tangent frame Gram-Schmidt orthogonalized against the vertex normal as the
      * ray sees it (a back face's normal is flipped, its bitangent with it) */
-    if (uv_ok && m->tangents && evr_material_texture(rs, &mat->tex[EVR_TEX_NORMAL], tu, tv, tex)) {
+    if (uv_ok && m->tangents &&
+        evr_material_texture(rs, &mat->tex[EVR_TEX_NORMAL], tu, tv, s->tex_lod, tex)) {
         const float ns = mat->tex[EVR_TEX_NORMAL].scale;
         evr_v3 t = evr_v3_sub(tw, evr_v3_scale(s->nv, evr_v3_dot(tw, s->nv)));
         const float tl = evr_v3_len(t);
@@ -253,7 +321,7 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
         }
     }
     float tr = mat->transmission;
-    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_TRANSMISSION], tu, tv, tex))
+    if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_TRANSMISSION], tu, tv, s->tex_lod, tex))
         tr *= tex[0];
     evr_material_params eff = *mat;
     eff.transmission = tr;

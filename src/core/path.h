@@ -17,6 +17,7 @@ typedef struct {
     evr_ray ray;
     float tnear;
     float w[3]; /* what its radiance is worth at the pixel */
+    float cone; /* width of the pixel's ray cone at its origin (texture filtering) */
     int depth;  /* reflections and refractions before it */
     int medium; /* material whose volume it travels in, -1: none */
 } evr_path_ray;
@@ -43,8 +44,8 @@ EVR_HD static inline int evr_refract_dir(evr_v3 d, evr_v3 n, float eta, evr_v3 *
 /* Pushes a ray from p along dir worth w (when it is worth tracing and there is room); returns
  * 0 when it is not pushed (the caller takes the ambient light for it). */
 EVR_HD static inline int evr_path_push(const evr_render_scene *rs, evr_path_stack *st, evr_v3 p,
-                                       evr_v3 dir, evr_v3 nv, const float w[3], int depth,
-                                       int medium)
+                                       evr_v3 dir, evr_v3 nv, const float w[3], float cone,
+                                       int depth, int medium)
 {
     if (depth > rs->max_bounces || st->n >= EVR_PATH_STACK) return 0;
     if (evr_luminance(w[0], w[1], w[2]) < EVR_PATH_MIN_WEIGHT) return 0;
@@ -53,17 +54,18 @@ EVR_HD static inline int evr_path_push(const evr_render_scene *rs, evr_path_stac
     r->ray.dir = dir;
     r->tnear = rs->ray_eps / fmaxf(fabsf(evr_v3_dot(nv, dir)), 0.05f);
     r->w[0] = w[0], r->w[1] = w[1], r->w[2] = w[2];
+    r->cone = cone;
     r->depth = depth;
     r->medium = medium;
     return 1;
 }
 
 /* The radiance of surface s, met by ray along d with its path's weight w at depth `depth` in
- * medium `medium`, from its lights' sum acc: adds w times what it sends back to out and pushes
+ * medium `medium` (its ray cone `cone` wide at s), from its lights' sum acc: adds w times what it sends back to out and pushes
  * the rays its coverage, reflection and refraction continue along. */
 EVR_HD static inline void evr_path_shade(const evr_render_scene *rs, const evr_surface *s, evr_v3 d,
-                                         const float acc[3], const float w[3], int depth,
-                                         int medium, evr_path_stack *st, float out[3])
+                                         const float acc[3], const float w[3], float cone,
+                                         int depth, int medium, evr_path_stack *st, float out[3])
 {
     const evr_material_params *mat = &rs->materials[s->material];
     const float a = s->opacity;
@@ -86,16 +88,16 @@ EVR_HD static inline void evr_path_shade(const evr_render_scene *rs, const evr_s
             }
         }
         if (wt[0] > 0.0f || wt[1] > 0.0f || wt[2] > 0.0f)
-            trans = evr_path_push(rs, st, s->p, dir, s->nv, wt, depth + 1, med);
+            trans = evr_path_push(rs, st, s->p, dir, s->nv, wt, cone, depth + 1, med);
     }
     if (evr_material_mirror(s)) {
         evr_v3 r = evr_v3_norm(evr_mirror_dir(d, s->n));
         if (evr_v3_dot(r, s->nv) <= 0.0f) r = evr_v3_norm(evr_mirror_dir(d, s->nv));
-        refl = evr_path_push(rs, st, s->p, r, s->nv, wr, depth + 1, medium);
+        refl = evr_path_push(rs, st, s->p, r, s->nv, wr, cone, depth + 1, medium);
     }
     evr_material_radiance(s, evr_v3_scale(d, -1.0f), acc, rs->ambient, refl, trans, rgb);
     for (c = 0; c < 3; c++) out[c] += w[c] * a * rgb[c];
-    if (a < 1.0f && !evr_path_push(rs, st, s->p, d, s->nv, wb, depth + 1, medium))
+    if (a < 1.0f && !evr_path_push(rs, st, s->p, d, s->nv, wb, cone, depth + 1, medium))
         for (c = 0; c < 3; c++) out[c] += wb[c] * rs->ambient;
 }
 
@@ -122,26 +124,29 @@ EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr
                         powf(fmaxf(m->attenuation_color[c], 1e-6f), h.t / m->attenuation_distance);
         }
         const evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), f);
+        const float cone = pr.cone + evr_camera_pixel_spread(&rs->camera) * h.t;
         evr_surface s;
-        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, f, pr.ray, h.t, &s);
+        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, f, pr.ray, h.t, cone, &s);
         float acc[3];
         evr_shade_direct_sum(rs, &s, evr_v3_scale(pr.ray.dir, -1.0f), f, o, rays, acc);
-        evr_path_shade(rs, &s, pr.ray.dir, acc, w, pr.depth, pr.medium, st, out);
+        evr_path_shade(rs, &s, pr.ray.dir, acc, w, cone, pr.depth, pr.medium, st, out);
     }
 }
 
-/* The sensor intensity of a camera ray along d whose hit s has the lights' sum acc, with every
+/* The sensor intensity of a camera ray along d whose hit s at distance t_hit has the lights' sum
+ * acc, with every
  * reflection and refraction its path takes; *deep is set when the path went beyond the
  * primary hit (change-driven sampling then treats the pixel as seeing the whole scene). */
 EVR_HD static inline float evr_path_intensity(const evr_render_scene *rs, const evr_surface *s,
-                                              evr_v3 d, const float acc[3], struct evr_occlusion *o,
-                                              float f, unsigned *rays, int *deep)
+                                              evr_v3 d, float t_hit, const float acc[3],
+                                              struct evr_occlusion *o, float f, unsigned *rays,
+                                              int *deep)
 {
     const float w[3] = {1.0f, 1.0f, 1.0f};
     float out[3] = {0.0f, 0.0f, 0.0f};
     evr_path_stack st;
     st.n = 0;
-    evr_path_shade(rs, s, d, acc, w, 0, -1, &st, out);
+    evr_path_shade(rs, s, d, acc, w, evr_camera_pixel_spread(&rs->camera) * t_hit, 0, -1, &st, out);
     if (st.n > 0) {
         *deep = 1;
         evr_path_follow(rs, o, f, &st, rays, out);

@@ -19,11 +19,41 @@ typedef struct {
 typedef struct evr_material_params evr_material_params;
 
 /* A texture and its mip levels: level 0 is width x height texels, level k+1 halves level k
- * (rounded down, at least 1) and follows it in rgba; 4 floats per texel, rows from v = 0. */
+ * (rounded down, at least 1: evr_mip_size) and follows it in rgba, levels in all (down to 1 x 1
+ * when built at import: scene/texture_mips.c); 4 floats per texel, rows from v = 0. Level k
+ * starts at 4 * (the texels of levels 0 .. k-1): evr_texture_level_view. */
 typedef struct {
     int width, height, levels; /* levels >= 1 */
     const float *rgba;
 } evr_texture_view;
+
+/* The size along one axis of level k of a texture n texels wide: floor(n / 2^k), at least 1. */
+EVR_HD static inline int evr_mip_size(int n, int k)
+{
+    int m = k < 31 ? n >> k : 0;
+    return m > 0 ? m : 1;
+}
+
+/* The texels of t's levels 0 .. k-1: where level k starts, in texels (k = t->levels: all). */
+EVR_HD static inline long evr_texture_texels(const evr_texture_view *t, int k)
+{
+    long n = 0;
+    for (int i = 0; i < k; i++)
+        n += (long)evr_mip_size(t->width, i) * (long)evr_mip_size(t->height, i);
+    return n;
+}
+
+/* Level k (0 <= k < t->levels) of t as a texture of one level. */
+EVR_HD static inline evr_texture_view evr_texture_level_view(const evr_texture_view *t, int k)
+{
+    evr_texture_view l;
+    const long off = evr_texture_texels(t, k);
+    l.width = evr_mip_size(t->width, k);
+    l.height = evr_mip_size(t->height, k);
+    l.levels = 1;
+    l.rgba = t->rgba + 4 * off;
+    return l;
+}
 
 typedef struct {
     int type;  /* evr_light_type */

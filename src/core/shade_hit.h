@@ -46,7 +46,7 @@ EVR_HD static inline int evr_shadow_pass(const evr_render_scene *rs, struct evr_
         if (!(mat->transmission > 0.0f) && mat->alpha_mode != EVR_ALPHA_BLEND) return 0;
         const evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), f);
         evr_surface s;
-        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, f, r, h.t, &s);
+        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, f, r, h.t, 0.0f, &s);
         for (int c = 0; c < 3; c++) T[c] *= (1.0f - s.opacity) + s.opacity * s.transmit[c];
         if (!(fmaxf(T[0], fmaxf(T[1], T[2])) > 1e-4f)) return 0;
         tnear = h.t + rs->ray_eps;

@@ -23,11 +23,33 @@ EVR_HD static inline float evr_luminance(float r, float g, float b)
     return EVR_LUMA_R * r + EVR_LUMA_G * g + EVR_LUMA_B * b;
 }
 
+/* The footprint (evr_surface.tex_lod) of a ray along dir whose cone is cone_width wide where it
+ * meets triangle (i0, i1, i2) of mesh m of instance inst, as the instance is at time f (xf). */
+EVR_HD static inline float evr_surface_tex_lod(const evr_render_scene *rs, int inst,
+                                               const evr_mesh_view *m, uint32_t i0, uint32_t i1,
+                                               uint32_t i2, const evr_m34 *xf, float f, evr_v3 dir,
+                                               float cone_width)
+{
+    if (!(cone_width > 0.0f) || !m->uvs || !evr_material_textured(&rs->materials[m->material]))
+        return EVR_TEX_LOD_SHARPEST;
+    const evr_v3 p0 = evr_m34_point(xf, evr_rs_vertex(rs, inst, m, i0, f));
+    const evr_v3 p1 = evr_m34_point(xf, evr_rs_vertex(rs, inst, m, i1, f));
+    const evr_v3 p2 = evr_m34_point(xf, evr_rs_vertex(rs, inst, m, i2, f));
+    const evr_v3 c = evr_v3_cross(evr_v3_sub(p1, p0), evr_v3_sub(p2, p0));
+    const float area2 = evr_v3_len(c); /* areas doubled */
+    const float *t0 = m->uvs + 2 * i0, *t1 = m->uvs + 2 * i1, *t2 = m->uvs + 2 * i2;
+    const float uv2 = fabsf((t1[0] - t0[0]) * (t2[1] - t0[1]) - (t2[0] - t0[0]) * (t1[1] - t0[1]));
+    const float cos_theta = area2 > 0.0f ? evr_v3_dot(c, dir) / area2 : 0.0f;
+    return evr_texture_lod(cone_width, cos_theta, area2, uv2);
+}
+
 /* Fills the surface at barycentrics (u, v) of triangle prim of instance inst, whose transform at
- * the ray's time f is xf; ray_dir is the incoming direction, t_hit the distance along it. */
+ * the ray's time f is xf; ray_dir is the incoming direction, t_hit the distance along it;
+ * cone_width the width of the ray's cone there (world units; 0: the sharpest texture level),
+ * which filters the textures (evr_surface_tex_lod). */
 EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, unsigned prim,
                                          float u, float v, const evr_m34 *xf, float f, evr_ray ray,
-                                         float t_hit, evr_surface *s)
+                                         float t_hit, float cone_width, evr_surface *s)
 {
     const evr_mesh_view *m = &rs->meshes[rs->instances[inst].mesh];
     uint32_t i0 = m->indices[3 * prim], i1 = m->indices[3 * prim + 1],
@@ -53,6 +75,7 @@ EVR_HD static inline void evr_surface_at(const evr_render_scene *rs, int inst, u
                                             w * t0[2] + u * t1[2] + v * t2[2]));
         tsign = t0[3] < 0.0f ? -1.0f : 1.0f;
     }
+    s->tex_lod = evr_surface_tex_lod(rs, inst, m, i0, i1, i2, xf, f, ray.dir, cone_width);
     evr_material_at(rs, m, i0, i1, i2, w, u, v, tw, tsign, evr_v3_scale(ray.dir, -1.0f), s);
 }
 

@@ -107,7 +107,8 @@ static void *gbuf_worker(void *arg)
             memset(g, 0, 8 * sizeof *g);
             if (!c->tr->closest(c->tr->user, ray, 0.0f, INFINITY, c->f, &h)) continue;
             evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), c->f);
-            evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, c->f, ray, h.t, &s);
+            evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, c->f, ray, h.t,
+                           evr_camera_pixel_spread(&rs->camera) * h.t, &s);
             evr_photon_cell_view(rs, c->fwd, &s, ray, h.t, g);
         }
     }
@@ -265,7 +266,7 @@ static void trace_path(pass_ctx *c, chunk_out *co, uint32_t i, evr_photon_trail 
         const evr_material_params *mat =
             &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), path.f);
-        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, path.f, path.pr.ray, h.t, &s);
+        evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, path.f, path.pr.ray, h.t, 0.0f, &s);
         int ev = evr_photon_path_hit(&path, c->pp, &s, mat, stored, absorbed, &key);
         add3(co->absorbed, absorbed, 1.0f);
         if (ev == EVR_PHOTON_STAY) {

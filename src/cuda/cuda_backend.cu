@@ -46,8 +46,8 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
         nf += (size_t)m->num_vertices * (m->uvs ? 8 : 6);
         ni += (size_t)m->num_triangles * 3;
     }
-    for (i = 0; i < s->num_textures; i++)
-        nt += (size_t)s->textures[i].width * s->textures[i].height * 4;
+    for (i = 0; i < s->num_textures; i++) /* every mip level */
+        nt += (size_t)evr_texture_texels(&b->host.textures[i], b->host.textures[i].levels) * 4;
     CK(b->d_floats.reserve(nf + 1));
     CK(b->d_indices.reserve(ni + 1));
     CK(b->d_texels.reserve(nt + 1));
@@ -88,7 +88,7 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
         oi += (size_t)m->num_triangles * 3;
     }
     for (i = 0; i < s->num_textures && e == cudaSuccess; i++) {
-        size_t n = (size_t)s->textures[i].width * s->textures[i].height * 4;
+        size_t n = (size_t)evr_texture_texels(&b->host.textures[i], b->host.textures[i].levels) * 4;
         tv[i] = b->host.textures[i];
         e = cudaMemcpy(b->d_texels.p + ot, s->textures[i].rgba, n * sizeof(float),
                        cudaMemcpyHostToDevice);

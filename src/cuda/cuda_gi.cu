@@ -64,7 +64,7 @@ __device__ void photon_path(const kernel_args &a, const photon_args &p, unsigned
         const evr_material_params *mat =
             &rs->materials[rs->meshes[rs->instances[h.instance].mesh].material];
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), path.f);
-        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.f, path.pr.ray, h.t, &s);
+        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, path.f, path.pr.ray, h.t, 0.0f, &s);
         const int ev = evr_photon_path_hit(&path, &p.pp, &s, mat, stored, absorbed, &key);
         if (ev == EVR_PHOTON_STAY) {
             evr_ray r;
@@ -166,7 +166,8 @@ __global__ void __launch_bounds__(BLOCK)
     if (gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &h)) {
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), f);
         evr_surface s;
-        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, f, ray, h.t, &s);
+        evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, f, ray, h.t,
+                       evr_camera_pixel_spread(&rs->camera) * h.t, &s);
         evr_photon_cell_view(rs, fwd, &s, ray, h.t, g);
     }
     for (int k = 0; k < 8; k++) buf.gbuf[8 * (size_t)cell + k] = g[k];

@@ -114,7 +114,8 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     *inst = hit.instance;
     *cam_org = ray.org;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
-    evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, f, ray, hit.t, s);
+    evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, f, ray, hit.t,
+                   evr_camera_pixel_spread(&rs->camera) * hit.t, s);
     struct evr_occlusion occ;
     occ.a = &a;
     occ.layout = LAYOUT;
@@ -122,7 +123,7 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     float acc[3];
     int dp = 0;
     evr_shade_direct_sum(rs, s, evr_v3_scale(ray.dir, -1.0f), f, &occ, rays, acc);
-    *direct = evr_path_intensity(rs, s, ray.dir, acc, &occ, f, rays, &dp);
+    *direct = evr_path_intensity(rs, s, ray.dir, *t_hit, acc, &occ, f, rays, &dp);
     *deep = dp;
     return true;
 }

@@ -1,5 +1,6 @@
 /* Textures: found beside the scene file or embedded in it (Assimp's names), or given as bytes (a
- * glTF image read from the JSON, import_gltf_material.c), decoded with stb_image to RGBA floats.
+ * glTF image read from the JSON, import_gltf_material.c), decoded with stb_image to RGBA floats, their mip levels appended
+ * (texture_mips.c).
  * Colour textures (base colour, emissive) are sRGB-decoded; data textures (metallic-roughness,
  * normal, occlusion, transmission) keep their values (v / 255). Each image is loaded once per
  * colour space however many materials use it: one image used both ways is decoded twice. */
@@ -15,6 +16,7 @@
 
 #include "core/shading.h"
 #include "scene/import_internal.h"
+#include "scene/texture_mips.h"
 
 /* The values of the 256 8-bit levels: sRGB-decoded, or i / 255 for data. */
 static void level8_table(float lut[256], int srgb)
@@ -143,6 +145,11 @@ static int find_texture(const importer *im, const char *key, int srgb)
 static evr_status add_texture(importer *im, const char *key, int srgb, evr_texture *t, int *out)
 {
     evr_scene *s = im->s;
+    evr_status st = evr_texture_build_mips(t, im->err);
+    if (st != EVR_OK) {
+        free(t->rgba);
+        return st;
+    }
     if (s->num_textures == im->tex_cap) {
         int ncap = im->tex_cap ? im->tex_cap * 2 : 8;
         evr_texture *nt = realloc(s->textures, (size_t)ncap * sizeof *nt);
