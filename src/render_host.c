@@ -1,4 +1,5 @@
 #include "backend.h"
+#include "core/hit_filter.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +30,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->meshes[i].indices = m->indices;
         h->meshes[i].num_triangles = m->num_triangles;
         h->meshes[i].material = m->material;
+        h->meshes[i].filter = evr_material_filter(&s->materials[m->material].p, m->uvs != NULL);
     }
     for (i = 0; i < s->num_materials; i++) h->materials[i] = s->materials[i].p;
     for (i = 0; i < s->num_textures; i++) {

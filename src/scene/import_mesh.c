@@ -1,5 +1,5 @@
 /* Materials (metallic-roughness factors, emission, the photon thresholds, the base colour
- * texture) and triangle meshes (positions, unit normals, the material's UV channel). */
+ * texture, alpha mode and cutoff, double-sidedness) and triangle meshes (positions, unit normals, the material's UV channel). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,6 +7,7 @@
 
 #include <assimp/scene.h>
 #include <assimp/material.h>
+#include <assimp/GltfMaterial.h>
 
 #include "core/photon.h"
 #include "scene/import_internal.h"
@@ -67,6 +68,20 @@ evr_status evr_import_materials(importer *im)
             m->p.roughness = (float)f;
         evr_photon_material_map(m->p.base_color, m->p.metallic, m->p.roughness, &m->p.t_diffuse,
                                 &m->p.t_specular);
+        { /* glTF alphaMode, alphaCutoff, doubleSided (Assimp's keys for them) */
+            int two = 0;
+            one = 1;
+            if (aiGetMaterialIntegerArray(am, AI_MATKEY_TWOSIDED, &two, &one) == aiReturn_SUCCESS)
+                m->p.double_sided = two != 0;
+            if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &str) == aiReturn_SUCCESS)
+                m->p.alpha_mode = !strcmp(str.data, "MASK")    ? EVR_ALPHA_MASK
+                                  : !strcmp(str.data, "BLEND") ? EVR_ALPHA_BLEND
+                                                               : EVR_ALPHA_OPAQUE;
+            one = 1;
+            if (aiGetMaterialFloatArray(am, AI_MATKEY_GLTF_ALPHACUTOFF, &f, &one) ==
+                aiReturn_SUCCESS)
+                m->p.alpha_cutoff = (float)f;
+        }
         if (im->have_side && (int)i < im->side.num_materials &&
             (im->side.t_extras[2 * i] != T_ABSENT || im->side.t_extras[2 * i + 1] != T_ABSENT)) {
             float td = im->side.t_extras[2 * i], ts = im->side.t_extras[2 * i + 1];
@@ -89,7 +104,8 @@ evr_status evr_import_materials(importer *im)
                 !str.data[0])
                 continue;
             {
-                evr_status st = evr_import_texture(im, str.data, m->name, &m->p.tex[EVR_TEX_BASE].index);
+                evr_status st =
+                    evr_import_texture(im, str.data, m->name, &m->p.tex[EVR_TEX_BASE].index);
                 if (st != EVR_OK) return st;
             }
             im->mat_uv[i] = (int)uv;
