@@ -19,6 +19,8 @@ uv (0, 0) at its top-left corner (u = x + 0.5, v = 0.5 - y).
   cull_back      the same card wound the other way: the camera sees its back, so it is invisible,
                  but its shadow is still on the wall
   both_back      cull_back's card made double-sided: seen
+  cull_mirrored  cull_back's card under a node of scale (-1, 1, 1): the mirroring flips its
+                 winding (glTF: a negative determinant), so its front faces the camera: seen
   mask_moving    the card alpha MASK with an 8x1 texture, alpha 0 on its left half (u < 0.5) and
                  1 on its right half, translating by +0.25 in x over t in [0, 1] (LINEAR): only
                  the opaque half's edges (at x = 0 and x = 0.5 at t = 0) make events
@@ -182,6 +184,13 @@ def both_back():
     return d.finish()
 
 
+def cull_mirrored():
+    d = _base()
+    d.quad("card", -0.5, 0.5, -0.5, 0.5, -2, d.material("one_sided", emissive=(0.3, 0.3, 0.3)),
+           towards_camera=False, scale=[-1, 1, 1])
+    return d.finish()
+
+
 def mask_moving():
     d = _base()
     card = d.quad("card", -0.5, 0.5, -0.5, 0.5, -2,
@@ -200,7 +209,8 @@ def mixed():
     return d.finish()
 
 
-ASSETS = {f.__name__: f for f in (mask_checker, cull_front, cull_back, both_back, mask_moving, mixed)}
+ASSETS = {f.__name__: f for f in (mask_checker, cull_front, cull_back, both_back, cull_mirrored, mask_moving,
+                                   mixed)}
 
 
 def write_all(outdir):

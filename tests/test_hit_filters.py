@@ -5,7 +5,8 @@ tests/filter_assets.py whose every pixel is known:
     away from the cells' edges; and the card's shadow on the wall has the same holes (the light is
     directional along the view: the wall at (x, y) is dark where the card at (x, y) is opaque);
   - a single-sided card: seen from the front, invisible from behind, and its shadow cast either
-    way (shadow rays see back faces); double-sided, seen from behind too;
+    way (shadow rays see back faces); double-sided, seen from behind too; wound away from the
+    camera under a mirroring node (scale -1), seen (glTF: the determinant flips the winding);
   - a card, opaque on its right half only, sliding right: `evray render` makes events only where
     the opaque half's edges move (its transparent left border makes none), and change-driven
     sampling gives exactly the events of brute force (--no-skip), also with GI and davis346."""
@@ -82,7 +83,7 @@ T.check(levels == {CARD, WALL_LIT, WALL_DARK}, "mask_checker: card, lit wall and
 
 # (c) single-sided: front seen, back invisible, the shadow cast both ways; double-sided: seen
 solid = lambda col, row: 1  # noqa: E731
-for name, seen in (("cull_front", True), ("cull_back", False), ("both_back", True)):
+for name, seen in (("cull_front", True), ("cull_back", False), ("both_back", True), ("cull_mirrored", True)):
     checked, wrong = compare(name, solid, seen)
     T.check(checked > 0.8 * N * N and wrong == 0, f"{name}: card {'seen' if seen else 'invisible'}, shadow cast")
 
