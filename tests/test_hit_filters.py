@@ -125,8 +125,8 @@ T.check(in_band(0, 30) == 0 and in_band(43, 46) == 0 and in_band(59, N) == 0,
 T.check(all(15 <= e["y"] <= 48 for e in ev), "mask_moving: no events above or below the card")
 
 # change-driven sampling stays exact with filtered hits
-for name in ("mask_moving", "mixed"):
-    for extra in ([], ["--sensor", "davis346"], ["--gi", "photon"]):
+for name, extras in (("mask_moving", ([], ["--sensor", "davis346"])), ("mixed", ([], ["--gi", "photon"]))):
+    for extra in extras:
         tag = "-".join([name] + [a.lstrip("-") for a in extra])
         skip = render(name, os.path.join(tmp, tag + "-skip"), *extra)
         brute = render(name, os.path.join(tmp, tag + "-brute"), "--no-skip", *extra)

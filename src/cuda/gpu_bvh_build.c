@@ -2,7 +2,7 @@
  * (gpu_bvh_tree.c builds and flattens each; the deforming groups' per segment, gpu_bvh_deform.c)
  * and the top level over the groups. */
 #include "cuda/gpu_bvh_internal.h"
-#include "core/hit_filter.h"
+#include "backend.h"
 #include "prep/instance_groups.h"
 #include "prep/swept_bounds.h"
 #include "scene/scene.h"
@@ -111,13 +111,6 @@ static int group_tris_reserve(group_tris *gt, size_t nt)
     return gt->cap != 0;
 }
 
-/* The hit filter bits of mesh m (evr_mesh_view.filter, as src/render_host.c sets them). */
-static int mesh_filter(const evr_scene *s, const evr_mesh *m)
-{
-    if (m->material < 0 || m->material >= s->num_materials) return 0;
-    return evr_material_filter(&s->materials[m->material].p, m->uvs != NULL);
-}
-
 /* Collects the usable triangles of group g (baked into world space for the static group, as
  * the CPU backend bakes them: each vertex through evr_m34_point in float) and their box.
  * Returns their number, or (size_t)-1 when out of memory. */
@@ -139,7 +132,7 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
         if (s->instances[i].mesh < 0 || s->instances[i].mesh >= s->num_meshes) continue;
         mesh = &s->meshes[s->instances[i].mesh];
         if (mesh->num_triangles == 0) continue;
-        filter = (uint32_t)mesh_filter(s, mesh);
+        filter = (uint32_t)evr_render_mesh_filter(s, mesh);
         pos = mesh->positions;
         if (bake) {
             evr_m34 world = evr_node_world_at(s, s->instances[i].node, s->anim_start);
@@ -213,7 +206,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     out->num_scene_instances = n;
     for (g = 0; g < n && !out->filtered; g++) /* then the kernels' general search */
         if (s->instances[g].mesh >= 0 && s->instances[g].mesh < s->num_meshes)
-            out->filtered = mesh_filter(s, &s->meshes[s->instances[g].mesh]) != 0;
+            out->filtered = evr_render_mesh_filter(s, &s->meshes[s->instances[g].mesh]) != 0;
     if (evr_instance_groups_build(s, out->grouped, &groups)) { /* its arrays are ours from here */
         out->num_groups = groups.num_groups;
         out->static_group = groups.static_group;
