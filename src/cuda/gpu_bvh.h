@@ -146,7 +146,9 @@ typedef struct {
 
 /* What the traversal reads; all pointers host or all device. */
 typedef struct {
-    int layout;                  /* EVR_GPU_LAYOUT_* */
+    int layout;   /* EVR_GPU_LAYOUT_* */
+    int filtered; /* some mesh's hits may be ruled out (evr_gpu_bvh.filtered); in the padding
+                     after layout: the kernels' arguments keep their size and offsets */
     const evr_gpu_node4 *nodes4; /* bottom level, layout BVH4 (else NULL) */
     const evr_gpu_node8 *nodes8; /* bottom level, layout CW8 (else NULL) */
     const evr_gpu_tri *tris;
@@ -160,7 +162,6 @@ typedef struct {
     const evr_gpu_node8 *dnodes8;
     const evr_gpu_dtri *dtris;
     uint32_t num_dnodes, num_dtris;
-    int filtered; /* some mesh's hits may be ruled out (evr_gpu_bvh.filtered) */
 } evr_gpu_scene_view;
 
 /* ---- host side ---- */

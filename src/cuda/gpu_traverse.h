@@ -323,6 +323,21 @@ typedef struct {
     uint32_t bits, dbits;
 } evr__filter_src;
 
+/* core/hit_filter.h's test, out of line on the device: inlined into each of the search's leaf
+ * loops it made the general kernels' traversal three times longer (PTX), and the instruction
+ * cache is what the traversal stalls on (cuda_trace.cuh). */
+#ifdef __CUDACC__
+#define EVR__NOINLINE __noinline__
+#else
+#define EVR__NOINLINE __attribute__((noinline))
+#endif
+EVR_HD static EVR__NOINLINE int evr__hit_filtered(const evr_render_scene *rs, int inst,
+                                                  uint32_t prim, float u, float v, evr_v3 dir,
+                                                  float f, int shadow)
+{
+    return evr_hit_filtered(rs, inst, prim, u, v, dir, 0, f, shadow);
+}
+
 /* Whether the hit at (u, v) of leaf item i is ruled out; never without fs (the rigid search,
  * where fs is a constant NULL and this folds away). A triangle whose mesh has no filter bits
  * (evr_gpu_tri.filter) costs a test of a field already loaded. */
@@ -343,7 +358,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__leaf_filtered(const evr_gpu_tri *tris,
         inst = fs->instance_base + tris[i].instance;
         prim = tris[i].prim;
     }
-    return evr_hit_filtered(fs->rs, inst, prim, u, v, fs->dir, 0, fs->f, fs->shadow);
+    return evr__hit_filtered(fs->rs, inst, prim, u, v, fs->dir, fs->f, fs->shadow);
 }
 
 /* The triangle and instance fields of a leaf item that was hit (read only then). */
