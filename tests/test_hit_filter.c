@@ -8,7 +8,8 @@
  *     shadow rays from the wall do (they see back faces);
  *   - a single-sided card wound away from the camera but under a mirroring node (scale -1 in x):
  *     its world-space winding faces the camera (glTF: the determinant flips the winding), seen;
- *   - the evr_material_filter bits, and a scene without filters keeps the rigid search. */
+ *   - the evr_material_filter bits; the alpha test reads the texture through its transform
+ *     (KHR_texture_transform, evr_texture_uv). */
 #include "check.h"
 #include "backend.h"
 #include "core/hit_filter.h"
@@ -266,6 +267,26 @@ static void test_layout(int layout, const char *what)
     evr_render_host_free(&host);
 }
 
+/* evr_hit_alpha_cut reads the base texture through its KHR_texture_transform: with
+ * uv' = (u / 2 + 1 / 4, v) the card's checkerboard shows cell column 1 where the untransformed
+ * texture shows column 0. */
+static void test_texture_transform(void)
+{
+    filter_scene f;
+    evr_render_host host;
+    scene_make(&f);
+    CHECK_OK(evr_render_host_init(&host, &f.s, 0, 8, 8, 0.0f, &e_));
+    /* triangle 0 of the card: uv = (1-a-b) (0,1) + a (1,1) + b (1,0) = (a + b, 1 - b); at
+     * (a, b) = (0.05, 0.05): uv (0.1, 0.95), cell (0, 3): a hole (bilinear alpha 0.34); through
+     * the transform uv (0.3, 0.95), cell (1, 3): opaque (alpha 0.58) */
+    CHECK(evr_hit_alpha_cut(&host.rs, &host.meshes[1], 0, 0.05f, 0.05f) == 1);
+    f.mats[1].p.tex[EVR_TEX_BASE].xf[0] = 0.5f;
+    f.mats[1].p.tex[EVR_TEX_BASE].xf[2] = 0.25f;
+    host.materials[1] = f.mats[1].p;
+    CHECK(evr_hit_alpha_cut(&host.rs, &host.meshes[1], 0, 0.05f, 0.05f) == 0);
+    evr_render_host_free(&host);
+}
+
 int main(void)
 {
     evr_material_params m;
@@ -283,6 +304,7 @@ int main(void)
     m.alpha_mode = EVR_ALPHA_BLEND;
     CHECK(evr_material_filter(&m, 1) == EVR_FILTER_CULL);
 
+    test_texture_transform();
     test_layout(EVR_GPU_LAYOUT_CW8, "CW8, baked");
     test_layout(EVR_GPU_LAYOUT_BVH4, "BVH4, baked");
     setenv("EVR_STATIC_BAKE_LIMIT", "0", 1);
