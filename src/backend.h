@@ -109,6 +109,9 @@ typedef struct {
 evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,
                                 int height, float ambient, evr_error *err);
 void evr_render_host_free(evr_render_host *h);
+/* The hit filter bits of mesh m of s (evr_mesh_view.filter, core/hit_filter.h): its material's,
+ * 0 for a mesh without a valid material. The GPU BVH copies them into its triangles. */
+int evr_render_mesh_filter(const evr_scene *s, const evr_mesh *m);
 
 evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
                                const evr_run_setup *setup, evr_backend **out, evr_error *err);

@@ -1,9 +1,16 @@
 #include "backend.h"
+#include "core/hit_filter.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+int evr_render_mesh_filter(const evr_scene *s, const evr_mesh *m)
+{
+    if (m->material < 0 || m->material >= s->num_materials) return 0;
+    return evr_material_filter(&s->materials[m->material].p, m->uvs != NULL);
+}
 
 evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int camera, int width,
                                 int height, float ambient, evr_error *err)
@@ -31,6 +38,7 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->meshes[i].indices = m->indices;
         h->meshes[i].num_triangles = m->num_triangles;
         h->meshes[i].material = m->material;
+        h->meshes[i].filter = evr_render_mesh_filter(s, m);
     }
     for (i = 0; i < s->num_materials; i++) {
         const evr_material_params *p = &s->materials[i].p;

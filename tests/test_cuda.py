@@ -2,11 +2,13 @@
 sensor and the davis346 sensor model, event counts within 0.5% and F1 >= 0.99 at 100 us (evray
 compare); with adaptive sampling within 2% and F1 >= 0.97, and the same samples within 2%; on
 the deforming test scenes (skins and morph targets, tests/deform_assets.py, where the importer
-reads them) likewise, uniformly and adaptively, and with global illumination (F1 >= 0.95).
-Skipped (exit 77)
+reads them) likewise, uniformly and adaptively, and with global illumination (F1 >= 0.95); and
+on a scene of hits a material rules out (tests/filter_assets.py's "mixed": an alpha-masked card
+and a single-sided card seen from behind) likewise. Skipped (exit 77)
 where this build has no CUDA backend or no GPU is usable."""
 import json
 import os
+import sys
 
 import evrtest as T
 
@@ -38,6 +40,15 @@ for asset in T.deform_assets(tmp):
     cases.append((asset, ["--res", "160x120", "--duration", "1.0"]))
     cases.append((asset, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
     cases.append((asset, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+# hits a material rules out (core/hit_filter.h; on the GPU the general kernels,
+# EVR_GPU_TRACE_GENERAL): an alpha-masked checkerboard card sliding in front of a single-sided card
+# seen from behind (invisible, its shadow cast) and a lit wall (tests/filter_assets.py's "mixed")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import filter_assets  # noqa: E402
+mixed = filter_assets.write_all(os.path.join(tmp, "filter-assets"))["mixed"]
+cases.append((mixed, ["--res", "160x120", "--duration", "1.0"]))
+cases.append((mixed, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
+cases.append((mixed, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)

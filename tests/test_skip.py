@@ -1,9 +1,11 @@
 """Change-driven sampling gives exactly the events of brute force (--no-skip): every built-in scene
 and the moving square, ideal sensor and the davis346 noise model, the deforming test scenes
-(skins and morph targets, tests/deform_assets.py, where the importer reads them), on the CPU and
+(skins and morph targets, tests/deform_assets.py, where the importer reads them), a scene of
+hits a material rules out (tests/filter_assets.py's "mixed"), on the CPU and
 (where a GPU is usable) on CUDA; and it really skips: run.json accounts for the samples traced
 and the pixels skipped per segment."""
 import os
+import sys
 
 import evrtest as T
 
@@ -30,6 +32,11 @@ for asset in T.deform_assets(tmp):
     cases.append((asset, ["--res", "64x48", "--duration", "1.0"]))
     cases.append((asset, ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
     cases.append((asset, ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
+# hits a material rules out (alpha MASK, single-sided; on CUDA the general kernels)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import filter_assets  # noqa: E402
+mixed = filter_assets.write_all(os.path.join(tmp, "filter-assets"))["mixed"]
+cases.append((mixed, ["--res", "64x48", "--duration", "1.0"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}

@@ -13,6 +13,7 @@ typedef struct {
     const uint32_t *indices;
     uint32_t num_triangles;
     int material;
+    int filter; /* tests its hits need (EVR_FILTER_* of core/hit_filter.h), 0: none */
 } evr_mesh_view;
 
 /* A material's parameters, defined with the model that reads them in core/material.h. */

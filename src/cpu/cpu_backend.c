@@ -41,6 +41,7 @@ typedef struct {
     RTCScene *group_scenes;
     int *deform_keys_set;    /* per group: the keys a deforming group's vertices have (0: none) */
     evr_cpu_deform *deforms; /* per group: a deforming group's triangles and current keys */
+    evr_cpu_filter_map filter_map; /* what the hit filters read (cpu/embree_filter.h) */
     RTCScene top;
     int time_grid; /* the segment's motion keys split it into this many equal intervals (1: none moves) */
     int gi;        /* global illumination on */
@@ -845,9 +846,9 @@ static void cpu_release(evr_backend *base)
 }
 
 /* Adds a mesh to an Embree scene as geometry geom_id, its vertices transformed by xf (NULL:
- * object space). */
+ * object space), with the hit filters of its material (filter: evr_mesh_view.filter). */
 static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf,
-                             unsigned geom_id)
+                             unsigned geom_id, const evr_cpu_filter_map *map, int filter)
 {
     uint32_t v;
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -870,6 +871,7 @@ static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, cons
         vb[3 * v + 2] = p.z;
     }
     memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+    evr_cpu_filter_set(g, map, filter);
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(sc, g, geom_id);
     rtcReleaseGeometry(g);
@@ -887,6 +889,10 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
         free(mesh_scenes);
         return 0;
     }
+    b->filter_map.rs = &b->host.rs;
+    b->filter_map.members = gr->members;
+    b->filter_map.group_first = gr->group_first;
+    b->filter_map.group_kind = gr->group_kind;
     b->group_scenes = calloc((size_t)gr->num_groups + 1, sizeof *b->group_scenes);
     b->deform_keys_set = calloc((size_t)gr->num_groups + 1, sizeof *b->deform_keys_set);
     b->deforms = calloc((size_t)gr->num_groups + 1, sizeof *b->deforms);
@@ -903,7 +909,8 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
                 }
                 mesh_scenes[mesh] = sc;
                 rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
-                if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0)) {
+                if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0, &b->filter_map,
+                                       b->host.meshes[mesh].filter)) {
                     ok = 0;
                     break;
                 }
@@ -919,9 +926,13 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
         }
         b->group_scenes[g] = sc;
         if (gr->group_kind[g] == EVR_GROUP_DEFORMING) { /* rebuilt every segment it moves */
-            const evr_mesh *m = &s->meshes[s->instances[gr->members[gr->group_first[g]]].mesh];
+            const int inst = gr->members[gr->group_first[g]];
+            const evr_mesh *m = &s->meshes[s->instances[inst].mesh];
             evr_cpu_deform *d = &b->deforms[g];
             RTCGeometry geom;
+            d->filter = b->host.meshes[s->instances[inst].mesh].filter;
+            d->instance = inst;
+            d->map = &b->filter_map;
             d->indices = m->indices;
             d->num_triangles = m->num_triangles;
             d->view.num_keys = 1; /* the rest pose until the first segment's keys */
@@ -946,7 +957,8 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
             if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh],
                                    gr->group_kind[g] == EVR_GROUP_BAKED ? &world : NULL,
-                                   (unsigned)(j - gr->group_first[g]))) {
+                                   (unsigned)(j - gr->group_first[g]), &b->filter_map,
+                                   b->host.meshes[in->mesh].filter)) {
                 ok = 0;
                 break;
             }

@@ -1,25 +1,10 @@
 /* Deforming triangles as Embree user geometry (see deform_geometry.h). */
 #include "cpu/deform_geometry.h"
 #include "core/ray_triangle.h"
+#include "core/hit_filter.h"
+#include "cpu/embree_soa.h"
 
 #include <math.h>
-
-/* Embree's packets of N rays in SOA layout (rtcore_ray.h; its accessors are C++ only): a ray's
- * fields, then a hit's, each N wide. */
-enum { RAY_ORG = 0, RAY_TNEAR = 3, RAY_DIR = 4, RAY_TIME = 7, RAY_TFAR = 8, RAY_FIELDS = 12 };
-enum { HIT_NG = 0, HIT_U = 3, HIT_V = 4, HIT_PRIM = 5, HIT_GEOM = 6, HIT_INST = 7 };
-static float *ray_field(struct RTCRayN *ray, unsigned n, unsigned field, unsigned i)
-{
-    return (float *)ray + (size_t)field * n + i;
-}
-static float *hit_float(struct RTCHitN *hit, unsigned n, unsigned field, unsigned i)
-{
-    return (float *)hit + (size_t)field * n + i;
-}
-static unsigned *hit_uint(struct RTCHitN *hit, unsigned n, unsigned field, unsigned i)
-{
-    return (unsigned *)hit + (size_t)field * n + i;
-}
 
 static void corners(const evr_cpu_deform *d, unsigned prim, float f, evr_v3 *a, evr_v3 *b,
                     evr_v3 *c)
@@ -54,8 +39,10 @@ static void bounds(const struct RTCBoundsFunctionArguments *args)
     o->upper_z = hi[2];
 }
 
+/* A hit of ray i on triangle prim, unless the material rules it out (shadow: an occlusion
+ * query). */
 static int ray_hits(const evr_cpu_deform *d, unsigned prim, struct RTCRayN *ray, unsigned n,
-                    unsigned i, float *t, float *u, float *v, evr_v3 *ng)
+                    unsigned i, int shadow, float *t, float *u, float *v, evr_v3 *ng)
 {
     const evr_v3 org =
         evr_v3_make(*ray_field(ray, n, RAY_ORG, i), *ray_field(ray, n, RAY_ORG + 1, i),
@@ -68,6 +55,10 @@ static int ray_hits(const evr_cpu_deform *d, unsigned prim, struct RTCRayN *ray,
     const evr_tri_ray r = evr_tri_ray_make(org, dir);
     if (!evr_tri_hit(&r, a, b, c, *ray_field(ray, n, RAY_TNEAR, i), *ray_field(ray, n, RAY_TFAR, i),
                      t, u, v))
+        return 0;
+    /* the ray is in the instance's own space (Embree's instance transform applied) */
+    if (d->filter && evr_hit_filtered(d->map->rs, d->instance, prim, *u, *v, dir, 1,
+                                      *ray_field(ray, n, RAY_TIME, i), shadow))
         return 0;
     *ng = evr_v3_cross(evr_v3_sub(b, a), evr_v3_sub(c, a));
     return 1;
@@ -82,7 +73,8 @@ static void intersect(const struct RTCIntersectFunctionNArguments *args)
     for (unsigned i = 0; i < n; i++) {
         float t, u, v;
         evr_v3 ng;
-        if (args->valid[i] == 0 || !ray_hits(d, args->primID, ray, n, i, &t, &u, &v, &ng)) continue;
+        if (args->valid[i] == 0 || !ray_hits(d, args->primID, ray, n, i, 0, &t, &u, &v, &ng))
+            continue;
         *ray_field(ray, n, RAY_TFAR, i) = t;
         *hit_float(hit, n, HIT_NG, i) = ng.x;
         *hit_float(hit, n, HIT_NG + 1, i) = ng.y;
@@ -103,7 +95,7 @@ static void occluded(const struct RTCOccludedFunctionNArguments *args)
         float t, u, v;
         evr_v3 ng;
         if (args->valid[i] != 0 &&
-            ray_hits(d, args->primID, args->ray, args->N, i, &t, &u, &v, &ng))
+            ray_hits(d, args->primID, args->ray, args->N, i, 1, &t, &u, &v, &ng))
             *ray_field(args->ray, args->N, RAY_TFAR, i) = -INFINITY;
     }
 }

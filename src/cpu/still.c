@@ -5,6 +5,7 @@
 #include "prep/deform_keys.h"
 #include "host_clock.h"
 #include "cpu/cpu_gi.h"
+#include "cpu/embree_filter.h"
 #include "cpu/workers.h"
 #include "backend.h"
 #include "core/photon.h"
@@ -252,6 +253,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
     int *toff = NULL, *tcnt = NULL;
     RTCDevice dev = NULL;
     RTCScene sc = NULL;
+    evr_cpu_filter_map fmap;
     evr_photon_buffer buf;
     evr_photon_emitters em;
     shade_ctx c;
@@ -340,6 +342,9 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         goto done;
     }
     rtcSetDeviceErrorFunction(dev, embree_error, emsg);
+    /* the hit filters' map: geometry g is instance g, in world space */
+    fmap.rs = &host.rs;
+    fmap.members = fmap.group_first = fmap.group_kind = NULL;
     sc = rtcNewScene(dev);
     rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
     evr_v3 lo = evr_v3_make(INFINITY, INFINITY, INFINITY),
@@ -367,6 +372,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
             hi = evr_v3_make(fmaxf(hi.x, q.x), fmaxf(hi.y, q.y), fmaxf(hi.z, q.z));
         }
         memcpy(ib, m->indices, sizeof(unsigned) * 3 * m->num_triangles);
+        evr_cpu_filter_set(g, &fmap, host.meshes[s->instances[i].mesh].filter);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(sc, g, (unsigned)i);
         rtcReleaseGeometry(g);

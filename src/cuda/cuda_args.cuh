@@ -38,9 +38,9 @@ static inline unsigned tiled_threads(int w, int h)
 }
 
 /* The kernels' compile-time variant of a run: its traversal layout (the node layout,
- * EVR_GPU_LAYOUT_*, with EVR_GPU_TRACE_DEFORMING where the scene has deforming meshes: the
- * kernels of a scene without them are the code they were before), the sensor model (1) or the
- * ideal one (0), global illumination. */
+ * EVR_GPU_LAYOUT_*, with EVR_GPU_TRACE_GENERAL where the scene has deforming meshes or meshes
+ * whose hits a material may rule out: the kernels of a scene without them are the code they
+ * were before), the sensor model (1) or the ideal one (0), global illumination. */
 struct kernel_variant {
     int layout;
     bool sensor, gi;
@@ -50,14 +50,12 @@ struct kernel_variant {
  * f(std::integral_constant<int, LAYOUT>{}). */
 template <typename F> static inline void with_layout(int layout, F f)
 {
-    const int deforming = layout & EVR_GPU_TRACE_DEFORMING;
-    if ((layout & ~EVR_GPU_TRACE_DEFORMING) == EVR_GPU_LAYOUT_CW8) {
-        if (deforming)
-            f(std::integral_constant<int, EVR_GPU_LAYOUT_CW8 | EVR_GPU_TRACE_DEFORMING>{});
+    const int general = layout & EVR_GPU_TRACE_GENERAL;
+    if ((layout & ~EVR_GPU_TRACE_GENERAL) == EVR_GPU_LAYOUT_CW8) {
+        if (general) f(std::integral_constant<int, EVR_GPU_LAYOUT_CW8 | EVR_GPU_TRACE_GENERAL>{});
         else f(std::integral_constant<int, EVR_GPU_LAYOUT_CW8>{});
     } else {
-        if (deforming)
-            f(std::integral_constant<int, EVR_GPU_LAYOUT_BVH4 | EVR_GPU_TRACE_DEFORMING>{});
+        if (general) f(std::integral_constant<int, EVR_GPU_LAYOUT_BVH4 | EVR_GPU_TRACE_GENERAL>{});
         else f(std::integral_constant<int, EVR_GPU_LAYOUT_BVH4>{});
     }
 }

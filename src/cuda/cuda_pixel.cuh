@@ -22,15 +22,15 @@ EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float 
                                       float f)
 {
 #ifdef __CUDA_ARCH__
-    const int deforming = EVR_GPU_TRACE_DEFORMING;
+    const int general = EVR_GPU_TRACE_GENERAL;
     if (o->layout == EVR_GPU_LAYOUT_CW8)
         return gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
-    if (o->layout == (EVR_GPU_LAYOUT_CW8 | deforming))
-        return gpu_trace<EVR_GPU_LAYOUT_CW8 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
-                                                         1, o->hit);
-    if (o->layout == (EVR_GPU_LAYOUT_BVH4 | deforming))
-        return gpu_trace<EVR_GPU_LAYOUT_BVH4 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
-                                                          1, o->hit);
+    if (o->layout == (EVR_GPU_LAYOUT_CW8 | general))
+        return gpu_trace<EVR_GPU_LAYOUT_CW8 | general>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1,
+                                                       o->hit);
+    if (o->layout == (EVR_GPU_LAYOUT_BVH4 | general))
+        return gpu_trace<EVR_GPU_LAYOUT_BVH4 | general>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
+                                                        1, o->hit);
     return gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
 #else
     (void)o, (void)r, (void)tnear, (void)tfar, (void)f;
@@ -43,7 +43,7 @@ EVR_HD static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float t
                                      float f, evr_hit *h)
 {
 #ifdef __CUDA_ARCH__
-    const int deforming = EVR_GPU_TRACE_DEFORMING;
+    const int deforming = EVR_GPU_TRACE_GENERAL;
     int found;
     if (o->layout == EVR_GPU_LAYOUT_CW8)
         found = gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 0, o->hit);

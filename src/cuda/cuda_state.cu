@@ -59,6 +59,7 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     a.view.dtris = sl->d_dtris.p;
     a.view.num_dnodes = sl->num_dnodes;
     a.view.num_dtris = sl->num_dtris;
+    a.view.filtered = b->bvh.filtered;
     a.state_in = b->d_state[sl->index % NRING].p;
     a.state_out = b->d_state[(sl->index + 1) % NRING].p;
     a.phase = b->d_phase.p;
@@ -97,7 +98,8 @@ kernel_args make_args(cuda_backend *b, slot *sl)
 kernel_variant run_variant(const cuda_backend *b)
 {
     kernel_variant v;
-    v.layout = b->bvh.layout | (b->bvh.num_deforming ? EVR_GPU_TRACE_DEFORMING : 0);
+    v.layout =
+        b->bvh.layout | (b->bvh.num_deforming || b->bvh.filtered ? EVR_GPU_TRACE_GENERAL : 0);
     v.sensor = !evr_pixel_params_ideal(&b->setup.pixel);
     v.gi = b->gi != 0;
     return v;

@@ -8,7 +8,8 @@
 
 /* One traversal body for primary and shadow rays, not inlined: a kernel with four inlined copies
  * (two queries, two node layouts) stalled on instruction-cache misses (measured with ncu).
- * LAYOUT: the node layout, with EVR_GPU_TRACE_DEFORMING where the scene has deforming groups. */
+ * LAYOUT: the node layout, with EVR_GPU_TRACE_GENERAL where the scene has deforming groups or
+ * filtered meshes (gpu_traverse.h's general search). */
 template <int LAYOUT>
 __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_render_scene *rs,
                                       evr_ray ray, float tnear, float tfar, float f, int any,
@@ -16,11 +17,11 @@ __device__ __noinline__ int gpu_trace(const evr_gpu_scene_view *view, const evr_
 {
     /* the dispatch of evr__trace, here with the template's constants (through evr__trace the
      * BVH4 kernels' registers came out otherwise) */
-    const int deform = (LAYOUT & EVR_GPU_TRACE_DEFORMING) != 0;
+    const int general = (LAYOUT & EVR_GPU_TRACE_GENERAL) != 0;
     if (view->num_top_nodes == 0) return 0;
-    if ((LAYOUT & ~EVR_GPU_TRACE_DEFORMING) == EVR_GPU_LAYOUT_CW8)
-        return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit, groups, deform);
-    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit, groups, deform);
+    if ((LAYOUT & ~EVR_GPU_TRACE_GENERAL) == EVR_GPU_LAYOUT_CW8)
+        return evr__trace8(view, rs, ray, tnear, tfar, f, any, hit, groups, general);
+    return evr__trace4(view, rs, ray, tnear, tfar, f, any, hit, groups, general);
 }
 
 /* A warp-aggregated append: every lane of the warp calls it; the lanes with `want` get

@@ -71,9 +71,12 @@ extern "C" {
 #ifndef EVR_GPU_LAYOUT_DEFAULT
 #define EVR_GPU_LAYOUT_DEFAULT EVR_GPU_LAYOUT_CW8
 #endif
-/* Or'ed into a traversal's layout (the CUDA backend's kernels' LAYOUT): the scene has deforming
- * groups (gpu_traverse.h: a search without them is the code it was before them). */
-#define EVR_GPU_TRACE_DEFORMING 0x10
+/* Or'ed into a traversal's layout (the CUDA backend's kernels' LAYOUT): the general search, for
+ * a scene with deforming groups or with meshes whose hits a material may rule out
+ * (core/hit_filter.h: alpha MASK, single-sided). gpu_traverse.h: a search without either is
+ * the code it was before them; one general kind for both keeps the kernels' instantiations (and
+ * the compile time) as they were. */
+#define EVR_GPU_TRACE_GENERAL 0x10
 /* Or'ed into evr_gpu_bvh_build's layout: no grouping, every instance a group of its own in its
  * node's object space (the trees of one mesh shared), as before grouping; for comparisons. */
 #define EVR_GPU_BVH_UNGROUPED 0x100
@@ -111,16 +114,16 @@ typedef struct {
 
 /* A triangle in leaf order, in its group's space, 48 bytes: vertices (as the mesh gives them,
  * or baked into world space for the static group; the watertight test needs the vertices
- * themselves, not edges), the triangle's index in its mesh and its scene instance (plus the
- * group's evr_gpu_inst.instance_base). With spatial splits one triangle may appear in several
- * leaves. */
+ * themselves, not edges), the triangle's index in its mesh, its scene instance (plus the
+ * group's evr_gpu_inst.instance_base) and its mesh's filter bits (evr_mesh_view.filter, read
+ * only by the general search). With spatial splits one triangle may appear in several leaves. */
 typedef struct {
     EVR_ALIGN16 float v0[3];
     uint32_t prim; /* triangle index in the instance's mesh */
     float v1[3];
     int32_t instance; /* scene instance, minus the group's instance_base */
     float v2[3];
-    uint32_t pad;
+    uint32_t filter; /* EVR_FILTER_* of its mesh (core/hit_filter.h), 0: none */
 } evr_gpu_tri;
 
 /* A deforming group's triangle in leaf order, 16 bytes: its vertices' indices into the group's
@@ -143,7 +146,9 @@ typedef struct {
 
 /* What the traversal reads; all pointers host or all device. */
 typedef struct {
-    int layout;                  /* EVR_GPU_LAYOUT_* */
+    int layout;   /* EVR_GPU_LAYOUT_* */
+    int filtered; /* some mesh's hits may be ruled out (evr_gpu_bvh.filtered); in the padding
+                     after layout: the kernels' arguments keep their size and offsets */
     const evr_gpu_node4 *nodes4; /* bottom level, layout BVH4 (else NULL) */
     const evr_gpu_node8 *nodes8; /* bottom level, layout CW8 (else NULL) */
     const evr_gpu_tri *tris;
@@ -182,6 +187,8 @@ typedef struct {
                                   for a deforming group: its tree is evr_gpu_deform's) */
     int *group_deform;   /* per group: its index among the deforming groups, -1: none */
     int num_deforming;   /* deforming groups */
+    int filtered;        /* some instance's mesh has filter bits (evr_mesh_view.filter): the
+                            general search */
     int32_t *group_instance_base; /* per group: evr_gpu_inst.instance_base */
     int *group_stack;             /* per group: stack entries its traversal needs at most */
     float *group_bounds;          /* per group: box of its triangles in its space, lo xyz hi xyz */

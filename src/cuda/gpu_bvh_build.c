@@ -2,6 +2,7 @@
  * (gpu_bvh_tree.c builds and flattens each; the deforming groups' per segment, gpu_bvh_deform.c)
  * and the top level over the groups. */
 #include "cuda/gpu_bvh_internal.h"
+#include "backend.h"
 #include "prep/instance_groups.h"
 #include "prep/swept_bounds.h"
 #include "scene/scene.h"
@@ -77,6 +78,7 @@ typedef struct {
     float *tri;                      /* 9 floats per triangle */
     uint32_t *prim;
     int32_t *inst;
+    uint32_t *filter;
     size_t cap;
     float *verts; /* a baked mesh's vertices */
     size_t cap_verts;
@@ -88,6 +90,7 @@ static void group_tris_free(group_tris *gt)
     free(gt->tri);
     free(gt->prim);
     free(gt->inst);
+    free(gt->filter);
     free(gt->verts);
 }
 
@@ -98,11 +101,13 @@ static int group_tris_reserve(group_tris *gt, size_t nt)
     free(gt->tri);
     free(gt->prim);
     free(gt->inst);
+    free(gt->filter);
     gt->prims = evr_gpu_tree_prims(2 * nt);
     gt->tri = malloc(sizeof(float) * 9 * nt);
     gt->prim = malloc(sizeof(uint32_t) * nt);
     gt->inst = malloc(sizeof(int32_t) * nt);
-    gt->cap = gt->prims && gt->tri && gt->prim && gt->inst ? nt : 0;
+    gt->filter = malloc(sizeof(uint32_t) * nt);
+    gt->cap = gt->prims && gt->tri && gt->prim && gt->inst && gt->filter ? nt : 0;
     return gt->cap != 0;
 }
 
@@ -122,10 +127,12 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
         int i = b->members[j], bake = b->group_node[g] < 0;
         const evr_mesh *mesh;
         const float *pos;
+        uint32_t filter;
         size_t t;
         if (s->instances[i].mesh < 0 || s->instances[i].mesh >= s->num_meshes) continue;
         mesh = &s->meshes[s->instances[i].mesh];
         if (mesh->num_triangles == 0) continue;
+        filter = (uint32_t)evr_render_mesh_filter(s, mesh);
         pos = mesh->positions;
         if (bake) {
             evr_m34 world = evr_node_world_at(s, s->instances[i].node, s->anim_start);
@@ -169,6 +176,7 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
                        pos + 3 * (size_t)mesh->indices[3 * t + (size_t)v], 3 * sizeof(float));
             gt->prim[n] = (uint32_t)t;
             gt->inst[n] = (int32_t)i - base;
+            gt->filter[n] = filter;
             evr_gpu_prim_set(pr, n, lo, hi, box);
             n++;
         }
@@ -196,6 +204,9 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
     if (n < 0) return fail(err, EVR_ERR_ARG, "a negative instance count", NULL);
     out->layout = layout;
     out->num_scene_instances = n;
+    for (g = 0; g < n && !out->filtered; g++) /* then the kernels' general search */
+        if (s->instances[g].mesh >= 0 && s->instances[g].mesh < s->num_meshes)
+            out->filtered = evr_render_mesh_filter(s, &s->meshes[s->instances[g].mesh]) != 0;
     if (evr_instance_groups_build(s, out->grouped, &groups)) { /* its arrays are ours from here */
         out->num_groups = groups.num_groups;
         out->static_group = groups.static_group;
@@ -290,6 +301,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         c.tri9 = gt.tri;
         c.tri_prim = gt.prim;
         c.tri_inst = gt.inst;
+        c.tri_filter = gt.filter;
         split.tri = gt.tri;
         st = evr_gpu_tree_build(dev, &c, gt.prims, cnt, 2 * cnt, RTC_BUILD_QUALITY_HIGH,
                                 layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4, &split, box, &root, err);
@@ -483,6 +495,7 @@ void evr_gpu_scene_view_host(const evr_gpu_bvh *b, const evr_gpu_deform *d, cons
     v->insts = top->insts;
     v->num_top_nodes = top->num_nodes;
     v->num_insts = top->num_insts;
+    v->filtered = b->filtered;
     if (d) {
         v->dnodes4 = d->nodes4;
         v->dnodes8 = d->nodes8;

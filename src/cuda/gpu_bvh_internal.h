@@ -40,6 +40,7 @@ typedef struct {
     const uint32_t *tri_vidx;     /* a deforming group's triangles, 3 vertex indices each */
     const uint32_t *tri_prim;     /* their indices in their meshes */
     const int32_t *tri_inst;      /* their instance fields */
+    const uint32_t *tri_filter;   /* their meshes' filter bits */
     const evr_gpu_inst *inst_src; /* the top level's groups */
     /* work list */
     flat_work *work;

@@ -238,6 +238,7 @@ static int emit_items(flat_ctx *c, const build_leaf *l, uint32_t *first)
             memcpy(t->v2, v + 6, 3 * sizeof(float));
             t->prim = c->tri_prim[p];
             t->instance = c->tri_inst[p];
+            t->filter = c->tri_filter[p];
         }
     }
     c->num_items = need;

@@ -16,14 +16,20 @@
  * normalizing its direction, so t stays the world parameter (the static group's space is the
  * world: an identity transform, exact in float). A deforming group's triangles get their
  * vertices at the ray's time from the segment's vertex keys (evr_deform_lerp_in, what shading
- * reads too); a top-level leaf is a deforming group when its root is negative. Whether a scene
- * has deforming groups at all is a constant of the search (`deform`; on the device a bit of the
- * kernel's LAYOUT, EVR_GPU_TRACE_DEFORMING): without them the search is the very code it was
- * before deforming meshes, instruction for instruction (nvdisasm, sm_90). Any trace of them in
- * that code changed the eye's render kernel's registers and spills (a branch per group entered,
- * a call to a search of their own inside or after this one, even passing a triangle's vertices
- * by pointer instead of the record); so the CUDA kernels come in both kinds, and the deforming
- * kind checks each group it enters. One source serves both, inlined with the constants folded
+ * reads too); a top-level leaf is a deforming group when its root is negative. Hits that a
+ * material rules out (core/hit_filter.h: alpha MASK holes, single-sided back faces; each
+ * triangle carries its mesh's filter bits) are passed over where they are met, and the search
+ * goes on behind them (a shadow ray's too). Whether a scene has deforming groups or such meshes
+ * at all is a constant of the search (`general`; on the device a bit of the kernel's LAYOUT,
+ * EVR_GPU_TRACE_GENERAL): without them the search is the very code it was before deforming
+ * meshes, instruction for instruction (nvdisasm, sm_90). Any trace of them in that code changed
+ * the eye's render kernel's registers and spills (a branch per group entered, a call to a
+ * search of their own inside or after this one, even passing a triangle's vertices by pointer
+ * instead of the record); so the CUDA kernels come in both kinds, and the general kind checks
+ * each group it enters and, where the scene has filtered meshes, each hit's filter bits. One
+ * general kind for both keeps the number of kernel instantiations (cuda_render.cu's compile
+ * time) as it was; a scene with deforming meshes but no filtered ones pays a test of a null
+ * pointer per hit. One source serves both, inlined with the constants folded
  * (EVR__ALWAYS_INLINE). Triangles are intersected with the
  * watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge or vertex
  * hits at least one of the triangles. Its edge functions must be evaluated without fused
@@ -42,6 +48,7 @@
 #include "core/motion.h"
 #include "core/camera.h"
 #include "core/render_scene.h"
+#include "core/hit_filter.h"
 #include "cuda/gpu_bvh.h"
 
 typedef struct {
@@ -303,6 +310,57 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__leaf_tri(const evr_gpu_tri *tris,
     return evr__tri(r, &tris[i], tnear, tfar, t, u, v);
 }
 
+/* What the general search needs to rule out a hit (core/hit_filter.h): the scene, the group's
+ * instance base, the world ray's direction and time, whether it is a shadow ray (any), the
+ * filter bits that count for it (a shadow ray sees back faces: EVR_FILTER_MASK only) and, for a
+ * deforming group, its mesh's bits among them. */
+typedef struct {
+    const evr_render_scene *rs;
+    int32_t instance_base;
+    evr_v3 dir;
+    float f;
+    int shadow;
+    uint32_t bits, dbits;
+} evr__filter_src;
+
+/* core/hit_filter.h's test, out of line on the device: inlined into each of the search's leaf
+ * loops it made the general kernels' traversal three times longer (PTX), and the instruction
+ * cache is what the traversal stalls on (cuda_trace.cuh). */
+#ifdef __CUDACC__
+#define EVR__NOINLINE __noinline__
+#else
+#define EVR__NOINLINE __attribute__((noinline))
+#endif
+EVR_HD static EVR__NOINLINE int evr__hit_filtered(const evr_render_scene *rs, int inst,
+                                                  uint32_t prim, float u, float v, evr_v3 dir,
+                                                  float f, int shadow)
+{
+    return evr_hit_filtered(rs, inst, prim, u, v, dir, 0, f, shadow);
+}
+
+/* Whether the hit at (u, v) of leaf item i is ruled out; never without fs (the rigid search,
+ * where fs is a constant NULL and this folds away). A triangle whose mesh has no filter bits
+ * (evr_gpu_tri.filter) costs a test of a field already loaded. */
+EVR_HD static EVR__ALWAYS_INLINE int evr__leaf_filtered(const evr_gpu_tri *tris,
+                                                        const evr__deform_src *ds,
+                                                        const evr__filter_src *fs, uint32_t i,
+                                                        float u, float v)
+{
+    int inst;
+    uint32_t prim;
+    if (!fs) return 0;
+    if (ds) {
+        if (!fs->dbits) return 0;
+        inst = fs->instance_base;
+        prim = ds->tris[i].prim;
+    } else {
+        if (!(tris[i].filter & fs->bits)) return 0;
+        inst = fs->instance_base + tris[i].instance;
+        prim = tris[i].prim;
+    }
+    return evr__hit_filtered(fs->rs, inst, prim, u, v, fs->dir, fs->f, fs->shadow);
+}
+
 /* The triangle and instance fields of a leaf item that was hit (read only then). */
 EVR_HD static EVR__ALWAYS_INLINE void
 evr__leaf_hit(const evr_gpu_tri *tris, const evr__deform_src *ds, uint32_t i, evr__tri_hit *th)
@@ -359,11 +417,10 @@ EVR_HD static inline void evr__node4(const evr_gpu_node4 *n, const evr__tray *r,
 
 /* Nearest (any != 0: first) triangle of one group in (tnear, *tfar]; shrinks *tfar. Uses the
  * stack above sp0. The triangles are tris, or with ds a deforming group's. */
-EVR_HD static EVR__ALWAYS_INLINE int evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris,
-                                                int root, const evr__tray *r, float tnear,
-                                                float *tfar, int any, evr__stack_entry *stack,
-                                                int sp0, evr__tri_hit *th,
-                                                const evr__deform_src *ds)
+EVR_HD static EVR__ALWAYS_INLINE int
+evr__blas4(const evr_gpu_node4 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
+           float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0, evr__tri_hit *th,
+           const evr__deform_src *ds, const evr__filter_src *fs)
 {
     int node = root, sp = sp0, found = 0;
     for (;;) {
@@ -376,7 +433,8 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__blas4(const evr_gpu_node4 *nodes, cons
             for (k = 0; k < lc[i]; k++) {
                 const uint32_t item = (uint32_t)lf[i] + k;
                 float t, u, v;
-                if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+                if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar &&
+                    !evr__leaf_filtered(tris, ds, fs, item, u, v)) {
                     *tfar = t;
                     evr__leaf_hit(tris, ds, item, th);
                     th->u = u;
@@ -494,11 +552,10 @@ EVR_HD static inline uint32_t evr__group_next(uint32_t *base, uint32_t *hits, co
 }
 
 /* As evr__blas4, for CW8 nodes. */
-EVR_HD static EVR__ALWAYS_INLINE int evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris,
-                                                int root, const evr__tray *r, float tnear,
-                                                float *tfar, int any, evr__stack_entry *stack,
-                                                int sp0, evr__tri_hit *th,
-                                                const evr__deform_src *ds)
+EVR_HD static EVR__ALWAYS_INLINE int
+evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const evr__tray *r,
+           float tnear, float *tfar, int any, evr__stack_entry *stack, int sp0, evr__tri_hit *th,
+           const evr__deform_src *ds, const evr__filter_src *fs)
 {
     uint32_t ng_base = (uint32_t)root, ng_hits = 0x80000000u, tg_base = 0, tg_hits = 0;
     int sp = sp0, found = 0;
@@ -516,7 +573,8 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__blas8(const evr_gpu_node8 *nodes, cons
             const uint32_t item = tg_base + (uint32_t)bit;
             float t, u, v;
             tg_hits &= ~(1u << bit);
-            if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar) {
+            if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar &&
+                !evr__leaf_filtered(tris, ds, fs, item, u, v)) {
                 *tfar = t;
                 evr__leaf_hit(tris, ds, item, th);
                 th->u = u;
@@ -538,17 +596,22 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__blas8(const evr_gpu_node8 *nodes, cons
 /* ---- groups ---- */
 
 /* Searches one group with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
- * and fills hit (when not NULL). deform (a constant where inlined): the group may be a deforming
- * one (root < 0: its tree in the deforming arrays, its vertices the segment's keys at time f). */
+ * and fills hit (when not NULL). general (a constant where inlined): the general search: the
+ * group may be a deforming one (root < 0: its tree in the deforming arrays, its vertices the
+ * segment's keys at time f), and where the scene has meshes whose hits a material may rule out
+ * (v->filtered), their hits are tested (core/hit_filter.h) and a ruled-out one is passed over:
+ * the search goes on behind it, a shadow ray's too. */
 EVR_HD static EVR__ALWAYS_INLINE int
 evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
               evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
-              evr__stack_entry *stack, int sp, evr_gpu_hit *hit, int deform)
+              evr__stack_entry *stack, int sp, evr_gpu_hit *hit, int general)
 {
     evr_m34 inv;
     evr_v3 oo, od;
     evr__tray r;
     evr__tri_hit th;
+    evr__filter_src fsrc;
+    const evr__filter_src *fs = (const evr__filter_src *)0;
     int found;
     if (in->moving) {
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, in->track), f);
@@ -563,23 +626,36 @@ evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr
     th.prim = 0;
     th.inst = 0;
     th.u = th.v = 0.0f;
-    if (deform && in->root < 0) {
+    if (general && v->filtered) {
+        fsrc.rs = rs;
+        fsrc.instance_base = in->instance_base;
+        fsrc.dir = d;
+        fsrc.f = f;
+        fsrc.shadow = any;
+        fsrc.bits = any ? EVR_FILTER_MASK : EVR_FILTER_MASK | EVR_FILTER_CULL;
+        fsrc.dbits = 0;
+        fs = &fsrc;
+    }
+    if (general && in->root < 0) {
         evr__deform_src ds;
         ds.tris = v->dtris;
         ds.view = rs->deforms[rs->instances[in->instance_base].deform];
         ds.fr = evr_key_interval(ds.view.num_keys, f, &ds.a);
+        if (fs)
+            fsrc.dbits =
+                (uint32_t)rs->meshes[rs->instances[in->instance_base].mesh].filter & fsrc.bits;
         if (v->layout == EVR_GPU_LAYOUT_CW8)
             found = evr__blas8(v->dnodes8, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
-                               &th, &ds);
+                               &th, &ds, fs);
         else
             found = evr__blas4(v->dnodes4, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
-                               &th, &ds);
+                               &th, &ds, fs);
     } else if (v->layout == EVR_GPU_LAYOUT_CW8) {
         found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th,
-                           (const evr__deform_src *)0);
+                           (const evr__deform_src *)0, fs);
     } else {
         found = evr__blas4(v->nodes4, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th,
-                           (const evr__deform_src *)0);
+                           (const evr__deform_src *)0, fs);
     }
     if (found && hit) {
         hit->t = *tfar;
@@ -604,11 +680,11 @@ EVR_HD static inline int evr__group_skipped(const evr_gpu_inst *in, int groups)
                                          : 0;
 }
 
-/* Top-level search; deform (a constant where inlined): some groups may be deforming ones. */
+/* Top-level search; general (a constant where inlined): the general search (evr__instance). */
 EVR_HD static EVR__ALWAYS_INLINE int evr__trace4(const evr_gpu_scene_view *v,
                                                  const evr_render_scene *rs, evr_ray ray,
                                                  float tnear, float tfar, float f, int any,
-                                                 evr_gpu_hit *hit, int groups, int deform)
+                                                 evr_gpu_hit *hit, int groups, int general)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -623,7 +699,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace4(const evr_gpu_scene_view *v,
             for (k = 0; k < lc[i]; k++) {
                 if (evr__group_skipped(&v->insts[(uint32_t)lf[i] + k], groups)) continue;
                 if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear,
-                                  &tfar, any, stack, sp, hit, deform)) {
+                                  &tfar, any, stack, sp, hit, general)) {
                     found = 1;
                     if (any) return 1;
                 }
@@ -656,7 +732,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace4(const evr_gpu_scene_view *v,
 EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
                                                  const evr_render_scene *rs, evr_ray ray,
                                                  float tnear, float tfar, float f, int any,
-                                                 evr_gpu_hit *hit, int groups, int deform)
+                                                 evr_gpu_hit *hit, int groups, int general)
 {
     evr__stack_entry stack[EVR_GPU_STACK_SIZE];
     evr__tray r;
@@ -677,7 +753,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
             tg_hits &= ~(1u << bit);
             if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
             if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear,
-                              &tfar, any, stack, sp, hit, deform)) {
+                              &tfar, any, stack, sp, hit, general)) {
                 found = 1;
                 if (any) return 1;
             }
@@ -693,16 +769,23 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
 }
 
 /* Nearest (any != 0: first) hit among some groups (EVR_GROUPS_*) in (tnear, tfar] at time f, in
- * node layout `layout`; deform: the scene has deforming groups (the host's queries below; the
- * CUDA kernels' gpu_trace makes the same choice with its template's constants). */
+ * node layout `layout`; general: the scene has deforming groups or filtered meshes
+ * (evr__trace_general; the CUDA kernels' gpu_trace makes the same choice with its template's
+ * constants). */
 EVR_HD static EVR__ALWAYS_INLINE int
 evr__trace(const evr_gpu_scene_view *v, const evr_render_scene *rs, evr_ray ray, float tnear,
-           float tfar, float f, int any, evr_gpu_hit *hit, int groups, int layout, int deform)
+           float tfar, float f, int any, evr_gpu_hit *hit, int groups, int layout, int general)
 {
     if (v->num_top_nodes == 0) return 0;
     if (layout == EVR_GPU_LAYOUT_CW8)
-        return evr__trace8(v, rs, ray, tnear, tfar, f, any, hit, groups, deform);
-    return evr__trace4(v, rs, ray, tnear, tfar, f, any, hit, groups, deform);
+        return evr__trace8(v, rs, ray, tnear, tfar, f, any, hit, groups, general);
+    return evr__trace4(v, rs, ray, tnear, tfar, f, any, hit, groups, general);
+}
+
+/* Whether the scene needs the general search (EVR_GPU_TRACE_GENERAL). */
+EVR_HD static inline int evr__trace_general(const evr_gpu_scene_view *v)
+{
+    return v->num_dtris != 0 || v->filtered;
 }
 
 /* The nearest hit among some groups only (EVR_GROUPS_*), nearer than tmax (ties go to tmax).
@@ -712,7 +795,7 @@ EVR_HD static inline int evr_trace_closest_groups(const evr_gpu_scene_view *v,
                                                   const evr_render_scene *rs, evr_ray ray,
                                                   float tmax, float f, int groups, evr_gpu_hit *hit)
 {
-    return evr__trace(v, rs, ray, 0.0f, tmax, f, 0, hit, groups, v->layout, v->num_dtris != 0);
+    return evr__trace(v, rs, ray, 0.0f, tmax, f, 0, hit, groups, v->layout, evr__trace_general(v));
 }
 
 /* Nearest hit along the world ray in (0, tmax] at normalized segment time f in [0, 1]. */
@@ -727,7 +810,7 @@ EVR_HD static inline int evr_trace_any(const evr_gpu_scene_view *v, const evr_re
                                        evr_ray ray, float tnear, float tfar, float f)
 {
     return evr__trace(v, rs, ray, tnear, tfar, f, 1, 0, EVR_GROUPS_ALL, v->layout,
-                      v->num_dtris != 0);
+                      evr__trace_general(v));
 }
 
 #endif

@@ -417,6 +417,7 @@ void evr_gltf_material_init(evr_gltf_material *m, const char *name)
     m->base_texture = -1;
     m->metallic = 0.0f;
     m->roughness = 1.0f;
+    m->double_sided = 1;
 }
 
 static int unit_range(const float *v, int n)

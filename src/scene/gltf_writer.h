@@ -65,7 +65,8 @@ void evr_gltf_free(evr_gltf *g);
 int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width,
                          int height, int channels);
 
-/* Defaults: white, no texture, metallic 0, roughness 1, no emission, single-sided. */
+/* Defaults: white, no texture, metallic 0, roughness 1, no emission, double-sided (the built-in
+ * scenes' surfaces are seen from both sides). */
 void evr_gltf_material_init(evr_gltf_material *m, const char *name);
 int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m);
 

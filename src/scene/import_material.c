@@ -101,6 +101,9 @@ static evr_status assimp_material(importer *im, const struct aiMaterial *am, evr
         m->p.base_color[3] = f;
         m->p.alpha_mode = EVR_ALPHA_BLEND;
     }
+    /* formats other than glTF have no rule that one side is invisible: both sides show unless
+     * the file says the material is one-sided */
+    m->p.double_sided = 1;
     if (aiGetMaterialIntegerArray(am, AI_MATKEY_TWOSIDED, &two, &one) == aiReturn_SUCCESS)
         m->p.double_sided = two != 0;
     one = 1;
