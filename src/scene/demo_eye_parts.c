@@ -548,7 +548,7 @@ int evr_eye_material(evr_gltf *g, const char *name, int texture, float roughness
 {
     evr_gltf_material m;
     evr_gltf_material_init(&m, name);
-    m.base_texture = texture;
+    m.base_texture.index = texture;
     m.roughness = roughness;
     return evr_gltf_add_material(g, &m);
 }

@@ -1,7 +1,8 @@
 /* The glTF JSON read directly (the .gltf text or the GLB's JSON chunk), for what Assimp 5.2
  * drops or mangles: which channels exist and their interpolation (quirks (d), (e), (f) and STEP
  * in import.c), the nodes' morph weights (quirk (h)),
- * KHR_materials_emissive_strength and the materials' photon extras. */
+ * KHR_materials_emissive_strength, the materials' photon extras and the lights' radii (a
+ * KHR_lights_punctual light's extras "radius", which Assimp does not keep). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +20,7 @@ void evr_gltf_side_free(gltf_side *g)
     free(g->ch);
     free(g->emissive_strength);
     free(g->t_extras);
+    free(g->light_radius);
     for (i = 0; i < g->num_nodes && g->node_weights; i++) free(g->node_weights[i]);
     free(g->node_weights);
     free(g->node_num_weights);
@@ -58,7 +60,7 @@ int evr_gltf_json_span(const unsigned char *data, size_t size, const char **json
 evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g, evr_error *err)
 {
     evr_jdoc d;
-    int root, nodes, anims, mats, i, a, m, cap = 0;
+    int root, nodes, anims, mats, lights, i, a, m, cap = 0;
     int *samplers = NULL;
     const char *json;
     size_t jlen;
@@ -81,13 +83,18 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->num_nodes = evr_jdoc_count(&d, nodes);
     g->num_anims = evr_jdoc_count(&d, anims);
     g->num_materials = evr_jdoc_count(&d, mats);
+    lights = evr_jdoc_get(
+        &d, evr_jdoc_get(&d, evr_jdoc_get(&d, root, "extensions"), "KHR_lights_punctual"),
+        "lights");
+    g->num_lights = evr_jdoc_count(&d, lights);
+    g->light_radius = calloc((size_t)g->num_lights + 1, sizeof *g->light_radius);
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->emissive_strength = calloc((size_t)g->num_materials + 1, sizeof *g->emissive_strength);
     g->t_extras = calloc(2 * (size_t)g->num_materials + 2, sizeof *g->t_extras);
     g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
     g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
     if (!g->node_names || !g->emissive_strength || !g->t_extras || !g->node_num_weights ||
-        !g->node_weights)
+        !g->node_weights || !g->light_radius)
         goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
@@ -162,6 +169,12 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
             &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_diffuse"), T_ABSENT);
         g->t_extras[2 * i + 1] = (float)evr_jdoc_number(
             &d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "t_specular"), T_ABSENT);
+    }
+    for (i = 0, m = g->num_lights ? evr_jdoc_first(&d, lights) : -1; m >= 0;
+         m = evr_jdoc_next(&d, m), i++) {
+        double r =
+            evr_jdoc_number(&d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "radius"), 0.0);
+        g->light_radius[i] = r > 0.0 && r < 1e30 ? (float)r : 0.0f; /* bad values: a point */
     }
     free(samplers);
     evr_jdoc_free(&d);
