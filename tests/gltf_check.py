@@ -118,7 +118,8 @@ def check(path):
             if "TANGENT" in at:
                 if "NORMAL" not in at:
                     g.bad(f"mesh {mi}: TANGENT without NORMAL")
-                if any(t[3] not in (1.0, -1.0) for t in g.accessor(at["TANGENT"])):
+                if d["accessors"][at["TANGENT"]]["type"] == "VEC4" and \
+                        any(t[3] not in (1.0, -1.0) for t in g.accessor(at["TANGENT"])):
                     g.bad(f"mesh {mi}: a TANGENT whose w is not +-1")
             if "material" in p and not 0 <= p["material"] < len(d.get("materials", [])):
                 g.bad(f"mesh {mi}: no material {p['material']}")
