@@ -427,9 +427,10 @@ static int iris_mesh(evr_gltf *g, int material)
     for (j = 0; j <= rows; j++) {
         double r = j <= rows_in ? PUPIL_R + (IRIS_R - PUPIL_R) * j / rows_in
                                 : IRIS_R + (limbus_r() - IRIS_R) * (j - rows_in) / rows_out;
-        /* the slope of the piece the ring starts (j < rows_in) or ends (j = rows_in) */
-        double slope = j < rows_in ? (iris_z(IRIS_R) - iris_z(PUPIL_R)) / (IRIS_R - PUPIL_R)
-                                   : (limbus_z() - iris_z(IRIS_R)) / (limbus_r() - IRIS_R);
+        /* the slope of the piece the ring lies on (at the kink between them, their mean) */
+        const double s_in = (iris_z(IRIS_R) - iris_z(PUPIL_R)) / (IRIS_R - PUPIL_R),
+                     s_out = (limbus_z() - iris_z(IRIS_R)) / (limbus_r() - IRIS_R);
+        double slope = j < rows_in ? s_in : (j > rows_in ? s_out : 0.5 * (s_in + s_out));
         double l = sqrt(1.0 + slope * slope);
         for (i = 0; i <= cols; i++) {
             double ph = 2.0 * PI * i / cols, x = r * cos(ph), y = r * sin(ph), n[3];
