@@ -6,7 +6,11 @@ float inverse bind matrices with last row 0 0 0 1); JOINTS_0 / WEIGHTS_0 (unsign
 joints inside the skin, weights >= 0 summing to 1, no joint twice); morph targets (the same count
 everywhere, POSITION bounds, mesh and node weights of that length); animations (increasing key
 times with bounds, outputs of keys x components, unit rotations, "weights" only on morph meshes,
-keys x targets values, each node and path once per animation). check(path) returns the parsed
+keys x targets values, each node and path once per animation); materials (factors in range,
+texture slots naming textures, KHR_texture_transform with offset/scale pairs, alphaMode, the
+KHR_materials extensions' values), TANGENT (VEC4 floats, w = +-1, with NORMAL), lights (a radius
+in extras >= 0, none on directional lights), and every extension used listed in extensionsUsed.
+check(path) returns the parsed
 document and a list of problems (empty when the file passes)."""
 import json
 import math
@@ -111,7 +115,16 @@ def check(path):
             g.expect(at["POSITION"], ["VEC3"], [FLOAT], f"mesh {mi} POSITION")
             _bounds_match(g, at["POSITION"], pos, f"mesh {mi} POSITION")
             count = len(pos)
+            if "TANGENT" in at:
+                if "NORMAL" not in at:
+                    g.bad(f"mesh {mi}: TANGENT without NORMAL")
+                if d["accessors"][at["TANGENT"]]["type"] == "VEC4" and \
+                        any(t[3] not in (1.0, -1.0) for t in g.accessor(at["TANGENT"])):
+                    g.bad(f"mesh {mi}: a TANGENT whose w is not +-1")
+            if "material" in p and not 0 <= p["material"] < len(d.get("materials", [])):
+                g.bad(f"mesh {mi}: no material {p['material']}")
             for name, types, cts in (("NORMAL", ["VEC3"], [FLOAT]), ("TEXCOORD_0", ["VEC2"], [FLOAT]),
+                                     ("TANGENT", ["VEC4"], [FLOAT]),
                                      ("JOINTS_0", ["VEC4"], [UBYTE, USHORT]), ("WEIGHTS_0", ["VEC4"], [FLOAT])):
                 if name in at:
                     g.expect(at[name], types, cts, f"mesh {mi} {name}")
@@ -213,4 +226,80 @@ def check(path):
                     g.bad(f"animation {ai}: {len(out)} outputs for {len(times)} keys")
                 if t["path"] == "rotation" and any(abs(math.sqrt(sum(x * x for x in q)) - 1) > 1e-3 for q in out):
                     g.bad(f"animation {ai}: a rotation that is not a unit quaternion")
+    _check_materials(g)
     return d, g.problems
+
+
+def _in(v, lo, hi):
+    return isinstance(v, (int, float)) and lo <= v <= hi
+
+
+def _ext(obj, used, g, what):
+    """The object's extensions, each checked to be listed in extensionsUsed."""
+    ext = obj.get("extensions", {})
+    for name in ext:
+        if name not in used:
+            g.bad(f"{what}: extension {name} is not in extensionsUsed")
+    return ext
+
+
+def _slot(g, used, info, what):
+    if info is None:
+        return
+    if not 0 <= info.get("index", -1) < len(g.doc.get("textures", [])):
+        g.bad(f"{what}: no texture {info.get('index')}")
+    tt = _ext(info, used, g, what).get("KHR_texture_transform")
+    if tt is not None:
+        if len(tt.get("offset", [0, 0])) != 2 or len(tt.get("scale", [1, 1])) != 2 or \
+                not math.isfinite(tt.get("rotation", 0.0)):
+            g.bad(f"{what}: a bad KHR_texture_transform {tt}")
+
+
+def _check_materials(g):
+    d = g.doc
+    used = set(d.get("extensionsUsed", []))
+    lights = _ext(d, used, g, "document").get("KHR_lights_punctual", {}).get("lights", [])
+    for li, l in enumerate(lights):
+        r = l.get("extras", {}).get("radius")
+        if r is not None and (not _in(r, 0.0, math.inf) or l.get("type") == "directional"):
+            g.bad(f"light {li}: radius {r}")
+    for ti, t in enumerate(d.get("textures", [])):
+        if not 0 <= t.get("source", -1) < len(d.get("images", [])):
+            g.bad(f"texture {ti}: no image")
+    for mi, m in enumerate(d.get("materials", [])):
+        w = f"material {mi}"
+        pbr = m.get("pbrMetallicRoughness", {})
+        if not all(_in(c, 0, 1) for c in pbr.get("baseColorFactor", [1, 1, 1, 1])) or \
+                not _in(pbr.get("metallicFactor", 1), 0, 1) or not _in(pbr.get("roughnessFactor", 1), 0, 1) or \
+                not all(_in(c, 0, 1) for c in m.get("emissiveFactor", [0, 0, 0])):
+            g.bad(f"{w}: a factor outside [0,1]")
+        for slot in ("baseColorTexture", "metallicRoughnessTexture"):
+            _slot(g, used, pbr.get(slot), f"{w} {slot}")
+        for slot in ("normalTexture", "occlusionTexture", "emissiveTexture"):
+            _slot(g, used, m.get(slot), f"{w} {slot}")
+        if not _in(m.get("occlusionTexture", {}).get("strength", 1), 0, 1):
+            g.bad(f"{w}: occlusion strength outside [0,1]")
+        if m.get("alphaMode", "OPAQUE") not in ("OPAQUE", "MASK", "BLEND") or not _in(m.get("alphaCutoff", 0.5), 0, math.inf):
+            g.bad(f"{w}: bad alphaMode or alphaCutoff")
+        if not isinstance(m.get("doubleSided", False), bool):
+            g.bad(f"{w}: doubleSided is not a boolean")
+        ext = _ext(m, used, g, w)
+        tr = ext.get("KHR_materials_transmission")
+        if tr is not None:
+            if not _in(tr.get("transmissionFactor", 0), 0, 1):
+                g.bad(f"{w}: transmissionFactor outside [0,1]")
+            _slot(g, used, tr.get("transmissionTexture"), f"{w} transmissionTexture")
+        ior = ext.get("KHR_materials_ior", {}).get("ior", 1.5)
+        if not (ior == 0 or _in(ior, 1, math.inf)):
+            g.bad(f"{w}: ior {ior}")
+        vol = ext.get("KHR_materials_volume")
+        if vol is not None and (not _in(vol.get("thicknessFactor", 0), 0, math.inf) or
+                                not _in(vol.get("attenuationDistance", 1), 1e-30, math.inf) or
+                                not all(_in(c, 0, 1) for c in vol.get("attenuationColor", [1, 1, 1]))):
+            g.bad(f"{w}: bad KHR_materials_volume {vol}")
+        sp = ext.get("KHR_materials_specular")
+        if sp is not None and (not _in(sp.get("specularFactor", 1), 0, 1) or
+                               not all(_in(c, 0, math.inf) for c in sp.get("specularColorFactor", [1, 1, 1]))):
+            g.bad(f"{w}: bad KHR_materials_specular {sp}")
+        if not _in(ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1), 0, math.inf):
+            g.bad(f"{w}: emissiveStrength < 0")

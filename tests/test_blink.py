@@ -1,7 +1,8 @@
 """The blink scene deforms, end to end on the CPU: its lids by morph targets, its finger by
 skinning (src/scene/demo_blink.c). Image regions come from the scene's documented geometry: the
 camera at (12, 0, 130) mm looking along -Z with yfov 2 atan(27/120) at 16:9; the eye's opening
-spans x in [-11.9, 11.9], y in [-7, 7.5] mm around the eye centre (the origin, skin at z ~ 10-15);
+spans x in [-11.9, 11.9], y in [-7, 7.5] mm around the eye centre (the origin, skin at z ~ 10-15),
+and the lids' eyelash cards reach y = 10.8 (upper, z up to 19) and -10.2 (lower, z up to 16);
 the finger stands at x ~ 32 (radius 9) in front of the face (z ~ 30, its tip coming towards the
 camera as it bends), lit from the upper left so its shadow falls to its right.
   - evray info lists the finger's skin (3 joints) and the lids' morph targets (2 and 1);
@@ -48,9 +49,10 @@ ev = np.load(os.path.join(d, "events.npy"))
 x, y, t = ev["x"].astype(float), ev["y"].astype(float), ev["t"] * 1e-6
 T.check(len(ev) > 0, f"events ({len(ev)})")
 
-# the lids: the skin's opening with a margin of 2 pixels (the lids are at z 12-15)
-lx0, ly0 = project(-11.9, 7.5, 14.0)
-lx1, ly1 = project(11.9, -7.0, 14.0)
+# the lids and their lashes: the skin's opening and the lash cards (which move with the lids and
+# shade the skin around them), with a margin of 2 pixels
+lx0, ly0 = project(-12.5, 11.5, 19.0)
+lx1, ly1 = project(12.5, -11.0, 16.0)
 lid = (x >= lx0 - 2) & (x <= lx1 + 2) & (y >= ly0 - 2) & (y <= ly1 + 2)
 blink = (t >= 0.40 - dt) & (t <= 0.70 + dt)
 n_blink, n_rest = int(np.sum(lid & blink)), int(np.sum(lid & ~blink))

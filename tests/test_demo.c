@@ -17,8 +17,8 @@
 
 typedef struct {
     const char *name;
-    const char *meshes[8]; /* NULL-terminated */
-    const char *materials[8];
+    const char *meshes[12]; /* NULL-terminated */
+    const char *materials[12];
     int min_textures;
     const char *textured_material; /* a material whose base colour comes from an embedded PNG */
     const char *camera;
@@ -33,9 +33,11 @@ typedef struct {
 
 static const expectation expected[] = {
     {"eye",
-     {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", NULL},
-     {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "orbit", NULL},
-     5,
+     {"sclera", "cornea", "iris", "pupil", "upper_lid", "lower_lid", "upper_lashes", "lower_lashes",
+      "skin", "orbit", NULL},
+     {"sclera", "cornea", "iris", "pupil", "upper_eyelid", "lower_eyelid", "upper_lashes",
+      "lower_lashes", "skin", "orbit", NULL},
+     7,
      "iris",
      "eye_camera",
      4.0f / 3.0f,
@@ -49,9 +51,11 @@ static const expectation expected[] = {
      10000,
      40000},
     {"eye-drift",
-     {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", NULL},
-     {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "orbit", NULL},
-     5,
+     {"sclera", "cornea", "iris", "pupil", "upper_lid", "lower_lid", "upper_lashes", "lower_lashes",
+      "skin", "orbit", NULL},
+     {"sclera", "cornea", "iris", "pupil", "upper_eyelid", "lower_eyelid", "upper_lashes",
+      "lower_lashes", "skin", "orbit", NULL},
+     7,
      "iris",
      "eye_camera",
      4.0f / 3.0f,
@@ -145,9 +149,11 @@ static const expectation expected[] = {
      40000,
      80000},
     {"blink", /* the eye's parts, lids deformed by morph targets, a skinned finger */
-     {"sclera", "cornea", "upper_lid", "lower_lid", "skin", "orbit", "finger", NULL},
-     {"sclera", "iris", "upper_eyelid", "lower_eyelid", "skin", "finger", "orbit", NULL},
-     6,
+     {"sclera", "cornea", "iris", "pupil", "upper_lid", "lower_lid", "upper_lashes", "lower_lashes",
+      "skin", "orbit", "finger", NULL},
+     {"sclera", "cornea", "iris", "pupil", "upper_eyelid", "lower_eyelid", "upper_lashes",
+      "lower_lashes", "skin", "finger", "orbit", NULL},
+     8,
      "finger",
      "blink_camera",
      16.0f / 9.0f,
@@ -187,8 +193,9 @@ static void check_glb_layout(const unsigned char *b, size_t n)
             memcpy(json, b + 20, json_len);
             json[json_len] = 0;
             CHECK(strstr(json, "\"version\":\"2.0\"") != NULL);
-            if (strstr(json, "KHR_lights_punctual"))
-                CHECK(strstr(json, "\"extensionsUsed\":[\"KHR_lights_punctual\"]") != NULL);
+            if (strstr(json, "KHR_lights_punctual")) { /* listed first when used */
+                CHECK(strstr(json, "\"extensionsUsed\":[\"KHR_lights_punctual\"") != NULL);
+            }
             free(json);
         }
     }
@@ -344,7 +351,8 @@ static const struct aiMesh *find_mesh(const struct aiScene *s, const char *name)
 }
 
 /* The blink scene's deformers as Assimp reads them: the finger's three bones (each vertex on at
- * most two, weights summing to 1), the lids' morph targets (2 and 1) and their weight channels,
+ * most two, weights summing to 1), the lids' morph targets (2 and 1) and the weight channels of
+ * the lids and their lashes,
  * keyed 0 at both ends (the animation loops). */
 static void check_blink_deformers(const struct aiScene *s)
 {
@@ -377,7 +385,8 @@ static void check_blink_deformers(const struct aiScene *s)
         free(count);
     }
     CHECK(up->mNumAnimMeshes == 2 && lo->mNumAnimMeshes == 1);
-    CHECK(s->mNumAnimations == 1 && s->mAnimations[0]->mNumMorphMeshChannels == 2);
+    /* the lids and their lashes */
+    CHECK(s->mNumAnimations == 1 && s->mAnimations[0]->mNumMorphMeshChannels == 4);
     for (i = 0; s->mNumAnimations == 1 && i < s->mAnimations[0]->mNumMorphMeshChannels; i++) {
         const struct aiMeshMorphAnim *c = s->mAnimations[0]->mMorphMeshChannels[i];
         CHECK(c->mNumKeys > 100);

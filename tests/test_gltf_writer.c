@@ -1,9 +1,12 @@
-/* The glTF builder's skins and morph targets (scene/gltf_writer.c), read back from the GLB's JSON
- * and binary chunks as glTF 2.0 lays them out: a skin (joints, skeleton, MAT4 inverse bind
- * matrices), JOINTS_0 as unsigned bytes or shorts (0 where the weight is 0) and WEIGHTS_0 as
- * floats, morph targets (POSITION with min/max, NORMAL), mesh and node weights, target names,
- * and a "weights" channel with keys x targets scalars; and every rule the builder enforces
- * refused with a message. */
+/* The glTF builder (scene/gltf_writer.c), read back from the GLB's JSON and binary chunks as
+ * glTF 2.0 lays them out: a skin (joints, skeleton, MAT4 inverse bind matrices), JOINTS_0 as
+ * unsigned bytes or shorts (0 where the weight is 0) and WEIGHTS_0 as floats, morph targets
+ * (POSITION with min/max, NORMAL), mesh and node weights, target names, and a "weights" channel
+ * with keys x targets scalars; materials with every texture slot, KHR_texture_transform, alpha,
+ * double-sidedness and the KHR_materials extensions (only those that differ from their defaults,
+ * each listed in extensionsUsed), TANGENT, a light's radius in its extras; and every rule the
+ * builder enforces refused with a message. */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -285,6 +288,209 @@ static void test_wide_joints(void)
     evr_gltf_free(g);
 }
 
+static double numf(const doc *o, int v, const char *key, double def)
+{
+    return evr_jdoc_number(&o->d, evr_jdoc_get(&o->d, v, key), def);
+}
+
+static double elem(const doc *o, int arr, int i)
+{
+    return evr_jdoc_number(&o->d, nth(o, arr, i), -1);
+}
+
+static int list_has(const doc *o, int arr, const char *s)
+{
+    int v;
+    for (v = evr_jdoc_first(&o->d, arr); v >= 0; v = evr_jdoc_next(&o->d, v))
+        if (str_is(o, v, s)) return 1;
+    return 0;
+}
+
+/* Materials: one with everything, one with the defaults; a mesh with tangents; lights with and
+ * without a radius. */
+static void test_materials(void)
+{
+    static const uint8_t px[4 * 4] = {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 9, 9, 9, 9};
+    static const float tangents[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, -1, 1, 0, 0, 1};
+    evr_gltf *g = evr_gltf_new("materials");
+    evr_gltf_material m;
+    evr_gltf_mesh_desc d;
+    evr_gltf_light_desc ld;
+    int tex[3], full, plain, node, k;
+    doc o;
+    for (k = 0; k < 3; k++) {
+        char name[8];
+        snprintf(name, sizeof name, "t%d", k);
+        tex[k] = evr_gltf_texture_png(g, name, px, 2, 2, k == 0 ? 4 : 3);
+    }
+    evr_gltf_material_init(&m, "plain");
+    CHECK(m.double_sided == 1 && m.ior == 1.5f && m.alpha_cutoff == 0.5f && m.specular == 1.0f &&
+          m.base_texture.index == -1 && m.normal_texture.scale[1] == 1.0f);
+    plain = evr_gltf_add_material(g, &m);
+    evr_gltf_material_init(&m, "full");
+    m.base_texture.index = tex[0];
+    m.base_texture.offset[0] = 0.25f;
+    m.base_texture.rotation = 0.5f;
+    m.base_texture.scale[1] = 2.0f;
+    m.metallic_roughness_texture.index = tex[1];
+    m.normal_texture.index = tex[2];
+    m.normal_scale = 0.75f;
+    m.occlusion_texture.index = tex[1];
+    m.occlusion_strength = 0.5f;
+    m.emissive_texture.index = tex[0];
+    m.emissive[0] = 1.0f;
+    m.emissive_strength = 4.0f;
+    m.alpha_mode = EVR_GLTF_MASK;
+    m.alpha_cutoff = 0.25f;
+    m.double_sided = 0;
+    m.unlit = 1;
+    m.transmission = 1.0f;
+    m.transmission_texture.index = tex[2];
+    m.ior = 1.376f;
+    m.thickness = 0.5f;
+    m.attenuation_distance = 2.0f;
+    m.attenuation_color[1] = 0.5f;
+    m.specular = 0.5f;
+    m.specular_color[2] = 2.0f;
+    full = evr_gltf_add_material(g, &m);
+    quad(&d, "tangent_quad");
+    d.tangents = tangents;
+    d.material = full;
+    node = evr_gltf_node(g, "tangent_quad", -1);
+    evr_gltf_node_mesh(g, node, evr_gltf_add_mesh(g, &d));
+    evr_gltf_light_desc_init(&ld, "led", EVR_GLTF_POINT);
+    ld.radius = 0.0015f;
+    ld.intensity = 2e-3f;
+    evr_gltf_node_light(g, evr_gltf_node(g, "led", -1), evr_gltf_add_light(g, &ld));
+    evr_gltf_node_light(g, evr_gltf_node(g, "spot", -1),
+                        evr_gltf_light(g, "spot", EVR_GLTF_SPOT, NULL, 1.0f, 0.1f, 0.2f));
+    CHECK(plain == 0 && full == 1);
+    CHECK(open_doc(g, &o));
+    if (o.root >= 0) {
+        const evr_jdoc *jd = &o.d;
+        int mats = evr_jdoc_get(jd, o.root, "materials"),
+            used = evr_jdoc_get(jd, o.root, "extensionsUsed");
+        int p0 = nth(&o, mats, 0), p1 = nth(&o, mats, 1), pbr, t, x, e, prim, lights, a;
+        static const char *const exts[] = {
+            "KHR_lights_punctual",  "KHR_texture_transform",      "KHR_materials_emissive_strength",
+            "KHR_materials_unlit",  "KHR_materials_transmission", "KHR_materials_ior",
+            "KHR_materials_volume", "KHR_materials_specular"};
+        CHECK(evr_jdoc_count(jd, used) == 8);
+        for (k = 0; k < 8; k++) CHECK(list_has(&o, used, exts[k]));
+        /* the defaults: nothing but the core, two-sided */
+        CHECK(evr_jdoc_get(jd, p0, "extensions") < 0 && evr_jdoc_get(jd, p0, "alphaMode") < 0 &&
+              evr_jdoc_get(jd, p0, "normalTexture") < 0);
+        CHECK(evr_jdoc_type(jd, evr_jdoc_get(jd, p0, "doubleSided")) == EVR_JDOC_BOOL &&
+              jd->v[evr_jdoc_get(jd, p0, "doubleSided")].num == 1.0);
+        CHECK(evr_jdoc_get(jd, evr_jdoc_get(jd, p0, "pbrMetallicRoughness"), "baseColorTexture") <
+              0);
+        /* everything */
+        pbr = evr_jdoc_get(jd, p1, "pbrMetallicRoughness");
+        t = evr_jdoc_get(jd, pbr, "baseColorTexture");
+        CHECK(num(&o, t, "index") == tex[0]);
+        x = evr_jdoc_get(jd, evr_jdoc_get(jd, t, "extensions"), "KHR_texture_transform");
+        CHECK(elem(&o, evr_jdoc_get(jd, x, "offset"), 0) == 0.25 &&
+              elem(&o, evr_jdoc_get(jd, x, "offset"), 1) == 0.0);
+        CHECK(numf(&o, x, "rotation", -1) == 0.5);
+        CHECK(elem(&o, evr_jdoc_get(jd, x, "scale"), 0) == 1.0 &&
+              elem(&o, evr_jdoc_get(jd, x, "scale"), 1) == 2.0);
+        CHECK(num(&o, evr_jdoc_get(jd, pbr, "metallicRoughnessTexture"), "index") == tex[1]);
+        CHECK(evr_jdoc_get(jd, evr_jdoc_get(jd, pbr, "metallicRoughnessTexture"), "extensions") <
+              0);
+        t = evr_jdoc_get(jd, p1, "normalTexture");
+        CHECK(num(&o, t, "index") == tex[2] && numf(&o, t, "scale", -1) == 0.75);
+        t = evr_jdoc_get(jd, p1, "occlusionTexture");
+        CHECK(num(&o, t, "index") == tex[1] && numf(&o, t, "strength", -1) == 0.5);
+        CHECK(num(&o, evr_jdoc_get(jd, p1, "emissiveTexture"), "index") == tex[0]);
+        CHECK(elem(&o, evr_jdoc_get(jd, p1, "emissiveFactor"), 0) == 1.0);
+        CHECK(str_is(&o, evr_jdoc_get(jd, p1, "alphaMode"), "MASK") &&
+              numf(&o, p1, "alphaCutoff", -1) == 0.25);
+        CHECK(evr_jdoc_get(jd, p1, "doubleSided") < 0);
+        e = evr_jdoc_get(jd, p1, "extensions");
+        CHECK(evr_jdoc_count(jd, e) == 0 && evr_jdoc_type(jd, e) == EVR_JDOC_OBJECT);
+        CHECK(numf(&o, evr_jdoc_get(jd, e, "KHR_materials_emissive_strength"), "emissiveStrength",
+                   -1) == 4.0);
+        CHECK(evr_jdoc_type(jd, evr_jdoc_get(jd, e, "KHR_materials_unlit")) == EVR_JDOC_OBJECT);
+        x = evr_jdoc_get(jd, e, "KHR_materials_transmission");
+        CHECK(numf(&o, x, "transmissionFactor", -1) == 1.0 &&
+              num(&o, evr_jdoc_get(jd, x, "transmissionTexture"), "index") == tex[2]);
+        CHECK((float)numf(&o, evr_jdoc_get(jd, e, "KHR_materials_ior"), "ior", -1) == 1.376f);
+        x = evr_jdoc_get(jd, e, "KHR_materials_volume");
+        CHECK(numf(&o, x, "thicknessFactor", -1) == 0.5 &&
+              numf(&o, x, "attenuationDistance", -1) == 2.0 &&
+              elem(&o, evr_jdoc_get(jd, x, "attenuationColor"), 1) == 0.5);
+        x = evr_jdoc_get(jd, e, "KHR_materials_specular");
+        CHECK(numf(&o, x, "specularFactor", -1) == 0.5 &&
+              elem(&o, evr_jdoc_get(jd, x, "specularColorFactor"), 2) == 2.0);
+        /* TANGENT: VEC4 floats as given */
+        prim = nth(
+            &o, evr_jdoc_get(jd, nth(&o, evr_jdoc_get(jd, o.root, "meshes"), 0), "primitives"), 0);
+        a = num(&o, evr_jdoc_get(jd, prim, "attributes"), "TANGENT");
+        CHECK(a >= 0 && str_is(&o, evr_jdoc_get(jd, accessor(&o, a), "type"), "VEC4") &&
+              num(&o, accessor(&o, a), "count") == 4);
+        if (a >= 0) CHECK(rdf(accessor_data(&o, a) + 4 * 11) == -1.0f);
+        /* the radius in the light's extras, none on the spot */
+        lights = evr_jdoc_get(
+            jd, evr_jdoc_get(jd, evr_jdoc_get(jd, o.root, "extensions"), "KHR_lights_punctual"),
+            "lights");
+        CHECK(evr_jdoc_count(jd, lights) == 2);
+        CHECK((float)numf(&o, evr_jdoc_get(jd, nth(&o, lights, 0), "extras"), "radius", -1) ==
+              0.0015f);
+        CHECK(evr_jdoc_get(jd, nth(&o, lights, 1), "extras") < 0);
+    }
+    close_doc(&o);
+    evr_gltf_free(g);
+}
+
+/* Materials, tangents and lights the builder refuses, each with a message containing `what`. */
+static void test_bad_material(int which)
+{
+    static const char *const what[] = {"IOR >= 1",
+                                       "no texture 7",
+                                       "texture transform",
+                                       "alpha mode",
+                                       "attenuation distance",
+                                       "tangents need normals",
+                                       "w = +-1",
+                                       "radius",
+                                       "emissive strength",
+                                       "specular in [0,1]"};
+    static const float tangents[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0.5f, 1, 0, 0, 1};
+    evr_gltf *g = evr_gltf_new(NULL);
+    evr_gltf_material m;
+    evr_gltf_mesh_desc d;
+    evr_gltf_light_desc ld;
+    evr_error err;
+    void *glb = NULL;
+    size_t size = 0;
+    evr_gltf_material_init(&m, "m");
+    if (which == 0) m.ior = 0.9f;
+    if (which == 1) m.occlusion_texture.index = 7;
+    if (which == 2) m.normal_texture.rotation = NAN;
+    if (which == 3) m.alpha_mode = (evr_gltf_alpha_mode)3;
+    if (which == 4) m.attenuation_distance = 0.0f;
+    if (which == 8) m.emissive_strength = -1.0f;
+    if (which == 9) m.specular = 1.5f;
+    evr_gltf_add_material(g, &m);
+    quad(&d, "q");
+    if (which == 5) {
+        d.normals = NULL;
+        d.tangents = tangents;
+    }
+    if (which == 6) d.tangents = tangents;
+    evr_gltf_add_mesh(g, &d);
+    evr_gltf_light_desc_init(&ld, "sun", EVR_GLTF_DIRECTIONAL);
+    if (which == 7) ld.radius = 0.01f;
+    evr_gltf_add_light(g, &ld);
+    err.msg[0] = 0;
+    CHECK(evr_gltf_glb(g, &glb, &size, &err) == EVR_ERR_ARG && glb == NULL);
+    if (!strstr(err.msg, what[which]))
+        fprintf(stderr, "material case %d: \"%s\" lacks \"%s\"\n", which, err.msg, what[which]);
+    CHECK(strstr(err.msg, what[which]) != NULL);
+    free(glb);
+    evr_gltf_free(g);
+}
+
 /* Each case builds a small document with one mistake; the builder must refuse it with a message
  * that contains `what`. */
 enum {
@@ -391,5 +597,7 @@ int main(void)
     test_document();
     test_wide_joints();
     for (k = 0; k < NUM_BAD; k++) test_bad(k);
+    test_materials();
+    for (k = 0; k < 10; k++) test_bad_material(k);
     return check_report("test_gltf_writer");
 }

@@ -1774,13 +1774,15 @@ int main(void)
     {
         /* a saccade starts at 1.025 s; a blink closes the upper lid over 0.665 .. 0.765 s */
         static const double eye_t0[2] = {1.0, 0.72}, square_t0[1] = {0.5};
-        /* grouped as the CPU backend groups: skin and orbit never move; sclera and cornea are on
-         * nodes of their own under the animated "eyeball" node, so each is a group */
-        /* and as built before deforming meshes: the same nodes and triangle references */
-        static const uint32_t eye_counts[4] = {5561, 35867, 8455, 35095};
-        scene_expect eye = {
-            "sclera: sclera | cornea: cornea | upper_lid: upper_lid | lower_lid: lower_lid | static: skin orbit",
-            eye_counts, 0, 0, 0};
+        /* grouped as the CPU backend groups: skin and orbit never move; sclera, cornea, iris and
+         * pupil are on nodes of their own under the animated "eyeball" node, the lashes under
+         * the lids', so each is a group */
+        /* and the nodes and triangle references of the eye with its iris, pupil and lashes */
+        static const uint32_t eye_counts[4] = {5485, 35781, 8519, 35243};
+        scene_expect eye = {"sclera: sclera | cornea: cornea | iris: iris | pupil: pupil | "
+                            "upper_lid: upper_lid | upper_lashes: upper_lashes | lower_lid: "
+                            "lower_lid | lower_lashes: lower_lashes | static: skin orbit",
+                            eye_counts, 0, 0, 0};
         /* deforming: moving (blob-a, the elbow), across the weight curve's key at 1.0, then
          * the weights and the elbow held (from 1.5 on): the last two segments hold still */
         static const double deform_t0[4] = {0.3, 0.98, 1.6, 1.6 + 1.0 / 30.0};

@@ -1,10 +1,10 @@
 /* The "blink" scene: an eye that blinks by morph targets and a finger beside it that beckons by
  * skinning. Units metres, +Y up, the face looks along +Z; glTF conventions. Sizes below in
- * millimetres. 42,560 triangles; 3 joints, 3 morph targets.
+ * millimetres. 41,920 triangles; 3 joints, 6 morph targets.
  *
  *   eye          the eye scene's parts (demo_eye.c describes them), the eye centre at the origin:
- *                node "eyeball" (sclera and cornea, still, looking along +Z), "skin" (out to a
- *                radius of 75, with a 1024 x 1024 texture) and "orbit".
+ *                node "eyeball" (sclera, cornea, iris and pupil, still, looking along +Z), "skin"
+ *                (out to a radius of 75, with a 1024 x 1024 texture) and "orbit".
  *   upper_lid,   the eye scene's lids, still nodes whose meshes deform by morph targets instead
  *   lower_lid    of turning. upper_lid: target "blink" is every vertex (and normal) turned by
  *                38 degrees about the X axis (front down), the closed lid; target "blink_arc" is
@@ -13,6 +13,8 @@
  *                the lid is exactly the lid turned by 0, 19 and 38 degrees, and between them it
  *                stays within 0.01 of that arc (the straight path alone would cut 0.8 inside it,
  *                into the cornea). lower_lid: target "blink" turns it up by 2.5 degrees, weight b.
+ *   upper_lashes, the eye scene's lashes on nodes of their own, with their lid's morph targets
+ *   lower_lashes (each vertex turned the same way) and the same weight curves.
  *   finger       a skinned mesh on node "finger_skin" (no transform): a tapered tube along its
  *                +Y from -22 to 58 (radius 9 at the knuckle, 7.3 towards the tip, elliptical:
  *                0.85 as deep as wide, small bumps at the joints) closed by a rounded tip at 65;
@@ -113,7 +115,8 @@ static int lid_targets(const evr_demo_mesh *m, double angle, int arc, float *dp,
     return arc ? 2 : 1;
 }
 
-static int lid_mesh(evr_gltf *g, int upper, int material)
+/* A lid (lashes = 0) or its lashes (lashes = 1) as a mesh with the lid's morph targets. */
+static int lid_mesh(evr_gltf *g, int upper, int lashes, int material)
 {
     static const char *const upper_names[2] = {"blink", "blink_arc"}, *const lower_names[1] = {
                                                                           "blink"};
@@ -122,13 +125,15 @@ static int lid_mesh(evr_gltf *g, int upper, int material)
     evr_gltf_mesh_desc d;
     float *dp, *dn;
     int r = -1;
-    evr_eye_lid(&m, upper);
+    if (lashes) evr_eye_lashes(&m, upper);
+    else evr_eye_lid(&m, upper);
     dp = malloc(sizeof(float) * 3 * 2 * (size_t)m.nv);
     dn = malloc(sizeof(float) * 3 * 2 * (size_t)m.nv);
     if (m.failed || !dp || !dn) {
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while generating the blink's lids");
     } else {
-        evr_gltf_mesh_desc_init(&d, upper ? "upper_lid" : "lower_lid");
+        evr_gltf_mesh_desc_init(&d, lashes ? (upper ? "upper_lashes" : "lower_lashes")
+                                           : (upper ? "upper_lid" : "lower_lid"));
         d.positions = m.pos;
         d.normals = m.nrm;
         d.texcoords = m.uv;
@@ -357,7 +362,7 @@ static double beckon(double t) { return 0.5 - 0.5 * cos(2.0 * PI * t / BEAT); }
 
 /* Weight keys: the ends of the animation and every <= 2 ms through each blink (the lids hold
  * bit-identical weights between blinks); joint keys every 1/60 s. */
-static void build_animation(evr_gltf *g, int upper, int lower, const int *joints)
+static void build_animation(evr_gltf *g, const int *upper, const int *lower, const int *joints)
 {
     const int max_keys = 1024;
     const int nj = (int)ceil(ANIM_LENGTH / JOINT_KEY_STEP - 1e-9);
@@ -386,8 +391,10 @@ static void build_animation(evr_gltf *g, int upper, int lower, const int *joints
         wl[k] = (float)b;
     }
     anim = evr_gltf_animation(g, "blink");
-    evr_gltf_channel(g, anim, upper, EVR_GLTF_WEIGHTS, times, wu, n, EVR_GLTF_LINEAR);
-    evr_gltf_channel(g, anim, lower, EVR_GLTF_WEIGHTS, times, wl, n, EVR_GLTF_LINEAR);
+    for (k = 0; k < 2; k++) { /* each lid and its lashes */
+        evr_gltf_channel(g, anim, upper[k], EVR_GLTF_WEIGHTS, times, wu, n, EVR_GLTF_LINEAR);
+        evr_gltf_channel(g, anim, lower[k], EVR_GLTF_WEIGHTS, times, wl, n, EVR_GLTF_LINEAR);
+    }
     for (k = 0; k < 3; k++) {
         for (i = 0; i <= nj; i++) {
             double t = i == nj ? ANIM_LENGTH : i * JOINT_KEY_STEP;
@@ -415,18 +422,18 @@ void evr_demo_build_blink(evr_gltf *g)
 {
     evr_gltf_material mat;
     float ibm[3 * 16];
-    int m_sclera, m_iris, m_lid_up, m_lid_lo, m_skin, m_orbit, m_finger, eyeball, node, upper,
-        lower, root, joints[3], skin, mount, cam, lamp, k;
+    int m_lid_up, m_lid_lo, m_lash_up, m_lash_lo, m_skin, m_orbit, m_finger, eyeball, node,
+        upper[2], lower[2], root, joints[3], skin, mount, cam, lamp, k;
 
-    m_sclera = evr_eye_material(g, "sclera", evr_eye_paint_sclera(g), 0.35f);
-    m_iris = evr_eye_material(g, "iris", evr_eye_paint_iris(g), 0.1f);
     m_lid_up = evr_eye_material(
-        g, "upper_eyelid", evr_eye_paint_eyelid(g, "upper_eyelid_texture", 4242u, 170, 22.0, 50.0),
-        0.6f);
+        g, "upper_eyelid", evr_eye_paint_eyelid(g, "upper_eyelid_texture", 4242u, 0, 22.0, 50.0),
+        0.55f);
     m_lid_lo = evr_eye_material(
-        g, "lower_eyelid", evr_eye_paint_eyelid(g, "lower_eyelid_texture", 4343u, 90, 10.0, 24.0),
-        0.6f);
-    m_skin = evr_eye_material(g, "skin", evr_eye_paint_skin(g, SKIN_OUTER, 1024), 0.6f);
+        g, "lower_eyelid", evr_eye_paint_eyelid(g, "lower_eyelid_texture", 4343u, 0, 10.0, 24.0),
+        0.55f);
+    m_lash_up = evr_eye_lash_material(g, 1);
+    m_lash_lo = evr_eye_lash_material(g, 0);
+    m_skin = evr_eye_material(g, "skin", evr_eye_paint_skin(g, SKIN_OUTER, 1024), 0.55f);
     m_finger = evr_eye_material(g, "finger", paint_finger(g), 0.5f);
     evr_gltf_material_init(&mat, "orbit");
     mat.base_color[0] = 0.25f;
@@ -436,14 +443,15 @@ void evr_demo_build_blink(evr_gltf *g)
     if (evr_gltf_status(g, NULL) != EVR_OK) return;
 
     eyeball = evr_gltf_node(g, "eyeball", -1);
-    node = evr_gltf_node(g, "sclera", eyeball);
-    evr_gltf_node_mesh(g, node, evr_eye_sclera(g, m_sclera));
-    node = evr_gltf_node(g, "cornea", eyeball);
-    evr_gltf_node_mesh(g, node, evr_eye_cornea(g, m_iris));
-    upper = evr_gltf_node(g, "upper_lid", -1);
-    evr_gltf_node_mesh(g, upper, lid_mesh(g, 1, m_lid_up));
-    lower = evr_gltf_node(g, "lower_lid", -1);
-    evr_gltf_node_mesh(g, lower, lid_mesh(g, 0, m_lid_lo));
+    evr_eye_globe(g, eyeball);
+    upper[0] = evr_gltf_node(g, "upper_lid", -1);
+    evr_gltf_node_mesh(g, upper[0], lid_mesh(g, 1, 0, m_lid_up));
+    upper[1] = evr_gltf_node(g, "upper_lashes", -1);
+    evr_gltf_node_mesh(g, upper[1], lid_mesh(g, 1, 1, m_lash_up));
+    lower[0] = evr_gltf_node(g, "lower_lid", -1);
+    evr_gltf_node_mesh(g, lower[0], lid_mesh(g, 0, 0, m_lid_lo));
+    lower[1] = evr_gltf_node(g, "lower_lashes", -1);
+    evr_gltf_node_mesh(g, lower[1], lid_mesh(g, 0, 1, m_lash_lo));
     node = evr_gltf_node(g, "skin", -1);
     evr_gltf_node_mesh(g, node, evr_eye_skin(g, m_skin, SKIN_OUTER));
     node = evr_gltf_node(g, "orbit", -1);

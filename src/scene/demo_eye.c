@@ -1,15 +1,24 @@
 /* The "eye" and "eye-drift" scenes: what a head-mounted eye tracker's camera sees. Units metres, +Y up, the
- * subject looks along +Z; glTF conventions. Sizes below are in millimetres. 31,856 triangles.
+ * subject looks along +Z; glTF conventions. Sizes below are in millimetres. 31,216 triangles.
  *
- *   eyeball      node "eyeball" at the origin, animated rotation (gaze); children:
- *     sclera     UV sphere of radius 12 (poles on the Z axis, the front pole at +Z), textured
- *                white-pink with faint conjunctival vessels.
- *     cornea     the corneal bulge: a spherical cap of radius 7.8 centred at z = 6.7 (apex at
- *                z = 14.5, 2.5 in front of the eyeball); it meets the eyeball at a radius of 7.3
- *                and continues a little inside it so that no crack shows. We have no refraction,
- *                so the iris (diameter 11.5, radial fibres, collarette, crypts, dark limbal ring)
- *                and the black pupil (diameter 3.6) are painted on it with a planar projection
- *                along Z; glossy (roughness 0.1) to give the corneal glint of the LED.
+ *   eyeball      node "eyeball" at the origin, animated rotation (gaze); children (demo_eye_parts.c,
+ *                evr_eye_globe, shared with the blink scene):
+ *     sclera     a UV sphere of radius 12 (poles on the Z axis) behind the limbus (polar angle
+ *                37.2 degrees and more from +Z), textured white-pink with faint conjunctival
+ *                vessels; a moist dielectric, roughness 0.25.
+ *     cornea     a closed volume of the cornea's (and aqueous humour's) index: its front surface
+ *                the spherical cap of radius 7.8 centred at z = 6.7 (apex at z = 14.5, 2.5 in
+ *                front of the eyeball) out to the limbus, where it meets the eyeball (z = 9.556,
+ *                radius 7.258); closed behind by a disc in the limbus plane. Clear: transmission 1,
+ *                IOR 1.376, roughness 0.03 (the tear film: the smooth dielectric whose reflection of
+ *                the LED is the glint, the first Purkinje image), KHR_materials_volume thickness
+ *                4.9 (apex to limbus plane).
+ *     iris       inside the cornea's volume: a ring from the pupil's edge (radius 1.8, z = 11.6,
+ *                2.9 behind the apex) nearly flat out to the visible iris's edge (radius 5.75,
+ *                z = 11.15), then down to its root at the limbus; textured by a planar projection
+ *                along Z (radial fibres, collarette, crypts, dark limbal ring; sclera-coloured
+ *                beyond 6.1, as the sclera overlaps a real cornea's edge); roughness 0.5.
+ *     pupil      a black unlit disc (radius 1.85) 0.05 behind the iris's inner edge: the hole.
  *   upper_lid,   sheets on nodes that rotate about the X axis through the eye centre. Each is a
  *   lower_lid    surface of revolution about that axis (so the rotation slides it over itself):
  *                at the middle a sphere around the eye centre of radius 14.8 (upper) or 15.1
@@ -21,7 +30,14 @@
  *                thickness, closing the gap to the eyeball). Larger than the ~12.8 of a thin
  *                lid on purpose: the cornea reaches 14.5 from the centre, and a lid sliding over
  *                it in a blink must pass outside it. The lower lid lies in front of the upper one,
- *                so a closed eye shows the lower margin. Lashes are painted along the margins.
+ *                so a closed eye shows the lower margin. The lash line is painted along the
+ *                margins. Lids and skin: roughness 0.55.
+ *   upper_lashes, eyelashes: children of the lids (moving with them), curved cards rooted just
+ *   lower_lashes outside each margin over |x| <= 9.5, in two pieces leaning from the lid's
+ *                outward normal towards "away" (upper: 20 then 55 degrees, 8.5 long at the middle;
+ *                lower: 35 then 65 degrees, 5 long), shortening to 0.4 of that at the ends;
+ *                an RGBA texture of 130 (upper) or 70 (lower) strands, alphaMode MASK (cutoff
+ *                0.5), two-sided.
  *   skin         a sheet of radius 35 around an almond-shaped opening (23.8 wide, 13.5 high)
  *                facing +Z: at the opening it hugs the lids (0.25 in front of the lower lid's
  *                surface, which is in front of the upper's, so no lid ever shows through and
@@ -34,9 +50,14 @@
  *                atan(10/40) = 14.04 degrees): yfov 45 degrees, aspectRatio 4/3, znear 1,
  *                zfar 1000.
  *   ir_led       a near-infrared point light at (5, -10, 40), beside the camera, white,
- *                2e-3 candela: a white Lambertian surface at the corneal apex (27.8 from the
- *                LED, facing it) gets radiance 0.82, the sclera, lids and skin 30-35 away about
- *                0.5-0.7 (times the cosine).
+ *                2e-3 candela, radius 1.5 (extras "radius": an LED's emitting size, which a
+ *                smooth cornea reflects as a small disc): a white Lambertian surface at the
+ *                corneal apex (27.8 from the LED, facing it) gets radiance 0.82, the sclera, lids
+ *                and skin 30-35 away about 0.5-0.7 (times the cosine). At rest gaze the glint
+ *                (the LED reflected by the corneal sphere towards the camera) lies at
+ *                (0.556, -2.238, 14.151), 17.2 degrees from the corneal axis: in a 640 x 480
+ *                image at (331.9, 212.9) px from the top-left corner (the pupil's centre at
+ *                (320.0, 185.6)); the glint moves about half as far as the pupil with gaze.
  *   animation    "gaze", 30 s, rotation channels of eyeball, upper_lid and lower_lid, from a gaze
  *                plan made in code: the first ten fixations are the original hand-written 3 s
  *                sequence, the rest is drawn from a fixed seed (splitmix64, EYE_PLAN_SEED). 84
@@ -55,7 +76,7 @@
  *                "eye-drift" (3,867 keys): the same plan plus slow drift throughout (two
  *                sinusoids per axis, < 0.15 degrees, < 0.6 deg/s), keys every <= 25 ms in
  *                fixations; its first 3 s are the original 3 s animation.
- * The parts (textures, eyeball, lids, skin, socket, the blink's shape) are in demo_eye_parts.c,
+ * The parts (textures, globe, lids, lashes, skin, socket, the blink's shape) are in demo_eye_parts.c,
  * which the blink scene shares; this file makes the gaze plan and puts the scene together. */
 #include <math.h>
 #include <stdlib.h>
@@ -67,6 +88,10 @@
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
 #define SKIN_OUTER 35.0 /* the skin's outer radius, mm */
+#define LED_POS_X 5.0   /* the LED, mm */
+#define LED_POS_Y (-10.0)
+#define LED_POS_Z 40.0
+#define LED_RADIUS 1.5
 
 /* animation */
 #define ANIM_LENGTH 30.0
@@ -361,24 +386,34 @@ static int build_lid(evr_gltf *g, int upper, int material)
     return evr_demo_mesh_finish(g, &m, upper ? "upper_lid" : "lower_lid", material);
 }
 
+/* A lid's lashes on a child node of the lid, so that they move with it. */
+static void build_lashes(evr_gltf *g, int lid, int upper, int material)
+{
+    evr_demo_mesh m = {0};
+    const char *name = upper ? "upper_lashes" : "lower_lashes";
+    evr_eye_lashes(&m, upper);
+    evr_gltf_node_mesh(g, evr_gltf_node(g, name, lid), evr_demo_mesh_finish(g, &m, name, material));
+}
+
 static void build_eye(evr_gltf *g, int drift)
 {
     static const double cam_pos[3] = {0.0, -10.0 * MM, 40.0 * MM}, target[3] = {0.0, 0.0, 0.0},
                         up[3] = {0.0, 1.0, 0.0};
     float q[4];
     evr_gltf_material mat;
-    int m_sclera, m_iris, m_lid_up, m_lid_lo, m_skin, m_orbit, eyeball, node, upper, lower, mount,
-        cam, led;
+    evr_gltf_light_desc led;
+    int m_lid_up, m_lid_lo, m_lash_up, m_lash_lo, m_skin, m_orbit, eyeball, node, upper, lower,
+        mount, cam;
 
-    m_sclera = evr_eye_material(g, "sclera", evr_eye_paint_sclera(g), 0.35f);
-    m_iris = evr_eye_material(g, "iris", evr_eye_paint_iris(g), 0.1f);
     m_lid_up = evr_eye_material(
-        g, "upper_eyelid", evr_eye_paint_eyelid(g, "upper_eyelid_texture", 4242u, 170, 22.0, 50.0),
-        0.6f);
+        g, "upper_eyelid", evr_eye_paint_eyelid(g, "upper_eyelid_texture", 4242u, 0, 22.0, 50.0),
+        0.55f);
     m_lid_lo = evr_eye_material(
-        g, "lower_eyelid", evr_eye_paint_eyelid(g, "lower_eyelid_texture", 4343u, 90, 10.0, 24.0),
-        0.6f);
-    m_skin = evr_eye_material(g, "skin", evr_eye_paint_skin(g, SKIN_OUTER, 512), 0.6f);
+        g, "lower_eyelid", evr_eye_paint_eyelid(g, "lower_eyelid_texture", 4343u, 0, 10.0, 24.0),
+        0.55f);
+    m_lash_up = evr_eye_lash_material(g, 1);
+    m_lash_lo = evr_eye_lash_material(g, 0);
+    m_skin = evr_eye_material(g, "skin", evr_eye_paint_skin(g, SKIN_OUTER, 512), 0.55f);
     evr_gltf_material_init(&mat, "orbit");
     mat.base_color[0] = 0.25f;
     mat.base_color[1] = 0.09f;
@@ -387,15 +422,14 @@ static void build_eye(evr_gltf *g, int drift)
     if (evr_gltf_status(g, NULL) != EVR_OK) return;
 
     eyeball = evr_gltf_node(g, "eyeball", -1);
-    node = evr_gltf_node(g, "sclera", eyeball);
-    evr_gltf_node_mesh(g, node, evr_eye_sclera(g, m_sclera));
-    node = evr_gltf_node(g, "cornea", eyeball);
-    evr_gltf_node_mesh(g, node, evr_eye_cornea(g, m_iris));
+    evr_eye_globe(g, eyeball);
 
     upper = evr_gltf_node(g, "upper_lid", -1);
     evr_gltf_node_mesh(g, upper, build_lid(g, 1, m_lid_up));
+    build_lashes(g, upper, 1, m_lash_up);
     lower = evr_gltf_node(g, "lower_lid", -1);
     evr_gltf_node_mesh(g, lower, build_lid(g, 0, m_lid_lo));
+    build_lashes(g, lower, 0, m_lash_lo);
 
     node = evr_gltf_node(g, "skin", -1);
     evr_gltf_node_mesh(g, node, evr_eye_skin(g, m_skin, SKIN_OUTER));
@@ -413,10 +447,14 @@ static void build_eye(evr_gltf *g, int drift)
     node = evr_gltf_node(g, "eye_camera", mount);
     evr_gltf_node_camera(g, node, cam);
 
-    led = evr_gltf_light(g, "ir_led", EVR_GLTF_POINT, NULL, 2e-3f, 0.0f, 0.0f);
+    /* the eye tracker's near-infrared LED: a small sphere beside the camera */
+    evr_gltf_light_desc_init(&led, "ir_led", EVR_GLTF_POINT);
+    led.intensity = 2e-3f;
+    led.radius = (float)(LED_RADIUS * MM);
     node = evr_gltf_node(g, "ir_led", -1);
-    evr_gltf_node_translation(g, node, (float)(5.0 * MM), (float)(-10.0 * MM), (float)(40.0 * MM));
-    evr_gltf_node_light(g, node, led);
+    evr_gltf_node_translation(g, node, (float)(LED_POS_X * MM), (float)(LED_POS_Y * MM),
+                              (float)(LED_POS_Z * MM));
+    evr_gltf_node_light(g, node, evr_gltf_add_light(g, &led));
 
     build_animation(g, eyeball, upper, lower, drift);
 }

@@ -13,14 +13,17 @@
 #define DEG (PI / 180.0)
 
 /* geometry, millimetres */
-#define EYE_R 12.0
-#define CORNEA_R 7.8
-#define CORNEA_C 6.7 /* centre of the corneal sphere on +Z: apex at 14.5 */
-#define CORNEA_PSI_MAX (72.0 * DEG)
+#define EYE_R EVR_EYE_R
+#define CORNEA_R EVR_EYE_CORNEA_R
+#define CORNEA_C EVR_EYE_CORNEA_C
 #define IRIS_TEX_HALF 7.5 /* the iris texture covers [-7.5, 7.5]^2 in x, y */
-#define IRIS_R 5.75
-#define PUPIL_R 1.8
-#define LID_UP_R 14.8 /* lid radii at the middle ... */
+#define IRIS_R EVR_EYE_IRIS_R
+#define PUPIL_R EVR_EYE_PUPIL_R
+#define PUPIL_BEHIND 0.05 /* the pupil's black disc lies this far behind the iris's inner edge */
+#define LASH_X 9.5        /* lashes grow on the margin over |x| <= LASH_X ... */
+#define LASH_UP_LEN 8.5   /* ... this long (upper) at the middle ... */
+#define LASH_LO_LEN 5.0   /* ... (lower), shorter towards the corners */
+#define LID_UP_R 14.8     /* lid radii at the middle ... */
 #define LID_LO_R 15.1
 #define LID_UP_R_CORNER 12.4 /* ... and towards the corners, where the lids hug the eyeball */
 #define LID_LO_R_CORNER 12.7
@@ -255,6 +258,42 @@ int evr_eye_paint_eyelid(evr_gltf *g, const char *name, uint32_t seed, int lashe
     return tex;
 }
 
+int evr_eye_paint_lashes(evr_gltf *g, int upper)
+{
+    evr_demo_image im;
+    evr_demo_rng r = {upper ? 5151u : 5252u};
+    const double lash[3] = {30.0, 23.0, 20.0};
+    const int count = upper ? 130 : 70;
+    int x, y, k, j;
+    if (!evr_demo_image_init(&im, 512, 64, 0)) {
+        evr_demo_image_free(&im);
+        evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while painting a demo texture");
+        return -1;
+    }
+    for (y = 0; y < im.h; y++)
+        for (x = 0; x < im.w; x++) evr_demo_image_set(&im, x, y, lash);
+    /* strands from the roots (row 0) to the tips, leaning towards the nearer corner and curling
+     * further that way; 2.6 texels (0.1 mm) thick at the root, thinning */
+    for (k = 0; k < count; k++) {
+        double u = evr_demo_rng_range(&r, 0.01, 0.99),
+               lean = (u - 0.5) * 1.2 + evr_demo_rng_range(&r, -0.25, 0.25);
+        double len = evr_demo_rng_range(&r, 0.6, 1.0) * im.h, px = u * im.w, py = 0.0;
+        const int n = 6;
+        for (j = 0; j < n; j++) {
+            double f0 = (double)j / n, f1 = (double)(j + 1) / n;
+            double nx = px + lean * (0.3 + 0.9 * f1) * len / n, ny = py + len / n;
+            evr_demo_image_stroke(&im, px, py, nx, ny, 1.3 * (1.0 - 0.5 * f0),
+                                  1.3 * (1.0 - 0.5 * f1), 1.0, 1.0);
+            px = nx;
+            py = ny;
+        }
+    }
+    k = evr_demo_image_texture_masked(g, &im,
+                                      upper ? "upper_lashes_texture" : "lower_lashes_texture");
+    evr_demo_image_free(&im);
+    return k;
+}
+
 int evr_eye_paint_skin(evr_gltf *g, double outer, int size)
 {
     evr_demo_image im;
@@ -298,47 +337,160 @@ int evr_eye_paint_skin(evr_gltf *g, double outer, int size)
 
 /* ---- geometry (built in millimetres, stored in metres) ---- */
 
-int evr_eye_sclera(evr_gltf *g, int material)
+/* The limbus, where the cornea's sphere meets the eyeball's: z and radius. The sclera ends there,
+ * the cornea's front surface begins, and the iris is rooted. */
+static double limbus_z(void)
+{
+    return (EYE_R * EYE_R - CORNEA_R * CORNEA_R + CORNEA_C * CORNEA_C) / (2.0 * CORNEA_C);
+}
+
+static double limbus_r(void) { return sqrt(EYE_R * EYE_R - limbus_z() * limbus_z()); }
+
+/* The eyeball behind the limbus: a UV sphere with its front cap (inside the limbus) left out,
+ * where the cornea and the iris take over. */
+static int sclera_mesh(evr_gltf *g, int material)
 {
     evr_demo_mesh m = {0};
-    const int cols = 64, rows = 48;
+    const int cols = 64, rows = 40;
+    const double th0 = atan2(limbus_r(), limbus_z());
     int i, j;
     for (j = 0; j <= rows; j++) {
-        double th = PI * j / rows;
+        double th = th0 + (PI - th0) * j / rows;
         for (i = 0; i <= cols; i++) {
             double ph = 2.0 * PI * i / cols, n[3];
             n[0] = sin(th) * cos(ph);
             n[1] = sin(th) * sin(ph);
             n[2] = cos(th);
             evr_demo_mesh_vertex_mm(&m, EYE_R * n[0], EYE_R * n[1], EYE_R * n[2], n,
-                                    (double)i / cols, (double)j / rows);
+                                    (double)i / cols, th / PI);
         }
     }
     evr_demo_mesh_grid(&m, 0, cols, rows);
     return evr_demo_mesh_finish(g, &m, "sclera", material);
 }
 
-int evr_eye_cornea(evr_gltf *g, int material)
+/* A closed volume of the cornea's (and aqueous humour's) index: the front surface, a spherical
+ * cap out to the limbus (its tear film is the smooth dielectric that gives the LED's glint),
+ * closed behind by a disc in the limbus plane facing back (into the eye). The iris and the pupil
+ * lie inside it. */
+static int cornea_mesh(evr_gltf *g, int material)
 {
     evr_demo_mesh m = {0};
-    const int cols = 96, rows = 32;
+    const int cols = 96, rows = 24;
+    const double psi_max = acos((limbus_z() - CORNEA_C) / CORNEA_R), back[3] = {0.0, 0.0, -1.0};
+    uint32_t centre, first;
     int i, j;
     for (j = 0; j <= rows; j++) {
-        double ps = CORNEA_PSI_MAX * j / rows;
+        double ps = psi_max * j / rows;
         for (i = 0; i <= cols; i++) {
-            double ph = 2.0 * PI * i / cols, n[3], x, y;
+            double ph = 2.0 * PI * i / cols, n[3];
             n[0] = sin(ps) * cos(ph);
             n[1] = sin(ps) * sin(ph);
             n[2] = cos(ps);
-            x = CORNEA_R * n[0];
-            y = CORNEA_R * n[1];
-            evr_demo_mesh_vertex_mm(&m, x, y, CORNEA_C + CORNEA_R * n[2], n,
-                                    0.5 + x / (2.0 * IRIS_TEX_HALF),
+            evr_demo_mesh_vertex_mm(&m, CORNEA_R * n[0], CORNEA_R * n[1],
+                                    CORNEA_C + CORNEA_R * n[2], n, (double)i / cols,
+                                    (double)j / rows);
+        }
+    }
+    evr_demo_mesh_grid(&m, 0, cols, rows);
+    centre = evr_demo_mesh_vertex_mm(&m, 0.0, 0.0, limbus_z(), back, 0.5, 1.0);
+    first = m.nv;
+    for (i = 0; i <= cols; i++) {
+        double ph = 2.0 * PI * i / cols;
+        evr_demo_mesh_vertex_mm(&m, limbus_r() * cos(ph), limbus_r() * sin(ph), limbus_z(), back,
+                                (double)i / cols, 1.0);
+    }
+    for (i = 0; i < cols; i++)
+        evr_demo_mesh_triangle(&m, centre, first + (uint32_t)i, first + (uint32_t)i + 1);
+    return evr_demo_mesh_finish(g, &m, "cornea", material);
+}
+
+/* The iris's front surface at radius r: nearly flat from the pupil's edge (2.9 behind the
+ * apex) to the visible iris's edge, then down to its root at the limbus. */
+static double iris_z(double r)
+{
+    if (r <= IRIS_R)
+        return EVR_EYE_PUPIL_Z -
+               (EVR_EYE_PUPIL_Z - EVR_EYE_IRIS_EDGE_Z) * (r - PUPIL_R) / (IRIS_R - PUPIL_R);
+    return EVR_EYE_IRIS_EDGE_Z +
+           (limbus_z() - EVR_EYE_IRIS_EDGE_Z) * (r - IRIS_R) / (limbus_r() - IRIS_R);
+}
+
+/* The iris: a ring from the pupil to the limbus, under the cornea, textured by a planar
+ * projection along Z (the painted iris spans IRIS_R; beyond it, towards the limbus, the texture
+ * is sclera-coloured, as the sclera overlaps the cornea's edge in a real eye). */
+static int iris_mesh(evr_gltf *g, int material)
+{
+    evr_demo_mesh m = {0};
+    const int cols = 64, rows_in = 8, rows_out = 3, rows = rows_in + rows_out;
+    int i, j;
+    for (j = 0; j <= rows; j++) {
+        double r = j <= rows_in ? PUPIL_R + (IRIS_R - PUPIL_R) * j / rows_in
+                                : IRIS_R + (limbus_r() - IRIS_R) * (j - rows_in) / rows_out;
+        /* the slope of the piece the ring lies on (at the kink between them, their mean) */
+        const double s_in = (iris_z(IRIS_R) - iris_z(PUPIL_R)) / (IRIS_R - PUPIL_R),
+                     s_out = (limbus_z() - iris_z(IRIS_R)) / (limbus_r() - IRIS_R);
+        double slope = j < rows_in ? s_in : (j > rows_in ? s_out : 0.5 * (s_in + s_out));
+        double l = sqrt(1.0 + slope * slope);
+        for (i = 0; i <= cols; i++) {
+            double ph = 2.0 * PI * i / cols, x = r * cos(ph), y = r * sin(ph), n[3];
+            n[0] = -slope * cos(ph) / l;
+            n[1] = -slope * sin(ph) / l;
+            n[2] = 1.0 / l;
+            evr_demo_mesh_vertex_mm(&m, x, y, iris_z(r), n, 0.5 + x / (2.0 * IRIS_TEX_HALF),
                                     0.5 - y / (2.0 * IRIS_TEX_HALF));
         }
     }
     evr_demo_mesh_grid(&m, 0, cols, rows);
-    return evr_demo_mesh_finish(g, &m, "cornea", material);
+    return evr_demo_mesh_finish(g, &m, "iris", material);
+}
+
+/* The pupil: a black disc just behind the iris's inner edge, a little wider than the hole. */
+static int pupil_mesh(evr_gltf *g, int material)
+{
+    evr_demo_mesh m = {0};
+    const int cols = 32;
+    const double z = EVR_EYE_PUPIL_Z - PUPIL_BEHIND, r = PUPIL_R + PUPIL_BEHIND,
+                 front[3] = {0.0, 0.0, 1.0};
+    uint32_t centre = evr_demo_mesh_vertex_mm(&m, 0.0, 0.0, z, front, 0.5, 0.5);
+    int i;
+    for (i = 0; i <= cols; i++) {
+        double ph = 2.0 * PI * i / cols;
+        evr_demo_mesh_vertex_mm(&m, r * cos(ph), r * sin(ph), z, front, 0.5, 0.5);
+    }
+    for (i = 0; i < cols; i++)
+        evr_demo_mesh_triangle(&m, centre, centre + 1 + (uint32_t)i, centre + 2 + (uint32_t)i);
+    return evr_demo_mesh_finish(g, &m, "pupil", material);
+}
+
+void evr_eye_globe(evr_gltf *g, int eyeball)
+{
+    evr_gltf_material mat;
+    int m_sclera, m_cornea, m_iris, m_pupil, node;
+    /* moist sclera: a dielectric with a soft sheen */
+    m_sclera = evr_eye_material(g, "sclera", evr_eye_paint_sclera(g), 0.25f);
+    /* the cornea and its tear film: clear, smooth, refracting; a volume (not thin-walled) */
+    evr_gltf_material_init(&mat, "cornea");
+    mat.roughness = 0.03f;
+    mat.transmission = 1.0f;
+    mat.ior = EVR_EYE_CORNEA_IOR;
+    mat.thickness = (float)((CORNEA_C + CORNEA_R - limbus_z()) * MM);
+    m_cornea = evr_gltf_add_material(g, &mat);
+    m_iris = evr_eye_material(g, "iris", evr_eye_paint_iris(g), 0.5f);
+    /* the pupil: a hole into the dark eye, nothing comes back out */
+    evr_gltf_material_init(&mat, "pupil");
+    mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = 0.0f;
+    mat.unlit = 1;
+    m_pupil = evr_gltf_add_material(g, &mat);
+    if (evr_gltf_status(g, NULL) != EVR_OK) return;
+    node = evr_gltf_node(g, "sclera", eyeball);
+    evr_gltf_node_mesh(g, node, sclera_mesh(g, m_sclera));
+    node = evr_gltf_node(g, "cornea", eyeball);
+    evr_gltf_node_mesh(g, node, cornea_mesh(g, m_cornea));
+    node = evr_gltf_node(g, "iris", eyeball);
+    evr_gltf_node_mesh(g, node, iris_mesh(g, m_iris));
+    node = evr_gltf_node(g, "pupil", eyeball);
+    evr_gltf_node_mesh(g, node, pupil_mesh(g, m_pupil));
 }
 
 /* Height of the lid margins (mm) at the front, as a function of x: an almond between the canthi
@@ -441,6 +593,66 @@ void evr_eye_lid(evr_demo_mesh *m, int upper)
         }
     }
     evr_demo_mesh_grid(m, band_first, cols, band_rows);
+}
+
+/* The lashes' direction at angle a from the lid's outward normal towards "away" (up for the
+ * upper lid, down for the lower), in the plane of the two. */
+static void lash_dir(const double nout[3], const double away[3], double a, double d[3])
+{
+    int k;
+    for (k = 0; k < 3; k++) d[k] = cos(a) * nout[k] + sin(a) * away[k];
+}
+
+void evr_eye_lashes(evr_demo_mesh *m, int upper)
+{
+    const int cols = 40, rows = 2;
+    const double a0 = (upper ? 20.0 : 35.0) * DEG, a1 = (upper ? 55.0 : 65.0) * DEG, h = 1e-3;
+    const double len_mid = upper ? LASH_UP_LEN : LASH_LO_LEN;
+    uint32_t first = m->nv;
+    int i, j, k;
+    for (j = 0; j <= rows; j++) {
+        for (i = 0; i <= cols; i++) {
+            double x = -LASH_X + 2.0 * LASH_X * i / cols, phm = margin_phi(x, upper);
+            double drho = (lid_rho(x + h, upper) - lid_rho(x - h, upper)) / (2.0 * h);
+            double t = x / LASH_X, len = len_mid * (0.4 + 0.6 * (1.0 - t * t));
+            double p[3], nout[3], away[3], d0[3], d1[3], dj[3], n[3], l;
+            lid_point(x, phm, upper, p);
+            l = sqrt(1.0 + drho * drho);
+            nout[0] = -drho / l;
+            nout[1] = sin(phm) / l;
+            nout[2] = cos(phm) / l;
+            away[0] = 0.0;
+            away[1] = upper ? cos(phm) : -cos(phm);
+            away[2] = upper ? -sin(phm) : sin(phm);
+            lash_dir(nout, away, a0, d0);
+            lash_dir(nout, away, a1, d1);
+            lash_dir(nout, away, j == 0 ? a0 : (j == 1 ? 0.5 * (a0 + a1) : a1), dj);
+            for (k = 0; k < 3; k++) /* the root just outside the lid, then two straight pieces */
+                p[k] += 0.05 * nout[k] + (j >= 1 ? 0.5 * len * d0[k] : 0.0) +
+                        (j >= 2 ? 0.5 * len * d1[k] : 0.0);
+            /* the card's normal: across the strands (x) and along them, on the outward side */
+            n[0] = 0.0;
+            n[1] = -dj[2];
+            n[2] = dj[1];
+            if (n[1] * nout[1] + n[2] * nout[2] < 0.0) {
+                n[1] = -n[1];
+                n[2] = -n[2];
+            }
+            evr_demo_mesh_vertex_mm(m, p[0], p[1], p[2], n, (double)i / cols, (double)j / rows);
+        }
+    }
+    evr_demo_mesh_grid(m, first, cols, rows);
+}
+
+int evr_eye_lash_material(evr_gltf *g, int upper)
+{
+    evr_gltf_material m;
+    evr_gltf_material_init(&m, upper ? "upper_lashes" : "lower_lashes");
+    m.base_texture.index = evr_eye_paint_lashes(g, upper);
+    m.roughness = 0.45f;
+    m.alpha_mode = EVR_GLTF_MASK;
+    m.alpha_cutoff = 0.5f;
+    return evr_gltf_add_material(g, &m);
 }
 
 /* The skin: a height field over a ring from the almond-shaped opening (s = 0) out to a circle of
@@ -548,7 +760,7 @@ int evr_eye_material(evr_gltf *g, const char *name, int texture, float roughness
 {
     evr_gltf_material m;
     evr_gltf_material_init(&m, name);
-    m.base_texture = texture;
+    m.base_texture.index = texture;
     m.roughness = roughness;
     return evr_gltf_add_material(g, &m);
 }

@@ -29,12 +29,31 @@ int evr_eye_paint_skin(evr_gltf *g, double outer, int size);
 /* Skin colour (sRGB, 0..255) at (x, y) mm: blotches and pores. */
 void evr_eye_skin_colour(double c[3], double x, double y, uint32_t seed);
 
-/* Meshes; each returns the mesh index (-1 on failure). */
-int evr_eye_sclera(evr_gltf *g, int material);
-int evr_eye_cornea(evr_gltf *g, int material);
+/* The eyelashes: dark strands on a transparent ground (RGBA, for an alpha-masked card), u along
+ * the lid, v from the roots (row 0) to the tips. */
+int evr_eye_paint_lashes(evr_gltf *g, int upper);
+
+/* The globe under node eyeball (the eye centre, looking along +Z): child nodes "sclera",
+ * "cornea", "iris" and "pupil" with their textures, materials and meshes. */
+void evr_eye_globe(evr_gltf *g, int eyeball);
+/* The anatomy the globe is built to (mm, eye centre at the origin, gaze along +Z), for tests and
+ * the scene's description. */
+#define EVR_EYE_R 12.0       /* the eyeball (sclera) */
+#define EVR_EYE_CORNEA_R 7.8 /* the cornea's front surface, a sphere centred on +Z ... */
+#define EVR_EYE_CORNEA_C 6.7 /* ... at this z: apex at 14.5 */
+#define EVR_EYE_PUPIL_R 1.8  /* the pupil's radius ... */
+#define EVR_EYE_PUPIL_Z 11.6 /* ... and its plane: 2.9 behind the apex */
+#define EVR_EYE_IRIS_R 5.75  /* the visible iris */
+#define EVR_EYE_IRIS_EDGE_Z 11.15
+#define EVR_EYE_CORNEA_IOR 1.376f
 /* The upper (upper = 1) or lower lid, added to m: a surface of revolution about the X axis, so
  * that turning it about that axis slides it over itself. */
 void evr_eye_lid(evr_demo_mesh *m, int upper);
+/* The lid's eyelashes, added to m in the lid's frame (move it with the lid): a curved card
+ * rooted along the lid's margin, textured by evr_eye_paint_lashes. */
+void evr_eye_lashes(evr_demo_mesh *m, int upper);
+/* The lashes' material: that texture, alpha-masked, two-sided. */
+int evr_eye_lash_material(evr_gltf *g, int upper);
 /* The skin from the eye's opening out to a circle of radius outer (mm). */
 int evr_eye_skin(evr_gltf *g, int material, double outer);
 int evr_eye_orbit(evr_gltf *g, int material);

@@ -145,19 +145,36 @@ void evr_demo_image_apply(evr_demo_image *im, const double c[3])
     }
 }
 
-int evr_demo_image_texture(evr_gltf *g, evr_demo_image *im, const char *name)
+/* The image as 8-bit pixels (with the mask as alpha when alpha is set), then a texture. */
+static int image_texture(evr_gltf *g, evr_demo_image *im, const char *name, int alpha)
 {
-    size_t i, n = (size_t)im->w * (size_t)im->h * 3;
-    uint8_t *px = malloc(n);
-    int tex;
+    const int ch = alpha ? 4 : 3;
+    size_t i, n = (size_t)im->w * (size_t)im->h;
+    uint8_t *px = malloc(n * (size_t)ch);
+    int k, tex;
     if (!px) {
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while painting a demo texture");
         return -1;
     }
-    for (i = 0; i < n; i++) px[i] = (uint8_t)evr_demo_clamp(floor(im->rgb[i] + 0.5), 0.0, 255.0);
-    tex = evr_gltf_texture_png(g, name, px, im->w, im->h, 3);
+    for (i = 0; i < n; i++) {
+        for (k = 0; k < 3; k++)
+            px[ch * i + k] = (uint8_t)evr_demo_clamp(floor(im->rgb[3 * i + k] + 0.5), 0.0, 255.0);
+        if (alpha)
+            px[ch * i + 3] = (uint8_t)evr_demo_clamp(floor(255.0 * im->mask[i] + 0.5), 0.0, 255.0);
+    }
+    tex = evr_gltf_texture_png(g, name, px, im->w, im->h, ch);
     free(px);
     return tex;
+}
+
+int evr_demo_image_texture(evr_gltf *g, evr_demo_image *im, const char *name)
+{
+    return image_texture(g, im, name, 0);
+}
+
+int evr_demo_image_texture_masked(evr_gltf *g, evr_demo_image *im, const char *name)
+{
+    return image_texture(g, im, name, 1);
 }
 
 void evr_demo_mix3(double out[3], const double a[3], const double b[3], double t)

@@ -46,6 +46,9 @@ void evr_demo_image_stroke(evr_demo_image *im, double xa, double ya, double xb, 
 void evr_demo_image_apply(evr_demo_image *im, const double c[3]);
 /* The image as a texture of the builder (its index, -1 on failure, recorded in g). */
 int evr_demo_image_texture(evr_gltf *g, evr_demo_image *im, const char *name);
+/* The same with an alpha channel: the coverage mask as it stands (strokes not yet applied), for
+ * cut-outs (alpha-masked materials). */
+int evr_demo_image_texture_masked(evr_gltf *g, evr_demo_image *im, const char *name);
 
 void evr_demo_mix3(double out[3], const double a[3], const double b[3], double t);
 

@@ -23,6 +23,23 @@
 #define GLTF_LINEAR 9729
 #define GLTF_REPEAT 10497
 
+/* The extensions the writer may use, in the order extensionsUsed lists them. */
+enum {
+    EXT_LIGHTS,
+    EXT_TEXTURE_TRANSFORM,
+    EXT_EMISSIVE_STRENGTH,
+    EXT_UNLIT,
+    EXT_TRANSMISSION,
+    EXT_IOR,
+    EXT_VOLUME,
+    EXT_SPECULAR,
+    EXT_COUNT
+};
+static const char *const ext_names[EXT_COUNT] = {
+    "KHR_lights_punctual",  "KHR_texture_transform",      "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",  "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_volume", "KHR_materials_specular"};
+
 /* A growing text buffer holding the comma-separated elements of one JSON array. */
 typedef struct {
     char *p;
@@ -66,6 +83,7 @@ struct evr_gltf {
     size_t bin_n, bin_cap;
     sbuf accessors, views, meshes, materials, textures, images, cameras, lights, skins;
     int has_sampler;
+    unsigned ext_used; /* EXT_* bits: the extensions written so far */
     gmesh *mesh_info;  /* one per mesh */
     int *skin_joints;  /* joint count of each skin */
     int cap_mesh_info; /* (meshes.count and skins.count are the counts) */
@@ -409,15 +427,38 @@ int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, i
     return g->status == EVR_OK ? tex : -1;
 }
 
+static void slot_none(evr_gltf_texture_slot *t)
+{
+    t->index = -1;
+    t->offset[0] = t->offset[1] = 0.0f;
+    t->rotation = 0.0f;
+    t->scale[0] = t->scale[1] = 1.0f;
+}
+
 void evr_gltf_material_init(evr_gltf_material *m, const char *name)
 {
     memset(m, 0, sizeof *m);
     m->name = name;
     m->base_color[0] = m->base_color[1] = m->base_color[2] = m->base_color[3] = 1.0f;
-    m->base_texture = -1;
+    slot_none(&m->base_texture);
+    slot_none(&m->metallic_roughness_texture);
+    slot_none(&m->normal_texture);
+    slot_none(&m->occlusion_texture);
+    slot_none(&m->emissive_texture);
+    slot_none(&m->transmission_texture);
     m->metallic = 0.0f;
     m->roughness = 1.0f;
     m->double_sided = 1;
+    m->normal_scale = 1.0f;
+    m->occlusion_strength = 1.0f;
+    m->emissive_strength = 1.0f;
+    m->alpha_mode = EVR_GLTF_OPAQUE;
+    m->alpha_cutoff = 0.5f;
+    m->ior = 1.5f;
+    m->attenuation_distance = INFINITY;
+    m->attenuation_color[0] = m->attenuation_color[1] = m->attenuation_color[2] = 1.0f;
+    m->specular = 1.0f;
+    m->specular_color[0] = m->specular_color[1] = m->specular_color[2] = 1.0f;
 }
 
 static int unit_range(const float *v, int n)
@@ -428,39 +469,200 @@ static int unit_range(const float *v, int n)
     return 1;
 }
 
-int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m)
+static int all_finite(const float *v, int n)
 {
-    sbuf *b = &g->materials;
-    int idx;
-    if (!check_name(g, "material", m->name)) return -1;
+    int i;
+    for (i = 0; i < n; i++)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+static int slot_identity(const evr_gltf_texture_slot *t)
+{
+    return t->offset[0] == 0.0f && t->offset[1] == 0.0f && t->rotation == 0.0f &&
+           t->scale[0] == 1.0f && t->scale[1] == 1.0f;
+}
+
+static int slot_ok(evr_gltf *g, const char *mat, const char *what, const evr_gltf_texture_slot *t)
+{
+    if (t->index < -1 || t->index >= g->textures.count) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": %s: no texture %d", mat, what, t->index);
+        return 0;
+    }
+    if (!all_finite(t->offset, 2) || !isfinite(t->rotation) || !all_finite(t->scale, 2)) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": %s: non-finite texture transform", mat, what);
+        return 0;
+    }
+    return 1;
+}
+
+/* A textureInfo: ,"key":{"index":i[,"<extra>":v][,"extensions":{"KHR_texture_transform":...}]}
+ * when the slot holds a texture; extra names normalTexture's scale or occlusionTexture's
+ * strength (NULL: none). */
+static void put_slot(evr_gltf *g, sbuf *b, const char *key, const evr_gltf_texture_slot *t,
+                     const char *extra, float extra_v)
+{
+    if (t->index < 0) return;
+    sb_printf(g, b, ",\"%s\":{\"index\":%d", key, t->index);
+    if (extra && extra_v != 1.0f) {
+        sb_printf(g, b, ",\"%s\":", extra);
+        sb_num(g, b, extra_v);
+    }
+    if (!slot_identity(t)) {
+        g->ext_used |= 1u << EXT_TEXTURE_TRANSFORM;
+        sb_cat(g, b, ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":");
+        sb_nums(g, b, t->offset, 2);
+        sb_cat(g, b, ",\"rotation\":");
+        sb_num(g, b, t->rotation);
+        sb_cat(g, b, ",\"scale\":");
+        sb_nums(g, b, t->scale, 2);
+        sb_cat(g, b, "}}");
+    }
+    sb_cat(g, b, "}");
+}
+
+static int material_ok(evr_gltf *g, const evr_gltf_material *m)
+{
+    const char *n = m->name;
     if (!unit_range(m->base_color, 4) || !unit_range(&m->metallic, 1) ||
         !unit_range(&m->roughness, 1) || !unit_range(m->emissive, 3)) {
         fail(g, EVR_ERR_ARG,
              "material \"%s\": colour, metallic, roughness and emissive factors must lie in [0,1]",
-             m->name);
-        return -1;
+             n);
+        return 0;
     }
-    if (m->base_texture < -1 || m->base_texture >= g->textures.count) {
-        fail(g, EVR_ERR_ARG, "material \"%s\": no texture %d", m->name, m->base_texture);
-        return -1;
+    if (!(m->emissive_strength >= 0.0f) || !isfinite(m->emissive_strength) ||
+        !isfinite(m->normal_scale) || !unit_range(&m->occlusion_strength, 1)) {
+        fail(g, EVR_ERR_ARG,
+             "material \"%s\": needs emissive strength >= 0, a finite normal scale and occlusion "
+             "strength in [0,1]",
+             n);
+        return 0;
     }
+    if ((int)m->alpha_mode < 0 || (int)m->alpha_mode > 2 || !(m->alpha_cutoff >= 0.0f) ||
+        !isfinite(m->alpha_cutoff)) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": bad alpha mode or cutoff", n);
+        return 0;
+    }
+    if (!unit_range(&m->transmission, 1) || !(m->ior >= 1.0f) || !isfinite(m->ior)) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": needs transmission in [0,1] and IOR >= 1", n);
+        return 0;
+    }
+    if (!(m->thickness >= 0.0f) || !isfinite(m->thickness) || !(m->attenuation_distance > 0.0f) ||
+        !unit_range(m->attenuation_color, 3)) {
+        fail(g, EVR_ERR_ARG,
+             "material \"%s\": volume needs thickness >= 0, attenuation distance > 0 and colour in "
+             "[0,1]",
+             n);
+        return 0;
+    }
+    if (!unit_range(&m->specular, 1) || !all_finite(m->specular_color, 3) ||
+        !(m->specular_color[0] >= 0.0f && m->specular_color[1] >= 0.0f &&
+          m->specular_color[2] >= 0.0f)) {
+        fail(g, EVR_ERR_ARG, "material \"%s\": needs specular in [0,1] and a colour >= 0", n);
+        return 0;
+    }
+    return slot_ok(g, n, "base colour texture", &m->base_texture) &&
+           slot_ok(g, n, "metallic-roughness texture", &m->metallic_roughness_texture) &&
+           slot_ok(g, n, "normal texture", &m->normal_texture) &&
+           slot_ok(g, n, "occlusion texture", &m->occlusion_texture) &&
+           slot_ok(g, n, "emissive texture", &m->emissive_texture) &&
+           slot_ok(g, n, "transmission texture", &m->transmission_texture);
+}
+
+/* The material's "extensions" object, when any differs from its defaults. */
+static void put_material_extensions(evr_gltf *g, sbuf *b, const evr_gltf_material *m)
+{
+    static const float white[3] = {1.0f, 1.0f, 1.0f};
+    int first = 1;
+#define EXT_OPEN(bit)                                                                     \
+    do {                                                                                  \
+        sb_printf(g, b, "%s\"%s\":{", first ? ",\"extensions\":{" : ",", ext_names[bit]); \
+        g->ext_used |= 1u << (bit);                                                       \
+        first = 0;                                                                        \
+    } while (0)
+    if (m->emissive_strength != 1.0f) {
+        EXT_OPEN(EXT_EMISSIVE_STRENGTH);
+        sb_cat(g, b, "\"emissiveStrength\":");
+        sb_num(g, b, m->emissive_strength);
+        sb_cat(g, b, "}");
+    }
+    if (m->unlit) {
+        EXT_OPEN(EXT_UNLIT);
+        sb_cat(g, b, "}");
+    }
+    if (m->transmission > 0.0f || m->transmission_texture.index >= 0) {
+        EXT_OPEN(EXT_TRANSMISSION);
+        sb_cat(g, b, "\"transmissionFactor\":");
+        sb_num(g, b, m->transmission);
+        put_slot(g, b, "transmissionTexture", &m->transmission_texture, NULL, 1.0f);
+        sb_cat(g, b, "}");
+    }
+    if (m->ior != 1.5f) {
+        EXT_OPEN(EXT_IOR);
+        sb_cat(g, b, "\"ior\":");
+        sb_num(g, b, m->ior);
+        sb_cat(g, b, "}");
+    }
+    if (m->thickness > 0.0f || isfinite(m->attenuation_distance) ||
+        memcmp(m->attenuation_color, white, sizeof white)) {
+        EXT_OPEN(EXT_VOLUME);
+        sb_cat(g, b, "\"thicknessFactor\":");
+        sb_num(g, b, m->thickness);
+        if (isfinite(m->attenuation_distance)) {
+            sb_cat(g, b, ",\"attenuationDistance\":");
+            sb_num(g, b, m->attenuation_distance);
+        }
+        sb_cat(g, b, ",\"attenuationColor\":");
+        sb_nums(g, b, m->attenuation_color, 3);
+        sb_cat(g, b, "}");
+    }
+    if (m->specular != 1.0f || memcmp(m->specular_color, white, sizeof white)) {
+        EXT_OPEN(EXT_SPECULAR);
+        sb_cat(g, b, "\"specularFactor\":");
+        sb_num(g, b, m->specular);
+        sb_cat(g, b, ",\"specularColorFactor\":");
+        sb_nums(g, b, m->specular_color, 3);
+        sb_cat(g, b, "}");
+    }
+#undef EXT_OPEN
+    if (!first) sb_cat(g, b, "}");
+}
+
+int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m)
+{
+    static const char *const modes[3] = {"OPAQUE", "MASK", "BLEND"};
+    sbuf *b = &g->materials;
+    int idx;
+    if (!check_name(g, "material", m->name)) return -1;
+    if (!material_ok(g, m)) return -1;
     idx = sb_elem(g, b);
     sb_cat(g, b, "{\"name\":");
     sb_str(g, b, m->name);
     sb_cat(g, b, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
     sb_nums(g, b, m->base_color, 4);
-    if (m->base_texture >= 0)
-        sb_printf(g, b, ",\"baseColorTexture\":{\"index\":%d}", m->base_texture);
+    put_slot(g, b, "baseColorTexture", &m->base_texture, NULL, 1.0f);
     sb_cat(g, b, ",\"metallicFactor\":");
     sb_num(g, b, m->metallic);
     sb_cat(g, b, ",\"roughnessFactor\":");
     sb_num(g, b, m->roughness);
+    put_slot(g, b, "metallicRoughnessTexture", &m->metallic_roughness_texture, NULL, 1.0f);
     sb_cat(g, b, "}");
+    put_slot(g, b, "normalTexture", &m->normal_texture, "scale", m->normal_scale);
+    put_slot(g, b, "occlusionTexture", &m->occlusion_texture, "strength", m->occlusion_strength);
+    put_slot(g, b, "emissiveTexture", &m->emissive_texture, NULL, 1.0f);
     if (m->emissive[0] > 0.0f || m->emissive[1] > 0.0f || m->emissive[2] > 0.0f) {
         sb_cat(g, b, ",\"emissiveFactor\":");
         sb_nums(g, b, m->emissive, 3);
     }
+    if (m->alpha_mode != EVR_GLTF_OPAQUE)
+        sb_printf(g, b, ",\"alphaMode\":\"%s\"", modes[m->alpha_mode]);
+    if (m->alpha_mode == EVR_GLTF_MASK && m->alpha_cutoff != 0.5f) {
+        sb_cat(g, b, ",\"alphaCutoff\":");
+        sb_num(g, b, m->alpha_cutoff);
+    }
     if (m->double_sided) sb_cat(g, b, ",\"doubleSided\":true");
+    put_material_extensions(g, b, m);
     sb_cat(g, b, "}");
     return g->status == EVR_OK ? idx : -1;
 }
@@ -558,7 +760,8 @@ int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d)
     sbuf *b = &g->meshes;
     const uint32_t nv = d->num_vertices;
     const size_t tstride = 3 * (size_t)nv;
-    int apos, anrm = -1, auv = -1, aidx, ajoints = -1, aweights = -1, idx, max_joint = -1, t;
+    int apos, anrm = -1, auv = -1, atan = -1, aidx, ajoints = -1, aweights = -1, idx,
+              max_joint = -1, t;
     int *acc_t = NULL; /* per target: POSITION accessor, then NORMAL accessor (or -1) */
     uint32_t i;
     if (!check_name(g, "mesh", name)) return -1;
@@ -574,6 +777,18 @@ int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d)
         if (d->indices[i] >= nv) {
             fail(g, EVR_ERR_ARG, "mesh \"%s\": index %lu out of range", name,
                  (unsigned long)d->indices[i]);
+            return -1;
+        }
+    }
+    if (d->tangents && !d->normals) {
+        fail(g, EVR_ERR_ARG, "mesh \"%s\": tangents need normals", name);
+        return -1;
+    }
+    for (i = 0; d->tangents && i < nv; i++) {
+        const float *tv = d->tangents + 4 * (size_t)i;
+        if (!all_finite(tv, 3) || (tv[3] != 1.0f && tv[3] != -1.0f)) {
+            fail(g, EVR_ERR_ARG, "mesh \"%s\": tangent %lu is not finite with w = +-1", name,
+                 (unsigned long)i);
             return -1;
         }
     }
@@ -606,6 +821,7 @@ int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d)
     apos = float_accessor(g, d->positions, nv, 3, GLTF_ARRAY_BUFFER, 1);
     if (d->normals) anrm = float_accessor(g, d->normals, nv, 3, GLTF_ARRAY_BUFFER, 0);
     if (d->texcoords) auv = float_accessor(g, d->texcoords, nv, 2, GLTF_ARRAY_BUFFER, 0);
+    if (d->tangents) atan = float_accessor(g, d->tangents, nv, 4, GLTF_ARRAY_BUFFER, 0);
     if (d->joints) {
         ajoints = joints_accessor(g, d, max_joint);
         aweights = float_accessor(g, d->weights, nv, 4, GLTF_ARRAY_BUFFER, 0);
@@ -632,6 +848,7 @@ int evr_gltf_add_mesh(evr_gltf *g, const evr_gltf_mesh_desc *d)
     sb_printf(g, b, ",\"primitives\":[{\"attributes\":{\"POSITION\":%d", apos);
     if (anrm >= 0) sb_printf(g, b, ",\"NORMAL\":%d", anrm);
     if (auv >= 0) sb_printf(g, b, ",\"TEXCOORD_0\":%d", auv);
+    if (atan >= 0) sb_printf(g, b, ",\"TANGENT\":%d", atan);
     if (ajoints >= 0) sb_printf(g, b, ",\"JOINTS_0\":%d,\"WEIGHTS_0\":%d", ajoints, aweights);
     sb_printf(g, b, "},\"indices\":%d", aidx);
     if (d->material >= 0) sb_printf(g, b, ",\"material\":%d", d->material);
@@ -760,23 +977,50 @@ int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, flo
     return g->status == EVR_OK ? idx : -1;
 }
 
+void evr_gltf_light_desc_init(evr_gltf_light_desc *d, const char *name, evr_gltf_light_type type)
+{
+    memset(d, 0, sizeof *d);
+    d->name = name;
+    d->type = type;
+    d->color[0] = d->color[1] = d->color[2] = 1.0f;
+    d->intensity = 1.0f;
+    d->outer_cone = 0.78539816f;
+}
+
 int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, const float color[3],
                    float intensity, float inner_cone, float outer_cone)
 {
+    evr_gltf_light_desc d;
+    evr_gltf_light_desc_init(&d, name, type);
+    if (color) memcpy(d.color, color, sizeof d.color);
+    d.intensity = intensity;
+    d.inner_cone = inner_cone;
+    d.outer_cone = outer_cone;
+    return evr_gltf_add_light(g, &d);
+}
+
+int evr_gltf_add_light(evr_gltf *g, const evr_gltf_light_desc *d)
+{
     static const char *const types[3] = {"point", "spot", "directional"};
-    static const float white[3] = {1.0f, 1.0f, 1.0f};
     sbuf *b = &g->lights;
+    const char *name = d->name;
+    const evr_gltf_light_type type = d->type;
     int idx;
     if (!check_name(g, "light", name)) return -1;
-    if (!color) color = white;
-    if ((int)type < 0 || (int)type > 2 || !(intensity >= 0.0f) || !isfinite(intensity) ||
-        !unit_range(color, 3)) {
+    if ((int)type < 0 || (int)type > 2 || !(d->intensity >= 0.0f) || !isfinite(d->intensity) ||
+        !unit_range(d->color, 3)) {
         fail(g, EVR_ERR_ARG, "light \"%s\": bad type, colour or intensity", name);
         return -1;
     }
     if (type == EVR_GLTF_SPOT &&
-        !(inner_cone >= 0.0f && inner_cone < outer_cone && outer_cone <= 1.5707964f)) {
+        !(d->inner_cone >= 0.0f && d->inner_cone < d->outer_cone && d->outer_cone <= 1.5707964f)) {
         fail(g, EVR_ERR_ARG, "light \"%s\": spot cone angles need 0 <= inner < outer <= pi/2",
+             name);
+        return -1;
+    }
+    if (!(d->radius >= 0.0f) || !isfinite(d->radius) ||
+        (d->radius > 0.0f && type == EVR_GLTF_DIRECTIONAL)) {
+        fail(g, EVR_ERR_ARG, "light \"%s\": a radius must be >= 0, and 0 for a directional light",
              name);
         return -1;
     }
@@ -784,18 +1028,25 @@ int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, cons
     sb_cat(g, b, "{\"name\":");
     sb_str(g, b, name);
     sb_printf(g, b, ",\"type\":\"%s\",\"color\":", types[type]);
-    sb_nums(g, b, color, 3);
+    sb_nums(g, b, d->color, 3);
     sb_cat(g, b, ",\"intensity\":");
-    sb_num(g, b, intensity);
+    sb_num(g, b, d->intensity);
     if (type == EVR_GLTF_SPOT) {
         sb_cat(g, b, ",\"spot\":{\"innerConeAngle\":");
-        sb_num(g, b, inner_cone);
+        sb_num(g, b, d->inner_cone);
         sb_cat(g, b, ",\"outerConeAngle\":");
-        sb_num(g, b, outer_cone);
+        sb_num(g, b, d->outer_cone);
+        sb_cat(g, b, "}");
+    }
+    if (d->radius > 0.0f) {
+        sb_cat(g, b, ",\"extras\":{\"radius\":");
+        sb_num(g, b, d->radius);
         sb_cat(g, b, "}");
     }
     sb_cat(g, b, "}");
-    return g->status == EVR_OK ? idx : -1;
+    if (g->status != EVR_OK) return -1;
+    g->ext_used |= 1u << EXT_LIGHTS;
+    return idx;
 }
 
 int evr_gltf_node(evr_gltf *g, const char *name, int parent)
@@ -1110,8 +1361,13 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
     if (g->status != EVR_OK) return evr_gltf_status(g, err);
 
     sb_cat(g, &j, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"evray gltf_writer\"}");
+    for (i = 0, first = 1; i < EXT_COUNT; i++) {
+        if (!(g->ext_used & (1u << i))) continue;
+        sb_printf(g, &j, "%s\"%s\"", first ? ",\"extensionsUsed\":[" : ",", ext_names[i]);
+        first = 0;
+    }
+    if (!first) sb_cat(g, &j, "]");
     if (g->lights.count) {
-        sb_cat(g, &j, ",\"extensionsUsed\":[\"KHR_lights_punctual\"]");
         sb_cat(g, &j, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
         sb_cat_n(g, &j, g->lights.p, g->lights.n);
         sb_cat(g, &j, "]}}");

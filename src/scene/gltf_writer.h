@@ -7,7 +7,7 @@
  *     int tex = evr_gltf_texture_png(g, "checker", pixels, 64, 64, 3);
  *     evr_gltf_material m;
  *     evr_gltf_material_init(&m, "paint");
- *     m.base_texture = tex;
+ *     m.base_texture.index = tex;
  *     int mat = evr_gltf_add_material(g, &m);
  *     int mesh = evr_gltf_mesh(g, "quad", pos, nrm, uv, 4, idx, 6, mat);
  *     int node = evr_gltf_node(g, "quad", -1);
@@ -45,14 +45,48 @@ typedef enum {
 } evr_gltf_path;
 typedef enum { EVR_GLTF_LINEAR = 0, EVR_GLTF_STEP = 1 } evr_gltf_interp;
 
-/* A metallic-roughness material; base_color is linear RGBA, multiplied by the texture. */
+/* A texture as a material's slot uses it: the texture (from evr_gltf_texture_png, -1: none) and
+ * its KHR_texture_transform, uv' = T(offset) R(rotation) S(scale) uv as the extension defines it
+ * (rotation in radians); the identity (offset 0, rotation 0, scale 1) is not written. */
+typedef struct {
+    int index;
+    float offset[2], rotation, scale[2];
+} evr_gltf_texture_slot;
+
+typedef enum {
+    EVR_GLTF_OPAQUE = 0,
+    EVR_GLTF_MASK = 1, /* alpha below alpha_cutoff is a hole */
+    EVR_GLTF_BLEND = 2
+} evr_gltf_alpha_mode;
+
+/* A metallic-roughness material with the KHR_materials extensions evray reads. Colours are
+ * linear; factors multiply their textures. Each extension is written (and listed in
+ * extensionsUsed) only when a field differs from its default. */
 typedef struct {
     const char *name;
-    float base_color[4];
-    int base_texture; /* texture index from evr_gltf_texture_png, -1: none */
-    float metallic, roughness;
-    float emissive[3]; /* linear RGB */
+    float base_color[4];                              /* RGBA in [0,1] */
+    evr_gltf_texture_slot base_texture;               /* sRGB colour, alpha */
+    float metallic, roughness;                        /* [0,1] */
+    evr_gltf_texture_slot metallic_roughness_texture; /* data: roughness in G, metallic in B */
+    evr_gltf_texture_slot normal_texture;             /* data: tangent-space normal */
+    float normal_scale;                               /* finite (1) */
+    evr_gltf_texture_slot occlusion_texture;          /* data: occlusion in R */
+    float occlusion_strength;                         /* [0,1] (1) */
+    float emissive[3];                                /* [0,1] */
+    float emissive_strength; /* KHR_materials_emissive_strength: >= 0 (1), scales emissive */
+    evr_gltf_texture_slot emissive_texture; /* sRGB */
+    evr_gltf_alpha_mode alpha_mode;
+    float alpha_cutoff; /* MASK: >= 0 (0.5) */
     int double_sided;
+    int unlit;                                  /* KHR_materials_unlit */
+    float transmission;                         /* KHR_materials_transmission: [0,1] (0) */
+    evr_gltf_texture_slot transmission_texture; /* data: transmission in R */
+    float ior;                                  /* KHR_materials_ior: >= 1 (1.5) */
+    /* KHR_materials_volume: thickness >= 0 (0: thin-walled), attenuation_distance > 0
+     * (INFINITY: none), attenuation_color in [0,1] (white) */
+    float thickness, attenuation_distance, attenuation_color[3];
+    /* KHR_materials_specular: factor in [0,1] (1), colour >= 0 (white) */
+    float specular, specular_color[3];
 } evr_gltf_material;
 
 /* Returns NULL when out of memory. scene_name may be NULL. */
@@ -65,8 +99,9 @@ void evr_gltf_free(evr_gltf *g);
 int evr_gltf_texture_png(evr_gltf *g, const char *name, const uint8_t *pixels, int width,
                          int height, int channels);
 
-/* Defaults: white, no texture, metallic 0, roughness 1, no emission, double-sided (the built-in
- * scenes' surfaces are seen from both sides). */
+/* Defaults: white, no textures (identity transforms), metallic 0, roughness 1, no emission
+ * (strength 1), opaque (cutoff 0.5), double-sided, lit, no transmission, IOR 1.5, thin-walled
+ * without attenuation, specular 1 white; normal scale and occlusion strength 1. */
 void evr_gltf_material_init(evr_gltf_material *m, const char *name);
 int evr_gltf_add_material(evr_gltf *g, const evr_gltf_material *m);
 
@@ -77,6 +112,8 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
                   uint32_t num_indices, int material);
 
 /* One triangle primitive that may deform: evr_gltf_mesh's arrays, and
+ *   tangents     TANGENT, 4 floats per vertex (unit xyz, w = +-1 the bitangent's sign), or NULL;
+ *                needs normals
  *   skin         joints and weights (JOINTS_0, WEIGHTS_0), 4 per vertex: indices into the joints
  *                of the skin that the mesh's node gives (evr_gltf_node_skin), and weights >= 0
  *                summing to 1 (within 1e-5), a joint at most once with a non-zero weight; both
@@ -92,6 +129,7 @@ int evr_gltf_mesh(evr_gltf *g, const char *name, const float *positions, const f
 typedef struct {
     const char *name;
     const float *positions, *normals, *texcoords;
+    const float *tangents;
     uint32_t num_vertices;
     const uint32_t *indices;
     uint32_t num_indices;
@@ -122,6 +160,20 @@ int evr_gltf_camera(evr_gltf *g, const char *name, float yfov, float aspect, flo
  * spot) or lux (directional); cone half-angles in radians (spot only; 0 <= inner < outer <= pi/2). */
 int evr_gltf_light(evr_gltf *g, const char *name, evr_gltf_light_type type, const float color[3],
                    float intensity, float inner_cone, float outer_cone);
+
+/* The same with every field, and a radius (metres, >= 0, point and spot lights only) written as
+ * the light's "extras": {"radius": r} when > 0: the emitter's size, so that a smooth surface
+ * reflects it as a disc (evr_light.radius). */
+typedef struct {
+    const char *name;
+    evr_gltf_light_type type;
+    float color[3];
+    float intensity, inner_cone, outer_cone, radius;
+} evr_gltf_light_desc;
+
+/* Defaults: white, intensity 1, cones 0 and pi/4, radius 0. */
+void evr_gltf_light_desc_init(evr_gltf_light_desc *d, const char *name, evr_gltf_light_type type);
+int evr_gltf_add_light(evr_gltf *g, const evr_gltf_light_desc *d);
 
 /* A node; parent is an existing node index or -1 for a root of the scene. */
 int evr_gltf_node(evr_gltf *g, const char *name, int parent);

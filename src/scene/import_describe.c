@@ -245,6 +245,7 @@ char *evr_scene_describe(const evr_scene *s)
         if (l->type == EVR_LIGHT_SPOT)
             sb_printf(&b, ", cone %.1f-%.1f deg (half angles)", l->inner_cone * 180.0 / EVR_PI_D,
                       l->outer_cone * 180.0 / EVR_PI_D);
+        if (l->radius > 0.0f) sb_printf(&b, ", radius %.4g m", l->radius);
         sb_printf(&b, "\n");
     }
 

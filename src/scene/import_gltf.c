@@ -1,7 +1,8 @@
 /* The glTF JSON read directly (the .gltf text or the GLB's JSON chunk), for what Assimp 5.2
  * drops or mangles: which channels exist and their interpolation (quirks (d), (e), (f) and STEP
- * in import.c) and the nodes' morph weights (quirk (h)). The materials are read from the JSON
- * in import_gltf_material.c. */
+ * in import.c), the nodes' morph weights (quirk (h)) and the lights' radii (a
+ * KHR_lights_punctual light's extras "radius", which Assimp does not keep). The materials are
+ * read from the JSON in import_gltf_material.c. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +18,7 @@ void evr_gltf_side_free(gltf_side *g)
     for (i = 0; i < g->num_nodes && g->node_names; i++) free(g->node_names[i]);
     free(g->node_names);
     free(g->ch);
+    free(g->light_radius);
     for (i = 0; i < g->num_nodes && g->node_weights; i++) free(g->node_weights[i]);
     free(g->node_weights);
     free(g->node_num_weights);
@@ -56,7 +58,7 @@ int evr_gltf_json_span(const unsigned char *data, size_t size, const char **json
 evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side *g, evr_error *err)
 {
     evr_jdoc d;
-    int root, nodes, anims, i, a, m, cap = 0;
+    int root, nodes, anims, lights, i, a, m, cap = 0;
     int *samplers = NULL;
     const char *json;
     size_t jlen;
@@ -78,10 +80,16 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->num_nodes = evr_jdoc_count(&d, nodes);
     g->num_anims = evr_jdoc_count(&d, anims);
     g->num_materials = evr_jdoc_count(&d, evr_jdoc_get(&d, root, "materials"));
+    lights = evr_jdoc_get(
+        &d, evr_jdoc_get(&d, evr_jdoc_get(&d, root, "extensions"), "KHR_lights_punctual"),
+        "lights");
+    g->num_lights = evr_jdoc_count(&d, lights);
+    g->light_radius = calloc((size_t)g->num_lights + 1, sizeof *g->light_radius);
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
     g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
-    if (!g->node_names || !g->node_num_weights || !g->node_weights) goto nomem;
+    if (!g->node_names || !g->node_num_weights || !g->node_weights || !g->light_radius)
+        goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
          m = evr_jdoc_next(&d, m), i++) {
@@ -144,6 +152,12 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
         }
     }
     if (g->num_ch) qsort(g->ch, (size_t)g->num_ch, sizeof *g->ch, side_channel_cmp);
+    for (i = 0, m = g->num_lights ? evr_jdoc_first(&d, lights) : -1; m >= 0;
+         m = evr_jdoc_next(&d, m), i++) {
+        double r =
+            evr_jdoc_number(&d, evr_jdoc_get(&d, evr_jdoc_get(&d, m, "extras"), "radius"), 0.0);
+        g->light_radius[i] = r > 0.0 && r < 1e30 ? (float)r : 0.0f; /* bad values: a point */
+    }
     free(samplers);
     evr_jdoc_free(&d);
     return EVR_OK;

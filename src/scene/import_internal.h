@@ -56,6 +56,8 @@ typedef struct {
     int num_materials;
     int *node_num_weights; /* per node: the morph weights it gives (node.weights), 0: none */
     float **node_weights;  /* per node: those weights, or NULL */
+    int num_lights;
+    float *light_radius; /* per KHR_lights_punctual light: extras.radius (>= 0; 0 when absent) */
 } gltf_side;
 
 /* A glTF index (a non-negative integer number), or -1. */

@@ -33,6 +33,9 @@ evr_status evr_import_lights(importer *im)
         l->color[2] = al->mColorDiffuse.b;
         l->position = evr_v3_make(al->mPosition.x, al->mPosition.y, al->mPosition.z);
         l->direction = evr_v3_len(dir) > 0.0f ? evr_v3_norm(dir) : evr_v3_make(0, 0, -1);
+        /* Assimp keeps glTF's light order (aiLight i is KHR_lights_punctual light i) */
+        if (im->have_side && (int)i < im->side.num_lights && l->type != EVR_LIGHT_DIRECTIONAL)
+            l->radius = im->side.light_radius[i];
         if (l->type == EVR_LIGHT_SPOT) {
             float k = im->gltf ? 1.0f : 0.5f; /* glTF gives half angles, the others full ones */
             l->inner_cone = al->mAngleInnerCone * k;
