@@ -133,24 +133,34 @@ EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr
     }
 }
 
-/* The sensor intensity of a camera ray along d whose hit s at distance t_hit has the lights' sum
- * acc, with every
- * reflection and refraction its path takes; *deep is set when the path went beyond the
- * primary hit (change-driven sampling then treats the pixel as seeing the whole scene). */
-EVR_HD static inline float evr_path_intensity(const evr_render_scene *rs, const evr_surface *s,
-                                              evr_v3 d, float t_hit, const float acc[3],
-                                              struct evr_occlusion *o, float f, unsigned *rays,
-                                              int *deep)
+/* The radiance (RGB) of a camera ray along d whose hit s at distance t_hit has the lights' sum
+ * acc, with every reflection and refraction its path takes; *deep is set when the path went
+ * beyond the primary hit (change-driven sampling then treats the pixel as seeing the whole
+ * scene). */
+EVR_HD static inline void evr_path_radiance(const evr_render_scene *rs, const evr_surface *s,
+                                            evr_v3 d, float t_hit, const float acc[3],
+                                            struct evr_occlusion *o, float f, unsigned *rays,
+                                            int *deep, float out[3])
 {
     const float w[3] = {1.0f, 1.0f, 1.0f};
-    float out[3] = {0.0f, 0.0f, 0.0f};
     evr_path_stack st;
     st.n = 0;
+    out[0] = out[1] = out[2] = 0.0f;
     evr_path_shade(rs, s, d, acc, w, evr_camera_pixel_spread(&rs->camera) * t_hit, 0, -1, &st, out);
     if (st.n > 0) {
         *deep = 1;
         evr_path_follow(rs, o, f, &st, rays, out);
     }
+}
+
+/* The sensor intensity of the same: the luminance of evr_path_radiance. */
+EVR_HD static inline float evr_path_intensity(const evr_render_scene *rs, const evr_surface *s,
+                                              evr_v3 d, float t_hit, const float acc[3],
+                                              struct evr_occlusion *o, float f, unsigned *rays,
+                                              int *deep)
+{
+    float out[3];
+    evr_path_radiance(rs, s, d, t_hit, acc, o, f, rays, deep, out);
     return evr_luminance(out[0], out[1], out[2]);
 }
 

@@ -94,6 +94,8 @@ static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, f
     return 1;
 }
 
+#include "core/path.h"
+
 /* The lights' sum acc at surface s seen along wo, shadow rays included (evr_shade_direct_sum):
  * the event pipeline's direct term one ray at a time. */
 static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, float acc[3])
@@ -191,7 +193,14 @@ static void shade_row(shade_ctx *c, int y)
         o->instance[i] = inst;
         const evr_v3 wo = evr_v3_scale(ray.dir, -1.0f);
         direct_lights(c, &s, wo, acc);
-        evr_material_radiance(&s, wo, acc, rs->ambient, 0, 0, dir);
+        {
+            struct evr_occlusion occ;
+            unsigned rays = 0;
+            int deep = 0;
+            occ.tr = &c->tr;
+            evr_path_radiance(rs, &s, ray.dir, evr_v3_len(evr_v3_sub(s.p, ray.org)), acc, &occ,
+                              0.0f, &rays, &deep, dir);
+        }
         for (k = 0; k < 3; k++) rgb[k] = dir[k];
         if (p->gi == EVR_GI_PHOTON) {
             float e[3], ind[3];

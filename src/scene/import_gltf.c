@@ -88,8 +88,7 @@ evr_status evr_gltf_side_parse(const unsigned char *data, size_t size, gltf_side
     g->node_names = calloc((size_t)g->num_nodes + 1, sizeof *g->node_names);
     g->node_num_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_num_weights);
     g->node_weights = calloc((size_t)g->num_nodes + 1, sizeof *g->node_weights);
-    if (!g->node_names || !g->node_num_weights || !g->node_weights || !g->light_radius)
-        goto nomem;
+    if (!g->node_names || !g->node_num_weights || !g->node_weights || !g->light_radius) goto nomem;
 
     for (i = 0, m = g->num_nodes ? evr_jdoc_first(&d, nodes) : -1; m >= 0;
          m = evr_jdoc_next(&d, m), i++) {

@@ -460,27 +460,54 @@ evr_status evr_gltf_material_check(const gltf_source *src, evr_error *err)
     return st;
 }
 
+/* The Assimp material that JSON material j (named `name`) became: Assimp 5.2 lists a glTF's
+ * materials in the order meshes first use them, not the file's, and keeps their names; a name
+ * that no untaken Assimp material has (an unnamed material) takes the first untaken one from j
+ * on. -1: none left. */
+static int assimp_index(const importer *im, const char *name, int j, const char *taken)
+{
+    const int n = im->s->num_materials;
+    if (name[0])
+        for (int i = 0; i < n; i++)
+            if (!taken[i] && !strcmp(im->s->materials[i].name, name)) return i;
+    for (int k = 0; k < n; k++) {
+        const int i = (j + k) % n;
+        if (!taken[i]) return i;
+    }
+    return -1;
+}
+
 evr_status evr_gltf_materials_read(importer *im, int *count)
 {
     evr_jdoc d;
     reader r;
     gltf_data gd;
-    int root, m, i = 0;
-    evr_status st = parse(&im->src, &d, &root, &r, im->err);
+    int root, m, j = 0, done = 0;
+    char *taken = calloc((size_t)im->s->num_materials + 1, 1);
+    evr_status st = taken ? parse(&im->src, &d, &root, &r, im->err)
+                          : evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory");
+    if (!taken) return st;
     memset(&gd, 0, sizeof gd);
     if (st == EVR_OK && root >= 0) st = evr_gltf_data_init(&gd, &d, root, &im->src, im->err);
     r.im = im;
     r.gd = &gd;
     for (m = st == EVR_OK && root >= 0 ? evr_jdoc_first(&d, evr_jdoc_get(&d, root, "materials"))
                                        : -1;
-         m >= 0 && st == EVR_OK && i < im->s->num_materials; m = evr_jdoc_next(&d, m), i++) {
+         m >= 0 && st == EVR_OK && done < im->s->num_materials; m = evr_jdoc_next(&d, m), j++) {
+        char name[64] = "";
+        if (!evr_jdoc_string(&d, evr_jdoc_get(&d, m, "name"), name, sizeof name)) name[0] = 0;
+        const int i = assimp_index(im, name, j, taken);
+        if (i < 0) break;
+        taken[i] = 1;
+        done++;
         evr_material *mat = &im->s->materials[i];
         r.name = mat->name;
         st = read_material(&r, m, &mat->p, &im->mat_uv[i]);
     }
-    *count = i;
+    *count = done;
     if (st == EVR_OK && root >= 0) warn_file_extensions(im, &d, root);
     if (root >= 0) evr_gltf_data_free(&gd);
     reader_free(&r, &d);
+    free(taken);
     return st;
 }

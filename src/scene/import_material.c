@@ -167,7 +167,8 @@ evr_status evr_import_materials(importer *im)
             evr_import_copy_name(m->name, sizeof m->name, str.data);
         else snprintf(m->name, sizeof m->name, "material%u", i);
     }
-    /* glTF: the JSON's materials (Assimp's first ones, in the same order) */
+    /* glTF: the JSON's materials (as many of Assimp's, matched by name: evr_gltf_materials_read);
+     * Assimp's own default material, when it added one, is the last */
     if (im->gltf && im->have_side && im->src.bytes &&
         (st = evr_gltf_materials_read(im, &from_json)) != EVR_OK)
         return st;
