@@ -71,7 +71,7 @@ class _Doc:
                   "textures": [], "samplers": [{"magFilter": 9729, "minFilter": 9729}],
                   "cameras": [{"type": "perspective", "perspective": {
                       "yfov": 2 * math.atan(0.5), "aspectRatio": 1.0, "znear": 0.01}}],
-                  "extensionsUsed": ["KHR_lights_punctual"],
+                  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
                   "extensions": {"KHR_lights_punctual": {"lights": [
                       {"type": "directional", "intensity": math.pi, "color": [1, 1, 1]}]}}}
         self.node("camera", camera=0)
@@ -109,7 +109,10 @@ class _Doc:
         pbr = {"baseColorFactor": list(base), "metallicFactor": 0.0, "roughnessFactor": 1.0}
         if texture is not None:
             pbr["baseColorTexture"] = {"index": texture}
-        m = {"name": name, "pbrMetallicRoughness": pbr, "emissiveFactor": list(emissive)}
+        # Lambert (no specular layer: KHR_materials_specular factor 0), so that the expected
+        # intensities are albedo / pi times the irradiance
+        m = {"name": name, "pbrMetallicRoughness": pbr, "emissiveFactor": list(emissive),
+             "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}
         if mask:
             m["alphaMode"] = "MASK"
             m["alphaCutoff"] = 0.5

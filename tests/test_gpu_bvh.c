@@ -1535,6 +1535,12 @@ static void test_demo(const char *name, const scene_expect *ex, const double *t0
     evr_error err;
     CHECK_OK(evr_demo_load(name, &s, &err));
     if (!s) return;
+    /* the traversal against Embree's plain triangles: every surface opaque and two-sided here
+     * (the hit filters, alpha holes and culled back faces, have tests/test_hit_filter.c) */
+    for (int i = 0; i < s->num_materials; i++) {
+        s->materials[i].p.alpha_mode = EVR_ALPHA_OPAQUE;
+        s->materials[i].p.double_sided = 1;
+    }
     test_scene(name, s, ex, t0s, nseg, n_cam, n_shadow, n_random, tot);
     evr_scene_release(s);
 }

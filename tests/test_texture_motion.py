@@ -47,7 +47,9 @@ def plane_gltf(path, texture):
     for p in parts:
         views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(p)})
         blob += p
-    mat = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}
+    # a matte dielectric (Lambert: no specular layer), whose intensity is its base colour's
+    mat = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.0},
+           "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}
     g = {
         "asset": {"version": "2.0"},
         "scene": 0,
@@ -56,7 +58,7 @@ def plane_gltf(path, texture):
                   {"name": "plane", "mesh": 0},
                   {"name": "sun", "extensions": {"KHR_lights_punctual": {"light": 0}},
                    "rotation": [-0.2588190, 0, 0, 0.9659258]}],
-        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
         "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 3.0}]}},
         "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
         "buffers": [{"byteLength": len(blob),

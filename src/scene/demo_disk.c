@@ -53,12 +53,15 @@ void evr_demo_build_disk(evr_gltf *g)
     float times[17], rot[17 * 4];
     int k;
     evr_gltf_material_init(&mat, "white");
+    mat.specular = 0.0f; /* matte: Lambert, whose intensities the tests know analytically */
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = 0.8f;
     int m_white = evr_gltf_add_material(g, &mat);
     evr_gltf_material_init(&mat, "black");
+    mat.specular = 0.0f; /* matte: Lambert, whose intensities the tests know analytically */
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = 0.05f;
     int m_black = evr_gltf_add_material(g, &mat);
     evr_gltf_material_init(&mat, "background");
+    mat.specular = 0.0f; /* matte: Lambert, whose intensities the tests know analytically */
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = 0.2f;
     int m_bg = evr_gltf_add_material(g, &mat);
 

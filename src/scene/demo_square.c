@@ -69,9 +69,11 @@ void evr_demo_build_square(evr_gltf *g)
     const float pos[6] = {-1.0f, 0.0f, 0.01f, 1.0f, 0.0f, 0.01f};
 
     evr_gltf_material_init(&mat, "background");
+    mat.specular = 0.0f; /* matte: Lambert, whose intensities the tests know analytically */
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = SQUARE_DARK;
     m_bg = evr_gltf_add_material(g, &mat);
     evr_gltf_material_init(&mat, "square");
+    mat.specular = 0.0f; /* matte: Lambert, whose intensities the tests know analytically */
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = SQUARE_BRIGHT;
     m_sq = evr_gltf_add_material(g, &mat);
 

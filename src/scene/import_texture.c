@@ -171,8 +171,7 @@ static evr_status add_texture(importer *im, const char *key, int srgb, evr_textu
     }
     strcpy(im->tex_keys[s->num_textures], key);
     im->tex_srgb[s->num_textures] = srgb;
-    t->levels = 1;
-    s->textures[s->num_textures] = *t;
+    s->textures[s->num_textures] = *t; /* levels: evr_texture_build_mips's */
     *out = s->num_textures++;
     return EVR_OK;
 }
