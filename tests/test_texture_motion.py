@@ -78,7 +78,7 @@ def plane_gltf(path, texture):
                         "samplers": [{"input": 4, "output": 5, "interpolation": "LINEAR"}]}],
     }
     if texture:
-        mat["pbrMetallicRoughness"] = {"baseColorTexture": {"index": 0}}
+        mat["pbrMetallicRoughness"] = {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}
         g["textures"] = [{"source": 0}]
         g["images"] = [{"uri": texture}]
     with open(path, "w") as f:
