@@ -25,14 +25,16 @@
 
 /* The tests a mesh of material mat needs (evr_mesh_view.filter): MASK when alpha can fall below
  * the cutoff (a base texture on a mesh with uvs, or a base alpha below it), CULL when the
- * material is single-sided. */
+ * material is single-sided and not a volume (KHR_materials_volume: a ray that entered it must
+ * meet its inner faces to leave it). */
 static inline int evr_material_filter(const evr_material_params *mat, int has_uvs)
 {
     int bits = 0;
     if (mat->alpha_mode == EVR_ALPHA_MASK &&
         ((mat->tex[EVR_TEX_BASE].index >= 0 && has_uvs) || mat->base_color[3] < mat->alpha_cutoff))
         bits |= EVR_FILTER_MASK;
-    if (!mat->double_sided) bits |= EVR_FILTER_CULL;
+    if (!mat->double_sided && !(mat->transmission > 0.0f && mat->thickness > 0.0f))
+        bits |= EVR_FILTER_CULL;
     return bits;
 }
 
