@@ -37,7 +37,9 @@ EVR_HD static inline int evr_shadow_pass(const evr_render_scene *rs, struct evr_
                                          evr_ray r, float tnear, float tfar, float f, float T[3])
 {
     T[0] = T[1] = T[2] = 1.0f;
-    if (!rs->translucent) return !evr_occluded(o, r, tnear, tfar, f);
+    /* nothing at all in the way: the common case, answered by the cheaper any-hit search */
+    if (!evr_occluded(o, r, tnear, tfar, f)) return 1;
+    if (!rs->translucent) return 0;
     for (int k = 0; k < EVR_SHADOW_LAYERS; k++) {
         evr_hit h;
         if (!evr_closest(o, r, tnear, tfar, f, &h)) return 1;

@@ -186,16 +186,10 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, fs[i], ray[i],
                        rh.ray.tfar[i], spread * rh.ray.tfar[i], &s[i]);
     }
-    /* core/shade.h's steps light by light: each light's shadow rays as one packet (through
-     * translucent surfaces: one ray at a time, evr_shade_direct_sum) */
-    for (i = 0; rs->translucent && i < PACKET; i++) {
-        struct evr_occlusion o = {b, rh.ray.time[i]};
-        unsigned r1 = 0;
-        if (!hit[i]) continue;
-        evr_shade_direct_sum(rs, &s[i], evr_v3_scale(ray[i].dir, -1.0f), fs[i], &o, &r1, acc[i]);
-        *rays += r1;
-    }
-    for (l = 0; !rs->translucent && l < rs->num_lights; l++) {
+    /* core/shade.h's steps light by light: each light's shadow rays as one packet; a blocked
+     * ray in a scene with translucent surfaces is followed through them one ray at a time
+     * (evr_shadow_pass) */
+    for (l = 0; l < rs->num_lights; l++) {
         evr_light_ray lr[PACKET];
         int any = 0;
         for (i = 0; i < PACKET; i++) {
@@ -219,9 +213,18 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         }
         if (!any) continue;
         rtcOccluded8(vmask, b->top, &ctx, &sr);
-        for (i = 0; i < PACKET; i++)
-            if (vmask[i] && sr.tfar[i] >= 0.0f)
-                evr_shade_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), &lr[i], acc[i]);
+        for (i = 0; i < PACKET; i++) {
+            if (!vmask[i]) continue;
+            if (sr.tfar[i] < 0.0f) { /* blocked: through translucent surfaces, or not at all */
+                struct evr_occlusion o = {b, rh.ray.time[i]};
+                float T[3];
+                if (!rs->translucent ||
+                    !evr_shadow_pass(rs, &o, lr[i].ray, lr[i].tnear, lr[i].tfar, fs[i], T))
+                    continue;
+                for (int c = 0; c < 3; c++) lr[i].e[c] *= T[c];
+            }
+            evr_shade_add_light(&s[i], evr_v3_scale(ray[i].dir, -1.0f), &lr[i], acc[i]);
+        }
     }
     for (i = 0; i < PACKET; i++) {
         if (!hit[i]) { /* GI: the pixel model's sample met nothing (frames leave the memo alone) */
