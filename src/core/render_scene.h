@@ -167,6 +167,13 @@ EVR_HD static inline evr_v3 evr_rs_normal(const evr_render_scene *rs, int inst,
     return evr_v3_make(m->normals[3 * v], m->normals[3 * v + 1], m->normals[3 * v + 2]);
 }
 
+/* A ray's closest hit: distance, barycentrics, triangle and scene instance. */
+typedef struct {
+    float t, u, v;
+    unsigned prim;
+    int inst;
+} evr_hit;
+
 /* Camera pose at normalized segment time f. */
 EVR_HD static inline evr_m34 evr_rs_camera_pose(const evr_render_scene *rs, float f)
 {

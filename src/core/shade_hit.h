@@ -11,13 +11,6 @@
 
 struct evr_occlusion;
 
-/* A ray's closest hit: distance, barycentrics, triangle and instance. */
-typedef struct {
-    float t, u, v;
-    unsigned prim;
-    int inst;
-} evr_hit;
-
 /* 1 when something blocks ray r over [tnear, tfar) at normalized segment time f. */
 EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
                                       float f);
@@ -37,9 +30,7 @@ EVR_HD static inline int evr_shadow_pass(const evr_render_scene *rs, struct evr_
                                          evr_ray r, float tnear, float tfar, float f, float T[3])
 {
     T[0] = T[1] = T[2] = 1.0f;
-    /* nothing at all in the way: the common case, answered by the cheaper any-hit search */
-    if (!evr_occluded(o, r, tnear, tfar, f)) return 1;
-    if (!rs->translucent) return 0;
+    if (!rs->translucent) return !evr_occluded(o, r, tnear, tfar, f);
     for (int k = 0; k < EVR_SHADOW_LAYERS; k++) {
         evr_hit h;
         if (!evr_closest(o, r, tnear, tfar, f, &h)) return 1;

@@ -113,17 +113,9 @@ static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, 
 static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f,
                               evr_hit *h)
 {
-    evr_trace_hit th;
     (void)f;
-    if (!evr_embree_closest1(o->b->top, o->b->groups.members, o->b->groups.group_first, r, tnear,
-                             tfar, o->trace_time, &th))
-        return 0;
-    h->t = th.t;
-    h->u = th.u;
-    h->v = th.v;
-    h->prim = th.prim;
-    h->inst = th.inst;
-    return 1;
+    return evr_embree_closest1(o->b->top, o->b->groups.members, o->b->groups.group_first, r, tnear,
+                               tfar, o->trace_time, h);
 }
 
 #include "core/path.h"

@@ -11,12 +11,8 @@
 #include "backend.h"
 #include "prep/photon_emitters.h"
 
-/* What a closest-hit query returns: the scene instance, its triangle, barycentrics, distance. */
-typedef struct {
-    int inst;
-    unsigned prim;
-    float u, v, t;
-} evr_trace_hit;
+/* What a closest-hit query returns (core/render_scene.h's evr_hit). */
+typedef evr_hit evr_trace_hit;
 
 /* The ray tracer the pass uses. Both calls must be safe to make from several threads at once.
  * f is the normalized segment time of the ray (motion blur); directions are unit vectors. */

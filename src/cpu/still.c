@@ -84,14 +84,7 @@ static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, 
 static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar, float f,
                               evr_hit *h)
 {
-    evr_trace_hit th;
-    if (!o->tr->closest(o->tr->user, r, tnear, tfar, f, &th)) return 0;
-    h->t = th.t;
-    h->u = th.u;
-    h->v = th.v;
-    h->prim = th.prim;
-    h->inst = th.inst;
-    return 1;
+    return o->tr->closest(o->tr->user, r, tnear, tfar, f, h);
 }
 
 #include "core/path.h"
