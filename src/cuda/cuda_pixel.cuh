@@ -18,55 +18,46 @@ struct evr_occlusion {
     evr_gpu_hit *hit;
 };
 
-EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
-                                      float f)
+/* Our traversal in the launch's node layout for one query (any 1: any hit, a shadow ray; 0: the
+ * closest, into *o->hit). */
+EVR_HD static inline int evr_occlusion_trace(struct evr_occlusion *o, evr_ray r, float tnear,
+                                             float tfar, float f, int any)
 {
 #ifdef __CUDA_ARCH__
     const int general = EVR_GPU_TRACE_GENERAL;
     if (o->layout == EVR_GPU_LAYOUT_CW8)
-        return gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
+        return gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, any,
+                                             o->hit);
     if (o->layout == (EVR_GPU_LAYOUT_CW8 | general))
-        return gpu_trace<EVR_GPU_LAYOUT_CW8 | general>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1,
-                                                       o->hit);
+        return gpu_trace<EVR_GPU_LAYOUT_CW8 | general>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
+                                                       any, o->hit);
     if (o->layout == (EVR_GPU_LAYOUT_BVH4 | general))
         return gpu_trace<EVR_GPU_LAYOUT_BVH4 | general>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
-                                                        1, o->hit);
-    return gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 1, o->hit);
+                                                        any, o->hit);
+    return gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, any, o->hit);
 #else
-    (void)o, (void)r, (void)tnear, (void)tfar, (void)f;
+    (void)o, (void)r, (void)tnear, (void)tfar, (void)f, (void)any;
     return 0;
 #endif
+}
+
+EVR_HD static inline int evr_occluded(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
+                                      float f)
+{
+    return evr_occlusion_trace(o, r, tnear, tfar, f, 1);
 }
 
 /* core/path.h's closest-hit query for the rays after the primary hit, the same traversal. */
 EVR_HD static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, float tfar,
                                      float f, evr_hit *h)
 {
-#ifdef __CUDA_ARCH__
-    const int deforming = EVR_GPU_TRACE_GENERAL;
-    int found;
-    if (o->layout == EVR_GPU_LAYOUT_CW8)
-        found = gpu_trace<EVR_GPU_LAYOUT_CW8>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 0, o->hit);
-    else if (o->layout == (EVR_GPU_LAYOUT_CW8 | deforming))
-        found = gpu_trace<EVR_GPU_LAYOUT_CW8 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar, f,
-                                                          0, o->hit);
-    else if (o->layout == (EVR_GPU_LAYOUT_BVH4 | deforming))
-        found = gpu_trace<EVR_GPU_LAYOUT_BVH4 | deforming>(&o->a->view, &o->a->rs, r, tnear, tfar,
-                                                           f, 0, o->hit);
-    else
-        found =
-            gpu_trace<EVR_GPU_LAYOUT_BVH4>(&o->a->view, &o->a->rs, r, tnear, tfar, f, 0, o->hit);
-    if (!found) return 0;
+    if (!evr_occlusion_trace(o, r, tnear, tfar, f, 0)) return 0;
     h->t = o->hit->t;
     h->u = o->hit->u;
     h->v = o->hit->v;
     h->prim = o->hit->prim;
     h->inst = o->hit->instance;
     return 1;
-#else
-    (void)o, (void)r, (void)tnear, (void)tfar, (void)f, (void)h;
-    return 0;
-#endif
 }
 
 #include "core/path.h"
