@@ -41,7 +41,7 @@ static evr_surface surface(bsdf_env *e, evr_v3 wo)
     s.alpha = fmaxf(s.rough * s.rough, EVR_GGX_ALPHA_MIN);
     s.opacity = s.occlusion = 1.0f;
     s.eta = 1.0f / e->mat.ior;
-    evr_material_view(&e->rs, &e->mat, wo, &s);
+    evr_material_view(&e->rs, &e->mat, e->mat.transmission, wo, &s);
     return s;
 }
 

@@ -189,7 +189,7 @@ static void flow_surface(const evr_render_scene *rs, const evr_material_params *
     s->alpha = mat->roughness * mat->roughness;
     s->opacity = s->occlusion = 1.0f;
     s->eta = 1.0f / mat->ior;
-    evr_material_view(rs, mat, wo, s);
+    evr_material_view(rs, mat, mat->transmission, wo, s);
 }
 
 /* One point light straight above a grey patch with no specular layer (KHR_materials_specular

@@ -213,10 +213,11 @@ EVR_HD static inline float evr_material_alpha(const evr_render_scene *rs,
 
 /* The view-dependent weights of s seen along wo (unit, on the side of s->n): the specular
  * lobe's albedo from the table (core/bsdf.h), the diffuse base scaled by what the dielectric
- * layer leaves, the transmitted share. Called once the frame and the parameters are set. */
+ * layer leaves, the transmitted share (mat's, transmission: its factor times its texture).
+ * Called once the frame and the parameters are set. */
 EVR_HD static inline void evr_material_view(const evr_render_scene *rs,
-                                            const evr_material_params *mat, evr_v3 wo,
-                                            evr_surface *s)
+                                            const evr_material_params *mat, float transmission,
+                                            evr_v3 wo, evr_surface *s)
 {
     const float mu = fmaxf(evr_v3_dot(s->n, wo), 1e-4f);
     float ta = 1.0f, tb = 0.0f;
@@ -226,7 +227,7 @@ EVR_HD static inline void evr_material_view(const evr_render_scene *rs,
     /* the dielectric layer: f0 from the IOR and KHR_materials_specular, f90 its factor */
     const float r = (mat->ior - 1.0f) / (mat->ior + 1.0f);
     const float m = s->metallic;
-    const float tr = mat->transmission;
+    const float tr = transmission;
     for (int c = 0; c < 3; c++) {
         const float f0d = fminf(r * r * mat->specular_color[c], 1.0f) * mat->specular;
         const float f90d = mat->specular;
@@ -323,9 +324,7 @@ EVR_HD static inline void evr_material_at(const evr_render_scene *rs, const evr_
     float tr = mat->transmission;
     if (uv_ok && evr_material_texture(rs, &mat->tex[EVR_TEX_TRANSMISSION], tu, tv, s->tex_lod, tex))
         tr *= tex[0];
-    evr_material_params eff = *mat;
-    eff.transmission = tr;
-    evr_material_view(rs, &eff, wo, s);
+    evr_material_view(rs, mat, tr, wo, s);
 }
 
 /* Radiance s emits towards wo (both sides emit). */
