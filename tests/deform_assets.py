@@ -1,7 +1,8 @@
 """glTF test assets for skins and morph targets, with exact numbers that tests check analytically.
 
-Standard library only. Each asset is a function returning the glTF dict (one buffer, embedded as
-a base64 data: URI); `python3 tests/deform_assets.py OUTDIR` writes every asset as OUTDIR/NAME.gltf.
+Standard library only, written through tests/gltf_build.py. Each asset is a function returning
+its document under construction (a gltf_build.Gltf; one buffer, embedded as a base64 data: URI;
+.write(PATH) writes it); `python3 tests/deform_assets.py OUTDIR` writes every asset as OUTDIR/NAME.gltf.
 
 Common to all: a camera node at the origin looking along -Z (no rotation; bend_cylinder's at
 (1, 0.5, 4)), perspective with yfov = 2 atan(0.5) (so the plane z = -1 spans [-0.5, 0.5] in x and
@@ -47,121 +48,62 @@ Extra assets (not in the lead's list), each pinning one of Assimp 5.2's quirks (
                       (1, 0, 0)); mesh weights [1], static. JoinIdenticalVertices would merge
                       the two.
 """
-import base64
-import json
 import math
 import os
-import struct
 import sys
 
-FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
-_FMT = {FLOAT: "f", UBYTE: "B", USHORT: "H", UINT: "I"}
-_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4", 16: "MAT4"}
+import gltf_build as B
+from gltf_build import FLOAT, UBYTE, UINT, USHORT
 
 IDENTITY = (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1)  # column-major, as glTF stores it
+# j1's inverse bind matrix: j1 sits at (1, 0, 0)
+SHIFTED = (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1)
 
 QUAD_POSITIONS = [(-2, -2, -1), (-0.5, -2, -1), (-0.5, 2, -1), (-2, 2, -1)]
 QUAD_INDICES = [0, 1, 2, 0, 2, 3]
 QUAD_NORMALS = [(0, 0, 1)] * 4
 
-
-class _Gltf:
-    """Accumulates one buffer's bytes, its views and accessors, then makes the document."""
-
-    def __init__(self):
-        self.data = bytearray()
-        self.views = []
-        self.accessors = []
-
-    def accessor(self, ctype, values, minmax=False):
-        """Appends values (a list of scalars or of equal-length tuples) as one accessor."""
-        rows = [v if isinstance(v, (tuple, list)) else (v,) for v in values]
-        dim = len(rows[0])
-        flat = [x for r in rows for x in r]
-        raw = struct.pack("<%d%s" % (len(flat), _FMT[ctype]), *flat)
-        while len(self.data) % 4:
-            self.data.append(0)
-        self.views.append({"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw)})
-        self.data += raw
-        acc = {"bufferView": len(self.views) - 1, "componentType": ctype, "count": len(rows),
-               "type": _TYPES[dim]}
-        if minmax:
-            acc["min"] = [min(r[i] for r in rows) for i in range(dim)]
-            acc["max"] = [max(r[i] for r in rows) for i in range(dim)]
-        self.accessors.append(acc)
-        return len(self.accessors) - 1
-
-    def document(self, nodes, meshes, roots, skins=None, animations=None, yfov=2 * math.atan(0.5)):
-        while len(self.data) % 4:
-            self.data.append(0)
-        doc = {
-            "asset": {"version": "2.0", "generator": "evray tests/deform_assets.py"},
-            "scene": 0,
-            "scenes": [{"nodes": roots}],
-            "nodes": nodes,
-            "meshes": meshes,
-            "materials": [{"name": "glow", "emissiveFactor": [1, 1, 1],
-                           "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1],
-                                                    "metallicFactor": 0, "roughnessFactor": 1}}],
-            "cameras": [{"type": "perspective",
-                         "perspective": {"yfov": yfov, "aspectRatio": 1.0, "znear": 0.01}}],
-            "accessors": self.accessors,
-            "bufferViews": self.views,
-            "buffers": [{"byteLength": len(self.data),
-                         "uri": "data:application/octet-stream;base64," +
-                                base64.b64encode(bytes(self.data)).decode("ascii")}],
-        }
-        if skins:
-            doc["skins"] = skins
-        if animations:
-            doc["animations"] = animations
-        return doc
+GLOW = {"name": "glow", "emissiveFactor": [1, 1, 1],
+        "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
+                                 "roughnessFactor": 1}}
 
 
-def _camera_node(translation=None):
-    n = {"name": "camera", "camera": 0}
-    if translation:
-        n["translation"] = list(translation)
-    return n
+def _gltf(camera_at=None, material=GLOW):
+    """A document with the camera (node 0, at camera_at) and one material (index 0)."""
+    g = B.Gltf("evray tests/deform_assets.py")
+    g.camera(**({"translation": camera_at} if camera_at else {}))
+    g.material(material)
+    return g
 
 
-def _quad_attributes(g):
-    return {"POSITION": g.accessor(FLOAT, QUAD_POSITIONS, minmax=True),
-            "NORMAL": g.accessor(FLOAT, QUAD_NORMALS)}
+def _quad_primitive(g, **extra):
+    prim = g.primitive(QUAD_POSITIONS, QUAD_INDICES, 0, QUAD_NORMALS)
+    prim.update(extra)
+    return prim
 
 
-def _linear_channel(g, node, path, times, values, interpolation="LINEAR"):
-    """One animation with one sampler and channel."""
-    return {"name": "%s_%s" % (path, node),
-            "samplers": [{"input": g.accessor(FLOAT, times, minmax=True),
-                          "output": g.accessor(FLOAT, values), "interpolation": interpolation}],
-            "channels": [{"sampler": 0, "target": {"node": node, "path": path}}]}
+def _turning(degrees=(0, 45, 90)):
+    """Rotation keys about +Z at t = 0, 0.5, 1."""
+    return [0.0, 0.5, 1.0], [B.quaternion((0, 0, 1), d) for d in degrees]
 
 
 # ---- morph targets ----
 
 def _morph_quad(target_deltas=None, node_weights=None, animate="LINEAR"):
-    g = _Gltf()
-    attrs = _quad_attributes(g)
-    idx = g.accessor(USHORT, QUAD_INDICES)
+    g = _gltf()
     deltas = target_deltas or [(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 0, 0)]
     target = {"POSITION": g.accessor(FLOAT, deltas, minmax=True)}
-    mesh = {"name": "quad", "primitives": [{"attributes": attrs, "indices": idx, "material": 0,
-                                            "targets": [target]}], "weights": [0]}
-    quad = {"name": "quad", "mesh": 0}
-    if node_weights is not None:
-        quad["weights"] = node_weights
-    nodes = [_camera_node(), quad]
-    anims = None
+    mesh = g.mesh("quad", [_quad_primitive(g, targets=[target])], weights=[0])
+    quad = g.node("quad", mesh=mesh, **({"weights": node_weights} if node_weights else {}))
     if animate == "LINEAR":
-        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [0.0, 1.0])]
+        g.animation([(quad, "weights", [0.0, 1.0], [0.0, 1.0])], name="weights_1")
     elif animate == "CUBICSPLINE":
         # per key: in-tangent, value, out-tangent (one target each)
-        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [2.0, 0.0, 3.0, 4.0, 1.0, 5.0],
-                                 "CUBICSPLINE")]
+        g.animation([(quad, "weights", [0.0, 1.0], [2.0, 0.0, 3.0, 4.0, 1.0, 5.0], "CUBICSPLINE")],
+                    name="weights_1")
     elif animate == "STEP":
-        anims = [_linear_channel(g, 1, "weights", [0.0, 1.0], [0.0, 1.0], "STEP")]
-    return g.document(nodes, [mesh], [0, 1], animations=anims)
+        g.animation([(quad, "weights", [0.0, 1.0], [0.0, 1.0], "STEP")], name="weights_1")
+    return g
 
 
 def morph_slide():
@@ -181,23 +123,22 @@ def morph_step():
 
 
 def morph_two_prims():
-    g = _Gltf()
+    g = _gltf()
     prims = []
     for shift in (0.0, 3.0):  # the second quad 3 units higher, its own accessors
-        attrs = {"POSITION": g.accessor(FLOAT, [(x, y + shift, z) for x, y, z in QUAD_POSITIONS],
-                                        minmax=True),
-                 "NORMAL": g.accessor(FLOAT, QUAD_NORMALS)}
         t1 = {"POSITION": g.accessor(FLOAT, [(0, 0, 0), (1, 0, 0), (1, 0, 0), (0, 0, 0)],
                                      minmax=True),
               "NORMAL": g.accessor(FLOAT, [(0, 0.5, 0)] * 4)}
         t2 = {"POSITION": g.accessor(FLOAT, [(0, 0, 0), (0, 1, 0), (0, 1, 0), (0, 0, 0)],
                                      minmax=True)}
-        prims.append({"attributes": attrs, "indices": g.accessor(USHORT, QUAD_INDICES),
-                      "material": 0, "targets": [t1, t2]})
-    mesh = {"name": "pair", "primitives": prims, "weights": [0.25, 0.5]}
-    nodes = [_camera_node(), {"name": "pair", "mesh": 0, "weights": [0.75, 0.125]}]
-    anims = [_linear_channel(g, 1, "weights", [0.0, 0.5, 1.0], [0.0, 0.1, 0.2, 0.3, 1.0, 0.9])]
-    return g.document(nodes, [mesh], [0, 1], animations=anims)
+        prim = g.primitive([(x, y + shift, z) for x, y, z in QUAD_POSITIONS], QUAD_INDICES, 0,
+                           QUAD_NORMALS)
+        prim["targets"] = [t1, t2]
+        prims.append(prim)
+    pair = g.node("pair", mesh=g.mesh("pair", prims, weights=[0.25, 0.5]), weights=[0.75, 0.125])
+    g.animation([(pair, "weights", [0.0, 0.5, 1.0], [0.0, 0.1, 0.2, 0.3, 1.0, 0.9])],
+                name="weights_1")
+    return g
 
 
 def bad_morph_count():
@@ -207,9 +148,7 @@ def bad_morph_count():
 # ---- skins ----
 
 def _skin_quad(eight=False, bad_joint=False, ibm_count=None, zero_weights=False, no_ibm=False):
-    g = _Gltf()
-    attrs = _quad_attributes(g)
-    idx = g.accessor(USHORT, QUAD_INDICES)
+    g = _gltf()
     on_edge = (1, 2)  # the right edge's vertices
     joints0, weights0, joints1, weights1 = [], [], [], []
     for v in range(4):
@@ -229,32 +168,26 @@ def _skin_quad(eight=False, bad_joint=False, ibm_count=None, zero_weights=False,
     if zero_weights:
         weights0[0] = (0, 0, 0, 0)
     jtype = USHORT if eight else UBYTE
-    attrs["JOINTS_0"] = g.accessor(jtype, joints0)
-    attrs["WEIGHTS_0"] = g.accessor(FLOAT, weights0)
+    prim = _quad_primitive(g)
+    prim["attributes"]["JOINTS_0"] = g.accessor(jtype, joints0)
+    prim["attributes"]["WEIGHTS_0"] = g.accessor(FLOAT, weights0)
     if eight:
-        attrs["JOINTS_1"] = g.accessor(jtype, joints1)
-        attrs["WEIGHTS_1"] = g.accessor(FLOAT, weights1)
-    mesh = {"name": "quad", "primitives": [{"attributes": attrs, "indices": idx, "material": 0}]}
+        prim["attributes"]["JOINTS_1"] = g.accessor(jtype, joints1)
+        prim["attributes"]["WEIGHTS_1"] = g.accessor(FLOAT, weights1)
     # nodes: 0 camera, 1 quad (skinned; its own transform is ignored), 2 root, 3 mover, [4 mover2]
-    nodes = [_camera_node(), {"name": "quad", "mesh": 0, "skin": 0, "translation": [5, 5, 5]},
-             {"name": "root"}, {"name": "mover"}]
-    joints = [2, 3]
+    g.node("quad", mesh=g.mesh("quad", [prim]), skin=0, translation=[5, 5, 5])
+    joints = [g.node("root"), g.node("mover")]
     if eight:
-        nodes.append({"name": "mover2"})
-        joints.append(4)
+        joints.append(g.node("mover2"))
     ibm = [IDENTITY] * (num_joints if ibm_count is None else ibm_count)
-    skins = [{"name": "quad_skin", "joints": joints, "inverseBindMatrices": g.accessor(FLOAT, ibm)}]
-    if no_ibm:
-        del skins[0]["inverseBindMatrices"]
+    skin = {"name": "quad_skin", "joints": joints}
+    if not no_ibm:
+        skin["inverseBindMatrices"] = g.accessor(FLOAT, ibm)
+    g.skins.append(skin)
     # one clip: every mover's translation (0,0,0) -> (1,0,0) over [0, 1]
-    anim = _linear_channel(g, 3, "translation", [0.0, 1.0], [(0, 0, 0), (1, 0, 0)])
-    anim["name"] = "slide"
-    for j in joints[2:]:
-        anim["samplers"].append(dict(anim["samplers"][0]))
-        anim["channels"].append({"sampler": len(anim["samplers"]) - 1,
-                                 "target": {"node": j, "path": "translation"}})
-    anims = [anim]
-    return g.document(nodes, [mesh], list(range(len(nodes))), skins=skins, animations=anims)
+    g.animation([(j, "translation", [0.0, 1.0], [(0, 0, 0), (1, 0, 0)]) for j in joints[1:]],
+                name="slide")
+    return g
 
 
 def skin_slide():
@@ -270,29 +203,25 @@ def skin_no_ibm():
 
 
 def skin_shared():
-    doc = _skin_quad()
-    doc["nodes"].append({"name": "quad2", "mesh": 0, "skin": 1})
-    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
-    doc["skins"].append({"name": "swapped", "joints": [3, 2],
-                         "inverseBindMatrices": doc["skins"][0]["inverseBindMatrices"]})
-    return doc
+    g = _skin_quad()
+    g.node("quad2", mesh=0, skin=1)
+    g.skins.append({"name": "swapped", "joints": [3, 2],
+                    "inverseBindMatrices": g.skins[0]["inverseBindMatrices"]})
+    return g
 
 
 def _static_skin(positions, indices, joints, weights, targets=None, mesh_weights=None):
     """A static mesh on joints [root, mover] (nodes 2, 3), identity inverse bind matrices."""
-    g = _Gltf()
-    attrs = {"POSITION": g.accessor(FLOAT, positions, minmax=True),
-             "NORMAL": g.accessor(FLOAT, [(0, 0, 1)] * len(positions)),
-             "JOINTS_0": g.accessor(UBYTE, joints), "WEIGHTS_0": g.accessor(FLOAT, weights)}
-    prim = {"attributes": attrs, "indices": g.accessor(USHORT, indices), "material": 0}
-    mesh = {"name": "quad", "primitives": [prim]}
+    g = _gltf()
+    prim = g.primitive(positions, indices, 0, [(0, 0, 1)] * len(positions))
+    prim["attributes"]["JOINTS_0"] = g.accessor(UBYTE, joints)
+    prim["attributes"]["WEIGHTS_0"] = g.accessor(FLOAT, weights)
     if targets:
         prim["targets"] = [{"POSITION": g.accessor(FLOAT, t, minmax=True)} for t in targets]
-        mesh["weights"] = mesh_weights
-    nodes = [_camera_node(), {"name": "quad", "mesh": 0, "skin": 0}, {"name": "root"},
-             {"name": "mover"}]
-    skins = [{"joints": [2, 3], "inverseBindMatrices": g.accessor(FLOAT, [IDENTITY] * 2)}]
-    return g.document(nodes, [mesh], [0, 1, 2, 3], skins=skins)
+    g.node("quad", mesh=g.mesh("quad", [prim], weights=mesh_weights if targets else None), skin=0)
+    g.skins.append({"joints": [g.node("root"), g.node("mover")],
+                    "inverseBindMatrices": g.accessor(FLOAT, [IDENTITY] * 2)})
+    return g
 
 
 def skin_unnormalized():
@@ -321,6 +250,16 @@ def bad_weights_zero():
     return _skin_quad(zero_weights=True)
 
 
+def _bent_skeleton(g, mesh):
+    """Nodes: 1 the skinned mesh, 2 j0 (static), 3 j1 (its child at (1, 0, 0), turning about +Z
+    by 0, 45, 90 degrees at t = 0, 0.5, 1); the skin; the turn's animation."""
+    g.node(g.meshes[mesh]["name"], mesh=mesh, skin=0)
+    j0 = g.node("j0", children=[3])
+    j1 = g.node("j1", root=False, translation=[1, 0, 0])
+    g.skins.append({"joints": [j0, j1], "inverseBindMatrices": g.accessor(FLOAT, [IDENTITY, SHIFTED])})
+    g.animation([(j1, "rotation", *_turning())], name="rotation_3")
+
+
 # ---- a bending cylinder ----
 
 CYL_RINGS, CYL_SEGMENTS, CYL_RADIUS, CYL_LENGTH = 17, 12, 0.1, 2.0
@@ -332,7 +271,7 @@ def _cyl_weight_j1(x):
 
 
 def bend_cylinder():
-    g = _Gltf()
+    g = _gltf(camera_at=(1, 0.5, 4))
     pos, nrm, idx = [], [], []
     for i in range(CYL_RINGS):
         x = CYL_LENGTH * i / (CYL_RINGS - 1)
@@ -361,23 +300,13 @@ def bend_cylinder():
         w1 = _cyl_weight_j1(p[0])
         joints.append((0, 1, 0, 0))
         weights.append((1.0 - w1, w1, 0.0, 0.0))
-    attrs = {"POSITION": g.accessor(FLOAT, pos, minmax=True), "NORMAL": g.accessor(FLOAT, nrm),
-             "JOINTS_0": g.accessor(UBYTE, joints), "WEIGHTS_0": g.accessor(FLOAT, weights)}
-    mesh = {"name": "cylinder",
-            "primitives": [{"attributes": attrs, "indices": g.accessor(USHORT, idx),
-                            "material": 0}]}
-    ibm = [IDENTITY, (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1)]
+    prim = g.primitive(pos, idx, 0, nrm)
+    prim["attributes"]["JOINTS_0"] = g.accessor(UBYTE, joints)
+    prim["attributes"]["WEIGHTS_0"] = g.accessor(FLOAT, weights)
     # nodes: 0 camera, 1 cylinder, 2 j0, 3 j1 (child of j0)
-    nodes = [_camera_node((1, 0.5, 4)), {"name": "cylinder", "mesh": 0, "skin": 0},
-             {"name": "j0", "children": [3]}, {"name": "j1", "translation": [1, 0, 0]}]
-    skins = [{"name": "cylinder_skin", "joints": [2, 3], "skeleton": 2,
-              "inverseBindMatrices": g.accessor(FLOAT, ibm)}]
-    rot = []
-    for deg in (0, 45, 90):
-        h = math.radians(deg) / 2
-        rot.append((0.0, 0.0, math.sin(h), math.cos(h)))  # glTF quaternions are x, y, z, w
-    anims = [_linear_channel(g, 3, "rotation", [0.0, 0.5, 1.0], rot)]
-    return g.document(nodes, [mesh], [0, 1, 2], skins=skins, animations=anims)
+    _bent_skeleton(g, g.mesh("cylinder", [prim]))
+    g.skins[0].update(name="cylinder_skin", skeleton=2)
+    return g
 
 
 def _arm_part(g, x0, x1, rings, segments, shift, skin_weights):
@@ -398,11 +327,11 @@ def _arm_part(g, x0, x1, rings, segments, shift, skin_weights):
         for j in range(segments):
             a, b = i * segments + j, i * segments + (j + 1) % segments
             idx += [a, b, b + segments, a, b + segments, a + segments]
-    attrs = {"POSITION": g.accessor(FLOAT, pos, minmax=True), "NORMAL": g.accessor(FLOAT, nrm)}
+    prim = g.primitive(pos, idx, 0, nrm, index_type=UINT)
     if skin_weights:
-        attrs["JOINTS_0"] = g.accessor(UBYTE, joints)
-        attrs["WEIGHTS_0"] = g.accessor(FLOAT, weights)
-    return {"attributes": attrs, "indices": g.accessor(UINT, idx), "material": 0}
+        prim["attributes"]["JOINTS_0"] = g.accessor(UBYTE, joints)
+        prim["attributes"]["WEIGHTS_0"] = g.accessor(FLOAT, weights)
+    return prim
 
 
 def bench_arm(skinned=True, rings=401, segments=64):
@@ -411,39 +340,22 @@ def bench_arm(skinned=True, rings=401, segments=64):
     one mesh on joints j0, j1 (the bend over x in [0.95, 1.05]); else its rigid twin, the same
     triangles as two meshes, the outer one on the turning node. 2 (rings - 1) segments
     triangles either way."""
-    g = _Gltf()
-    rot = []
-    for deg in (0, 45, 90):
-        h = math.radians(deg) / 2
-        rot.append((0.0, 0.0, math.sin(h), math.cos(h)))
+    g = _gltf(camera_at=(1, 0.8, 6), material={"name": "grey", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.6, 0.6, 0.6, 1], "metallicFactor": 0, "roughnessFactor": 1}})
     half = rings // 2 + 1
     if skinned:
         prim = _arm_part(g, 0.0, 2.0, rings, segments, 0.0,
                          lambda x: min(1.0, max(0.0, (x - 0.95) / 0.1)))
-        meshes = [{"name": "arm", "primitives": [prim]}]
-        nodes = [_camera_node((1, 0.8, 6)), {"name": "arm", "mesh": 0, "skin": 0},
-                 {"name": "j0", "children": [3]}, {"name": "j1", "translation": [1, 0, 0]}]
-        ibm = [IDENTITY, (1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1)]
-        skins = [{"joints": [2, 3], "inverseBindMatrices": g.accessor(FLOAT, ibm)}]
-        roots = [0, 1, 2, 4]
+        _bent_skeleton(g, g.mesh("arm", [prim]))
     else:
         inner = _arm_part(g, 0.0, 1.0, half, segments, 0.0, None)
         outer = _arm_part(g, 1.0, 2.0, rings - half + 1, segments, 1.0, None)
-        meshes = [{"name": "upper", "primitives": [inner]}, {"name": "fore", "primitives": [outer]}]
-        nodes = [_camera_node((1, 0.8, 6)), {"name": "upper", "mesh": 0},
-                 {"name": "j0", "children": [3]}, {"name": "j1", "translation": [1, 0, 0], "mesh": 1}]
-        skins = None
-        roots = [0, 1, 2, 4]
-    nodes.append({"name": "light", "translation": [1, 3, 4],
-                  "extensions": {"KHR_lights_punctual": {"light": 0}}})
-    anims = [_linear_channel(g, 3, "rotation", [0.0, 0.5, 1.0], rot)]
-    doc = g.document(nodes, meshes, roots, skins=skins, animations=anims)
-    doc["materials"] = [{"name": "grey", "pbrMetallicRoughness": {
-        "baseColorFactor": [0.6, 0.6, 0.6, 1], "metallicFactor": 0, "roughnessFactor": 1}}]
-    doc["extensionsUsed"] = ["KHR_lights_punctual"]
-    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
-        {"type": "point", "color": [1, 1, 1], "intensity": 60}]}}
-    return doc
+        g.node("upper", mesh=g.mesh("upper", [inner]))
+        g.node("j0", children=[3])
+        j1 = g.node("j1", root=False, translation=[1, 0, 0], mesh=g.mesh("fore", [outer]))
+        g.animation([(j1, "rotation", *_turning())], name="rotation_3")
+    g.light("light", "point", 60, translation=[1, 3, 4])
+    return g
 
 
 ASSETS = {f.__name__: f for f in (morph_slide, skin_slide, skin_slide8, bend_cylinder,
@@ -455,30 +367,16 @@ BAD = ("bad_joint_index", "bad_ibm_count", "bad_morph_count", "bad_weights_zero"
 GLB_TOO = ("skin_no_ibm",)  # also written as NAME.glb
 
 
-def glb_bytes(doc):
-    """The document as a GLB: its one buffer becomes the BIN chunk."""
-    doc = json.loads(json.dumps(doc))
-    data = base64.b64decode(doc["buffers"][0].pop("uri").split(",", 1)[1])
-    text = json.dumps(doc).encode()
-    text += b" " * (-len(text) % 4)
-    data += b"\0" * (-len(data) % 4)
-    return (struct.pack("<4sII", b"glTF", 2, 28 + len(text) + len(data)) +
-            struct.pack("<I4s", len(text), b"JSON") + text +
-            struct.pack("<I4s", len(data), b"BIN\0") + data)
-
-
 def write_all(outdir):
     """Writes every asset as outdir/NAME.gltf (and NAME.glb for GLB_TOO); returns {name: path}
     of the .gltf files."""
     os.makedirs(outdir, exist_ok=True)
     paths = {}
     for name, make in ASSETS.items():
-        paths[name] = os.path.join(outdir, name + ".gltf")
-        with open(paths[name], "w") as f:
-            json.dump(make(), f, indent=1)
+        g = make()
+        paths[name] = g.write(os.path.join(outdir, name + ".gltf"), indent=1)
         if name in GLB_TOO:
-            with open(os.path.join(outdir, name + ".glb"), "wb") as f:
-                f.write(glb_bytes(make()))
+            g.write(os.path.join(outdir, name + ".glb"))
     return paths
 
 
@@ -486,10 +384,7 @@ if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--bench":  # the benchmark pair (docs/benchmarks.md)
         os.makedirs(sys.argv[2], exist_ok=True)
         for name, skinned in (("bench_arm_skinned", True), ("bench_arm_rigid", False)):
-            path = os.path.join(sys.argv[2], name + ".gltf")
-            with open(path, "w") as f:
-                json.dump(bench_arm(skinned), f)
-            print(path)
+            print(bench_arm(skinned).write(os.path.join(sys.argv[2], name + ".gltf")))
     elif len(sys.argv) == 2:
         for path in write_all(sys.argv[1]).values():
             print(path)

@@ -1,5 +1,4 @@
 """Shared helpers for the Python tests: run the evray binary, load its outputs."""
-import base64
 import json
 import os
 import struct
@@ -7,6 +6,8 @@ import subprocess
 import sys
 import shutil
 import tempfile
+
+import gltf_build  # tests/, beside this file
 
 EVRAY = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("EVRAY", "build/evray")
 failures = []
@@ -129,90 +130,34 @@ def boundary_share(npy, segments, duration):
 
 def quad_gltf(path, with_triangles=True, animated=False):
     """A lit grey quad facing +Z seen by a camera at z = 3; optionally moving."""
-    pos = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
-    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
-    times = struct.pack("<2f", 0.0, 1.0)
-    trans = struct.pack("<6f", 0, 0, 0, 0.5, 0, 0)
-    blob = pos + idx + times + trans
-    g = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0, 1]}],
-        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 3]}, {"name": "quad"}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
-        "buffers": [{"byteLength": len(blob),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
-                        {"buffer": 0, "byteOffset": 48, "byteLength": 12},
-                        {"buffer": 0, "byteOffset": 60, "byteLength": 8},
-                        {"buffer": 0, "byteOffset": 68, "byteLength": 24}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-                       "min": [-1, -1, 0], "max": [1, 1, 0]},
-                      {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
-                      {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
-                      {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"}],
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],
-        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
-    }
+    g = gltf_build.Gltf()
+    g.camera("cam", yfov=0.8, translation=[0, 0, 3])
+    grey = g.material({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})
     if with_triangles:
-        g["nodes"][1]["mesh"] = 0
+        pos, _, _, idx = gltf_build.rect(-1, 1, -1, 1, 0)
+        quad = g.node("quad", mesh=g.mesh("quad", [g.primitive(pos, idx, grey)]))
     else:
-        del g["meshes"]
+        quad = g.node("quad")
     if animated:
-        g["animations"] = [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
-                            "samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}]}]
-    with open(path, "w") as f:
-        json.dump(g, f)
+        g.animation([(quad, "translation", [0.0, 1.0], [(0, 0, 0), (0.5, 0, 0)])])
+    g.write(path)
 
 
 def clips_gltf(path, clips):
     """Two lit grey quads facing +Z, "a" at x = -1.2 and "b" at x = +1.2 (0.8 wide), seen by a
     camera at z = 6, and animation clips: clips is a list of (name, channels), each channel
     (node name, path, key times, flat values) with path translation or scale."""
-    blob = b""
-    views, accessors = [], []
-
-    def accessor(fmt_count, values, typ, extra=None):
-        nonlocal blob
-        data = struct.pack("<%d%s" % (len(values), fmt_count), *values)
-        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
-        blob += data + b"\0" * (-len(data) % 4)
-        a = {"bufferView": len(views) - 1, "componentType": 5126 if fmt_count == "f" else 5123,
-             "count": len(values) // {"SCALAR": 1, "VEC3": 3}[typ], "type": typ}
-        a.update(extra or {})
-        accessors.append(a)
-        return len(accessors) - 1
-
-    pos = accessor("f", [-0.4, -0.4, 0, 0.4, -0.4, 0, 0.4, 0.4, 0, -0.4, 0.4, 0], "VEC3",
-                   {"min": [-0.4, -0.4, 0], "max": [0.4, 0.4, 0]})
-    idx = accessor("H", [0, 1, 2, 0, 2, 3], "SCALAR")
-    names = {"a": 1, "b": 2}
-    animations = []
+    g = gltf_build.Gltf()
+    g.camera("cam", yfov=0.8, translation=[0, 0, 6])
+    grey = g.material({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})
+    pos, _, _, idx = gltf_build.rect(-0.4, 0.4, -0.4, 0.4, 0)
+    quad = g.mesh("quad", [g.primitive(pos, idx, grey)])
+    names = {"a": g.node("a", mesh=quad, translation=[-1.2, 0, 0]),
+             "b": g.node("b", mesh=quad, translation=[1.2, 0, 0])}
     for name, channels in clips:
-        samplers, chans = [], []
-        for node, prop, times, values in channels:
-            t = accessor("f", times, "SCALAR", {"min": [min(times)], "max": [max(times)]})
-            samplers.append({"input": t, "output": accessor("f", values, "VEC3"), "interpolation": "LINEAR"})
-            chans.append({"sampler": len(samplers) - 1, "target": {"node": names[node], "path": prop}})
-        animations.append({"name": name, "samplers": samplers, "channels": chans})
-    g = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0, 1, 2]}],
-        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 6]},
-                  {"name": "a", "mesh": 0, "translation": [-1.2, 0, 0]},
-                  {"name": "b", "mesh": 0, "translation": [1.2, 0, 0]}],
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
-        "buffers": [{"byteLength": len(blob),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-        "bufferViews": views,
-        "accessors": accessors,
-        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],
-        "meshes": [{"name": "quad", "primitives": [{"attributes": {"POSITION": pos}, "indices": idx, "material": 0}]}],
-        "animations": animations,
-    }
-    with open(path, "w") as f:
-        json.dump(g, f)
+        g.animation([(names[node], prop, times, values) for node, prop, times, values in channels],
+                    name=name)
+    g.write(path)
 
 
 def read_pfm(path):

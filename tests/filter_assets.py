@@ -1,7 +1,7 @@
 """glTF test scenes for the hit filters (src/core/hit_filter.h): alpha MASK cut-outs and
 single-sided surfaces, with geometry simple enough that the tests know every pixel.
 
-Standard library only (the PNG written with zlib). `python3 tests/filter_assets.py OUTDIR` writes
+Standard library only, written through tests/gltf_build.py. `python3 tests/filter_assets.py OUTDIR` writes
 every scene as OUTDIR/NAME.gltf.
 
 Common to all: a camera node at the origin looking along -Z, perspective with yfov = 2 atan(0.5)
@@ -27,27 +27,11 @@ uv (0, 0) at its top-left corner (u = x + 0.5, v = 0.5 - y).
   mixed          mask_checker's card, mask_moving's card's translation, and cull_back's card
                  behind it at z = -3 offset by (0.6, 0.4): the CPU-vs-CUDA scene
 """
-import base64
-import json
 import math
 import os
-import struct
 import sys
-import zlib
 
-FLOAT, UINT = 5126, 5125
-
-
-def png_rgba(width, height, pixels):
-    """An 8-bit RGBA PNG of pixels (rows top to bottom, (r, g, b, a) tuples)."""
-    raw = b"".join(b"\x00" + bytes(c for p in pixels[y * width:(y + 1) * width] for c in p)
-                   for y in range(height))
-
-    def chunk(kind, data):
-        return (struct.pack(">I", len(data)) + kind + data +
-                struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)) +
-            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+import gltf_build as B
 
 
 def checker_alpha(col, row):
@@ -56,53 +40,25 @@ def checker_alpha(col, row):
 
 
 def checker_png():
-    return png_rgba(4, 4, [(255, 255, 255, 255 * checker_alpha(c, r)) for r in range(4) for c in range(4)])
+    return B.png_bytes(4, 4, [(255, 255, 255, 255 * checker_alpha(c, r))
+                              for r in range(4) for c in range(4)])
 
 
 def half_png():
-    return png_rgba(8, 1, [(255, 255, 255, 255 if c >= 4 else 0) for c in range(8)])
+    return B.png_bytes(8, 1, [(255, 255, 255, 255 if c >= 4 else 0) for c in range(8)])
 
 
-class _Doc:
+class _Doc(B.Gltf):
+    """A scene with the common camera and sun; textures sampled linearly."""
+
     def __init__(self):
-        self.data = bytearray()
-        self.g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": []}], "nodes": [],
-                  "meshes": [], "materials": [], "accessors": [], "bufferViews": [], "images": [],
-                  "textures": [], "samplers": [{"magFilter": 9729, "minFilter": 9729}],
-                  "cameras": [{"type": "perspective", "perspective": {
-                      "yfov": 2 * math.atan(0.5), "aspectRatio": 1.0, "znear": 0.01}}],
-                  "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
-                  "extensions": {"KHR_lights_punctual": {"lights": [
-                      {"type": "directional", "intensity": math.pi, "color": [1, 1, 1]}]}}}
-        self.node("camera", camera=0)
-        self.node("sun", extensions={"KHR_lights_punctual": {"light": 0}})
-
-    def accessor(self, ctype, rows, minmax=False):
-        dim = len(rows[0])
-        fmt = "f" if ctype == FLOAT else "I"
-        while len(self.data) % 4:
-            self.data.append(0)
-        off = len(self.data)
-        for r in rows:
-            self.data += struct.pack("<" + fmt * dim, *r)
-        self.g["bufferViews"].append({"buffer": 0, "byteOffset": off, "byteLength": len(self.data) - off})
-        a = {"bufferView": len(self.g["bufferViews"]) - 1, "componentType": ctype, "count": len(rows),
-             "type": {1: "SCALAR", 2: "VEC2", 3: "VEC3"}[dim]}
-        if minmax:
-            a["min"] = [min(r[i] for r in rows) for i in range(dim)]
-            a["max"] = [max(r[i] for r in rows) for i in range(dim)]
-        self.g["accessors"].append(a)
-        return len(self.g["accessors"]) - 1
-
-    def node(self, name, **kw):
-        self.g["nodes"].append(dict(name=name, **kw))
-        self.g["scenes"][0]["nodes"].append(len(self.g["nodes"]) - 1)
-        return len(self.g["nodes"]) - 1
+        super().__init__()
+        self.linear = self.sampler(magFilter=B.LINEAR, minFilter=B.LINEAR)
+        self.camera()
+        self.light("sun", "directional", math.pi)
 
     def texture(self, png):
-        self.g["images"].append({"uri": "data:image/png;base64," + base64.b64encode(png).decode()})
-        self.g["textures"].append({"source": len(self.g["images"]) - 1, "sampler": 0})
-        return len(self.g["textures"]) - 1
+        return super().texture(self.image(png), sampler=self.linear)
 
     def material(self, name, base=(0, 0, 0, 1), emissive=(0, 0, 0), texture=None, mask=False,
                  double_sided=False):
@@ -118,40 +74,19 @@ class _Doc:
             m["alphaCutoff"] = 0.5
         if double_sided:
             m["doubleSided"] = True
-        self.g["materials"].append(m)
-        return len(self.g["materials"]) - 1
+        return super().material(m)
 
     def quad(self, name, x0, x1, y0, y1, z, material, towards_camera=True, **node):
         """A quad in the plane z, uv (0, 0) at its top-left corner; its front (counter-clockwise)
         faces +Z (the camera) or, with towards_camera False, -Z."""
-        pos = [(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)]
-        uv = [(0, 1), (1, 1), (1, 0), (0, 0)]
-        idx = [(0, 1, 2), (0, 2, 3)] if towards_camera else [(0, 2, 1), (0, 3, 2)]
-        nz = 1.0 if towards_camera else -1.0
-        prim = {"attributes": {"POSITION": self.accessor(FLOAT, pos, minmax=True),
-                               "NORMAL": self.accessor(FLOAT, [(0, 0, nz)] * 4),
-                               "TEXCOORD_0": self.accessor(FLOAT, uv)},
-                "indices": self.accessor(UINT, [(i,) for t in idx for i in t]), "material": material}
-        self.g["meshes"].append({"name": name, "primitives": [prim]})
-        return self.node(name, mesh=len(self.g["meshes"]) - 1, **node)
+        pos, nrm, uv, idx = B.rect(x0, x1, y0, y1, z, facing=1 if towards_camera else -1)
+        return self.mesh_node(name, pos, nrm, uv, idx, material, index_type=B.UINT, **node)
 
     def translate_x(self, node, dx):
         """Animates node's translation from its own to +dx in x over t in [0, 1], LINEAR."""
-        t0 = self.g["nodes"][node].get("translation", [0, 0, 0])
-        times = self.accessor(FLOAT, [(0.0,), (1.0,)], minmax=True)
-        vals = self.accessor(FLOAT, [tuple(t0), (t0[0] + dx, t0[1], t0[2])])
-        self.g["nodes"][node]["translation"] = list(t0)
-        self.g.setdefault("animations", []).append({
-            "name": "slide", "samplers": [{"input": times, "output": vals, "interpolation": "LINEAR"}],
-            "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}]})
-
-    def finish(self):
-        self.g["buffers"] = [{"byteLength": len(self.data), "uri": "data:application/octet-stream;base64," +
-                              base64.b64encode(bytes(self.data)).decode()}]
-        for k in ("images", "textures"):
-            if not self.g[k]:
-                del self.g[k]
-        return self.g
+        t0 = self.nodes[node].setdefault("translation", [0, 0, 0])
+        self.animation([(node, "translation", [0.0, 1.0], [tuple(t0), (t0[0] + dx, t0[1], t0[2])])],
+                       name="slide")
 
 
 def _base():
@@ -164,34 +99,34 @@ def mask_checker():
     d = _base()
     d.quad("card", -0.5, 0.5, -0.5, 0.5, -2,
            d.material("cutout", emissive=(0.3, 0.3, 0.3), texture=d.texture(checker_png()), mask=True))
-    return d.finish()
+    return d
 
 
 def cull_front():
     d = _base()
     d.quad("card", -0.5, 0.5, -0.5, 0.5, -2, d.material("one_sided", emissive=(0.3, 0.3, 0.3)))
-    return d.finish()
+    return d
 
 
 def cull_back():
     d = _base()
     d.quad("card", -0.5, 0.5, -0.5, 0.5, -2, d.material("one_sided", emissive=(0.3, 0.3, 0.3)),
            towards_camera=False)
-    return d.finish()
+    return d
 
 
 def both_back():
     d = _base()
     d.quad("card", -0.5, 0.5, -0.5, 0.5, -2,
            d.material("two_sided", emissive=(0.3, 0.3, 0.3), double_sided=True), towards_camera=False)
-    return d.finish()
+    return d
 
 
 def cull_mirrored():
     d = _base()
     d.quad("card", -0.5, 0.5, -0.5, 0.5, -2, d.material("one_sided", emissive=(0.3, 0.3, 0.3)),
            towards_camera=False, scale=[-1, 1, 1])
-    return d.finish()
+    return d
 
 
 def mask_moving():
@@ -199,7 +134,7 @@ def mask_moving():
     card = d.quad("card", -0.5, 0.5, -0.5, 0.5, -2,
                   d.material("cutout", emissive=(0.3, 0.3, 0.3), texture=d.texture(half_png()), mask=True))
     d.translate_x(card, 0.25)
-    return d.finish()
+    return d
 
 
 def mixed():
@@ -209,7 +144,7 @@ def mixed():
     d.translate_x(card, 0.25)
     d.quad("back", -0.5, 0.5, -0.5, 0.5, 0, d.material("one_sided", emissive=(0.3, 0.3, 0.3)),
            towards_camera=False, translation=[0.6, 0.4, -3])
-    return d.finish()
+    return d
 
 
 ASSETS = {f.__name__: f for f in (mask_checker, cull_front, cull_back, both_back, cull_mirrored, mask_moving,
@@ -219,12 +154,7 @@ ASSETS = {f.__name__: f for f in (mask_checker, cull_front, cull_back, both_back
 def write_all(outdir):
     """Writes every scene as outdir/NAME.gltf; returns {name: path}."""
     os.makedirs(outdir, exist_ok=True)
-    paths = {}
-    for name, f in ASSETS.items():
-        paths[name] = os.path.join(outdir, name + ".gltf")
-        with open(paths[name], "w") as fh:
-            json.dump(f(), fh)
-    return paths
+    return {name: f().write(os.path.join(outdir, name + ".gltf")) for name, f in ASSETS.items()}
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """glTF test assets for materials (issue 21): every property evray reads, with known ground truth.
 
-Standard library only (runs with /usr/bin/python3): PNG images are written by hand with zlib and
-embedded, like the buffer, as base64 data: URIs. Each asset is a function NAME(outdir) that writes
+Standard library only (runs with /usr/bin/python3), written through tests/gltf_build.py: PNG
+images and the buffer embedded as base64 data: URIs. Each asset is a function NAME(outdir) that writes
 OUTDIR/NAME.gltf and returns its path; `python3 tests/material_assets.py OUTDIR` writes them all.
 
 Common to all (unless an asset says otherwise): a camera node "camera" at the origin looking along
@@ -61,6 +61,11 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
                      seen through the slab, the edge appears at x = +0.038763 on the backdrop
                      (the ray aimed there lands on x = 0), about 0.74 degrees right of the image
                      centre's column; other rays: the same formula with their own incidence angle.
+  glint_sphere       a UV sphere "ball" (radius 0.4, centre (0, 0, -1.5), 160 segments x 80 rings),
+                     material "tear_film": a smooth black dielectric (base (0,0,0), metallic 0,
+                     roughness 0.05); the lamp at (0.6, 0.35, 0), intensity 10, extras radius
+                     0.01 (a sphere light): its highlight lies at the point whose normal halves
+                     the directions to the camera and the lamp.
   emissive_texture   quad, material "glow_checker": base (0,0,0,1), emissiveFactor (1, 1, 1),
                      KHR_materials_emissive_strength 5, emissiveTexture "checker" (4x4 cells of
                      0.25 x 0.25: white where (column + row) is even, the top-left cell white):
@@ -101,37 +106,14 @@ upright, its left half on the left of the view (x < 0). Pixel values below are 8
   bad_texture        quad, material "bad_texture": baseColorTexture index 7, the file has one
                      texture (an error).
 """
-import base64
-import json
 import math
 import os
-import struct
 import sys
-import zlib
 
-FLOAT, USHORT = 5126, 5123
-_FMT = {FLOAT: "f", USHORT: "H"}
-_TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
+import gltf_build as B
+from gltf_build import png_bytes
 
-YFOV = 2 * math.atan(0.5)
-
-
-def png_bytes(width, height, pixels, channels=4):
-    """An 8-bit PNG (colour type 6 RGBA or 2 RGB) of pixels: rows top first, each texel a tuple
-    of `channels` ints in [0, 255]."""
-    raw = bytearray()
-    for y in range(height):
-        raw.append(0)  # filter: none
-        for x in range(width):
-            raw += bytes(pixels[y * width + x])
-
-    def chunk(tag, data):
-        return (struct.pack(">I", len(data)) + tag + data +
-                struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF))
-
-    ihdr = struct.pack(">IIBBBBB", width, height, 8, 6 if channels == 4 else 2, 0, 0, 0)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) +
-            chunk(b"IDAT", zlib.compress(bytes(raw), 9)) + chunk(b"IEND", b""))
+YFOV = B.YFOV
 
 
 def _solid(rgb, n=2):
@@ -152,128 +134,40 @@ IMAGES = {
 }
 
 
-class Gltf:
-    """Accumulates one buffer, its views and accessors, images, textures, materials, meshes
-    and nodes, then writes the document."""
+class Gltf(B.Gltf):
+    """A document with the common camera (node 0) and lamp (node 1, a white point light of
+    `lamp` cd at lamp_at, radius lamp_radius), the images of IMAGES by name."""
 
-    def __init__(self):
-        self.data = bytearray()
-        self.views, self.accessors = [], []
-        self.images, self.textures, self.image_index = [], [], {}
-        self.samplers = []
-        self.materials, self.meshes = [], []
-        self.nodes = [{"name": "camera", "camera": 0},
-                      {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}}]
-        self.used = set()
-
-    def accessor(self, ctype, rows):
-        rows = [r if isinstance(r, (tuple, list)) else (r,) for r in rows]
-        flat = [x for r in rows for x in r]
-        raw = struct.pack("<%d%s" % (len(flat), _FMT[ctype]), *flat)
-        while len(self.data) % 4:
-            self.data.append(0)
-        self.views.append({"buffer": 0, "byteOffset": len(self.data), "byteLength": len(raw)})
-        self.data += raw
-        acc = {"bufferView": len(self.views) - 1, "componentType": ctype, "count": len(rows),
-               "type": _TYPES[len(rows[0])]}
-        if ctype == FLOAT and len(rows[0]) == 3:
-            acc["min"] = [min(r[i] for r in rows) for i in range(3)]
-            acc["max"] = [max(r[i] for r in rows) for i in range(3)]
-        self.accessors.append(acc)
-        return len(self.accessors) - 1
+    def __init__(self, lamp=1.0, lamp_at=None, lamp_radius=None):
+        super().__init__("evray tests/material_assets.py")
+        self.camera()
+        self.light("lamp", "point", lamp, radius=lamp_radius,
+                   **({"translation": lamp_at} if lamp_at else {}))
+        self.image_index = {}
 
     def texture(self, image):
         """The texture index of a named image of IMAGES (one texture per image)."""
         if image not in self.image_index:
-            self.images.append({"name": image, "uri": "data:image/png;base64," +
-                                base64.b64encode(IMAGES[image]()).decode("ascii")})
-            self.textures.append({"source": len(self.images) - 1})
-            self.image_index[image] = len(self.textures) - 1
+            source = self.image(IMAGES[image](), name=image)
+            self.image_index[image] = super().texture(source)
         return self.image_index[image]
 
     def clamped_texture(self, image):
         """A second texture of a named image, sampled with CLAMP_TO_EDGE in u and v."""
-        self.texture(image)
+        source = self.textures[self.texture(image)]["source"]
         if not self.samplers:
-            self.samplers.append({"wrapS": 33071, "wrapT": 33071})
-        self.textures.append({"source": self.textures[self.image_index[image]]["source"],
-                              "sampler": 0})
-        return len(self.textures) - 1
-
-    def material(self, mat):
-        for ext in mat.get("extensions", {}):
-            self.used.add(ext)
-        self.materials.append(mat)
-        return len(self.materials) - 1
-
-    def mesh(self, name, positions, normals, uvs, indices, material, tangents=None, uvs1=None,
-             translation=None, rotation=None):
-        attrs = {"POSITION": self.accessor(FLOAT, positions),
-                 "NORMAL": self.accessor(FLOAT, normals)}
-        if uvs is not None:
-            attrs["TEXCOORD_0"] = self.accessor(FLOAT, uvs)
-        if uvs1 is not None:
-            attrs["TEXCOORD_1"] = self.accessor(FLOAT, uvs1)
-        if tangents is not None:
-            attrs["TANGENT"] = self.accessor(FLOAT, tangents)
-        self.meshes.append({"name": name, "primitives": [{
-            "attributes": attrs, "indices": self.accessor(USHORT, indices),
-            "material": material}]})
-        node = {"name": name, "mesh": len(self.meshes) - 1}
-        if translation:
-            node["translation"] = list(translation)
-        if rotation:
-            node["rotation"] = list(rotation)
-        self.nodes.append(node)
+            self.sampler(wrapS=B.CLAMP_TO_EDGE, wrapT=B.CLAMP_TO_EDGE)
+        return super().texture(source, sampler=0)
 
     def write(self, outdir, name, extra_used=()):
-        while len(self.data) % 4:
-            self.data.append(0)
-        used = sorted(self.used | {"KHR_lights_punctual"} | set(extra_used))
-        doc = {
-            "asset": {"version": "2.0", "generator": "evray tests/material_assets.py"},
-            "extensionsUsed": used,
-            "extensions": {"KHR_lights_punctual": {"lights": [
-                {"name": "lamp", "type": "point", "color": [1, 1, 1], "intensity": 1}]}},
-            "scene": 0,
-            "scenes": [{"nodes": list(range(len(self.nodes)))}],
-            "nodes": self.nodes,
-            "meshes": self.meshes,
-            "materials": self.materials,
-            "cameras": [{"type": "perspective",
-                         "perspective": {"yfov": YFOV, "aspectRatio": 1.0, "znear": 0.01}}],
-            "accessors": self.accessors,
-            "bufferViews": self.views,
-            "buffers": [{"byteLength": len(self.data),
-                         "uri": "data:application/octet-stream;base64," +
-                                base64.b64encode(bytes(self.data)).decode("ascii")}],
-        }
-        if self.images:
-            doc["images"] = self.images
-            doc["textures"] = self.textures
-        if self.samplers:
-            doc["samplers"] = self.samplers
-        path = os.path.join(outdir, name + ".gltf")
-        with open(path, "w") as f:
-            json.dump(doc, f, indent=1)
-        return path
-
-
-def _rect(x0, x1, y0, y1, z, mirrored=False):
-    """A rectangle facing +Z: positions, normals, uvs (u across x, v down y; mirrored: u flips),
-    indices (counter-clockwise seen from +Z)."""
-    pos = [(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)]
-    uv = []
-    for x, y, _ in pos:
-        u = (x - x0) / (x1 - x0)
-        uv.append((1 - u if mirrored else u, (y1 - y) / (y1 - y0)))
-    return pos, [(0, 0, 1)] * 4, uv, [0, 1, 2, 0, 2, 3]
+        self.used |= set(extra_used)
+        return super().write(os.path.join(outdir, name + ".gltf"), indent=1)
 
 
 def _quad(g, name, material, **kw):
     mirrored = kw.pop("mirrored", False)
-    pos, nrm, uv, idx = _rect(-0.5, 0.5, -0.5, 0.5, -1.0, mirrored)
-    g.mesh(name, pos, nrm, uv, idx, material, **kw)
+    pos, nrm, uv, idx = B.rect(-0.5, 0.5, -0.5, 0.5, -1.0, mirrored)
+    g.mesh_node(name, pos, nrm, uv, idx, material, **kw)
 
 
 def _tex(g, image, **kw):
@@ -310,8 +204,8 @@ def colour_spaces(outdir):
     b = g.material({"name": "grey_data",
                     "pbrMetallicRoughness": {"metallicRoughnessTexture": _tex(g, "grey")}})
     for name, mat, x0, x1 in (("left", a, -0.5, 0.0), ("right", b, 0.0, 0.5)):
-        pos, nrm, uv, idx = _rect(x0, x1, -0.5, 0.5, -1.0)
-        g.mesh(name, pos, nrm, uv, idx, mat)
+        pos, nrm, uv, idx = B.rect(x0, x1, -0.5, 0.5, -1.0)
+        g.mesh_node(name, pos, nrm, uv, idx, mat)
     return g.write(outdir, "colour_spaces")
 
 
@@ -321,20 +215,19 @@ def texture_transform(outdir):
                                     "texCoord": 1}}
     m = g.material({"name": "xf", "pbrMetallicRoughness": {
         "baseColorTexture": _tex(g, "quadrants", texCoord=0, extensions=xf)}})
-    g.used.add("KHR_texture_transform")
     mixed = g.material({"name": "mixed_uv",
                         "pbrMetallicRoughness": {"baseColorTexture": _tex(g, "quadrants")},
                         "normalTexture": _tex(g, "tilt", texCoord=1)})
-    pos, nrm, uv, idx = _rect(-0.5, 0.5, -0.5, 0.5, -1.0)
-    g.mesh("quad", pos, nrm, uv, idx, m, uvs1=[(u / 2, v / 2) for u, v in uv])
-    pos, nrm, uv, idx = _rect(-1, 1, -1, 1, -3.0)
-    g.mesh("mixed", pos, nrm, uv, idx, mixed, uvs1=[(u / 2, v / 2) for u, v in uv])
+    pos, nrm, uv, idx = B.rect(-0.5, 0.5, -0.5, 0.5, -1.0)
+    g.mesh_node("quad", pos, nrm, uv, idx, m, uvs1=[(u / 2, v / 2) for u, v in uv])
+    pos, nrm, uv, idx = B.rect(-1, 1, -1, 1, -3.0)
+    g.mesh_node("mixed", pos, nrm, uv, idx, mixed, uvs1=[(u / 2, v / 2) for u, v in uv])
     return g.write(outdir, "texture_transform")
 
 
 def _backdrop(g, material, z=-2.0, half=1.0, name="backdrop"):
-    pos, nrm, uv, idx = _rect(-half, half, -half, half, z)
-    g.mesh(name, pos, nrm, uv, idx, material)
+    pos, nrm, uv, idx = B.rect(-half, half, -half, half, z)
+    g.mesh_node(name, pos, nrm, uv, idx, material)
 
 
 def alpha_mask_card(outdir):
@@ -361,22 +254,6 @@ def alpha_blend_card(outdir):
     return g.write(outdir, "alpha_blend_card")
 
 
-def _box(x0, x1, y0, y1, z0, z1):
-    """An axis-aligned box with flat faces (4 vertices each, outward normals)."""
-    pos, nrm, uv, idx = [], [], [], []
-    c = [(x, y, z) for z in (z0, z1) for y in (y0, y1) for x in (x0, x1)]
-    faces = [((0, 2, 3, 1), (0, 0, -1)), ((4, 5, 7, 6), (0, 0, 1)), ((0, 1, 5, 4), (0, -1, 0)),
-             ((2, 6, 7, 3), (0, 1, 0)), ((0, 4, 6, 2), (-1, 0, 0)), ((1, 3, 7, 5), (1, 0, 0))]
-    for corners, n in faces:
-        base = len(pos)
-        for k, ci in enumerate(corners):
-            pos.append(c[ci])
-            nrm.append(n)
-            uv.append(((0, 1, 1, 0)[k], (0, 0, 1, 1)[k]))
-        idx += [base, base + 1, base + 2, base, base + 2, base + 3]
-    return pos, nrm, uv, idx
-
-
 def transmission_slab(outdir):
     g = Gltf()
     glass = g.material({
@@ -394,13 +271,12 @@ def transmission_slab(outdir):
                                                                 "metallicFactor": 0}})
     lit = g.material({"name": "lit", "emissiveFactor": [1, 1, 1], "pbrMetallicRoughness": {
         "baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}})
-    pos, nrm, uv, idx = _box(-1, 1, -1, 1, -0.1, 0.1)
-    h = math.radians(30) / 2
-    g.mesh("slab", pos, nrm, uv, idx, glass, translation=(0, 0, -1.1),
-           rotation=(0, math.sin(h), 0, math.cos(h)))
+    pos, nrm, uv, idx = B.box(-1, 1, -1, 1, -0.1, 0.1)
+    g.mesh_node("slab", pos, nrm, uv, idx, glass, translation=(0, 0, -1.1),
+                rotation=B.quaternion((0, 1, 0), 30))
     for name, mat, x0, x1 in (("left", dark, -3, 0), ("right", lit, 0, 3)):
-        pos, nrm, uv, idx = _rect(x0, x1, -3, 3, -3.0)
-        g.mesh(name, pos, nrm, uv, idx, mat)
+        pos, nrm, uv, idx = B.rect(x0, x1, -3, 3, -3.0)
+        g.mesh_node(name, pos, nrm, uv, idx, mat)
     return g.write(outdir, "transmission_slab")
 
 
@@ -444,40 +320,28 @@ def normal_plane_mirrored_tangents(outdir):
     return g.write(outdir, "normal_plane_mirrored_tangents")
 
 
-def sphere(radius=0.4, segments=24, rings=12):
-    """A UV sphere about the origin: u = segment / segments, v = ring / rings, the vertex at
-    r (sin(th) sin(ph), cos(th), sin(th) cos(ph)) with ph = 2 pi u, th = pi v (u = 0 faces +z,
-    v = 0 is the north pole +Y). The seam column is duplicated (u = 0 and 1)."""
-    pos, nrm, uv, idx = [], [], [], []
-    for j in range(rings + 1):
-        th = math.pi * j / rings
-        for i in range(segments + 1):
-            ph = 2 * math.pi * i / segments
-            n = (math.sin(th) * math.sin(ph), math.cos(th), math.sin(th) * math.cos(ph))
-            pos.append(tuple(radius * c for c in n))
-            nrm.append(n)
-            uv.append((i / segments, j / rings))
-    w = segments + 1
-    for j in range(rings):
-        for i in range(segments):
-            a, b, c, d = j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i
-            if j > 0:
-                idx += [a, d, b]
-            if j < rings - 1:
-                idx += [b, d, c]
-    return pos, nrm, uv, idx
+GLINT_CENTRE, GLINT_RADIUS, GLINT_LAMP = (0.0, 0.0, -1.5), 0.4, (0.6, 0.35, 0.0)
+
+
+def glint_sphere(outdir):
+    g = Gltf(lamp=10.0, lamp_at=GLINT_LAMP, lamp_radius=0.01)
+    black = g.material({"name": "tear_film", "pbrMetallicRoughness": {
+        "baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 0.05}})
+    pos, nrm, uv, idx = B.uv_sphere(radius=GLINT_RADIUS, segments=160, rings=80)
+    g.mesh_node("ball", pos, nrm, uv, idx, black, translation=GLINT_CENTRE)
+    return g.write(outdir, "glint_sphere")
 
 
 def normal_sphere(outdir):
     g = Gltf()
-    pos, nrm, uv, idx = sphere()
-    g.mesh("ball", pos, nrm, uv, idx, _bumpy(g), translation=(0, 0, -1.5))
+    pos, nrm, uv, idx = B.uv_sphere()
+    g.mesh_node("ball", pos, nrm, uv, idx, _bumpy(g), translation=(0, 0, -1.5))
     return g.write(outdir, "normal_sphere")
 
 
 def warped_sphere():
-    """sphere() with its uvs warped: (u + 0.15 sin(2 pi v), v + 0.1 sin(2 pi u))."""
-    pos, nrm, uv, idx = sphere()
+    """B.uv_sphere() with its uvs warped: (u + 0.15 sin(2 pi v), v + 0.1 sin(2 pi u))."""
+    pos, nrm, uv, idx = B.uv_sphere()
     uv = [(u + 0.15 * math.sin(2 * math.pi * v), v + 0.1 * math.sin(2 * math.pi * u))
           for u, v in uv]
     return pos, nrm, uv, idx
@@ -486,7 +350,7 @@ def warped_sphere():
 def normal_warped(outdir):
     g = Gltf()
     pos, nrm, uv, idx = warped_sphere()
-    g.mesh("ball", pos, nrm, uv, idx, _bumpy(g), translation=(0, 0, -1.5))
+    g.mesh_node("ball", pos, nrm, uv, idx, _bumpy(g), translation=(0, 0, -1.5))
     return g.write(outdir, "normal_warped")
 
 
@@ -503,10 +367,10 @@ def unsupported(outdir):
     clamped = g.material({"name": "clamped", "pbrMetallicRoughness": {
         "baseColorTexture": {"index": g.clamped_texture("quadrants")}}})
     _quad(g, "quad", coated)
-    pos, nrm, uv, idx = _rect(-1, 1, -1, 1, -3.0)
-    g.mesh("back", pos, nrm, uv, idx, vol)
-    pos, nrm, uv, idx = _rect(-2, 2, -2, 2, -5.0)
-    g.mesh("far", pos, nrm, uv, idx, clamped)
+    pos, nrm, uv, idx = B.rect(-1, 1, -1, 1, -3.0)
+    g.mesh_node("back", pos, nrm, uv, idx, vol)
+    pos, nrm, uv, idx = B.rect(-2, 2, -2, 2, -5.0)
+    g.mesh_node("far", pos, nrm, uv, idx, clamped)
     return g.write(outdir, "unsupported", extra_used=["KHR_materials_iridescence"])
 
 
@@ -537,7 +401,7 @@ def bad_texture(outdir):
 
 
 ASSETS = [slots, colour_spaces, texture_transform, alpha_mask_card, alpha_blend_card,
-          transmission_slab, emissive_texture, normal_plane_tangents, normal_plane,
+          transmission_slab, glint_sphere, emissive_texture, normal_plane_tangents, normal_plane,
           normal_plane_mirrored, normal_plane_mirrored_tangents, normal_sphere,
           normal_warped, unsupported, bad_ior, bad_factor, bad_cutoff,
           bad_texture]

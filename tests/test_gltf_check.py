@@ -3,20 +3,12 @@ with every material field the writer can give (texture slots with KHR_texture_tr
 the KHR_materials extensions), a TANGENT attribute and a light with a radius passes; each of a
 list of single mistakes is reported."""
 import copy
-import json
 import os
 import struct
 
 import evrtest as T
+import gltf_build
 import gltf_check
-
-
-def glb(doc, binary):
-    j = json.dumps(doc).encode()
-    j += b" " * (-len(j) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    body = struct.pack("<I4s", len(j), b"JSON") + j + struct.pack("<I4s", len(binary), b"BIN\0") + binary
-    return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
 
 
 pos = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
@@ -71,7 +63,7 @@ tmp = T.tmpdir()
 def problems(doc, bin_=binary):
     path = os.path.join(tmp, "check.glb")
     with open(path, "wb") as f:
-        f.write(glb(doc, bin_))
+        f.write(gltf_build.glb_bytes(doc, bin_))
     return gltf_check.check(path)[1]
 
 

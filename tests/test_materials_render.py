@@ -9,7 +9,6 @@ origin looking along -Z, yfov 2 atan(0.5), a point lamp at the origin unless mov
   - an emissive texture shows its checker pattern at radiance 5 (strength 5);
   - a normal-mapped plane shades exactly as a plane whose normals are the mapped normal;
   - an alpha-masked card's cut-out matches its texture."""
-import json
 import math
 import os
 import sys
@@ -17,6 +16,7 @@ import sys
 import evrtest as T
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_build as B  # noqa: E402
 import material_assets as MA  # noqa: E402
 
 TMP = T.tmpdir()
@@ -103,20 +103,8 @@ T.check(abs(expected - straight) > 2.0, "the offset is more than two pixels (the
 
 # ---- a glint at the half-vector point ----
 RES = 160
-g = MA.Gltf()
-black = g.material({"name": "tear_film", "pbrMetallicRoughness": {
-    "baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 0.05}})
-pos, nrm, uv, idx = MA.sphere(radius=0.4, segments=160, rings=80)
-CENTRE, RADIUS, LAMP = (0.0, 0.0, -1.5), 0.4, (0.6, 0.35, 0.0)
-g.mesh("ball", pos, nrm, uv, idx, black, translation=CENTRE)
-g.nodes[1]["translation"] = list(LAMP)
-path = g.write(TMP, "glint")
-with open(path) as f:
-    doc = json.load(f)
-doc["extensions"]["KHR_lights_punctual"]["lights"][0]["extras"] = {"radius": 0.01}
-doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = 10.0
-with open(path, "w") as f:
-    json.dump(doc, f)
+CENTRE, RADIUS, LAMP = MA.GLINT_CENTRE, MA.GLINT_RADIUS, MA.GLINT_LAMP
+path = MA.glint_sphere(TMP)
 img = still(path, "glint", RES)
 peak = max(max(r) for r in img)
 sx = sy = sw = 0.0
@@ -170,8 +158,8 @@ g = MA.Gltf()
 flat = g.material({"name": "tilted", "pbrMetallicRoughness": {"metallicFactor": 0,
                                                               "roughnessFactor": 0.5}})
 n8 = norm(tuple(v / 255 * 2 - 1 for v in (173, 189, 230)))
-pos, _, uv, idx = MA._rect(-0.5, 0.5, -0.5, 0.5, -1.0)
-g.mesh("quad", pos, [n8] * 4, uv, idx, flat)
+pos, _, uv, idx = B.rect(-0.5, 0.5, -0.5, 0.5, -1.0)
+g.mesh_node("quad", pos, [n8] * 4, uv, idx, flat)
 tilted = still(g.write(TMP, "tilted"), "tilted", RES)
 worst = max(abs(a - b) / max(b, 1e-6) for ra, rb in zip(mapped, tilted) for a, b in zip(ra, rb))
 print(f"normal map: largest relative difference to the tilted plane {worst:.2e}")

@@ -11,13 +11,10 @@ pixel spans about 12 texels, a step between samples about a twentieth of a texel
   events over the 0.5 s.
 - coarse (checks of 48 texels, 4 pixels): resolved by the pixels, the same motion makes many
   events: the scene's motion is real, the fine texture's silence is the filtering's."""
-import base64
-import json
 import os
-import struct
-import zlib
 
 import evrtest as T
+import gltf_build as B
 
 W = H = 48
 TEX = 1024
@@ -25,64 +22,24 @@ TEX = 1024
 
 def png_grey(path, n, value):
     """An 8-bit greyscale n x n PNG with pixel (x, y) = value(x, y)."""
-    rows = b"".join(b"\0" + bytes(value(x, y) for x in range(n)) for y in range(n))
-
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
     with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", n, n, 8, 0, 0, 0, 0))
-                + chunk(b"IDAT", zlib.compress(rows, 9)) + chunk(b"IEND", b""))
+        f.write(B.png_bytes(n, n, [value(x, y) for y in range(n) for x in range(n)], channels=1))
 
 
 def plane_gltf(path, texture):
     """The sliding plane with texture (a PNG beside it) or, texture None, base colour 0.5."""
-    pos = struct.pack("<12f", -3, -3, 0, 3, -3, 0, 3, 3, 0, -3, 3, 0)
-    nrm = struct.pack("<12f", *([0, 0, 1] * 4))
-    uv = struct.pack("<8f", 0, 1, 1, 1, 1, 0, 0, 0)
-    idx = struct.pack("<6H", 0, 1, 2, 0, 2, 3) + b"\0\0"
-    times = struct.pack("<2f", 0.0, 1.0)
-    trans = struct.pack("<6f", 0, 0, 0, 0.1, 0, 0)
-    parts = [pos, nrm, uv, idx, times, trans]
-    views, blob = [], b""
-    for p in parts:
-        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(p)})
-        blob += p
+    g = B.Gltf()
+    g.camera("cam", yfov=0.8, translation=[0, 0, 4])
     # a matte dielectric (Lambert: no specular layer), whose intensity is its base colour's
-    mat = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.0},
-           "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}
-    g = {
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0, 1, 2]}],
-        "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 4]},
-                  {"name": "plane", "mesh": 0},
-                  {"name": "sun", "extensions": {"KHR_lights_punctual": {"light": 0}},
-                   "rotation": [-0.2588190, 0, 0, 0.9659258]}],
-        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_specular"],
-        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "directional", "intensity": 3.0}]}},
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.0, "znear": 0.01}}],
-        "buffers": [{"byteLength": len(blob),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-        "bufferViews": views,
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-                       "min": [-3, -3, 0], "max": [3, 3, 0]},
-                      {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-                      {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-                      {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"},
-                      {"bufferView": 4, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
-                      {"bufferView": 5, "componentType": 5126, "count": 2, "type": "VEC3"}],
-        "materials": [mat],
-        "meshes": [{"name": "plane", "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
-                                                     "indices": 3, "material": 0}]}],
-        "animations": [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
-                        "samplers": [{"input": 4, "output": 5, "interpolation": "LINEAR"}]}],
-    }
+    pbr = {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.0}
     if texture:
-        mat["pbrMetallicRoughness"] = {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}
-        g["textures"] = [{"source": 0}]
-        g["images"] = [{"uri": texture}]
-    with open(path, "w") as f:
-        json.dump(g, f)
+        pbr = {"baseColorTexture": {"index": g.texture(g.image(uri=texture))}, "metallicFactor": 0.0}
+    mat = g.material({"pbrMetallicRoughness": pbr,
+                      "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}})
+    plane = g.mesh_node("plane", *B.rect(-3, 3, -3, 3, 0), mat)
+    g.light("sun", "directional", 3.0, rotation=[-0.2588190, 0, 0, 0.9659258])
+    g.animation([(plane, "translation", [0.0, 1.0], [(0, 0, 0), (0.1, 0, 0)])])
+    g.write(path)
 
 
 def events(scene, name):
