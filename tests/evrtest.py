@@ -173,6 +173,41 @@ def read_pfm(path):
     return w, h, px
 
 
+def pfm_rows(path):
+    """A PFM image as rows top to bottom, each a list of (r, g, b)."""
+    w, h, px = read_pfm(path)
+    return [[tuple(px[3 * (r * w + c):3 * (r * w + c) + 3]) for c in range(w)]
+            for r in reversed(range(h))]
+
+
+def luminance(rgb):
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+
+
+def glint_point(centre, radius, light):
+    """The point of a sphere whose normal halves the directions to the camera (at the origin)
+    and to a point light: where a smooth sphere shows the light's glint (fixed-point iteration)."""
+    def unit(v):
+        n = sum(x * x for x in v) ** 0.5
+        return tuple(x / n for x in v)
+    p = (centre[0], centre[1], centre[2] + radius)
+    for _ in range(200):
+        h = unit(tuple(a + b for a, b in zip(unit(tuple(-x for x in p)),
+                                             unit(tuple(l - x for l, x in zip(light, p))))))
+        p = tuple(c + radius * x for c, x in zip(centre, h))
+    return p
+
+
+def bright_centroid(values):
+    """values: {(column, row): luminance}; the luminance-weighted centre (pixel centres at + 0.5)
+    of those above half the largest, and the largest."""
+    peak = max(values.values())
+    bright = [(c, r, v) for (c, r), v in values.items() if v > 0.5 * peak]
+    w = sum(v for _, _, v in bright)
+    return (sum((c + 0.5) * v for c, _, v in bright) / w,
+            sum((r + 0.5) * v for _, r, v in bright) / w, peak)
+
+
 def deform_assets(tmp):
     """The moving deforming test scenes (skins and morph targets) that tests/deform_assets.py
     writes into a folder under tmp (`deform_assets.py DIR`), those `evray info` reads: their

@@ -4,7 +4,8 @@ compare); with adaptive sampling within 2% and F1 >= 0.97, and the same samples 
 the deforming test scenes (skins and morph targets, tests/deform_assets.py, where the importer
 reads them) likewise, uniformly and adaptively, and with global illumination (F1 >= 0.95); and
 on a scene of hits a material rules out (tests/filter_assets.py's "mixed": an alpha-masked card
-and a single-sided card seen from behind) likewise. Skipped (exit 77)
+and a single-sided card seen from behind) likewise; and on the scene with every material feature
+(tests/all_materials.py: glint, glass, MASK, BLEND, emission, normal map, culling) likewise. Skipped (exit 77)
 where this build has no CUDA backend or no GPU is usable."""
 import json
 import os
@@ -49,6 +50,16 @@ mixed = filter_assets.write_all(os.path.join(tmp, "filter-assets"))["mixed"]
 cases.append((mixed, ["--res", "160x120", "--duration", "1.0"]))
 cases.append((mixed, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
 cases.append((mixed, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+# every material feature at once (tests/all_materials.py: a gold mirror sphere with the glint of a
+# sphere light, a glass slab with volume attenuation over a checker, alpha MASK and BLEND cards,
+# an emissive texture, a normal map, a single-sided quad seen from behind; things move, the lamp
+# from t = 0.5 on). The adaptive run stops at 0.5 s, before the lamp moves (while a light moves,
+# adaptive sampling samples every pixel every --min-dt), and so does the GI run (to be short).
+import all_materials  # noqa: E402
+every = all_materials.write(os.path.join(tmp, "all-materials"))
+cases.append((every, ["--res", "160x120", "--duration", "1.0"]))
+cases.append((every, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
+cases.append((every, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)

@@ -26,14 +26,7 @@ HALF = 0.5  # tan(yfov / 2)
 def still(scene, name, res):
     pfm = os.path.join(TMP, name + ".pfm")
     T.run("still", scene, "--res", f"{res}x{res}", "--threads", 2, "-o", pfm)
-    w, h, px = T.read_pfm(pfm)
-    # luminance, rows top to bottom
-    lum = [[0.0] * w for _ in range(h)]
-    for r in range(h):
-        for c in range(w):
-            i = 3 * ((h - 1 - r) * w + c)
-            lum[r][c] = 0.2126 * px[i] + 0.7152 * px[i + 1] + 0.0722 * px[i + 2]
-    return lum
+    return [[T.luminance(p) for p in row] for row in T.pfm_rows(pfm)]
 
 
 def ray_dir(px, py, res):
@@ -106,21 +99,8 @@ RES = 160
 CENTRE, RADIUS, LAMP = MA.GLINT_CENTRE, MA.GLINT_RADIUS, MA.GLINT_LAMP
 path = MA.glint_sphere(TMP)
 img = still(path, "glint", RES)
-peak = max(max(r) for r in img)
-sx = sy = sw = 0.0
-for r in range(RES):
-    for c in range(RES):
-        if img[r][c] > 0.5 * peak:
-            sx += (c + 0.5) * img[r][c]
-            sy += (r + 0.5) * img[r][c]
-            sw += img[r][c]
-gx, gy = sx / sw, sy / sw
-# the point whose normal halves the directions to the camera and the lamp
-p = (CENTRE[0], CENTRE[1], CENTRE[2] + RADIUS)
-for _ in range(200):
-    h = norm(tuple(a + b for a, b in zip(norm(tuple(-x for x in p)),
-                                         norm(tuple(l - x for l, x in zip(LAMP, p))))))
-    p = tuple(c + RADIUS * x for c, x in zip(CENTRE, h))
+gx, gy, peak = T.bright_centroid({(c, r): img[r][c] for r in range(RES) for c in range(RES)})
+p = T.glint_point(CENTRE, RADIUS, LAMP)
 ex, ey = (p[0] / -p[2] / HALF + 1) * RES / 2, (1 - p[1] / -p[2] / HALF) * RES / 2
 print(f"glint: at ({gx:.2f}, {gy:.2f}), analytic ({ex:.2f}, {ey:.2f}), peak {peak:.3g}")
 T.check(math.hypot(gx - ex, gy - ey) <= 1.0, "the glint lies at the analytic half-vector point")

@@ -1,7 +1,8 @@
 """Change-driven sampling gives exactly the events of brute force (--no-skip): every built-in scene
 and the moving square, ideal sensor and the davis346 noise model, the deforming test scenes
 (skins and morph targets, tests/deform_assets.py, where the importer reads them), a scene of
-hits a material rules out (tests/filter_assets.py's "mixed"), on the CPU and
+hits a material rules out (tests/filter_assets.py's "mixed"), the scene with every material
+feature (tests/all_materials.py), on the CPU and
 (where a GPU is usable) on CUDA; and it really skips: run.json accounts for the samples traced
 and the pixels skipped per segment."""
 import os
@@ -37,6 +38,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import filter_assets  # noqa: E402
 mixed = filter_assets.write_all(os.path.join(tmp, "filter-assets"))["mixed"]
 cases.append((mixed, ["--res", "64x48", "--duration", "1.0"]))
+# every material feature at once (tests/all_materials.py): a pixel depends on every ray of its
+# path (reflected, refracted, BLEND layers, each vertex's shadow rays); the lamp holds still until
+# t = 0.5, so pixels that see nothing moving skip until then
+import all_materials  # noqa: E402
+every = all_materials.write(os.path.join(tmp, "all-materials"))
+cases.append((every, ["--res", "64x48", "--duration", "1.0"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}
@@ -65,6 +72,8 @@ for backend in backends:
         T.check(ss["samples_traced"] <= untouched, f"{backend} {scene}: traced + skipped samples <= all samples")
         if scene in ("square", "cornell"):
             T.check(ss["samples_traced"] < untouched, f"{backend} {scene}: pixels settle after their first sample")
+        if scene == every:
+            T.check(ss["pixels_skipped"] > 0, f"{backend} all materials: pixels skip while the lamp holds still")
         if scene in ("square", "cornell"):   # a small mover on a still background
             T.check(ss["samples_traced"] < 0.5 * ss["samples"], f"{backend} {scene}: most samples skipped")
             T.check(ss["rays"] < sb["rays"], f"{backend} {scene}: fewer rays")
