@@ -41,9 +41,8 @@ import os
 import sys
 
 import gltf_build as B
-import material_assets as MA
 
-ASPECT = 4 / 3
+YFOV, ASPECT = B.YFOV, 4 / 3
 ROW_Y, COL_X, Z = 0.7, 1.3, -3.0
 CARD = 0.4            # half size of the cards and panels
 SPHERE_R = 0.4
@@ -93,7 +92,7 @@ def _card(g, name, x, y, material, z=Z, **node):
 
 def build():
     g = B.Gltf("evray tests/all_materials.py")
-    g.camera(yfov=MA.YFOV, aspect=ASPECT)
+    g.camera(yfov=YFOV, aspect=ASPECT)
     lamp = g.light("lamp", "point", 30.0, radius=0.05, translation=list(LAMP_FROM))
     checker = g.texture(g.image(checker_png(), name="checker"))
     cutout = g.texture(g.image(checker_png(alpha=True), name="checker_alpha"))
@@ -170,7 +169,7 @@ def write(outdir):
 def project(p, width, height):
     """The image position (column, row from the top, in pixels) of the point p (camera space)
     at width x height."""
-    half_h = math.tan(MA.YFOV / 2)
+    half_h = math.tan(YFOV / 2)
     x, y = p[0] / -p[2] / (half_h * ASPECT), p[1] / -p[2] / half_h
     return (x + 1) * width / 2, (1 - y) * height / 2
 

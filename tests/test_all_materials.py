@@ -50,7 +50,7 @@ def lamp_through(p, z):
 centre = (-AM.COL_X, AM.ROW_Y, AM.Z)
 ex, ey = AM.project(T.glint_point(centre, AM.SPHERE_R, AM.LAMP_FROM), W, H)
 c0, r0 = AM.project(centre, W, H)
-rad = AM.SPHERE_R / -centre[2] / math.tan(AM.MA.YFOV / 2) * H / 2 * 0.9  # inside the disc
+rad = AM.SPHERE_R / -centre[2] / math.tan(AM.YFOV / 2) * H / 2 * 0.9  # inside the disc
 lums = {(c, r): T.luminance(img[r][c]) for r in range(H) for c in range(W)
         if math.hypot(c + 0.5 - c0, r + 0.5 - r0) < rad}
 gx, gy, peak = T.bright_centroid(lums)
