@@ -11,6 +11,7 @@
 #define EVR_CORE_PATH_H
 
 #include "core/shade_hit.h"
+#include "core/skip.h"
 
 /* A ray of a pixel's path still to follow. */
 typedef struct {
@@ -103,16 +104,24 @@ EVR_HD static inline void evr_path_shade(const evr_render_scene *rs, const evr_s
 
 /* Follows the rays on the stack to the end: each one's closest hit shaded with its lights
  * (their shadow rays through evr_shadow_pass) and its own continuations; a ray that meets
- * nothing sees the ambient environment. *rays counts every ray. */
+ * nothing sees the ambient environment. *rays counts every ray. With a skip plan pl, *deep gains
+ * EVR_DEEP_MOVED when a ray, or the segment from its hit to a light, meets anything that moves
+ * in the segment (without one it gains it anyway). */
 EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr_occlusion *o,
-                                          float f, evr_path_stack *st, unsigned *rays, float out[3])
+                                          float f, const evr_skip_plan *pl, evr_path_stack *st,
+                                          unsigned *rays, int *deep, float out[3])
 {
+    if (!pl) *deep |= EVR_DEEP_MOVED;
     while (st->n > 0) {
         const evr_path_ray pr = st->r[--st->n];
         evr_hit h;
         float w[3] = {pr.w[0], pr.w[1], pr.w[2]};
         (*rays)++;
-        if (!evr_closest(o, pr.ray, pr.tnear, 1e30f, f, &h)) {
+        const int hit = evr_closest(o, pr.ray, pr.tnear, 1e30f, f, &h);
+        if (!(*deep & EVR_DEEP_MOVED) && pl->num_boxes > 0 &&
+            evr_skip_hit_ray_meets(pl, pr.ray, hit ? h.t : INFINITY))
+            *deep |= EVR_DEEP_MOVED;
+        if (!hit) {
             for (int c = 0; c < 3; c++) out[c] += w[c] * rs->ambient;
             continue;
         }
@@ -127,6 +136,8 @@ EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr
         const float cone = pr.cone + evr_camera_pixel_spread(&rs->camera) * h.t;
         evr_surface s;
         evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, f, pr.ray, h.t, cone, &s);
+        if (!(*deep & EVR_DEEP_MOVED) && pl->num_boxes > 0 && evr_skip_lights_meet(rs, pl, s.p))
+            *deep |= EVR_DEEP_MOVED;
         float acc[3];
         evr_shade_direct_sum(rs, &s, evr_v3_scale(pr.ray.dir, -1.0f), f, o, rays, acc);
         evr_path_shade(rs, &s, pr.ray.dir, acc, w, cone, pr.depth, pr.medium, st, out);
@@ -134,13 +145,14 @@ EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr
 }
 
 /* The radiance (RGB) of a camera ray along d whose hit s at distance t_hit has the lights' sum
- * acc, with every reflection and refraction its path takes; *deep is set when the path went
- * beyond the primary hit (change-driven sampling then treats the pixel as seeing the whole
- * scene). */
+ * acc, with every reflection and refraction its path takes; *deep gets EVR_DEEP_PATH when the
+ * path went beyond the primary hit, and EVR_DEEP_MOVED as evr_path_follow says (pl: the
+ * segment's skip plan, NULL: none). */
 EVR_HD static inline void evr_path_radiance(const evr_render_scene *rs, const evr_surface *s,
                                             evr_v3 d, float t_hit, const float acc[3],
-                                            struct evr_occlusion *o, float f, unsigned *rays,
-                                            int *deep, float out[3])
+                                            struct evr_occlusion *o, float f,
+                                            const evr_skip_plan *pl, unsigned *rays, int *deep,
+                                            float out[3])
 {
     const float w[3] = {1.0f, 1.0f, 1.0f};
     evr_path_stack st;
@@ -148,19 +160,19 @@ EVR_HD static inline void evr_path_radiance(const evr_render_scene *rs, const ev
     out[0] = out[1] = out[2] = 0.0f;
     evr_path_shade(rs, s, d, acc, w, evr_camera_pixel_spread(&rs->camera) * t_hit, 0, -1, &st, out);
     if (st.n > 0) {
-        *deep = 1;
-        evr_path_follow(rs, o, f, &st, rays, out);
+        *deep |= EVR_DEEP_PATH;
+        evr_path_follow(rs, o, f, pl, &st, rays, deep, out);
     }
 }
 
 /* The sensor intensity of the same: the luminance of evr_path_radiance. */
 EVR_HD static inline float evr_path_intensity(const evr_render_scene *rs, const evr_surface *s,
                                               evr_v3 d, float t_hit, const float acc[3],
-                                              struct evr_occlusion *o, float f, unsigned *rays,
-                                              int *deep)
+                                              struct evr_occlusion *o, float f,
+                                              const evr_skip_plan *pl, unsigned *rays, int *deep)
 {
     float out[3];
-    evr_path_radiance(rs, s, d, t_hit, acc, o, f, rays, deep, out);
+    evr_path_radiance(rs, s, d, t_hit, acc, o, f, pl, rays, deep, out);
     return evr_luminance(out[0], out[1], out[2]);
 }
 

@@ -137,20 +137,11 @@ EVR_HD static inline int evr_skip_ray_meets_any(const evr_skip_plan *pl, evr_v3 
     return 0;
 }
 
-/* Whether a sample's rays meet anything that moves: the primary ray up to its hit at distance
- * t_hit (INFINITY or more than 1e29: nothing hit, the whole ray) and, from the hit point computed
- * exactly as the shading computes it, the segment to every light that sends light there (the
- * lights do not move when this is asked: their position at time 0 is theirs). */
-EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const evr_skip_plan *pl,
-                                            evr_ray ray, float t_hit)
+/* Whether the segment from surface point p to a light that sends light there meets anything that
+ * moves (the lights do not move when this is asked: their position at time 0 is theirs). */
+EVR_HD static inline int evr_skip_lights_meet(const evr_render_scene *rs, const evr_skip_plan *pl,
+                                              evr_v3 p)
 {
-    if (pl->num_boxes == 0) return 0;
-    const int hit = t_hit < 1e29f;
-    /* a little past the hit: the surface itself may lie on a box's face */
-    if (evr_skip_ray_meets_any(pl, ray.org, ray.dir, hit ? t_hit * 1.0001f + pl->pad : INFINITY))
-        return 1;
-    if (!hit) return 0;
-    const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
     for (int l = 0; l < rs->num_lights; l++) {
         evr_v3 wi;
         float dist, e[3];
@@ -160,10 +151,39 @@ EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const ev
     return 0;
 }
 
+/* Whether the ray from its origin up to its hit at distance t_hit (INFINITY or more than 1e29:
+ * nothing hit, the whole ray) meets anything that moves. */
+EVR_HD static inline int evr_skip_hit_ray_meets(const evr_skip_plan *pl, evr_ray ray, float t_hit)
+{
+    /* a little past the hit: the surface itself may lie on a box's face */
+    return evr_skip_ray_meets_any(pl, ray.org, ray.dir,
+                                  t_hit < 1e29f ? t_hit * 1.0001f + pl->pad : INFINITY);
+}
+
+/* Whether a sample's rays meet anything that moves: the primary ray up to its hit at distance
+ * t_hit and, from the hit point computed exactly as the shading computes it, the segment to
+ * every light that sends light there. */
+EVR_HD static inline int evr_skip_rays_meet(const evr_render_scene *rs, const evr_skip_plan *pl,
+                                            evr_ray ray, float t_hit)
+{
+    if (pl->num_boxes == 0) return 0;
+    if (evr_skip_hit_ray_meets(pl, ray, t_hit)) return 1;
+    if (!(t_hit < 1e29f)) return 0;
+    return evr_skip_lights_meet(rs, pl, evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit)));
+}
+
+/* What a sample's path beyond its primary hit tells change-driven sampling (core/path.h sets
+ * it): EVR_DEEP_PATH when the path went on past the primary hit (a reflection, refraction or
+ * blended layer), with EVR_DEEP_MOVED when one of those rays, or a shadow ray from where it
+ * hit, meets anything that moves in the segment. */
+#define EVR_DEEP_PATH 1
+#define EVR_DEEP_MOVED 2
+
 /* The pixel's cache as stored in its state: the distance of its last traced sample's hit
  * (INFINITY: none) when clean, negative when not. EVR_SKIP_DEEP: clean, but its path went on
- * past the primary hit (core/path.h: a reflection, refraction or blended layer), whose rays
- * the cache does not keep: it may be reused only in a segment where nothing moves. */
+ * past the primary hit, whose rays the cache does not keep: it may be reused only in a segment
+ * where nothing moves (within its own segment, a deep sample whose rays all miss what moves
+ * settles like any other). */
 #define EVR_SKIP_DIRTY (-1.0f)
 #define EVR_SKIP_DEEP (-2.0f)
 
@@ -183,15 +203,16 @@ EVR_HD static inline int evr_skip_pixel(const evr_render_scene *rs, const evr_sk
 }
 
 /* The cache a traced pixel keeps: its last sample's hit distance if clean, else EVR_SKIP_DIRTY;
- * deep: the sample's path went past the primary hit (EVR_SKIP_DEEP when nothing moves). */
+ * deep: the sample's EVR_DEEP_* bits (EVR_SKIP_DEEP when clean). */
 EVR_HD static inline float evr_skip_cache_after_trace(const evr_render_scene *rs,
                                                       const evr_skip_plan *pl, evr_ray ray,
                                                       float t_hit, int deep)
 {
-    if (!pl->cache) return EVR_SKIP_DIRTY;
-    if (deep) return pl->num_boxes == 0 ? EVR_SKIP_DEEP : EVR_SKIP_DIRTY;
+    if (!pl->cache || (deep & EVR_DEEP_MOVED)) return EVR_SKIP_DIRTY;
+    if (deep && pl->num_boxes == 0) return EVR_SKIP_DEEP; /* t_hit may be EVR_SKIP_DEEP itself */
     const float d = t_hit < 1e29f ? t_hit : INFINITY;
-    return evr_skip_rays_meet(rs, pl, ray, d) ? EVR_SKIP_DIRTY : d;
+    if (evr_skip_rays_meet(rs, pl, ray, d)) return EVR_SKIP_DIRTY;
+    return deep ? EVR_SKIP_DEEP : d;
 }
 
 #endif

@@ -226,8 +226,8 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         struct evr_occlusion o = {b, rh.ray.time[i]};
         unsigned r1 = 0;
         int dp = 0;
-        out[i] =
-            evr_path_intensity(rs, &s[i], ray[i].dir, rh.ray.tfar[i], acc[i], &o, fs[i], &r1, &dp);
+        out[i] = evr_path_intensity(rs, &s[i], ray[i].dir, rh.ray.tfar[i], acc[i], &o, fs[i],
+                                    b->seg->skip->cache ? b->seg->skip : NULL, &r1, &dp);
         *rays += r1;
         if (deep) deep[i] = dp;
         if (direct) direct[i] = out[i];

@@ -192,7 +192,7 @@ static void shade_row(shade_ctx *c, int y)
             int deep = 0;
             occ.tr = &c->tr;
             evr_path_radiance(rs, &s, ray.dir, evr_v3_len(evr_v3_sub(s.p, ray.org)), acc, &occ,
-                              0.0f, &rays, &deep, dir);
+                              0.0f, NULL, &rays, &deep, dir);
         }
         for (k = 0; k < 3; k++) rgb[k] = dir[k];
         if (p->gi == EVR_GI_PHOTON) {

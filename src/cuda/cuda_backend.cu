@@ -43,7 +43,7 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
     int i;
     for (i = 0; i < s->num_meshes; i++) {
         const evr_mesh *m = &s->meshes[i];
-        nf += (size_t)m->num_vertices * (m->uvs ? 8 : 6);
+        nf += (size_t)m->num_vertices * (6 + (m->uvs ? 2 : 0) + (m->tangents ? 4 : 0));
         ni += (size_t)m->num_triangles * 3;
     }
     for (i = 0; i < s->num_textures; i++) /* every mip level */
@@ -80,6 +80,13 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
                            cudaMemcpyHostToDevice);
             mv[i].uvs = b->d_floats.p + of;
             of += nv * 2;
+        }
+        mv[i].tangents = NULL; /* a normal map's frames */
+        if (m->tangents && e == cudaSuccess) {
+            e = cudaMemcpy(b->d_floats.p + of, m->tangents, nv * 4 * sizeof(float),
+                           cudaMemcpyHostToDevice);
+            mv[i].tangents = b->d_floats.p + of;
+            of += nv * 4;
         }
         if (e == cudaSuccess)
             e = cudaMemcpy(b->d_indices.p + oi, m->indices,

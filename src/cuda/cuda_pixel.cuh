@@ -114,7 +114,8 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     float acc[3];
     int dp = 0;
     evr_shade_direct_sum(rs, s, evr_v3_scale(ray.dir, -1.0f), f, &occ, rays, acc);
-    *direct = evr_path_intensity(rs, s, ray.dir, *t_hit, acc, &occ, f, rays, &dp);
+    *direct = evr_path_intensity(rs, s, ray.dir, *t_hit, acc, &occ, f,
+                                 a.plan->cache ? a.plan : nullptr, rays, &dp);
     *deep = dp;
     return true;
 }
