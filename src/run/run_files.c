@@ -61,7 +61,7 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
         }
         sim->created_dir = 1;
     }
-    if (sim->cfg.preview_window > 0.0) {
+    if (sim->cfg.preview_window > 0.0 && sim->cfg.preview != EVR_PREVIEW_NONE) {
         if (path_join(p, sizeof p, sim->out_dir, "preview", err) != EVR_OK) return EVR_ERR_ARG;
         if (evr_mkdir_p(p) != 0) {
             snprintf(err->msg, sizeof err->msg, "cannot create %s: %s", p, strerror(errno));

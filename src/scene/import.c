@@ -128,7 +128,7 @@ evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...)
 void evr_import_warn(importer *im, const char *fmt, ...)
 {
     evr_scene *s = im->s;
-    char line[256], *p;
+    char line[512], *p;
     size_t have = s->warnings ? strlen(s->warnings) : 0, n;
     va_list ap;
     va_start(ap, fmt);
@@ -290,11 +290,14 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     uint64_t tris = 0;
     int i;
 
+    evr_error local;
     memset(&im, 0, sizeof im);
+    if (!err) err = &local; /* the steps read messages back (a texture's, for its warning) */
     s = calloc(1, sizeof *s);
     if (!s) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     im.ai = ai;
     im.s = s;
+    im.strict = opts->strict;
     im.err = err;
     evr_import_copy_name(im.dir, sizeof im.dir, dir);
     evr_import_copy_name(s->source, sizeof s->source, source);
@@ -333,6 +336,13 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_lights(&im)) != EVR_OK) goto fail;
+    if (opts->strict && s->num_warnings) {
+        const char *w = evr_scene_warnings(s);
+        int first = (int)strcspn(w, "\n");
+        st = evr_import_fail(err, EVR_ERR_FORMAT, "'%s' (strict): %.*s%s", source, first, w,
+                             s->num_warnings > 1 ? " (and more: evray info lists them)" : "");
+        goto fail;
+    }
     importer_free(&im);
     *out = s;
     return EVR_OK;

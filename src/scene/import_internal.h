@@ -154,6 +154,7 @@ typedef struct {
     unsigned char *clip_played;     /* per aiAnimation: 1 when its curves are imported (NULL:
                                        every clip plays) */
     name_index *by_name;            /* nodes sorted by Assimp name */
+    int strict;                     /* evr_load_options.strict: a warning is an error */
 } importer;
 
 /* ---- shared helpers (import.c) ---- */
