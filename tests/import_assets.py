@@ -3,14 +3,16 @@ meshes (KHR_mesh_quantization), GPU instancing (EXT_mesh_gpu_instancing) and KTX
 
 Standard library only (runs with /usr/bin/python3). Each asset is a function NAME(outdir) that
 writes OUTDIR/NAME.gltf (and any file beside it) and returns its path;
-`python3 tests/import_assets.py OUTDIR` writes them all.
+`python3 tests/import_assets.py OUTDIR` writes them all (with GLB copies of the quantized and
+instanced ones: to_glb).
 
 Common to all: a camera node "camera" at (0, 0, 2) looking along -Z, perspective with
 yfov = 2 atan(0.5) and aspect 1, so the plane z = 0 spans [-1, 1] in x and y and fills the view.
 No light: evray adds its headlight. A "unit quad" is two triangles in the plane z = 0 spanning
 x, y in [-0.5, 0.5] (its true size) with normal +Z: it covers the middle half of the view in x
-and y, a quarter of the image. Materials are unlit emissive white unless an asset says
-otherwise, so that a rendered pixel is 1 on the quad and 0 beside it.
+and y, a quarter of the image. Materials are unlit white unless an asset says
+otherwise, so that a rendered pixel is 1 on the quad and 0 beside it (KHR_materials_unlit with
+base colour 1).
 
   missing_texture      unit quad, material "painted": baseColorFactor (0.8, 0.2, 0.1, 1),
                        metallic 0, roughness 0.5, baseColorTexture -> image uri
@@ -50,8 +52,8 @@ BYTE, UBYTE, SHORT, USHORT, UINT, FLOAT = 5120, 5121, 5122, 5123, 5125, 5126
 _FMT = {BYTE: "b", UBYTE: "B", SHORT: "h", USHORT: "H", UINT: "I", FLOAT: "f"}
 _TYPES = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
 YFOV = 2 * math.atan(0.5)
-WHITE_GLOW = {"name": "glow", "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
-              "emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_unlit": {}}}
+WHITE = {"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]},
+         "extensions": {"KHR_materials_unlit": {}}}
 
 
 def png_bytes(width, height, rgb):
@@ -215,7 +217,7 @@ def quantized_short(outdir):
     m = g.mesh("quad", {"POSITION": g.accessor(SHORT, pos, normalized=True, minmax=True),
                         "NORMAL": g.accessor(BYTE, [(0, 0, 127)] * 4, normalized=True),
                         "TEXCOORD_0": g.accessor(USHORT, uv, normalized=True)},
-               QUAD_TRIS, g.material(WHITE_GLOW))
+               QUAD_TRIS, g.material(WHITE))
     g.nodes.append({"name": "quad", "mesh": m, "scale": [0.5, 0.5, 0.5]})
     return g.write(outdir, "quantized_short")
 
@@ -227,7 +229,7 @@ def quantized_byte(outdir):
     pos = [(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)]
     m = g.mesh("quad", {"POSITION": g.accessor(UBYTE, pos, minmax=True),
                         "NORMAL": g.accessor(SHORT, [(0, 0, 32767)] * 4, normalized=True)},
-               QUAD_TRIS, g.material(WHITE_GLOW))
+               QUAD_TRIS, g.material(WHITE))
     g.nodes.append({"name": "quad", "mesh": m, "translation": [-0.5, -0.5, 0],
                     "scale": [0.25, 0.25, 1]})
     return g.write(outdir, "quantized_byte")
@@ -273,13 +275,34 @@ def instanced(outdir):
     return g.write(outdir, "instanced")
 
 
+def to_glb(gltf_path):
+    """The same document as a GLB beside it (buffer 0 moved into the BIN chunk): its path."""
+    with open(gltf_path) as f:
+        doc = json.load(f)
+    uri = doc["buffers"][0].pop("uri")
+    data = base64.b64decode(uri.split(",", 1)[1])
+    data += b"\0" * (-len(data) % 4)
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    body = (struct.pack("<I", len(text)) + b"JSON" + text +
+            struct.pack("<I", len(data)) + b"BIN\0" + data)
+    path = gltf_path[:-5] + ".glb"
+    with open(path, "wb") as f:
+        f.write(b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body)
+    return path
+
+
 ASSETS = [missing_texture, unreadable_texture, missing_texture_obj, ktx2_texture,
           quantized_short, quantized_byte, instanced]
 
 
 def write_all(outdir):
+    """Every asset, and GLB copies of the quantized and instanced ones (NAME_glb)."""
     os.makedirs(outdir, exist_ok=True)
-    return {f.__name__: f(outdir) for f in ASSETS}
+    paths = {f.__name__: f(outdir) for f in ASSETS}
+    for name in ("quantized_short", "instanced"):
+        paths[name + "_glb"] = to_glb(paths[name])
+    return paths
 
 
 if __name__ == "__main__":

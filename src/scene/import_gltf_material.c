@@ -29,7 +29,8 @@ static const char *const rendered_ext[] = {"KHR_materials_emissive_strength",
                                            "KHR_materials_pbrSpecularGlossiness"};
 /* Extensions of the file (extensionsUsed) that evray or Assimp reads besides those. */
 static const char *const read_ext[] = {"KHR_texture_transform", "KHR_lights_punctual",
-                                       "KHR_mesh_quantization", "EXT_mesh_gpu_instancing"};
+                                       "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+                                       "KHR_draco_mesh_compression"};
 
 typedef struct {
     const evr_jdoc *d;
