@@ -39,6 +39,20 @@ base colour 1).
                        (0, 0, -1): the instances' centres span x, y in [-0.6, 0.6], z in
                        [-1.6, -0.4]; world bounds (-0.65, -0.65, -1.65) to (0.65, 0.65, -0.35).
                        No instance sits at the node's own origin alone: the grid is the scene.
+  odd_clip             unit quad "quad" (grey, lit) whose translation moves from (0, 0, 0) at
+                       t = 0 to (0.2, 0, 0) at t = 41/12 s (3.41666...: the float32 nearest),
+                       one LINEAR channel: a clip length that a rounded print would not give back.
+
+For previews (tests/test_preview.py, docs/img):
+  dark_stage           on a black background (nothing behind): a 3 x 3 x 3 grid "grid" of grey
+                       boxes (0.12 a side, pitch 0.3, EXT_mesh_gpu_instancing) at (0, 0.15, -0.5)
+                       turning about +Y by 90 degrees over 1 s (keys at 0, 0.5, 1 s); a static
+                       grey strip "strip" (x in [-0.9, 0.9], y in [-0.95, -0.75], z = 0); a
+                       bright emissive quad "flare" (0.3 x 0.3, emissive 1 times
+                       KHR_materials_emissive_strength 20) entering from the right: x = 2.0 at
+                       t <= 0.5 s, x = 0.7 at t = 1 s (y = -0.4, z = 0). Lit by evray's
+                       headlight. The strip's pixels never change; the flare brightens the
+                       frames after 0.5 s.
 """
 import base64
 import json
@@ -275,6 +289,78 @@ def instanced(outdir):
     return g.write(outdir, "instanced")
 
 
+def _grey(g):
+    return g.material({"name": "grey", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.6, 0.6, 0.6, 1], "metallicFactor": 0, "roughnessFactor": 0.8}})
+
+
+def _channel(g, node, path, times, values):
+    return ({"input": g.accessor(FLOAT, [(t,) for t in times], attribute=False, minmax=True),
+             "output": g.accessor(FLOAT, values, attribute=False), "interpolation": "LINEAR"},
+            {"sampler": None, "target": {"node": node, "path": path}})
+
+
+def _animations(g, channels):
+    samplers, chans = [], []
+    for sampler, chan in channels:
+        chan["sampler"] = len(samplers)
+        samplers.append(sampler)
+        chans.append(chan)
+    return [{"name": "motion", "samplers": samplers, "channels": chans}]
+
+
+def odd_clip(outdir):
+    g = Doc()
+    m = g.mesh("quad", {"POSITION": g.accessor(FLOAT, QUAD, minmax=True),
+                        "NORMAL": g.accessor(FLOAT, [(0, 0, 1)] * 4)}, QUAD_TRIS, _grey(g))
+    g.nodes.append({"name": "quad", "mesh": m})
+    anims = _animations(g, [_channel(g, 1, "translation", [0.0, 41 / 12], [(0, 0, 0), (0.2, 0, 0)])])
+    path = g.write(outdir, "odd_clip")
+    with open(path) as f:
+        doc = json.load(f)
+    doc["animations"] = anims
+    with open(path, "w") as f:
+        json.dump(doc, f, indent=1)
+    return path
+
+
+def dark_stage(outdir):
+    g = Doc()
+    g.used.add("EXT_mesh_gpu_instancing")
+    grey = _grey(g)
+    pos, nrm, idx = cube(0.06)
+    box = g.mesh("box", {"POSITION": g.accessor(FLOAT, pos, minmax=True),
+                         "NORMAL": g.accessor(FLOAT, nrm)}, idx, grey)
+    grid = [(0.3 * i - 0.3, 0.3 * j - 0.3, 0.3 * k - 0.3)
+            for i in range(3) for j in range(3) for k in range(3)]
+    inst = {"TRANSLATION": g.accessor(FLOAT, grid, attribute=False)}
+    g.nodes.append({"name": "grid", "mesh": box, "translation": [0, 0.15, -0.5],
+                    "extensions": {"EXT_mesh_gpu_instancing": {"attributes": inst}}})
+    strip = [(-0.9, -0.95, 0), (0.9, -0.95, 0), (0.9, -0.75, 0), (-0.9, -0.75, 0)]
+    m = g.mesh("strip", {"POSITION": g.accessor(FLOAT, strip, minmax=True),
+                         "NORMAL": g.accessor(FLOAT, [(0, 0, 1)] * 4)}, QUAD_TRIS, grey)
+    g.nodes.append({"name": "strip", "mesh": m})
+    flare = [(-0.15, -0.15, 0), (0.15, -0.15, 0), (0.15, 0.15, 0), (-0.15, 0.15, 0)]
+    glow = g.material({"name": "flare", "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+                       "emissiveFactor": [1, 1, 1],
+                       "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 20}}})
+    m = g.mesh("flare", {"POSITION": g.accessor(FLOAT, flare, minmax=True),
+                         "NORMAL": g.accessor(FLOAT, [(0, 0, 1)] * 4)}, QUAD_TRIS, glow)
+    g.nodes.append({"name": "flare", "mesh": m, "translation": [2.0, -0.4, 0]})
+    h = math.sqrt(0.5)
+    anims = _animations(g, [
+        _channel(g, 1, "rotation", [0.0, 0.5, 1.0],
+                 [(0, 0, 0, 1), (0, math.sin(math.pi / 8), 0, math.cos(math.pi / 8)), (0, h, 0, h)]),
+        _channel(g, 3, "translation", [0.0, 0.5, 1.0], [(2.0, -0.4, 0), (2.0, -0.4, 0), (0.7, -0.4, 0)])])
+    path = g.write(outdir, "dark_stage")
+    with open(path) as f:
+        doc = json.load(f)
+    doc["animations"] = anims
+    with open(path, "w") as f:
+        json.dump(doc, f, indent=1)
+    return path
+
+
 def to_glb(gltf_path):
     """The same document as a GLB beside it (buffer 0 moved into the BIN chunk): its path."""
     with open(gltf_path) as f:
@@ -293,7 +379,7 @@ def to_glb(gltf_path):
 
 
 ASSETS = [missing_texture, unreadable_texture, missing_texture_obj, ktx2_texture,
-          quantized_short, quantized_byte, instanced]
+          quantized_short, quantized_byte, instanced, odd_clip, dark_stage]
 
 
 def write_all(outdir):
