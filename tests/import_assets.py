@@ -45,7 +45,7 @@ base colour 1).
 
 For previews (tests/test_preview.py, docs/img):
   dark_stage           on a black background (nothing behind): a 3 x 3 x 3 grid "grid" of grey
-                       boxes (0.12 a side, pitch 0.3, EXT_mesh_gpu_instancing) at (0, 0.15, -0.5)
+                       boxes (0.2 a side, pitch 0.3, EXT_mesh_gpu_instancing) at (0, 0.15, -0.5)
                        turning about +Y by 90 degrees over 1 s (keys at 0, 0.5, 1 s); a static
                        grey strip "strip" (x in [-0.9, 0.9], y in [-0.95, -0.75], z = 0); a
                        bright emissive quad "flare" (0.3 x 0.3, emissive 1 times
@@ -328,7 +328,7 @@ def dark_stage(outdir):
     g = Doc()
     g.used.add("EXT_mesh_gpu_instancing")
     grey = _grey(g)
-    pos, nrm, idx = cube(0.06)
+    pos, nrm, idx = cube(0.1)
     box = g.mesh("box", {"POSITION": g.accessor(FLOAT, pos, minmax=True),
                          "NORMAL": g.accessor(FLOAT, nrm)}, idx, grey)
     grid = [(0.3 * i - 0.3, 0.3 * j - 0.3, 0.3 * k - 0.3)
