@@ -100,6 +100,15 @@ with open(lines, "w") as f:
 w = warnings_of(info(lines).stdout)
 T.check(len(w) == 1 and "3 lines" in w[0] and "not rendered" in w[0], f"lines left out are named: {w}")
 
+# ---- vertex colours: named (a normalized UNSIGNED_BYTE COLOR_0, dequantized on the way) ----
+g = import_assets.Doc()
+m = g.mesh("painted", {"POSITION": g.accessor(import_assets.FLOAT, import_assets.QUAD, minmax=True),
+                       "COLOR_0": g.accessor(import_assets.UBYTE, [(255, 0, 0, 255)] * 4, normalized=True)},
+           import_assets.QUAD_TRIS, g.material(import_assets.WHITE))
+g.nodes.append({"name": "painted", "mesh": m})
+w = warnings_of(info(g.write(tmp, "colours")).stdout)
+T.check(len(w) == 1 and "vertex colours" in w[0] and "painted" in w[0], f"vertex colours are named: {w}")
+
 # ---- exact durations ----
 p = info(A["odd_clip"])
 m = re.search(r"animation: \S+ s to (\S+) s", p.stdout)
