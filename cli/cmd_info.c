@@ -9,18 +9,23 @@
 int cmd_info(int argc, char **argv)
 {
     const char *path = NULL, *animation = NULL;
-    int i, r;
+    int i, r, strict = 0;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             fputs(
-                "usage: evray info SCENE [--animation CLIP]\n\nDescribes a scene as evray imports it: cameras, lights, animation clips (each\n"
+                "usage: evray info SCENE [--animation CLIP] [--strict]\n\nDescribes a scene as evray imports it: cameras, lights, animation clips (each\n"
                 "one's duration, as --duration takes it, and whether it plays), animated nodes and\n"
-                "their time ranges, meshes, instances and triangles.\n\n" CLI_ANIMATION_HELP,
+                "their time ranges, meshes, instances and triangles, and what evray leaves out of\n"
+                "the file (warnings).\n\n" CLI_ANIMATION_HELP CLI_STRICT_HELP,
                 stdout);
             return 0;
         }
         if ((r = cli_is_animation_option(argc, argv, &i, &animation)) != 0) {
             if (r < 0) return 2;
+            continue;
+        }
+        if (!strcmp(argv[i], "--strict")) {
+            strict = 1;
             continue;
         }
         if (argv[i][0] == '-') {
@@ -38,7 +43,7 @@ int cmd_info(int argc, char **argv)
         return 2;
     }
     /* quiet: the description says which clips play and why the others do not */
-    evr_scene *s = cli_load_scene(path, NULL, animation, CLI_LOAD_DESCRIBED);
+    evr_scene *s = cli_load_scene(path, NULL, animation, strict, CLI_LOAD_DESCRIBED);
     if (!s) return 1;
     char *text = evr_scene_describe(s);
     if (text) fputs(text, stdout);

@@ -71,7 +71,8 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
     return argv[*i];
 }
 
-evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet)
+evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
+                          int quiet)
 {
     evr_error err = {{0}};
     evr_scene *scene = NULL;
@@ -79,6 +80,7 @@ evr_scene *cli_load_scene(const char *path, const char *demo, const char *animat
     evr_status st;
     evr_load_options_defaults(&opts);
     opts.animation = animation;
+    opts.strict = strict;
     if (path) {
         st = evr_scene_load_with(path, &opts, &scene, &err);
     } else { /* a built-in scene goes through the same importer, from memory */

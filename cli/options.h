@@ -21,10 +21,11 @@ int opt_is(const char *arg, const char *name);
 void cli_error(const char *fmt, ...);
 
 /* The scene file at path, else the built-in scene demo, with --animation's choice (NULL: the
- * default rule); prints the loader's notice unless quiet, and the scene's warnings
- * (evr_scene_warnings) always, on stderr. NULL (after the error message) when it cannot be
- * loaded, a clip the file does not have included. */
-evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int quiet);
+ * default rule) and --strict's (every import warning an error); prints the loader's notice
+ * unless quiet, and the scene's warnings (evr_scene_warnings) always, on stderr. NULL (after the
+ * error message) when it cannot be loaded, a clip the file does not have included. */
+evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
+                          int quiet);
 /* cli_load_scene's quiet for a caller that prints the notice and the warnings itself */
 #define CLI_LOAD_DESCRIBED (-1)
 /* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when
@@ -36,5 +37,11 @@ int cli_is_animation_option(int argc, char **argv, int *i, const char **animatio
     "                             alone, or all (default: clips that animate disjoint nodes\n" \
     "                             play together, the later of two sharing a node does not;\n"  \
     "                             evray info SCENE lists them)\n"
+
+/* The help line of --strict, for the commands that parse it themselves (info, still). */
+#define CLI_STRICT_HELP                                                                    \
+    "  --strict                   fail on anything evray would otherwise warn about and\n" \
+    "                             leave out of the file (a texture it cannot find or\n"    \
+    "                             decode, an extension it does not render, ...)\n"
 
 #endif

@@ -65,10 +65,17 @@ evr_status evr_scene_load_memory(const void *data, size_t size, const char *hint
  *     are used.
  *   a clip's name, else its 0-based index in the file ("2"): that clip alone. "all" is always
  *     the keyword (name such a clip by index). A name or index the file does not have fails
- *     with EVR_ERR_ARG and a message listing the clips. */
+ *     with EVR_ERR_ARG and a message listing the clips.
+ *
+ * strict: 0 (the default): what evray cannot render of the file as it is (a texture it cannot
+ *   find, read or decode, an extension it does not render, ...) is a warning
+ *   (evr_scene_warnings) and the load goes on: a material whose texture is missing keeps its
+ *   factors. 1: any such warning fails the load with EVR_ERR_FORMAT and a message giving the
+ *   first one. */
 typedef struct {
     size_t size; /* sizeof(evr_load_options) as the caller sees it: set by the defaults */
     const char *animation;
+    int strict;
 } evr_load_options;
 
 void evr_load_options_init(evr_load_options *o, size_t size);
@@ -162,7 +169,7 @@ typedef struct {
     /* output */
     const char *out_dir;
     int formats;           /* evr_format bits */
-    double preview_window; /* seconds per preview frame; <= 0: no previews */
+    double preview_window; /* seconds per preview frame; <= 0: no previews (see preview) */
     int force;             /* overwrite an existing run folder (and frames in frames_out) */
     /* intensity frames for frame-based tools (v2e and the like): frame k is every pixel's
      * intensity at exactly t_k = start + k / frames_fps (one sample at the pixel centre, not seen
@@ -184,7 +191,17 @@ typedef struct {
     int gi_bounces;      /* indirect bounces of a photon */
     /* shading: reflections and refractions a camera ray may take (core/path.h) */
     int max_bounces;
+    /* previews (one per preview_window): EVR_PREVIEW_VIDEO, one animated PNG preview.apng in
+     * the run folder with each window's events and intensity side by side; EVR_PREVIEW_PNG, two
+     * PNG files per window in preview/; EVR_PREVIEW_NONE, none. The intensity is tone mapped with
+     * one exposure for the whole run (io/preview.h). */
+    int preview;
+    /* scene loading: 1 makes every import warning an error (evr_load_options.strict); the evray
+     * program loads the scene with it, evr_sim_new does not read it */
+    int strict;
 } evr_config;
+
+enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };
 
 /* Fills c with the defaults (the ideal sensor at 346x260, docs/sensors.md) and sets c->size.
  * The macro passes the size of the caller's evr_config. */

@@ -331,12 +331,17 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     evr_event_vec *v = &sim->pending;
     size_t n = evr_events_before(v->data, v->n, limit_us);
     evr_status st;
-    if (n == 0) return EVR_OK;
     double t = evr_host_seconds();
+    /* no event before limit_us is to come: the previews' windows that end by then are done */
+    if (n == 0) {
+        st = evr_run_preview_events(sim, NULL, 0, limit_us, err);
+        sim->time_preview += evr_host_seconds() - t;
+        return st;
+    }
     count_events_start(sim, v->data, n); /* finishes the batch before it first */
     sim->time_write += evr_host_seconds() - t;
     t = evr_host_seconds();
-    if ((st = evr_run_preview_events(sim, v->data, n, err)) != EVR_OK) return st;
+    if ((st = evr_run_preview_events(sim, v->data, n, limit_us, err)) != EVR_OK) return st;
     sim->time_preview += evr_host_seconds() - t;
     t = evr_host_seconds();
     /* the writers take the buffer; the events held back move to one of the queue's */
@@ -512,7 +517,7 @@ void evr_sim_release(evr_sim *sim)
     evr_deform_tracker_free(&sim->deform);
     free(sim->skipped_per_segment);
     free(sim->config_json);
-    evr_event_frame_release(&sim->preview);
+    evr_preview_out_release(sim->preview);
     evr_frames_free(sim);
     free(sim);
 }

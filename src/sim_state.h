@@ -8,7 +8,7 @@
 #include "run/segment_planner.h"
 #include "prep/skip_plan.h"
 #include "io/event_writer.h"
-#include "io/preview.h"
+#include "run/preview_out.h"
 #include "run/write_queue.h"
 
 #define EVR_MAX_WRITERS 16 /* formats a run may write (io/event_formats.h) */
@@ -55,11 +55,9 @@ struct evr_sim {
     evr_event_counts counting[EVR_COUNT_PARTS];
     int count_parts;
     /* previews */
-    evr_event_frame preview; /* event frame being accumulated (width 0: previews off) */
+    evr_preview_out *preview; /* NULL: previews off */
     int64_t preview_window_us;
-    int64_t preview_frame;   /* index of the event frame being accumulated */
     int64_t intensity_frame; /* index of the next intensity frame due */
-    int previews_written;
     /* intensity frames for other tools (frames_out.h); num_frames 0: none */
     char frames_dir[4096];
     double frames_fps;

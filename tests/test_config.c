@@ -194,8 +194,13 @@ static void test_special_options(void)
     CHECK(c.width == 640 && c.height == 480 && !strcmp(name, "--res"));
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--thres", &name), "0.3", &err));
     CHECK(c.pos_thres == 0.3f && c.neg_thres == 0.3f);
+    CHECK(c.preview == EVR_PREVIEW_VIDEO);
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--no-preview", &name), NULL, &err));
-    CHECK(c.preview_window == 0.0);
+    CHECK(c.preview == EVR_PREVIEW_NONE);
+    CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--preview", &name), "png", &err));
+    CHECK(c.preview == EVR_PREVIEW_PNG);
+    CHECK(evr_config_option_set(&c, evr_config_option_find("--preview", &name), "mp4", &err) ==
+          EVR_ERR_ARG);
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--format", &name), "all", &err));
     CHECK(c.formats == evr_event_formats_all());
     CHECK_OK(evr_config_option_set(&c, evr_config_option_find("--gpu-event-capacity", &name),

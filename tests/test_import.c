@@ -466,15 +466,24 @@ static void test_bad_inputs(void)
     /* a folder is not a scene */
     st = evr_scene_load(dir, &s, &err);
     check_one_line(st, EVR_ERR_IO, &err);
-    /* an external texture that is missing */
+    /* an external texture that is missing: a warning naming it (the material keeps its
+     * factors), an error when loading strictly */
     {
         size_t m = 0;
         unsigned char *txt = read_bytes(DATA "lights.gltf", &m);
         CHECK(txt != NULL);
         if (txt) {
+            evr_load_options o;
             snprintf(path, sizeof path, "%s/lights.gltf", dir);
             CHECK(write_bytes(path, txt, m));
-            st = evr_scene_load(path, &s, &err);
+            CHECK_OK(evr_scene_load(path, &s, &e_));
+            CHECK(s && strstr(evr_scene_warnings(s), "checker.png") &&
+                  strstr(evr_scene_warnings(s), "keeps its factors"));
+            evr_scene_release(s);
+            s = NULL;
+            evr_load_options_defaults(&o);
+            o.strict = 1;
+            st = evr_scene_load_with(path, &o, &s, &err);
             check_one_line(st, EVR_ERR_IO, &err);
             CHECK(strstr(err.msg, "checker.png") != NULL);
             CHECK(s == NULL);

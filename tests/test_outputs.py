@@ -10,7 +10,7 @@ import evrtest as T
 d = os.path.join(T.tmpdir(), "run")
 W, H = 96, 72
 T.run("demo", "--scene", "eye", "-o", d, "--res", f"{W}x{H}", "--duration", "0.6", "--format", "all",
-      "--samples-per-frame", "4", "--quiet")
+      "--samples-per-frame", "4", "--preview", "png", "--quiet")
 meta = T.load_run_json(d)
 stats = meta["stats"]
 ev, ms, attrs = T.load_h5(os.path.join(d, "events.h5"))
@@ -65,6 +65,7 @@ T.check(meta["config"]["width"] == W and meta["config"]["pos_thres"] == 0.2, "co
 prev = sorted(os.listdir(os.path.join(d, "preview")))
 T.check(sum(p.startswith("events_") for p in prev) == 12, "one event frame per 50 ms window")
 T.check(sum(p.startswith("intensity_") for p in prev) == 12, "one intensity frame per 50 ms window")
+T.check(not os.path.exists(os.path.join(d, "preview.apng")), "--preview png: no video")
 T.check(not any(f.endswith(".tmp") for f in os.listdir(d)), "no temporary files left")
 
 # an existing run folder is not overwritten without --force

@@ -1483,95 +1483,6 @@ static void test_json(void)
 
 /* ---- previews ---- */
 
-static void test_tonemap(const char *root)
-{
-    enum { N = 4096 };
-    float *v = malloc(N * sizeof *v);
-    uint8_t *o = malloc(N);
-    evr_error err;
-    uint64_t s = 99;
-    int mono = 1;
-
-    /* random values: the map must be monotonic */
-    for (int i = 0; i < N; i++)
-        v[i] = (float)(rng_next(&s) % 100000) * 1e-3f * (i % 7 == 0 ? 50.0f : 1.0f);
-    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
-    for (int i = 0; i < N; i++)
-        for (int k = i + 1; k < N; k += 97)
-            if ((v[i] < v[k] && o[i] > o[k]) || (v[i] > v[k] && o[i] < o[k])) mono = 0;
-    CHECK(mono);
-
-    /* a ramp: non-decreasing, black stays black, the top reaches white */
-    for (int i = 0; i < N; i++) v[i] = (float)i / (N - 1) * 10.0f;
-    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
-    mono = 1;
-    for (int i = 1; i < N; i++)
-        if (o[i] < o[i - 1]) mono = 0;
-    CHECK(mono);
-    CHECK(o[0] == 0);
-    CHECK(o[N - 1] == 255);
-    CHECK(o[N / 2] > 0 && o[N / 2] < 255);
-
-    /* scale invariance (the key is the log-average) */
-    {
-        uint8_t *o2 = malloc(N);
-        int same = 1;
-        for (int i = 0; i < N; i++) v[i] *= 1000.0f;
-        CHECK_OK(evr_tonemap_reinhard(v, N, o2, &e_));
-        for (int i = 0; i < N; i++)
-            if (abs((int)o[i] - (int)o2[i]) > 1) same = 0;
-        CHECK(same);
-        free(o2);
-    }
-
-    /* a few hot pixels do not darken the rest; NaN, negative and infinite values are handled */
-    for (int i = 0; i < N; i++) v[i] = 0.5f + 0.5f * (float)(i % 64) / 63.0f;
-    v[10] = 1e9f;
-    v[11] = 1e9f;
-    v[12] = 0.0f / 0.0f;
-    v[13] = -3.0f;
-    v[14] = 1.0f / 0.0f;
-    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
-    CHECK(o[63] == 255); /* value 1.0: at the 99.5th percentile */
-    CHECK(o[64] > 100);  /* value 0.5: bright, not pushed to black by the hot pixels */
-    CHECK(o[10] == 255 && o[14] == 255);
-    CHECK(o[12] == 0 && o[13] == 0);
-
-    /* all black */
-    memset(v, 0, N * sizeof *v);
-    CHECK_OK(evr_tonemap_reinhard(v, N, o, &e_));
-    {
-        int black = 1;
-        for (int i = 0; i < N; i++)
-            if (o[i]) black = 0;
-        CHECK(black);
-    }
-
-    /* a PNG: 64 x 48, brighter towards the bottom; y = 0 is the top row */
-    {
-        char path[600];
-        int w = 64, h = 48, iw = 0, ih = 0, ic = 0;
-        unsigned char *img;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) v[y * w + x] = 0.01f + (float)y * 0.1f + (float)x * 0.001f;
-        snprintf(path, sizeof path, "%s/intensity.png", root);
-        CHECK_OK(evr_preview_intensity_png(path, v, w, h, &e_));
-        CHECK(evr_preview_intensity_png(path, v, 0, h, &err) == EVR_ERR_ARG);
-        img = stbi_load(path, &iw, &ih, &ic, 0);
-        CHECK(img != NULL);
-        if (img) {
-            CHECK(iw == w && ih == h && ic == 1);
-            if (iw == w && ih == h && ic == 1) {
-                CHECK(img[0] < img[(h - 1) * w]);
-                CHECK(img[0] <= img[w - 1]);
-            }
-            stbi_image_free(img);
-        }
-    }
-    free(v);
-    free(o);
-}
-
 static void test_event_frames(const char *root)
 {
     evr_event_frame f;
@@ -1731,7 +1642,6 @@ int main(void)
     test_camera_formats(root);
     test_camera_parts(root);
     test_rosbag(root);
-    test_tonemap(root);
     test_event_frames(root);
     bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");
     bench_writer(root, "evt2", evr_evt2_writer_open, "bench_evt2.raw");

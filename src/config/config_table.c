@@ -74,7 +74,7 @@ static evr_status parse_thres(evr_config *c, const char *v, evr_error *err)
 }
 static evr_status parse_no_preview(evr_config *c, const char *v, evr_error *err)
 {
-    c->preview_window = 0.0;
+    c->preview = EVR_PREVIEW_NONE;
     return EVR_OK;
 }
 static evr_status parse_formats(evr_config *c, const char *v, evr_error *err)
@@ -183,6 +183,10 @@ static const evr_opt_choice skip_choices[] = {/* no_skip's names in run.json */
                                               {NULL, 0, "exact", NULL},
                                               {NULL, 1, "off", NULL},
                                               {NULL, -1, NULL, NULL}};
+static const evr_opt_choice preview_choices[] = {{"video", EVR_PREVIEW_VIDEO, "video", NULL},
+                                                 {"png", EVR_PREVIEW_PNG, "png", NULL},
+                                                 {"none", EVR_PREVIEW_NONE, "none", NULL},
+                                                 {NULL, -1, NULL, NULL}};
 static const evr_opt_choice gi_choices[] = {
     {"none", 0, "none", NULL},
     {"photon", 1, "photon", NULL},
@@ -233,12 +237,28 @@ static const evr_config_option table[] = {
      .help = "seconds per preview frame (default 0.05)",
      .json = "preview_window",
      .json_rank = 41},
+    {.name = "preview",
+     .type = EVR_OPT_CHOICE,
+     .offset = F(preview),
+     .def = EVR_PREVIEW_VIDEO,
+     .choices = preview_choices,
+     .noun = "preview",
+     .what = "unknown preview kind",
+     .flag = "--preview",
+     .label = "--preview KIND",
+     .help = "video (default): one animated PNG, preview.apng, with each\n"
+             "window's events (ON blue, OFF red) and intensity side by side,\n"
+             "playing in real time (open it in a web browser); png: two PNG\n"
+             "files per window in preview/; none. The intensity has one\n"
+             "exposure for the whole run, from the visible scene",
+     .json = "preview",
+     .json_rank = 48},
     {.name = "no_preview",
      .flag = "--no-preview",
      .no_value = 1,
      .parse = parse_no_preview,
      .label = "--no-preview",
-     .help = "no preview images"},
+     .help = "no previews (--preview none)"},
     {.name = "quiet",
      .flag = "--quiet",
      .alias = "-q",
@@ -868,6 +888,20 @@ static const evr_config_option table[] = {
      .help = "reflections and refractions a camera ray may take (default 4)",
      .json = "max_bounces",
      .json_rank = 47},
+
+    /* ---- scene loading ---- */
+    {.name = "strict",
+     .type = EVR_OPT_FLAG,
+     .offset = F(strict),
+     .flag = "--strict",
+     .section = "scene loading",
+     .label = "--strict",
+     .help = "fail on anything evray would otherwise warn about and leave\n"
+             "out (a texture it cannot find or decode, an extension it does\n"
+             "not render, ...); by default each is one warning and the load\n"
+             "goes on (a material whose texture is missing keeps its factors)",
+     .json = "strict",
+     .json_rank = 49},
 };
 
 const evr_config_option *evr_config_table(int *count)

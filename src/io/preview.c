@@ -243,61 +243,60 @@ static float clean(float v)
     return 0.0f;
 }
 
-evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr_error *err)
+evr_status evr_exposure_of(const float *linear, size_t n, evr_exposure *e, evr_error *err)
 {
-    float *tmp;
-    double sum_log = 0.0, white, delta, scale, lw;
+    float *vis;
+    size_t m = 0, k999, k99;
+    double median, p99, p999;
+    e->scale = 0.0;
+    e->white = 1.0;
     if (n == 0) return EVR_OK;
-    tmp = malloc(n * sizeof *tmp);
-    if (!tmp) {
+    if (!(vis = malloc(n * sizeof *vis))) {
         snprintf(err->msg, sizeof err->msg, "tone mapping: out of memory");
         return EVR_ERR_NOMEM;
     }
-    for (size_t i = 0; i < n; i++) tmp[i] = clean(linear[i]);
-    white = select_kth(tmp, n, (size_t)floor(0.995 * (double)(n - 1) + 0.5));
-    if (!(white > 0.0)) { /* mostly black: take the brightest value */
-        white = 0.0;
-        for (size_t i = 0; i < n; i++)
-            if (tmp[i] > white) white = tmp[i];
+    for (size_t i = 0; i < n; i++) {
+        float v = clean(linear[i]);
+        if (v > 0.0f) vis[m++] = v;
     }
-    free(tmp);
-    if (!(white > 0.0)) {
-        memset(out, 0, n);
+    if (m == 0) {
+        free(vis);
         return EVR_OK;
     }
-    /* log-average with a floor relative to the white point, so the result is scale invariant */
-    delta = 1e-4 * white;
-    for (size_t i = 0; i < n; i++) sum_log += log(delta + (double)clean(linear[i]));
-    scale = 0.18 / exp(sum_log / (double)n);
-    lw = white * scale;
+    /* from the top down: each selection leaves the k smallest values below index k, where the
+     * next one looks */
+    k999 = (size_t)floor(0.999 * (double)(m - 1) + 0.5);
+    k99 = (size_t)floor(0.99 * (double)(m - 1) + 0.5);
+    p999 = select_kth(vis, m, k999);
+    p99 = select_kth(vis, k999 + 1, k99);
+    median = select_kth(vis, k99 + 1, (m - 1) / 2);
+    free(vis);
+    e->scale = EVR_EXPOSURE_KEY / median;
+    if (p99 * e->scale > 1.0) e->scale = 1.0 / p99;
+    if (p999 * e->scale > 1.0) e->white = p999 * e->scale;
+    if (!(e->white < 1e30)) e->white = 1e30; /* an infinite pixel: the curve stays finite */
+    return EVR_OK;
+}
+
+void evr_tonemap_exposed(const float *linear, size_t n, const evr_exposure *e, uint8_t *out)
+{
+    const double w2 = e->white * e->white;
     for (size_t i = 0; i < n; i++) {
-        double l = (double)clean(linear[i]) * scale, v;
-        if (l >= lw) v = 1.0; /* the curve reaches 1 at the white point */
-        else v = l * (1.0 + l / (lw * lw)) / (1.0 + l);
+        double l = (double)clean(linear[i]) * e->scale, v;
+        if (e->white <= 1.0) v = l;      /* the curve with white 1 is the identity */
+        else if (l >= e->white) v = 1.0; /* it reaches 1 at the white point */
+        else v = l * (1.0 + l / w2) / (1.0 + l);
         if (v > 1.0) v = 1.0;
         v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
         long q = lround(v * 255.0);
         out[i] = (uint8_t)(q < 0 ? 0 : q > 255 ? 255 : q);
     }
-    return EVR_OK;
 }
 
-evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h,
-                                     evr_error *err)
+evr_status evr_tonemap_frame(const float *linear, size_t n, uint8_t *out, evr_error *err)
 {
-    uint8_t *gray;
-    evr_status st;
-    if (w <= 0 || h <= 0 || !linear) {
-        snprintf(err->msg, sizeof err->msg, "intensity preview: bad size %dx%d", w, h);
-        return EVR_ERR_ARG;
-    }
-    gray = malloc((size_t)w * (size_t)h);
-    if (!gray) {
-        snprintf(err->msg, sizeof err->msg, "intensity preview: out of memory");
-        return EVR_ERR_NOMEM;
-    }
-    st = evr_tonemap_reinhard(linear, (size_t)w * (size_t)h, gray, err);
-    if (st == EVR_OK) st = evr_png_write(path, gray, w, h, 1, 8, err);
-    free(gray);
+    evr_exposure e;
+    evr_status st = evr_exposure_of(linear, n, &e, err);
+    if (st == EVR_OK) evr_tonemap_exposed(linear, n, &e, out);
     return st;
 }

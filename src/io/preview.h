@@ -52,14 +52,28 @@ void evr_event_preview_release(evr_event_preview *p);
 
 /* ---- intensity frames ---- */
 
-/* Tone maps n linear luminance values to 8-bit sRGB gray. Reinhard's photographic operator:
- * the frame is scaled so that its log-average maps to the key 0.18, then the extended Reinhard
- * curve L*(1 + L/Lw^2)/(1 + L) with the white point Lw = the 99.5th percentile of the scaled
- * values (so a few hot pixels do not darken the frame), then the sRGB transfer curve. The map is
- * monotonic within a frame. Negative and NaN values count as 0. */
-evr_status evr_tonemap_reinhard(const float *linear, size_t n, uint8_t *out, evr_error *err);
-/* Tone maps a w x h linear luminance frame as above and writes an 8-bit gray PNG. */
-evr_status evr_preview_intensity_png(const char *path, const float *linear, int w, int h,
-                                     evr_error *err);
+/* An exposure: linear luminance L is shown as sRGB(min(1, R(L * scale))), with R the extended
+ * Reinhard curve l (1 + l / white^2) / (1 + l), which is the identity below 1 when white is 1.
+ *
+ * It is made from the visible scene only: pixels above 0 (where rays meet nothing, the
+ * intensity is 0: a black background must not count, or a small object on it comes out white).
+ * Of those, the median is shown at EVR_EXPOSURE_KEY of white (linear), unless that puts more
+ * than 1% of them above white: then the 99th percentile is white. The white point is the 99.9th
+ * percentile's scaled value when that is above 1 (those pixels compressed, not clipped), else
+ * 1. A run fixes one exposure from its first frames (src/run/preview_out.c), so that a pixel
+ * that keeps its intensity keeps its gray level: previews cannot flicker. */
+typedef struct {
+    double scale, white; /* scale 0: nothing visible yet (every pixel shows black) */
+} evr_exposure;
+
+#define EVR_EXPOSURE_KEY 0.3
+
+/* The exposure of n values (one frame, or several frames' values one after another); negative
+ * and NaN values count as 0, +infinity as the largest float. Out of memory is the only error. */
+evr_status evr_exposure_of(const float *linear, size_t n, evr_exposure *e, evr_error *err);
+/* Tone maps n values to 8-bit sRGB gray with exposure e (monotonic; 0 stays 0). */
+void evr_tonemap_exposed(const float *linear, size_t n, const evr_exposure *e, uint8_t *out);
+/* One frame tone mapped with its own exposure (evr_exposure_of, then evr_tonemap_exposed). */
+evr_status evr_tonemap_frame(const float *linear, size_t n, uint8_t *out, evr_error *err);
 
 #endif

@@ -29,7 +29,6 @@ static evr_status path_join(char *out, size_t n, const char *dir, const char *na
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
 {
     struct stat sb;
-    char p[4200];
     if (stat(sim->out_dir, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode)) {
             snprintf(err->msg, sizeof err->msg, "output path %s exists and is not a folder",
@@ -61,16 +60,12 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
         }
         sim->created_dir = 1;
     }
-    if (sim->cfg.preview_window > 0.0) {
-        if (path_join(p, sizeof p, sim->out_dir, "preview", err) != EVR_OK) return EVR_ERR_ARG;
-        if (evr_mkdir_p(p) != 0) {
-            snprintf(err->msg, sizeof err->msg, "cannot create %s: %s", p, strerror(errno));
-            return EVR_ERR_IO;
-        }
-        evr_status st = evr_event_frame_init(&sim->preview, sim->cfg.width, sim->cfg.height, err);
-        if (st != EVR_OK) return st;
+    if (sim->cfg.preview_window > 0.0 && sim->cfg.preview != EVR_PREVIEW_NONE) {
         sim->preview_window_us = (int64_t)llround(sim->cfg.preview_window * 1e6);
         if (sim->preview_window_us < 1) sim->preview_window_us = 1;
+        return evr_preview_out_new(sim->cfg.preview, sim->out_dir, sim->cfg.width, sim->cfg.height,
+                                   (int64_t)llround(sim->cfg.start * 1e6), sim->preview_window_us,
+                                   &sim->preview, err);
     }
     return EVR_OK;
 }
@@ -100,36 +95,14 @@ evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
     return EVR_OK;
 }
 
-static evr_status write_event_frame(evr_sim *sim, evr_error *err)
+evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, int64_t limit_us,
+                                  evr_error *err)
 {
-    char name[64], p[4200];
     evr_status st;
-    snprintf(name, sizeof name, "preview/events_%06lld.png", (long long)sim->preview_frame);
-    if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
-    st = evr_event_frame_write_png(&sim->preview, p, err);
-    evr_event_frame_clear(&sim->preview);
-    sim->previews_written++;
-    return st;
-}
-
-evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, evr_error *err)
-{
-    size_t i = 0, j;
-    evr_status st;
-    if (!sim->preview.width) return EVR_OK;
-    int64_t start_us = (int64_t)llround(sim->cfg.start * 1e6);
-    while (i < n) {
-        int64_t frame = (ev[i].t - start_us) / sim->preview_window_us;
-        while (frame > sim->preview_frame) { /* frames with no events are written too */
-            if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
-            sim->preview_frame++;
-        }
-        int64_t end_us = start_us + (sim->preview_frame + 1) * sim->preview_window_us;
-        for (j = i; j < n && ev[j].t < end_us; j++) {}
-        evr_event_frame_add(&sim->preview, ev + i, j - i);
-        i = j;
-    }
-    return EVR_OK;
+    if (!sim->preview) return EVR_OK;
+    if ((st = evr_preview_out_events(sim->preview, ev, n, err)) != EVR_OK) return st;
+    /* the run's last events (no limit): evr_run_close completes the windows */
+    return limit_us == INT64_MAX ? EVR_OK : evr_preview_out_advance(sim->preview, limit_us, err);
 }
 
 /* Intensity frame k is taken at the end of the first segment that ends at or after the end of
@@ -143,7 +116,7 @@ static int intensity_frame_due(const evr_sim *sim, int64_t frame, double t, int 
 
 int evr_run_preview_due(const evr_sim *sim, double t, int last)
 {
-    if (!sim->preview.width) return 0; /* previews off */
+    if (!sim->preview) return 0; /* previews off */
     /* frames already due at an earlier segment end are written when that one is collected */
     int64_t next = sim->intensity_frame;
     while (sim->preview_window_us > 0 && intensity_frame_due(sim, next, t - 1.0 / sim->fps, 0))
@@ -154,16 +127,10 @@ int evr_run_preview_due(const evr_sim *sim, double t, int last)
 evr_status evr_run_preview_intensity(evr_sim *sim, const float *intensity, double t, int last,
                                      evr_error *err)
 {
-    char name[64], p[4200];
     evr_status st;
-    if (!sim->preview.width) return EVR_OK;
+    if (!sim->preview) return EVR_OK;
     while (intensity_frame_due(sim, sim->intensity_frame, t, last)) {
-        snprintf(name, sizeof name, "preview/intensity_%06lld.png",
-                 (long long)sim->intensity_frame);
-        if ((st = path_join(p, sizeof p, sim->out_dir, name, err)) != EVR_OK) return st;
-        if ((st = evr_preview_intensity_png(p, intensity, sim->cfg.width, sim->cfg.height, err)) !=
-            EVR_OK)
-            return st;
+        if ((st = evr_preview_out_intensity(sim->preview, intensity, err)) != EVR_OK) return st;
         sim->intensity_frame++;
     }
     return EVR_OK;
@@ -335,8 +302,12 @@ static char *run_json(const evr_sim *sim)
     evr_json_number(&j, sim->time_write_thread);
     evr_json_key(&j, "time_preview_seconds");
     evr_json_number(&j, sim->time_preview);
-    evr_json_key(&j, "preview_frames");
-    evr_json_integer(&j, sim->previews_written);
+    evr_json_key(&j, "preview_frames"); /* windows: video frames, or pairs of PNG files */
+    evr_json_integer(&j, evr_preview_out_windows(sim->preview));
+    if (sim->preview) { /* the intensity's one exposure: linear intensity times this is white */
+        evr_json_key(&j, "preview_exposure");
+        evr_json_number(&j, evr_preview_out_exposure(sim->preview).scale);
+    }
     if (sim->num_frames) {
         evr_json_key(&j, "intensity_frames");
         evr_json_integer(&j, sim->frames_written);
@@ -390,12 +361,8 @@ evr_status evr_run_close(evr_sim *sim, evr_error *err)
         if (s2 != EVR_OK && st == EVR_OK) st = s2;
     }
     if (st != EVR_OK) return st;
-    if (sim->preview.width) {
-        int64_t end_frame = (dur_us - 1) / sim->preview_window_us;
-        while (sim->preview_frame <= end_frame)
-            if ((st = write_event_frame(sim, err)) != EVR_OK) return st;
-            else sim->preview_frame++;
-    }
+    if (sim->preview && (st = evr_preview_out_finish(sim->preview, dur_us, err)) != EVR_OK)
+        return st;
     return evr_frames_finish(sim, err);
 }
 
@@ -436,7 +403,9 @@ void evr_run_dir_discard(evr_sim *sim)
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
         sim->writers[w] = NULL;
     }
-    /* previews of this run */
+    /* previews of this run: the video (an unfinished one is removed on release) and the PNGs */
+    snprintf(p, sizeof p, "%s/preview.apng", sim->out_dir);
+    if (sim->preview) remove(p);
     snprintf(p, sizeof p, "%s/preview", sim->out_dir);
     DIR *d = opendir(p);
     if (d) {

@@ -6,8 +6,10 @@
 
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err);
 evr_status evr_run_writers_open(evr_sim *sim, evr_error *err);
-/* Accumulates time-ordered events into event preview frames, writing each finished frame. */
-evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, evr_error *err);
+/* Accumulates time-ordered events into the previews' event frames; no event before limit_us is
+ * to come after them (INT64_MAX: the run's last), so the windows that end by then are done. */
+evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, int64_t limit_us,
+                                  evr_error *err);
 /* Whether a segment ending at absolute time t ends a preview window (so its intensities are due). */
 int evr_run_preview_due(const evr_sim *sim, double t, int last);
 /* At a segment end (absolute time t): writes the intensity previews of the windows it ends. */

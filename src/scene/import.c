@@ -58,6 +58,13 @@
  *  (n) a mesh placed by nodes with different skins (or with and without one) is one aiMesh with
  *      the bones of the last such node only (the earlier bones leak): the patched copy of (j)
  *      gives each further (mesh, skin) pair a copy of the mesh, referenced by its nodes.
+ *  (o) KHR_mesh_quantization: an integer vertex attribute's bytes are copied into Assimp's
+ *      floats as they are (a quantized mesh collapses to a point, without a message): Assimp
+ *      reads a copy with every non-float attribute (JOINTS_n excepted) as a float accessor,
+ *      normalized integers scaled as glTF says (import_gltf_geometry.c); node scales are
+ *      applied as usual;
+ *  (p) EXT_mesh_gpu_instancing is ignored (one copy of the mesh shows): the copy gives each
+ *      instance a child node of its own (import_gltf_geometry.c).
  *  Assimp 5.2 does read JOINTS_1/WEIGHTS_1 (8 influences and more), sparse morph targets and
  *  unnamed joints (bones and nodes both named "nodes[i]"); it does not normalize the weights
  *  (we do, per vertex) and gives a bone without weights one of 0 on vertex 0 (ignored).
@@ -128,7 +135,7 @@ evr_status evr_import_fail(evr_error *err, evr_status st, const char *fmt, ...)
 void evr_import_warn(importer *im, const char *fmt, ...)
 {
     evr_scene *s = im->s;
-    char line[256], *p;
+    char line[512], *p;
     size_t have = s->warnings ? strlen(s->warnings) : 0, n;
     va_list ap;
     va_start(ap, fmt);
@@ -244,19 +251,60 @@ static void read_format(const struct aiScene *ai, char *out, size_t cap)
 static unsigned import_flags(void)
 {
     /* FlipUVs: Assimp stores v upwards (it flips glTF's v); flipped back, v = 0 is the image's
-     * first row, as stb_image returns it and as glTF defines it. JoinIdenticalVertices comes
-     * after, in join_vertices (quirk (i)). */
-    return aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_SortByPType |
-           aiProcess_ValidateDataStructure | aiProcess_FlipUVs;
+     * first row, as stb_image returns it and as glTF defines it. SortByPType (which removes
+     * points and lines) and JoinIdenticalVertices come after, in sort_and_join: what is removed
+     * is counted first, and quirk (i). */
+    return aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_ValidateDataStructure |
+           aiProcess_FlipUVs;
 }
 
-/* Quirk (i): identical vertices joined, unless a mesh has bones or morph targets (which the
- * join ignores). Assimp runs JoinIdenticalVertices after the import's other steps either way, so
- * a scene without them comes out as from one pass with every flag. NULL: Assimp failed (and
- * released the scene). */
-static const struct aiScene *join_vertices(const struct aiScene *ai)
+/* The points and lines SortByPType is about to remove (AI_CONFIG_PP_SBP_REMOVE, make_props), as
+ * one warning line into buf ("" when there are none); returns the number of other faces. */
+static unsigned note_points_lines(const struct aiScene *ai, char *buf, size_t cap)
+{
+    unsigned i, f, meshes = 0, points = 0, lines = 0, others = 0;
+    const char *first = NULL;
+    buf[0] = 0;
+    for (i = 0; i < ai->mNumMeshes; i++) {
+        const struct aiMesh *m = ai->mMeshes[i];
+        unsigned p0 = points, l0 = lines;
+        for (f = 0; f < m->mNumFaces; f++) {
+            points += m->mFaces[f].mNumIndices == 1;
+            lines += m->mFaces[f].mNumIndices == 2;
+            others += m->mFaces[f].mNumIndices > 2;
+        }
+        if (points == p0 && lines == l0) continue;
+        if (!meshes++) first = m->mName.data;
+    }
+    if (meshes) {
+        char p[32] = "", l[32] = "";
+        if (points) snprintf(p, sizeof p, "%u point%s", points, points == 1 ? "" : "s");
+        if (lines) snprintf(l, sizeof l, "%u line%s", lines, lines == 1 ? "" : "s");
+        snprintf(buf, cap,
+                 "%s%s%s in %u mesh%s (the first '%.64s') %s not rendered: evray renders triangles",
+                 p, points && lines ? " and " : "", l, meshes, meshes == 1 ? "" : "es",
+                 first && first[0] ? first : "(unnamed)", points + lines == 1 ? "is" : "are");
+    }
+    return others;
+}
+
+/* Points and lines noted (into dropped) and removed, then quirk (i): identical vertices
+ * joined, unless a mesh has bones or morph targets (which the join ignores). Assimp runs
+ * SortByPType and JoinIdenticalVertices after the import's other steps either way (with the
+ * import's properties), so a scene comes out as from one pass with every flag. NULL: Assimp
+ * failed (and released the scene), or the scene has no triangles (*none set, the scene
+ * released: Assimp 5.2 crashes releasing it after SortByPType removed every mesh). */
+static const struct aiScene *sort_and_join(const struct aiScene *ai, char *dropped, size_t cap,
+                                           int *none)
 {
     unsigned i;
+    *none = 0;
+    if (!note_points_lines(ai, dropped, cap)) {
+        *none = 1;
+        aiReleaseImport(ai);
+        return NULL;
+    }
+    if (!(ai = aiApplyPostProcessing(ai, aiProcess_SortByPType))) return NULL;
     for (i = 0; i < ai->mNumMeshes; i++)
         if (ai->mMeshes[i]->mNumBones || ai->mMeshes[i]->mNumAnimMeshes) return ai;
     return aiApplyPostProcessing(ai, aiProcess_JoinIdenticalVertices);
@@ -281,8 +329,8 @@ static void importer_free(importer *im)
  * caller's (current) options. */
 static evr_status convert(const struct aiScene *ai, const char *source, const char *path,
                           const char *dir, const char *ext, const unsigned char *bytes,
-                          size_t nbytes, const evr_load_options *opts, evr_scene **out,
-                          evr_error *err)
+                          size_t nbytes, const evr_load_options *opts, const char *dropped,
+                          evr_scene **out, evr_error *err)
 {
     importer im;
     evr_scene *s;
@@ -290,11 +338,14 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     uint64_t tris = 0;
     int i;
 
+    evr_error local;
     memset(&im, 0, sizeof im);
+    if (!err) err = &local; /* the steps read messages back (a texture's, for its warning) */
     s = calloc(1, sizeof *s);
     if (!s) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     im.ai = ai;
     im.s = s;
+    im.strict = opts->strict;
     im.err = err;
     evr_import_copy_name(im.dir, sizeof im.dir, dir);
     evr_import_copy_name(s->source, sizeof s->source, source);
@@ -312,6 +363,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
         im.src.dir = path ? dir : NULL;
     }
 
+    if (dropped[0]) evr_import_warn(&im, "%s", dropped);
     if ((st = evr_import_materials(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_meshes(&im, &tris)) != EVR_OK) goto fail;
     if (tris == 0) {
@@ -333,6 +385,13 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_lights(&im)) != EVR_OK) goto fail;
+    if (opts->strict && s->num_warnings) {
+        const char *w = evr_scene_warnings(s);
+        int first = (int)strcspn(w, "\n");
+        st = evr_import_fail(err, EVR_ERR_FORMAT, "'%s' (strict): %.*s%s", source, first, w,
+                             s->num_warnings > 1 ? " (and more: evray info lists them)" : "");
+        goto fail;
+    }
     importer_free(&im);
     *out = s;
     return EVR_OK;
@@ -342,11 +401,12 @@ fail:
     return st;
 }
 
-/* Assimp failed: its reason, or ours when SortByPType removed every mesh. */
-static evr_status import_error(evr_error *err, const char *source)
+/* Assimp failed: its reason, or ours when there are no triangles (none, or SortByPType removed
+ * every mesh). */
+static evr_status import_error(evr_error *err, const char *source, int none)
 {
     const char *why = aiGetErrorString();
-    if (why && strstr(why, "No meshes remaining"))
+    if (none || (why && strstr(why, "No meshes remaining")))
         return evr_import_fail(err, EVR_ERR_FORMAT,
                                "'%s' has no triangles (points and lines are not rendered)", source);
     return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source,
@@ -422,6 +482,39 @@ static evr_status read_gltf_json(const char *path, const char *ext, unsigned cha
     return evr_import_read_file(path, want, bytes, nbytes, err);
 }
 
+/* What runs on a glTF before Assimp reads it, in order: the materials checked, then each stage
+ * that checks and patches (skins and morph targets, quantized attributes and GPU instancing) on
+ * the output of the one before. *patched: the copy Assimp is to read, NULL for the file as it
+ * is. */
+static evr_status gltf_before_assimp(const gltf_source *src, unsigned char **patched,
+                                     size_t *npatched, evr_error *err)
+{
+    typedef evr_status (*stage)(const gltf_source *, unsigned char **, size_t *, evr_error *);
+    static const stage stages[] = {evr_gltf_deform_check, evr_gltf_geometry_patch};
+    gltf_source cur = *src;
+    evr_status st;
+    size_t k;
+    *patched = NULL;
+    *npatched = 0;
+    if ((st = evr_gltf_material_check(src, err)) != EVR_OK) return st;
+    for (k = 0; k < sizeof stages / sizeof *stages; k++) {
+        unsigned char *out = NULL;
+        size_t n = 0;
+        if ((st = stages[k](&cur, &out, &n, err)) != EVR_OK) {
+            free(*patched);
+            *patched = NULL;
+            return st;
+        }
+        if (!out) continue;
+        free(*patched);
+        *patched = out;
+        *npatched = n;
+        cur.bytes = out;
+        cur.nbytes = n;
+    }
+    return EVR_OK;
+}
+
 evr_status evr_scene_load(const char *path, evr_scene **out, evr_error *err)
 {
     return evr_scene_load_with(path, NULL, out, err);
@@ -437,9 +530,10 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     struct aiFileIO *io = NULL;
     unsigned char *bytes = NULL, *patched = NULL;
     size_t nbytes = 0, npatched = 0;
-    char dir[512];
+    char dir[512], dropped[256];
     const char *ext, *slash;
     evr_status st;
+    int none = 0;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
@@ -472,8 +566,9 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     } else {
         dir[0] = 0; /* the current folder */
     }
-    /* The glTF JSON before Assimp reads the file: skins and morph targets are checked first
-     * (quirks (j) to (m)), and what Assimp drops is read from it after. */
+    /* The glTF JSON before Assimp reads the file: materials, skins and morph targets are
+     * checked first (quirks (j) to (m)), quantized attributes and GPU instancing patched (quirks
+     * (o), (p)), and what Assimp drops is read from it after. */
     if ((st = read_gltf_json(path, ext, &bytes, &nbytes, err)) != EVR_OK) return st;
     if (bytes) {
         gltf_source src;
@@ -481,8 +576,7 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         src.nbytes = nbytes;
         src.path = path;
         src.dir = dir;
-        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
-            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK) {
+        if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) {
             free(bytes);
             return st;
         }
@@ -504,12 +598,12 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
-    if (ai) ai = join_vertices(ai);
+    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
     if (!ai) {
         free(bytes);
-        return import_error(err, path);
+        return import_error(err, path, none);
     }
-    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, out, err);
+    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, dropped, out, err);
     free(bytes);
     aiReleaseImport(ai);
     return st;
@@ -529,8 +623,9 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     struct aiPropertyStore *props;
     unsigned char *patched = NULL;
     size_t npatched = 0;
-    char source[64];
+    char source[64], dropped[256];
     evr_status st;
+    int none = 0;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
@@ -540,15 +635,13 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (size > UINT_MAX)
         return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
     if (!hint) hint = "";
-    if (may_be_gltf(data, size, hint)) { /* as for a file (quirks (j) to (m)) */
+    if (may_be_gltf(data, size, hint)) { /* as for a file (quirks (j) to (p)) */
         gltf_source src;
         src.bytes = data;
         src.nbytes = size;
         src.path = NULL;
         src.dir = NULL;
-        if ((st = evr_gltf_material_check(&src, err)) != EVR_OK ||
-            (st = evr_gltf_deform_check(&src, &patched, &npatched, err)) != EVR_OK)
-            return st;
+        if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) return st;
     }
     props = make_props();
     if (!props) {
@@ -560,10 +653,11 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
                                               import_flags(), hint, props);
     aiReleasePropertyStore(props);
     free(patched);
-    if (ai) ai = join_vertices(ai);
+    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
     snprintf(source, sizeof source, "<memory>.%s", hint);
-    if (!ai) return import_error(err, source);
-    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, out, err);
+    if (!ai) return import_error(err, source, none);
+    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, dropped, out,
+                 err);
     aiReleaseImport(ai);
     return st;
 }

@@ -113,11 +113,22 @@ evr_status evr_import_animation(importer *im)
         const struct aiAnimation *an = ai->mAnimations[a];
         double tps = evr_import_ticks_per_second(an);
         if (!evr_import_clip_played(im, a)) continue;
+        if (an->mNumMeshChannels) /* vertex animation by swapping meshes (MD2, MD3, ...) */
+            evr_import_warn(im,
+                            "clip '%s': its %u mesh channel%s (meshes swapped per key) %s not "
+                            "rendered",
+                            an->mName.data, an->mNumMeshChannels,
+                            an->mNumMeshChannels == 1 ? "" : "s",
+                            an->mNumMeshChannels == 1 ? "is" : "are");
         for (ch = 0; ch < an->mNumChannels; ch++) {
             const struct aiNodeAnim *na = an->mChannels[ch];
             int ni = evr_import_find_node(im, na->mNodeName.data), kind;
             evr_node *n;
-            if (ni < 0) continue; /* targets no node of the scene */
+            if (ni < 0) {
+                evr_import_warn(im, "clip '%s': a channel animates '%s', which no node is named",
+                                an->mName.data, na->mNodeName.data);
+                continue;
+            }
             n = &s->nodes[ni];
             for (kind = 0; kind < 3; kind++) {
                 evr_curve *c = kind == PATH_T   ? &n->t_curve

@@ -217,6 +217,7 @@ char *evr_scene_describe(const evr_scene *s)
     uint64_t tris = 0, verts = 0, inst_tris = 0;
     static const char *light_types[3] = {"point", "spot", "directional"};
     const int max_list = 50;
+    char a_start[32], a_end[32];
 
     memset(&b, 0, sizeof b);
     if (!s) return NULL;
@@ -252,10 +253,13 @@ char *evr_scene_describe(const evr_scene *s)
     if (s->num_animations) describe_clips(&b, s, max_list);
     for (i = 0; i < s->num_nodes; i++)
         animated += s->nodes[i].animated || s->nodes[i].w_curve.num_keys > 0;
+    /* exact, like the clips' durations: the end is what --duration takes to play it all */
+    exact_number(a_start, sizeof a_start, s->anim_start);
+    exact_number(a_end, sizeof a_end, s->anim_end);
     if (animated) {
         int listed = 0;
-        sb_printf(&b, "animation: %.4g s to %.4g s, %d animated node%s", s->anim_start, s->anim_end,
-                  animated, animated == 1 ? "" : "s");
+        sb_printf(&b, "animation: %s s to %s s, %d animated node%s", a_start, a_end, animated,
+                  animated == 1 ? "" : "s");
         if (s->frame_rate > 0) sb_printf(&b, ", %.4g frames/s", s->frame_rate);
         sb_printf(&b, "\n");
         for (i = 0; i < s->num_nodes && listed < max_list; i++) {
@@ -271,7 +275,7 @@ char *evr_scene_describe(const evr_scene *s)
         }
         if (animated > listed) sb_printf(&b, "  ... and %d more\n", animated - listed);
     } else if (s->anim_end > s->anim_start) { /* played clips whose curves hold the rest pose */
-        sb_printf(&b, "animation: %.4g s to %.4g s, no node moves\n", s->anim_start, s->anim_end);
+        sb_printf(&b, "animation: %s s to %s s, no node moves\n", a_start, a_end);
     } else {
         sb_printf(&b, "animation: none (static scene)\n");
     }

@@ -290,7 +290,10 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
     ctype = evr_gltf_index(d, evr_jdoc_get(d, acc, "componentType"));
     csize = component_size(ctype);
     nc = type_components(d, acc);
-    norm = evr_jdoc_number(d, evr_jdoc_get(d, acc, "normalized"), 0) != 0;
+    { /* a JSON boolean (evr_jdoc_number reads numbers only) */
+        int nv = evr_jdoc_get(d, acc, "normalized");
+        norm = evr_jdoc_type(d, nv) == EVR_JDOC_BOOL && d->v[nv].num != 0;
+    }
     cnt = evr_jdoc_number(d, evr_jdoc_get(d, acc, "count"), -1);
     /* matrices of 1- and 2-byte components pad their columns: never needed here */
     if (!csize || !nc || nc > 4 || !(cnt >= 0 && cnt <= (double)(1 << 30)))

@@ -176,96 +176,11 @@ static int check_skin(checker *c, int skin, const char *ml, const char *sl, int 
     return nj;
 }
 
-/* ---- the patched copy ---- */
-
-/* Replace text[at, at + len) by `text` (len 0: insert). */
-typedef struct {
-    size_t at, len;
-    char *text;
-} edit;
-
-typedef struct {
-    edit *e;
-    int n, cap;
-} edits;
-
-static int edit_cmp(const void *pa, const void *pb)
-{
-    const edit *a = pa, *b = pb;
-    return (a->at > b->at) - (a->at < b->at);
-}
-
-/* Adds an edit taking ownership of text; 0 when memory ran out (text freed). */
-static int add_edit(edits *E, size_t at, size_t len, char *text)
-{
-    if (!text) return 0;
-    if (E->n == E->cap) {
-        int ncap = E->cap ? 2 * E->cap : 16;
-        edit *ne = realloc(E->e, (size_t)ncap * sizeof *ne);
-        if (!ne) {
-            free(text);
-            return 0;
-        }
-        E->e = ne;
-        E->cap = ncap;
-    }
-    E->e[E->n].at = at;
-    E->e[E->n].len = len;
-    E->e[E->n++].text = text;
-    return 1;
-}
-
-static void edits_free(edits *E)
-{
-    for (int i = 0; i < E->n; i++) free(E->e[i].text);
-    free(E->e);
-    memset(E, 0, sizeof *E);
-}
-
-static char *b64_encode(const unsigned char *p, size_t n)
-{
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    char *out = malloc((n + 2) / 3 * 4 + 1), *o = out;
-    size_t i;
-    if (!out) return NULL;
-    for (i = 0; i + 2 < n; i += 3) {
-        unsigned v = (unsigned)p[i] << 16 | (unsigned)p[i + 1] << 8 | p[i + 2];
-        *o++ = tab[v >> 18];
-        *o++ = tab[(v >> 12) & 63];
-        *o++ = tab[(v >> 6) & 63];
-        *o++ = tab[v & 63];
-    }
-    if (i < n) {
-        unsigned v = (unsigned)p[i] << 16 | (i + 1 < n ? (unsigned)p[i + 1] << 8 : 0);
-        *o++ = tab[v >> 18];
-        *o++ = tab[(v >> 12) & 63];
-        *o++ = i + 1 < n ? tab[(v >> 6) & 63] : '=';
-        *o++ = '=';
-    }
-    *o = 0;
-    return out;
-}
-
-/* Appends elements (JSON text, comma-separated) to the root array `key`: before its ']', or as
- * a whole member after the root's '{' when the array is missing. */
-static int append_to_array(edits *E, const evr_jdoc *d, int root, const char *key,
-                           const char *elems)
-{
-    int arr = evr_jdoc_get(d, root, key);
-    size_t n = strlen(key) + strlen(elems) + 16;
-    char *t = malloc(n);
-    if (!t) return 0;
-    if (arr >= 0 && evr_jdoc_type(d, arr) == EVR_JDOC_ARRAY) {
-        snprintf(t, n, "%s%s", evr_jdoc_count(d, arr) ? "," : "", elems);
-        return add_edit(E, d->v[arr].off + d->v[arr].len - 1, 0, t);
-    }
-    snprintf(t, n, "\"%s\":[%s],", key, elems);
-    return add_edit(E, d->v[root].off + 1, 0, t);
-}
+/* ---- the patched copy (import_gltf_patch.c) ---- */
 
 /* Gives the skins marked in need[] an accessor of `count` identity matrices as their
  * inverseBindMatrices (quirk (j)). */
-static int add_identity(edits *E, const evr_jdoc *d, int root, const checker *c,
+static int add_identity(gltf_edits *E, const evr_jdoc *d, int root, const checker *c,
                         const unsigned char *need, int count)
 {
     int acc_index = evr_jdoc_count(d, evr_jdoc_get(d, root, "accessors"));
@@ -282,89 +197,28 @@ static int add_identity(edits *E, const evr_jdoc *d, int root, const checker *c,
             memcpy(&u, &f, sizeof u);
             evr_put_le32(mats + (size_t)i * 64 + (size_t)k * 4, u);
         }
-    if (!(b64 = b64_encode(mats, (size_t)count * 64)) || !(elem = malloc(strlen(b64) + 128)))
+    if (!(b64 = evr_gltf_b64(mats, (size_t)count * 64)) || !(elem = malloc(strlen(b64) + 128)))
         goto done;
     for (int s = 0; s < c->num_skins; s++) {
         char *t;
         if (!need[s]) continue;
         if (!(t = malloc(48))) goto done;
         snprintf(t, 48, "\"inverseBindMatrices\":%d,", acc_index);
-        if (!add_edit(E, d->v[c->skin_v[s]].off + 1, 0, t)) goto done;
+        if (!evr_gltf_edit(E, d->v[c->skin_v[s]].off + 1, 0, t)) goto done;
     }
     sprintf(elem, "{\"bufferView\":%d,\"componentType\":5126,\"count\":%d,\"type\":\"MAT4\"}",
             view_index, count);
-    if (!append_to_array(E, d, root, "accessors", elem)) goto done;
+    if (!evr_gltf_append(E, d, root, "accessors", elem)) goto done;
     sprintf(elem, "{\"buffer\":%d,\"byteLength\":%d}", buf_index, count * 64);
-    if (!append_to_array(E, d, root, "bufferViews", elem)) goto done;
+    if (!evr_gltf_append(E, d, root, "bufferViews", elem)) goto done;
     sprintf(elem, "{\"byteLength\":%d,\"uri\":\"data:application/octet-stream;base64,%s\"}",
             count * 64, b64);
-    ok = append_to_array(E, d, root, "buffers", elem);
+    ok = evr_gltf_append(E, d, root, "buffers", elem);
 done:
     free(mats);
     free(b64);
     free(elem);
     return ok;
-}
-
-/* The file with the edits applied (sorted by place); a GLB keeps its BIN chunk (read from the
- * file when the bytes hold only the JSON). */
-static evr_status apply_edits(const gltf_source *src, edits *E, const char *json, size_t jlen,
-                              unsigned char **out, size_t *nout, evr_error *err)
-{
-    unsigned char *file = NULL, *res;
-    const unsigned char *rest = NULL;
-    size_t nrest = 0, nfile = 0, total = jlen + 24, o, prev = 0;
-    int glb = src->nbytes >= 20 && !memcmp(src->bytes, "glTF", 4), i;
-    evr_status st;
-
-    qsort(E->e, (size_t)E->n, sizeof *E->e, edit_cmp);
-    if (glb) { /* what follows the JSON chunk (the BIN chunk) */
-        size_t end = 20 + (size_t)evr_get_le32(src->bytes + 12);
-        size_t whole = evr_get_le32(src->bytes + 8); /* the GLB's length, from its header */
-        if (src->nbytes < whole && src->path) {
-            if ((st = evr_import_read_file(src->path, 0, &file, &nfile, err)) != EVR_OK) return st;
-            if (nfile < end) {
-                free(file);
-                return evr_import_fail(err, EVR_ERR_FORMAT, "glTF: the GLB '%s' is cut short",
-                                       src->path);
-            }
-            rest = file + end;
-            nrest = nfile - end;
-        } else if (src->nbytes >= end) {
-            rest = src->bytes + end;
-            nrest = src->nbytes - end;
-        }
-    }
-    total += nrest;
-    for (i = 0; i < E->n; i++) total += strlen(E->e[i].text);
-    if (!(res = malloc(total + 4))) {
-        free(file);
-        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory patching the glTF");
-    }
-    o = glb ? 20 : 0;
-    for (i = 0; i < E->n; i++) {
-        size_t n = strlen(E->e[i].text);
-        memcpy(res + o, json + prev, E->e[i].at - prev);
-        o += E->e[i].at - prev;
-        memcpy(res + o, E->e[i].text, n);
-        o += n;
-        prev = E->e[i].at + E->e[i].len;
-    }
-    memcpy(res + o, json + prev, jlen - prev);
-    o += jlen - prev;
-    if (glb) {
-        while ((o - 20) % 4) res[o++] = ' '; /* chunks are 4-byte aligned, JSON padded by spaces */
-        memcpy(res, src->bytes, 12);
-        evr_put_le32(res + 12, (uint32_t)(o - 20));
-        memcpy(res + 16, "JSON", 4);
-        if (nrest) memcpy(res + o, rest, nrest);
-        o += nrest;
-        evr_put_le32(res + 8, (uint32_t)o);
-    }
-    free(file);
-    *out = res;
-    *nout = o;
-    return EVR_OK;
 }
 
 /* A mesh placed with another skin than its first node's (or with and without one) gets a copy
@@ -385,7 +239,7 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
     int *mesh_targets = NULL, *mesh_skin_checked = NULL, *mesh_first_skin = NULL;
     unsigned char *need = NULL;
     mesh_copy *copies = NULL;
-    edits E;
+    gltf_edits E;
     evr_status st = EVR_OK;
 
     *patched = NULL;
@@ -461,7 +315,7 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
                 copies[k].skin = s;
                 copies[k].index = c.num_meshes + ncopies++;
             }
-            if (!add_edit(&E, d.v[mn].off, d.v[mn].len, malloc(16))) goto nomem;
+            if (!evr_gltf_edit(&E, d.v[mn].off, d.v[mn].len, malloc(16))) goto nomem;
             snprintf(E.e[E.n - 1].text, 16, "%d", copies[k].index);
         }
         if (s < 0 || mesh_skin_checked[m] == s) continue; /* unskinned, or checked */
@@ -494,18 +348,18 @@ evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched
             o += v->len;
         }
         all[o] = 0;
-        if (!append_to_array(&E, &d, root, "meshes", all)) {
+        if (!evr_gltf_append(&E, &d, root, "meshes", all)) {
             free(all);
             goto nomem;
         }
         free(all);
     }
-    if (E.n) st = apply_edits(src, &E, json, jlen, patched, npatched, err);
+    if (E.n) st = evr_gltf_edits_apply(src, &E, json, jlen, patched, npatched, err);
     goto done;
 nomem:
     st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading the glTF JSON");
 done:
-    edits_free(&E);
+    evr_gltf_edits_free(&E);
     free(mesh_targets);
     free(mesh_skin_checked);
     free(mesh_first_skin);

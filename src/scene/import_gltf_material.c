@@ -29,7 +29,8 @@ static const char *const rendered_ext[] = {"KHR_materials_emissive_strength",
                                            "KHR_materials_pbrSpecularGlossiness"};
 /* Extensions of the file (extensionsUsed) that evray or Assimp reads besides those. */
 static const char *const read_ext[] = {"KHR_texture_transform", "KHR_lights_punctual",
-                                       "KHR_mesh_quantization", "KHR_draco_mesh_compression"};
+                                       "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+                                       "KHR_draco_mesh_compression"};
 
 typedef struct {
     const evr_jdoc *d;
@@ -100,7 +101,7 @@ static void key_of(const evr_jdoc *d, int m, char *out, size_t cap)
 
 static void warn(reader *r, const char *fmt, ...)
 {
-    char line[200];
+    char line[400];
     va_list ap;
     if (!r->im) return;
     va_start(ap, fmt);
@@ -156,9 +157,23 @@ static evr_status load(reader *r, int index, int slot, evr_texture_ref *ref)
     evr_status st;
     if (src < 0) { /* only in an extension's format (KHR_texture_basisu, EXT_texture_webp, ...) */
         int m = evr_jdoc_first(d, evr_jdoc_get(d, tv, "extensions"));
-        char ext[64] = "no image";
+        int img = m >= 0 ? evr_gltf_index(d, evr_jdoc_get(d, m, "source")) : -1;
+        char ext[64] = "no image", uri[160] = "";
         if (m >= 0) key_of(d, m, ext, sizeof ext);
-        warn(r, "texture %d has no PNG or JPEG image (%s): the slot is ignored", index, ext);
+        if (img >= 0 && img < r->num_images &&
+            !evr_jdoc_string(d, evr_jdoc_get(d, r->img_v[img], "uri"), uri, sizeof uri))
+            evr_jdoc_string(d, evr_jdoc_get(d, r->img_v[img], "name"), uri, sizeof uri);
+        if (!strcmp(ext, "KHR_texture_basisu"))
+            warn(r,
+                 "texture %d's image%s%s%s is KTX2 (Basis Universal, KHR_texture_basisu), which "
+                 "evray cannot decode (no Debian 12 library does): the slot is empty, the "
+                 "material keeps its factors",
+                 index, uri[0] ? " '" : "", uri, uri[0] ? "'" : "");
+        else
+            warn(r,
+                 "texture %d has no PNG or JPEG image (%s): the slot is empty, the material "
+                 "keeps its factors",
+                 index, ext);
         return EVR_OK;
     }
     if (src >= r->num_images)
@@ -375,7 +390,7 @@ static evr_status read_material(reader *r, int m, evr_material_params *p, int *u
  * names (a material's own are warned about with it): one warning each. */
 static void warn_file_extensions(importer *im, const evr_jdoc *d, int root)
 {
-    int e, m, mats = evr_jdoc_get(d, root, "materials");
+    int e, m, mats = evr_jdoc_get(d, root, "materials"), texs = evr_jdoc_get(d, root, "textures");
     for (e = evr_jdoc_first(d, evr_jdoc_get(d, root, "extensionsUsed")); e >= 0;
          e = evr_jdoc_next(d, e)) {
         char name[64];
@@ -387,6 +402,9 @@ static void warn_file_extensions(importer *im, const evr_jdoc *d, int root)
         for (k = 0; k < sizeof read_ext / sizeof *read_ext; k++)
             if (!strcmp(name, read_ext[k])) named = 1;
         for (m = evr_jdoc_first(d, mats); m >= 0 && !named; m = evr_jdoc_next(d, m))
+            named = member(d, m, "extensions", name) >= 0;
+        /* a texture's (KHR_texture_basisu, EXT_texture_webp): warned about with its material */
+        for (m = evr_jdoc_first(d, texs); m >= 0 && !named; m = evr_jdoc_next(d, m))
             named = member(d, m, "extensions", name) >= 0;
         if (!named)
             evr_import_warn(im, "the file uses %s, which evray does not read (ignored)", name);

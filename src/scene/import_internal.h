@@ -6,6 +6,8 @@
  *   import_gltf.c      the glTF JSON read directly, for what Assimp drops
  *   import_gltf_data.c glTF buffers and accessors read directly (data: URIs, files, GLB BIN)
  *   import_gltf_deform.c  glTF skins and morph targets checked before Assimp reads them
+ *   import_gltf_geometry.c  glTF quantized attributes and GPU instancing, patched for Assimp
+ *   import_gltf_patch.c   the patched copy of a glTF that Assimp reads
  *   import_memfile.c   an aiFileIO that serves Assimp a patched copy of the scene file
  *   import_texture.c   textures: finding, decoding (sRGB for colour, as is for data), sharing
  *   import_material.c  materials as Assimp gives them (every format but glTF)
@@ -121,6 +123,45 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
 evr_status evr_gltf_deform_check(const gltf_source *src, unsigned char **patched, size_t *npatched,
                                  evr_error *err);
 
+/* ---- the patched copy of a glTF (import_gltf_patch.c) ---- */
+
+/* Replace text[at, at + len) of the JSON by `text` (len 0: insert). */
+typedef struct {
+    size_t at, len;
+    int seq; /* the order edits at one place are made in */
+    char *text;
+} gltf_edit;
+
+typedef struct {
+    gltf_edit *e;
+    int n, cap;
+} gltf_edits;
+
+/* Adds an edit taking ownership of text (malloc'ed); 0 when memory ran out (text freed). */
+int evr_gltf_edit(gltf_edits *E, size_t at, size_t len, char *text);
+/* Appends elements (JSON text, comma-separated) to the root array `key`: before its ']', or as
+ * a whole member after the root's '{' when the array is missing. 0: out of memory. */
+int evr_gltf_append(gltf_edits *E, const evr_jdoc *d, int root, const char *key, const char *elems);
+/* Base64 text of n bytes (free()), NULL when out of memory. */
+char *evr_gltf_b64(const unsigned char *p, size_t n);
+/* The file with the edits applied (sorted by place): *out (free()); a GLB keeps its BIN chunk
+ * (read from the file when src holds only the JSON). */
+evr_status evr_gltf_edits_apply(const gltf_source *src, gltf_edits *E, const char *json,
+                                size_t jlen, unsigned char **out, size_t *nout, evr_error *err);
+void evr_gltf_edits_free(gltf_edits *E);
+
+/* ---- glTF geometry Assimp 5.2 misreads (import_gltf_geometry.c) ---- */
+
+/* KHR_mesh_quantization: Assimp 5.2 copies an integer attribute's bytes into its floats
+ * (positions collapse to a point, silently). Every non-float vertex attribute but JOINTS_n
+ * (mesh and morph target) is read here, normalized integers scaled as glTF says, and given to
+ * Assimp as a float accessor. EXT_mesh_gpu_instancing: Assimp ignores it (one instance shows);
+ * each instance becomes a child node of the instancing node with the instance's translation,
+ * rotation and scale, placing the node's mesh (and skin, weights), and the node itself places
+ * none. *patched as in evr_gltf_deform_check (NULL: nothing to change). */
+evr_status evr_gltf_geometry_patch(const gltf_source *src, unsigned char **patched,
+                                   size_t *npatched, evr_error *err);
+
 /* ---- serving Assimp a patched file (import_memfile.c) ---- */
 
 struct aiFileIO;
@@ -154,6 +195,7 @@ typedef struct {
     unsigned char *clip_played;     /* per aiAnimation: 1 when its curves are imported (NULL:
                                        every clip plays) */
     name_index *by_name;            /* nodes sorted by Assimp name */
+    int strict;                     /* evr_load_options.strict: a warning is an error */
 } importer;
 
 /* ---- shared helpers (import.c) ---- */

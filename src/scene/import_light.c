@@ -22,7 +22,14 @@ evr_status evr_import_lights(importer *im)
         if (al->mType == aiLightSource_POINT) l->type = EVR_LIGHT_POINT;
         else if (al->mType == aiLightSource_SPOT) l->type = EVR_LIGHT_SPOT;
         else if (al->mType == aiLightSource_DIRECTIONAL) l->type = EVR_LIGHT_DIRECTIONAL;
-        else continue; /* ambient and area lights: not punctual (the config has an ambient term) */
+        else { /* ambient and area lights: not punctual (the config has an ambient term) */
+            evr_import_warn(im,
+                            "light '%s' is an %s light, which evray does not render (--ambient "
+                            "sets an ambient term)",
+                            al->mName.data,
+                            al->mType == aiLightSource_AMBIENT ? "ambient" : "area");
+            continue;
+        }
         s->num_lights++;
         evr_import_copy_name(l->name, sizeof l->name, al->mName.data);
         if (!l->name[0]) snprintf(l->name, sizeof l->name, "light%u", i);

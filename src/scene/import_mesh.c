@@ -59,7 +59,8 @@ evr_status evr_import_meshes(importer *im, uint64_t *total_tris)
 {
     const struct aiScene *ai = im->ai;
     evr_scene *s = im->s;
-    unsigned i;
+    unsigned i, coloured = 0;
+    const char *first_coloured = NULL;
     *total_tris = 0;
     s->meshes = calloc((size_t)ai->mNumMeshes + 1, sizeof *s->meshes);
     if (!s->meshes) return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory reading meshes");
@@ -178,7 +179,14 @@ evr_status evr_import_meshes(importer *im, uint64_t *total_tris)
             evr_status st = mesh_tangents(im, am, m);
             if (st != EVR_OK) return st;
         }
+        if (am->mColors[0] && !coloured++) first_coloured = m->name;
         *total_tris += ntri;
     }
+    /* glTF's COLOR_0 multiplies the base colour, other formats' paint the surface: neither is
+     * rendered, one line says so */
+    if (coloured)
+        evr_import_warn(
+            im, "%u mesh%s (the first '%s') %s vertex colours, which evray does not render",
+            coloured, coloured == 1 ? "" : "es", first_coloured, coloured == 1 ? "has" : "have");
     return EVR_OK;
 }

@@ -1,6 +1,9 @@
 /* Textures: found beside the scene file or embedded in it (Assimp's names), or given as bytes (a
  * glTF image read from the JSON, import_gltf_material.c), decoded with stb_image to RGBA floats, their mip levels appended
- * (texture_mips.c).
+ * (texture_mips.c). A texture that cannot be read or decoded (a path from another machine, a
+ * broken file, a format stb_image does not read such as KTX2) is a warning naming it: its slot
+ * stays empty and the material keeps its factors (evr_load_options.strict makes every warning an
+ * error). Only running out of memory stops the import here.
  * Colour textures (base colour, emissive) are sRGB-decoded; data textures (metallic-roughness,
  * normal, occlusion, transmission) keep their values (v / 255). Each image is loaded once per
  * colour space however many materials use it: one image used both ways is decoded twice. */
@@ -25,6 +28,22 @@ static void level8_table(float lut[256], int srgb)
         lut[i] = srgb ? evr_srgb_to_linear((float)i / 255.0f) : (float)i / 255.0f;
 }
 
+/* The name of an image format stb_image does not decode, from its first bytes, or NULL. KTX2
+ * (Basis Universal) has no decoder in Debian 12 (no libktx), so such textures are named in the
+ * warning rather than decoded. */
+static const char *undecodable_format(const unsigned char *p, size_t n)
+{
+    static const unsigned char ktx2[12] = {0xAB, 'K',  'T',  'X',  ' ',  '2',
+                                           '0',  0xBB, '\r', '\n', 0x1A, '\n'};
+    static const unsigned char ktx1[12] = {0xAB, 'K',  'T',  'X',  ' ',  '1',
+                                           '1',  0xBB, '\r', '\n', 0x1A, '\n'};
+    if (n >= 12 && !memcmp(p, ktx2, 12)) return "KTX2 (Basis Universal)";
+    if (n >= 12 && !memcmp(p, ktx1, 12)) return "KTX";
+    if (n >= 4 && !memcmp(p, "DDS ", 4)) return "DDS";
+    if (n >= 12 && !memcmp(p, "RIFF", 4) && !memcmp(p + 8, "WEBP", 4)) return "WebP";
+    return NULL;
+}
+
 /* Decodes an encoded image (PNG, JPEG, ...) into RGBA floats: HDR images are linear already;
  * 16- and 8-bit colour channels are sRGB-decoded when srgb, else scaled to [0, 1]; alpha is
  * linear. */
@@ -35,6 +54,10 @@ static evr_status decode_image(const unsigned char *data, size_t size, const cha
     int w = 0, h = 0, comp = 0;
     size_t i, n;
     void *px;
+    const char *fmt = undecodable_format(data, size);
+    if (fmt)
+        return evr_import_fail(err, EVR_ERR_FORMAT,
+                               "texture %s is a %s image, which evray cannot decode", what, fmt);
     if (size > INT_MAX)
         return evr_import_fail(err, EVR_ERR_FORMAT, "texture %s: image too large", what);
     if (stbi_is_hdr_from_memory(data, (int)size)) {
@@ -176,6 +199,18 @@ static evr_status add_texture(importer *im, const char *key, int srgb, evr_textu
     return EVR_OK;
 }
 
+/* A texture that failed with st (not EVR_OK): out of memory stops the import, and so does
+ * anything else when loading strictly; otherwise (the file missing or unreadable, the image
+ * undecodable) it is a warning, the slot left empty. */
+static evr_status texture_failed(importer *im, evr_status st, int *out)
+{
+    *out = -1;
+    if (st == EVR_ERR_NOMEM || im->strict) return st;
+    evr_import_warn(im, "%s: the material keeps its factors", im->err->msg);
+    im->err->msg[0] = 0;
+    return EVR_OK;
+}
+
 /* A file's texture: decoded once per colour space. */
 static evr_status load_file(importer *im, const char *key, const char *what, int srgb, int *out)
 {
@@ -187,10 +222,11 @@ static evr_status load_file(importer *im, const char *key, const char *what, int
     memset(&t, 0, sizeof t);
     if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
     st = evr_import_read_file(key, 0, &data, &size, &e);
-    if (st != EVR_OK) return evr_import_fail(im->err, st, "texture %s: %s", what, e.msg);
+    if (st != EVR_OK)
+        return texture_failed(im, evr_import_fail(im->err, st, "texture %s: %s", what, e.msg), out);
     st = decode_image(data, size, what, srgb, &t, im->err);
     free(data);
-    if (st != EVR_OK) return st;
+    if (st != EVR_OK) return texture_failed(im, st, out);
     return add_texture(im, key, srgb, &t, out);
 }
 
@@ -202,7 +238,8 @@ evr_status evr_import_texture_image(importer *im, const char *key, const unsigne
     memset(&t, 0, sizeof t);
     if (!data) return load_file(im, key, what, srgb, out);
     if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
-    if ((st = decode_image(data, n, what, srgb, &t, im->err)) != EVR_OK) return st;
+    if ((st = decode_image(data, n, what, srgb, &t, im->err)) != EVR_OK)
+        return texture_failed(im, st, out);
     return add_texture(im, key, srgb, &t, out);
 }
 
@@ -221,9 +258,12 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         char *end;
         long k = strtol(ai_path + 1, &end, 10);
         if (*end || k < 0 || k >= (long)ai->mNumTextures)
-            return evr_import_fail(im->err, EVR_ERR_FORMAT,
-                                   "material '%s': embedded texture '%s' does not exist", mat_name,
-                                   ai_path);
+            return texture_failed(im,
+                                  evr_import_fail(im->err, EVR_ERR_FORMAT,
+                                                  "material '%s': embedded texture '%s' does not "
+                                                  "exist",
+                                                  mat_name, ai_path),
+                                  out);
         emb = (int)k;
     } else if (short_name(ai_path)[0]) {
         /* aiScene::GetEmbeddedTexture: match by file name without folders */
@@ -263,13 +303,15 @@ evr_status evr_import_texture(importer *im, const char *ai_path, const char *mat
         const struct aiTexture *tex = ai->mTextures[emb];
         if (tex->mHeight == 0) {
             if (!tex->pcData)
-                return evr_import_fail(im->err, EVR_ERR_FORMAT, "texture %s: no image data", what);
+                return texture_failed(
+                    im, evr_import_fail(im->err, EVR_ERR_FORMAT, "texture %s: no image data", what),
+                    out);
             st = decode_image((const unsigned char *)tex->pcData, tex->mWidth, what, srgb, &t,
                               im->err);
         } else {
             st = decode_texels(tex, what, srgb, &t, im->err);
         }
     }
-    if (st != EVR_OK) return st;
+    if (st != EVR_OK) return texture_failed(im, st, out);
     return add_texture(im, key, srgb, &t, out);
 }
