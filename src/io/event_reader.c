@@ -1,4 +1,5 @@
 #include "io/event_reader.h"
+#include "io/aedat4_read.h"
 #include "io/prophesee_read.h"
 #include "io/rosbag_read.h"
 #include "io/byte_order.h"
@@ -648,7 +649,8 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
     if (ext_is(path, "h5") || ext_is(path, "hdf5")) return read_h5(path, ev, n, width, height, err);
     if (ext_is(path, "txt")) st = read_txt(path, ev, n, err);
     else if (ext_is(path, "npy")) st = read_npy(path, ev, n, err);
-    else if (ext_is(path, "raw") || ext_is(path, "dat") || ext_is(path, "bag")) {
+    else if (ext_is(path, "raw") || ext_is(path, "dat") || ext_is(path, "bag") ||
+             ext_is(path, "aedat4") || ext_is(path, "aedat")) {
         char *data;
         size_t size;
         st = evr_file_slurp(path, &data, &size, err);
@@ -658,12 +660,16 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
         else if (ext_is(path, "bag"))
             st = evr_rosbag_parse(path, (const unsigned char *)data, size, ev, n, width, height,
                                   err);
+        else if (ext_is(path, "aedat4") || ext_is(path, "aedat"))
+            st = evr_aedat4_parse(path, (const unsigned char *)data, size, ev, n, width, height,
+                                  err);
         else st = evr_dat_parse(path, (const unsigned char *)data, size, ev, n, width, height, err);
         free(data);
     } else {
         snprintf(
             err->msg, sizeof err->msg,
-            "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .raw, .dat or .bag)",
+            "%s: unknown event file type (expected .h5, .hdf5, .txt, .npy, .raw, .dat, .bag or "
+            ".aedat4)",
             path);
         return EVR_ERR_ARG;
     }

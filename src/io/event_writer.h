@@ -46,5 +46,7 @@ evr_status evr_dat_writer_open(const char *path, const evr_writer_meta *meta,
                                evr_event_writer **out, evr_error *err);
 evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
                                   evr_event_writer **out, evr_error *err);
+evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
+                                  evr_event_writer **out, evr_error *err);
 
 #endif
