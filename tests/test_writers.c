@@ -1,4 +1,6 @@
-/* Event writers (HDF5, text, NPY, Prophesee EVT 2.0, EVT 3.0, DAT, ROS1 bag), the event reader, the JSON builder and the preview images.
+/* Event writers (HDF5, text, NPY, Prophesee EVT 2.0, EVT 3.0, DAT, ROS1 bag; AEDAT 4.0 is
+ * tests/test_aedat4.c's, benchmarked here too), the event reader, the JSON builder and the
+ * preview images.
  * Python (h5py, numpy) reads the files as an independent check when it is installed. */
 #include <dirent.h>
 #include <stdint.h>
@@ -1648,6 +1650,7 @@ int main(void)
     bench_writer(root, "evt3", evr_evt3_writer_open, "bench_evt3.raw");
     bench_writer(root, "dat", evr_dat_writer_open, "bench.dat");
     bench_writer(root, "rosbag", evr_rosbag_writer_open, "bench.bag");
+    bench_writer(root, "aedat4", evr_aedat4_writer_open, "bench.aedat4");
     if (check_failures == 0) remove_tree(root);
     else fprintf(stderr, "test_writers: files kept in %s\n", root);
     (void)python_ok;

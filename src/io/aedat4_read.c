@@ -410,6 +410,8 @@ evr_status evr_aedat4_parse(const char *path, const unsigned char *data, size_t 
     *n = 0;
     if (size < 9 || memcmp(data, "#!AER-DAT", 9) != 0)
         return fail(&r, "not an AEDAT file (no #!AER-DAT4.0 line)");
+    if (size < EVR_AEDAT4_VERSION_LEN && !memcmp(data, EVR_AEDAT4_VERSION, size))
+        return fail(&r, "truncated AEDAT 4.0 header (in its version line)");
     if (size < EVR_AEDAT4_VERSION_LEN || memcmp(data, EVR_AEDAT4_VERSION, EVR_AEDAT4_VERSION_LEN)) {
         size_t v = 9;
         while (v < size && v < 16 && data[v] != '\r' && data[v] != '\n') v++;
@@ -445,7 +447,12 @@ evr_status evr_aedat4_parse(const char *path, const unsigned char *data, size_t 
         }
         id = (int32_t)evr_get_le32(data + pos);
         len = (int32_t)evr_get_le32(data + pos + 4);
-        if (len < 0 || (size_t)len > end - pos - 8) {
+        if (len < 0) {
+            st = fail(&r, "corrupt AEDAT 4.0 packet header at byte %zu (size %" PRId32 ")", pos,
+                      len);
+            break;
+        }
+        if ((size_t)len > end - pos - 8) {
             st = fail(&r, "truncated AEDAT 4.0 packet at byte %zu (%" PRId32 " bytes, %zu left)",
                       pos, len, end - pos - 8);
             break;

@@ -58,7 +58,9 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     pack_job j;
     size_t room = 0, total = 0;
     *bytes = 0;
-    if (!pk->pool) pk->pool = evr_par_pool_new(evr_par_threads(PAR_PACK_THREADS));
+    if (!pk->pool)
+        pk->pool =
+            evr_par_pool_new(evr_par_threads(pk->threads > 0 ? pk->threads : PAR_PACK_THREADS));
     if (!pk->pool) return EVR_PAR_PACK_SERIAL; /* the serial path needs no threads */
     memset(&j, 0, sizeof j);
     j.p = p;

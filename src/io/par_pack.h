@@ -36,6 +36,7 @@ typedef struct {
     evr_par_pool *pool;
     unsigned char *big;
     size_t cap;
+    int threads; /* the pool's threads at most (0: 4); formats that compress ask for more */
 } evr_par_packing;
 
 typedef enum {
