@@ -21,7 +21,7 @@ static void usage(FILE *f)
         "  plot EVENTS [-o PNG]     event rate over time (ON/OFF per bin) and an events-per-pixel heat map\n"
         "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
         "  still SCENE -o OUT.png   one image at one time, optionally with global illumination (--gi)\n"
-        "  convert IN OUT           an event file to another format (h5, txt, npy, EVT 2.0/3.0 raw, dat)\n"
+        "  convert IN OUT           an event file to another format (h5, txt, npy, EVT 2.0/3.0 raw, dat, bag, aedat4)\n"
         "\n"
         "  evray COMMAND --help     options of a command\n"
         "  evray --version          version of evray and its libraries\n",
