@@ -3,7 +3,7 @@
  * complete file holding every event so far), the file's bytes depend only on the events (one
  * write, small writes, large writes packed in parallel parts), a dense millisecond spreads over
  * several packets (checked by tests/test_aedat4.py, which reads the files with dv-processing and
- * aedat), what the format cannot hold is refused, and bad files give one line. */
+ * aedat), what the format cannot hold is refused, and bad or damaged files give one line. */
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -320,6 +320,48 @@ static void test_bad_files(const char *dir)
     free(ev);
 }
 
+/* Random damage (bytes changed anywhere, most in the header and the first packet; the file cut
+ * anywhere): every read either succeeds or fails with one line, never crashes (the sanitizer
+ * build runs this too). */
+static void test_damage(const char *dir)
+{
+    const size_t n = 2000;
+    evr_event *ev = make_events(n, n);
+    char path[512], bad[512];
+    size_t len = 0;
+    uint64_t s = 99;
+    unsigned char *d, *b;
+    snprintf(path, sizeof path, "%s/good.aedat4", dir);
+    snprintf(bad, sizeof bad, "%s/damaged.aedat4", dir);
+    d = ev ? write_events(path, ev, n, n, n, 0, 0, NULL, &len) : NULL;
+    b = d ? malloc(len) : NULL;
+    CHECK(d && b && len > 1000);
+    for (int k = 0; b && k < 600; k++) {
+        evr_event *got = NULL;
+        size_t ngot = 0, cut = len;
+        evr_error err;
+        evr_status st;
+        memcpy(b, d, len);
+        if (k % 4 == 3) cut = (size_t)(rng_next(&s) % len);
+        else
+            for (int j = 0; j < 1 + k % 3; j++) {
+                const size_t span = rng_next(&s) & 1 ? 1200 : len;
+                b[rng_next(&s) % span] = (unsigned char)rng_next(&s);
+            }
+        write_file(bad, b, cut);
+        err.msg[0] = 0;
+        st = evr_events_read(bad, &got, &ngot, NULL, NULL, &err);
+        CHECK(st == EVR_OK || (st == EVR_ERR_FORMAT && got == NULL && strstr(err.msg, bad) &&
+                               !strchr(err.msg, '\n')));
+        free(got);
+    }
+    remove(bad);
+    remove(path);
+    free(b);
+    free(d);
+    free(ev);
+}
+
 int main(void)
 {
     char root[] = "/tmp/evr_test_aedat4_XXXXXX";
@@ -331,6 +373,7 @@ int main(void)
     test_empty(root);
     test_refused(root);
     test_bad_files(root);
+    test_damage(root);
     rmdir(root);
     return check_report("test_aedat4");
 }
