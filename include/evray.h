@@ -184,6 +184,15 @@ typedef struct {
     int gi_bounces;      /* indirect bounces of a photon */
     /* shading: reflections and refractions a camera ray may take (core/path.h) */
     int max_bounces;
+    /* the camera (README, "Camera paths and framing"): camera_path moves it along built-in
+     * motions and/or a TUM trajectory file (the syntax: src/scene/camera_path.h; NULL: its own
+     * motion only); look_from / look_at (when their _set is 1) place it at a world position
+     * and aim it at a world point, replacing its own pose; fov > 0 sets a perspective camera's
+     * vertical field of view in degrees */
+    const char *camera_path;
+    double fov;
+    int look_from_set, look_at_set;
+    double look_from[3], look_at[3];
 } evr_config;
 
 /* Fills c with the defaults (the ideal sensor at 346x260, docs/sensors.md) and sets c->size.
