@@ -403,6 +403,41 @@ static void test_collada_camera(void)
     evr_scene_release(s);
 }
 
+/* ---- a 3DS camera (make_data.py's camera_3ds): Z-up, a keyframer section ---- */
+
+static void test_3ds_camera(void)
+{
+    evr_scene *s = NULL;
+    evr_error err;
+    if (evr_scene_load(DATA "camera.3ds", &s, &err) != EVR_OK) {
+        fprintf(stderr, "camera.3ds: %s\n", err.msg);
+        CHECK(!"camera.3ds loads");
+        return;
+    }
+    CHECK(s->num_cameras == 1 && !s->cameras[0].automatic && !s->cameras[0].ortho);
+    /* lens 43.456 mm across 36 mm: 45 degrees horizontally; no aspect in the file, so the image
+     * gives the vertical angle */
+    CHECK_NEAR(s->cameras[0].xfov, PI_D / 4, 1e-4);
+    CHECK_NEAR(evr_camera_yfov(&s->cameras[0], 2.0f), 2.0 * atan(tan(PI_D / 8) / 2.0), 1e-4);
+    /* (1, -10, 1) in 3DS's Z-up world is (1, 1, 10) in Y-up, once (the node repeats it); it
+     * looks along 3DS +Y (-Z) with 3DS +Z (+Y) up */
+    evr_m34 w = camera_world(s, 0, 0.0);
+    CHECK_NEAR(w.m[0][3], 1.0, 1e-5);
+    CHECK_NEAR(w.m[1][3], 1.0, 1e-5);
+    CHECK_NEAR(w.m[2][3], 10.0, 1e-5);
+    CHECK_NEAR(w.m[2][2], 1.0, 1e-5); /* +Z back */
+    CHECK_NEAR(w.m[1][1], 1.0, 1e-5); /* +Y up */
+    CHECK_NEAR(w.m[0][0], 1.0, 1e-5); /* +X right */
+    /* the L's long bar (3DS x 0..2 at z 0..0.5) lies below and right of the view's centre */
+    {
+        const evr_m34 inv = evr_m34_inverse(&w);
+        const evr_v3 end = evr_m34_point(&inv, evr_v3_make(2, 0.25f, 0));
+        const evr_v3 top = evr_m34_point(&inv, evr_v3_make(0.25f, 2, 0));
+        CHECK(end.x > 0.5f && end.y < 0.0f && top.y > 0.5f && top.x < 0.0f);
+    }
+    evr_scene_release(s);
+}
+
 /* ---- loading from memory: the same glTF handling (STEP read from the JSON) ---- */
 
 static void test_memory(void)
@@ -593,6 +628,7 @@ int main(void)
     test_lights_materials(DATA "lights.glb", 1);
     test_plain();
     test_collada_camera();
+    test_3ds_camera();
     test_memory();
     test_bad_inputs();
     return check_report("test_import");
