@@ -19,8 +19,9 @@
  *       and why: RMS amp degrees of drift, default 0.25, and tremor degrees at 8-12 Hz,
  *       default 0.02; move scene units of drift, default 0.2% of the camera's distance to the
  *       centre; seed, default the run's)
- *   tum:FILE (or FILE alone)  the poses of a TUM trajectory file, which replace the camera's
- *       own (only first in a path): lines "t tx ty tz qx qy qz qw" (# comments, blank lines),
+ *   tum:FILE (or FILE alone, when it has a '.' or '/')  the poses of a TUM trajectory file
+ *       (its name without '+'), which replace the camera's own (only first in a path): lines
+ *       "t tx ty tz qx qy qz qw" (# comments, blank lines),
  *       t in seconds strictly increasing (the first line is scene time 0), the camera's optical
  *       frame (x right, y down, z forward, as TUM, EuRoC and ESIM) to world, poses between
  *       lines interpolated by core/motion.h (lerp and shortest-arc slerp)
