@@ -199,6 +199,15 @@ typedef struct {
     /* scene loading: 1 makes every import warning an error (evr_load_options.strict); the evray
      * program loads the scene with it, evr_sim_new does not read it */
     int strict;
+    /* the camera (README, "Camera paths and framing"): camera_path moves it along built-in
+     * motions and/or a TUM trajectory file (the syntax: src/scene/camera_path.h; NULL: its own
+     * motion only); look_from / look_at (when their _set is 1) place it at a world position
+     * and aim it at a world point, replacing its own pose; fov > 0 sets a perspective camera's
+     * vertical field of view in degrees */
+    const char *camera_path;
+    double fov;
+    int look_from_set, look_at_set;
+    double look_from[3], look_at[3];
 } evr_config;
 
 enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };

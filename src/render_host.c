@@ -97,7 +97,10 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
     rs->num_deforms = h->num_deforms;
     rs->camera_track = cam->node >= 0 ? cam->node : s->num_nodes;
     rs->camera_local = cam->local;
-    rs->camera = evr_camera_intr_make(width, height, cam->yfov);
+    rs->camera = cam->ortho
+                     ? evr_camera_intr_ortho(width, height, cam->ymag)
+                     : evr_camera_intr_make(width, height,
+                                            evr_camera_yfov(cam, (float)width / (float)height));
     rs->ambient = ambient;
     rs->ray_eps = 1e-5f * h->scene_size;
     rs->bsdf_table = h->bsdf_table;

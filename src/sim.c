@@ -8,6 +8,7 @@
 #include "io/preview.h"
 #include "run/run_files.h"
 #include "run/frames_out.h"
+#include "run/camera_poses.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -116,19 +117,45 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         for (i = 0; names[i]; i++)
             if (!strcmp(names[i], c->sensor)) sim->cfg.sensor = names[i];
     }
+    if (c->camera_path) { /* kept: the configuration's strings are the caller's */
+        snprintf(sim->camera_path, sizeof sim->camera_path, "%s", c->camera_path);
+        sim->cfg.camera_path = sim->camera_path;
+    }
     sim->camera = c->camera ? evr_scene_find_camera(s, c->camera) : 0;
+    if ((st = evr_camera_rig_init(&sim->rig, s, sim->camera, c, err)) != EVR_OK) {
+        evr_camera_rig_free(&sim->rig);
+        free(sim);
+        return st;
+    }
+    const double path_end = evr_camera_rig_path_end(&sim->rig);
     sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
     if (c->duration > 0.0) sim->duration = c->duration;
+    else if (path_end > c->start) sim->duration = path_end - c->start; /* the trajectory's */
     else if (s->anim_end > c->start) sim->duration = s->anim_end - c->start;
     else sim->duration = 1.0; /* a static scene: one second unless told */
     sim->num_segments = (int)ceil(sim->duration * sim->fps - 1e-9);
     if (sim->num_segments < 1) sim->num_segments = 1;
-
-    if ((st = evr_render_host_init(&sim->host, s, sim->camera, c->width, c->height, c->ambient,
+    if ((st = evr_camera_rig_setup(&sim->rig, c, c->start, c->start + sim->duration, err)) !=
+            EVR_OK ||
+        (st = evr_render_host_init(&sim->host, s, sim->camera, c->width, c->height, c->ambient,
                                    err)) != EVR_OK) {
+        evr_camera_rig_free(&sim->rig);
         free(sim);
         return st;
     }
+    /* the camera as the rig says: its projection, and a fixed pose or a track of its own */
+    evr_render_scene *rs = &sim->host.rs;
+    rs->camera = sim->rig.ortho ? evr_camera_intr_ortho(c->width, c->height, sim->rig.ymag)
+                                : evr_camera_intr_make(c->width, c->height, sim->rig.yfov);
+    sim->num_tracks = s->num_nodes + 1;
+    if (sim->rig.has_path) {
+        rs->camera_track = sim->num_tracks++;
+        rs->camera_local = evr_m34_identity();
+    } else if (sim->rig.node < 0) {
+        rs->camera_track = s->num_nodes; /* the world frame */
+        rs->camera_local = sim->rig.local;
+    }
+    sim->poses_last = evr_quat_make(1, 0, 0, 0);
     sim->host.rs.max_bounces = c->max_bounces;
     sim->setup.width = c->width;
     sim->setup.height = c->height;
@@ -168,7 +195,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.gi_bounces = c->gi_bounces;
     sim->timestamp_slack_us = timestamp_slack_us(sim);
 
-    int ntracks = s->num_nodes + 1;
+    int ntracks = sim->num_tracks;
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
     sim->par = evr_par_pool_new(evr_par_threads(8)); /* NULL: counted on this thread */
     if (!sim->node_used || !evr_skip_tracker_init(&sim->skip, ntracks) ||
@@ -185,7 +212,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     }
     for (i = 0; i < s->num_instances; i++) mark_used(sim, s->instances[i].node);
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
-    mark_used(sim, s->cameras[sim->camera].node);
+    if (!sim->rig.has_path) mark_used(sim, sim->rig.node);
 
     double t_setup = evr_host_seconds();
     st = make_backend(sim, err);
@@ -205,7 +232,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
-    if ((st = evr_frames_prepare(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_prepare(sim, err)) != EVR_OK ||
+        (st = evr_camera_poses_open(sim, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -253,6 +281,12 @@ static void plan_segment(void *user, int i, evr_planned_segment *out)
         out->track_offset[n] = off;
         out->track_count[n] = c;
         off += c;
+    }
+    if (sim->rig.has_path) { /* the camera's own track, last */
+        out->track_offset[s->num_nodes + 1] = off;
+        out->track_count[s->num_nodes + 1] =
+            evr_camera_rig_keys(&sim->rig, t0, t1, tol, out->keys + off, EVR_MAX_KEYS);
+        off += out->track_count[s->num_nodes + 1];
     }
     out->num_keys = off;
     evr_skip_tracker_update(&sim->skip, out->keys, out->track_offset, out->track_count,
@@ -369,12 +403,24 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.keys = pl->keys;
     seg.track_offset = pl->track_offset;
     seg.track_count = pl->track_count;
-    seg.num_tracks = sim->scene->num_nodes + 1;
+    seg.num_tracks = sim->num_tracks;
     seg.num_keys = pl->num_keys;
     seg.camera_static = pl->track_count[sim->host.rs.camera_track] == 1;
     seg.skip = &pl->plan;
     seg.adapt = sim->setup.adaptive ? &pl->adapt : NULL;
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
+    { /* the camera's poses as the backend renders them */
+        evr_render_scene rs = sim->host.rs;
+        rs.keys = pl->keys;
+        rs.track_offset = pl->track_offset;
+        rs.track_count = pl->track_count;
+        evr_status pst =
+            evr_camera_poses_segment(sim, &rs, seg.t0, seg.t1, i + 1 == sim->num_segments, err);
+        if (pst != EVR_OK) {
+            evr_planner_release(sim->planner, i);
+            return pst;
+        }
+    }
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
     seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
@@ -456,9 +502,8 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
      * one is taken in and written) */
     const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;
     if (!sim->planner) {
-        sim->planner =
-            evr_planner_start(sim->num_segments, (size_t)(sim->scene->num_nodes + 1) * EVR_MAX_KEYS,
-                              sim->scene->num_nodes + 1, plan_segment, sim);
+        sim->planner = evr_planner_start(sim->num_segments, (size_t)sim->num_tracks * EVR_MAX_KEYS,
+                                         sim->num_tracks, plan_segment, sim);
         if (!sim->planner) return nomem(err);
     }
     if ((st = submit_segment(sim, 0, err)) == EVR_OK) submitted = 1;
@@ -519,5 +564,8 @@ void evr_sim_release(evr_sim *sim)
     free(sim->config_json);
     evr_preview_out_release(sim->preview);
     evr_frames_free(sim);
+    evr_camera_poses_discard(sim); /* nothing when the run closed it */
+    free(sim->poses_tmp);
+    evr_camera_rig_free(&sim->rig);
     free(sim);
 }

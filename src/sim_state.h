@@ -4,12 +4,15 @@
 #ifndef EVR_SIM_STATE_H
 #define EVR_SIM_STATE_H
 
+#include <stdio.h>
+
 #include "backend.h"
 #include "run/segment_planner.h"
 #include "prep/skip_plan.h"
 #include "io/event_writer.h"
 #include "run/preview_out.h"
 #include "run/write_queue.h"
+#include "scene/camera_rig.h"
 
 #define EVR_MAX_WRITERS 16 /* formats a run may write (io/event_formats.h) */
 
@@ -30,6 +33,12 @@ struct evr_sim {
     char out_dir[4096];
     int created_dir;
     int camera;
+    evr_camera_rig rig;     /* the camera as the run renders it (scene/camera_rig.h) */
+    char camera_path[4096]; /* the configuration's camera path, kept */
+    int num_tracks;         /* motion tracks: the nodes', the world frame, the camera's own */
+    FILE *poses;            /* camera_poses.txt being written (run/camera_poses.h), or NULL */
+    char *poses_tmp;
+    evr_quat poses_last; /* the last pose's rotation written (the next takes its hemisphere) */
     double fps, duration;
     int num_segments;
     int64_t timestamp_slack_us; /* how far jitter and rounding move a timestamp from its crossing */

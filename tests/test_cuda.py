@@ -4,8 +4,9 @@ compare); with adaptive sampling within 2% and F1 >= 0.97, and the same samples 
 the deforming test scenes (skins and morph targets, tests/deform_assets.py, where the importer
 reads them) likewise, uniformly and adaptively, and with global illumination (F1 >= 0.95); and
 on a scene of hits a material rules out (tests/filter_assets.py's "mixed": an alpha-masked card
-and a single-sided card seen from behind) likewise; and on the scene with every material feature
-(tests/all_materials.py: glint, glass, MASK, BLEND, emission, normal map, culling) likewise. Skipped (exit 77)
+and a single-sided card seen from behind) likewise; on the scene with every material feature
+(tests/all_materials.py: glint, glass, MASK, BLEND, emission, normal map, culling) likewise; with
+camera paths and an orthographic camera likewise. Skipped (exit 77)
 where this build has no CUDA backend or no GPU is usable."""
 import json
 import os
@@ -60,6 +61,25 @@ every = all_materials.write(os.path.join(tmp, "all-materials"))
 cases.append((every, ["--res", "160x120", "--duration", "1.0"]))
 cases.append((every, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
 cases.append((every, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+# camera paths (the camera's own motion track, docs/camera.md), with and without GI, and an
+# orthographic camera (core/camera.h's parallel rays, photons seen along them) over a moving quad
+cases.append(("square", ["--res", "160x160", "--duration", "0.3", "--camera-path", "orbit+shake"]))
+cases.append(("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.3", "--camera-path", "pan:rate=10"]))
+ortho = os.path.join(tmp, "ortho.gltf")
+T.quad_gltf(ortho, animated=True)
+with open(ortho) as f:
+    g = json.load(f)
+g["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 1.5, "ymag": 1.5, "znear": 0.01, "zfar": 100}}]
+with open(ortho, "w") as f:
+    json.dump(g, f)
+cases.append((ortho, ["--res", "128x128", "--duration", "1.0"]))
+with open(mixed) as f:  # GI: photons seen along the parallel rays, between the cards and the wall
+    g = json.load(f)
+g["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2.0, "ymag": 2.0, "znear": 0.01, "zfar": 100}}]
+mixed_ortho = os.path.join(os.path.dirname(mixed), "mixed_ortho.gltf")
+with open(mixed_ortho, "w") as f:
+    json.dump(g, f)
+cases.append((mixed_ortho, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)

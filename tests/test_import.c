@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include "check.h"
 #include "io/png.h"
+#include "scene/framing.h"
 #include "scene/scene.h"
 
 #include <stb/stb_image_write.h>
@@ -30,6 +31,36 @@ static int mesh_index(const evr_scene *s, const char *name)
     for (i = 0; i < s->num_meshes; i++)
         if (!strcmp(s->meshes[i].name, name)) return i;
     return -1;
+}
+
+/* The automatic camera (no camera in the file, a still scene): 45 degrees, looking at the rest
+ * bounds' centre from the direction framing.h picks, close enough that a corner of the bounds
+ * lies at the edge of 90% of a square image and none beyond. */
+static void check_automatic(const evr_scene *s)
+{
+    const evr_camera_desc *c = &s->cameras[0];
+    const evr_v3 ctr = evr_v3_scale(evr_v3_add(s->bounds_min, s->bounds_max), 0.5f);
+    const evr_v3 dir = evr_frame_direction(s, 0.0);
+    const evr_v3 pos = evr_v3_make(c->local.m[0][3], c->local.m[1][3], c->local.m[2][3]);
+    const evr_v3 back = evr_v3_make(c->local.m[0][2], c->local.m[1][2], c->local.m[2][2]);
+    const evr_m34 inv = evr_m34_inverse(&c->local);
+    const double lim = tan(PI_D / 8) * 0.9;
+    double worst = 0.0;
+    CHECK(c->automatic == 1 && c->node == -1 && !c->ortho);
+    CHECK_NEAR(c->yfov, PI_D / 4, 1e-6);
+    CHECK_NEAR(evr_v3_dot(back, dir), 1.0, 1e-5); /* the camera's +Z points back along dir */
+    CHECK_NEAR(evr_v3_len(evr_v3_cross(evr_v3_sub(pos, ctr), dir)), 0.0, 1e-4);
+    for (int k = 0; k < 8; k++) {
+        const evr_v3 p = evr_v3_make(k & 1 ? s->bounds_max.x : s->bounds_min.x,
+                                     k & 2 ? s->bounds_max.y : s->bounds_min.y,
+                                     k & 4 ? s->bounds_max.z : s->bounds_min.z);
+        const evr_v3 q = evr_m34_point(&inv, p);
+        CHECK(q.z < 0.0f);
+        worst = fmax(worst, fmax(fabs(q.x / q.z), fabs(q.y / q.z)) / lim);
+    }
+    CHECK(worst <= 1.0 + 1e-4 && worst > 0.999);
+    CHECK(c->znear > 0.0f);
+    CHECK(evr_scene_find_camera(s, "automatic") == 0);
 }
 
 static double srgb(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
@@ -210,20 +241,9 @@ static void test_lights_materials(const char *path, int glb)
             CHECK(!"unexpected light name");
         }
     }
-    /* no camera in the file: an automatic one looking along -Z at the bounds' centre */
+    /* no camera in the file: an automatic one framing the bounds */
     CHECK(s->num_cameras == 1);
-    if (s->num_cameras == 1) {
-        const evr_camera_desc *c = &s->cameras[0];
-        evr_v3 ctr = evr_v3_scale(evr_v3_add(s->bounds_min, s->bounds_max), 0.5f);
-        float r = 0.5f * evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min));
-        CHECK(c->automatic == 1 && c->node == -1);
-        CHECK_NEAR(c->yfov, PI_D / 4, 1e-6);
-        CHECK_NEAR(c->local.m[0][3], ctr.x, 1e-5);
-        CHECK_NEAR(c->local.m[1][3], ctr.y, 1e-5);
-        CHECK_NEAR(c->local.m[2][3], ctr.z + r / sin(PI_D / 8), 1e-4);
-        CHECK_NEAR(c->local.m[2][2], 1.0, 1e-6);
-        CHECK(evr_scene_find_camera(s, "automatic") == 0);
-    }
+    if (s->num_cameras == 1) check_automatic(s);
     /* bounds: the cube (-0.5..0.5) and the triangles at x = 2 and x = -2 */
     CHECK_NEAR(s->bounds_min.x, -2.0, 1e-6);
     CHECK_NEAR(s->bounds_max.x, 3.0, 1e-6);
@@ -336,18 +356,24 @@ static void test_plain(void)
     CHECK_NEAR(s->bounds_max.x, 1.5, 1e-6);
     CHECK_NEAR(s->bounds_min.z, -0.5, 1e-6);
     CHECK_NEAR(s->bounds_max.z, 0.5, 1e-6);
+    /* the headlight shines along the automatic camera's view, from above-left */
     if (s->num_lights == 1) {
         const evr_light *l = &s->lights[0];
+        const evr_m34 *m = &s->cameras[0].local;
+        const evr_v3 fwd = evr_v3_make(-m->m[0][2], -m->m[1][2], -m->m[2][2]);
+        const evr_v3 up = evr_v3_make(m->m[0][1], m->m[1][1], m->m[2][1]);
+        const evr_v3 right = evr_v3_make(m->m[0][0], m->m[1][0], m->m[2][0]);
         CHECK(l->node == -1);
-        CHECK(l->direction.z < -0.9f && l->direction.y < 0.0f && l->direction.x > 0.0f);
+        CHECK(evr_v3_dot(l->direction, fwd) > 0.9f && evr_v3_dot(l->direction, up) < 0.0f &&
+              evr_v3_dot(l->direction, right) > 0.0f);
     }
-    /* the automatic camera sees the whole bounding sphere within 45 degrees */
+    /* two cubes side by side: seen from in front, turned and raised (more of their faces) */
+    check_automatic(s);
     {
-        const evr_camera_desc *c = &s->cameras[0];
-        double r = 0.5 * evr_v3_len(evr_v3_sub(s->bounds_max, s->bounds_min));
-        double dist = c->local.m[2][3];
-        CHECK_NEAR(asin(r / dist) * 2.0, PI_D / 4, 1e-5);
-        CHECK(c->znear > 0.0f && c->znear < dist - r);
+        const evr_v3 d = evr_frame_direction(s, 0.0);
+        CHECK_NEAR(d.x, sin(PI_D / 4) * cos(PI_D / 6), 1e-5);
+        CHECK_NEAR(d.y, 0.5, 1e-5);
+        CHECK_NEAR(d.z, cos(PI_D / 4) * cos(PI_D / 6), 1e-5);
     }
     CHECK(s->anim_start == 0.0 && s->anim_end == 0.0);
     evr_scene_release(s);
@@ -374,6 +400,41 @@ static void test_collada_camera(void)
         CHECK_NEAR(w.m[2][2], 1.0, 1e-5);
     }
     CHECK(strcmp(s->format, "Collada Importer") == 0);
+    evr_scene_release(s);
+}
+
+/* ---- a 3DS camera (make_data.py's camera_3ds): Z-up, a keyframer section ---- */
+
+static void test_3ds_camera(void)
+{
+    evr_scene *s = NULL;
+    evr_error err;
+    if (evr_scene_load(DATA "camera.3ds", &s, &err) != EVR_OK) {
+        fprintf(stderr, "camera.3ds: %s\n", err.msg);
+        CHECK(!"camera.3ds loads");
+        return;
+    }
+    CHECK(s->num_cameras == 1 && !s->cameras[0].automatic && !s->cameras[0].ortho);
+    /* lens 43.456 mm across 36 mm: 45 degrees horizontally; no aspect in the file, so the image
+     * gives the vertical angle */
+    CHECK_NEAR(s->cameras[0].xfov, PI_D / 4, 1e-4);
+    CHECK_NEAR(evr_camera_yfov(&s->cameras[0], 2.0f), 2.0 * atan(tan(PI_D / 8) / 2.0), 1e-4);
+    /* (1, -10, 1) in 3DS's Z-up world is (1, 1, 10) in Y-up, once (the node repeats it); it
+     * looks along 3DS +Y (-Z) with 3DS +Z (+Y) up */
+    evr_m34 w = camera_world(s, 0, 0.0);
+    CHECK_NEAR(w.m[0][3], 1.0, 1e-5);
+    CHECK_NEAR(w.m[1][3], 1.0, 1e-5);
+    CHECK_NEAR(w.m[2][3], 10.0, 1e-5);
+    CHECK_NEAR(w.m[2][2], 1.0, 1e-5); /* +Z back */
+    CHECK_NEAR(w.m[1][1], 1.0, 1e-5); /* +Y up */
+    CHECK_NEAR(w.m[0][0], 1.0, 1e-5); /* +X right */
+    /* the L's long bar (3DS x 0..2 at z 0..0.5) lies below and right of the view's centre */
+    {
+        const evr_m34 inv = evr_m34_inverse(&w);
+        const evr_v3 end = evr_m34_point(&inv, evr_v3_make(2, 0.25f, 0));
+        const evr_v3 top = evr_m34_point(&inv, evr_v3_make(0.25f, 2, 0));
+        CHECK(end.x > 0.5f && end.y < 0.0f && top.y > 0.5f && top.x < 0.0f);
+    }
     evr_scene_release(s);
 }
 
@@ -576,6 +637,7 @@ int main(void)
     test_lights_materials(DATA "lights.glb", 1);
     test_plain();
     test_collada_camera();
+    test_3ds_camera();
     test_memory();
     test_bad_inputs();
     return check_report("test_import");

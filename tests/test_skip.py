@@ -2,7 +2,8 @@
 and the moving square, ideal sensor and the davis346 noise model, the deforming test scenes
 (skins and morph targets, tests/deform_assets.py, where the importer reads them), a scene of
 hits a material rules out (tests/filter_assets.py's "mixed"), the scene with every material
-feature (tests/all_materials.py), on the CPU and
+feature (tests/all_materials.py), camera paths (a moving camera, and a trajectory that holds still
+between moves), on the CPU and
 (where a GPU is usable) on CUDA; and it really skips: run.json accounts for the samples traced
 and the pixels skipped per segment."""
 import os
@@ -44,6 +45,14 @@ cases.append((mixed, ["--res", "64x48", "--duration", "1.0"]))
 import all_materials  # noqa: E402
 every = all_materials.write(os.path.join(tmp, "all-materials"))
 cases.append((every, ["--res", "64x48", "--duration", "1.0"]))
+# camera paths (docs/camera.md): a moving camera is "everything changes", and a trajectory that
+# holds still, then moves, then holds again skips exactly where it holds
+still_move = os.path.join(tmp, "still-move.txt")
+with open(still_move, "w") as f:
+    f.write("0 0 0 4 1 0 0 0\n0.2 0 0 4 1 0 0 0\n0.3 0.05 0 4 0.9999 0 -0.01 0\n0.5 0.05 0 4 0.9999 0 -0.01 0\n")
+cases.append(("square", ["--res", "64x48", "--duration", "0.4", "--camera-path", "orbit+shake"]))
+cases.append(("square", ["--res", "64x48", "--duration", "0.5", "--camera-path", "tum:" + still_move]))
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--camera-path", "pan:rate=5"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
         runs = {}
@@ -70,13 +79,19 @@ for backend in backends:
         # traces them all
         untouched = ss["samples"] - ss["pixels_skipped"] * 10
         T.check(ss["samples_traced"] <= untouched, f"{backend} {scene}: traced + skipped samples <= all samples")
-        if scene in ("square", "cornell"):
+        path = extra[extra.index("--camera-path") + 1] if "--camera-path" in extra else None
+        if scene in ("square", "cornell") and not path:
             T.check(ss["samples_traced"] < untouched, f"{backend} {scene}: pixels settle after their first sample")
         if scene == every:
             T.check(ss["pixels_skipped"] > 0, f"{backend} all materials: pixels skip while the lamp holds still")
-        if scene in ("square", "cornell"):   # a small mover on a still background
+        if scene in ("square", "cornell") and not path:   # a small mover on a still background
             T.check(ss["samples_traced"] < 0.5 * ss["samples"], f"{backend} {scene}: most samples skipped")
             T.check(ss["rays"] < sb["rays"], f"{backend} {scene}: fewer rays")
+        if path and path.startswith("tum:"):  # still over segments 0-5 and 9-14, moving over 6-8
+            T.check(sum(per[1:6]) > 0 and per[6:9] == [0, 0, 0] and sum(per[10:]) > 0,
+                    f"{backend} {scene} {path}: skips while the camera holds still only ({per})")
+        elif path:
+            T.check(ss["pixels_skipped"] == 0, f"{backend} {scene} {path}: a moving camera skips nothing")
 # inside one of the eye's fixations (3.5-3.8 s) nothing moves: after the first segment, whose pixels
 # settle after one sample each, every pixel skips every segment (still nodes must be bitwise still:
 # one key per segment, held curve values exact, the same key from segment to segment)

@@ -250,7 +250,8 @@ evr_status evr_config_validate(const evr_config *given, const evr_scene *s, evr_
                 names[0] ? names : "none");
         }
         double end = s->anim_end;
-        if (end > 0.0) {
+        if (end > 0.0 && !c->camera_path) { /* a camera path may go on past it (the scene
+                                               holds its last pose) */
             if (c->start >= end)
                 BAD("start time %g s is at or beyond the end of the animation (%g s)", c->start,
                     end);

@@ -3,9 +3,12 @@
 #include "config/config_table.h"
 #include "evray_experimental.h"
 #include "io/event_formats.h"
+#include "scene/camera_path.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define F(field) offsetof(evr_config, field)
@@ -15,6 +18,10 @@
 static int is_adaptive(const evr_config *c) { return c->sampling == EVR_SAMPLING_ADAPTIVE; }
 static int has_gi(const evr_config *c) { return c->gi != 0; }
 static int has_frames(const evr_config *c) { return c->frames_out != NULL; }
+static int has_camera_path(const evr_config *c) { return c->camera_path != NULL; }
+static int has_look_from(const evr_config *c) { return c->look_from_set; }
+static int has_look_at(const evr_config *c) { return c->look_at_set; }
+static int has_fov(const evr_config *c) { return c->fov > 0.0; }
 
 /* ---- values that are not one field's ---- */
 static void json_scene(evr_json *j, const evr_config *c, const evr_config_run *r)
@@ -44,6 +51,20 @@ static void json_max_dt(evr_json *j, const evr_config *c, const evr_config_run *
 static void json_frames_fps(evr_json *j, const evr_config *c, const evr_config_run *r)
 {
     evr_json_number(j, c->frames_fps > 0.0 ? c->frames_fps : r->fps);
+}
+static void json_vec3(evr_json *j, const double v[3])
+{
+    evr_json_begin_array(j);
+    for (int k = 0; k < 3; k++) evr_json_number(j, v[k]);
+    evr_json_end_array(j);
+}
+static void json_look_from(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    json_vec3(j, c->look_from);
+}
+static void json_look_at(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    json_vec3(j, c->look_at);
 }
 static void json_formats(evr_json *j, const evr_config *c, const evr_config_run *r)
 {
@@ -101,6 +122,52 @@ static evr_status parse_sensor(evr_config *c, const char *v, evr_error *err)
     char list[128];
     if (!name) FAIL("--sensor: unknown sensor '%s' (%s)", v, evr_sensor_list(list, sizeof list));
     c->sensor = name;
+    return EVR_OK;
+}
+
+/* X,Y,Z: three finite numbers. */
+static evr_status parse_vec3(const char *opt, const char *v, double out[3], evr_error *err)
+{
+    const char *p = v;
+    for (int k = 0; k < 3; k++) {
+        char *end;
+        errno = 0;
+        out[k] = strtod(p, &end);
+        if (end == p || errno || !isfinite(out[k]) || *end != (k < 2 ? ',' : 0))
+            FAIL("%s expects X,Y,Z (three numbers, scene units), got '%s'", opt, v);
+        p = end + 1;
+    }
+    return EVR_OK;
+}
+static evr_status parse_look_from(evr_config *c, const char *v, evr_error *err)
+{
+    evr_status st = parse_vec3("--look-from", v, c->look_from, err);
+    if (st == EVR_OK) c->look_from_set = 1;
+    return st;
+}
+static evr_status parse_look_at(evr_config *c, const char *v, evr_error *err)
+{
+    evr_status st = parse_vec3("--look-at", v, c->look_at, err);
+    if (st == EVR_OK) c->look_at_set = 1;
+    return st;
+}
+/* The path's syntax (its file is read when a run starts, evr_camera_rig_init). */
+static evr_status check_camera_path(const evr_config *c, evr_error *err)
+{
+    evr_camera_path p;
+    evr_status st = evr_camera_path_parse(c->camera_path, 0, &p, err);
+    evr_camera_path_free(&p);
+    return st;
+}
+static evr_status check_look(const evr_config *c, evr_error *err)
+{
+    for (int k = 0; k < 3; k++)
+        if ((c->look_from_set && !isfinite(c->look_from[k])) ||
+            (c->look_at_set && !isfinite(c->look_at[k])))
+            FAIL("look from and look at must be finite points");
+    if (c->look_from_set && c->look_at_set && c->look_from[0] == c->look_at[0] &&
+        c->look_from[1] == c->look_at[1] && c->look_from[2] == c->look_at[2])
+        FAIL("--look-from and --look-at are the same point: the camera would look nowhere");
     return EVR_OK;
 }
 
@@ -902,6 +969,64 @@ static const evr_config_option table[] = {
              "goes on (a material whose texture is missing keeps its factors)",
      .json = "strict",
      .json_rank = 49},
+    /* ---- the camera ---- */
+    {.name = "camera_path",
+     .type = EVR_OPT_STRING,
+     .offset = F(camera_path),
+     .applies = has_camera_path,
+     .check = check_camera_path,
+     .flag = "--camera-path",
+     .section = "camera (README: camera paths and framing)",
+     .label = "--camera-path P",
+     .help = "move the camera (on top of its own motion): orbit[:period=S][:centre=X,Y,Z]\n"
+             "[:axis=X,Y,Z], dolly[:speed=U][:dir=X,Y,Z] (or fly), pan[:rate=D] or\n"
+             "pan:amp=D[:period=S], tilt (the same), shake[:amp=D][:tremor=D][:move=U]\n"
+             "[:seed=N] (hand-held), joined by + (orbit+shake); or tum:FILE, a TUM\n"
+             "trajectory 't tx ty tz qx qy qz qw' that replaces its pose; scene units,\n"
+             "seconds, degrees. The pose used is written to camera_poses.txt",
+     .json = "camera_path",
+     .json_rank = 50,
+     .json_if = has_camera_path},
+    {.name = "look_from",
+     .flag = "--look-from",
+     .parse = parse_look_from,
+     .check = check_look,
+     .label = "--look-from X,Y,Z",
+     .help = "place the camera there (world), fixed (default: where it is; with\n"
+             "--look-at alone, its position at the start)",
+     .json = "look_from",
+     .json_rank = 51,
+     .json_if = has_look_from,
+     .json_value = json_look_from},
+    {.name = "look_at",
+     .flag = "--look-at",
+     .parse = parse_look_at,
+     .label = "--look-at X,Y,Z",
+     .help = "aim the camera at that point (default with --look-from: the centre of\n"
+             "the scene's bounds over its animation); also the orbit's centre",
+     .json = "look_at",
+     .json_rank = 52,
+     .json_if = has_look_at,
+     .json_value = json_look_at},
+    {.name = "fov",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(fov),
+     .def = 0.0,
+     .lo = 0,
+     .hi = 180,
+     .hi_open = 1,
+     .what = "field of view must be between 0 (the camera's own) and 180 degrees",
+     .flag = "--fov",
+     .cli_lo = 0,
+     .cli_hi = 180,
+     .cli_lo_open = 1,
+     .cli_what = "%s must be between 0 and 180 degrees (got %s)",
+     .label = "--fov DEG",
+     .help = "vertical field of view of a perspective camera (default: the camera's\n"
+             "own; the automatic camera's 45, framed again for it)",
+     .json = "fov",
+     .json_rank = 53,
+     .json_if = has_fov},
 };
 
 const evr_config_option *evr_config_table(int *count)

@@ -158,7 +158,7 @@ EVR_HD static inline void evr_path_radiance(const evr_render_scene *rs, const ev
     evr_path_stack st;
     st.n = 0;
     out[0] = out[1] = out[2] = 0.0f;
-    evr_path_shade(rs, s, d, acc, w, evr_camera_pixel_spread(&rs->camera) * t_hit, 0, -1, &st, out);
+    evr_path_shade(rs, s, d, acc, w, evr_camera_cone(&rs->camera, t_hit), 0, -1, &st, out);
     if (st.n > 0) {
         *deep |= EVR_DEEP_PATH;
         evr_path_follow(rs, o, f, pl, &st, rays, deep, out);

@@ -65,6 +65,11 @@ EVR_HD static inline int evr_photon_view_ray(const evr_render_scene *rs, const e
     evr_v3 cam = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
     evr_v3 d = evr_v3_sub(cam, s->p);
     float dist = evr_v3_len(d);
+    if (rs->camera.ortho) { /* the camera's ray through s: straight back to its plane */
+        const evr_v3 back = evr_v3_norm(evr_m34_vector(&pose, evr_v3_make(0.0f, 0.0f, 1.0f)));
+        dist = evr_v3_dot(d, back);
+        d = evr_v3_scale(back, dist);
+    }
     if (!(dist > 0.0f) || evr_v3_dot(d, s->n) <= 0.0f) return 0;
     if (!evr_photon_pixel(&rs->camera, &inv, s->p, margin, x, y)) return 0;
     r->org = s->p;
@@ -132,7 +137,8 @@ EVR_HD static inline evr_ray evr_photon_cell_ray(const evr_render_scene *rs, con
 
 /* A cell's view (gbuf, 8 floats) from the surface s met at distance t along its ray; fwd: the
  * camera's forward axis. The area is the pixel's at unit distance * depth^2 * cos(off-axis
- * angle) / |cos of the incidence| (the cosine at least 0.1). */
+ * angle) / |cos of the incidence| (the cosine at least 0.1); an orthographic camera's pixel has
+ * the same area at every depth. */
 EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v3 fwd,
                                                const evr_surface *s, evr_ray ray, float t,
                                                float g[8])
@@ -147,7 +153,12 @@ EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v
     g[3] = s->n.x;
     g[4] = s->n.y;
     g[5] = s->n.z;
-    g[6] = a * z * z * ca / ct;
+    if (rs->camera.ortho) {
+        const float px = evr_camera_pixel_size(&rs->camera, t);
+        g[6] = px * px / ct;
+    } else {
+        g[6] = a * z * z * ca / ct;
+    }
     g[7] = 0.0f;
 }
 

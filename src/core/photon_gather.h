@@ -116,7 +116,7 @@ EVR_HD static inline evr_gather_window evr_photon_gather_window(const evr_photon
     w.r = r;
     w.r2 = r * r;
     w.s2 = 0.25f * w.r2;
-    w.pix = 2.0f * cam->tan_half_y * fmaxf(cam_dist, 1e-6f) / (float)cam->height;
+    w.pix = evr_camera_pixel_size(cam, cam_dist);
     float hf = ceilf(r / w.pix) + 1.0f;
     w.h = hf > (float)gp->max_window ? gp->max_window : (int)hf;
     w.cx = px + b->margin;

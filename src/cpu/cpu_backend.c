@@ -139,7 +139,6 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     float acc[PACKET][3];
     _Alignas(32) int vmask[PACKET]; /* Embree reads the valid mask with aligned vector loads */
     int hit[PACKET], inst_of[PACKET], i, l;
-    const float spread = evr_camera_pixel_spread(&rs->camera); /* the pixels' ray cones */
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     for (i = 0; i < PACKET; i++) {
@@ -176,7 +175,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         inst_of[i] = inst;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, fs[i], ray[i],
-                       rh.ray.tfar[i], spread * rh.ray.tfar[i], &s[i]);
+                       rh.ray.tfar[i], evr_camera_cone(&rs->camera, rh.ray.tfar[i]), &s[i]);
     }
     /* core/shade.h's steps light by light: each light's shadow rays as one packet; a blocked
      * ray in a scene with translucent surfaces is followed through them one ray at a time

@@ -108,7 +108,7 @@ static void *gbuf_worker(void *arg)
             if (!c->tr->closest(c->tr->user, ray, 0.0f, INFINITY, c->f, &h)) continue;
             evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), c->f);
             evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, c->f, ray, h.t,
-                           evr_camera_pixel_spread(&rs->camera) * h.t, &s);
+                           evr_camera_cone(&rs->camera, h.t), &s);
             evr_photon_cell_view(rs, c->fwd, &s, ray, h.t, g);
         }
     }

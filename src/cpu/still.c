@@ -99,16 +99,17 @@ static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, f
     evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
-/* The surface ray meets beyond tnear; spread: the angle of its cone (textures are filtered by
- * spread * the distance; 0: the sharpest level). */
-static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, float spread, evr_surface *s,
-                      const evr_material_params **mat, int *inst)
+/* The surface ray meets beyond tnear; cam: the camera whose pixel cone the ray carries (textures
+ * are filtered by the cone's width there; NULL: the sharpest level). */
+static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, const evr_camera_intr *cam,
+                      evr_surface *s, const evr_material_params **mat, int *inst)
 {
     const evr_render_scene *rs = c->rs;
     evr_trace_hit h;
     if (!c->tr.closest(c->tr.user, ray, tnear, INFINITY, 0.0f, &h)) return 0;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), 0.0f);
-    evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, 0.0f, ray, h.t, spread * h.t, s);
+    evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, 0.0f, ray, h.t,
+                   cam ? evr_camera_cone(cam, h.t) : 0.0f, s);
     *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
     if (inst) *inst = h.inst;
     return 1;
@@ -150,7 +151,7 @@ static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_mat
         r.org = s.p;
         r.dir = wo;
         /* the path's bounces sample textures sharply: many paths average them */
-        if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), 0.0f, &y, &my, NULL)) return;
+        if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), NULL, &y, &my, NULL)) return;
         float acc[3], em[3];
         const evr_v3 back = evr_v3_scale(wo, -1.0f);
         direct_lights(c, &y, back, acc); /* the BSDF's direct light, RGB radiance */
@@ -181,8 +182,7 @@ static void shade_row(shade_ctx *c, int y)
         int inst;
         rgb[0] = rgb[1] = rgb[2] = dir[0] = dir[1] = dir[2] = 0.0f;
         o->instance[i] = -1;
-        if (!surface_of(c, ray, 0.0f, evr_camera_pixel_spread(&rs->camera), &s, &mat, &inst))
-            continue;
+        if (!surface_of(c, ray, 0.0f, &rs->camera, &s, &mat, &inst)) continue;
         o->instance[i] = inst;
         const evr_v3 wo = evr_v3_scale(ray.dir, -1.0f);
         direct_lights(c, &s, wo, acc);

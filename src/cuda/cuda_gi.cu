@@ -167,7 +167,7 @@ __global__ void __launch_bounds__(BLOCK)
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), f);
         evr_surface s;
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, f, ray, h.t,
-                       evr_camera_pixel_spread(&rs->camera) * h.t, &s);
+                       evr_camera_cone(&rs->camera, h.t), &s);
         evr_photon_cell_view(rs, fwd, &s, ray, h.t, g);
     }
     for (int k = 0; k < 8; k++) buf.gbuf[8 * (size_t)cell + k] = g[k];

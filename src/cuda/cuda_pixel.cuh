@@ -106,7 +106,7 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
     *cam_org = ray.org;
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[hit.instance].track), f);
     evr_surface_at(rs, hit.instance, hit.prim, hit.u, hit.v, &xf, f, ray, hit.t,
-                   evr_camera_pixel_spread(&rs->camera) * hit.t, s);
+                   evr_camera_cone(&rs->camera, hit.t), s);
     struct evr_occlusion occ;
     occ.a = &a;
     occ.layout = LAYOUT;

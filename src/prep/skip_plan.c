@@ -588,7 +588,8 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
     }
     if (pl->all_min) return;
     /* a world displacement d at distance r from the camera moves the image by at most
-     * d / r * f_px * (1 + tx^2 + ty^2) pixels (the pinhole's largest stretch, at the corners) */
+     * d / r * f_px * (1 + tx^2 + ty^2) pixels (the pinhole's largest stretch, at the corners);
+     * an orthographic camera's image by d / (the pixel's size) */
     evr_m34 pose = evr_rs_camera_pose(rs, 0.0f);
     evr_v3 eye = evr_v3_make(pose.m[0][3], pose.m[1][3], pose.m[2][3]);
     const float ty = rs->camera.tan_half_y, tx = ty * rs->camera.aspect;
@@ -629,8 +630,15 @@ void evr_adapt_plan_build(const evr_skip_tracker *t, const evr_scene *s, const e
                          (float)seconds;
             jump += stretch * dk->motion[di].jump;
         }
-        float jump_px = jump * px_per_rad / r;
-        speed = r > 0.0f ? speed * px_per_rad / r : INFINITY;
+        float jump_px;
+        if (rs->camera.ortho) { /* parallel rays: a displacement moves the image as far anywhere */
+            const float px_per_unit = 1.0f / evr_camera_pixel_size(&rs->camera, 0.0f);
+            jump_px = jump * px_per_unit;
+            speed *= px_per_unit;
+        } else {
+            jump_px = jump * px_per_rad / r;
+            speed = r > 0.0f ? speed * px_per_rad / r : INFINITY;
+        }
         if (!(speed >= 0.0f)) speed = INFINITY;
         if (pl->num_boxes < EVR_SKIP_MAX_BOXES) {
             b = pl->num_boxes++;

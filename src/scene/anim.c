@@ -138,11 +138,7 @@ static int probe_points(const evr_scene *s, int node, float size, evr_v3 *p)
                                   (i & 2) ? n->bounds_max.y : n->bounds_min.y,
                                   (i & 4) ? n->bounds_max.z : n->bounds_min.z);
     }
-    p[np++] = evr_v3_make(0, 0, 0);
-    p[np++] = evr_v3_make(size, 0, 0);
-    p[np++] = evr_v3_make(0, size, 0);
-    p[np++] = evr_v3_make(0, 0, size);
-    return np;
+    return np + evr_motion_frame_probes(size, p + np);
 }
 
 /* Largest distance between where a and b put the probe points. */
@@ -157,10 +153,8 @@ static float probe_error(const evr_m34 *a, const evr_m34 *b, const evr_v3 *p, in
     return worst;
 }
 
-/* Appends the key times of a node's curves and its ancestors' curves that lie strictly inside
- * (t0, t1): where a piecewise curve bends, the check must look. Returns the new count. */
-static int inner_key_times(const evr_scene *s, int node, double t0, double t1, double *out, int n,
-                           int cap)
+int evr_node_inner_key_times(const evr_scene *s, int node, double t0, double t1, double *out, int n,
+                             int cap)
 {
     int guard = 0;
     while (node >= 0 && node < s->num_nodes && guard++ <= s->num_nodes) {
@@ -184,41 +178,29 @@ static int inner_key_times(const evr_scene *s, int node, double t0, double t1, d
 /* Rotation step between two unit quaternions is below 120 degrees: |dot| > cos(60 degrees). */
 static int rotation_step_ok(evr_quat a, evr_quat b) { return fabsf(evr_quat_dot(a, b)) > 0.5f; }
 
-#define EVR_MAX_INNER_TIMES 256
-
-int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, float tol,
-                         evr_motion_key *keys, int max_keys)
+int evr_motion_fit_keys(const evr_motion_fit *fit, double t0, double t1, evr_motion_key *keys,
+                        int max_keys)
 {
-    evr_v3 probes[12];
-    double inner[EVR_MAX_INNER_TIMES];
-    float size, limit;
-    int np, ninner, cap, n, i, k;
+    const evr_v3 *probes = fit->probes;
+    const double *inner = fit->inner;
+    const int np = fit->num_probes, ninner = fit->num_inner;
+    const float limit = fit->limit;
+    int cap, n, i, k;
 
-    if (!s || !keys || max_keys < 1) return 0;
+    if (!keys || max_keys < 1) return 0;
     {
-        evr_m34 m0 = evr_node_world_at(s, node, t0);
+        evr_m34 m0 = fit->pose(fit->user, t0);
         keys[0] = evr_motion_key_from_matrix(&m0);
     }
-    if (max_keys < 2 || node < 0 || node >= s->num_nodes || !(t1 > t0) ||
-        !evr_node_chain_animated(s, node))
-        return 1;
+    if (max_keys < 2 || !(t1 > t0) || !fit->moves) return 1;
 
     /* Largest 2^k + 1 that fits. */
     cap = 2;
     while ((cap - 1) * 2 + 1 <= max_keys) cap = (cap - 1) * 2 + 1;
 
-    {
-        evr_v3 ext = evr_v3_sub(s->bounds_max, s->bounds_min);
-        size = evr_v3_len(ext);
-        if (!(size > 0.0f) || !isfinite(size)) size = 1.0f;
-    }
-    limit = (tol > 0.0f ? tol : 1e-4f) * size;
-    np = probe_points(s, node, size, probes);
-    ninner = inner_key_times(s, node, t0, t1, inner, 0, EVR_MAX_INNER_TIMES);
-
     /* Start with the two end keys, then double the number of intervals, reusing old keys. */
     {
-        evr_m34 m1 = evr_node_world_at(s, node, t1);
+        evr_m34 m1 = fit->pose(fit->user, t1);
         keys[1] = evr_motion_key_from_matrix(&m1);
     }
     n = 2;
@@ -243,15 +225,15 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
             static const double fr[3] = {0.25, 0.5, 0.75};
             for (k = 0; k < 3 && ok; k++) {
                 double f = ((double)i + fr[k]) / (double)(n - 1);
-                evr_m34 truth = evr_node_world_at(s, node, t0 + span * f);
+                evr_m34 truth = fit->pose(fit->user, t0 + span * f);
                 evr_m34 approx = evr_motion_eval(tr, (float)f);
                 if (probe_error(&truth, &approx, probes, np) > limit) ok = 0;
             }
         }
-        /* Where a curve bends. */
+        /* Where the motion bends. */
         for (i = 0; i < ninner && ok; i++) {
             double f = (inner[i] - t0) / span;
-            evr_m34 truth = evr_node_world_at(s, node, inner[i]);
+            evr_m34 truth = fit->pose(fit->user, inner[i]);
             evr_m34 approx = evr_motion_eval(tr, (float)f);
             if (probe_error(&truth, &approx, probes, np) > limit) ok = 0;
         }
@@ -260,15 +242,15 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
             /* Still in the segment (every checked point where the first key is): one key. The
              * world matrices are compared, not the keys' matrices (a key's rebuilt matrix is off
              * by rounding from the matrix it came from). */
-            evr_m34 a = evr_node_world_at(s, node, t0), b = evr_node_world_at(s, node, t1);
+            evr_m34 a = fit->pose(fit->user, t0), b = fit->pose(fit->user, t1);
             if (probe_error(&a, &b, probes, np) <= limit * 1e-3f) {
                 int still = 1;
                 for (i = 0; i < ninner && still; i++) {
-                    evr_m34 m = evr_node_world_at(s, node, inner[i]);
+                    evr_m34 m = fit->pose(fit->user, inner[i]);
                     if (probe_error(&a, &m, probes, np) > limit * 1e-3f) still = 0;
                 }
                 for (k = 1; k < 4 && still; k++) {
-                    evr_m34 m = evr_node_world_at(s, node, t0 + span * 0.25 * k);
+                    evr_m34 m = fit->pose(fit->user, t0 + span * 0.25 * k);
                     if (probe_error(&a, &m, probes, np) > limit * 1e-3f) still = 0;
                 }
                 if (still) return 1;
@@ -281,10 +263,63 @@ int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, flo
             int n2 = (n - 1) * 2 + 1;
             for (i = n - 1; i >= 1; i--) keys[2 * i] = keys[i];
             for (i = 1; i < n2; i += 2) {
-                evr_m34 m = evr_node_world_at(s, node, t0 + span * (double)i / (double)(n2 - 1));
+                evr_m34 m = fit->pose(fit->user, t0 + span * (double)i / (double)(n2 - 1));
                 keys[i] = evr_motion_key_from_matrix(&m);
             }
             n = n2;
         }
     }
+}
+
+float evr_motion_fit_size(const evr_scene *s)
+{
+    evr_v3 ext = evr_v3_sub(s->bounds_max, s->bounds_min);
+    float size = evr_v3_len(ext);
+    if (!(size > 0.0f) || !isfinite(size)) size = 1.0f;
+    return size;
+}
+
+int evr_motion_frame_probes(float size, evr_v3 *p)
+{
+    p[0] = evr_v3_make(0, 0, 0);
+    p[1] = evr_v3_make(size, 0, 0);
+    p[2] = evr_v3_make(0, size, 0);
+    p[3] = evr_v3_make(0, 0, size);
+    return 4;
+}
+
+typedef struct {
+    const evr_scene *s;
+    int node;
+} node_pose;
+
+static evr_m34 node_pose_at(const void *user, double t)
+{
+    const node_pose *np = user;
+    return evr_node_world_at(np->s, np->node, t);
+}
+
+int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, float tol,
+                         evr_motion_key *keys, int max_keys)
+{
+    evr_v3 probes[12];
+    double inner[EVR_MAX_INNER_TIMES];
+    node_pose np = {s, node};
+    evr_motion_fit fit;
+    float size;
+
+    if (!s || !keys || max_keys < 1) return 0;
+    memset(&fit, 0, sizeof fit);
+    fit.pose = node_pose_at;
+    fit.user = &np;
+    fit.moves = node >= 0 && node < s->num_nodes && evr_node_chain_animated(s, node);
+    if (fit.moves && max_keys >= 2 && t1 > t0) {
+        size = evr_motion_fit_size(s);
+        fit.limit = (tol > 0.0f ? tol : 1e-4f) * size;
+        fit.probes = probes;
+        fit.num_probes = probe_points(s, node, size, probes);
+        fit.inner = inner;
+        fit.num_inner = evr_node_inner_key_times(s, node, t0, t1, inner, 0, EVR_MAX_INNER_TIMES);
+    }
+    return evr_motion_fit_keys(&fit, t0, t1, keys, max_keys);
 }

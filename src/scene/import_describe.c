@@ -227,8 +227,12 @@ char *evr_scene_describe(const evr_scene *s)
     sb_printf(&b, "cameras: %d\n", s->num_cameras);
     for (i = 0; i < s->num_cameras; i++) {
         const evr_camera_desc *c = &s->cameras[i];
-        sb_printf(&b, "  [%d] \"%s\" node \"%s\", yfov %.2f deg", i, c->name,
-                  node_label(s, c->node), c->yfov * 180.0 / EVR_PI_D);
+        sb_printf(&b, "  [%d] \"%s\" node \"%s\", ", i, c->name, node_label(s, c->node));
+        if (c->ortho) sb_printf(&b, "orthographic, %.4g high", 2.0 * c->ymag);
+        else if (c->xfov > 0.0f)
+            sb_printf(&b, "xfov %.2f deg (yfov from the image's aspect)",
+                      c->xfov * 180.0 / EVR_PI_D);
+        else sb_printf(&b, "yfov %.2f deg", c->yfov * 180.0 / EVR_PI_D);
         if (c->aspect > 0.0f) sb_printf(&b, ", aspect %.4g", c->aspect);
         sb_printf(&b, ", znear %.4g%s\n", c->znear,
                   c->automatic ? ", automatic (the file has no camera)" : "");

@@ -103,7 +103,11 @@ typedef struct {
 typedef struct {
     char name[64];
     int node;     /* -1: fixed in world space */
-    float yfov;   /* vertical field of view, radians */
+    float yfov;   /* vertical field of view, radians (perspective) */
+    int ortho;    /* 1: orthographic (glTF type "orthographic"; Assimp's mOrthographicWidth) */
+    float ymag;   /* orthographic: half the view's height in scene units */
+    float xfov;   /* > 0: the file gives the horizontal angle only (radians), and the image's
+                     aspect sets yfov (evr_camera_yfov) */
     float aspect; /* width / height from the file, 0 if unknown */
     float znear;
     /* Pose in node space: position, looking along -Z, up +Y after this transform. */
@@ -153,6 +157,7 @@ struct evr_scene {
 };
 
 #define EVR_MAX_WARNINGS 16
+#define EVR_PI_D 3.14159265358979323846
 
 /* Animation evaluation (scene/anim.c). */
 evr_m34 evr_node_local_at(const evr_node *n, double t);
@@ -175,12 +180,47 @@ int evr_instance_deformed_range(const evr_scene *s, int instance, double t, uint
 /* The morph weights of node n at time t into w (n->num_weights of them). */
 void evr_node_weights_at(const evr_node *n, double t, float *w);
 
+/* Fitting motion keys to a moving frame (a node's world transform, the camera's pose): the
+ * fewest uniformly spaced keys (2^k + 1, at most max_keys) such that interpolating them moves
+ * every probe point (in the frame's space) within limit of where pose puts it, at the quarter
+ * points of every key interval and at the inner times (where the motion bends, inside
+ * (t0, t1)), and neighbouring rotations differ by less than 120 degrees. moves 0: one key, pose
+ * at t0. One key too when the frame holds still over the segment. Returns the keys written. */
+typedef evr_m34 (*evr_pose_fn)(const void *user, double t);
+typedef struct {
+    evr_pose_fn pose;
+    const void *user;
+    int moves;
+    const evr_v3 *probes;
+    int num_probes;
+    const double *inner;
+    int num_inner;
+    float limit;
+} evr_motion_fit;
+int evr_motion_fit_keys(const evr_motion_fit *fit, double t0, double t1, evr_motion_key *keys,
+                        int max_keys);
+/* The scene's size the key tolerance is relative to (its rest bounds' diagonal, 1 if none). */
+float evr_motion_fit_size(const evr_scene *s);
+/* A frame's probe points without geometry: its origin and unit axes scaled by size, so that a
+ * rotation is checked as the motion of points at that distance. Returns 4. */
+int evr_motion_frame_probes(float size, evr_v3 *p);
+
+/* Appends the key times of a node's curves and its ancestors' curves that lie strictly inside
+ * (t0, t1) to out[n..cap): where a piecewise curve bends, a fit must look. Returns the new
+ * count. */
+int evr_node_inner_key_times(const evr_scene *s, int node, double t0, double t1, double *out, int n,
+                             int cap);
+#define EVR_MAX_INNER_TIMES 256
+
 /* Motion keys of a node's world transform over [t0, t1]: the fewest uniformly spaced keys
  * (2^k + 1, at most max_keys) such that interpolating them matches the curves within tol
  * (relative to the scene's size) and neighbouring rotations differ by less than 120 degrees.
  * Returns the number of keys written (1 for a node that does not move in the segment). */
 int evr_node_motion_keys(const evr_scene *s, int node, double t0, double t1, float tol,
                          evr_motion_key *keys, int max_keys);
+
+/* The vertical field of view of camera c on an image of the given aspect (width / height). */
+float evr_camera_yfov(const evr_camera_desc *c, float aspect);
 
 /* Index of the camera whose name is `name`, or -1; NULL or "" gives 0 (the first camera). */
 int evr_scene_find_camera(const evr_scene *s, const char *name);

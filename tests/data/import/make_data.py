@@ -266,10 +266,42 @@ def clips():
     write("clips.gltf", g.finish())
 
 
+# ---- camera.3ds: a 3DS camera (Z-up) with a keyframer section ------------------------------------
+def camera_3ds():
+    """An L of 4 triangles in the 3DS XZ plane (y = 0, facing -Y): a bar x 0..2, z 0..0.5 and a bar
+    x 0..0.5, z 0..2. Camera01 at (1, -10, 1) looks at (1, 0, 1) (along +Y), bank 0, lens
+    43.456 mm (45 degrees across 3ds Max's 36 mm film). The keyframer section gives the camera's
+    node one position key, (1, -10, 1), which Assimp also keeps in mPosition."""
+    def chunk(cid, data):
+        return struct.pack('<HI', cid, 6 + len(data)) + data
+
+    def cstr(text):
+        return text.encode() + b'\0'
+
+    verts = [(0, 0, 0), (2, 0, 0), (2, 0, 0.5), (0.5, 0, 0.5), (0.5, 0, 2), (0, 0, 2)]
+    faces = [(0, 1, 2), (0, 2, 3), (0, 3, 4), (0, 4, 5)]
+    vdata = struct.pack('<H', len(verts)) + b''.join(struct.pack('<3f', *v) for v in verts)
+    fdata = struct.pack('<H', len(faces)) + b''.join(struct.pack('<4H', a, b, c, 0) for a, b, c in faces)
+    mesh = chunk(0x4000, cstr('shape') + chunk(0x4100, chunk(0x4110, vdata) + chunk(0x4120, fdata)))
+    cam = chunk(0x4000, cstr('Camera01') + chunk(0x4700, struct.pack('<8f', 1, -10, 1, 1, 0, 1, 0, 43.456)))
+    edit = chunk(0x3D3D, chunk(0x3D3E, struct.pack('<I', 3)) + mesh + cam)
+
+    def node(name):
+        return chunk(0xB010, cstr(name) + struct.pack('<HHH', 0, 0, 0xFFFF))
+
+    def position(p):  # one key at frame 0, no TCB data
+        return chunk(0xB020, struct.pack('<5H', 0, 0, 0, 0, 0) + struct.pack('<IIH', 1, 0, 0) + struct.pack('<3f', *p))
+    kf = chunk(0xB000, chunk(0xB00A, struct.pack('<H', 5) + cstr('MAXSCENE') + struct.pack('<I', 100)) +
+               chunk(0xB002, node('shape')) + chunk(0xB003, node('Camera01') + position((1, -10, 1))) +
+               chunk(0xB004, node('Camera01') + position((1, 0, 1))))
+    write("camera.3ds", chunk(0x4D4D, chunk(0x0002, struct.pack('<I', 3)) + edit + kf))
+
+
 anim()
 clips()
 lights(False)
 lights(True)
 plain()
 lines()
+camera_3ds()
 write("checker.png", CHECKER)
