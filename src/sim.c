@@ -8,6 +8,7 @@
 #include "io/preview.h"
 #include "run/run_files.h"
 #include "run/frames_out.h"
+#include "run/labels_out.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -179,7 +180,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
-    if ((st = evr_frames_plan(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_plan(sim, err)) != EVR_OK || (st = evr_labels_plan(sim, err)) != EVR_OK) {
         evr_sim_release(sim);
         return st;
     }
@@ -205,7 +206,14 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
-    if ((st = evr_frames_prepare(sim, err)) != EVR_OK) {
+    if (sim->labels && evr_labels_times(sim) && !sim->backend->label_hits) {
+        snprintf(err->msg, sizeof err->msg, "the %s backend cannot make label frames",
+                 sim->backend->name);
+        evr_sim_release(sim);
+        return EVR_ERR_ARG;
+    }
+    if ((st = evr_frames_prepare(sim, err)) != EVR_OK ||
+        (st = evr_labels_open(sim, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -378,6 +386,8 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
     seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
+    evr_labels_of_segment(sim, i, &first, &seg.num_labels);
+    seg.label_times = seg.num_labels ? evr_labels_times(sim) + first : NULL;
     double t =
         evr_host_seconds(); /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
@@ -430,6 +440,13 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
             return st;
     }
     sim->time_preview += evr_host_seconds() - t;
+    if (sim->labels) {
+        t = evr_host_seconds();
+        const evr_hit *hits =
+            sim->backend->label_hits ? sim->backend->label_hits(sim->backend) : NULL;
+        if ((st = evr_labels_segment(sim, i, t0, t1, last, hits, err)) != EVR_OK) return st;
+        sim->time_preview += evr_host_seconds() - t;
+    }
     sim->st.segments_done = i + 1;
     sim->st.samples = sim->backend->samples;
     sim->st.rays = sim->backend->rays;
@@ -519,5 +536,6 @@ void evr_sim_release(evr_sim *sim)
     free(sim->config_json);
     evr_preview_out_release(sim->preview);
     evr_frames_free(sim);
+    evr_labels_free(sim);
     free(sim);
 }
