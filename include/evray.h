@@ -208,6 +208,18 @@ typedef struct {
     double fov;
     int look_from_set, look_at_set;
     double look_from[3], look_at[3];
+    /* ground truth (README "Ground truth"): labels_fps > 0 writes labels.h5 in the run folder,
+     * label frame k at exactly start + k / labels_fps (both ends included, as intensity frames):
+     * every pixel's depth, instance id, optical flow (image velocity of the surface point it
+     * sees, px/s, from the motion) and its displacement over flow_dt seconds, and with
+     * label_normals its surface normal. trajectories: imu.txt (an ideal IMU on the camera) and
+     * node_poses.txt (every animated node's world pose) at 1 kHz. eye_labels: eye.txt (gaze,
+     * pupil, eyelids and phase at 1 kHz) for a scene with an eye's named nodes. */
+    double labels_fps; /* <= 0: no labels.h5 */
+    double flow_dt;    /* seconds, > 0 */
+    int label_normals;
+    int trajectories;
+    int eye_labels;
 } evr_config;
 
 enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };

@@ -53,6 +53,12 @@ typedef struct {
      * they are not counted in samples or rays. */
     const double *frame_times;
     int num_frames;
+    /* Label frames wanted inside this segment (--labels-fps): num_labels absolute times in
+     * [t0, t1], like frame_times. For each, every pixel's primary hit through its centre at
+     * exactly that time (the samples' camera and motion, no shading): what the host's ground
+     * truth (core/labels.h) is computed from. Unseen by the pixel model, uncounted. */
+    const double *label_times;
+    int num_labels;
     /* Change-driven sampling (core/skip.h): which pixels may keep their cached intensity, and
      * which may cache one. Never NULL; a plan that neither reuses nor caches is brute force. */
     const evr_skip_plan *skip;
@@ -76,6 +82,10 @@ struct evr_backend {
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, int64_t emit_before_us,
                           const float **intensity, const float **frames, evr_error *err);
     void (*release)(evr_backend *b);
+    /* The primary hits of the segment collected last: its num_labels images, one after the
+     * other (each row-major, top row first; inst -1: the pixel sees nothing), or NULL when it
+     * asked for none. Valid until the next collect(). */
+    const evr_hit *(*label_hits)(evr_backend *b);
     int depth; /* segments the backend holds submitted and not yet collected, at most */
     uint64_t samples, rays;  /* totals so far (samples: every pixel sample, traced or not;
                                      adaptive sampling: every sample taken) */

@@ -9,6 +9,7 @@
 #include "run/run_files.h"
 #include "run/frames_out.h"
 #include "run/camera_poses.h"
+#include "run/labels_out.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -206,7 +207,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
-    if ((st = evr_frames_plan(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_plan(sim, err)) != EVR_OK || (st = evr_labels_plan(sim, err)) != EVR_OK) {
         evr_sim_release(sim);
         return st;
     }
@@ -232,8 +233,21 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
+    if (sim->labels && sim->rig.ortho) { /* core/labels.h projects through a perspective camera */
+        snprintf(err->msg, sizeof err->msg,
+                 "--labels-fps: label frames through an orthographic camera are not supported");
+        evr_sim_release(sim);
+        return EVR_ERR_ARG;
+    }
+    if (sim->labels && evr_labels_times(sim) && !sim->backend->label_hits) {
+        snprintf(err->msg, sizeof err->msg, "the %s backend cannot make label frames",
+                 sim->backend->name);
+        evr_sim_release(sim);
+        return EVR_ERR_ARG;
+    }
     if ((st = evr_frames_prepare(sim, err)) != EVR_OK ||
-        (st = evr_camera_poses_open(sim, err)) != EVR_OK) {
+        (st = evr_camera_poses_open(sim, err)) != EVR_OK ||
+        (st = evr_labels_open(sim, err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -424,6 +438,8 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     int first;
     evr_frames_of_segment(sim, i, &first, &seg.num_frames);
     seg.frame_times = seg.num_frames ? sim->frame_times + first : NULL;
+    evr_labels_of_segment(sim, i, &first, &seg.num_labels);
+    seg.label_times = seg.num_labels ? evr_labels_times(sim) + first : NULL;
     double t =
         evr_host_seconds(); /* the CPU backend renders inside submit, a GPU only queues work */
     evr_status st = sim->backend->submit(sim->backend, &seg, err);
@@ -476,6 +492,13 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_e
             return st;
     }
     sim->time_preview += evr_host_seconds() - t;
+    if (sim->labels) {
+        t = evr_host_seconds();
+        const evr_hit *hits =
+            sim->backend->label_hits ? sim->backend->label_hits(sim->backend) : NULL;
+        if ((st = evr_labels_segment(sim, i, t0, t1, last, hits, err)) != EVR_OK) return st;
+        sim->time_preview += evr_host_seconds() - t;
+    }
     sim->st.segments_done = i + 1;
     sim->st.samples = sim->backend->samples;
     sim->st.rays = sim->backend->rays;
@@ -567,5 +590,6 @@ void evr_sim_release(evr_sim *sim)
     evr_camera_poses_discard(sim); /* nothing when the run closed it */
     free(sim->poses_tmp);
     evr_camera_rig_free(&sim->rig);
+    evr_labels_free(sim);
     free(sim);
 }

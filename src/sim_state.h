@@ -78,6 +78,8 @@ struct evr_sim {
     int created_frames_dir;
     uint8_t *frame8;
     uint16_t *frame16;
+    /* ground truth (run/labels_out.h); NULL: none wanted */
+    struct evr_labels_out *labels;
     /* statistics */
     evr_stats st;
     double wall0;          /* the run's start: its wall time ends when every output is complete */

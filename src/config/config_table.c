@@ -22,6 +22,7 @@ static int has_camera_path(const evr_config *c) { return c->camera_path != NULL;
 static int has_look_from(const evr_config *c) { return c->look_from_set; }
 static int has_look_at(const evr_config *c) { return c->look_at_set; }
 static int has_fov(const evr_config *c) { return c->fov > 0.0; }
+static int has_labels(const evr_config *c) { return c->labels_fps > 0.0; }
 
 /* ---- values that are not one field's ---- */
 static void json_scene(evr_json *j, const evr_config *c, const evr_config_run *r)
@@ -955,6 +956,74 @@ static const evr_config_option table[] = {
      .help = "reflections and refractions a camera ray may take (default 4)",
      .json = "max_bounces",
      .json_rank = 47},
+
+    /* ---- ground truth ---- */
+    {.name = "labels_fps",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(labels_fps),
+     .def = 0.0,
+     .lo = 0,
+     .hi = 1e6,
+     .what = "labels fps must be between 0 and 1e6 frames per second",
+     .flag = "--labels-fps",
+     .cli_lo = 0,
+     .cli_hi = NO_LIMIT,
+     .cli_lo_open = 1,
+     .cli_what = "%s must be a positive number (got %s)",
+     .section = "ground truth (README \"Ground truth\")",
+     .label = "--labels-fps F",
+     .help = "write labels.h5: at every start + k/F up to and including the\n"
+             "end, each pixel's depth, instance id, optical flow (px/s, from\n"
+             "the motion) and displacement over --flow-dt (default: off)",
+     .json = "labels_fps",
+     .json_rank = 54},
+    {.name = "flow_dt",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(flow_dt),
+     .def = 0.01,
+     .lo = 0,
+     .hi = 1e6,
+     .lo_open = 1,
+     .what = "flow dt must be a positive number of seconds",
+     .flag = "--flow-dt",
+     .cli_lo = 0,
+     .cli_hi = NO_LIMIT,
+     .cli_lo_open = 1,
+     .cli_what = "%s must be a positive number of seconds (got %s)",
+     .label = "--flow-dt S",
+     .help = "labels.h5: the forward displacement's time step, seconds\n"
+             "(default 0.01)",
+     .json = "flow_dt",
+     .json_rank = 55,
+     .json_if = has_labels},
+    {.name = "label_normals",
+     .type = EVR_OPT_FLAG,
+     .offset = F(label_normals),
+     .flag = "--label-normals",
+     .label = "--label-normals",
+     .help = "labels.h5: also each pixel's surface normal",
+     .json = "label_normals",
+     .json_rank = 56,
+     .json_if = has_labels},
+    {.name = "trajectories",
+     .type = EVR_OPT_FLAG,
+     .offset = F(trajectories),
+     .flag = "--trajectories",
+     .label = "--trajectories",
+     .help = "write imu.txt (an ideal IMU on the camera) and node_poses.txt\n"
+             "(every animated node's world pose) at 1 kHz",
+     .json = "trajectories",
+     .json_rank = 57},
+    {.name = "eye_labels",
+     .type = EVR_OPT_FLAG,
+     .offset = F(eye_labels),
+     .flag = "--eye-labels",
+     .label = "--eye-labels",
+     .help = "write eye.txt at 1 kHz: gaze, pupil centre and radius in the\n"
+             "image, eyelid openness, phase (a scene with an eye's nodes:\n"
+             "README \"Ground truth\")",
+     .json = "eye_labels",
+     .json_rank = 58},
 
     /* ---- scene loading ---- */
     {.name = "strict",

@@ -58,6 +58,10 @@ typedef struct {
     float *done_frames[2];     /* intensity frames of the segment (done_num_frames images) */
     size_t done_frames_cap[2]; /* images done_frames has room for */
     int done_num_frames[2];
+    evr_hit *done_labels[2];   /* label hits of the segment (done_num_labels images) */
+    size_t done_labels_cap[2]; /* images done_labels has room for */
+    int done_num_labels[2];
+    int collected;                        /* the slot collected last, -1: none yet */
     unsigned long long done_counts[2][4]; /* samples, rays, samples traced, pixels skipped */
     int head, queued;
     char embree_error[256];
@@ -66,6 +70,9 @@ typedef struct {
     float *frame_f; /* normalized segment time of each wanted frame */
     int frame_f_cap;
     float *frame_out; /* where the segment's frames go */
+    float *label_f;   /* normalized segment time of each wanted label frame */
+    int label_f_cap;
+    evr_hit *label_out; /* where the segment's label hits go */
     atomic_int next_tile;
     atomic_ullong samples, rays, samples_traced, pixels_skipped;
     atomic_int failed;
@@ -126,6 +133,49 @@ static inline int evr_closest(struct evr_occlusion *o, evr_ray r, float tnear, f
  * ray's hit distance (INFINITY: none); NULL for a frame's samples, which are not the pixel
  * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. */
 #define PACKET 8
+
+/* The primary rays of eight samples (pixel centres, each at its own time; pose_static: the
+ * camera's pose for all of them, NULL: each at its time) through Embree's packet traversal:
+ * their rays into ray, their closest hits into rh. Counts the rays it traces. */
+static void primary_packet8(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
+                            const int *ys, const float *fs, const int *valid, evr_ray *ray,
+                            struct RTCRayHit8 *rh, unsigned long long *rays)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    struct RTCIntersectContext ctx;
+    _Alignas(32) int vmask[PACKET]; /* Embree reads the valid mask with aligned vector loads */
+    int i;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (i = 0; i < PACKET; i++) {
+        evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
+        ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
+        vmask[i] = valid[i] ? -1 : 0;
+        rh->ray.org_x[i] = ray[i].org.x;
+        rh->ray.org_y[i] = ray[i].org.y;
+        rh->ray.org_z[i] = ray[i].org.z;
+        rh->ray.dir_x[i] = ray[i].dir.x;
+        rh->ray.dir_y[i] = ray[i].dir.y;
+        rh->ray.dir_z[i] = ray[i].dir.z;
+        rh->ray.tnear[i] = 0.0f;
+        rh->ray.tfar[i] = INFINITY;
+        rh->ray.time[i] =
+            evr_skip_trace_time(b->seg->skip, fs[i]); /* a still span: one time for Embree */
+        rh->ray.mask[i] = 0xffffffffu;
+        rh->ray.id[i] = (unsigned)i;
+        rh->ray.flags[i] = 0;
+        rh->hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh->hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        if (valid[i]) (*rays)++;
+    }
+    rtcIntersect8(vmask, b->top, &ctx, rh);
+}
+
+/* Intensity of eight samples at once (neighbouring pixels of a row, each at its own time):
+ * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
+ * shared shading of src/core lane by lane. Counts the rays it traces; t_hit gets each primary
+ * ray's hit distance (INFINITY: none); NULL for a frame's samples, which are not the pixel
+ * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. */
 static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
                                    const int *ys, const float *fs, const int *valid, float *out,
                                    float *t_hit, float *direct, int *deep, unsigned long long *rays)
@@ -141,28 +191,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     int hit[PACKET], inst_of[PACKET], i, l;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    for (i = 0; i < PACKET; i++) {
-        evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
-        ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
-        vmask[i] = valid[i] ? -1 : 0;
-        rh.ray.org_x[i] = ray[i].org.x;
-        rh.ray.org_y[i] = ray[i].org.y;
-        rh.ray.org_z[i] = ray[i].org.z;
-        rh.ray.dir_x[i] = ray[i].dir.x;
-        rh.ray.dir_y[i] = ray[i].dir.y;
-        rh.ray.dir_z[i] = ray[i].dir.z;
-        rh.ray.tnear[i] = 0.0f;
-        rh.ray.tfar[i] = INFINITY;
-        rh.ray.time[i] =
-            evr_skip_trace_time(b->seg->skip, fs[i]); /* a still span: one time for Embree */
-        rh.ray.mask[i] = 0xffffffffu;
-        rh.ray.id[i] = (unsigned)i;
-        rh.ray.flags[i] = 0;
-        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-        if (valid[i]) (*rays)++;
-    }
-    rtcIntersect8(vmask, b->top, &ctx, &rh);
+    primary_packet8(b, pose_static, xs, ys, fs, valid, ray, &rh, rays);
     for (i = 0; i < PACKET; i++) {
         out[i] = 0.0f; /* nothing: black */
         if (direct) direct[i] = 0.0f;
@@ -518,6 +547,42 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1)
             }
         }
     }
+    /* label frames: each pixel's primary hit at the label's exact time (core/labels.h) */
+    for (k = 0; k < seg->num_labels; k++) {
+        const float f = b->label_f[k];
+        evr_m34 pose = evr_rs_camera_pose(rs, f);
+        evr_hit *img = b->label_out + (size_t)k * (size_t)w * (size_t)h;
+        unsigned long long label_rays = 0; /* not counted: not the pixel model's */
+        for (y = y0; y < y1; y++) {
+            for (x = x0; x < x1; x += PACKET) {
+                struct RTCRayHit8 rh;
+                evr_ray ray[PACKET];
+                float fs[PACKET];
+                int xs[PACKET], ys[PACKET], valid[PACKET], i;
+                for (i = 0; i < PACKET; i++) {
+                    xs[i] = x + i < x1 ? x + i : x1 - 1;
+                    ys[i] = y;
+                    valid[i] = x + i < x1;
+                    fs[i] = f;
+                }
+                primary_packet8(b, &pose, xs, ys, fs, valid, ray, &rh, &label_rays);
+                for (i = 0; i < PACKET && x + i < x1; i++) {
+                    evr_hit *o = &img[(size_t)y * (size_t)w + (size_t)(x + i)];
+                    o->inst = -1;
+                    o->t = INFINITY;
+                    o->u = o->v = 0.0f;
+                    o->prim = 0;
+                    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+                    o->inst = b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] +
+                                                (int)rh.hit.geomID[i]];
+                    o->t = rh.ray.tfar[i];
+                    o->u = rh.hit.u[i];
+                    o->v = rh.hit.v[i];
+                    o->prim = rh.hit.primID[i];
+                }
+            }
+        }
+    }
 }
 
 /* Adaptive sampling (core/adaptive.h): every pixel of the tile takes its samples at its own
@@ -734,6 +799,35 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
         b->frame_out = b->done_frames[slot];
     }
     b->done_num_frames[slot] = seg->num_frames > 0 ? seg->num_frames : 0;
+    if (seg->num_labels > 0) {
+        size_t npix = (size_t)b->setup.width * (size_t)b->setup.height,
+               nl = (size_t)seg->num_labels;
+        if (seg->num_labels > b->label_f_cap) {
+            float *ff = realloc(b->label_f, nl * sizeof *ff);
+            if (!ff) {
+                snprintf(err->msg, sizeof err->msg, "out of memory for label frames");
+                return EVR_ERR_NOMEM;
+            }
+            b->label_f = ff;
+            b->label_f_cap = seg->num_labels;
+        }
+        if (nl > b->done_labels_cap[slot]) {
+            evr_hit *img = realloc(b->done_labels[slot], nl * npix * sizeof *img);
+            if (!img) {
+                snprintf(err->msg, sizeof err->msg, "out of memory for label frames");
+                return EVR_ERR_NOMEM;
+            }
+            b->done_labels[slot] = img;
+            b->done_labels_cap[slot] = nl;
+        }
+        for (i = 0; i < seg->num_labels; i++) {
+            double f =
+                seg->t1 > seg->t0 ? (seg->label_times[i] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            b->label_f[i] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+        }
+        b->label_out = b->done_labels[slot];
+    }
+    b->done_num_labels[slot] = seg->num_labels > 0 ? seg->num_labels : 0;
     b->seg = seg;
     atomic_store(&b->next_tile, 0);
     atomic_store(&b->samples, 0);
@@ -793,6 +887,7 @@ static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, int64_t emi
     int slot = b->head;
     b->head = (b->head + 1) % 2;
     b->queued--;
+    b->collected = slot;
     base->samples += b->done_counts[slot][0];
     base->rays += b->done_counts[slot][1];
     base->samples_traced += b->done_counts[slot][2];
@@ -804,6 +899,13 @@ static evr_status cpu_collect(evr_backend *base, evr_event_vec *out, int64_t emi
         return EVR_ERR_NOMEM;
     }
     return EVR_OK;
+}
+
+static const evr_hit *cpu_label_hits(evr_backend *base)
+{
+    cpu_backend *b = (cpu_backend *)base;
+    if (b->collected < 0 || b->done_num_labels[b->collected] <= 0) return NULL;
+    return b->done_labels[b->collected];
 }
 
 static void cpu_release(evr_backend *base)
@@ -830,12 +932,14 @@ static void cpu_release(evr_backend *base)
         evr_event_vec_free(&b->done[i]);
         free(b->done_intensity[i]);
         free(b->done_frames[i]);
+        free(b->done_labels[i]);
     }
     evr_event_vec_free(&b->scratch);
     free(b->pixels);
     free(b->phase);
     free(b->next_t);
     free(b->frame_f);
+    free(b->label_f);
     free(b);
 }
 
@@ -977,6 +1081,8 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
     b->base.submit = cpu_submit;
     b->base.collect = cpu_collect;
     b->base.release = cpu_release;
+    b->base.label_hits = cpu_label_hits;
+    b->collected = -1;
     b->scene = s;
     b->host = *h;
     b->setup = *setup;

@@ -143,6 +143,11 @@ static evr_status upload_scene(cuda_backend *b, evr_error *err)
     return EVR_OK;
 }
 
+static const evr_hit *cuda_label_hits(evr_backend *base)
+{
+    return ((cuda_backend *)base)->labels_hits;
+}
+
 static void cuda_release(evr_backend *base)
 {
     cuda_backend *b = (cuda_backend *)base;
@@ -371,6 +376,7 @@ extern "C" evr_status evr_cuda_backend_new(const evr_scene *s, const evr_render_
     b->base.submit = cuda_submit;
     b->base.collect = cuda_collect;
     b->base.release = cuda_release;
+    b->base.label_hits = cuda_label_hits;
     b->base.samples = 0;
     b->base.rays = 0;
     b->base.device_seconds = 0.0;

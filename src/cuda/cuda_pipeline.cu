@@ -63,6 +63,11 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
         CK(cudaGetLastError());
         CK(cudaEventRecord(sl->framed, b->render));
     }
+    if (sl->num_labels > 0) {
+        cuda_launch_labels(a, v, sl->d_label_f.p, sl->num_labels, sl->d_labels.p, grid, rs);
+        CK(cudaGetLastError());
+        CK(cudaEventRecord(sl->framed, b->render));
+    }
     CK(cudaStreamWaitEvent(sl->copy, sl->rendered, 0));
     CK(cudaMemcpyAsync(sl->h_count.p, sl->d_count.p + COUNT_EVENTS, sizeof(unsigned int),
                        cudaMemcpyDeviceToHost, sl->copy));
@@ -163,6 +168,13 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
         CK(sl->h_frames.reserve(nf));
         CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
         CK(cudaMemcpyAsync(sl->h_frames.p, sl->d_frames.p, nf * sizeof(float),
+                           cudaMemcpyDeviceToHost, sl->copy));
+    }
+    if (sl->num_labels) {
+        size_t nl = (size_t)sl->num_labels * (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_labels.reserve(nl));
+        CK(cudaStreamWaitEvent(sl->copy, sl->framed, 0));
+        CK(cudaMemcpyAsync(sl->h_labels.p, sl->d_labels.p, nl * sizeof(evr_hit),
                            cudaMemcpyDeviceToHost, sl->copy));
     }
     CK(cudaEventRecord(sl->copied, sl->copy));
@@ -293,6 +305,20 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
             sl->h_frame_f.p[k] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
         }
         CK(cudaMemcpyAsync(sl->d_frame_f.p, sl->h_frame_f.p, nf * sizeof(float),
+                           cudaMemcpyHostToDevice, b->render));
+    }
+    sl->num_labels = seg->num_labels > 0 ? seg->num_labels : 0;
+    if (sl->num_labels) {
+        size_t nl = (size_t)sl->num_labels, npix = (size_t)b->setup.width * b->setup.height;
+        CK(sl->h_label_f.reserve(nl));
+        CK(sl->d_label_f.reserve(nl));
+        CK(sl->d_labels.reserve(nl * npix));
+        for (int k = 0; k < sl->num_labels; k++) {
+            double f =
+                seg->t1 > seg->t0 ? (seg->label_times[k] - seg->t0) / (seg->t1 - seg->t0) : 0.0;
+            sl->h_label_f.p[k] = (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+        }
+        CK(cudaMemcpyAsync(sl->d_label_f.p, sl->h_label_f.p, nl * sizeof(float),
                            cudaMemcpyHostToDevice, b->render));
     }
     /* events reach back to the previous segment (a pixel's last sample there; with adaptive
@@ -544,6 +570,7 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
     }
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
     *frames = sl->num_frames ? sl->h_frames.p : NULL;
+    b->labels_hits = sl->num_labels ? sl->h_labels.p : NULL;
     base->device_bytes = device_bytes(b);
     if (timeline_rec *r = timeline_at(&b->tl, sl->index)) r->col1 = evr_host_seconds();
     b->head = (b->head + 1) % NSLOT;

@@ -253,6 +253,38 @@ __global__ void __launch_bounds__(BLOCK)
     }
 }
 
+/* Label frames (backend.h): every pixel's primary hit through its centre at normalized segment
+ * time label_f[k], written to hits[k * npix + pix] (inst -1: none), the host's ground truth's
+ * input (core/labels.h). Like the frames, a kernel of its own, its rays uncounted. */
+template <int LAYOUT>
+__global__ void __launch_bounds__(BLOCK)
+    label_kernel(kernel_args a, const float *label_f, int num_labels, evr_hit *hits)
+{
+    const int npix = a.width * a.height;
+    const int pix = blockIdx.x * blockDim.x + threadIdx.x;
+    if (pix >= npix) return;
+    const int x = pix % a.width, y = pix / a.width;
+    for (int k = 0; k < num_labels; k++) {
+        const float f = label_f[k];
+        const evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
+        const evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
+        evr_gpu_hit hit;
+        evr_hit o;
+        o.t = INFINITY;
+        o.u = o.v = 0.0f;
+        o.prim = 0;
+        o.inst = -1;
+        if (gpu_trace<LAYOUT>(&a.view, &a.rs, ray, 0.0f, 1e30f, f, 0, &hit)) {
+            o.t = hit.t;
+            o.u = hit.u;
+            o.v = hit.v;
+            o.prim = hit.prim;
+            o.inst = hit.instance;
+        }
+        hits[(size_t)k * (size_t)npix + (size_t)pix] = o;
+    }
+}
+
 /* Every pixel's first state and its sample phase. */
 __global__ void init_pixels(evr_pixel_state *st, float *phase, int width, int height,
                             unsigned long long seed)
@@ -320,6 +352,14 @@ void cuda_launch_frames(const kernel_args &a, kernel_variant v, const float *fra
     with_variant(v, [&](auto k) {
         frame_kernel<decltype(k)::layout, decltype(k)::gi>
             <<<grid, BLOCK, 0, s>>>(a, frame_f, num_frames, frames);
+    });
+}
+
+void cuda_launch_labels(const kernel_args &a, kernel_variant v, const float *label_f,
+                        int num_labels, evr_hit *hits, unsigned grid, cudaStream_t s)
+{
+    with_variant(v, [&](auto k) {
+        label_kernel<decltype(k)::layout><<<grid, BLOCK, 0, s>>>(a, label_f, num_labels, hits);
     });
 }
 

@@ -18,6 +18,8 @@ void cuda_launch_render(const kernel_args &a, kernel_variant v, unsigned grid, c
 void cuda_launch_adapt(const kernel_args &a, const adapt_args &d, kernel_variant v, unsigned grid,
                        cudaStream_t s);
 /* Intensity frames at normalized segment times frame_f. */
+void cuda_launch_labels(const kernel_args &a, kernel_variant v, const float *label_f,
+                        int num_labels, evr_hit *hits, unsigned grid, cudaStream_t s);
 void cuda_launch_frames(const kernel_args &a, kernel_variant v, const float *frame_f,
                         int num_frames, float *frames, unsigned grid, cudaStream_t s);
 /* Every pixel's first state and sample phase, on the default stream. */

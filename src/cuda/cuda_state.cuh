@@ -74,6 +74,11 @@ struct slot {
     dbuf<float> d_frame_f;
     dbuf<float> d_frames;
     hbuf<float> h_frames;
+    int num_labels;        /* label frames wanted in this segment (backend.h) */
+    hbuf<float> h_label_f; /* their normalized times */
+    dbuf<float> d_label_f;
+    dbuf<evr_hit> d_labels; /* every pixel's primary hit at each */
+    hbuf<evr_hit> h_labels;
     cudaStream_t copy = nullptr;
     cudaEvent_t framed = nullptr; /* the frame kernel is done */
     cudaEvent_t started = nullptr, rendered = nullptr, counted = nullptr, sorted = nullptr,
@@ -106,6 +111,7 @@ struct gi_buffer {
 
 struct cuda_backend {
     evr_backend base;
+    const evr_hit *labels_hits; /* the label hits of the segment collected last, or NULL */
     const evr_scene *scene;
     /* every pixel's camera ray in the static group, for a still camera at static_cam (the
      * camera track's key); static_gen counts the times it was made (0: not yet); static_off:

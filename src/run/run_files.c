@@ -1,6 +1,7 @@
 #include "run/run_files.h"
 #include "run/frames_out.h"
 #include "run/camera_poses.h"
+#include "run/labels_out.h"
 #include "io/mkdir_p.h"
 #include "io/event_formats.h"
 #include "io/json.h"
@@ -365,6 +366,7 @@ evr_status evr_run_close(evr_sim *sim, evr_error *err)
     if (sim->preview && (st = evr_preview_out_finish(sim->preview, dur_us, err)) != EVR_OK)
         return st;
     if ((st = evr_camera_poses_close(sim, err)) != EVR_OK) return st;
+    if ((st = evr_labels_close(sim, err)) != EVR_OK) return st;
     return evr_frames_finish(sim, err);
 }
 
@@ -400,6 +402,7 @@ void evr_run_dir_discard(evr_sim *sim)
     char p[4200];
     evr_frames_discard(sim);
     evr_camera_poses_discard(sim);
+    evr_labels_discard(sim);
     evr_write_queue_stop(sim->wq); /* the thread must be done with the writers */
     sim->wq = NULL;
     for (w = 0; w < sim->num_writers; w++) {
