@@ -1,4 +1,4 @@
-/* The indirect light a pixel gets from the buffers: a surface point's diffuse share, its gather
+/* The indirect light a pixel gets from the buffers: a surface point's diffuse weight, its gather
  * (limited, or the fixed-point sums and their update), and the blend between a segment's start
  * and end buffers. */
 #ifndef EVR_CORE_PHOTON_INDIRECT_H

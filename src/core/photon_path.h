@@ -3,6 +3,7 @@
 #ifndef EVR_CORE_PHOTON_PATH_H
 #define EVR_CORE_PHOTON_PATH_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include "core/shading.h"
 #include "core/photon_emit.h"
