@@ -5,45 +5,10 @@
  * incidence, a dielectric about 4%), and a light's radius widening the lobe with its energy
  * kept. */
 #include "check.h"
-#include "core/shading.h"
+#include "bsdf_env.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-/* A render scene of one material (no geometry): what evr_material_view reads. */
-typedef struct {
-    evr_render_scene rs;
-    evr_material_params mat;
-    float table[2 * EVR_BSDF_MU * EVR_BSDF_ROUGH];
-} bsdf_env;
-
-static void env_init(bsdf_env *e)
-{
-    memset(&e->rs, 0, sizeof e->rs);
-    evr_material_defaults(&e->mat);
-    evr_bsdf_table_fill(e->table, 1024);
-    e->rs.materials = &e->mat;
-    e->rs.bsdf_table = e->table;
-}
-
-/* The surface of e's material at the origin, normal +z, seen along wo. */
-static evr_surface surface(bsdf_env *e, evr_v3 wo)
-{
-    evr_surface s;
-    memset(&s, 0, sizeof s);
-    s.n = s.nv = evr_v3_make(0.0f, 0.0f, 1.0f);
-    s.front = 1;
-    s.albedo[0] = e->mat.base_color[0];
-    s.albedo[1] = e->mat.base_color[1];
-    s.albedo[2] = e->mat.base_color[2];
-    s.metallic = e->mat.metallic;
-    s.rough = e->mat.roughness;
-    s.alpha = fmaxf(s.rough * s.rough, EVR_GGX_ALPHA_MIN);
-    s.opacity = s.occlusion = 1.0f;
-    s.eta = 1.0f / e->mat.ior;
-    evr_material_view(&e->rs, &e->mat, e->mat.transmission, wo, &s);
-    return s;
-}
 
 /* Directional albedo of s seen along wo: the integral of BSDF * cos over the hemisphere (unit
  * irradiance from every direction), on a grid in (cos theta, phi) refined near the normal. */
@@ -68,8 +33,6 @@ static double albedo(const evr_surface *s, evr_v3 wo, float spread, int n_mu, in
     }
     return sum;
 }
-
-static evr_v3 view(float mu) { return evr_v3_make(sqrtf(1.0f - mu * mu), 0.0f, mu); }
 
 static void test_white_furnace(void)
 {

@@ -71,7 +71,6 @@ static void test_slots(void)
 {
     evr_scene *s = load("slots");
     const evr_material *m;
-    float td, ts;
     int k;
     if (!s || !(m = material(s, "slots"))) goto done;
     CHECK_NEAR(m->p.base_color[0], 0.9, 1e-6);
@@ -88,8 +87,6 @@ static void test_slots(void)
     CHECK_NEAR(m->p.tex[EVR_TEX_OCCLUSION].scale, 0.75, 1e-6);
     CHECK(m->p.alpha_mode == EVR_ALPHA_OPAQUE && !m->p.double_sided && !m->p.unlit);
     CHECK_NEAR(m->p.ior, 1.5, 1e-6);
-    evr_photon_material_map(m->p.base_color, m->p.metallic, m->p.roughness, &td, &ts);
-    CHECK(m->p.t_diffuse == td && m->p.t_specular == ts);
     for (k = 0; k < EVR_TEX_COUNT; k++) {
         CHECK(m->p.tex[k].index >= 0);
         CHECK(identity_xf(&m->p.tex[k]));

@@ -2,6 +2,7 @@
  * search, kernel, gather units, flux conservation of the pass in a closed box, determinism, the
  * photons' trails. */
 #include "check.h"
+#include "bsdf_env.h"
 #include "core/photon.h"
 #include "cpu/cpu_gi.h"
 #include "cpu/photon_pass.h"
@@ -246,30 +247,107 @@ static void test_gather_units(void)
     evr_photon_buffer_free(&b);
 }
 
-static void test_material(void)
+/* One hit of evr_photon_path_hit for many photons (their own random numbers) arriving along
+ * -wi at the surface of e's material: the stored flux estimates the incident flux (mean 1 where
+ * a photon may stay) and the flux going on has the mean of the BSDF's adjoint albedo, the
+ * integral over the leaving direction wo of f(wo, wi) cos(wo) with f as direct light evaluates
+ * it (evr_material_add_light on the surface seen from wo), plus the mirror's and the
+ * transmission's shares, which leave along one direction. */
+static void hit_energy(const bsdf_env *e, float mu, int direct, const char *what)
 {
-    const float white[3] = {0.725f, 0.71f, 0.68f}, black[3] = {0, 0, 0};
-    float td, ts, w;
-    evr_photon_material_map(white, 0.0f, 1.0f, &td, &ts);
-    CHECK_NEAR(td, 0.275, 1e-6);
-    CHECK_NEAR(ts, 1.0, 1e-6);
-    CHECK_NEAR(evr_photon_mirror_share(td, ts), 0.0, 1e-6);
-    evr_photon_material_map(white, 1.0f, 0.0f, &td, &ts); /* a polished metal: a mirror */
-    CHECK_NEAR(ts, td, 1e-6);
-    CHECK_NEAR(evr_photon_mirror_share(td, ts), 1.0, 1e-6);
-    evr_photon_material_map(black, 0.0f, 1.0f, &td, &ts);
-    CHECK_NEAR(td, 0.95, 1e-6);
-    /* decisions and weights */
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 1, &w) == EVR_PHOTON_STAY);
-    CHECK_NEAR(w, 1.0 / 0.3, 1e-5);
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.5f, 1, &w) == EVR_PHOTON_DIFFUSE);
-    CHECK_NEAR(w, 1.0 / 0.7, 1e-5);
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.9f, 1, &w) == EVR_PHOTON_MIRROR);
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.1f, 0, &w) ==
-          EVR_PHOTON_DIFFUSE); /* no stay at a light's first hit */
-    CHECK_NEAR(w, 1.0, 1e-6);
-    CHECK(evr_photon_scatter(0.3f, 0.8f, 0.95f, 0, &w) == EVR_PHOTON_MIRROR);
-    CHECK(evr_photon_scatter(1.0f, 1.0f, 0.5f, 0, &w) == EVR_PHOTON_ABSORB);
+    const evr_v3 wi = view(mu);
+    const evr_surface s = surface(e, wi);
+    evr_photon_params pp;
+    memset(&pp, 0, sizeof pp);
+    pp.seed = 11;
+    pp.ray_eps = 1e-5f;
+    const uint32_t n = 400000;
+    double stored[3] = {0, 0, 0}, out[3] = {0, 0, 0}, absorbed[3] = {0, 0, 0}, want[3] = {0, 0, 0};
+    uint32_t stays = 0;
+    for (uint32_t j = 0; j < n; j++) {
+        evr_photon_path p;
+        float st[3], ab[3];
+        uint32_t key = 0;
+        memset(&p, 0, sizeof p);
+        p.i = p.j = j;
+        p.direct = direct;
+        p.pr.from_light = direct;
+        p.pr.ray.org = wi;
+        p.pr.ray.dir = evr_v3_scale(wi, -1.0f);
+        p.pr.flux[0] = p.pr.flux[1] = p.pr.flux[2] = 1.0f;
+        p.max_hits = 16;
+        const int ev = evr_photon_path_hit(&p, &pp, &s, &e->mat, st, ab, &key);
+        for (int c = 0; c < 3; c++) {
+            absorbed[c] += ab[c];
+            if (ev == EVR_PHOTON_STAY) stored[c] += st[c];
+            if (ev == EVR_PHOTON_BOUNCE) out[c] += p.pr.flux[c];
+        }
+        stays += ev == EVR_PHOTON_STAY;
+        if (ev == EVR_PHOTON_STAY) CHECK(key == j * 16u);
+        if (ev == EVR_PHOTON_BOUNCE)
+            CHECK(p.bounce == 1 && fabsf(evr_v3_len(p.pr.ray.dir) - 1.0f) < 1e-4f);
+    }
+    /* the adjoint albedo: the rough lobes by quadrature, a mirror's and transmission's shares
+     * as they are (they leave at the angle they arrive) */
+    const int mirror = evr_material_mirror(&s);
+    const int n_mu = 400, n_phi = 240;
+    for (int i = 0; i < n_mu; i++) {
+        const double u0 = (double)i / n_mu, u1 = (double)(i + 1) / n_mu, um = 0.5 * (u0 + u1);
+        const double c = 1.0 - um * um, dc = (1.0 - u0 * u0) - (1.0 - u1 * u1);
+        const double st = sqrt(fmax(0.0, 1.0 - c * c));
+        for (int k = 0; k < n_phi; k++) {
+            const double phi = 6.283185307179586 * (k + 0.5) / n_phi;
+            const evr_v3 wo = evr_v3_make((float)(st * cos(phi)), (float)(st * sin(phi)), (float)c);
+            evr_surface so = surface(e, wo);
+            const float one[3] = {1.0f, 1.0f, 1.0f};
+            float acc[3] = {0.0f, 0.0f, 0.0f};
+            if (mirror) so.f0[0] = so.f0[1] = so.f0[2] = so.f90 = 0.0f; /* the diffuse base alone */
+            evr_material_add_light(&so, wo, wi, one, 0.0f, acc);
+            for (int ch = 0; ch < 3; ch++)
+                want[ch] += (double)acc[ch] / wi.z * c * dc * 6.283185307179586 / n_phi;
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        if (mirror) want[c] += s.spec_albedo[c];
+        want[c] += s.transmit[c];
+        stored[c] /= n;
+        out[c] /= n;
+        absorbed[c] /= n;
+        if (fabs(out[c] - want[c]) > 0.02 * want[c])
+            fprintf(stderr, "photon hit (%s, mu %.2f): channel %d goes on with %.4f, BSDF %.4f\n",
+                    what, (double)mu, c, out[c], want[c]);
+        CHECK(fabs(out[c] - want[c]) <= 0.02 * want[c]);
+        if (direct) CHECK(stored[c] == 0.0);
+        else CHECK_NEAR(stored[c], 1.0, 0.02);
+        /* the bookkeeping: what the hit absorbs in expectation, by the albedo as seen */
+        CHECK_NEAR(absorbed[c], 1.0 - (s.diffuse[c] + s.spec_albedo[c] + s.transmit[c]), 1e-4);
+    }
+    printf("photon hit (%s, mu %.2f): %.3f stayed, %.4f %.4f %.4f go on (BSDF %.4f %.4f %.4f)\n",
+           what, (double)mu, (double)stays / n, out[0], out[1], out[2], want[0], want[1], want[2]);
+}
+
+static void test_hit_energy(void)
+{
+    static bsdf_env e;
+    env_init(&e);
+    e.mat.base_color[0] = 0.8f, e.mat.base_color[1] = 0.5f, e.mat.base_color[2] = 0.3f;
+    e.mat.roughness = 0.6f;
+    hit_energy(&e, 0.8f, 0, "rough dielectric");
+    hit_energy(&e, 0.3f, 1, "rough dielectric, a light's photon");
+    e.mat.metallic = 1.0f;
+    e.mat.roughness = 0.35f;
+    hit_energy(&e, 0.6f, 1, "rough metal");
+    e.mat.metallic = 0.3f;
+    hit_energy(&e, 0.6f, 0, "part metal");
+    e.mat.metallic = 0.0f;
+    e.mat.roughness = 0.1f; /* a mirror lobe over the diffuse base */
+    hit_energy(&e, 0.5f, 0, "polished dielectric");
+    e.mat.transmission = 0.6f; /* a thin wall that lets light through */
+    hit_energy(&e, 0.5f, 0, "thin glass");
+}
+
+static void test_directions(void)
+{
     /* cosine directions stay in the hemisphere and have mean cosine 2/3 */
     {
         evr_v3 n = evr_v3_norm(evr_v3_make(0.3f, -0.8f, 0.5f));
@@ -493,10 +571,7 @@ static void test_pass(void)
     mesh.num_triangles = 12;
     evr_material_defaults(&mat);
     mat.base_color[0] = mat.base_color[1] = mat.base_color[2] = rho;
-    {
-        float c3[3] = {rho, rho, rho};
-        evr_photon_material_map(c3, 0.0f, 1.0f, &mat.t_diffuse, &mat.t_specular);
-    }
+    mat.specular = 0.0f; /* Lambert: the albedo is rho whatever the angle */
     inst.mesh = 0;
     inst.track = 0;
     inst.deform = -1;
@@ -585,7 +660,8 @@ static void test_pass(void)
     CHECK(same_buffer(&b1, &b2));
     CHECK(same_buffer(&b1, &b3));
     CHECK(memcmp(s1.absorbed, s3.absorbed, sizeof s1.absorbed) == 0);
-    /* a stored photon's flux: the light's power per photon, over t_diffuse, times albedo (one bounce at least) */
+    /* a stored photon's flux: the light's power per photon times the bounces' weights over the
+     * odds of staying */
     {
         size_t i, npix = (size_t)b1.width * (size_t)b1.height;
         int found = 0;
@@ -825,7 +901,8 @@ int main(void)
     test_gather_walk();
     test_kernel();
     test_gather_units();
-    test_material();
+    test_directions();
+    test_hit_energy();
     test_emission();
     test_pass();
     test_trail();

@@ -29,6 +29,39 @@ EVR_HD static inline float evr_smith_v(float alpha, float nl, float nv)
     return s > 0.0f ? 0.5f / s : 0.0f;
 }
 
+/* Smith's masking G1 of the GGX lobe seen at cos nv; with evr_smith_v, the weight of a
+ * direction sampled from the visible normals: G2 / G1(v) = 4 V nl nv / G1(v). */
+EVR_HD static inline float evr_smith_g1(float alpha, float nv)
+{
+    const float a2 = alpha * alpha;
+    return 2.0f * nv / (nv + sqrtf(nv * nv * (1.0f - a2) + a2));
+}
+
+/* A GGX microfacet normal drawn from the normals visible from v (their distribution
+ * D_v(h) = G1(v) max(v.h, 0) D(h) / nv), in the frame where the macro normal is +z and v.z > 0:
+ * stretch v to the alpha = 1 configuration, draw a point on the spherical cap of the unit sphere
+ * that v sees (Dupuy and Benyoub, "Sampling Visible GGX Normals with Spherical Caps", 2023),
+ * offset it by v, and unstretch. (u1, u2) in [0, 1)^2. The reflected direction
+ * l = 2 (v.h) h - v then has the density G1(v) D(h) / (4 nv). */
+EVR_HD static inline void evr_ggx_vndf_local(float vx, float vy, float vz, float alpha, float u1,
+                                             float u2, float h[3])
+{
+    float sx = alpha * vx, sy = alpha * vy, sz = vz;
+    const float inv = 1.0f / sqrtf(sx * sx + sy * sy + sz * sz);
+    sx *= inv, sy *= inv, sz *= inv;
+    const float phi = 6.28318530718f * u1;
+    const float z = (1.0f - u2) * (1.0f + sz) - sz; /* uniform over the cap z >= -sz */
+    const float st = sqrtf(fminf(fmaxf(1.0f - z * z, 0.0f), 1.0f));
+    const float hx = alpha * (st * cosf(phi) + sx), hy = alpha * (st * sinf(phi) + sy),
+                hz = fmaxf(z + sz, 0.0f);
+    const float hl = sqrtf(hx * hx + hy * hy + hz * hz);
+    if (!(hl > 0.0f)) { /* v at the horizon and a sample at its rim: the normal itself */
+        h[0] = h[1] = 0.0f, h[2] = 1.0f;
+        return;
+    }
+    h[0] = hx / hl, h[1] = hy / hl, h[2] = hz / hl;
+}
+
 /* Schlick's Fresnel weight (1 - c)^5 at cos c. */
 EVR_HD static inline float evr_schlick_w(float c)
 {

@@ -1,17 +1,18 @@
 /* Materials: everything a surface's material decides at a hit, written once for direct light
- * (core/shading.h, core/shade.h), the photon pass (core/photon.h) and the path tracer
- * (src/cpu/still.c):
- *   - the material record at the hit (evr_material_at: base colour times texture, emission),
+ * (core/shading.h, core/shade.h), specular paths (core/path.h), the photon pass (core/photon.h)
+ * and the path tracer (src/cpu/still.c):
+ *   - the material record at the hit (evr_material_at: base colour times texture, emission, and
+ *     the BSDF's view-dependent weights, evr_material_view / evr_material_lobes),
  *   - emission (evr_material_emission),
- *   - the BSDF for a light direction (evr_material_add_light, then evr_material_radiance),
- *   - the photon pass's stay / diffuse / mirror decision (evr_material_photon_event), the path
- *     tracer's diffuse / mirror choice (evr_material_path_event) and the bounce directions,
- *   - the diffuse share that turns an irradiance estimate into radiance (evr_material_diffuse_k).
- * The model today is Lambert (albedo / pi) plus a mirror share for indirect light. A new model
- * (glTF metallic-roughness: GGX/Smith with Fresnel, transmission) adds its parameters to
- * evr_material_params and evr_material_defaults below, fills in these functions (and the record
- * in evr_surface), and reads the parameters in scene/import_mesh.c; the callers pass the shading
- * frame (evr_surface's n), wo and wi already.
+ *   - the BSDF for a light direction (evr_material_add_light, then evr_material_radiance).
+ * The model is glTF 2.0's metallic-roughness (Lambert + GGX/Smith with Fresnel, the parts in
+ * core/bsdf.h) with transmission. Indirect light samples the same BSDF: core/bsdf_sample.h
+ * draws its lobes (diffuse, glossy or mirror, transmission) for the photon pass and the path
+ * tracer, and the photon gather weighs an irradiance with evr_surface's diffuse weight
+ * (core/photon_indirect.h).
+ * A new parameter goes into evr_material_params and evr_material_defaults below, is read in
+ * scene/import_gltf_material.c (and scene/import_material.c for other formats), and shapes the
+ * record in evr_surface.
  * Floating-point expressions here are the ones the golden events were made with: keep their
  * order when editing (the GPU must not gain or lose fused multiply-adds). */
 #ifndef EVR_CORE_MATERIAL_H
@@ -47,14 +48,10 @@ enum { EVR_ALPHA_OPAQUE = 0, EVR_ALPHA_MASK = 1, EVR_ALPHA_BLEND = 2 };
 /* What a material is: the scene holds one per material (scene/scene.h), the backends read them
  * (evr_render_scene.materials): glTF 2.0 metallic-roughness with the KHR_materials extensions
  * evray renders. A new parameter goes here, its default in evr_material_defaults below and its
- * reading in scene/import_mesh.c. */
+ * reading in scene/import_gltf_material.c (scene/import_material.c for other formats). */
 struct evr_material_params {
     float base_color[4]; /* linear RGBA factor */
     float emissive[3];   /* linear RGB, radiance units: emissiveFactor times emissive_strength */
-    /* the photon pass's thresholds, 0 <= t_diffuse <= t_specular <= 1: from the material's
-     * extras "t_diffuse" and "t_specular" when the glTF gives them, else from the BSDF
-     * (evr_photon_material_map) */
-    float t_diffuse, t_specular;
     float metallic, roughness;  /* factors (perceptual roughness; GGX alpha = roughness^2) */
     int alpha_mode;             /* EVR_ALPHA_* */
     float alpha_cutoff;         /* MASK: alpha below it is a hole */
@@ -84,6 +81,7 @@ typedef struct {
     float comp[3];        /* the lobe's multiple-scattering compensation (1: none) */
     float spec_albedo[3]; /* the specular lobe's directional albedo seen from the viewer */
     float transmit[3];    /* the share transmitted through the surface (transmission) */
+    float transmission;   /* the transmission factor (times its texture) */
     float metallic;
     float rough, alpha;      /* perceptual roughness and GGX alpha */
     float opacity;           /* BLEND: coverage (base alpha); 1 otherwise */
@@ -211,36 +209,51 @@ EVR_HD static inline float evr_material_alpha(const evr_render_scene *rs,
     return a;
 }
 
-/* The view-dependent weights of s seen along wo (unit, on the side of s->n): the specular
- * lobe's albedo from the table (core/bsdf.h), the diffuse base scaled by what the dielectric
- * layer leaves, the transmitted share (mat's, transmission: its factor times its texture).
- * Called once the frame and the parameters are set. */
-EVR_HD static inline void evr_material_view(const evr_render_scene *rs,
-                                            const evr_material_params *mat, float transmission,
-                                            evr_v3 wo, evr_surface *s)
+/* The view-dependent weights of a surface seen at cos mu (> 0) from the side of its normal:
+ * the specular lobe's albedo from the table (core/bsdf.h; NULL: single scattering only), its
+ * multiple-scattering compensation, the diffuse base scaled by what the dielectric layer leaves,
+ * and the transmitted share; f0 and f90 of the lobe with them. The surface is material mat's
+ * with base colour albedo, metallic m, perceptual roughness rough and transmission tr (the
+ * factor times its texture). evr_material_view fills evr_surface with them for the direction it
+ * is seen from; the photon pass asks them for the direction a photon leaves in
+ * (core/bsdf_sample.h), so light and camera paths weigh a bounce alike. */
+EVR_HD static inline void evr_material_lobes(const float *table, const evr_material_params *mat,
+                                             const float albedo[3], float m, float rough, float tr,
+                                             float mu, float f0[3], float *f90, float comp[3],
+                                             float diffuse[3], float transmit[3],
+                                             float spec_albedo[3])
 {
-    const float mu = fmaxf(evr_v3_dot(s->n, wo), 1e-4f);
     float ta = 1.0f, tb = 0.0f;
-    s->bsdf_table = rs->bsdf_table;
-    if (rs->bsdf_table) evr_bsdf_table_ab(rs->bsdf_table, mu, s->rough, &ta, &tb);
+    if (table) evr_bsdf_table_ab(table, mu, rough, &ta, &tb);
     const float e1 = fmaxf(ta + tb, 1e-3f);
     /* the dielectric layer: f0 from the IOR and KHR_materials_specular, f90 its factor */
     const float r = (mat->ior - 1.0f) / (mat->ior + 1.0f);
-    const float m = s->metallic;
-    const float tr = transmission;
     for (int c = 0; c < 3; c++) {
         const float f0d = fminf(r * r * mat->specular_color[c], 1.0f) * mat->specular;
         const float f90d = mat->specular;
         const float compd = 1.0f + f0d * (1.0f / e1 - 1.0f);
         const float ed = fminf((f0d * ta + f90d * tb) * compd, 1.0f);
-        s->f0[c] = f0d + (s->albedo[c] - f0d) * m;
-        s->comp[c] = 1.0f + s->f0[c] * (1.0f / e1 - 1.0f);
-        s->diffuse[c] = (1.0f - m) * (1.0f - tr) * s->albedo[c] * (1.0f - ed);
-        s->transmit[c] = (1.0f - m) * tr * s->albedo[c] * (1.0f - ed);
+        f0[c] = f0d + (albedo[c] - f0d) * m;
+        comp[c] = 1.0f + f0[c] * (1.0f / e1 - 1.0f);
+        diffuse[c] = (1.0f - m) * (1.0f - tr) * albedo[c] * (1.0f - ed);
+        transmit[c] = (1.0f - m) * tr * albedo[c] * (1.0f - ed);
     }
-    s->f90 = mat->specular + (1.0f - mat->specular) * m;
-    for (int c = 0; c < 3; c++)
-        s->spec_albedo[c] = fminf((s->f0[c] * ta + s->f90 * tb) * s->comp[c], 1.0f);
+    *f90 = mat->specular + (1.0f - mat->specular) * m;
+    for (int c = 0; c < 3; c++) spec_albedo[c] = fminf((f0[c] * ta + *f90 * tb) * comp[c], 1.0f);
+}
+
+/* The view-dependent weights of s seen along wo (unit, on the side of s->n): evr_material_lobes
+ * at cos(n, wo), the material mat's with transmission factor `transmission` (its factor times
+ * its texture). Called once the frame and the parameters are set. */
+EVR_HD static inline void evr_material_view(const evr_render_scene *rs,
+                                            const evr_material_params *mat, float transmission,
+                                            evr_v3 wo, evr_surface *s)
+{
+    const float mu = fmaxf(evr_v3_dot(s->n, wo), 1e-4f);
+    s->bsdf_table = rs->bsdf_table;
+    s->transmission = transmission;
+    evr_material_lobes(rs->bsdf_table, mat, s->albedo, s->metallic, s->rough, transmission, mu,
+                       s->f0, &s->f90, s->comp, s->diffuse, s->transmit, s->spec_albedo);
 }
 
 /* Perceptual roughness below which a surface reflects (and refracts) along one ray: a mirror
@@ -409,22 +422,6 @@ EVR_HD static inline int evr_material_transmits(const evr_surface *s)
     return !s->unlit && (s->transmit[0] > 0.0f || s->transmit[1] > 0.0f || s->transmit[2] > 0.0f);
 }
 
-/* ---- indirect light: photon thresholds, decisions and bounce directions ---- */
-
-/* glTF metallic-roughness to the photon thresholds: reflectance R = max(base colour) clamped to
- * [0.05, 0.95]; mirror = metallic * (1 - roughness);
- * t_diffuse = 1 - R, t_specular = t_diffuse + R * (1 - mirror). */
-EVR_HD static inline void evr_photon_material_map(const float base_color[3], float metallic,
-                                                  float roughness, float *t_diffuse,
-                                                  float *t_specular)
-{
-    float r = fmaxf(base_color[0], fmaxf(base_color[1], base_color[2]));
-    float m = fminf(fmaxf(metallic, 0.0f), 1.0f) * (1.0f - fminf(fmaxf(roughness, 0.0f), 1.0f));
-    r = fminf(fmaxf(r, 0.05f), 0.95f);
-    *t_diffuse = 1.0f - r;
-    *t_specular = *t_diffuse + r * (1.0f - m);
-}
-
 /* A texture slot with nothing in it. */
 static inline void evr_texture_ref_none(evr_texture_ref *t)
 {
@@ -455,109 +452,6 @@ static inline void evr_material_defaults(evr_material_params *m)
     m->attenuation_distance = INFINITY;
     m->attenuation_color[0] = m->attenuation_color[1] = m->attenuation_color[2] = 1.0f;
     for (int i = 0; i < EVR_TEX_COUNT; i++) evr_texture_ref_none(&m->tex[i]);
-    evr_photon_material_map(m->base_color, m->metallic, m->roughness, &m->t_diffuse,
-                            &m->t_specular);
-}
-
-/* Share of the reflected light that is a mirror reflection. */
-EVR_HD static inline float evr_photon_mirror_share(float t_diffuse, float t_specular)
-{
-    float refl = 1.0f - t_diffuse;
-    return refl > 0.0f ? fminf(fmaxf((1.0f - t_specular) / refl, 0.0f), 1.0f) : 0.0f;
-}
-
-enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_DIFFUSE = 1, EVR_PHOTON_MIRROR = 2, EVR_PHOTON_ABSORB = 3 };
-
-/* The decision at a hit for random xi in [0, 1). *weight multiplies the flux: stay 1/t_diffuse,
- * bounce 1/(1 - t_diffuse) (times the albedo, which the caller applies), 1 for a bounce when
- * staying is not allowed. ABSORB only when nothing else is possible. */
-EVR_HD static inline int evr_photon_scatter(float t_diffuse, float t_specular, float xi,
-                                            int allow_stay, float *weight)
-{
-    float td = fminf(fmaxf(t_diffuse, 0.0f), 1.0f), ts = fminf(fmaxf(t_specular, td), 1.0f);
-    if (allow_stay) {
-        if (xi < td) {
-            *weight = 1.0f / td;
-            return EVR_PHOTON_STAY;
-        }
-        if (td >= 1.0f) {
-            *weight = 0.0f;
-            return EVR_PHOTON_ABSORB;
-        }
-        *weight = 1.0f / (1.0f - td);
-        return xi < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
-    }
-    if (td >= 1.0f) {
-        *weight = 0.0f;
-        return EVR_PHOTON_ABSORB;
-    }
-    *weight = 1.0f;
-    /* xi spread over the bounce options only */
-    return td + xi * (1.0f - td) < ts ? EVR_PHOTON_DIFFUSE : EVR_PHOTON_MIRROR;
-}
-
-/* Orthonormal basis around unit n (Duff et al. 2017). */
-EVR_HD static inline void evr_onb(evr_v3 n, evr_v3 *t, evr_v3 *b)
-{
-    float s = n.z >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (s + n.z), c = n.x * n.y * a;
-    *t = evr_v3_make(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
-    *b = evr_v3_make(c, s + n.y * n.y * a, -n.y);
-}
-
-/* Cosine-distributed direction around unit n from (u1, u2) in [0, 1)^2 (pdf cos / pi). */
-EVR_HD static inline evr_v3 evr_cosine_dir(evr_v3 n, float u1, float u2)
-{
-    evr_v3 t, b;
-    float r = sqrtf(u1), phi = 6.28318530718f * u2;
-    float x = r * cosf(phi), y = r * sinf(phi), z = sqrtf(fmaxf(0.0f, 1.0f - u1));
-    evr_onb(n, &t, &b);
-    return evr_v3_norm(
-        evr_v3_add(evr_v3_add(evr_v3_scale(t, x), evr_v3_scale(b, y)), evr_v3_scale(n, z)));
-}
-
-/* Mirror direction of incoming d about unit n. */
-EVR_HD static inline evr_v3 evr_mirror_dir(evr_v3 d, evr_v3 n)
-{
-    return evr_v3_sub(d, evr_v3_scale(n, 2.0f * evr_v3_dot(d, n)));
-}
-
-/* The photon pass's decision at a hit of material mat for random xi in [0, 1) (d_in: the
- * photon's direction of travel): evr_photon_scatter's event and *weight. */
-EVR_HD static inline int evr_material_photon_event(const evr_material_params *mat,
-                                                   const evr_surface *s, evr_v3 d_in, float xi,
-                                                   int allow_stay, float *weight)
-{
-    (void)s;
-    (void)d_in;
-    return evr_photon_scatter(mat->t_diffuse, mat->t_specular, xi, allow_stay, weight);
-}
-
-/* The path tracer's choice at a hit of material mat for random xi in [0, 1): EVR_PHOTON_MIRROR
- * with the mirror share's odds, else EVR_PHOTON_DIFFUSE (it never stays). */
-EVR_HD static inline int evr_material_path_event(const evr_material_params *mat,
-                                                 const evr_surface *s, evr_v3 d_in, float xi)
-{
-    (void)s;
-    (void)d_in;
-    float ms = evr_photon_mirror_share(mat->t_diffuse, mat->t_specular);
-    return xi < ms ? EVR_PHOTON_MIRROR : EVR_PHOTON_DIFFUSE;
-}
-
-/* The direction a bounce of kind ev (EVR_PHOTON_DIFFUSE or EVR_PHOTON_MIRROR) leaves s in, for a
- * ray travelling along d_in; (u1, u2) in [0, 1)^2 pick the diffuse direction. */
-EVR_HD static inline evr_v3 evr_material_bounce_dir(const evr_surface *s, int ev, evr_v3 d_in,
-                                                    float u1, float u2)
-{
-    return ev == EVR_PHOTON_DIFFUSE ? evr_cosine_dir(s->n, u1, u2)
-                                    : evr_v3_norm(evr_mirror_dir(d_in, s->n));
-}
-
-/* What multiplies the albedo and an irradiance for the indirect (diffusely reflected) radiance
- * leaving a surface of material mat: the diffuse share over pi. */
-EVR_HD static inline float evr_material_diffuse_k(const evr_material_params *mat)
-{
-    return (1.0f - evr_photon_mirror_share(mat->t_diffuse, mat->t_specular)) / EVR_PI;
 }
 
 #endif

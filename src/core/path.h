@@ -11,6 +11,7 @@
 #define EVR_CORE_PATH_H
 
 #include "core/shade_hit.h"
+#include "core/bsdf_sample.h"
 #include "core/skip.h"
 
 /* A ray of a pixel's path still to follow. */
@@ -31,16 +32,6 @@ typedef struct {
     evr_path_ray r[EVR_PATH_STACK];
     int n;
 } evr_path_stack;
-
-/* Refraction of unit d through a surface with unit normal n (facing d's origin side) and ratio
- * of IORs eta (from / to); 0 on total internal reflection. */
-EVR_HD static inline int evr_refract_dir(evr_v3 d, evr_v3 n, float eta, evr_v3 *out)
-{
-    const float c = -evr_v3_dot(d, n), k = 1.0f - eta * eta * (1.0f - c * c);
-    if (k < 0.0f) return 0;
-    *out = evr_v3_norm(evr_v3_add(evr_v3_scale(d, eta), evr_v3_scale(n, eta * c - sqrtf(k))));
-    return 1;
-}
 
 /* Pushes a ray from p along dir worth w (when it is worth tracing and there is room); returns
  * 0 when it is not pushed (the caller takes the ambient light for it). */
@@ -92,8 +83,7 @@ EVR_HD static inline void evr_path_shade(const evr_render_scene *rs, const evr_s
             trans = evr_path_push(rs, st, s->p, dir, s->nv, wt, cone, depth + 1, med);
     }
     if (evr_material_mirror(s)) {
-        evr_v3 r = evr_v3_norm(evr_mirror_dir(d, s->n));
-        if (evr_v3_dot(r, s->nv) <= 0.0f) r = evr_v3_norm(evr_mirror_dir(d, s->nv));
+        const evr_v3 r = evr_surface_mirror_dir(s, d);
         refl = evr_path_push(rs, st, s->p, r, s->nv, wr, cone, depth + 1, medium);
     }
     evr_material_radiance(s, evr_v3_scale(d, -1.0f), acc, rs->ambient, refl, trans, rgb);
@@ -125,13 +115,8 @@ EVR_HD static inline void evr_path_follow(const evr_render_scene *rs, struct evr
             for (int c = 0; c < 3; c++) out[c] += w[c] * rs->ambient;
             continue;
         }
-        if (pr.medium >= 0) { /* Beer-Lambert through the volume it crossed */
-            const evr_material_params *m = &rs->materials[pr.medium];
-            if (m->attenuation_distance < 1e30f)
-                for (int c = 0; c < 3; c++)
-                    w[c] *=
-                        powf(fmaxf(m->attenuation_color[c], 1e-6f), h.t / m->attenuation_distance);
-        }
+        if (pr.medium >= 0) /* Beer-Lambert through the volume it crossed */
+            evr_volume_attenuate(&rs->materials[pr.medium], h.t, w);
         const evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), f);
         const float cone = pr.cone + evr_camera_pixel_spread(&rs->camera) * h.t;
         evr_surface s;

@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 #include "core/shading.h"
+#include "core/bsdf_sample.h"
 
 /* Uniform direction on the sphere. */
 EVR_HD static inline evr_v3 evr_sphere_dir(float u1, float u2)

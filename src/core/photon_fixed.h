@@ -10,7 +10,7 @@
  * changed instead of walking its whole window again, and gets exactly what a fresh gather gets
  * (brute force and change-driven sampling stay identical). The flux is summed as the luminance
  * of the light the point sends back (its weights c = the luminance's coefficients times the
- * point's diffuse share k, per RGB channel): one sum, what the pixel model takes. Dot products
+ * point's diffuse weight k, per RGB channel): one sum, what the pixel model takes. Dot products
  * and distances are written with products no compiler fuses with the sums (evr_dot_rn), so that
  * the terms are the same bits wherever they are computed (and on the CPU and GPU alike). */
 #ifndef EVR_CORE_PHOTON_FIXED_H

@@ -1,4 +1,4 @@
-/* The indirect light a pixel gets from the buffers: a surface point's diffuse share, its gather
+/* The indirect light a pixel gets from the buffers: a surface point's diffuse weight, its gather
  * (limited, or the fixed-point sums and their update), and the blend between a segment's start
  * and end buffers. */
 #ifndef EVR_CORE_PHOTON_INDIRECT_H
@@ -8,31 +8,32 @@
 #include "core/photon_gather.h"
 #include "core/photon_fixed.h"
 
-/* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s of material
- * mat: the diffuse share of the albedo over pi. */
-EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s,
-                                                const evr_material_params *mat, float k_rgb[3])
+/* What multiplies the irradiance (RGB) for the indirect radiance leaving surface s towards the
+ * direction it is seen from: its diffuse weight (evr_surface.diffuse, the direct term's diffuse
+ * base) over pi, times its coverage; nothing for an unlit surface. The stored photons estimate
+ * the irradiance; what the specular lobe makes of it is not in the buffer (core/photon_path.h). */
+EVR_HD static inline void evr_photon_indirect_k(const evr_surface *s, float k_rgb[3])
 {
-    float k = evr_material_diffuse_k(mat);
-    k_rgb[0] = s->albedo[0] * k;
-    k_rgb[1] = s->albedo[1] * k;
-    k_rgb[2] = s->albedo[2] * k;
+    const float k = s->unlit ? 0.0f : s->opacity * (1.0f / EVR_PI);
+    k_rgb[0] = s->diffuse[0] * k;
+    k_rgb[1] = s->diffuse[1] * k;
+    k_rgb[2] = s->diffuse[2] * k;
 }
 
-/* Indirect radiance leaving surface s (material mat) from an irradiance estimate: the diffuse
- * share of the albedo over pi, per RGB channel (add its luminance to evr_surface_intensity). */
-EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const evr_material_params *mat,
-                                              const float e_rgb[3], float out_rgb[3])
+/* Indirect radiance leaving surface s from an irradiance estimate (evr_photon_indirect_k per
+ * RGB channel; add its luminance to evr_surface_intensity). */
+EVR_HD static inline void evr_photon_indirect(const evr_surface *s, const float e_rgb[3],
+                                              float out_rgb[3])
 {
     float k[3];
-    evr_photon_indirect_k(s, mat, k);
+    evr_photon_indirect_k(s, k);
     out_rgb[0] = k[0] * e_rgb[0];
     out_rgb[1] = k[1] * e_rgb[1];
     out_rgb[2] = k[2] * e_rgb[2];
 }
 
-/* What a gather needs of a surface point: position, normal, distance from the camera and the
- * diffuse share of the albedo over pi (evr_photon_indirect_k). Made where the ray meets the
+/* What a gather needs of a surface point: position, normal, distance from the camera and what
+ * turns irradiance into radiance (evr_photon_indirect_k). Made where the ray meets the
  * surface; the gather itself may run later (the GPU defers it to a kernel of its own). */
 typedef struct evr_gather_point {
     evr_v3 p, n;
@@ -40,13 +41,13 @@ typedef struct evr_gather_point {
     float k[3];
 } evr_gather_point;
 
-EVR_HD static inline void evr_gather_point_at(const evr_surface *s, const evr_material_params *mat,
-                                              evr_v3 cam_org, evr_gather_point *g)
+EVR_HD static inline void evr_gather_point_at(const evr_surface *s, evr_v3 cam_org,
+                                              evr_gather_point *g)
 {
     g->p = s->p;
     g->n = s->n;
     g->dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
-    evr_photon_indirect_k(s, mat, g->k);
+    evr_photon_indirect_k(s, g->k);
 }
 
 /* max_photons 0: gather point g's query and window in b (pixel (x, y)). */
@@ -131,17 +132,5 @@ EVR_HD static inline float evr_gather_point_lum(const evr_photon_buffer *b,
  * fmaf: the same rounding on every backend and in every kernel, and exactly ls where le == ls
  * (still windows keep their light bit for bit). */
 EVR_HD static inline float evr_gi_lerp(float ls, float le, float f) { return fmaf(f, le - ls, ls); }
-
-/* Luminance of the indirect light leaving surface s (material mat) seen from cam_org through
- * image pixel (x, y): the gather and the diffuse share. */
-EVR_HD static inline float
-evr_photon_indirect_lum(const evr_photon_buffer *b, const evr_camera_intr *cam,
-                        const evr_gather_params *gp, const evr_material_params *mat,
-                        const evr_surface *s, evr_v3 cam_org, int x, int y)
-{
-    evr_gather_point g;
-    evr_gather_point_at(s, mat, cam_org, &g);
-    return evr_gather_point_lum(b, cam, gp, &g, x, y);
-}
 
 #endif

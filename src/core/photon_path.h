@@ -3,10 +3,12 @@
 #ifndef EVR_CORE_PHOTON_PATH_H
 #define EVR_CORE_PHOTON_PATH_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include "core/shading.h"
 #include "core/photon_emit.h"
 #include "core/photon_rand.h"
+#include "core/bsdf_sample.h"
 
 /* What a pass traces with (the CPU's and the GPU's). */
 typedef struct {
@@ -37,6 +39,11 @@ typedef struct {
     uint32_t i, j;        /* photon number in the pass, in its emitter */
     int ei;               /* emitter */
     int bounce, max_hits; /* hits so far; the path ends at max_hits ("capped") */
+    /* 1 while the photon is a light's (point, spot, directional) and has only passed straight
+     * on through surfaces that shadow rays pass too (transmission, BLEND's uncovered share):
+     * the light it carries is still the direct term's, so it may not stay */
+    int direct;
+    const evr_material_params *medium; /* the volume the photon travels in, NULL: none */
 } evr_photon_path;
 
 /* Starts photon i of a pass over emitters e[0..n) (cdf: the emissive instances' cumulative
@@ -65,46 +72,79 @@ EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs,
         if (!evr_photon_emit_surface(rs, em, cdf, &xf, p->f, u, &p->pr)) return 0;
     }
     p->bounce = 0;
+    p->direct = p->pr.from_light;
+    p->medium = NULL;
     p->max_hits = p->pr.from_light ? pp->max_bounces + 1 : pp->max_bounces;
     p->tnear = p->pr.from_light ? 0.0f : pp->ray_eps;
     return 1;
 }
 
-/* The path meets surface s (material mat). Returns EVR_PHOTON_STAY (stored[] gets the flux the
- * photon stands for, *key its canonical order), EVR_PHOTON_DIFFUSE or EVR_PHOTON_MIRROR (the
+enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_BOUNCE = 1, EVR_PHOTON_ABSORB = 2 };
+
+/* The most a photon keeps going with at a hit (Russian roulette's odds): a little is always
+ * left to stay, and a white surface does not keep a photon forever. */
+#define EVR_PHOTON_KEEP_MAX 0.95f
+
+/* The path meets surface s (material mat) and the BSDF decides (core/bsdf_sample.h). With A the
+ * largest channel of s's albedo (all lobes, as seen from the photon's side) and q = A clamped
+ * to [0.05, 0.95] (at most 0.95 where it may not stay), one number xi decides:
+ *   - xi < 1 - q: the photon stays, stored[] = its flux / (1 - q): the stored photons estimate
+ *     the incident flux without bias (the gather turns it into radiance with the diffuse
+ *     weight). Only on a surface with a diffuse part, and not while the photon is `direct`;
+ *     otherwise that share of xi absorbs it (Russian roulette);
+ *   - else a lobe by its weight (the rest of xi spread over the lobes, evr_bsdf_pick), a
+ *     direction from it, and the flux times f cos / pdf over the odds of the choice.
+ * Returns EVR_PHOTON_STAY (stored[] and *key, its canonical order, set), EVR_PHOTON_BOUNCE (the
  * path's ray is the next one to trace while bounce < max_hits; past that the path is capped) or
- * EVR_PHOTON_ABSORB (the path ends). absorbed[] gets the flux this hit absorbs (bookkeeping). */
+ * EVR_PHOTON_ABSORB (the path ends). absorbed[] gets the flux the hit absorbs in expectation,
+ * flux * (1 - albedo) (bookkeeping: over many photons emitted = absorbed + escaped + capped). */
 EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photon_params *pp,
                                              const evr_surface *s, const evr_material_params *mat,
                                              float stored[3], float absorbed[3], uint32_t *key)
 {
-    float w;
-    const int first_light = p->pr.from_light && p->bounce == 0;
-    const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
-    const int ev = evr_material_photon_event(mat, s, p->pr.ray.dir, xi, !first_light, &w);
-    int c;
+    float w[EVR_LOBES][3], wt[3], pick;
+    int c, k;
     for (c = 0; c < 3; c++) absorbed[c] = stored[c] = 0.0f;
-    if (ev == EVR_PHOTON_STAY) {
-        for (c = 0; c < 3; c++) {
-            stored[c] = p->pr.flux[c] * w;
-            absorbed[c] = stored[c] * (1.0f - s->albedo[c]);
-        }
-        *key = p->i * 16u + (uint32_t)(p->bounce < 15 ? p->bounce : 15);
-        return ev;
+    if (p->medium) /* Beer-Lambert through the volume it crossed */
+        evr_volume_attenuate(p->medium, evr_v3_len(evr_v3_sub(s->p, p->pr.ray.org)), p->pr.flux);
+    evr_bsdf_lobe_weights(s, w);
+    float amax = 0.0f;
+    for (c = 0; c < 3; c++) {
+        float a = 0.0f;
+        for (k = 0; k < EVR_LOBES; k++) a += w[k][c];
+        absorbed[c] = p->pr.flux[c] * fmaxf(1.0f - a, 0.0f);
+        amax = fmaxf(amax, a);
     }
-    if (first_light) /* the direct term's light: the part the surface absorbs */
-        for (c = 0; c < 3; c++) absorbed[c] = p->pr.flux[c] * (1.0f - s->albedo[c]);
-    if (ev == EVR_PHOTON_ABSORB) return ev;
-    for (c = 0; c < 3; c++) p->pr.flux[c] *= s->albedo[c] * w;
-    if (ev == EVR_PHOTON_DIFFUSE)
-        p->pr.ray.dir =
-            evr_cosine_dir(s->n, evr_photon_rand(pp->seed, p->ei, p->j, 6 + 3 * p->bounce),
-                           evr_photon_rand(pp->seed, p->ei, p->j, 7 + 3 * p->bounce));
-    else p->pr.ray.dir = evr_v3_norm(evr_mirror_dir(p->pr.ray.dir, s->n));
+    const int can_stay = !p->direct && !s->unlit &&
+                         (w[EVR_LOBE_DIFFUSE][0] > 0.0f || w[EVR_LOBE_DIFFUSE][1] > 0.0f ||
+                          w[EVR_LOBE_DIFFUSE][2] > 0.0f);
+    float q = fminf(amax, EVR_PHOTON_KEEP_MAX);
+    if (can_stay) q = fmaxf(q, 1.0f - EVR_PHOTON_KEEP_MAX);
+    const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
+    if (xi < 1.0f - q) {
+        if (!can_stay) return EVR_PHOTON_ABSORB;
+        for (c = 0; c < 3; c++) stored[c] = p->pr.flux[c] / (1.0f - q);
+        *key = p->i * 16u + (uint32_t)(p->bounce < 15 ? p->bounce : 15);
+        return EVR_PHOTON_STAY;
+    }
+    const float x = fminf((xi - (1.0f - q)) / q, 0.99999994f);
+    const int lobe = evr_bsdf_pick(w, x, &pick);
+    if (lobe < 0) return EVR_PHOTON_ABSORB;
+    const evr_v3 d = p->pr.ray.dir;
+    if (!evr_bsdf_sample(s, mat, lobe, d, evr_photon_rand(pp->seed, p->ei, p->j, 6 + 3 * p->bounce),
+                         evr_photon_rand(pp->seed, p->ei, p->j, 7 + 3 * p->bounce), 1,
+                         &p->pr.ray.dir, wt))
+        return EVR_PHOTON_ABSORB;
+    for (c = 0; c < 3; c++) p->pr.flux[c] *= wt[c] / (q * pick);
+    p->direct = p->direct && (lobe == EVR_LOBE_TRANSMIT || lobe == EVR_LOBE_PASS);
+    if (lobe == EVR_LOBE_TRANSMIT && evr_v3_dot(p->pr.ray.dir, s->nv) < 0.0f) {
+        const int cross = evr_bsdf_crossing(s, mat);
+        if (cross) p->medium = cross > 0 ? mat : NULL;
+    }
     p->pr.ray.org = s->p;
-    p->tnear = evr_shadow_tnear(s, p->pr.ray.dir, pp->ray_eps);
+    p->tnear = pp->ray_eps / fmaxf(fabsf(evr_v3_dot(s->nv, p->pr.ray.dir)), 0.05f);
     p->bounce++;
-    return ev;
+    return EVR_PHOTON_BOUNCE;
 }
 
 #endif

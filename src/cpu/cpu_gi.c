@@ -209,14 +209,14 @@ int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int
  * photons at the segment's start (ls) and end (le); one gather where the window saw no change
  * over the segment (the same cells, the same estimate); end_only: le alone. (Walking the two
  * buffers together, cell by cell, was 4-6% faster here and 4% slower on the GPU: one walk kept.) */
-static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs,
-                        const evr_material_params *mat, const evr_surface *s, evr_v3 cam_org, int x,
-                        int y, int end_only, float *ls, float *le, evr_gather_sum *se)
+static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_surface *s,
+                        evr_v3 cam_org, int x, int y, int end_only, float *ls, float *le,
+                        evr_gather_sum *se)
 {
     const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height,
                                                   g->end.margin, g->window, x, y);
     evr_gather_point gp;
-    evr_gather_point_at(s, mat, cam_org, &gp);
+    evr_gather_point_at(s, cam_org, &gp);
     if (g->gp.max_photons <=
         0) { /* fixed-point sums: the end's from the start's (se) and the cells that changed */
         if (!end_only) {
@@ -236,21 +236,22 @@ static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs,
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,
                           const evr_surface *s, evr_v3 cam_org, int x, int y, float f, int memo)
 {
-    const evr_material_params *mat = &rs->materials[rs->meshes[rs->instances[inst].mesh].material];
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
     if (!memo) {
         float ls, le;
         evr_gather_sum se;
-        gather_ends(g, rs, mat, s, cam_org, x, y, 0, &ls, &le, &se);
+        gather_ends(g, rs, s, cam_org, x, y, 0, &ls, &le, &se);
         return evr_gi_lerp(ls, le, f);
     }
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
     const float key[7] = {s->p.x, s->p.y, s->p.z, s->n.x, s->n.y, s->n.z, dist};
     m->missed = 0;
-    /* the albedo is the surface's at p (same point, same triangle side: same albedo) */
+    /* the gather depends on the surface's diffuse weight as the camera sees it: the same
+     * instance, point, normal and distance bit for bit are the same view (a camera that moves
+     * moves every point it sees) */
     if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) {
         if (!m->end_valid) {
-            gather_ends(g, rs, mat, s, cam_org, x, y, 1, &m->ls, &m->le, &m->se);
+            gather_ends(g, rs, s, cam_org, x, y, 1, &m->ls, &m->le, &m->se);
             m->end_valid = 1;
             m->flat = m->le == m->ls;
         }
@@ -258,7 +259,7 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
     }
     memcpy(m->key, key, sizeof key);
     m->inst = inst;
-    gather_ends(g, rs, mat, s, cam_org, x, y, 0, &m->ls, &m->le, &m->se);
+    gather_ends(g, rs, s, cam_org, x, y, 0, &m->ls, &m->le, &m->se);
     m->valid = m->end_valid = 1;
     m->flat = m->le == m->ls;
     return evr_gi_lerp(m->ls, m->le, f);

@@ -43,8 +43,10 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
                               evr_photon_buffer *buf, int threads, evr_error *err);
 
 /* Energy bookkeeping (RGB flux) and counts of one pass. Absorbed is the estimate
- * sum(first hits of light photons: F (1 - albedo)) + sum(stays: F / t_diffuse * (1 - albedo));
- * on a closed scene with enough bounces emitted = absorbed + capped within Monte Carlo error. */
+ * sum(every hit: F (1 - albedo)) with the flux F arriving there and the surface's albedo (all
+ * its lobes) as seen from the photon's side (core/photon_path.h); on a closed scene with enough
+ * bounces emitted = absorbed + capped within Monte Carlo error (exactly in expectation where the
+ * albedo does not depend on the direction light leaves in, as a Lambert surface's). */
 typedef struct {
     double emitted[3], stored[3], absorbed[3], escaped[3], capped[3];
     uint64_t paths, stored_photons, visible, inserted, collisions;

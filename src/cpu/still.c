@@ -99,10 +99,11 @@ static void direct_lights(const shade_ctx *c, const evr_surface *s, evr_v3 wo, f
     evr_shade_direct_sum(c->rs, s, wo, 0.0f, &o, &rays, acc);
 }
 
-/* The surface ray meets beyond tnear; cam: the camera whose pixel cone the ray carries (textures
- * are filtered by the cone's width there; NULL: the sharpest level). */
+/* The surface ray meets beyond tnear, at distance *t; cam: the camera whose pixel cone the ray
+ * carries (textures are filtered by the cone's width there; NULL: the sharpest level); *inst its
+ * instance (inst and t may be NULL). */
 static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, const evr_camera_intr *cam,
-                      evr_surface *s, const evr_material_params **mat, int *inst)
+                      evr_surface *s, int *inst, float *t)
 {
     const evr_render_scene *rs = c->rs;
     evr_trace_hit h;
@@ -110,58 +111,87 @@ static int surface_of(const shade_ctx *c, evr_ray ray, float tnear, const evr_ca
     evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), 0.0f);
     evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, 0.0f, ray, h.t,
                    cam ? evr_camera_cone(cam, h.t) : 0.0f, s);
-    *mat = &rs->materials[rs->meshes[rs->instances[h.inst].mesh].material];
     if (inst) *inst = h.inst;
+    if (t) *t = h.t;
     return 1;
 }
 
-/* One path from surface s0 (reached along dir_in): the radiance it reflects towards dir_in's
- * origin, excluding the direct term: paths of 1 .. max_bounces bounces ending on a light (next-
- * event estimation with the direct term's lights, diffuse share) or on an emissive surface. */
-static void path_sample(const shade_ctx *c, const evr_surface *s0, const evr_material_params *m0,
-                        evr_v3 dir_in, uint64_t pix, uint64_t sample, float out[3])
+/* One path of the indirect light at the camera ray's hit s0 (the ray along d0): what the event
+ * pipeline's direct term (evr_path_radiance: s0's lights and emission, and the mirror,
+ * refraction and BLEND rays that core/path.h traces from it, with theirs) leaves out. The path
+ * samples s0's BSDF (core/bsdf_sample.h) and goes on; at each surface it meets it adds that
+ * surface's emission and its lights (next-event estimation with the direct term's code,
+ * evr_shade_direct_sum and evr_material_add_light), unless every bounce so far was one the
+ * direct term traces itself (then that surface was shaded there already). Point lights are met
+ * only by their shadow rays and emissive surfaces only by the path, so no light is counted
+ * twice. A path ends past --max-bounces, in the void (the ambient light is the direct term's),
+ * or by Russian roulette after three bounces. */
+static void path_sample(const shade_ctx *c, const evr_surface *s0, evr_v3 d0, uint64_t pix,
+                        uint64_t sample, float out[3])
 {
     const evr_render_scene *rs = c->rs;
     const uint64_t seed = c->p->seed ^ 0x70617468ull; /* "path" */
     evr_surface s = *s0;
-    const evr_material_params *m = m0;
-    float beta[3] = {1.0f, 1.0f, 1.0f};
-    int depth, dim = 0;
+    evr_v3 d = d0;
+    float beta[3] = {1.0f, 1.0f, 1.0f}; /* the path's weight */
+    float wdet[3] = {1.0f, 1.0f, 1.0f}; /* while det: the weight core/path.h gives the ray */
+    int depth, dim = 0, det = 1, medium = -1, k;
     out[0] = out[1] = out[2] = 0.0f;
     for (depth = 0; depth < c->p->max_bounces; depth++) {
-        float xi = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
-        float u1 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
-        float u2 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
-        evr_v3 wo =
-            evr_material_bounce_dir(&s, evr_material_path_event(m, &s, dir_in, xi), dir_in, u1, u2);
-        beta[0] *= s.albedo[0];
-        beta[1] *= s.albedo[1];
-        beta[2] *= s.albedo[2];
+        const float xi = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        const float u1 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        const float u2 = evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++));
+        const evr_material_params *m = &rs->materials[s.material];
+        float w[EVR_LOBES][3], wt[3], pick;
+        evr_v3 dir;
+        evr_bsdf_lobe_weights(&s, w);
+        const int lobe = evr_bsdf_pick(w, xi, &pick);
+        if (lobe < 0 || !evr_bsdf_sample(&s, m, lobe, d, u1, u2, 0, &dir, wt)) return;
+        const int crossed = evr_v3_dot(dir, s.nv) < 0.0f;
+        /* core/path.h traces the uncovered share, the transmission and a mirror's reflection
+         * (total internal reflection joins the reflection) while deep and bright enough */
+        const int traced =
+            lobe == EVR_LOBE_PASS || (lobe == EVR_LOBE_TRANSMIT && crossed) ||
+            ((lobe == EVR_LOBE_SPECULAR || lobe == EVR_LOBE_TRANSMIT) && evr_material_mirror(&s));
+        for (k = 0; k < 3; k++) {
+            beta[k] *= wt[k] / pick;
+            wdet[k] *= wt[k];
+        }
+        det = det && traced && depth + 1 <= rs->max_bounces &&
+              evr_luminance(wdet[0], wdet[1], wdet[2]) >= EVR_PATH_MIN_WEIGHT;
+        if (lobe == EVR_LOBE_TRANSMIT && crossed) {
+            const int cross = evr_bsdf_crossing(&s, m);
+            if (cross) medium = cross > 0 ? s.material : -1;
+        }
         if (depth >= 3) { /* Russian roulette */
             float q = fminf(fmaxf(beta[0], fmaxf(beta[1], beta[2])), 0.95f);
             if (evr_uniform(evr_hash4(seed, pix, sample, (uint64_t)dim++)) >= q) return;
-            beta[0] /= q;
-            beta[1] /= q;
-            beta[2] /= q;
+            for (k = 0; k < 3; k++) beta[k] /= q;
         }
         if (!(beta[0] > 0.0f || beta[1] > 0.0f || beta[2] > 0.0f)) return;
         evr_ray r;
         evr_surface y;
-        const evr_material_params *my;
+        float t;
         r.org = s.p;
-        r.dir = wo;
+        r.dir = dir;
         /* the path's bounces sample textures sharply: many paths average them */
-        if (!surface_of(c, r, evr_shadow_tnear(&s, wo, rs->ray_eps), NULL, &y, &my, NULL)) return;
-        float acc[3], em[3];
-        const evr_v3 back = evr_v3_scale(wo, -1.0f);
-        direct_lights(c, &y, back, acc); /* the BSDF's direct light, RGB radiance */
-        evr_material_emission(&y, back, em);
-        out[0] += beta[0] * (em[0] + acc[0]);
-        out[1] += beta[1] * (em[1] + acc[1]);
-        out[2] += beta[2] * (em[2] + acc[2]);
+        if (!surface_of(c, r, rs->ray_eps / fmaxf(fabsf(evr_v3_dot(s.nv, dir)), 0.05f), NULL, &y,
+                        NULL, &t))
+            return;
+        if (medium >= 0) { /* Beer-Lambert through the volume it crossed */
+            evr_volume_attenuate(&rs->materials[medium], t, beta);
+            evr_volume_attenuate(&rs->materials[medium], t, wdet);
+        }
+        if (!det) { /* y's emission and lights: its radiance as the direct term shades it */
+            float acc[3], em[3];
+            const evr_v3 back = evr_v3_scale(dir, -1.0f);
+            direct_lights(c, &y, back, acc);
+            evr_material_emission(&y, back, em);
+            for (k = 0; k < 3; k++)
+                out[k] += beta[k] * y.opacity * (y.unlit ? y.albedo[k] : em[k] + acc[k]);
+        }
         s = y;
-        m = my;
-        dir_in = wo;
+        d = dir;
     }
 }
 
@@ -178,11 +208,10 @@ static void shade_row(shade_ctx *c, int y)
         float *rgb = o->rgb + 3 * i, *dir = o->direct + 3 * i, acc[3];
         evr_ray ray = evr_camera_ray(&rs->camera, &c->pose, (float)x + 0.5f, (float)y + 0.5f);
         evr_surface s;
-        const evr_material_params *mat;
         int inst;
         rgb[0] = rgb[1] = rgb[2] = dir[0] = dir[1] = dir[2] = 0.0f;
         o->instance[i] = -1;
-        if (!surface_of(c, ray, 0.0f, &rs->camera, &s, &mat, &inst)) continue;
+        if (!surface_of(c, ray, 0.0f, &rs->camera, &s, &inst, NULL)) continue;
         o->instance[i] = inst;
         const evr_v3 wo = evr_v3_scale(ray.dir, -1.0f);
         direct_lights(c, &s, wo, acc);
@@ -200,14 +229,14 @@ static void shade_row(shade_ctx *c, int y)
             float dist = evr_v3_len(evr_v3_sub(s.p, ray.org));
             used += evr_photon_gather(c->buf, &rs->camera, x, y, s.p, s.n, dist, &c->gp, e);
             hits++;
-            evr_photon_indirect(&s, mat, e, ind);
+            evr_photon_indirect(&s, e, ind);
             for (k = 0; k < 3; k++) rgb[k] += ind[k];
         } else if (p->gi == EVR_GI_PATH) {
             double sum[3] = {0, 0, 0};
             int n;
             for (n = 0; n < p->spp; n++) {
                 float l[3];
-                path_sample(c, &s, mat, ray.dir, (uint64_t)i, (uint64_t)n, l);
+                path_sample(c, &s, ray.dir, (uint64_t)i, (uint64_t)n, l);
                 for (k = 0; k < 3; k++) sum[k] += (double)l[k];
             }
             for (k = 0; k < 3; k++) rgb[k] += (float)(sum[k] / (double)p->spp);

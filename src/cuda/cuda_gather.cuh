@@ -28,8 +28,8 @@ __device__ static __noinline__ void gpu_gather_point(const evr_render_scene *rs,
                                                      const evr_surface *s, evr_v3 cam_org,
                                                      evr_gather_point *g)
 {
-    evr_gather_point_at(s, &rs->materials[rs->meshes[rs->instances[inst].mesh].material], cam_org,
-                        g);
+    (void)rs, (void)inst; /* the surface record holds what the gather needs of its material */
+    evr_gather_point_at(s, cam_org, g);
 }
 
 /* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those

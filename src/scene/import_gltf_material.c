@@ -331,7 +331,6 @@ static evr_status read_material(reader *r, int m, evr_material_params *p, int *u
     int pbr = evr_jdoc_get(d, m, "pbrMetallicRoughness"), v, s;
     char mode[16];
     evr_status st;
-    float td = T_ABSENT, ts = T_ABSENT;
 
     for (s = 0; s < EVR_TEX_COUNT; s++) r->uv[s] = -1;
     /* the spec's defaults (Assimp 5.2 reports the same): metallic and roughness 1 */
@@ -369,20 +368,10 @@ static evr_status read_material(reader *r, int m, evr_material_params *p, int *u
     if ((st = extensions(r, m, p)) != EVR_OK) return st;
     *uv = uv_set(r);
 
-    evr_photon_material_map(p->base_color, p->metallic, p->roughness, &p->t_diffuse,
-                            &p->t_specular);
+    /* the photon thresholds of evray before its BSDF: photons follow the BSDF now */
     v = evr_jdoc_get(d, m, "extras");
-    td = (float)evr_jdoc_number(d, evr_jdoc_get(d, v, "t_diffuse"), T_ABSENT);
-    ts = (float)evr_jdoc_number(d, evr_jdoc_get(d, v, "t_specular"), T_ABSENT);
-    if (td != T_ABSENT || ts != T_ABSENT) {
-        if (td == T_ABSENT) td = p->t_diffuse;
-        if (ts == T_ABSENT) ts = td > p->t_specular ? td : p->t_specular;
-        if (!(td >= 0.0f && td <= ts && ts <= 1.0f))
-            return bad(r, "extras need 0 <= t_diffuse <= t_specular <= 1 (got %g, %g)", (double)td,
-                       (double)ts);
-        p->t_diffuse = td;
-        p->t_specular = ts;
-    }
+    if (evr_jdoc_get(d, v, "t_diffuse") >= 0 || evr_jdoc_get(d, v, "t_specular") >= 0)
+        warn(r, "extras t_diffuse / t_specular are not read (photons follow the BSDF): ignored");
     return EVR_OK;
 }
 

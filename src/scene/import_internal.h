@@ -40,8 +40,6 @@ struct aiAnimation;
 enum { PATH_T = 0, PATH_R = 1, PATH_S = 2, PATH_W = 3 };
 enum { GL_LINEAR = 0, GL_STEP = 1, GL_CUBIC = 2 };
 
-#define T_ABSENT -1e30f
-
 /* One glTF animation channel that targets a node's translation, rotation, scale or morph
  * weights. */
 typedef struct {

@@ -115,8 +115,6 @@ static evr_status assimp_material(importer *im, const struct aiMaterial *am, evr
         m->p.transmission = f;
         if (get_float(am, AI_MATKEY_REFRACTI, &f) && f >= 1.0f) m->p.ior = f;
     }
-    evr_photon_material_map(m->p.base_color, m->p.metallic, m->p.roughness, &m->p.t_diffuse,
-                            &m->p.t_specular);
 
     for (s = 0; s < EVR_TEX_COUNT; s++) uv[s] = -1;
     if ((st = assimp_slot(im, am, m, base, 2, EVR_TEX_BASE, &uv[EVR_TEX_BASE])) != EVR_OK ||
