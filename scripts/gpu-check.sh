@@ -37,6 +37,14 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene cornell -
     --duration 0.3 -o "$OUT/cs-gi" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck gi exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --backend cuda --res 64x48 \
     --duration 0.2 -o "$OUT/cs-gi2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck gi exit $?" >> "$OUT/sanitizer.log"
+# every material feature (normal maps, glass, MASK/BLEND, a sphere light's glint), a camera path
+# and label frames (the label kernel) under memcheck
+python3 tests/all_materials.py /tmp/evray-am > /dev/null
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" render /tmp/evray-am/all_materials.gltf --backend cuda --res 64x48 \
+    --duration 1.0 -o "$OUT/cs-am" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck all_materials exit $?" >> "$OUT/sanitizer.log"
+compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x48 --duration 0.3 \
+    --camera-path orbit+shake --labels-fps 30 -o "$OUT/cs-path" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck path+labels exit $?" >> "$OUT/sanitizer.log"
+python3 tests/test_cuda_labels.py "$E" > "$OUT/test_cuda_labels.log" 2>&1; echo "test_cuda_labels exit $?" >> "$OUT/test_cuda_labels.log"
 # issue 7's figure: the eye at 1280x720, 10 samples per frame, 30 fps, the whole 30 s, ideal
 # sensor, change-driven sampling against brute force in the same run, with the identity check
 "$E" bench --scene eye --backend cuda --res 1280x720 --samples-per-frame 10 --vs-brute > "$OUT/bench.log" 2>&1
