@@ -83,6 +83,17 @@ static int64_t timestamp_slack_us(const evr_sim *sim)
            sim->setup.pixel.time_res_us;
 }
 
+/* The writers' flush interval: EVR_WRITE_FLUSH_SECONDS, or the hidden EVR_FLUSH_SECONDS (tests
+ * flush after every batch with 0 to show that when files are flushed changes none of their
+ * bytes). */
+static double flush_seconds(void)
+{
+    const char *v = getenv("EVR_FLUSH_SECONDS");
+    char *end;
+    double s = v ? strtod(v, &end) : 0.0;
+    return v && end != v && !*end && s >= 0.0 && s <= 1e6 ? s : EVR_WRITE_FLUSH_SECONDS;
+}
+
 /* The run's wall time so far, and the rates that follow from it, into sim->st. */
 static void set_wall(evr_sim *sim)
 {
@@ -211,8 +222,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         return st;
     }
     if ((st = evr_run_writers_open(sim, err)) != EVR_OK ||
-        (st = evr_write_queue_start(sim->writers, sim->num_writers, EVR_WRITE_FLUSH_SECONDS,
-                                    &sim->wq, err)) != EVR_OK) {
+        (st = evr_write_queue_start(sim->writers, sim->num_writers, flush_seconds(), &sim->wq,
+                                    err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;

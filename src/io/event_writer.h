@@ -12,8 +12,9 @@ typedef struct evr_event_writer evr_event_writer;
 struct evr_event_writer {
     /* Appends n events (sorted by t, and t not below any earlier call's). */
     evr_status (*write)(evr_event_writer *w, const evr_event *ev, size_t n, evr_error *err);
-    /* Makes what has been written durable, so an interrupted run keeps it (the simulation calls it
-     * about once a second: write_queue.h). */
+    /* Makes what has been written durable, so a killed run keeps it (the simulation calls it
+     * about once a second: write_queue.h); the HDF5 writer keeps its last partial chunk's events
+     * (fewer than 65,536) in memory, so that the timing of flushes changes no byte of its file. */
     evr_status (*flush)(evr_event_writer *w, evr_error *err);
     /* Completes the file; duration_us is the simulated time span (for indices such as ms_to_idx).
      * Frees the writer whatever the result. */

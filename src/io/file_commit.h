@@ -1,5 +1,6 @@
 /* A file written under a temporary name (its path plus ".tmp"): created, and completed by closing
- * it and, if everything went well, renaming it to its final name, otherwise removing it. */
+ * it and, if everything went well, syncing it and renaming it to its final name, otherwise
+ * removing it. */
 #ifndef EVR_IO_FILE_COMMIT_H
 #define EVR_IO_FILE_COMMIT_H
 
@@ -15,7 +16,17 @@ FILE *evr_file_create(const char *tmp, const char *who, evr_error *err);
 /* Gives up a file: closes and removes it. */
 void evr_file_discard(FILE *f, const char *tmp);
 
-/* st is the status so far (an earlier failure keeps its message); who names the writer in
+/* Makes the file tmp durable under the name path: tmp's data is synced to the disk, then its
+ * folder, then tmp is renamed to path and the folder synced again, so that after a power loss
+ * path is either absent (or its earlier self) or complete. 0, or -1 with errno set. */
+int evr_file_publish(const char *tmp, const char *path);
+
+/* Syncs the folder that holds path (after creating, renaming or removing a file in it). 0, or -1
+ * with errno set. */
+int evr_folder_sync(const char *path);
+
+/* Closes f and publishes tmp as path (evr_file_publish) when everything went well; otherwise
+ * removes tmp. st is the status so far (an earlier failure keeps its message); who names the writer in
  * messages. Returns the final status. */
 evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st,
                            const char *who, evr_error *err);

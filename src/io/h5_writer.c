@@ -14,9 +14,13 @@
  * chunks are filtered here instead, by a pool of threads (chunk_compress.c makes the very bytes
  * HDF5's shuffle and deflate filters would make), and stored with H5Dwrite_chunk: readers see
  * the same datasets, filters and chunks. Events are staged until a batch of chunks is full;
- * flush() also stores the partial last chunk (zero beyond the data, as HDF5 fills it) and
- * flushes the file, so the temporary file of an interrupted run is readable up to the last
- * flush; the next store of that chunk replaces it. ms_to_idx is small and goes through H5Dwrite.
+ * flush() stores the full chunks staged and flushes the file, so the temporary file of a killed
+ * run is readable and holds every event up to the last flush but those of the last partial
+ * chunk (fewer than 65,536), which stay in memory until finish() stores them (zero beyond the
+ * data, as HDF5 fills it). ms_to_idx is small, goes through H5Dwrite and is written by finish().
+ * Storing the partial chunk at each flush and replacing it later would leave holes whose places
+ * depend on when the (timed) flushes came: as it is, the same events give the same bytes
+ * however the flushes fell, and no object carries a time stamp (create_file).
  * HDF5's automatic error printing is switched off around every call (H5E_BEGIN_TRY) and its
  * error stack is turned into the message instead. */
 #include "io/event_formats.h"
@@ -24,6 +28,7 @@
 #include "io/file_commit.h"
 #include "par_pool.h"
 
+#include <errno.h>
 #include <hdf5.h>
 #include <inttypes.h>
 #include <stddef.h>
@@ -84,7 +89,7 @@ typedef struct {
 
 /* Collects the most specific HDF5 error description (the walk starts where the error arose). */
 typedef struct {
-    char desc[200];
+    char desc[1024]; /* room for the errno after a long file name */
     int got;
 } h5_walk_data;
 
@@ -102,11 +107,17 @@ static herr_t h5_walk(unsigned n, const H5E_error2_t *e, void *data)
 static evr_status h5_fail(evr_error *err, const char *what, const char *path)
 {
     h5_walk_data d;
+    const char *at;
+    int code;
     d.desc[0] = 0;
     d.got = 0;
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, &d);
     H5Eclear2(H5E_DEFAULT);
-    if (d.got) snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, d.desc);
+    /* a failed system call: HDF5's description names the time, the descriptor, the buffer...
+     * and errno, which is all the user needs ("No space left on device") */
+    if (d.got && (at = strstr(d.desc, "errno = ")) != NULL && sscanf(at + 8, "%d", &code) == 1)
+        snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, strerror(code));
+    else if (d.got) snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, d.desc);
     else snprintf(err->msg, sizeof err->msg, "hdf5: %s %s", what, path);
     return EVR_ERR_IO;
 }
@@ -117,7 +128,8 @@ static hid_t make_extendible(hid_t loc, const char *name, hid_t type, hsize_t ch
     hid_t space = H5Screate_simple(1, dims, maxdims);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, 1, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0 &&
+        H5Pset_chunk(dcpl, 1, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
         H5Pset_deflate(dcpl, H5W_DEFLATE) >= 0)
         ds = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (dcpl >= 0) H5Pclose(dcpl);
@@ -141,6 +153,20 @@ static herr_t append(hid_t ds, hid_t mtype, const void *data, uint64_t old, size
     if (mspace >= 0) H5Sclose(mspace);
     if (fspace >= 0) H5Sclose(fspace);
     return r;
+}
+
+/* Creates (truncates) the file so that the same calls give the same bytes: no modification times
+ * on any object (the root group's come from the file creation list), and the file format pinned
+ * to HDF5 1.8's (readable by 1.8 and later), whatever library version writes it. */
+static hid_t create_file(const char *path)
+{
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS), f = -1;
+    if (fcpl >= 0 && fapl >= 0 && H5Pset_obj_track_times(fcpl, 0) >= 0 &&
+        H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18) >= 0)
+        f = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
+    if (fapl >= 0) H5Pclose(fapl);
+    if (fcpl >= 0) H5Pclose(fcpl);
+    return f;
 }
 
 static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
@@ -171,9 +197,11 @@ static herr_t write_string_attr(hid_t loc, const char *name, const char *text)
 static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
                                    const void *value)
 {
-    hid_t space = H5Screate(H5S_SCALAR), ds = -1;
+    hid_t space = H5Screate(H5S_SCALAR), dcpl = H5Pcreate(H5P_DATASET_CREATE), ds = -1;
     herr_t r = -1;
-    if (space >= 0) ds = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0)
+        ds = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (dcpl >= 0) H5Pclose(dcpl);
     if (ds >= 0) r = H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, value);
     if (ds >= 0) H5Dclose(ds);
     if (space >= 0) H5Sclose(space);
@@ -578,11 +606,12 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
     return EVR_OK;
 }
 
+/* Full chunks only: see the top of the file. */
 static evr_status h5_flush(evr_event_writer *base, evr_error *err)
 {
     h5_writer *w = (h5_writer *)base;
     herr_t r;
-    evr_status st = drain(w, err);
+    evr_status st = store(w, 0, err);
     if (st != EVR_OK) return st;
     H5E_BEGIN_TRY { r = H5Fflush(w->file, H5F_SCOPE_GLOBAL); }
     H5E_END_TRY;
@@ -633,8 +662,9 @@ static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_err
         st = h5_fail(err, "cannot complete", w->tmp);
         goto fail;
     }
-    if (rename(w->tmp, w->path) != 0) {
-        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot rename %s to %s", w->tmp, w->path);
+    if (evr_file_publish(w->tmp, w->path) != 0) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot complete %s: %s", w->path,
+                 strerror(errno));
         st = EVR_ERR_IO;
         goto fail;
     }
@@ -655,6 +685,11 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     const char *what = "cannot create";
 
     *out = NULL;
+    /* A file whose closing failed (a full disk, an I/O error) is left half closed by HDF5, and
+     * the library's own clean-up at exit then crashes on it: the process ends without that
+     * clean-up (the writer closes its files itself). Only before HDF5's first call in the
+     * process does this take effect. */
+    H5dont_atexit();
     if (!path || !*path || !meta) {
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: no path or metadata given");
         return EVR_ERR_ARG;
@@ -691,10 +726,13 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         int32_t width = meta->width, height = meta->height;
         int64_t zero = 0;
         int8_t incomplete = 0;
-        w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+        w->file = create_file(w->tmp);
         if (w->file >= 0) {
+            hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
             what = "cannot lay out";
-            w->group = H5Gcreate2(w->file, "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+            if (gcpl >= 0 && H5Pset_obj_track_times(gcpl, 0) >= 0)
+                w->group = H5Gcreate2(w->file, "events", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+            if (gcpl >= 0) H5Pclose(gcpl);
         }
         if (w->group >= 0) w->ds_x = make_extendible(w->group, "x", H5T_STD_U16LE, H5W_CHUNK);
         if (w->ds_x >= 0) w->ds_y = make_extendible(w->group, "y", H5T_STD_U16LE, H5W_CHUNK);

@@ -1,6 +1,7 @@
 #include "run/run_files.h"
 #include "run/frames_out.h"
 #include "io/mkdir_p.h"
+#include "io/file_commit.h"
 #include "io/event_formats.h"
 #include "io/json.h"
 #include "io/preview.h"
@@ -384,9 +385,10 @@ evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
     int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
     if (f) ok = (fclose(f) == 0) && ok;
     free(text);
-    if (!ok || rename(tmp, p) != 0) {
+    if (!ok || evr_file_publish(tmp, p) != 0) {
+        const int e = errno;
         remove(tmp);
-        snprintf(err->msg, sizeof err->msg, "cannot write %s", p);
+        snprintf(err->msg, sizeof err->msg, "cannot write %s: %s", p, strerror(e));
         return EVR_ERR_IO;
     }
     return EVR_OK;
