@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -83,4 +84,49 @@ evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_statu
     }
     if (st != EVR_OK) remove(tmp);
     return st;
+}
+
+evr_status evr_file_salvage(FILE *f, const char *tmp, const char *path, uint64_t keep,
+                            uint64_t stream_end, const unsigned char *tail, size_t tail_len,
+                            const void *head, size_t head_len, const char *who, evr_error *err)
+{
+    struct stat sb;
+    int fd;
+    const char *what = "cannot reopen";
+    /* closing writes out what stdio still holds; if that fails, the file is a shorter prefix */
+    fclose(f);
+    errno = 0;
+    fd = open(tmp, O_WRONLY | O_CLOEXEC);
+    if (fd >= 0) {
+        what = "cannot read the size of";
+        if (fstat(fd, &sb) == 0) {
+            /* the file holds the stream's first size bytes (appends in order: a failed write
+             * leaves a shorter prefix); the bytes it lacks must come from the tail in memory */
+            uint64_t size = (uint64_t)sb.st_size, tail_at = stream_end - tail_len;
+            what = "lost written events in";
+            if (keep > stream_end || (size < keep && size < tail_at)) {
+                errno = 0;
+                goto fail;
+            }
+            what = "cannot complete";
+            if (size < keep && pwrite(fd, tail + (size - tail_at), (size_t)(keep - size),
+                                      (off_t)size) != (ssize_t)(keep - size))
+                goto fail;
+            if (ftruncate(fd, (off_t)keep) != 0) goto fail;
+            if (head_len && pwrite(fd, head, head_len, 0) != (ssize_t)head_len) goto fail;
+            if (fsync(fd) != 0) goto fail;
+            if (close(fd) != 0) {
+                fd = -1;
+                goto fail;
+            }
+            fd = -1;
+            if (evr_file_publish(tmp, path) == 0) return EVR_OK;
+        }
+    }
+fail:
+    snprintf(err->msg, sizeof err->msg, "%s: %s %s%s%s", who, what, tmp, errno ? ": " : "",
+             errno ? strerror(errno) : "");
+    if (fd >= 0) close(fd);
+    remove(tmp);
+    return EVR_ERR_IO;
 }

@@ -4,6 +4,7 @@
 #ifndef EVR_IO_FILE_COMMIT_H
 #define EVR_IO_FILE_COMMIT_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include "evray.h"
 
@@ -30,5 +31,16 @@ int evr_folder_sync(const char *path);
  * messages. Returns the final status. */
 evr_status evr_file_commit(FILE *f, const char *tmp, const char *path, evr_status st,
                            const char *who, evr_error *err);
+
+/* The end of a failed run for a file written as one stream of appends (and, at most, a header
+ * rewritten in place): closes f (what stdio holds goes out, if it can), makes tmp hold exactly
+ * the stream's first keep bytes and publishes it as path. The stream was meant to be stream_end
+ * bytes long, of which the last tail_len are in tail (not written yet, or their write failed);
+ * the bytes the file lacks are written from there. head (head_len bytes, may be 0) is written
+ * over the start (a header that depends on keep). Fails, removing tmp, when the file lacks
+ * bytes that tail does not hold or cannot be written. */
+evr_status evr_file_salvage(FILE *f, const char *tmp, const char *path, uint64_t keep,
+                            uint64_t stream_end, const unsigned char *tail, size_t tail_len,
+                            const void *head, size_t head_len, const char *who, evr_error *err);
 
 #endif

@@ -77,6 +77,9 @@ typedef struct {
     int fill, inflight;
     uint64_t inflight_at;
     size_t batch; /* chunks in a full stage */
+    /* a full batch whose storing failed (salvage stores it again): its set and first index */
+    int unstored, unstored_set;
+    uint64_t unstored_at;
     int64_t last_t;
     int have_last;
     int t32; /* events/t is uint32 (else int64) */
@@ -351,6 +354,15 @@ static evr_status compress_failed(evr_error *err)
     return EVR_ERR_NOMEM;
 }
 
+/* The full batch of set s from index at could not be stored: salvage tries again (the set's
+ * compressed chunks stay as they are, since nothing is written after a failure). */
+static void set_unstored(h5_writer *w, int s, uint64_t at)
+{
+    w->unstored = 1;
+    w->unstored_set = s;
+    w->unstored_at = at;
+}
+
 /* Waits for the batch in flight, if any, and stores it. */
 static evr_status land_inflight(h5_writer *w, evr_error *err)
 {
@@ -358,7 +370,9 @@ static evr_status land_inflight(h5_writer *w, evr_error *err)
     w->inflight = 0;
     if (!evr_chunk_pool_wait(w->pool)) return compress_failed(err);
     const uint64_t end = w->inflight_at + w->batch * H5W_CHUNK;
-    return put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at, end, err);
+    evr_status st = put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at, end, err);
+    if (st != EVR_OK) set_unstored(w, 1 - w->fill, w->inflight_at);
+    return st;
 }
 
 /* A full stage (batch chunks): compressed by the pool while the writer goes on; the batch in
@@ -376,9 +390,12 @@ static evr_status store_full(h5_writer *w, evr_error *err)
     w->nstage = 0;
     w->tail_stored = 0;
     w->fill = 1 - w->fill; /* the landed batch's set stages next */
-    if (was_inflight)
-        return put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at,
-                          prev_at + w->batch * H5W_CHUNK, err);
+    if (was_inflight) {
+        evr_status st = put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at,
+                                   prev_at + w->batch * H5W_CHUNK, err);
+        if (st != EVR_OK) set_unstored(w, w->fill, prev_at);
+        return st;
+    }
     return EVR_OK;
 }
 
@@ -627,6 +644,38 @@ static void h5_abort(evr_event_writer *base)
     free_writer(w);
 }
 
+/* Closes the file and publishes it under its final name; frees the writer whatever the result
+ * (removing the file when that fails). */
+static evr_status close_publish(h5_writer *w, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    herr_t r = 0;
+    H5E_BEGIN_TRY
+    {
+        /* closing the datasets first lets H5Fclose really close the file */
+        hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
+        for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
+            if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
+            *ids[i] = -1;
+        }
+        if (H5Fclose(w->file) < 0) r = -1;
+        w->file = -1;
+    }
+    H5E_END_TRY;
+    if (r < 0) st = h5_fail(err, "cannot complete", w->tmp);
+    else if (evr_file_publish(w->tmp, w->path) != 0) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot complete %s: %s", w->path,
+                 strerror(errno));
+        st = EVR_ERR_IO;
+    }
+    if (st != EVR_OK) {
+        close_all(w);
+        remove(w->tmp);
+    }
+    free_writer(w);
+    return st;
+}
+
 static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
 {
     h5_writer *w = (h5_writer *)base;
@@ -646,30 +695,71 @@ static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_err
     {
         int8_t complete = 1;
         r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
-        if (r >= 0) {
-            /* closing the datasets first lets H5Fclose really close the file */
-            hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
-            for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
-                if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
-                *ids[i] = -1;
-            }
-            if (H5Fclose(w->file) < 0) r = -1;
-            w->file = -1;
-        }
     }
     H5E_END_TRY;
     if (r < 0) {
         st = h5_fail(err, "cannot complete", w->tmp);
         goto fail;
     }
-    if (evr_file_publish(w->tmp, w->path) != 0) {
-        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot complete %s: %s", w->path,
-                 strerror(errno));
+    return close_publish(w, err);
+fail:
+    close_all(w);
+    remove(w->tmp);
+    free_writer(w);
+    return st;
+}
+
+/* Stores everything staged or in flight (again, where a store failed), cuts the datasets to the
+ * first `events` events and ms_to_idx to its entries within them, and completes the file with
+ * its attribute complete at 0. */
+static evr_status h5_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                             evr_error *err)
+{
+    h5_writer *w = (h5_writer *)base;
+    evr_status st = EVR_OK;
+    herr_t r = 0;
+    size_t keep_ms = 0;
+    (void)duration_us;
+    if (events > w->total) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot keep %llu events of %s",
+                 (unsigned long long)events, w->path);
         st = EVR_ERR_IO;
         goto fail;
     }
-    free_writer(w);
-    return EVR_OK;
+    if (w->inflight) {
+        w->inflight = 0;
+        if (!evr_chunk_pool_wait(w->pool)) st = compress_failed(err);
+        else
+            st = put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at,
+                            w->inflight_at + w->batch * H5W_CHUNK, err);
+    }
+    if (st == EVR_OK && w->unstored)
+        st = put_chunks(w, w->set[w->unstored_set].jobs, w->batch, w->unstored_at,
+                        w->unstored_at + w->batch * H5W_CHUNK, err);
+    if (st == EVR_OK) st = store(w, 1, err);
+    if (st != EVR_OK) goto fail;
+    /* ms_to_idx[i] is the first event at or after i ms: right for the first `events` events too
+     * while it is at most `events` (entries only grow) */
+    while (keep_ms < w->nms && w->ms[keep_ms] <= events) keep_ms++;
+    H5E_BEGIN_TRY
+    {
+        hsize_t size[1] = {(hsize_t)events};
+        int8_t complete = 0;
+        for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
+            if (H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
+        if (r >= 0 && keep_ms &&
+            append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, keep_ms) < 0)
+            r = -1;
+        if (r >= 0)
+            r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
+    }
+    H5E_END_TRY;
+    if (r < 0) {
+        st = h5_fail(err, "cannot complete", w->tmp);
+        goto fail;
+    }
+    w->nms = 0;
+    return close_publish(w, err);
 fail:
     close_all(w);
     remove(w->tmp);
@@ -765,6 +855,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     w->base.flush = h5_flush;
     w->base.finish = h5_finish;
     w->base.abort = h5_abort;
+    w->base.salvage = h5_salvage;
     *out = &w->base;
     return EVR_OK;
 }
