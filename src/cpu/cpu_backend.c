@@ -774,10 +774,15 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
         return EVR_ERR_BACKEND;
     }
     for (i = 0; i < ntiles; i++) { /* tile order: deterministic whatever the thread count */
-        if (!evr_event_vec_append(out, b->tile_events[i].data, b->tile_events[i].n)) {
+        evr_event_vec *te = &b->tile_events[i];
+        if (!evr_event_vec_append(out, te->data, te->n)) {
             snprintf(err->msg, sizeof err->msg, "out of memory for events");
             return EVR_ERR_NOMEM;
         }
+        /* a tile's buffer grows to its busiest segment; one far larger than this segment's needs
+         * goes, so that the run's memory follows its current bursts rather than the sum of every
+         * tile's worst ever */
+        if (te->cap > 4 * te->n + 4096) evr_event_vec_free(te);
     }
     const double ts0 = evr_host_seconds();
     int sorted = evr_events_sort(out, &b->scratch);
