@@ -10,12 +10,21 @@
 #include <time.h>
 #include <unistd.h>
 
-static volatile sig_atomic_t interrupted;
+static volatile sig_atomic_t interrupted, signals;
+static evr_sim *volatile running; /* the run the signals stop */
 
+/* The first Ctrl-C stops the run after the segments being rendered; a second, or SIGTERM, stops
+ * it at once (evr_sim_cancel); either way the files are completed. Should that hang, the third
+ * signal ends the process as the signal does. */
 static void on_signal(int sig)
 {
-    (void)sig;
+    signals++;
     interrupted = 1;
+    if (sig == SIGTERM || signals >= 2) evr_sim_cancel(running);
+    if (signals >= 3) {
+        signal(sig, SIG_DFL);
+        raise(sig);
+    }
 }
 
 typedef struct {
@@ -120,8 +129,11 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
+    running = sim;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* a file past the process's size limit is a write error (EFBIG), not the end of evray */
+    signal(SIGXFSZ, SIG_IGN);
 
     progress_state ps;
     ps.show = !quiet && isatty(2);
@@ -133,6 +145,11 @@ int cmd_render(int argc, char **argv, const char *default_demo)
     int rc = 0;
     if (st != EVR_OK && st != EVR_ERR_INTERRUPTED) {
         cli_error("%s", err.msg);
+        if (stats->outputs_kept)
+            fprintf(stderr,
+                    "evray: %s keeps every event before t = %.6f s (run.json: the run failed)\n",
+                    cfg.out_dir, stats->complete_until);
+        else fprintf(stderr, "evray: nothing kept in %s\n", cfg.out_dir);
         rc = 1;
     } else {
         if (!quiet) {
@@ -154,11 +171,12 @@ int cmd_render(int argc, char **argv, const char *default_demo)
                     "(a static scene gives none with the ideal sensor)\n");
         }
         if (st == EVR_ERR_INTERRUPTED) {
-            fprintf(stderr, "evray: interrupted: %s holds every event of the first %.3f s\n",
-                    cfg.out_dir, stats->sim_time);
+            fprintf(stderr, "evray: interrupted: %s holds every event before t = %.6f s\n",
+                    cfg.out_dir, stats->complete_until);
             rc = 130;
         }
     }
+    running = NULL;
     evr_sim_release(sim);
     evr_scene_release(scene);
     return rc;

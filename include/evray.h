@@ -261,6 +261,14 @@ typedef struct {
     char backend[16];       /* the backend that ran: "cpu" or "cuda" */
     char device[128];       /* CPU threads or the GPU's name */
     char notice[256];       /* e.g. why auto fell back to the CPU; empty if nothing to say */
+    /* What the event files hold: every event with t (seconds, absolute) before complete_until
+     * and none after (the run's end when it ran to the end: an interrupted or failed run's
+     * files stop earlier). */
+    double complete_until;
+    /* A failed run (evr_sim_run's error): outputs_kept 1 when the run folder keeps valid files
+     * holding every event before complete_until and a run.json saying the run failed, 0 when
+     * the run left nothing. */
+    int outputs_kept;
 } evr_stats;
 
 typedef struct evr_sim evr_sim;
@@ -271,8 +279,15 @@ typedef int (*evr_progress_fn)(void *user, const evr_stats *st);
 /* The scene must outlive the simulation: evr_sim_new keeps a pointer to it (not a copy), so
  * release the simulation before the scene. The configuration is copied. */
 evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, evr_error *err);
-/* Runs to the end (or until progress asks to stop) and finalizes every output file. */
+/* Runs to the end (or until progress asks to stop, or evr_sim_cancel) and finalizes every output
+ * file. Stopped, it returns EVR_ERR_INTERRUPTED with valid files holding every event before
+ * stats.complete_until. Failed (a full disk...), it keeps valid files holding every event the
+ * writers had taken, marked as failed in run.json, or nothing (stats.outputs_kept). */
 evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_error *err);
+/* Asks a running evr_sim_run to stop at once: the segments being rendered are given up and the
+ * files completed with every event before stats.complete_until (a progress callback's stop
+ * finishes the segments in flight first). Async-signal-safe and callable from any thread. */
+void evr_sim_cancel(evr_sim *sim);
 const evr_stats *evr_sim_stats(const evr_sim *sim);
 void evr_sim_release(evr_sim *sim);
 

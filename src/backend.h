@@ -29,6 +29,10 @@ typedef struct {
     int gather_max, gather_window, photon_layers, gi_bounces;
     int adaptive;           /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
     evr_adapt_params adapt; /* its parameters (max_dt resolved: > 0) */
+    /* non-zero (read with __atomic_load_n) once the run is to stop at once (evr_sim_cancel): a
+     * backend may then give up the segment it renders, its submit() returning
+     * EVR_ERR_INTERRUPTED; NULL: never */
+    const int *cancel;
 } evr_run_setup;
 
 /* One segment: absolute times and the motion keys of every track (one track per scene node, and

@@ -85,6 +85,17 @@ static int64_t timestamp_slack_us(const evr_sim *sim)
            sim->setup.pixel.time_res_us;
 }
 
+/* The writers' flush interval: EVR_WRITE_FLUSH_SECONDS, or the hidden EVR_FLUSH_SECONDS (tests
+ * flush after every batch with 0 to show that when files are flushed changes none of their
+ * bytes). */
+static double flush_seconds(void)
+{
+    const char *v = getenv("EVR_FLUSH_SECONDS");
+    char *end;
+    double s = v ? strtod(v, &end) : 0.0;
+    return v && end != v && !*end && s >= 0.0 && s <= 1e6 ? s : EVR_WRITE_FLUSH_SECONDS;
+}
+
 /* The run's wall time so far, and the rates that follow from it, into sim->st. */
 static void set_wall(evr_sim *sim)
 {
@@ -195,6 +206,9 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.photon_layers = c->photon_layers;
     sim->setup.gi_bounces = c->gi_bounces;
     sim->timestamp_slack_us = timestamp_slack_us(sim);
+    sim->setup.cancel = &sim->cancel;
+    sim->emitted_until_us = (int64_t)llround(c->start * 1e6);
+    sim->st.complete_until = c->start;
 
     int ntracks = sim->num_tracks;
     sim->node_used = calloc((size_t)ntracks, sizeof(int));
@@ -228,8 +242,12 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return nomem(err);
     }
-    if ((st = evr_frames_check(sim, err)) != EVR_OK ||
-        (st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+    if ((st = evr_frames_check(sim, err)) != EVR_OK) {
+        evr_sim_release(sim);
+        return st;
+    }
+    if ((st = evr_run_dir_prepare(sim, err)) != EVR_OK) {
+        evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
     }
@@ -253,8 +271,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         return st;
     }
     if ((st = evr_run_writers_open(sim, err)) != EVR_OK ||
-        (st = evr_write_queue_start(sim->writers, sim->num_writers, EVR_WRITE_FLUSH_SECONDS,
-                                    &sim->wq, err)) != EVR_OK) {
+        (st = evr_write_queue_start(sim->writers, sim->num_writers, flush_seconds(), &sim->wq,
+                                    err)) != EVR_OK) {
         evr_run_dir_discard(sim);
         evr_sim_release(sim);
         return st;
@@ -347,6 +365,10 @@ static void count_events_finish(evr_sim *sim)
         sim->st.unique_timestamps += sim->counting[k].changes;
     }
     sim->count_parts = 0;
+    evr_batch_mark *m = &sim->marks[sim->counting_batch % EVR_BATCH_MARKS];
+    m->events = sim->st.events_on + sim->st.events_off;
+    m->on = sim->st.events_on;
+    m->unique = sim->st.unique_timestamps;
 }
 
 /* Starts counting ev[0 .. n) in parts on the pool; the writers only read the events, so the loop
@@ -369,6 +391,7 @@ static void count_events_start(evr_sim *sim, const evr_event *ev, size_t n)
     }
     if (n) sim->last_t = ev[n - 1].t;
     sim->count_parts = (int)parts;
+    sim->counting_batch = sim->batches; /* the batch about to be pushed */
     if (sim->par) evr_par_pool_start(sim->par, (int)parts, count_part, sim->counting);
     else evr_par_pool_run(NULL, (int)parts, count_part, sim->counting); /* no pool: here, now */
 }
@@ -384,6 +407,7 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     if (n == 0) {
         st = evr_run_preview_events(sim, NULL, 0, limit_us, err);
         sim->time_preview += evr_host_seconds() - t;
+        if (st == EVR_OK) sim->emitted_until_us = limit_us;
         return st;
     }
     count_events_start(sim, v->data, n); /* finishes the batch before it first */
@@ -393,7 +417,10 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     sim->time_preview += evr_host_seconds() - t;
     t = evr_host_seconds();
     /* the writers take the buffer; the events held back move to one of the queue's */
+    sim->marks[sim->batches % EVR_BATCH_MARKS].before_us = sim->emitted_until_us;
     if ((st = evr_write_queue_push_take(sim->wq, v, n, err)) != EVR_OK) return st;
+    sim->batches++;
+    sim->emitted_until_us = limit_us;
     sim->time_write += evr_host_seconds() - t;
     return EVR_OK;
 }
@@ -448,10 +475,13 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     return st;
 }
 
+static int cancelled(const evr_sim *sim) { return __atomic_load_n(&sim->cancel, __ATOMIC_RELAXED); }
+
 /* Segment i's events: merged into the pending (time-ordered) events, of which those that no
- * later segment can precede go to the writers. */
-static evr_status finish_segment(evr_sim *sim, int i, int last, int final, evr_error *err)
+ * later segment can precede go to the writers (all of them after the last segment). */
+static evr_status finish_segment(evr_sim *sim, int i, int last, evr_error *err)
 {
+    const int final = last;
     const int n = sim->cfg.samples_per_frame;
     const float *intensity = NULL, *frames = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
@@ -535,34 +565,37 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
             if ((st = submit_segment(sim, submitted, err)) != EVR_OK) break;
             submitted++;
         }
+        if (st == EVR_OK && cancelled(sim)) st = EVR_ERR_INTERRUPTED; /* not one more segment */
         if (st != EVR_OK) break;
-        /* the last to finish: every segment submitted (or the run stopped), this the newest */
-        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, i + 1 == submitted, err)) !=
-            EVR_OK)
-            break;
+        if ((st = finish_segment(sim, i, i + 1 == sim->num_segments, err)) != EVR_OK) break;
         if (progress && progress(user, &sim->st)) stop = 1;
     }
     sim->time_motion = evr_planner_busy_seconds(sim->planner);
     evr_planner_stop(sim->planner); /* stops early when the run did */
     sim->planner = NULL;
     count_events_finish(sim);
-    if (st != EVR_OK) {
-        /* a failed run leaves nothing behind that looks complete */
+    set_wall(sim);
+    if (st != EVR_OK && st != EVR_ERR_INTERRUPTED) return evr_run_fail(sim, st, err);
+    /* Stopped (or cancelled: the segments in flight given up), the events held back are not
+     * kept: the next segment's samples would have added events before them. The files hold
+     * every event before the last limit emitted, and say so. */
+    sim->st.interrupted = st == EVR_ERR_INTERRUPTED || sim->st.segments_done < sim->num_segments;
+    sim->st.complete_until = sim->emitted_until_us == INT64_MAX
+                                 ? sim->cfg.start + sim->duration
+                                 : (double)sim->emitted_until_us * 1e-6;
+    if ((st = evr_run_close(sim, err)) != EVR_OK) return st;
+    set_wall(sim); /* the run's wall time includes draining and closing every output */
+    if ((st = evr_run_write_json(sim, err)) != EVR_OK) {
+        /* no outputs without the run.json that says what they are */
         evr_run_dir_discard(sim);
         return st;
     }
-    if (sim->pending.n) { /* interrupted: keep every event of the finished segments */
-        if ((st = emit_events(sim, INT64_MAX, err)) != EVR_OK) {
-            evr_run_dir_discard(sim);
-            return st;
-        }
-    }
-    count_events_finish(sim); /* the interrupted run's last batch */
-    sim->st.interrupted = sim->st.segments_done < sim->num_segments;
-    if ((st = evr_run_close(sim, err)) != EVR_OK) return st;
-    set_wall(sim); /* the run's wall time includes draining and closing every output */
-    if ((st = evr_run_write_json(sim, err)) != EVR_OK) return st;
     return sim->st.interrupted ? EVR_ERR_INTERRUPTED : EVR_OK;
+}
+
+void evr_sim_cancel(evr_sim *sim)
+{
+    if (sim) __atomic_store_n(&sim->cancel, 1, __ATOMIC_RELAXED);
 }
 
 const evr_stats *evr_sim_stats(const evr_sim *sim) { return &sim->st; }

@@ -27,11 +27,24 @@ typedef struct {
 
 #define EVR_COUNT_PARTS 8
 
+/* A batch of events pushed to the writers: every event before before_us was in the batches
+ * before it; the run's counts once it is counted too. */
+typedef struct {
+    int64_t before_us;
+    uint64_t events, on, unique;
+} evr_batch_mark;
+
+/* Marks of the last batches (a ring by batch number): the writer queue holds at most nine
+ * batches not yet taken by every writer, so a failed run finds the counts of what the writers
+ * took here. */
+#define EVR_BATCH_MARKS 32
+
 struct evr_sim {
     const evr_scene *scene;
     evr_config cfg;
     char out_dir[4096];
     int created_dir;
+    int dir_ours; /* the folder holds no file of evray's but this run's (new, empty, or cleaned) */
     int camera;
     evr_camera_rig rig;     /* the camera as the run renders it (scene/camera_rig.h) */
     char camera_path[4096]; /* the configuration's camera path, kept */
@@ -48,7 +61,8 @@ struct evr_sim {
     evr_event_writer *writers[EVR_MAX_WRITERS];
     const char *writer_names[EVR_MAX_WRITERS];
     int num_writers;
-    evr_write_queue *wq; /* writes on its own thread */
+    int writer_lost[EVR_MAX_WRITERS]; /* a failed run could not keep its file */
+    evr_write_queue *wq;              /* writes on its own thread */
     char *config_json;
     /* per-segment motion and plans (segment_planner.h: the tracker is the planner thread's) */
     evr_planner *planner;
@@ -63,6 +77,14 @@ struct evr_sim {
     /* the last emitted batch, counted on the pool while the loop goes on (count_parts 0: none) */
     evr_event_counts counting[EVR_COUNT_PARTS];
     int count_parts;
+    uint64_t batches;         /* batches pushed to the writers */
+    uint64_t counting_batch;  /* the batch counted on the pool */
+    int64_t emitted_until_us; /* every event before it has gone to the writers */
+    evr_batch_mark marks[EVR_BATCH_MARKS];
+    int cancel;        /* evr_sim_cancel: stop at once (atomic; the backend reads it) */
+    int reserve_made;  /* the run folder's reserve file (run_files.c) is there */
+    char failure[512]; /* a failed run's error, for run.json */
+    char lost[1024];   /* outputs a failed run could not keep, and why */
     /* previews */
     evr_preview_out *preview; /* NULL: previews off */
     int64_t preview_window_us;

@@ -88,11 +88,18 @@ int main(void)
         CHECK_OK(evr_write_queue_start(ws, 2, 1000.0, &q, &err));
         for (i = 0; i < 20; i++) CHECK_OK(push(q, &t, 1000 + (size_t)i, &err));
         CHECK_OK(evr_write_queue_drain(q, &err));
+        CHECK(a.flushes == 0 && b.flushes == 0);
+        uint64_t events = 0, batches = 0;
+        evr_write_queue_accepted(q, &events, &batches);
+        CHECK(events == (uint64_t)t && batches == 20); /* every writer took every batch */
+        /* a flush asked for: everything written, then every writer flushed */
+        CHECK_OK(push(q, &t, 10, &err));
+        CHECK_OK(evr_write_queue_flush(q, &err));
+        CHECK(a.flushes == 1 && b.flushes == 1 && a.flushed_events == (size_t)t);
         evr_write_queue_stop(q);
         CHECK(a.in_order && b.in_order);
         CHECK(a.events == (size_t)t && b.events == (size_t)t);
-        CHECK(a.writes == 20 && b.writes == 20);
-        CHECK(a.flushes == 0 && b.flushes == 0);
+        CHECK(a.writes == 21 && b.writes == 21);
     }
     /* interval 0: a flush after every batch */
     {

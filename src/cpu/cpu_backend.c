@@ -78,6 +78,12 @@ typedef struct {
     atomic_int failed;
 } cpu_backend;
 
+/* evr_sim_cancel asked the run to stop at once: the segment's work is given up. */
+static int cancelled(const cpu_backend *b)
+{
+    return b->setup.cancel && __atomic_load_n(b->setup.cancel, __ATOMIC_RELAXED);
+}
+
 static void embree_error(void *user, enum RTCError code, const char *str)
 {
     cpu_backend *b = (cpu_backend *)user;
@@ -208,7 +214,9 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     }
     /* core/shade.h's steps light by light: each light's shadow rays as one packet; a blocked
      * ray in a scene with translucent surfaces is followed through them one ray at a time
-     * (evr_shadow_pass) */
+     * (evr_shadow_pass). Embree reads every lane's fields, masked ones too: all start as an
+     * empty ray (valgrind found the masked lanes' fields never written). */
+    if (rs->num_lights > 0) memset(&sr, 0, sizeof sr);
     for (l = 0; l < rs->num_lights; l++) {
         evr_light_ray lr[PACKET];
         int any = 0;
@@ -387,6 +395,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     int c, i, j, k, g;
     for (k = k0; k < k1; k++) {
         int ntr = 0;
+        if (k > k0 && cancelled(b)) return; /* a long segment still stops at once */
         for (g = 0; g <= grid; g++) first[g] = 0;
         for (j = 0; j < count; j++) {
             tile_pixel *q = &px[list[j]];
@@ -626,7 +635,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         tnext[j] = evr_adapt_start(rs, ap, plan, st, ray, b->next_t[pix], b->phase[pix], dt);
         if (tnext[j] < dt) act[nact++] = j;
     }
-    while (nact > 0) {
+    while (nact > 0 && !cancelled(b)) {
         int base, kept = 0;
         for (base = 0; base < nact; base += PACKET) {
             int xs[PACKET], ys[PACKET], valid[PACKET], js[PACKET], i;
@@ -680,7 +689,7 @@ static void *worker(void *arg)
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 #endif
     int ntiles = b->tiles_x * b->tiles_y, t;
-    while ((t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) {
+    while (!cancelled(b) && (t = atomic_fetch_add(&b->next_tile, 1)) < ntiles) {
         if (b->setup.adaptive) render_tile_adaptive(b, t, &samples, &rays);
         else render_tile(b, t, &samples, &rays, &traced, &skipped);
     }
@@ -845,6 +854,10 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
     b->done_counts[slot][1] = atomic_load(&b->rays);
     b->done_counts[slot][2] = atomic_load(&b->samples_traced);
     b->done_counts[slot][3] = atomic_load(&b->pixels_skipped);
+    if (cancelled(b)) {
+        snprintf(err->msg, sizeof err->msg, "stopped");
+        return EVR_ERR_INTERRUPTED;
+    }
     if (atomic_load(&b->failed)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
@@ -854,10 +867,15 @@ static evr_status cpu_submit(evr_backend *base, const evr_segment *seg, evr_erro
         return EVR_ERR_BACKEND;
     }
     for (i = 0; i < ntiles; i++) { /* tile order: deterministic whatever the thread count */
-        if (!evr_event_vec_append(out, b->tile_events[i].data, b->tile_events[i].n)) {
+        evr_event_vec *te = &b->tile_events[i];
+        if (!evr_event_vec_append(out, te->data, te->n)) {
             snprintf(err->msg, sizeof err->msg, "out of memory for events");
             return EVR_ERR_NOMEM;
         }
+        /* a tile's buffer grows to its busiest segment; one far larger than this segment's needs
+         * goes, so that the run's memory follows its current bursts rather than the sum of every
+         * tile's worst ever */
+        if (te->cap > 4 * te->n + 4096) evr_event_vec_free(te);
     }
     const double ts0 = evr_host_seconds();
     int sorted = evr_events_sort(out, &b->scratch);

@@ -5,12 +5,14 @@
  * Sequence numbers count the fcTL and fdAT chunks from 0. */
 #include "io/apng.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
 
 #include "io/png.h"
+#include "io/file_commit.h"
 
 struct evr_apng {
     FILE *f;
@@ -53,7 +55,7 @@ static int put_chunk(FILE *f, const char *type, const unsigned char *prefix, con
 
 static evr_status io_fail(evr_apng *a, evr_error *err)
 {
-    snprintf(err->msg, sizeof err->msg, "cannot write %s", a->tmp);
+    snprintf(err->msg, sizeof err->msg, "cannot write %s: %s", a->tmp, strerror(errno));
     return EVR_ERR_IO;
 }
 
@@ -177,7 +179,7 @@ evr_status evr_apng_finish(evr_apng *a, evr_error *err)
          fwrite(actl, 1, 8, a->f) == 8 && fwrite(crc, 1, 4, a->f) == 4;
     ok = fclose(a->f) == 0 && ok;
     a->f = NULL;
-    if (!ok || rename(a->tmp, a->path) != 0) st = io_fail(a, err);
+    if (!ok || evr_file_publish(a->tmp, a->path) != 0) st = io_fail(a, err);
     evr_apng_abort(a); /* the temporary file is gone once renamed */
     return st;
 }

@@ -5,6 +5,7 @@
 #define EVR_IO_EVENT_WRITER_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "evray.h"
 
 typedef struct evr_event_writer evr_event_writer;
@@ -12,14 +13,24 @@ typedef struct evr_event_writer evr_event_writer;
 struct evr_event_writer {
     /* Appends n events (sorted by t, and t not below any earlier call's). */
     evr_status (*write)(evr_event_writer *w, const evr_event *ev, size_t n, evr_error *err);
-    /* Makes what has been written durable, so an interrupted run keeps it (the simulation calls it
-     * about once a second: write_queue.h). */
+    /* Makes what has been written durable, so a killed run keeps it (the simulation calls it
+     * about once a second: write_queue.h); the HDF5 writer keeps its last partial chunk's events
+     * (fewer than 65,536) in memory, so that the timing of flushes changes no byte of its file. */
     evr_status (*flush)(evr_event_writer *w, evr_error *err);
     /* Completes the file; duration_us is the simulated time span (for indices such as ms_to_idx).
      * Frees the writer whatever the result. */
     evr_status (*finish)(evr_event_writer *w, int64_t duration_us, evr_error *err);
     /* Removes the partial file and frees the writer. */
     void (*abort)(evr_event_writer *w);
+    /* Ends the file of a run that failed or stopped short (a failed write() or flush() of this
+     * writer or another, or a failure elsewhere): keeps exactly the first `events` events it was
+     * given, completes the file as finish() does (the HDF5 file's attribute complete stays 0)
+     * and renames it to its final name. `events` is what every writer of the run took: all this
+     * one was given, or all but the events of its last write() call. A writer that cannot hold
+     * to that (the events are lost, or the file cannot be written) removes its file and says
+     * why. Frees the writer whatever the result. */
+    evr_status (*salvage)(evr_event_writer *w, uint64_t events, int64_t duration_us,
+                          evr_error *err);
 };
 
 /* Metadata every writer may store: image size and the full configuration as JSON text; and

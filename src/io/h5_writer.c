@@ -14,9 +14,13 @@
  * chunks are filtered here instead, by a pool of threads (chunk_compress.c makes the very bytes
  * HDF5's shuffle and deflate filters would make), and stored with H5Dwrite_chunk: readers see
  * the same datasets, filters and chunks. Events are staged until a batch of chunks is full;
- * flush() also stores the partial last chunk (zero beyond the data, as HDF5 fills it) and
- * flushes the file, so the temporary file of an interrupted run is readable up to the last
- * flush; the next store of that chunk replaces it. ms_to_idx is small and goes through H5Dwrite.
+ * flush() stores the full chunks staged and flushes the file, so the temporary file of a killed
+ * run is readable and holds every event up to the last flush but those of the last partial
+ * chunk (fewer than 65,536), which stay in memory until finish() stores them (zero beyond the
+ * data, as HDF5 fills it). ms_to_idx is small, goes through H5Dwrite and is written by finish().
+ * Storing the partial chunk at each flush and replacing it later would leave holes whose places
+ * depend on when the (timed) flushes came: as it is, the same events give the same bytes
+ * however the flushes fell, and no object carries a time stamp (create_file).
  * HDF5's automatic error printing is switched off around every call (H5E_BEGIN_TRY) and its
  * error stack is turned into the message instead. */
 #include "io/event_formats.h"
@@ -24,6 +28,7 @@
 #include "io/file_commit.h"
 #include "par_pool.h"
 
+#include <errno.h>
 #include <hdf5.h>
 #include <inttypes.h>
 #include <stddef.h>
@@ -72,6 +77,9 @@ typedef struct {
     int fill, inflight;
     uint64_t inflight_at;
     size_t batch; /* chunks in a full stage */
+    /* a full batch whose storing failed (salvage stores it again): its set and first index */
+    int unstored, unstored_set;
+    uint64_t unstored_at;
     int64_t last_t;
     int have_last;
     int t32; /* events/t is uint32 (else int64) */
@@ -84,7 +92,7 @@ typedef struct {
 
 /* Collects the most specific HDF5 error description (the walk starts where the error arose). */
 typedef struct {
-    char desc[200];
+    char desc[1024]; /* room for the errno after a long file name */
     int got;
 } h5_walk_data;
 
@@ -102,11 +110,17 @@ static herr_t h5_walk(unsigned n, const H5E_error2_t *e, void *data)
 static evr_status h5_fail(evr_error *err, const char *what, const char *path)
 {
     h5_walk_data d;
+    const char *at;
+    int code;
     d.desc[0] = 0;
     d.got = 0;
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5_walk, &d);
     H5Eclear2(H5E_DEFAULT);
-    if (d.got) snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, d.desc);
+    /* a failed system call: HDF5's description names the time, the descriptor, the buffer...
+     * and errno, which is all the user needs ("No space left on device") */
+    if (d.got && (at = strstr(d.desc, "errno = ")) != NULL && sscanf(at + 8, "%d", &code) == 1)
+        snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, strerror(code));
+    else if (d.got) snprintf(err->msg, sizeof err->msg, "hdf5: %s %s: %s", what, path, d.desc);
     else snprintf(err->msg, sizeof err->msg, "hdf5: %s %s", what, path);
     return EVR_ERR_IO;
 }
@@ -117,7 +131,8 @@ static hid_t make_extendible(hid_t loc, const char *name, hid_t type, hsize_t ch
     hid_t space = H5Screate_simple(1, dims, maxdims);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, 1, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0 &&
+        H5Pset_chunk(dcpl, 1, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
         H5Pset_deflate(dcpl, H5W_DEFLATE) >= 0)
         ds = H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (dcpl >= 0) H5Pclose(dcpl);
@@ -141,6 +156,20 @@ static herr_t append(hid_t ds, hid_t mtype, const void *data, uint64_t old, size
     if (mspace >= 0) H5Sclose(mspace);
     if (fspace >= 0) H5Sclose(fspace);
     return r;
+}
+
+/* Creates (truncates) the file so that the same calls give the same bytes: no modification times
+ * on any object (the root group's come from the file creation list), and the file format pinned
+ * to HDF5 1.8's (readable by 1.8 and later), whatever library version writes it. */
+static hid_t create_file(const char *path)
+{
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS), f = -1;
+    if (fcpl >= 0 && fapl >= 0 && H5Pset_obj_track_times(fcpl, 0) >= 0 &&
+        H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18) >= 0)
+        f = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
+    if (fapl >= 0) H5Pclose(fapl);
+    if (fcpl >= 0) H5Pclose(fcpl);
+    return f;
 }
 
 static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
@@ -171,9 +200,11 @@ static herr_t write_string_attr(hid_t loc, const char *name, const char *text)
 static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
                                    const void *value)
 {
-    hid_t space = H5Screate(H5S_SCALAR), ds = -1;
+    hid_t space = H5Screate(H5S_SCALAR), dcpl = H5Pcreate(H5P_DATASET_CREATE), ds = -1;
     herr_t r = -1;
-    if (space >= 0) ds = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0)
+        ds = H5Dcreate2(loc, name, ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+    if (dcpl >= 0) H5Pclose(dcpl);
     if (ds >= 0) r = H5Dwrite(ds, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, value);
     if (ds >= 0) H5Dclose(ds);
     if (space >= 0) H5Sclose(space);
@@ -323,6 +354,15 @@ static evr_status compress_failed(evr_error *err)
     return EVR_ERR_NOMEM;
 }
 
+/* The full batch of set s from index at could not be stored: salvage tries again (the set's
+ * compressed chunks stay as they are, since nothing is written after a failure). */
+static void set_unstored(h5_writer *w, int s, uint64_t at)
+{
+    w->unstored = 1;
+    w->unstored_set = s;
+    w->unstored_at = at;
+}
+
 /* Waits for the batch in flight, if any, and stores it. */
 static evr_status land_inflight(h5_writer *w, evr_error *err)
 {
@@ -330,7 +370,9 @@ static evr_status land_inflight(h5_writer *w, evr_error *err)
     w->inflight = 0;
     if (!evr_chunk_pool_wait(w->pool)) return compress_failed(err);
     const uint64_t end = w->inflight_at + w->batch * H5W_CHUNK;
-    return put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at, end, err);
+    evr_status st = put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at, end, err);
+    if (st != EVR_OK) set_unstored(w, 1 - w->fill, w->inflight_at);
+    return st;
 }
 
 /* A full stage (batch chunks): compressed by the pool while the writer goes on; the batch in
@@ -348,9 +390,12 @@ static evr_status store_full(h5_writer *w, evr_error *err)
     w->nstage = 0;
     w->tail_stored = 0;
     w->fill = 1 - w->fill; /* the landed batch's set stages next */
-    if (was_inflight)
-        return put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at,
-                          prev_at + w->batch * H5W_CHUNK, err);
+    if (was_inflight) {
+        evr_status st = put_chunks(w, w->set[w->fill].jobs, w->batch, prev_at,
+                                   prev_at + w->batch * H5W_CHUNK, err);
+        if (st != EVR_OK) set_unstored(w, w->fill, prev_at);
+        return st;
+    }
     return EVR_OK;
 }
 
@@ -578,11 +623,12 @@ static evr_status h5_write(evr_event_writer *base, const evr_event *ev, size_t n
     return EVR_OK;
 }
 
+/* Full chunks only: see the top of the file. */
 static evr_status h5_flush(evr_event_writer *base, evr_error *err)
 {
     h5_writer *w = (h5_writer *)base;
     herr_t r;
-    evr_status st = drain(w, err);
+    evr_status st = store(w, 0, err);
     if (st != EVR_OK) return st;
     H5E_BEGIN_TRY { r = H5Fflush(w->file, H5F_SCOPE_GLOBAL); }
     H5E_END_TRY;
@@ -596,6 +642,38 @@ static void h5_abort(evr_event_writer *base)
     close_all(w);
     remove(w->tmp);
     free_writer(w);
+}
+
+/* Closes the file and publishes it under its final name; frees the writer whatever the result
+ * (removing the file when that fails). */
+static evr_status close_publish(h5_writer *w, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    herr_t r = 0;
+    H5E_BEGIN_TRY
+    {
+        /* closing the datasets first lets H5Fclose really close the file */
+        hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
+        for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
+            if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
+            *ids[i] = -1;
+        }
+        if (H5Fclose(w->file) < 0) r = -1;
+        w->file = -1;
+    }
+    H5E_END_TRY;
+    if (r < 0) st = h5_fail(err, "cannot complete", w->tmp);
+    else if (evr_file_publish(w->tmp, w->path) != 0) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot complete %s: %s", w->path,
+                 strerror(errno));
+        st = EVR_ERR_IO;
+    }
+    if (st != EVR_OK) {
+        close_all(w);
+        remove(w->tmp);
+    }
+    free_writer(w);
+    return st;
 }
 
 static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
@@ -617,29 +695,71 @@ static evr_status h5_finish(evr_event_writer *base, int64_t duration_us, evr_err
     {
         int8_t complete = 1;
         r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
-        if (r >= 0) {
-            /* closing the datasets first lets H5Fclose really close the file */
-            hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
-            for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
-                if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
-                *ids[i] = -1;
-            }
-            if (H5Fclose(w->file) < 0) r = -1;
-            w->file = -1;
-        }
     }
     H5E_END_TRY;
     if (r < 0) {
         st = h5_fail(err, "cannot complete", w->tmp);
         goto fail;
     }
-    if (rename(w->tmp, w->path) != 0) {
-        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot rename %s to %s", w->tmp, w->path);
+    return close_publish(w, err);
+fail:
+    close_all(w);
+    remove(w->tmp);
+    free_writer(w);
+    return st;
+}
+
+/* Stores everything staged or in flight (again, where a store failed), cuts the datasets to the
+ * first `events` events and ms_to_idx to its entries within them, and completes the file with
+ * its attribute complete at 0. */
+static evr_status h5_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                             evr_error *err)
+{
+    h5_writer *w = (h5_writer *)base;
+    evr_status st = EVR_OK;
+    herr_t r = 0;
+    size_t keep_ms = 0;
+    (void)duration_us;
+    if (events > w->total) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot keep %llu events of %s",
+                 (unsigned long long)events, w->path);
         st = EVR_ERR_IO;
         goto fail;
     }
-    free_writer(w);
-    return EVR_OK;
+    if (w->inflight) {
+        w->inflight = 0;
+        if (!evr_chunk_pool_wait(w->pool)) st = compress_failed(err);
+        else
+            st = put_chunks(w, w->set[1 - w->fill].jobs, w->batch, w->inflight_at,
+                            w->inflight_at + w->batch * H5W_CHUNK, err);
+    }
+    if (st == EVR_OK && w->unstored)
+        st = put_chunks(w, w->set[w->unstored_set].jobs, w->batch, w->unstored_at,
+                        w->unstored_at + w->batch * H5W_CHUNK, err);
+    if (st == EVR_OK) st = store(w, 1, err);
+    if (st != EVR_OK) goto fail;
+    /* ms_to_idx[i] is the first event at or after i ms: right for the first `events` events too
+     * while it is at most `events` (entries only grow) */
+    while (keep_ms < w->nms && w->ms[keep_ms] <= events) keep_ms++;
+    H5E_BEGIN_TRY
+    {
+        hsize_t size[1] = {(hsize_t)events};
+        int8_t complete = 0;
+        for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
+            if (H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
+        if (r >= 0 && keep_ms &&
+            append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, keep_ms) < 0)
+            r = -1;
+        if (r >= 0)
+            r = write_scalar_attr(w->file, "complete", H5T_STD_I8LE, H5T_NATIVE_INT8, &complete);
+    }
+    H5E_END_TRY;
+    if (r < 0) {
+        st = h5_fail(err, "cannot complete", w->tmp);
+        goto fail;
+    }
+    w->nms = 0;
+    return close_publish(w, err);
 fail:
     close_all(w);
     remove(w->tmp);
@@ -655,6 +775,11 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     const char *what = "cannot create";
 
     *out = NULL;
+    /* A file whose closing failed (a full disk, an I/O error) is left half closed by HDF5, and
+     * the library's own clean-up at exit then crashes on it: the process ends without that
+     * clean-up (the writer closes its files itself). Only before HDF5's first call in the
+     * process does this take effect. */
+    H5dont_atexit();
     if (!path || !*path || !meta) {
         snprintf(err->msg, sizeof err->msg, "hdf5 writer: no path or metadata given");
         return EVR_ERR_ARG;
@@ -691,10 +816,13 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         int32_t width = meta->width, height = meta->height;
         int64_t zero = 0;
         int8_t incomplete = 0;
-        w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+        w->file = create_file(w->tmp);
         if (w->file >= 0) {
+            hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
             what = "cannot lay out";
-            w->group = H5Gcreate2(w->file, "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+            if (gcpl >= 0 && H5Pset_obj_track_times(gcpl, 0) >= 0)
+                w->group = H5Gcreate2(w->file, "events", H5P_DEFAULT, gcpl, H5P_DEFAULT);
+            if (gcpl >= 0) H5Pclose(gcpl);
         }
         if (w->group >= 0) w->ds_x = make_extendible(w->group, "x", H5T_STD_U16LE, H5W_CHUNK);
         if (w->ds_x >= 0) w->ds_y = make_extendible(w->group, "y", H5T_STD_U16LE, H5W_CHUNK);
@@ -727,6 +855,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
     w->base.flush = h5_flush;
     w->base.finish = h5_finish;
     w->base.abort = h5_abort;
+    w->base.salvage = h5_salvage;
     *out = &w->base;
     return EVR_OK;
 }

@@ -10,6 +10,7 @@
 #include "io/file_commit.h"
 #include "io/par_pack.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +30,7 @@ typedef struct {
     size_t header_len; /* bytes before the first record */
     int64_t last_t;
     int have_last;
+    uint64_t prev_given; /* records given (count + nbuf) as the last write() began (salvage) */
     /* large writes, packed in parts (io/par_pack.h): one thread packing and copying 2.84 GB into
      * the page cache kept the eye's 30 s waiting (H100 machine: writer busy 1.9-2.2 s, the loop
      * waiting 0.7-1.0 s) */
@@ -61,7 +63,8 @@ static evr_status write_header(npy_writer *w, evr_error *err)
     size_t n = build_header(h, sizeof h, w->count, w->header_len);
     if (n != w->header_len || fseek(w->f, 0, SEEK_SET) != 0 || fwrite(h, 1, n, w->f) != n ||
         fseek(w->f, 0, SEEK_END) != 0) {
-        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write the header of %s", w->tmp);
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot write the header of %s: %s", w->tmp,
+                 strerror(errno));
         return EVR_ERR_IO;
     }
     return EVR_OK;
@@ -70,7 +73,7 @@ static evr_status write_header(npy_writer *w, evr_error *err)
 /* The error of a failed write to the temporary file. */
 static evr_status cannot_write(const npy_writer *w, evr_error *err)
 {
-    snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s", w->tmp);
+    snprintf(err->msg, sizeof err->msg, "npy writer: cannot write %s: %s", w->tmp, strerror(errno));
     return EVR_ERR_IO;
 }
 
@@ -146,6 +149,7 @@ static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_erro
 static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     npy_writer *w = (npy_writer *)base;
+    w->prev_given = w->count + w->nbuf;
     if (n >= EVR_PAR_PACK_MIN && !(w->have_last && ev[0].t < w->last_t)) {
         evr_status st;
         if (write_parallel(w, ev, n, err, &st)) return st;
@@ -200,6 +204,30 @@ static evr_status npy_finish(evr_event_writer *base, int64_t duration_us, evr_er
     return st;
 }
 
+static evr_status npy_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                              evr_error *err)
+{
+    npy_writer *w = (npy_writer *)base;
+    const uint64_t given = w->count + w->nbuf;
+    char h[256];
+    evr_status st;
+    (void)duration_us;
+    if ((events != given && events != w->prev_given) ||
+        build_header(h, sizeof h, events, w->header_len) != w->header_len) {
+        snprintf(err->msg, sizeof err->msg, "npy writer: cannot keep %llu events of %s",
+                 (unsigned long long)events, w->path);
+        evr_file_discard(w->f, w->tmp);
+        st = EVR_ERR_IO;
+    } else {
+        st = evr_file_salvage(w->f, w->tmp, w->path, w->header_len + events * NPY_RECORD,
+                              w->header_len + given * NPY_RECORD, w->buf, w->nbuf * NPY_RECORD, h,
+                              w->header_len, "npy writer", err);
+    }
+    w->f = NULL;
+    free_writer(w);
+    return st;
+}
+
 evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
                                evr_event_writer **out, evr_error *err)
 {
@@ -238,6 +266,7 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
     w->base.flush = npy_flush;
     w->base.finish = npy_finish;
     w->base.abort = npy_abort;
+    w->base.salvage = npy_salvage;
     *out = &w->base;
     return EVR_OK;
 }

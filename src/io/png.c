@@ -1,5 +1,7 @@
 #include "io/png.h"
+#include "io/file_commit.h"
 
+#include <errno.h>
 #include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -112,9 +114,10 @@ evr_status evr_png_write(const char *path, const void *pixels, int width, int he
     int ok = fwrite(buf, 1, n, f) == n;
     ok = (fclose(f) == 0) && ok;
     free(buf);
-    if (!ok || rename(tmp, path) != 0) {
+    if (!ok || evr_file_publish(tmp, path) != 0) {
+        const int e = errno;
         remove(tmp);
-        snprintf(err->msg, sizeof err->msg, "cannot write %s", path);
+        snprintf(err->msg, sizeof err->msg, "cannot write %s: %s", path, strerror(e));
         return EVR_ERR_IO;
     }
     return EVR_OK;

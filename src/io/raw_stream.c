@@ -1,6 +1,7 @@
 #include "io/raw_stream.h"
 #include "io/file_commit.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,13 +21,14 @@ static void free_stream(evr_raw_stream *s)
 
 static evr_status cannot_write(const evr_raw_stream *s, evr_error *err)
 {
-    snprintf(err->msg, sizeof err->msg, "%s: cannot write %s", s->who, s->tmp);
+    snprintf(err->msg, sizeof err->msg, "%s: cannot write %s: %s", s->who, s->tmp, strerror(errno));
     return EVR_ERR_IO;
 }
 
 static evr_status drain(evr_raw_stream *s, evr_error *err)
 {
     if (s->len && fwrite(s->buf, 1, s->len, s->f) != s->len) return cannot_write(s, err);
+    s->handed += s->len;
     s->len = 0;
     return EVR_OK;
 }
@@ -45,6 +47,36 @@ static evr_status raw_finish(evr_event_writer *base, int64_t duration_us, evr_er
     evr_status st = drain(s, err);
     (void)duration_us;
     st = evr_file_commit(s->f, s->tmp, s->path, st, s->who, err);
+    free_stream(s);
+    return st;
+}
+
+static evr_status raw_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
+{
+    evr_raw_stream *s = (evr_raw_stream *)base;
+    s->prev_count = s->count;
+    s->prev_bytes = s->handed + s->len;
+    evr_status st = s->write_fn(base, ev, n, err);
+    if (st == EVR_OK) s->count += n;
+    return st;
+}
+
+static evr_status raw_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                              evr_error *err)
+{
+    evr_raw_stream *s = (evr_raw_stream *)base;
+    evr_status st;
+    (void)duration_us;
+    if (events != s->count && events != s->prev_count) {
+        snprintf(err->msg, sizeof err->msg, "%s: cannot keep %llu events of %s", s->who,
+                 (unsigned long long)events, s->path);
+        evr_file_discard(s->f, s->tmp);
+        st = EVR_ERR_IO;
+    } else {
+        st = evr_file_salvage(s->f, s->tmp, s->path,
+                              events == s->count ? s->handed + s->len : s->prev_bytes,
+                              s->handed + s->len, s->buf, s->len, NULL, 0, s->who, err);
+    }
     free_stream(s);
     return st;
 }
@@ -88,16 +120,19 @@ evr_status evr_raw_writer_open(size_t size, const char *path, const char *who, i
         free_stream(s);
         return EVR_ERR_IO;
     }
+    s->handed = len;
     if (fwrite(header, 1, len, s->f) != len) {
         cannot_write(s, err);
         evr_file_discard(s->f, s->tmp);
         free_stream(s);
         return EVR_ERR_IO;
     }
-    s->base.write = write;
+    s->write_fn = write;
+    s->base.write = raw_write;
     s->base.flush = raw_flush;
     s->base.finish = raw_finish;
     s->base.abort = raw_abort;
+    s->base.salvage = raw_salvage;
     *out = &s->base;
     return EVR_OK;
 }
@@ -141,6 +176,7 @@ int evr_raw_stream_write_parts(evr_raw_stream *s, const evr_par_packer *p, const
         *st = cannot_write(s, err);
         return 1;
     }
+    s->handed += bytes;
     s->last_t = ev[n - 1].t;
     s->have_last = 1;
     return 1;

@@ -24,11 +24,16 @@ typedef struct {
     int max_xy;            /* x and y must stay below it */
     int64_t max_t;         /* t must not pass it */
     evr_par_packing parts; /* large writes, packed in parts */
+    /* the format's write(), which the stream's wraps to count (salvage): events it took, bytes
+     * handed to stdio (the stream is `handed + len` bytes long), and both as the last write()
+     * began */
+    evr_status (*write_fn)(evr_event_writer *w, const evr_event *ev, size_t n, evr_error *err);
+    uint64_t count, handed, prev_count, prev_bytes;
 } evr_raw_stream;
 
 /* Allocates a writer of size bytes (a struct whose first member is an evr_raw_stream, the rest
  * zeroed), creates path + ".tmp" holding header (len bytes), and gives it write and the stream's
- * flush, finish and abort. */
+ * flush, finish, abort and salvage (a stream of appends: a format that seeks has its own). */
 evr_status evr_raw_writer_open(size_t size, const char *path, const char *who, int max_xy,
                                int64_t max_t, const char *header, size_t len,
                                evr_status (*write)(evr_event_writer *w, const evr_event *ev,

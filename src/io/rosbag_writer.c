@@ -88,6 +88,7 @@ typedef struct {
     chunk_info *infos;
     size_t n_infos, cap_infos;
     uint64_t index_pos; /* where the next chunk (and now the tail) starts */
+    int broken;         /* a write or flush failed: chunks may be cut, the tail overwritten */
 } bag_writer;
 
 /* Room for n more bytes at b->p + b->len (NULL, and b->failed, when out of memory). */
@@ -344,11 +345,14 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     for (size_t i = 0; i < n; i++) {
         const evr_event *e = &ev[i];
         evr_status st = evr_raw_stream_check(&w->s, e, err);
-        if (st != EVR_OK) return st;
+        if (st != EVR_OK) return st; /* refused before anything changed */
         int64_t win = e->t * MSG_HZ / 1000000;
         if (w->msg_n && (win != w->msg_win || w->msg_n == MSG_MAX_EVENTS)) {
             end_message(w);
-            if (w->chunk.len >= CHUNK_BYTES && (st = end_chunk(w, err)) != EVR_OK) return st;
+            if (w->chunk.len >= CHUNK_BYTES && (st = end_chunk(w, err)) != EVR_OK) {
+                w->broken = 1;
+                return st;
+            }
         }
         w->msg_win = win;
         w->msg_t = e->t;
@@ -370,7 +374,9 @@ static evr_status bag_flush(evr_event_writer *base, evr_error *err)
 {
     bag_writer *w = (bag_writer *)base;
     evr_status st = end_chunk(w, err);
-    return st == EVR_OK ? write_tail(w, err) : st;
+    if (st == EVR_OK) st = write_tail(w, err);
+    if (st != EVR_OK) w->broken = 1;
+    return st;
 }
 
 static void free_bag(bag_writer *w)
@@ -394,6 +400,21 @@ static evr_status bag_finish(evr_event_writer *base, int64_t duration_us, evr_er
         return st;
     }
     return w->raw_finish(base, duration_us, err);
+}
+
+/* A bag's chunks and tail are rewritten in place: it is kept only when it took every event it
+ * was given without a failure (it then ends as finish() ends it). */
+static evr_status bag_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                              evr_error *err)
+{
+    bag_writer *w = (bag_writer *)base;
+    if (!w->broken && events == w->s.count) return bag_finish(base, duration_us, err);
+    snprintf(err->msg, sizeof err->msg,
+             "rosbag writer: cannot keep %llu events of %s (a bag cut short is not kept)",
+             (unsigned long long)events, w->s.path);
+    free_bag(w);
+    w->raw_abort(base);
+    return EVR_ERR_IO;
 }
 
 static void bag_abort(evr_event_writer *base)
@@ -424,6 +445,7 @@ evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
         w->s.base.flush = bag_flush;
         w->s.base.finish = bag_finish;
         w->s.base.abort = bag_abort;
+        w->s.base.salvage = bag_salvage;
         w->width = (uint32_t)meta->width;
         w->height = (uint32_t)meta->height;
         w->index_pos = head.len;

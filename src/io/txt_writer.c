@@ -4,6 +4,7 @@
 #include "io/event_formats.h"
 #include "io/file_commit.h"
 
+#include <errno.h>
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +21,9 @@ typedef struct {
     size_t len;
     int64_t last_t;
     int have_last;
+    /* events and text bytes given so far (written and buffered), and as the last write() began
+     * (salvage) */
+    uint64_t count, bytes, prev_count, prev_bytes;
 } txt_writer;
 
 static char *put_uint(char *o, uint64_t v)
@@ -58,7 +62,8 @@ static char *format_event(char *o, const evr_event *e)
 static evr_status drain(txt_writer *w, evr_error *err)
 {
     if (w->len && fwrite(w->buf, 1, w->len, w->f) != w->len) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s", w->tmp);
+        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s: %s", w->tmp,
+                 strerror(errno));
         return EVR_ERR_IO;
     }
     w->len = 0;
@@ -76,6 +81,8 @@ static void free_writer(txt_writer *w)
 static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     txt_writer *w = (txt_writer *)base;
+    w->prev_count = w->count;
+    w->prev_bytes = w->bytes;
     for (size_t i = 0; i < n; i++) {
         if (w->have_last && ev[i].t < w->last_t) {
             snprintf(err->msg, sizeof err->msg,
@@ -89,7 +96,10 @@ static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t 
             evr_status st = drain(w, err);
             if (st != EVR_OK) return st;
         }
-        w->len = (size_t)(format_event(w->buf + w->len, &ev[i]) - w->buf);
+        size_t len = (size_t)(format_event(w->buf + w->len, &ev[i]) - w->buf);
+        w->bytes += len - w->len;
+        w->len = len;
+        w->count++;
     }
     return EVR_OK;
 }
@@ -100,7 +110,8 @@ static evr_status txt_flush(evr_event_writer *base, evr_error *err)
     evr_status st = drain(w, err);
     if (st != EVR_OK) return st;
     if (fflush(w->f) != 0) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s", w->tmp);
+        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s: %s", w->tmp,
+                 strerror(errno));
         return EVR_ERR_IO;
     }
     return EVR_OK;
@@ -120,6 +131,26 @@ static evr_status txt_finish(evr_event_writer *base, int64_t duration_us, evr_er
     (void)duration_us;
     st = evr_file_commit(w->f, w->tmp, w->path, st, "text writer", err);
     w->f = NULL;
+    free_writer(w);
+    return st;
+}
+
+static evr_status txt_salvage(evr_event_writer *base, uint64_t events, int64_t duration_us,
+                              evr_error *err)
+{
+    txt_writer *w = (txt_writer *)base;
+    evr_status st;
+    (void)duration_us;
+    if (events != w->count && events != w->prev_count) {
+        snprintf(err->msg, sizeof err->msg, "text writer: cannot keep %llu events of %s",
+                 (unsigned long long)events, w->path);
+        evr_file_discard(w->f, w->tmp);
+        st = EVR_ERR_IO;
+    } else {
+        st = evr_file_salvage(w->f, w->tmp, w->path, events == w->count ? w->bytes : w->prev_bytes,
+                              w->bytes, (const unsigned char *)w->buf, w->len, NULL, 0,
+                              "text writer", err);
+    }
     free_writer(w);
     return st;
 }
@@ -154,6 +185,7 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
     w->base.flush = txt_flush;
     w->base.finish = txt_finish;
     w->base.abort = txt_abort;
+    w->base.salvage = txt_salvage;
     *out = &w->base;
     return EVR_OK;
 }

@@ -2,6 +2,7 @@
 #include "run/frames_out.h"
 #include "core/shading.h"
 #include "io/png.h"
+#include "io/file_commit.h"
 #include "io/mkdir_p.h"
 
 #include <dirent.h>
@@ -203,9 +204,10 @@ evr_status evr_frames_finish(evr_sim *sim, evr_error *err)
         ok = fprintf(f, "%d,%.9f,%s,%s\n", k, sim->frame_times[k], n8, n16) > 0;
     }
     if (f) ok = (fclose(f) == 0) && ok;
-    if (!ok || rename(tmp, p) != 0) {
+    if (!ok || evr_file_publish(tmp, p) != 0) {
+        const int e = errno;
         remove(tmp);
-        snprintf(err->msg, sizeof err->msg, "cannot write %s", p);
+        snprintf(err->msg, sizeof err->msg, "cannot write %s: %s", p, strerror(e));
         return EVR_ERR_IO;
     }
     return EVR_OK;

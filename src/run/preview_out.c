@@ -32,7 +32,8 @@ struct evr_preview_out {
     /* video */
     evr_apng *video;
     fifo ev_rgb, gray;
-    uint8_t *both; /* one video frame: 2 width x height RGB */
+    uint8_t *both;    /* one video frame: 2 width x height RGB */
+    int video_failed; /* a frame's write failed: the video may end inside it */
 };
 
 static evr_status nomem(evr_error *err)
@@ -165,7 +166,10 @@ static evr_status pair(evr_preview_out *p, evr_error *err)
         }
         free(ev);
         free(gray);
-        if ((st = evr_apng_add(p->video, p->both, err)) != EVR_OK) return st;
+        if ((st = evr_apng_add(p->video, p->both, err)) != EVR_OK) {
+            p->video_failed = 1;
+            return st;
+        }
     }
     return EVR_OK;
 }
@@ -281,6 +285,11 @@ evr_status evr_preview_out_finish(evr_preview_out *p, int64_t dur_us, evr_error 
     int64_t last = (dur_us - 1) / p->window_us; /* the last window that starts before the end */
     while (st == EVR_OK && p->event_index <= last) st = event_frame_done(p, err);
     if (st == EVR_OK && !p->exposure_fixed) st = fix_exposure(p, err);
+    if (st == EVR_OK && p->video_failed) {
+        snprintf(err->msg, sizeof err->msg,
+                 "previews: preview.apng not kept (a frame's write failed)");
+        st = EVR_ERR_IO;
+    }
     if (st == EVR_OK && p->video) {
         /* a half without its other (a window without its intensity) is left out */
         st = evr_apng_finish(p->video, err);

@@ -3,11 +3,13 @@
 #include "run/camera_poses.h"
 #include "run/labels_out.h"
 #include "io/mkdir_p.h"
+#include "io/file_commit.h"
 #include "io/event_formats.h"
 #include "io/json.h"
 #include "io/preview.h"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <math.h>
 #include <errno.h>
 #include <stdio.h>
@@ -28,9 +30,102 @@ static evr_status path_join(char *out, size_t n, const char *dir, const char *na
     return EVR_OK;
 }
 
+/* The reserve: a file of EVR_RESERVE_BYTES made when the run starts and removed when it ends, or
+ * as soon as a write fails, so that a full disk still leaves room to complete the files (the
+ * HDF5 file's last chunk, index and metadata, run.json, the video's end). */
+#define EVR_RESERVE_FILE ".evray-reserve"
+#define EVR_RESERVE_BYTES ((off_t)2 << 20)
+
+static evr_status make_reserve(evr_sim *sim, evr_error *err)
+{
+    char p[4200];
+    int fd, r;
+    evr_status st;
+    if ((st = path_join(p, sizeof p, sim->out_dir, EVR_RESERVE_FILE, err)) != EVR_OK) return st;
+    fd = open(p, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        snprintf(err->msg, sizeof err->msg, "cannot write in %s: %s", sim->out_dir,
+                 strerror(errno));
+        return EVR_ERR_IO;
+    }
+    r = posix_fallocate(fd, 0, EVR_RESERVE_BYTES); /* an error number, not errno */
+    close(fd);
+    if (r == 0) {
+        sim->reserve_made = 1;
+        return EVR_OK;
+    }
+    remove(p);
+    if (r == ENOSPC || r == EDQUOT) {
+        snprintf(err->msg, sizeof err->msg,
+                 "not enough free space in %s: a run needs at least %d MB free to start (kept "
+                 "in reserve to complete its files should the disk fill up)",
+                 sim->out_dir, (int)(EVR_RESERVE_BYTES >> 20));
+        return EVR_ERR_IO;
+    }
+    return EVR_OK; /* e.g. a file size limit below it: the run goes on without a reserve */
+}
+
+static void release_reserve(evr_sim *sim)
+{
+    char p[4200];
+    if (!sim->reserve_made) return;
+    snprintf(p, sizeof p, "%s/%s", sim->out_dir, EVR_RESERVE_FILE);
+    remove(p);
+    sim->reserve_made = 0;
+}
+
+/* Whether name (in the run folder, or in its preview/ when in_preview) is a file evray writes. */
+static int owned_name(const char *name, int in_preview)
+{
+    static const char *const fixed[] = {"run.json",         "preview.apng", EVR_RESERVE_FILE,
+                                        "camera_poses.txt", "labels.h5",    "imu.txt",
+                                        "node_poses.txt",   "eye.txt"};
+    char base[256];
+    size_t n = strlen(name);
+    int i, count;
+    if (n >= sizeof base) return 0;
+    strcpy(base, name);
+    if (n > 4 && !strcmp(base + n - 4, ".tmp")) base[n - 4] = 0; /* and its temporary file */
+    if (in_preview)
+        return (!strncmp(base, "events_", 7) || !strncmp(base, "intensity_", 10)) &&
+               strlen(base) > 4 && !strcmp(base + strlen(base) - 4, ".png");
+    for (i = 0; i < (int)(sizeof fixed / sizeof fixed[0]); i++)
+        if (!strcmp(base, fixed[i])) return 1;
+    const evr_event_format *const *formats = evr_event_formats(&count);
+    for (i = 0; i < count; i++)
+        if (!strcmp(base, formats[i]->file)) return 1;
+    return 0;
+}
+
+/* Removes the files evray writes in folder dir (in_preview: its preview/ folder); others stay. */
+static void remove_owned(const char *dir, int in_preview)
+{
+    DIR *d = opendir(dir);
+    struct dirent *de;
+    char p[4600];
+    if (!d) return;
+    while ((de = readdir(d)) != NULL) {
+        if (!owned_name(de->d_name, in_preview)) continue;
+        snprintf(p, sizeof p, "%s/%s", dir, de->d_name);
+        remove(p);
+    }
+    closedir(d);
+}
+
+void evr_run_dir_clean(const char *dir)
+{
+    char p[4200];
+    snprintf(p, sizeof p, "%s/preview", dir);
+    remove_owned(p, 1);
+    rmdir(p); /* unless it holds something else */
+    remove_owned(dir, 0);
+    evr_folder_sync(p);
+}
+
 evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
 {
     struct stat sb;
+    evr_status st;
     if (stat(sim->out_dir, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode)) {
             snprintf(err->msg, sizeof err->msg, "output path %s exists and is not a folder",
@@ -54,6 +149,8 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
                      sim->out_dir);
             return EVR_ERR_ARG;
         }
+        /* --force: an earlier run's files go first, so that none stays beside this run's */
+        if (!empty) evr_run_dir_clean(sim->out_dir);
     } else {
         if (evr_mkdir_p(sim->out_dir) != 0) {
             snprintf(err->msg, sizeof err->msg, "cannot create output folder %s: %s", sim->out_dir,
@@ -62,6 +159,8 @@ evr_status evr_run_dir_prepare(evr_sim *sim, evr_error *err)
         }
         sim->created_dir = 1;
     }
+    sim->dir_ours = 1;
+    if ((st = make_reserve(sim, err)) != EVR_OK) return st;
     if (sim->cfg.preview_window > 0.0 && sim->cfg.preview != EVR_PREVIEW_NONE) {
         sim->preview_window_us = (int64_t)llround(sim->cfg.preview_window * 1e6);
         if (sim->preview_window_us < 1) sim->preview_window_us = 1;
@@ -193,8 +292,17 @@ static char *run_json(const evr_sim *sim)
     evr_json_end_object(&j);
     evr_json_key(&j, "outputs");
     evr_json_begin_array(&j);
-    for (i = 0; i < sim->num_writers; i++) evr_json_string(&j, sim->writer_names[i]);
+    for (i = 0; i < sim->num_writers; i++)
+        if (!sim->writer_lost[i]) evr_json_string(&j, sim->writer_names[i]);
     evr_json_end_array(&j);
+    if (sim->failure[0]) { /* a failed run: its error, and the outputs it could not keep */
+        evr_json_key(&j, "failed");
+        evr_json_string(&j, sim->failure);
+        if (sim->lost[0]) {
+            evr_json_key(&j, "lost");
+            evr_json_string(&j, sim->lost);
+        }
+    }
     evr_json_key(&j, "backend");
     evr_json_string(&j, s->backend);
     evr_json_key(&j, "device");
@@ -257,6 +365,12 @@ static char *run_json(const evr_sim *sim)
     evr_json_integer(&j, s->segments_total);
     evr_json_key(&j, "interrupted");
     evr_json_boolean(&j, s->interrupted);
+    /* the run ran to its end and every output is whole */
+    evr_json_key(&j, "complete");
+    evr_json_boolean(&j, !s->interrupted && !sim->failure[0]);
+    /* the event files hold every event before this time (absolute seconds), none after */
+    evr_json_key(&j, "complete_until_seconds");
+    evr_json_number(&j, s->complete_until);
     evr_json_key(&j, "simulated_seconds");
     evr_json_number(&j, s->sim_time);
     evr_json_key(&j, "wall_seconds");
@@ -336,38 +450,137 @@ static char *run_json(const evr_sim *sim)
     return out;
 }
 
-evr_status evr_run_close(evr_sim *sim, evr_error *err)
+/* The backend's timings into the statistics. */
+static void backend_times(evr_sim *sim)
 {
-    evr_status st = EVR_OK;
-    int w;
-    int64_t dur_us = (int64_t)llround(sim->st.sim_time * 1e6);
     sim->st.time_setup = sim->time_setup;
     sim->st.time_render = sim->time_render;
     sim->st.time_device = sim->backend->device_seconds;
     sim->st.time_sort = sim->backend->sort_seconds;
     sim->st.time_copy = sim->backend->copy_seconds;
     sim->st.device_memory = sim->backend->device_bytes;
+}
+
+/* Stops the writer thread, its timings into the statistics. */
+static void stop_queue(evr_sim *sim)
+{
+    if (!sim->wq) return;
+    sim->time_write = evr_write_queue_wait_seconds(sim->wq);
+    sim->time_write_thread = evr_write_queue_busy_seconds(sim->wq);
+    sim->st.time_write = sim->time_write_thread;
+    evr_write_queue_stop(sim->wq);
+    sim->wq = NULL;
+}
+
+/* The simulated time the event files hold every event of (an interrupted run's, up to
+ * complete_until), in microseconds: the writers' and previews' duration. */
+static int64_t complete_us(const evr_sim *sim)
+{
+    return (int64_t)llround((sim->st.complete_until - sim->cfg.start) * 1e6);
+}
+
+/* Notes an output a failed run could not keep. */
+static void note_lost(evr_sim *sim, const char *why)
+{
+    size_t len = strlen(sim->lost);
+    snprintf(sim->lost + len, sizeof sim->lost - len, "%s%s", len ? "; " : "", why);
+}
+
+/* The end of a failed run once its outputs are settled: run.json says so, or, if it cannot be
+ * written, nothing is left (no file that looks complete without it). Returns st, err kept. */
+static evr_status end_failed(evr_sim *sim, evr_status st)
+{
+    evr_error e2;
+    sim->st.interrupted = 1;
+    sim->st.outputs_kept = evr_run_write_json(sim, &e2) == EVR_OK;
+    if (!sim->st.outputs_kept) evr_run_dir_discard(sim);
+    return st;
+}
+
+evr_status evr_run_fail(evr_sim *sim, evr_status st, evr_error *err)
+{
+    evr_error e2;
+    uint64_t events = 0, batches = 0;
+    int64_t until_us = sim->emitted_until_us;
+    int w;
+    snprintf(sim->failure, sizeof sim->failure, "%s", err->msg);
+    release_reserve(sim); /* room to complete the files */
+    backend_times(sim);
     if (sim->wq) {
-        st = evr_write_queue_drain(sim->wq, err);
-        sim->time_write = evr_write_queue_wait_seconds(sim->wq);
-        sim->time_write_thread = evr_write_queue_busy_seconds(sim->wq);
-        sim->st.time_write = sim->time_write_thread;
-        evr_write_queue_stop(sim->wq);
-        sim->wq = NULL;
-        if (st != EVR_OK) return st;
+        evr_write_queue_drain(sim->wq,
+                              &e2); /* a queue that did not fail still writes its batches */
+        evr_write_queue_accepted(sim->wq, &events, &batches);
+        stop_queue(sim);
+        /* the files keep what every writer took: the counts and the time of those batches */
+        if (batches < sim->batches) until_us = sim->marks[batches % EVR_BATCH_MARKS].before_us;
+        if (batches > 0) {
+            const evr_batch_mark *m = &sim->marks[(batches - 1) % EVR_BATCH_MARKS];
+            sim->st.events_on = m->on;
+            sim->st.events_off = m->events - m->on;
+            sim->st.unique_timestamps = m->unique;
+        } else {
+            sim->st.events_on = sim->st.events_off = sim->st.unique_timestamps = 0;
+        }
     }
+    sim->st.complete_until =
+        until_us == INT64_MAX ? sim->cfg.start + sim->duration : (double)until_us * 1e-6;
     for (w = 0; w < sim->num_writers; w++) {
         evr_event_writer *wr = sim->writers[w];
         sim->writers[w] = NULL;
-        evr_status s2 = wr->finish(wr, dur_us, err);
-        if (s2 != EVR_OK && st == EVR_OK) st = s2;
+        if (wr->salvage(wr, events, complete_us(sim), &e2) != EVR_OK) {
+            sim->writer_lost[w] = 1;
+            note_lost(sim, e2.msg);
+        }
     }
-    if (st != EVR_OK) return st;
-    if (sim->preview && (st = evr_preview_out_finish(sim->preview, dur_us, err)) != EVR_OK)
-        return st;
-    if ((st = evr_camera_poses_close(sim, err)) != EVR_OK) return st;
-    if ((st = evr_labels_close(sim, err)) != EVR_OK) return st;
-    return evr_frames_finish(sim, err);
+    if (sim->preview && evr_preview_out_finish(sim->preview, complete_us(sim), &e2) != EVR_OK)
+        note_lost(sim, e2.msg);
+    if (evr_frames_finish(sim, &e2) != EVR_OK) note_lost(sim, e2.msg);
+    /* the camera's poses and the labels are kept only with a complete run */
+    evr_camera_poses_discard(sim);
+    evr_labels_discard(sim);
+    return end_failed(sim, st);
+}
+
+evr_status evr_run_close(evr_sim *sim, evr_error *err)
+{
+    evr_status st = EVR_OK;
+    evr_error e2;
+    int w;
+    backend_times(sim);
+    /* everything written and flushed while the reserve is still there: a write that fails here
+     * still leaves room to salvage the files */
+    if (sim->wq) {
+        st = evr_write_queue_flush(sim->wq, err);
+        if (st != EVR_OK) return evr_run_fail(sim, st, err);
+        stop_queue(sim);
+    }
+    release_reserve(sim); /* room for what completing the files writes */
+    for (w = 0; w < sim->num_writers; w++) {
+        evr_event_writer *wr = sim->writers[w];
+        sim->writers[w] = NULL;
+        if (wr->finish(wr, complete_us(sim), &e2) != EVR_OK) { /* its file is gone */
+            sim->writer_lost[w] = 1;
+            if (st == EVR_OK) *err = e2;
+            st = EVR_ERR_IO;
+            note_lost(sim, e2.msg);
+        }
+    }
+    if (sim->preview && evr_preview_out_finish(sim->preview, complete_us(sim), &e2) != EVR_OK) {
+        if (st == EVR_OK) *err = e2;
+        st = EVR_ERR_IO;
+        note_lost(sim, e2.msg);
+    }
+    if (evr_frames_finish(sim, &e2) != EVR_OK || evr_camera_poses_close(sim, &e2) != EVR_OK ||
+        evr_labels_close(sim, &e2) != EVR_OK) {
+        if (st == EVR_OK) *err = e2;
+        st = EVR_ERR_IO;
+        note_lost(sim, e2.msg);
+    }
+    if (st != EVR_OK) {
+        snprintf(sim->failure, sizeof sim->failure, "%s", err->msg);
+        return end_failed(sim, st);
+    }
+    return EVR_OK;
 }
 
 evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
@@ -388,9 +601,10 @@ evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
     int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
     if (f) ok = (fclose(f) == 0) && ok;
     free(text);
-    if (!ok || rename(tmp, p) != 0) {
+    if (!ok || evr_file_publish(tmp, p) != 0) {
+        const int e = errno;
         remove(tmp);
-        snprintf(err->msg, sizeof err->msg, "cannot write %s", p);
+        snprintf(err->msg, sizeof err->msg, "cannot write %s: %s", p, strerror(e));
         return EVR_ERR_IO;
     }
     return EVR_OK;
@@ -399,7 +613,6 @@ evr_status evr_run_write_json(evr_sim *sim, evr_error *err)
 void evr_run_dir_discard(evr_sim *sim)
 {
     int w;
-    char p[4200];
     evr_frames_discard(sim);
     evr_camera_poses_discard(sim);
     evr_labels_discard(sim);
@@ -409,22 +622,11 @@ void evr_run_dir_discard(evr_sim *sim)
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
         sim->writers[w] = NULL;
     }
-    /* previews of this run: the video (an unfinished one is removed on release) and the PNGs */
-    snprintf(p, sizeof p, "%s/preview.apng", sim->out_dir);
-    if (sim->preview) remove(p);
-    snprintf(p, sizeof p, "%s/preview", sim->out_dir);
-    DIR *d = opendir(p);
-    if (d) {
-        struct dirent *de;
-        char f[4600];
-        while ((de = readdir(d)) != NULL) {
-            if (strncmp(de->d_name, "events_", 7) && strncmp(de->d_name, "intensity_", 10))
-                continue;
-            snprintf(f, sizeof f, "%s/%s", p, de->d_name);
-            remove(f);
-        }
-        closedir(d);
-        rmdir(p);
-    }
+    evr_preview_out_release(sim->preview); /* an unfinished video's temporary file goes */
+    sim->preview = NULL;
+    sim->reserve_made = 0;
+    /* the folder held nothing of evray's before this run (it was new, empty, or emptied of
+     * evray's files by --force): whatever of evray's it holds is this run's */
+    if (sim->dir_ours) evr_run_dir_clean(sim->out_dir);
     if (sim->created_dir) rmdir(sim->out_dir);
 }

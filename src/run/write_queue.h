@@ -1,14 +1,16 @@
 /* Writes event batches on a thread of its own, so that the host writes segment i while the
  * backend renders segment i + 1. Batches are written in the order pushed. Every writer is
  * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
- * flush, and otherwise once the thread has been idle until then: an interrupted run's files lag
- * at most about flush_seconds (plus the batch being written) behind the batches pushed, and a
- * fast run does not store and flush per segment (the HDF5 writer recompresses its partial last
- * chunk at each flush). At most eight batches wait (write_queue.c). */
+ * flush, and otherwise once the thread has been idle until then: a killed run's files lag at
+ * most about flush_seconds (plus the batch being written, and the HDF5 writer's last partial
+ * chunk) behind the batches pushed, and a fast run does not flush per segment. At most eight
+ * batches wait (write_queue.c). A stopped or failed run completes the files itself
+ * (run/run_files.h), with what every writer took (evr_write_queue_accepted). */
 #ifndef EVR_WRITE_QUEUE_H
 #define EVR_WRITE_QUEUE_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "events.h"
 #include "io/event_writer.h"
 
@@ -28,6 +30,12 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
 /* Waits until everything pushed is written (not necessarily flushed: the writers' finish()
  * completes the files); returns the first error, if any. */
 evr_status evr_write_queue_drain(evr_write_queue *q, evr_error *err);
+/* Waits until everything pushed is written, then flushes every writer; returns the first error,
+ * if any. */
+evr_status evr_write_queue_flush(evr_write_queue *q, evr_error *err);
+/* The events and batches (counted from the first push) that every writer took: after a failure,
+ * what the files can keep (io/event_writer.h, salvage). */
+void evr_write_queue_accepted(evr_write_queue *q, uint64_t *events, uint64_t *batches);
 /* Seconds the writer thread spent writing and flushing, and the caller spent waiting in
  * push/drain. */
 double evr_write_queue_busy_seconds(evr_write_queue *q);
