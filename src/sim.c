@@ -4,6 +4,7 @@
 #include "par_pool.h"
 #include "host_clock.h"
 #include "config/config_json.h"
+#include "config/config_table.h"
 #include "io/json.h"
 #include "io/preview.h"
 #include "run/run_files.h"
@@ -117,10 +118,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
             if (!strcmp(names[i], c->sensor)) sim->cfg.sensor = names[i];
     }
     sim->camera = c->camera ? evr_scene_find_camera(s, c->camera) : 0;
-    sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
-    if (c->duration > 0.0) sim->duration = c->duration;
-    else if (s->anim_end > c->start) sim->duration = s->anim_end - c->start;
-    else sim->duration = 1.0; /* a static scene: one second unless told */
+    evr_config_run_span(c, s, &sim->duration, &sim->fps); /* bounded by evr_config_validate */
     sim->num_segments = (int)ceil(sim->duration * sim->fps - 1e-9);
     if (sim->num_segments < 1) sim->num_segments = 1;
 

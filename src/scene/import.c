@@ -110,6 +110,7 @@
 #include <assimp/config.h>
 
 #include "io/byte_order.h"
+#include "io/file_read.h"
 #include "scene/import_internal.h"
 
 /* The first evr_load_options (size and animation): the smallest size a caller may pass. */
@@ -168,12 +169,13 @@ void evr_import_copy_name(char *dst, size_t cap, const char *src)
 evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
                                 evr_error *err)
 {
-    FILE *f = fopen(path, "rb");
+    const char *why = NULL;
+    FILE *f = evr_fopen_regular(path, &why);
     unsigned char *buf = NULL;
     size_t len = 0, cap = 0;
     *data = NULL;
     *size = 0;
-    if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open '%s': %s", path, why);
     for (;;) {
         size_t want, got;
         if (len == cap) {
@@ -540,17 +542,14 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     *out = NULL;
     if ((st = current_options(opts, &o, err)) != EVR_OK) return st;
     if (!path || !path[0]) return evr_import_fail(err, EVR_ERR_ARG, "no scene file given");
-    if (stat(path, &sb) != 0)
-        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
-                               strerror(errno));
-    if (S_ISDIR(sb.st_mode))
-        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': it is a folder",
-                               path);
     {
-        FILE *f = fopen(path, "rb");
-        if (!f)
+        const char *why = NULL;
+        FILE *f = evr_fopen_regular(path, &why); /* a FIFO or a device is refused */
+        if (!f || fstat(fileno(f), &sb) != 0) {
+            if (f) fclose(f);
             return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
-                                   strerror(errno));
+                                   why ? why : strerror(errno));
+        }
         fclose(f);
     }
     if (sb.st_size == 0)
