@@ -39,7 +39,7 @@ static double field_number(const evr_config *c, const evr_config_option *o)
 
 /* The smallest evr_config a caller may pass: the first version with a size field. When fields
  * are added at the end, this stays and older callers' configurations get defaults for the rest. */
-#define EVR_CONFIG_FIRST_SIZE offsetof(evr_config, allow_external_files)
+#define EVR_CONFIG_FIRST_SIZE sizeof(evr_config)
 
 static void fill_defaults(evr_config *c)
 {

@@ -348,6 +348,8 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     im.ai = ai;
     im.s = s;
     im.strict = opts->strict;
+    im.allow_external = opts->allow_external;
+    im.in_memory = path == NULL;
     im.err = err;
     evr_import_copy_name(im.dir, sizeof im.dir, dir);
     evr_import_copy_name(s->source, sizeof s->source, source);
@@ -363,6 +365,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
         im.src.nbytes = nbytes;
         im.src.path = path;
         im.src.dir = path ? dir : NULL;
+        im.src.allow_external = opts->allow_external;
     }
 
     if (dropped[0]) evr_import_warn(&im, "%s", dropped);
@@ -498,6 +501,7 @@ static evr_status gltf_before_assimp(const gltf_source *src, unsigned char **pat
     size_t k;
     *patched = NULL;
     *npatched = 0;
+    if ((st = evr_gltf_validate(src, err)) != EVR_OK) return st;
     if ((st = evr_gltf_material_check(src, err)) != EVR_OK) return st;
     for (k = 0; k < sizeof stages / sizeof *stages; k++) {
         unsigned char *out = NULL;
@@ -575,15 +579,17 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         src.nbytes = nbytes;
         src.path = path;
         src.dir = dir;
+        src.allow_external = o.allow_external;
         if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) {
             free(bytes);
             return st;
         }
-        if (patched && !(io = evr_memfile_io_new(path, patched, npatched))) {
-            free(bytes);
-            free(patched);
-            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
-        }
+    }
+    /* every file Assimp opens goes through this (import_memfile.c) */
+    if (!(io = evr_memfile_io_new(path, patched, npatched, dir, o.allow_external))) {
+        free(bytes);
+        free(patched);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
 
     props = make_props();
@@ -620,9 +626,10 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
+    struct aiFileIO *io;
     unsigned char *patched = NULL;
     size_t npatched = 0;
-    char source[64], dropped[256];
+    char source[64], dropped[256], name[64];
     evr_status st;
     int none = 0;
 
@@ -640,17 +647,24 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         src.nbytes = size;
         src.path = NULL;
         src.dir = NULL;
+        src.allow_external = o.allow_external;
         if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) return st;
     }
+    /* Assimp reads the bytes as a file of this name through import_memfile.c, which opens no
+     * other file unless external files are allowed (then relative to the current folder) */
+    snprintf(name, sizeof name, "evray-memory.%.32s", hint);
     props = make_props();
-    if (!props) {
+    io = evr_memfile_io_new(name, patched ? patched : (const unsigned char *)data,
+                            patched ? npatched : size, NULL, o.allow_external);
+    if (!props || !io) {
+        if (props) aiReleasePropertyStore(props);
+        evr_memfile_io_free(io);
         free(patched);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
-    ai = aiImportFileFromMemoryWithProperties(patched ? (const char *)patched : (const char *)data,
-                                              patched ? (unsigned)npatched : (unsigned)size,
-                                              import_flags(), hint, props);
+    ai = aiImportFileExWithProperties(name, import_flags(), io, props);
     aiReleasePropertyStore(props);
+    evr_memfile_io_free(io);
     free(patched);
     if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
     snprintf(source, sizeof source, "<memory>.%s", hint);
