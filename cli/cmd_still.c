@@ -31,6 +31,7 @@ static void help(void)
         "                         together, the later of two sharing a node does not)\n"
         "  --strict               fail on anything evray would otherwise warn about and leave\n"
         "                         out of the file (a texture it cannot find or decode, ...)\n"
+        "  --allow-external-files let the scene read files outside its own folder\n"
         "  --gi MODE              none (default: direct light only), photon (image-space photon\n"
         "                         mapping) or path (brute-force path tracing: the reference)\n"
         "  --spp N                path: paths per pixel (default 64)\n"
@@ -209,7 +210,7 @@ int cmd_still(int argc, char **argv)
                *region = NULL, *v;
     const char *cmp_path = NULL, *animation = NULL;
     float exposure = 1.0f;
-    int quiet = 0, strict = 0, i, ar;
+    int quiet = 0, strict = 0, external = 0, i, ar;
     evr_still_defaults(&p);
 #define VAL(name)                                             \
     do {                                                      \
@@ -222,6 +223,7 @@ int cmd_still(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
         else if (!strcmp(a, "--strict")) strict = 1;
+        else if (!strcmp(a, "--allow-external-files")) external = 1;
         else if (!strcmp(a, "-o")) {
             VAL("-o");
             out = v;
@@ -404,7 +406,7 @@ int cmd_still(int argc, char **argv)
             return 2;
         }
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, quiet);
+    evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, external, quiet);
     if (!scene) {
         free(ref);
         free(cmp);
