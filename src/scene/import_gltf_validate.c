@@ -171,6 +171,23 @@ static int check_glb(gv *c)
 
 /* ---- buffers, views, accessors ---- */
 
+static int mime_char(char ch)
+{
+    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+           (ch && strchr("!#$&^_.+-", ch));
+}
+
+int evr_gv_data_uri(const char *uri)
+{
+    const char *p = uri + 5; /* after "data:" */
+    int n = 0;
+    /* Assimp 5.2 dereferences the media type it fails to parse: type/subtype;base64, only */
+    while (mime_char(*p)) p++, n++;
+    if (!n || *p++ != '/') return 0;
+    for (n = 0; mime_char(*p); p++) n++;
+    return n && !strncmp(p, ";base64,", 8);
+}
+
 /* Bytes a data: URI's base64 text decodes to. */
 static size_t b64_length(const char *s, size_t n)
 {
@@ -213,8 +230,9 @@ static int check_buffer(gv *c, int i, int b)
     if (!strncmp(text, "data:", 5)) {
         const char *comma = strstr(text, ";base64,");
         size_t have = comma ? b64_length(comma + 8, strlen(comma + 8)) : 0;
+        int ok = evr_gv_data_uri(text);
         free(text);
-        if (!comma) return evr_gv_fail(c, "%s's data: URI is not base64", what);
+        if (!ok) return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
         if ((double)have < len)
             return evr_gv_fail(c, "%s's data: URI holds %zu bytes, its byteLength says %.0f", what,
                                have, len);
@@ -341,6 +359,9 @@ static int check_accessor(gv *c, int i, int a)
         return -1;
     if (view >= 0) {
         if (fits_view(c, view, off, count, elem_size(nc, cs), what)) return -1;
+    } else if (evr_jdoc_get(d, a, "sparse") < 0) {
+        /* zeros by glTF's rule, but Assimp 5.2 fails on it ("data is null") and leaks */
+        return evr_gv_fail(c, "%s has no buffer view (evray reads no accessor of zeros)", what);
     } else if (count > MAX_VIEWLESS_COUNT) {
         return evr_gv_fail(c, "%s has %.0f elements but no buffer view (at most %d)", what, count,
                            MAX_VIEWLESS_COUNT);

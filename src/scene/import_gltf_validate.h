@@ -46,6 +46,8 @@ int evr_gv_integer(gv *c, int obj, const char *key, double lo, double hi, double
 int evr_gv_numbers(gv *c, int obj, const char *key, int want, double *out, const char *what);
 /* A finite number member, def when absent. */
 int evr_gv_number(gv *c, int obj, const char *key, double def, const char *what, double *out);
+/* 1 when a "data:" URI has the form data:TYPE/SUBTYPE;base64, (all Assimp reads safely). */
+int evr_gv_data_uri(const char *uri);
 /* Accessor a's values (evr_gltf_accessor_read). */
 int evr_gv_read(gv *c, int a, double **vals, int *count, int *nc);
 /* Every value of accessor a finite (read once per accessor). */

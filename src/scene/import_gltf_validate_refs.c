@@ -446,6 +446,13 @@ static int check_textures(gv *c)
         snprintf(what, sizeof what, "image %d", i);
         if (uri >= 0 && evr_jdoc_type(d, uri) != EVR_JDOC_STRING)
             return evr_gv_fail(c, "%s: 'uri' must be a string", what);
+        if (uri >= 0) {
+            char head[80];
+            /* the media type is all that is parsed here (the string cut to head's size) */
+            evr_jdoc_string(d, uri, head, sizeof head);
+            if (!strncmp(head, "data:", 5) && !evr_gv_data_uri(head))
+                return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+        }
         if (evr_gv_index(c, t, "bufferView", c->n_views, 0, what, "buffer view", &k)) return -1;
         if (uri < 0 && k < 0) return evr_gv_fail(c, "%s has neither uri nor bufferView", what);
     }
