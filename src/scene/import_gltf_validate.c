@@ -188,16 +188,22 @@ int evr_gv_data_uri(const char *uri)
     return n && !strncmp(p, ";base64,", 8);
 }
 
-/* Bytes a data: URI's base64 text decodes to. */
-static size_t b64_length(const char *s, size_t n)
+size_t evr_gv_base64(const char *s, size_t n, int json)
 {
-    size_t k = 0, i;
+    size_t i, k = 0, pad = 0;
     for (i = 0; i < n; i++) {
         char ch = s[i];
-        k += (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') ||
-             ch == '+' || ch == '/' || ch == '-' || ch == '_';
+        if (json && ch == '\\' && i + 1 < n && s[i + 1] == '/') ch = s[++i]; /* JSON's "\/" */
+        if (ch == '=') {
+            pad++;
+        } else if (pad || !((ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') ||
+                            (ch >= '0' && ch <= '9') || ch == '+' || ch == '/')) {
+            return (size_t)-1; /* Assimp fails on it, and leaks */
+        }
+        k++;
     }
-    return k * 6 / 8;
+    if (k % 4 || pad > 2) return (size_t)-1;
+    return k / 4 * 3 - pad;
 }
 
 static int check_buffer(gv *c, int i, int b)
@@ -229,10 +235,11 @@ static int check_buffer(gv *c, int i, int b)
     evr_jdoc_string(d, uri, text, d->v[uri].len + 1);
     if (!strncmp(text, "data:", 5)) {
         const char *comma = strstr(text, ";base64,");
-        size_t have = comma ? b64_length(comma + 8, strlen(comma + 8)) : 0;
+        size_t have = comma ? evr_gv_base64(comma + 8, strlen(comma + 8), 0) : 0;
         int ok = evr_gv_data_uri(text);
         free(text);
         if (!ok) return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+        if (have == (size_t)-1) return evr_gv_fail(c, "%s's data: URI is not valid base64", what);
         if ((double)have < len)
             return evr_gv_fail(c, "%s's data: URI holds %zu bytes, its byteLength says %.0f", what,
                                have, len);

@@ -48,6 +48,9 @@ int evr_gv_numbers(gv *c, int obj, const char *key, int want, double *out, const
 int evr_gv_number(gv *c, int obj, const char *key, double def, const char *what, double *out);
 /* 1 when a "data:" URI has the form data:TYPE/SUBTYPE;base64, (all Assimp reads safely). */
 int evr_gv_data_uri(const char *uri);
+/* The bytes base64 text s[0 .. n) decodes to (json: as it stands in the JSON text, "\/" for
+ * '/'), or (size_t)-1 when it is not standard padded base64. */
+size_t evr_gv_base64(const char *s, size_t n, int json);
 /* Accessor a's values (evr_gltf_accessor_read). */
 int evr_gv_read(gv *c, int a, double **vals, int *count, int *nc);
 /* Every value of accessor a finite (read once per accessor). */

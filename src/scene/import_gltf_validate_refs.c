@@ -450,8 +450,16 @@ static int check_textures(gv *c)
             char head[80];
             /* the media type is all that is parsed here (the string cut to head's size) */
             evr_jdoc_string(d, uri, head, sizeof head);
-            if (!strncmp(head, "data:", 5) && !evr_gv_data_uri(head))
-                return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+            if (!strncmp(head, "data:", 5)) {
+                const char *raw = d->text + d->v[uri].off, *comma;
+                size_t len = d->v[uri].len;
+                if (!evr_gv_data_uri(head))
+                    return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+                comma = memchr(raw, ',', len);
+                if (!comma ||
+                    evr_gv_base64(comma + 1, len - (size_t)(comma + 1 - raw), 1) == (size_t)-1)
+                    return evr_gv_fail(c, "%s's data: URI is not valid base64", what);
+            }
         }
         if (evr_gv_index(c, t, "bufferView", c->n_views, 0, what, "buffer view", &k)) return -1;
         if (uri < 0 && k < 0) return evr_gv_fail(c, "%s has neither uri nor bufferView", what);
