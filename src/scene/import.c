@@ -390,6 +390,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_lights(&im)) != EVR_OK) goto fail;
+    if ((st = evr_import_check_numbers(&im)) != EVR_OK) goto fail;
     if (opts->strict && s->num_warnings) {
         const char *w = evr_scene_warnings(s);
         int first = (int)strcspn(w, "\n");

@@ -289,5 +289,9 @@ evr_status evr_import_deform(importer *im);
 void evr_import_bounds(evr_scene *s);
 evr_status evr_import_cameras(importer *im);
 evr_status evr_import_lights(importer *im);
+/* Every number of the imported scene finite (vertices, transforms, keys, cameras, lights),
+ * quaternions not zero, cameras with a field of view in (0, pi) and znear > 0, lights not
+ * negative: one error line naming the element (import_check.c). */
+evr_status evr_import_check_numbers(importer *im);
 
 #endif
