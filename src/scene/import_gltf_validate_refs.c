@@ -213,8 +213,13 @@ static int check_scenes(gv *c)
             if (c->parent[k] >= 0)
                 return evr_gv_fail(c, "%s lists node %d, which is a child of node %d", what, k,
                                    c->parent[k]);
+            if (c->parent[k] == -2 - i) /* Assimp attaches it twice and leaks it */
+                return evr_gv_fail(c, "%s lists node %d twice", what, k);
+            c->parent[k] = -2 - i; /* a root of scene i (reset below) */
         }
     }
+    for (k = 0; k < c->n_nodes; k++)
+        if (c->parent[k] < -1) c->parent[k] = -1;
     return evr_gv_index(c, c->root, "scene", c->n_scenes, 0, "the document", "scene", &scene);
 }
 
