@@ -216,6 +216,21 @@ for name, text, want in (
         f.write(text)
     refused(name, want, "info", path)
 
+# ---- files that crash or hang Assimp's other importers (found by tests/fuzz/fuzz_scene_assimp.c;
+# the first byte of a corpus file is the target's choice of format): read in a child process
+# first, a crash or a hang there is one line here ----
+regress = os.path.join(os.path.dirname(os.path.abspath(__file__)), "fuzz", "regress", "scene_assimp")
+for name, want in (("ply-assert-abort", "Assimp crashed reading it"),
+                   ("ply-hang", "took longer than 3 s")):
+    with open(os.path.join(regress, name), "rb") as f:
+        body = f.read()[1:]
+    path = os.path.join(tmp, name + ".ply")
+    with open(path, "wb") as f:
+        f.write(body)
+    os.environ["EVR_IMPORT_SECONDS"] = "3"
+    refused(name, want, "info", path)
+    os.environ.pop("EVR_IMPORT_SECONDS")
+
 # ---- animations too long to run: refused before the run, info still describes them ----
 far = write_gltf("far_keys", *scene(times=(0.0, 1e30)))
 rc, lines, _ = run("info", far)

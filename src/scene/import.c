@@ -409,14 +409,59 @@ fail:
 
 /* Assimp failed: its reason, or ours when there are no triangles (none, or SortByPType removed
  * every mesh). */
-static evr_status import_error(evr_error *err, const char *source, int none)
+/* One read of a file by Assimp, post-processing included (sort_and_join), as a job that
+ * import_isolate.c can run in a child process. */
+typedef struct {
+    const char *path;
+    struct aiFileIO *io;
+    struct aiPropertyStore *props;
+    char *dropped;
+    size_t ndropped;
+} assimp_read;
+
+/* Failure lines: "\001" for a file without triangles, else Assimp's reason. */
+static const void *assimp_read_run(void *ctx, char *msg, size_t cap)
 {
-    const char *why = aiGetErrorString();
-    if (none || (why && strstr(why, "No meshes remaining")))
+    assimp_read *r = ctx;
+    int none = 0;
+    const struct aiScene *ai =
+        aiImportFileExWithProperties(r->path, import_flags(), r->io, r->props);
+    if (ai) ai = sort_and_join(ai, r->dropped, r->ndropped, &none);
+    if (!ai) {
+        const char *why = aiGetErrorString();
+        if (none || (why && strstr(why, "No meshes remaining"))) snprintf(msg, cap, "\001");
+        else snprintf(msg, cap, "%s", why && why[0] ? why : "unknown Assimp error");
+    }
+    return ai;
+}
+
+/* The longest a child process may read a file of another format than glTF: 60 s, or
+ * EVR_IMPORT_SECONDS (a test's switch, to see a hang refused in seconds). */
+static int isolated_read_seconds(void)
+{
+    const char *e = getenv("EVR_IMPORT_SECONDS");
+    int v = e ? atoi(e) : 0;
+    return v > 0 ? v : 60;
+}
+
+/* Assimp reads the file: a glTF (checked before) in this process, any other format first in a
+ * child process (import_isolate.c), where a crash or a hang becomes an error line. */
+static evr_status assimp_load(assimp_read *r, int gltf, const char *source,
+                              const struct aiScene **out, evr_error *err)
+{
+    char msg[512];
+    int child =
+        gltf ? -2
+             : evr_import_isolated(assimp_read_run, r, isolated_read_seconds(), msg, sizeof msg);
+    *out = NULL;
+    if (child == -1)
+        return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, msg);
+    if (child != 0) *out = assimp_read_run(r, msg, sizeof msg);
+    if (*out) return EVR_OK;
+    if (!strcmp(msg, "\001"))
         return evr_import_fail(err, EVR_ERR_FORMAT,
                                "'%s' has no triangles (points and lines are not rendered)", source);
-    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source,
-                           why && why[0] ? why : "unknown Assimp error");
+    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, msg);
 }
 
 static struct aiPropertyStore *make_props(void)
@@ -540,7 +585,6 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     char dir[512], dropped[256];
     const char *ext, *slash;
     evr_status st;
-    int none = 0;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
@@ -600,14 +644,16 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         evr_memfile_io_free(io);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
-    ai = aiImportFileExWithProperties(path, import_flags(), io, props);
+    {
+        assimp_read r = {path, io, props, dropped, sizeof dropped};
+        st = assimp_load(&r, bytes != NULL, path, &ai, err);
+    }
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
-    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
-    if (!ai) {
+    if (st != EVR_OK) {
         free(bytes);
-        return import_error(err, path, none);
+        return st;
     }
     st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, dropped, out, err);
     free(bytes);
@@ -632,7 +678,7 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     size_t npatched = 0;
     char source[64], dropped[256], name[64];
     evr_status st;
-    int none = 0;
+    int gltf;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
@@ -642,7 +688,8 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (size > UINT_MAX)
         return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
     if (!hint) hint = "";
-    if (may_be_gltf(data, size, hint)) { /* as for a file (quirks (j) to (p)) */
+    gltf = may_be_gltf(data, size, hint);
+    if (gltf) { /* as for a file (quirks (j) to (p)) */
         gltf_source src;
         src.bytes = data;
         src.nbytes = size;
@@ -663,13 +710,15 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         free(patched);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
-    ai = aiImportFileExWithProperties(name, import_flags(), io, props);
+    snprintf(source, sizeof source, "<memory>.%s", hint);
+    {
+        assimp_read r = {name, io, props, dropped, sizeof dropped};
+        st = assimp_load(&r, gltf, source, &ai, err);
+    }
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
-    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
-    snprintf(source, sizeof source, "<memory>.%s", hint);
-    if (!ai) return import_error(err, source, none);
+    if (st != EVR_OK) return st;
     st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, dropped, out,
                  err);
     aiReleaseImport(ai);
