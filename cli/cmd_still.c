@@ -252,6 +252,10 @@ int cmd_still(int argc, char **argv)
         } else if (opt_is(a, "--time")) {
             VAL("--time");
             if (!opt_double("--time", v, &p.time)) return 2;
+            if (!(p.time >= 0.0 && p.time <= 1e6)) {
+                cli_error("--time must be between 0 and 1e6 seconds (got %s)", v);
+                return 2;
+            }
         } else if (opt_is(a, "--res")) {
             VAL("--res");
             if (!opt_size("--res", v, &p.width, &p.height)) return 2;
@@ -272,8 +276,8 @@ int cmd_still(int argc, char **argv)
         } else if (opt_is(a, "--spp")) {
             VAL("--spp");
             if (!opt_int("--spp", v, &p.spp)) return 2;
-            if (p.spp < 1) {
-                cli_error("--spp must be at least 1 (got %s)", v);
+            if (p.spp < 1 || p.spp > 1000000) {
+                cli_error("--spp must be between 1 and 1000000 (got %s)", v);
                 return 2;
             }
         } else if (opt_is(a, "--photons")) {
@@ -405,6 +409,14 @@ int cmd_still(int argc, char **argv)
             free(cmp);
             return 2;
         }
+    }
+    /* a path-traced reference is the one still image whose work has no natural bound */
+    if (p.gi == EVR_GI_PATH && (double)p.width * p.height * p.spp > 1e12) {
+        cli_error("--gi path: %dx%d pixels x %d paths is more than 1e12 paths", p.width, p.height,
+                  p.spp);
+        free(ref);
+        free(cmp);
+        return 2;
     }
     evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, external, quiet);
     if (!scene) {

@@ -257,6 +257,11 @@ for args, want in ((("--start", "1e308"), "start time must be between 0 and 1e6"
                    (("--leak-rate-hz", "1000", "--duration", "100"), "more than --max-noise-events")):
     refused("render " + " ".join(args), want, "render", static, "-o", out, *args)
 T.check(not os.path.exists(out), "a refused run leaves no run folder")
+for args, want in ((("--time", "1e308"), "--time must be between 0 and 1e6"),
+                   (("--time", "-1"), "--time must be between 0 and 1e6"),
+                   (("--gi", "path", "--spp", "1000000", "--res", "16384x16384"), "more than 1e12 paths"),
+                   (("--gi", "path", "--spp", "1000000000"), "--spp must be between 1 and 1000000")):
+    refused("still " + " ".join(args), want, "still", static, "-o", os.path.join(tmp, "s.png"), *args)
 # the limits can be raised: the same run starts (a short one, to see it accepted)
 rc, lines, _ = run("render", static, "-o", os.path.join(tmp, "o4"), "--res", "8x6", "--duration", "0.1",
                    "--max-samples", "0", "--no-preview", "--format", "npy", "--quiet")
