@@ -159,7 +159,8 @@ static int check_glb(gv *c)
                                "the GLB's chunk at byte %zu (%u bytes) reaches past the end "
                                "of the file",
                                at, clen);
-        if (!memcmp(head + 4, "BIN", 4) && !c->has_bin && at == ((20 + (size_t)jlen + 3) & ~3u)) {
+        if (!memcmp(head + 4, "BIN", 4) && !c->has_bin &&
+            at == ((20 + (size_t)jlen + 3) & ~(size_t)3)) {
             c->has_bin = 1;
             c->bin_len = clen;
         }

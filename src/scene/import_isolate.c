@@ -52,8 +52,7 @@ int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, 
     pid_t pid;
     msg[0] = 0;
     if (pipe(fds) != 0) return -2;
-    fflush(NULL); /* nothing buffered is written twice */
-    pid = fork();
+    pid = fork(); /* the child leaves by _exit: what the caller has buffered is not written twice */
     if (pid < 0) {
         close(fds[0]);
         close(fds[1]);
