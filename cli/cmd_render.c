@@ -114,7 +114,8 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         return 2;
     }
 
-    evr_scene *scene = cli_load_scene(scene_path, default_demo, animation, cfg.strict, quiet);
+    evr_scene *scene = cli_load_scene(scene_path, default_demo, animation, cfg.strict,
+                                      cfg.allow_external_files, quiet);
     if (!scene) return 1;
     evr_error err = {{0}};
     evr_status st;

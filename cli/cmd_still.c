@@ -31,6 +31,7 @@ static void help(void)
         "                         together, the later of two sharing a node does not)\n"
         "  --strict               fail on anything evray would otherwise warn about and leave\n"
         "                         out of the file (a texture it cannot find or decode, ...)\n"
+        "  --allow-external-files let the scene read files outside its own folder\n"
         "  --gi MODE              none (default: direct light only), photon (image-space photon\n"
         "                         mapping) or path (brute-force path tracing: the reference)\n"
         "  --spp N                path: paths per pixel (default 64)\n"
@@ -209,7 +210,7 @@ int cmd_still(int argc, char **argv)
                *region = NULL, *v;
     const char *cmp_path = NULL, *animation = NULL;
     float exposure = 1.0f;
-    int quiet = 0, strict = 0, i, ar;
+    int quiet = 0, strict = 0, external = 0, i, ar;
     evr_still_defaults(&p);
 #define VAL(name)                                             \
     do {                                                      \
@@ -222,6 +223,7 @@ int cmd_still(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
         else if (!strcmp(a, "--strict")) strict = 1;
+        else if (!strcmp(a, "--allow-external-files")) external = 1;
         else if (!strcmp(a, "-o")) {
             VAL("-o");
             out = v;
@@ -250,6 +252,10 @@ int cmd_still(int argc, char **argv)
         } else if (opt_is(a, "--time")) {
             VAL("--time");
             if (!opt_double("--time", v, &p.time)) return 2;
+            if (!(p.time >= 0.0 && p.time <= 1e6)) {
+                cli_error("--time must be between 0 and 1e6 seconds (got %s)", v);
+                return 2;
+            }
         } else if (opt_is(a, "--res")) {
             VAL("--res");
             if (!opt_size("--res", v, &p.width, &p.height)) return 2;
@@ -270,8 +276,8 @@ int cmd_still(int argc, char **argv)
         } else if (opt_is(a, "--spp")) {
             VAL("--spp");
             if (!opt_int("--spp", v, &p.spp)) return 2;
-            if (p.spp < 1) {
-                cli_error("--spp must be at least 1 (got %s)", v);
+            if (p.spp < 1 || p.spp > 1000000) {
+                cli_error("--spp must be between 1 and 1000000 (got %s)", v);
                 return 2;
             }
         } else if (opt_is(a, "--photons")) {
@@ -404,7 +410,15 @@ int cmd_still(int argc, char **argv)
             return 2;
         }
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, quiet);
+    /* a path-traced reference is the one still image whose work has no natural bound */
+    if (p.gi == EVR_GI_PATH && (double)p.width * p.height * p.spp > 1e12) {
+        cli_error("--gi path: %dx%d pixels x %d paths is more than 1e12 paths", p.width, p.height,
+                  p.spp);
+        free(ref);
+        free(cmp);
+        return 2;
+    }
+    evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, external, quiet);
     if (!scene) {
         free(ref);
         free(cmp);

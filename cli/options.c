@@ -72,7 +72,7 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
 }
 
 evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
-                          int quiet)
+                          int allow_external, int quiet)
 {
     evr_error err = {{0}};
     evr_scene *scene = NULL;
@@ -81,6 +81,7 @@ evr_scene *cli_load_scene(const char *path, const char *demo, const char *animat
     evr_load_options_defaults(&opts);
     opts.animation = animation;
     opts.strict = strict;
+    opts.allow_external = allow_external;
     if (path) {
         st = evr_scene_load_with(path, &opts, &scene, &err);
     } else { /* a built-in scene goes through the same importer, from memory */

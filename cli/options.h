@@ -21,11 +21,12 @@ int opt_is(const char *arg, const char *name);
 void cli_error(const char *fmt, ...);
 
 /* The scene file at path, else the built-in scene demo, with --animation's choice (NULL: the
- * default rule) and --strict's (every import warning an error); prints the loader's notice
+ * default rule), --strict's (every import warning an error) and --allow-external-files' (files
+ * outside the scene's folder may be read); prints the loader's notice
  * unless quiet, and the scene's warnings (evr_scene_warnings) always, on stderr. NULL (after the
  * error message) when it cannot be loaded, a clip the file does not have included. */
 evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
-                          int quiet);
+                          int allow_external, int quiet);
 /* cli_load_scene's quiet for a caller that prints the notice and the warnings itself */
 #define CLI_LOAD_DESCRIBED (-1)
 /* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when
@@ -43,5 +44,9 @@ int cli_is_animation_option(int argc, char **argv, int *i, const char **animatio
     "  --strict                   fail on anything evray would otherwise warn about and\n" \
     "                             leave out of the file (a texture it cannot find or\n"    \
     "                             decode, an extension it does not render, ...)\n"
+#define CLI_EXTERNAL_HELP                                                                 \
+    "  --allow-external-files     let the scene read files outside its own folder (by\n"  \
+    "                             default a buffer or image named by an absolute path,\n" \
+    "                             by '..' or through a link out of it is refused)\n"
 
 #endif

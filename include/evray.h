@@ -76,6 +76,12 @@ typedef struct {
     size_t size; /* sizeof(evr_load_options) as the caller sees it: set by the defaults */
     const char *animation;
     int strict;
+    /* 0 (the default): the scene reads only files inside its own folder (buffers, images,
+     * materials a format names beside it); a path that leads outside it (an absolute path, '..',
+     * a symbolic link out) fails the load (a texture: a warning, as a missing one). 1: any
+     * file. Either way only regular files are read (never a FIFO or a device). A scene in memory
+     * has no folder: 0 reads no file at all, 1 reads them relative to the current folder. */
+    int allow_external;
 } evr_load_options;
 
 void evr_load_options_init(evr_load_options *o, size_t size);
@@ -220,6 +226,15 @@ typedef struct {
     int label_normals;
     int trajectories;
     int eye_labels;
+    /* scene loading: 1 lets a scene read files outside its folder (evr_load_options
+     * .allow_external); the evray program loads the scene with it */
+    int allow_external_files;
+    /* The most a run may take, refused by evr_sim_new before anything starts (0: no limit):
+     * max_samples bounds the pixel work, width x height x (samples per segment x segments +
+     * intensity frames + preview frames); max_noise_events the expected noise events (pixels x
+     * duration x the leak, shot and hot-pixel rates). */
+    double max_samples;
+    double max_noise_events;
 } evr_config;
 
 enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };

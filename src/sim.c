@@ -4,6 +4,7 @@
 #include "par_pool.h"
 #include "host_clock.h"
 #include "config/config_json.h"
+#include "config/config_table.h"
 #include "io/json.h"
 #include "io/preview.h"
 #include "run/run_files.h"
@@ -140,11 +141,19 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         return st;
     }
     const double path_end = evr_camera_rig_path_end(&sim->rig);
-    sim->fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
-    if (c->duration > 0.0) sim->duration = c->duration;
-    else if (path_end > c->start) sim->duration = path_end - c->start; /* the trajectory's */
-    else if (s->anim_end > c->start) sim->duration = s->anim_end - c->start;
-    else sim->duration = 1.0; /* a static scene: one second unless told */
+    evr_config_run_span(c, s, &sim->duration, &sim->fps); /* bounded by evr_config_validate */
+    if (!(c->duration > 0.0) && path_end > c->start) {
+        sim->duration = path_end - c->start; /* the trajectory's */
+        if (!(sim->duration <= EVR_MAX_DURATION)) {
+            snprintf(err->msg, sizeof err->msg,
+                     "the camera's trajectory runs %g s from --start: more than %g s cannot be "
+                     "simulated (give --duration)",
+                     sim->duration, EVR_MAX_DURATION);
+            evr_camera_rig_free(&sim->rig);
+            free(sim);
+            return EVR_ERR_ARG;
+        }
+    }
     sim->num_segments = (int)ceil(sim->duration * sim->fps - 1e-9);
     if (sim->num_segments < 1) sim->num_segments = 1;
     if ((st = evr_camera_rig_setup(&sim->rig, c, c->start, c->start + sim->duration, err)) !=

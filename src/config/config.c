@@ -174,6 +174,8 @@ evr_status evr_config_current(const evr_config *c, evr_config *out, evr_error *e
     return EVR_OK;
 }
 
+static evr_status check_run_size(const evr_config *c, const evr_scene *s, evr_error *err);
+
 #define BAD(...)                                          \
     do {                                                  \
         snprintf(err->msg, sizeof err->msg, __VA_ARGS__); \
@@ -259,7 +261,57 @@ evr_status evr_config_validate(const evr_config *given, const evr_scene *s, evr_
                 BAD("duration %g s from %g s goes beyond the end of the animation (%g s)",
                     c->duration, c->start, end);
         }
+        if ((st = check_run_size(c, s, err)) != EVR_OK) return st;
     }
+    return EVR_OK;
+}
+
+void evr_config_run_span(const evr_config *c, const evr_scene *s, double *duration, double *fps)
+{
+    *fps = c->fps > 0.0 ? c->fps : (s->frame_rate > 0.0 ? s->frame_rate : 30.0);
+    if (c->duration > 0.0) *duration = c->duration;
+    else if (s->anim_end > c->start) *duration = s->anim_end - c->start;
+    else *duration = 1.0; /* a static scene: one second unless told */
+}
+
+/* The work the run will do, estimated before anything is allocated: a run that would take days,
+ * fill the disk with noise or overflow its counters is refused with one line, past limits the
+ * caller can raise (max_samples, max_noise_events), rather than started. */
+static evr_status check_run_size(const evr_config *c, const evr_scene *s, evr_error *err)
+{
+    double duration, fps, segments, per_pixel, frames = 0.0, previews = 0.0, work, noise;
+    double pixels = (double)c->width * (double)c->height;
+    evr_config_run_span(c, s, &duration, &fps);
+    if (!(duration <= EVR_MAX_DURATION))
+        BAD("the scene's animation runs to %g s: more than %g s from --start %g s cannot be "
+            "simulated (give --duration)",
+            s->anim_end, EVR_MAX_DURATION, c->start);
+    segments = ceil(duration * fps - 1e-9);
+    if (segments > EVR_MAX_SEGMENTS)
+        BAD("%g s at %g segments per second is %.4g segments, more than %g: lower --fps or "
+            "--duration",
+            duration, fps, segments, EVR_MAX_SEGMENTS);
+    if (segments < 1.0) segments = 1.0;
+    /* adaptive sampling may take a sample every min_dt */
+    per_pixel = c->sampling == EVR_SAMPLING_ADAPTIVE ? ceil(duration / c->min_dt)
+                                                     : (double)c->samples_per_frame * segments;
+    if (c->frames_out)
+        frames = floor(duration * (c->frames_fps > 0.0 ? c->frames_fps : fps) + 1e-9) + 1.0;
+    if (c->preview != EVR_PREVIEW_NONE && c->preview_window > 0.0)
+        previews = ceil(duration / c->preview_window);
+    work = pixels * (per_pixel + frames + previews);
+    if (c->max_samples > 0.0 && work > c->max_samples)
+        BAD("the run would take %.3g pixel samples (%dx%d pixels x (%.4g samples + %.4g frames + "
+            "%.4g previews) over %g s), more than --max-samples %g: shorten it or raise the limit",
+            work, c->width, c->height, per_pixel, frames, previews, duration, c->max_samples);
+    noise = pixels * duration *
+            ((double)c->leak_rate * (1.0 + (double)c->leak_jitter) + (double)c->shot_rate +
+             (double)c->hot_fraction * (double)c->hot_rate);
+    if (c->max_noise_events > 0.0 && noise > c->max_noise_events)
+        BAD("the noise settings would make about %.3g events (%dx%d pixels x %g s x the leak, shot "
+            "and hot-pixel rates), more than --max-noise-events %g: lower the rates or raise the "
+            "limit",
+            noise, c->width, c->height, duration, c->max_noise_events);
     return EVR_OK;
 }
 

@@ -13,6 +13,8 @@
 
 #define F(field) offsetof(evr_config, field)
 #define NO_LIMIT HUGE_VAL
+/* below this a threshold makes thousands of events per unit of log intensity */
+#define EVR_MIN_THRES 1e-3
 
 /* ---- when a setting matters ---- */
 static int is_adaptive(const evr_config *c) { return c->sampling == EVR_SAMPLING_ADAPTIVE; }
@@ -83,6 +85,15 @@ static void json_formats(evr_json *j, const evr_config *c, const evr_config_run 
         snprintf(err->msg, sizeof err->msg, __VA_ARGS__); \
         return EVR_ERR_ARG;                               \
     } while (0)
+
+/* 0 turns previews off; a window shorter than a millisecond would make a file per event */
+static evr_status check_preview_window(const evr_config *c, evr_error *err)
+{
+    if (c->preview_window > 0.0 && c->preview_window < 1e-3)
+        FAIL("preview window must be 0 (no previews) or at least 0.001 seconds (got %g)",
+             c->preview_window);
+    return EVR_OK;
+}
 
 static evr_status parse_res(evr_config *c, const char *v, evr_error *err)
 {
@@ -298,11 +309,13 @@ static const evr_config_option table[] = {
      .offset = F(preview_window),
      .def = 0.05,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "preview window must be >= 0 seconds",
+     .hi = 1e4,
+     .check = check_preview_window,
+     .what = "preview window must be between 0 (no previews) and 1e4 seconds",
      .flag = "--preview-window",
      .label = "--preview-window S",
-     .help = "seconds per preview frame (default 0.05)",
+     .help = "seconds per preview frame: 0 (no previews), or 0.001 to 1e4\n"
+             "(default 0.05)",
      .json = "preview_window",
      .json_rank = 41},
     {.name = "preview",
@@ -376,9 +389,9 @@ static const evr_config_option table[] = {
      .offset = F(frames_exposure),
      .def = 1.0,
      .lo = 0,
-     .hi = NO_LIMIT,
+     .hi = 1e9,
      .lo_open = 1,
-     .what = "frames exposure must be a positive number",
+     .what = "frames exposure must be in (0, 1e9]",
      .flag = "--frames-exposure",
      .cli_lo = 0,
      .cli_hi = NO_LIMIT,
@@ -395,9 +408,9 @@ static const evr_config_option table[] = {
      .offset = F(frames_max),
      .def = 4.0,
      .lo = 0,
-     .hi = NO_LIMIT,
+     .hi = 1e9,
      .lo_open = 1,
-     .what = "frames max must be a positive intensity",
+     .what = "frames max must be an intensity in (0, 1e9]",
      .flag = "--frames-max",
      .cli_lo = 0,
      .cli_hi = NO_LIMIT,
@@ -444,15 +457,16 @@ static const evr_config_option table[] = {
      .offset = F(duration),
      .def = 0.0,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "duration must be a positive number of seconds",
+     .hi = EVR_MAX_DURATION,
+     .what = "duration must be a positive number of seconds, at most 1e6",
      .flag = "--duration",
      .cli_lo = 0,
-     .cli_hi = NO_LIMIT,
+     .cli_hi = EVR_MAX_DURATION,
      .cli_lo_open = 1,
-     .cli_what = "%s must be a positive number of seconds (got %s)",
+     .cli_what = "%s must be a positive number of seconds, at most 1e6 (got %s)",
      .label = "--duration S",
-     .help = "seconds to simulate (default: the animation's length)",
+     .help = "seconds to simulate, at most 1e6 (default: the animation's\n"
+             "length)",
      .json = "duration",
      .json_rank = 6,
      .json_value = json_duration},
@@ -461,11 +475,11 @@ static const evr_config_option table[] = {
      .offset = F(start),
      .def = 0.0,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "start time must be >= 0 seconds",
+     .hi = EVR_MAX_DURATION,
+     .what = "start time must be between 0 and 1e6 seconds",
      .flag = "--start",
      .label = "--start S",
-     .help = "start time in the animation (default 0)",
+     .help = "start time in the animation, 0 to 1e6 (default 0)",
      .json = "start",
      .json_rank = 5},
     {.name = "fps",
@@ -661,8 +675,8 @@ static const evr_config_option table[] = {
      .offset = F(gather_radius),
      .def = 0.0,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "--gather-radius must be a positive number, or 0 for automatic",
+     .hi = 1e9,
+     .what = "--gather-radius must be a positive number up to 1e9, or 0 for automatic",
      .applies = has_gi,
      .flag = "--gather-radius",
      .label = "--gather-radius R",
@@ -746,23 +760,22 @@ static const evr_config_option table[] = {
      .type = EVR_OPT_FLOAT,
      .offset = F(pos_thres),
      .def = 0.2,
-     .lo = 0,
-     .hi = NO_LIMIT,
-     .lo_open = 1,
-     .what = "ON threshold must be a positive number",
+     .lo = EVR_MIN_THRES,
+     .hi = 100,
+     .what = "ON threshold must be between 0.001 and 100",
      .flag = "--pos-thres",
      .label = "--pos-thres C, --neg-thres C",
-     .help = "ON/OFF contrast thresholds in log intensity (default 0.2)",
+     .help = "ON/OFF contrast thresholds in log intensity, 0.001 to 100\n"
+             "(default 0.2)",
      .json = "pos_thres",
      .json_rank = 13},
     {.name = "neg_thres",
      .type = EVR_OPT_FLOAT,
      .offset = F(neg_thres),
      .def = 0.2,
-     .lo = 0,
-     .hi = NO_LIMIT,
-     .lo_open = 1,
-     .what = "OFF threshold must be a positive number",
+     .lo = EVR_MIN_THRES,
+     .hi = 100,
+     .what = "OFF threshold must be between 0.001 and 100",
      .flag = "--neg-thres",
      .json = "neg_thres",
      .json_rank = 14},
@@ -776,8 +789,8 @@ static const evr_config_option table[] = {
      .offset = F(sigma_thres),
      .def = 0.0,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "threshold mismatch must be >= 0",
+     .hi = 10,
+     .what = "threshold mismatch must be between 0 and 10",
      .flag = "--sigma-thres",
      .label = "--sigma-thres S",
      .help = "threshold mismatch: per-pixel thresholds drawn once from\n"
@@ -789,8 +802,8 @@ static const evr_config_option table[] = {
      .offset = F(refractory),
      .def = 0.0,
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "refractory period must be >= 0 seconds",
+     .hi = 1000,
+     .what = "refractory period must be between 0 and 1000 seconds",
      .flag = "--refractory",
      .label = "--refractory S",
      .help = "refractory period in seconds (default 0)",
@@ -839,8 +852,8 @@ static const evr_config_option table[] = {
      .offset = F(leak_jitter),
      .def = 0.1, /* v2e's leak_jitter_fraction */
      .lo = 0,
-     .hi = NO_LIMIT,
-     .what = "leak jitter must be >= 0",
+     .hi = 10,
+     .what = "leak jitter must be between 0 and 10",
      .flag = "--leak-jitter",
      .label = "--leak-jitter J",
      .help = "relative spread of the per-pixel leak rates (default 0.1)",
@@ -1096,6 +1109,49 @@ static const evr_config_option table[] = {
      .json = "fov",
      .json_rank = 53,
      .json_if = has_fov},
+    {.name = "allow_external_files",
+     .type = EVR_OPT_FLAG,
+     .offset = F(allow_external_files),
+     .flag = "--allow-external-files",
+     .label = "--allow-external-files",
+     .help = "let the scene read files outside its own folder (buffers and\n"
+             "images given by an absolute path, by '..' or through a link\n"
+             "out of the folder); by default such a buffer fails the load\n"
+             "and such a texture is a warning. FIFOs and devices are never\n"
+             "read",
+     .json = "allow_external_files",
+     .json_rank = 59},
+
+    /* ---- how much a run may take ---- */
+    {.name = "max_samples",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(max_samples),
+     .def = 1e12,
+     .lo = 0,
+     .hi = NO_LIMIT,
+     .what = "--max-samples must be >= 0 (0: no limit)",
+     .flag = "--max-samples",
+     .section = "limits (checked before the run starts)",
+     .label = "--max-samples N",
+     .help = "refuse a run whose pixel work, width x height x (samples per\n"
+             "segment x segments + intensity frames + preview frames), is\n"
+             "more than N (default 1e12; 0: no limit)",
+     .json = "max_samples",
+     .json_rank = 60},
+    {.name = "max_noise_events",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(max_noise_events),
+     .def = 1e9,
+     .lo = 0,
+     .hi = NO_LIMIT,
+     .what = "--max-noise-events must be >= 0 (0: no limit)",
+     .flag = "--max-noise-events",
+     .label = "--max-noise-events N",
+     .help = "refuse a run expected to make more than N noise events\n"
+             "(pixels x duration x the leak, shot and hot-pixel rates;\n"
+             "default 1e9; 0: no limit)",
+     .json = "max_noise_events",
+     .json_rank = 61},
 };
 
 const evr_config_option *evr_config_table(int *count)

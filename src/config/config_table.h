@@ -82,6 +82,16 @@ struct evr_config_option {
 
 typedef struct evr_config_option evr_config_option;
 
+/* The longest run (seconds, whatever the animation says) and the most segments a run may have:
+ * the duration and start rows' bound, and past it int64 microseconds and the per-segment
+ * arrays would not hold. */
+#define EVR_MAX_DURATION 1e6
+#define EVR_MAX_SEGMENTS 1e7
+
+/* The duration and segment rate a run of c over scene s has (c's, else the scene's: the
+ * animation from c->start to its end, one second for a static scene; its frame rate, else 30). */
+void evr_config_run_span(const evr_config *c, const evr_scene *s, double *duration, double *fps);
+
 /* The rows, in --help order; *count is set to their number. */
 const evr_config_option *evr_config_table(int *count);
 

@@ -3,6 +3,7 @@
 #include "io/prophesee_read.h"
 #include "io/rosbag_read.h"
 #include "io/byte_order.h"
+#include "io/file_read.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -28,11 +29,12 @@ static int ext_is(const char *path, const char *ext)
 
 evr_status evr_file_slurp(const char *path, char **data, size_t *size, evr_error *err)
 {
-    FILE *f = fopen(path, "rb");
+    const char *why = NULL;
+    FILE *f = evr_fopen_regular(path, &why);
     char *buf = NULL;
     size_t len = 0, cap = 0;
     if (!f) {
-        snprintf(err->msg, sizeof err->msg, "cannot open %s: %s", path, strerror(errno));
+        snprintf(err->msg, sizeof err->msg, "cannot open %s: %s", path, why);
         return EVR_ERR_IO;
     }
     for (;;) {
@@ -470,6 +472,15 @@ static int h5r_int_attr(hid_t file, const char *name)
     return v;
 }
 
+/* HDF5 would open a FIFO and block, or read a device: a regular file only. */
+static evr_status h5r_regular(const char *path, evr_error *err)
+{
+    const char *why = NULL;
+    if (evr_is_regular_file(path, &why)) return EVR_OK;
+    snprintf(err->msg, sizeof err->msg, "cannot open %s: %s", path, why);
+    return EVR_ERR_IO;
+}
+
 static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *width, int *height,
                           evr_error *err)
 {
@@ -484,6 +495,7 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
     const char *what = NULL;
     int w = -1, h = -1;
 
+    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
     H5E_BEGIN_TRY
     {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -589,6 +601,7 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     const char *what = NULL;
     *idx = NULL;
     *n = 0;
+    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
     H5E_BEGIN_TRY
     {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);

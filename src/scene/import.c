@@ -110,6 +110,7 @@
 #include <assimp/config.h>
 
 #include "io/byte_order.h"
+#include "io/file_read.h"
 #include "scene/import_internal.h"
 
 /* The first evr_load_options (size and animation): the smallest size a caller may pass. */
@@ -168,12 +169,13 @@ void evr_import_copy_name(char *dst, size_t cap, const char *src)
 evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
                                 evr_error *err)
 {
-    FILE *f = fopen(path, "rb");
+    const char *why = NULL;
+    FILE *f = evr_fopen_regular(path, &why);
     unsigned char *buf = NULL;
     size_t len = 0, cap = 0;
     *data = NULL;
     *size = 0;
-    if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    if (!f) return evr_import_fail(err, EVR_ERR_IO, "cannot open '%s': %s", path, why);
     for (;;) {
         size_t want, got;
         if (len == cap) {
@@ -346,6 +348,8 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     im.ai = ai;
     im.s = s;
     im.strict = opts->strict;
+    im.allow_external = opts->allow_external;
+    im.in_memory = path == NULL;
     im.err = err;
     evr_import_copy_name(im.dir, sizeof im.dir, dir);
     evr_import_copy_name(s->source, sizeof s->source, source);
@@ -361,6 +365,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
         im.src.nbytes = nbytes;
         im.src.path = path;
         im.src.dir = path ? dir : NULL;
+        im.src.allow_external = opts->allow_external;
     }
 
     if (dropped[0]) evr_import_warn(&im, "%s", dropped);
@@ -385,6 +390,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     evr_import_bounds(s);
     if ((st = evr_import_cameras(&im)) != EVR_OK) goto fail;
     if ((st = evr_import_lights(&im)) != EVR_OK) goto fail;
+    if ((st = evr_import_check_numbers(&im)) != EVR_OK) goto fail;
     if (opts->strict && s->num_warnings) {
         const char *w = evr_scene_warnings(s);
         int first = (int)strcspn(w, "\n");
@@ -403,14 +409,59 @@ fail:
 
 /* Assimp failed: its reason, or ours when there are no triangles (none, or SortByPType removed
  * every mesh). */
-static evr_status import_error(evr_error *err, const char *source, int none)
+/* One read of a file by Assimp, post-processing included (sort_and_join), as a job that
+ * import_isolate.c can run in a child process. */
+typedef struct {
+    const char *path;
+    struct aiFileIO *io;
+    struct aiPropertyStore *props;
+    char *dropped;
+    size_t ndropped;
+} assimp_read;
+
+/* Failure lines: "\001" for a file without triangles, else Assimp's reason. */
+static const void *assimp_read_run(void *ctx, char *msg, size_t cap)
 {
-    const char *why = aiGetErrorString();
-    if (none || (why && strstr(why, "No meshes remaining")))
+    assimp_read *r = ctx;
+    int none = 0;
+    const struct aiScene *ai =
+        aiImportFileExWithProperties(r->path, import_flags(), r->io, r->props);
+    if (ai) ai = sort_and_join(ai, r->dropped, r->ndropped, &none);
+    if (!ai) {
+        const char *why = aiGetErrorString();
+        if (none || (why && strstr(why, "No meshes remaining"))) snprintf(msg, cap, "\001");
+        else snprintf(msg, cap, "%s", why && why[0] ? why : "unknown Assimp error");
+    }
+    return ai;
+}
+
+/* The longest a child process may read a file of another format than glTF: 60 s, or
+ * EVR_IMPORT_SECONDS (a test's switch, to see a hang refused in seconds). */
+static int isolated_read_seconds(void)
+{
+    const char *e = getenv("EVR_IMPORT_SECONDS");
+    int v = e ? atoi(e) : 0;
+    return v > 0 ? v : 60;
+}
+
+/* Assimp reads the file: a glTF (checked before) in this process, any other format first in a
+ * child process (import_isolate.c), where a crash or a hang becomes an error line. */
+static evr_status assimp_load(assimp_read *r, int gltf, const char *source,
+                              const struct aiScene **out, evr_error *err)
+{
+    char msg[512];
+    int child =
+        gltf ? -2
+             : evr_import_isolated(assimp_read_run, r, isolated_read_seconds(), msg, sizeof msg);
+    *out = NULL;
+    if (child == -1)
+        return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, msg);
+    if (child != 0) *out = assimp_read_run(r, msg, sizeof msg);
+    if (*out) return EVR_OK;
+    if (!strcmp(msg, "\001"))
         return evr_import_fail(err, EVR_ERR_FORMAT,
                                "'%s' has no triangles (points and lines are not rendered)", source);
-    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source,
-                           why && why[0] ? why : "unknown Assimp error");
+    return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, msg);
 }
 
 static struct aiPropertyStore *make_props(void)
@@ -496,6 +547,7 @@ static evr_status gltf_before_assimp(const gltf_source *src, unsigned char **pat
     size_t k;
     *patched = NULL;
     *npatched = 0;
+    if ((st = evr_gltf_validate(src, err)) != EVR_OK) return st;
     if ((st = evr_gltf_material_check(src, err)) != EVR_OK) return st;
     for (k = 0; k < sizeof stages / sizeof *stages; k++) {
         unsigned char *out = NULL;
@@ -533,24 +585,20 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     char dir[512], dropped[256];
     const char *ext, *slash;
     evr_status st;
-    int none = 0;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
     *out = NULL;
     if ((st = current_options(opts, &o, err)) != EVR_OK) return st;
     if (!path || !path[0]) return evr_import_fail(err, EVR_ERR_ARG, "no scene file given");
-    if (stat(path, &sb) != 0)
-        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
-                               strerror(errno));
-    if (S_ISDIR(sb.st_mode))
-        return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': it is a folder",
-                               path);
     {
-        FILE *f = fopen(path, "rb");
-        if (!f)
+        const char *why = NULL;
+        FILE *f = evr_fopen_regular(path, &why); /* a FIFO or a device is refused */
+        if (!f || fstat(fileno(f), &sb) != 0) {
+            if (f) fclose(f);
             return evr_import_fail(err, EVR_ERR_IO, "cannot open scene file '%s': %s", path,
-                                   strerror(errno));
+                                   why ? why : strerror(errno));
+        }
         fclose(f);
     }
     if (sb.st_size == 0)
@@ -576,15 +624,17 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         src.nbytes = nbytes;
         src.path = path;
         src.dir = dir;
+        src.allow_external = o.allow_external;
         if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) {
             free(bytes);
             return st;
         }
-        if (patched && !(io = evr_memfile_io_new(path, patched, npatched))) {
-            free(bytes);
-            free(patched);
-            return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
-        }
+    }
+    /* every file Assimp opens goes through this (import_memfile.c) */
+    if (!(io = evr_memfile_io_new(path, patched, npatched, dir, o.allow_external))) {
+        free(bytes);
+        free(patched);
+        return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
 
     props = make_props();
@@ -594,14 +644,16 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         evr_memfile_io_free(io);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
-    ai = aiImportFileExWithProperties(path, import_flags(), io, props);
+    {
+        assimp_read r = {path, io, props, dropped, sizeof dropped};
+        st = assimp_load(&r, bytes != NULL, path, &ai, err);
+    }
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
-    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
-    if (!ai) {
+    if (st != EVR_OK) {
         free(bytes);
-        return import_error(err, path, none);
+        return st;
     }
     st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, dropped, out, err);
     free(bytes);
@@ -621,11 +673,12 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     evr_load_options o;
     const struct aiScene *ai;
     struct aiPropertyStore *props;
+    struct aiFileIO *io;
     unsigned char *patched = NULL;
     size_t npatched = 0;
-    char source[64], dropped[256];
+    char source[64], dropped[256], name[64];
     evr_status st;
-    int none = 0;
+    int gltf;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
@@ -635,27 +688,37 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     if (size > UINT_MAX)
         return evr_import_fail(err, EVR_ERR_ARG, "scene data too large (%zu bytes)", size);
     if (!hint) hint = "";
-    if (may_be_gltf(data, size, hint)) { /* as for a file (quirks (j) to (p)) */
+    gltf = may_be_gltf(data, size, hint);
+    if (gltf) { /* as for a file (quirks (j) to (p)) */
         gltf_source src;
         src.bytes = data;
         src.nbytes = size;
         src.path = NULL;
         src.dir = NULL;
+        src.allow_external = o.allow_external;
         if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) return st;
     }
+    /* Assimp reads the bytes as a file of this name through import_memfile.c, which opens no
+     * other file unless external files are allowed (then relative to the current folder) */
+    snprintf(name, sizeof name, "evray-memory.%.32s", hint);
     props = make_props();
-    if (!props) {
+    io = evr_memfile_io_new(name, patched ? patched : (const unsigned char *)data,
+                            patched ? npatched : size, NULL, o.allow_external);
+    if (!props || !io) {
+        if (props) aiReleasePropertyStore(props);
+        evr_memfile_io_free(io);
         free(patched);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
-    ai = aiImportFileFromMemoryWithProperties(patched ? (const char *)patched : (const char *)data,
-                                              patched ? (unsigned)npatched : (unsigned)size,
-                                              import_flags(), hint, props);
-    aiReleasePropertyStore(props);
-    free(patched);
-    if (ai) ai = sort_and_join(ai, dropped, sizeof dropped, &none);
     snprintf(source, sizeof source, "<memory>.%s", hint);
-    if (!ai) return import_error(err, source, none);
+    {
+        assimp_read r = {name, io, props, dropped, sizeof dropped};
+        st = assimp_load(&r, gltf, source, &ai, err);
+    }
+    aiReleasePropertyStore(props);
+    evr_memfile_io_free(io);
+    free(patched);
+    if (st != EVR_OK) return st;
     st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, dropped, out,
                  err);
     aiReleaseImport(ai);

@@ -79,8 +79,7 @@ static unsigned char *b64_decode(const char *s, size_t n, size_t *out_len)
     return out;
 }
 
-/* A URI's percent escapes decoded (file names with spaces are written %20). */
-static void uri_decode(const char *in, char *out, size_t cap)
+void evr_gltf_uri_decode(const char *in, char *out, size_t cap)
 {
     size_t o = 0;
     while (*in && o + 1 < cap) {
@@ -174,15 +173,18 @@ static evr_status load_buffer(gltf_data *g, int i, evr_error *err)
             st = g->buf[i]
                      ? EVR_OK
                      : evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading glTF buffers");
-        } else if (!g->src->dir) {
+        } else if (!g->src->dir && !g->src->allow_external) {
             st = evr_import_fail(
                 err, EVR_ERR_FORMAT,
                 "glTF: buffer %d is an external file, which a scene in memory cannot read", i);
         } else {
-            char name[1024], path[1600];
-            uri_decode(text, name, sizeof name);
-            snprintf(path, sizeof path, "%s%s", g->src->dir, name);
-            st = evr_import_read_file(path, 0, &g->buf[i], &g->buf_len[i], err);
+            char name[1024], path[1600], what[32];
+            evr_gltf_uri_decode(text, name, sizeof name);
+            snprintf(path, sizeof path, "%s%s", g->src->dir && name[0] != '/' ? g->src->dir : "",
+                     name);
+            snprintf(what, sizeof what, "glTF: buffer %d", i);
+            st = evr_import_file_check(g->src->dir, path, g->src->allow_external, what, err);
+            if (st == EVR_OK) st = evr_import_read_file(path, 0, &g->buf[i], &g->buf_len[i], err);
         }
         free(text);
     }
@@ -295,8 +297,9 @@ evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count,
         norm = evr_jdoc_type(d, nv) == EVR_JDOC_BOOL && d->v[nv].num != 0;
     }
     cnt = evr_jdoc_number(d, evr_jdoc_get(d, acc, "count"), -1);
-    /* matrices of 1- and 2-byte components pad their columns: never needed here */
-    if (!csize || !nc || nc > 4 || !(cnt >= 0 && cnt <= (double)(1 << 30)))
+    /* matrices of 1- and 2-byte components pad their columns: never needed here (float
+     * matrices have no padding) */
+    if (!csize || !nc || (nc > 4 && csize < 4) || !(cnt >= 0 && cnt <= (double)(1 << 30)))
         return evr_import_fail(err, EVR_ERR_FORMAT,
                                "glTF: accessor %d has an unsupported type or count", a);
     n = (size_t)cnt;
@@ -392,7 +395,7 @@ evr_status evr_gltf_image_source(gltf_data *g, int img, unsigned char **data, si
                 st = evr_import_fail(err, EVR_ERR_NOMEM, "out of memory reading glTF images");
         } else {
             char name[1024];
-            uri_decode(text, name, sizeof name);
+            evr_gltf_uri_decode(text, name, sizeof name);
             /* a scene in memory: relative to the current folder, as Assimp would look */
             snprintf(path, cap, "%s%s", g->src->dir && name[0] != '/' ? g->src->dir : "", name);
         }

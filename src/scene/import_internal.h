@@ -80,8 +80,9 @@ int evr_gltf_side_interp(const gltf_side *g, int anim, const char *name, int pat
 typedef struct {
     const unsigned char *bytes;
     size_t nbytes;
-    const char *path; /* the file, NULL for memory */
-    const char *dir;  /* folder with a trailing '/' ("" the current one); NULL: none (memory) */
+    const char *path;   /* the file, NULL for memory */
+    const char *dir;    /* folder with a trailing '/' ("" the current one); NULL: none (memory) */
+    int allow_external; /* files outside dir may be read (evr_load_options.allow_external) */
 } gltf_source;
 
 /* Accessors of one parsed glTF document; buffers are loaded when first read. */
@@ -102,14 +103,28 @@ void evr_gltf_data_free(gltf_data *g);
 int evr_gltf_accessor(const gltf_data *g, int a);
 /* Accessor a's element count (-1 when there is no such accessor) and components per element. */
 int evr_gltf_accessor_count(const gltf_data *g, int a, int *ncomp);
+/* A URI's percent escapes decoded (file names with spaces are written %20) into out. */
+void evr_gltf_uri_decode(const char *in, char *out, size_t cap);
 /* Image value img's encoded bytes: *data (free()) for a data: URI or a buffer view; else *data
  * NULL and path the file (dir + its decoded uri). */
 evr_status evr_gltf_image_source(gltf_data *g, int img, unsigned char **data, size_t *n, char *path,
                                  size_t cap, evr_error *err);
-/* Reads accessor a (SCALAR to VEC4; strides, normalized integers and sparse values applied)
+/* Reads accessor a (SCALAR to VEC4, float matrices; strides, normalized integers and sparse
+ * values applied)
  * into *out, count * ncomp doubles (free()). */
 evr_status evr_gltf_accessor_read(gltf_data *g, int a, double **out, int *count, int *ncomp,
                                   evr_error *err);
+
+/* ---- the glTF checked before anything else reads it (import_gltf_validate.c) ---- */
+
+/* Checks a glTF 2.0 file against its own structure before Assimp (or any other stage) reads
+ * it: the GLB container against the file's size, every index (buffers, views, accessors,
+ * meshes, nodes, skins, animations, cameras, lights, textures, images) in range, accessors
+ * inside their views and views inside their buffers, vertex indices below the vertex count, a
+ * node tree without loops, every number finite (vertices, transforms, keys, quaternions not
+ * zero) and cameras and lights with valid parameters, buffers that may be read
+ * (evr_import_file_check). One line naming the first problem. */
+evr_status evr_gltf_validate(const gltf_source *src, evr_error *err);
 
 /* ---- glTF skins and morph targets before Assimp (import_gltf_deform.c) ---- */
 
@@ -163,11 +178,21 @@ evr_status evr_gltf_geometry_patch(const gltf_source *src, unsigned char **patch
 /* ---- serving Assimp a patched file (import_memfile.c) ---- */
 
 struct aiFileIO;
-/* An aiFileIO that gives Assimp `bytes` (which must outlive the import) for the file `path` and
- * opens every other file (the buffers and textures beside it) from disk; NULL when out of
- * memory. */
-struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes, size_t n);
+/* An aiFileIO that gives Assimp `bytes` (which must outlive the import; NULL: the file on disk)
+ * for the file `path` and opens every other file (the buffers and textures beside it) from disk
+ * when evr_import_file_check(dir, ..., allow_external) allows it; NULL when out of memory. */
+struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes, size_t n,
+                                    const char *dir, int allow_external);
 void evr_memfile_io_free(struct aiFileIO *io);
+
+/* ---- Assimp in a child process (import_isolate.c) ---- */
+
+/* A reading job: non-NULL on success; on failure NULL and one line into msg. */
+typedef const void *(*evr_import_job)(void *ctx, char *msg, size_t cap);
+/* Runs fn(ctx) in a child process, at most timeout_s seconds: 1 when it succeeded there, 0 when
+ * it failed (msg: its line), -1 when it crashed or hung (msg says so), -2 when no child could be
+ * made (run it here). */
+int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, size_t cap);
 
 /* ---- the importer's state while it converts one aiScene ---- */
 
@@ -194,6 +219,8 @@ typedef struct {
                                        every clip plays) */
     name_index *by_name;            /* nodes sorted by Assimp name */
     int strict;                     /* evr_load_options.strict: a warning is an error */
+    int allow_external;             /* evr_load_options.allow_external */
+    int in_memory;                  /* loaded from memory: no folder to read files from */
 } importer;
 
 /* ---- shared helpers (import.c) ---- */
@@ -206,6 +233,13 @@ void evr_import_warn(importer *im, const char *fmt, ...);
 /* An Assimp matrix as evr_m34 (its last row dropped). */
 struct aiMatrix4x4;
 evr_m34 evr_import_m34(const struct aiMatrix4x4 *a);
+/* Whether a scene in folder dir (with a trailing '/', "" the current one, NULL: a scene in
+ * memory, which has none) may read the file at path (dir and the name joined): a regular file
+ * inside the folder, or anywhere when allow_external (import_files.c). Else one line naming it
+ * (`what`: "buffer 0", "texture", ...): EVR_ERR_IO when it cannot be read, EVR_ERR_FORMAT when
+ * it is outside. */
+evr_status evr_import_file_check(const char *dir, const char *path, int allow_external,
+                                 const char *what, evr_error *err);
 /* Reads at most max bytes of a file (the whole file when max is 0), 0-ended. */
 evr_status evr_import_read_file(const char *path, size_t max, unsigned char **data, size_t *size,
                                 evr_error *err);
@@ -262,5 +296,9 @@ evr_status evr_import_deform(importer *im);
 void evr_import_bounds(evr_scene *s);
 evr_status evr_import_cameras(importer *im);
 evr_status evr_import_lights(importer *im);
+/* Every number of the imported scene finite (vertices, transforms, keys, cameras, lights),
+ * quaternions not zero, cameras with a field of view in (0, pi) and znear > 0, lights not
+ * negative: one error line naming the element (import_check.c). */
+evr_status evr_import_check_numbers(importer *im);
 
 #endif

@@ -1,19 +1,25 @@
-/* An aiFileIO that serves Assimp one file from memory (a patched copy of the scene file, quirk
- * (j) in import.c) under the file's own name, and every other file from disk, so that the
- * buffers and textures a .gltf names beside it are still found. */
+/* The aiFileIO every import goes through. It serves Assimp the scene file (from memory: a
+ * patched copy, quirk (j) in import.c, or a scene given in memory; else from disk) under the
+ * file's own name, and every other file Assimp asks for (the buffers a .gltf names, an OBJ's
+ * material library, ...) from disk when evr_import_file_check allows it: inside the scene's
+ * folder unless external files are allowed, and never a FIFO or a device. A refused file is one
+ * Assimp cannot open. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <assimp/cfileio.h>
 
+#include "io/file_read.h"
 #include "scene/import_internal.h"
 
 typedef struct {
     struct aiFileIO io; /* first: Assimp's callbacks get this pointer */
     const char *path;
-    const unsigned char *bytes;
+    const unsigned char *bytes; /* NULL: the file on disk */
     size_t n;
+    const char *dir; /* the scene's folder (NULL: none, a scene in memory) */
+    int allow_external;
 } memfile_io;
 
 typedef struct {
@@ -87,12 +93,17 @@ static struct aiFile *mf_open(struct aiFileIO *io, const char *path, const char 
     if (strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')) return NULL;
     m = calloc(1, sizeof *m);
     if (!m) return NULL;
-    if (!strcmp(path, mio->path)) {
+    if (!strcmp(path, mio->path) && mio->bytes) {
         m->bytes = mio->bytes;
         m->n = mio->n;
-    } else if (!(m->fp = fopen(path, "rb"))) {
-        free(m);
-        return NULL;
+    } else {
+        const char *why;
+        if ((strcmp(path, mio->path) &&
+             evr_import_file_check(mio->dir, path, mio->allow_external, "file", NULL) != EVR_OK) ||
+            !(m->fp = evr_fopen_regular(path, &why))) {
+            free(m);
+            return NULL;
+        }
     }
     m->f.ReadProc = mf_read;
     m->f.WriteProc = mf_write;
@@ -111,7 +122,8 @@ static void mf_close(struct aiFileIO *io, struct aiFile *af)
     free(m);
 }
 
-struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes, size_t n)
+struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes, size_t n,
+                                    const char *dir, int allow_external)
 {
     memfile_io *m = calloc(1, sizeof *m);
     if (!m) return NULL;
@@ -120,6 +132,8 @@ struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes
     m->path = path;
     m->bytes = bytes;
     m->n = n;
+    m->dir = dir;
+    m->allow_external = allow_external;
     return &m->io;
 }
 

@@ -221,7 +221,8 @@ static evr_status load_file(importer *im, const char *key, const char *what, int
     evr_error e;
     memset(&t, 0, sizeof t);
     if ((*out = find_texture(im, key, srgb)) >= 0) return EVR_OK;
-    st = evr_import_read_file(key, 0, &data, &size, &e);
+    st = evr_import_file_check(im->in_memory ? NULL : im->dir, key, im->allow_external, "file", &e);
+    if (st == EVR_OK) st = evr_import_read_file(key, 0, &data, &size, &e);
     if (st != EVR_OK)
         return texture_failed(im, evr_import_fail(im->err, st, "texture %s: %s", what, e.msg), out);
     st = decode_image(data, size, what, srgb, &t, im->err);
