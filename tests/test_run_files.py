@@ -105,7 +105,7 @@ T.check(os.path.isdir(os.path.join(f, "preview")) and os.path.exists(os.path.joi
 with open(os.path.join(f, "notes.txt"), "w") as fh:
     fh.write("mine\n")
 T.run("-o", f, *EYE, "--duration", "0.1", "--format", "h5", "--no-preview", "--force")
-T.check(sorted(os.listdir(f)) == ["events.h5", "notes.txt", "run.json"],
+T.check(sorted(os.listdir(f)) == ["camera_poses.txt", "events.h5", "notes.txt", "run.json"],
         f"--force: only the new run's files and the user's ({sorted(os.listdir(f))})")
 
 # --- a write that fails (a file size limit of 3 MB: EFBIG, as a full disk's ENOSPC): one line of

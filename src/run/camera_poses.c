@@ -2,9 +2,11 @@
 #include "run/camera_poses.h"
 #include "io/file_commit.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 static const char *const WHO = "camera poses";
 
@@ -46,7 +48,8 @@ evr_status evr_camera_poses_segment(evr_sim *sim, const evr_render_scene *rs, do
         sim->poses_last = q;
         if (fprintf(sim->poses, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", t, pose.m[0][3],
                     pose.m[1][3], pose.m[2][3], q.x, q.y, q.z, q.w) < 0) {
-            snprintf(err->msg, sizeof err->msg, "%s: cannot write %s", WHO, sim->poses_tmp);
+            snprintf(err->msg, sizeof err->msg, "%s: cannot write %s: %s", WHO, sim->poses_tmp,
+                     strerror(errno));
             return EVR_ERR_IO;
         }
     }
