@@ -19,10 +19,19 @@
 
 #include "io/child_job.h"
 
+/* Set by a sanitizer runtime (the fuzz builds); absent otherwise. */
+extern void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
 static void child(evr_child_job fn, void *ctx, int fd)
 {
+    static const int deadly[] = {SIGSEGV, SIGBUS,  SIGFPE, SIGILL,
+                                 SIGABRT, SIGALRM, SIGINT, SIGTERM};
     char msg[512];
-    int null = open("/dev/null", O_WRONLY);
+    int null = open("/dev/null", O_WRONLY), k;
+    /* The child dies of its crash as it is: no handler of the caller's (a fuzzer's would save
+     * the input as a crash of its own, which the parent has contained) */
+    for (k = 0; k < (int)(sizeof deadly / sizeof *deadly); k++) signal(deadly[k], SIG_DFL);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(NULL);
     /* Assimp's own assertion messages: the parent says what happened, in one line */
     if (null >= 0) {
         dup2(null, 1);
