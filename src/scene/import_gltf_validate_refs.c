@@ -87,7 +87,11 @@ static int check_primitive(gv *c, int prim, const char *what, int *ntargets)
         if (c->acc_count[a] != nv)
             return evr_gv_fail(c, "%s: attribute %s has %d elements, POSITION %d", what, name,
                                c->acc_count[a], nv);
-        if (c->acc_ctype[a] == 5126 && evr_gv_finite(c, a, what)) return -1;
+        /* normals and tangents that are not finite are replaced at import (face normals,
+         * generated tangents), as for a degenerate face: only the others must be finite */
+        if (c->acc_ctype[a] == 5126 && strcmp(name, "NORMAL") && strcmp(name, "TANGENT") &&
+            evr_gv_finite(c, a, what))
+            return -1;
     }
     if (c->acc_ctype[pos] != 5126 && evr_gv_finite(c, pos, what)) return -1;
     if (evr_gv_integer(c, prim, "mode", 0, 6, 4, what, &mode) ||
