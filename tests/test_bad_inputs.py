@@ -361,6 +361,12 @@ for name, b in cuts.items():
         T.check(rc not in (None, 0), f"corrupt h5 ({name}), {cmd[0]}: a non-zero exit (got {rc})")
         T.check(len(lines) == 1 and lines[0].startswith("evray: error:") and "HDF5-DIAG" not in " ".join(lines),
                 f"corrupt h5 ({name}), {cmd[0]}: one error line, no HDF5 error stack (got {lines[:3]})")
+# HDF5 itself divides by zero on this one (found by tests/fuzz/fuzz_events_h5.c): read in a child
+# process first, one line here
+rc, lines, _ = run("plot", os.path.join(os.path.dirname(os.path.abspath(__file__)), "fuzz", "regress",
+                                        "events_h5", "hdf5-crash-2.h5"), "-o", os.path.join(tmp, "p.png"))
+T.check(rc == 1 and len(lines) == 1 and "HDF5 crashed reading it" in lines[0],
+        f"an h5 file that crashes HDF5: one error line, exit 1 ({rc}: {lines})")
 for ext in ("npy", "raw", "bag"):
     src = [os.path.join(run_dir, n) for n in os.listdir(run_dir) if n.endswith("." + ext)][0]
     with open(src, "rb") as f:

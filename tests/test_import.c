@@ -460,6 +460,32 @@ static void test_memory(void)
     free(b);
 }
 
+/* A scene in memory has no folder: it reads no file (an OBJ's material library, a glTF's
+ * buffer), unless external files are allowed (then relative to the current folder). */
+static void test_memory_reads_no_files(void)
+{
+    static const char obj[] = "mtllib ../../../../../../etc/passwd\nv 0 0 -1\nv 1 0 -1\n"
+                              "v 0 1 -1\nf 1 2 3\n";
+    static const char gltf[] =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"/etc/passwd\","
+        "\"byteLength\":4}]}";
+    evr_scene *s = NULL;
+    evr_error err;
+    evr_load_options o;
+    CHECK(evr_scene_load_memory(gltf, sizeof gltf - 1, "gltf", &s, &err) == EVR_ERR_FORMAT &&
+          strstr(err.msg, "a scene in memory cannot read") != NULL);
+    CHECK(s == NULL);
+    /* the OBJ loads, without the material library Assimp was refused */
+    CHECK_OK(evr_scene_load_memory(obj, sizeof obj - 1, "obj", &s, &err));
+    evr_scene_release(s);
+    s = NULL;
+    evr_load_options_defaults(&o);
+    o.allow_external = 1; /* allowed: the file is read, and the document fails on what it is */
+    CHECK(evr_scene_load_memory_with(gltf, sizeof gltf - 1, "gltf", &o, &s, &err) != EVR_OK &&
+          strstr(err.msg, "buffer") == NULL);
+    evr_scene_release(s);
+}
+
 /* ---- bad inputs ---- */
 
 static void test_bad_inputs(void)
@@ -639,6 +665,7 @@ int main(void)
     test_collada_camera();
     test_3ds_camera();
     test_memory();
+    test_memory_reads_no_files();
     test_bad_inputs();
     return check_report("test_import");
 }

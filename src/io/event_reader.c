@@ -3,6 +3,7 @@
 #include "io/prophesee_read.h"
 #include "io/rosbag_read.h"
 #include "io/byte_order.h"
+#include "io/child_job.h"
 #include "io/file_read.h"
 
 #include <ctype.h>
@@ -647,6 +648,54 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     return EVR_OK;
 }
 
+/* HDF5 1.10 crashes on some corrupt files (a division by zero, reads past its buffers: found by
+ * tests/fuzz/fuzz_events_h5.c), so a file is read in a child process first (io/child_job.c). */
+typedef struct {
+    const char *path;
+    evr_error err;
+} h5_probe;
+
+static const void *h5_probe_run(void *ctx, char *msg, size_t cap)
+{
+    h5_probe *p = ctx;
+    evr_event *ev = NULL;
+    uint64_t *idx = NULL;
+    size_t n = 0;
+    int w, h;
+    if (read_h5(p->path, &ev, &n, &w, &h, &p->err) != EVR_OK) {
+        snprintf(msg, cap, "%s", p->err.msg);
+        return NULL;
+    }
+    free(ev);
+    if (evr_h5_read_ms_to_idx(p->path, &idx, &n, &p->err) == EVR_OK) free(idx); /* optional */
+    return p;
+}
+
+/* The longest the child may read: 600 s, or EVR_IMPORT_SECONDS (a test's switch). */
+static int h5_probe_seconds(void)
+{
+    const char *e = getenv("EVR_IMPORT_SECONDS");
+    int v = e ? atoi(e) : 0;
+    return v > 0 ? v : 600;
+}
+
+static evr_status read_h5_isolated(const char *path, evr_event **ev, size_t *n, int *width,
+                                   int *height, evr_error *err)
+{
+    h5_probe p;
+    char msg[sizeof err->msg];
+    evr_status st;
+    int r;
+    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
+    p.path = path;
+    p.err.msg[0] = 0;
+    r = evr_child_job_run(h5_probe_run, &p, "HDF5", h5_probe_seconds(), msg, sizeof msg);
+    if (r == -1) snprintf(err->msg, sizeof err->msg, "%s: %s", path, msg);
+    else if (r == 0) snprintf(err->msg, sizeof err->msg, "%s", msg);
+    if (r == -1 || r == 0) return EVR_ERR_FORMAT;
+    return read_h5(path, ev, n, width, height, err);
+}
+
 evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *width, int *height,
                            evr_error *err)
 {
@@ -659,7 +708,8 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
         snprintf(err->msg, sizeof err->msg, "no event file given");
         return EVR_ERR_ARG;
     }
-    if (ext_is(path, "h5") || ext_is(path, "hdf5")) return read_h5(path, ev, n, width, height, err);
+    if (ext_is(path, "h5") || ext_is(path, "hdf5"))
+        return read_h5_isolated(path, ev, n, width, height, err);
     if (ext_is(path, "txt")) st = read_txt(path, ev, n, err);
     else if (ext_is(path, "npy")) st = read_npy(path, ev, n, err);
     else if (ext_is(path, "raw") || ext_is(path, "dat") || ext_is(path, "bag") ||

@@ -110,6 +110,7 @@
 #include <assimp/config.h>
 
 #include "io/byte_order.h"
+#include "io/child_job.h"
 #include "io/file_read.h"
 #include "scene/import_internal.h"
 
@@ -410,7 +411,7 @@ fail:
 /* Assimp failed: its reason, or ours when there are no triangles (none, or SortByPType removed
  * every mesh). */
 /* One read of a file by Assimp, post-processing included (sort_and_join), as a job that
- * import_isolate.c can run in a child process. */
+ * io/child_job.c can run in a child process. */
 typedef struct {
     const char *path;
     struct aiFileIO *io;
@@ -445,14 +446,14 @@ static int isolated_read_seconds(void)
 }
 
 /* Assimp reads the file: a glTF (checked before) in this process, any other format first in a
- * child process (import_isolate.c), where a crash or a hang becomes an error line. */
+ * child process (io/child_job.c), where a crash or a hang becomes an error line. */
 static evr_status assimp_load(assimp_read *r, int gltf, const char *source,
                               const struct aiScene **out, evr_error *err)
 {
     char msg[512];
-    int child =
-        gltf ? -2
-             : evr_import_isolated(assimp_read_run, r, isolated_read_seconds(), msg, sizeof msg);
+    int child = gltf ? -2
+                     : evr_child_job_run(assimp_read_run, r, "Assimp", isolated_read_seconds(), msg,
+                                         sizeof msg);
     *out = NULL;
     if (child == -1)
         return evr_import_fail(err, EVR_ERR_FORMAT, "cannot import '%s': %s", source, msg);

@@ -182,11 +182,12 @@ int evr_gv_data_uri(const char *uri)
 {
     const char *p = uri + 5; /* after "data:" */
     int n = 0;
-    /* Assimp 5.2 dereferences the media type it fails to parse: type/subtype;base64, only */
+    /* Assimp 5.2 dereferences the media type it fails to parse: type/subtype;base64, only, */
     while (mime_char(*p)) p++, n++;
     if (!n || *p++ != '/') return 0;
     for (n = 0; mime_char(*p); p++) n++;
-    return n && !strncmp(p, ";base64,", 8);
+    /* and keeps the offsets of its parts in a char: past 127 bytes they wrap */
+    return n && !strncmp(p, ";base64,", 8) && p + 8 - uri < 128;
 }
 
 size_t evr_gv_base64(const char *s, size_t n, int json)
@@ -239,7 +240,10 @@ static int check_buffer(gv *c, int i, int b)
         size_t have = comma ? evr_gv_base64(comma + 8, strlen(comma + 8), 0) : 0;
         int ok = evr_gv_data_uri(text);
         free(text);
-        if (!ok) return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+        if (!ok)
+            return evr_gv_fail(
+                c, "%s's data: URI does not start data:TYPE/SUBTYPE;base64, (in under 128 bytes)",
+                what);
         if (have == (size_t)-1) return evr_gv_fail(c, "%s's data: URI is not valid base64", what);
         if ((double)have < len)
             return evr_gv_fail(c, "%s's data: URI holds %zu bytes, its byteLength says %.0f", what,

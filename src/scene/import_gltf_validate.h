@@ -46,7 +46,8 @@ int evr_gv_integer(gv *c, int obj, const char *key, double lo, double hi, double
 int evr_gv_numbers(gv *c, int obj, const char *key, int want, double *out, const char *what);
 /* A finite number member, def when absent. */
 int evr_gv_number(gv *c, int obj, const char *key, double def, const char *what, double *out);
-/* 1 when a "data:" URI has the form data:TYPE/SUBTYPE;base64, (all Assimp reads safely). */
+/* 1 when a "data:" URI has the form data:TYPE/SUBTYPE;base64, in less than 128 bytes (all
+ * Assimp reads safely). */
 int evr_gv_data_uri(const char *uri);
 /* The bytes base64 text s[0 .. n) decodes to (json: as it stands in the JSON text, "\/" for
  * '/'), or (size_t)-1 when it is not standard padded base64. */

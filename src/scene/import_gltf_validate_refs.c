@@ -87,7 +87,11 @@ static int check_primitive(gv *c, int prim, const char *what, int *ntargets)
         if (c->acc_count[a] != nv)
             return evr_gv_fail(c, "%s: attribute %s has %d elements, POSITION %d", what, name,
                                c->acc_count[a], nv);
-        if (c->acc_ctype[a] == 5126 && evr_gv_finite(c, a, what)) return -1;
+        /* normals and tangents that are not finite are replaced at import (face normals,
+         * generated tangents), as for a degenerate face: only the others must be finite */
+        if (c->acc_ctype[a] == 5126 && strcmp(name, "NORMAL") && strcmp(name, "TANGENT") &&
+            evr_gv_finite(c, a, what))
+            return -1;
     }
     if (c->acc_ctype[pos] != 5126 && evr_gv_finite(c, pos, what)) return -1;
     if (evr_gv_integer(c, prim, "mode", 0, 6, 4, what, &mode) ||
@@ -452,14 +456,17 @@ static int check_textures(gv *c)
         if (uri >= 0 && evr_jdoc_type(d, uri) != EVR_JDOC_STRING)
             return evr_gv_fail(c, "%s: 'uri' must be a string", what);
         if (uri >= 0) {
-            char head[80];
+            char head[160];
             /* the media type is all that is parsed here (the string cut to head's size) */
             evr_jdoc_string(d, uri, head, sizeof head);
             if (!strncmp(head, "data:", 5)) {
                 const char *raw = d->text + d->v[uri].off, *comma;
                 size_t len = d->v[uri].len;
                 if (!evr_gv_data_uri(head))
-                    return evr_gv_fail(c, "%s's data: URI is not data:TYPE/SUBTYPE;base64,", what);
+                    return evr_gv_fail(
+                        c,
+                        "%s's data: URI does not start data:TYPE/SUBTYPE;base64, (in under 128 bytes)",
+                        what);
                 comma = memchr(raw, ',', len);
                 if (!comma ||
                     evr_gv_base64(comma + 1, len - (size_t)(comma + 1 - raw), 1) == (size_t)-1)

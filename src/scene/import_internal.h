@@ -185,15 +185,6 @@ struct aiFileIO *evr_memfile_io_new(const char *path, const unsigned char *bytes
                                     const char *dir, int allow_external);
 void evr_memfile_io_free(struct aiFileIO *io);
 
-/* ---- Assimp in a child process (import_isolate.c) ---- */
-
-/* A reading job: non-NULL on success; on failure NULL and one line into msg. */
-typedef const void *(*evr_import_job)(void *ctx, char *msg, size_t cap);
-/* Runs fn(ctx) in a child process, at most timeout_s seconds: 1 when it succeeded there, 0 when
- * it failed (msg: its line), -1 when it crashed or hung (msg says so), -2 when no child could be
- * made (run it here). */
-int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, size_t cap);
-
 /* ---- the importer's state while it converts one aiScene ---- */
 
 typedef struct {

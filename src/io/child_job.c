@@ -1,10 +1,11 @@
-/* Assimp's importers of the formats other than glTF (a glTF is checked before Assimp reads it:
- * import_gltf_validate.c) crash, hang and leak on malformed files: tests/fuzz/
- * fuzz_scene_assimp.c finds PLY files that crash or hang it, Collada and STL files that leak, in
- * minutes. Such a file is therefore read once in a child process first: a crash or a hang
- * there is one error line here, a failure is Assimp's message without its leaks, and only a
- * file the child read completely is read again in this process. The child shares nothing but a
- * pipe (a status byte and the message), and leaves with _exit. */
+/* A job run in a child process, for the third-party readers that crash, hang and leak on
+ * malformed files: Assimp's importers of the formats other than glTF (a glTF is checked before
+ * Assimp reads it: scene/import_gltf_validate.c; tests/fuzz/fuzz_scene_assimp.c finds PLY files
+ * that crash or hang Assimp, Collada and STL files that leak, in minutes) and HDF5 1.10 (a 26 KB
+ * file makes it divide by zero: tests/fuzz/fuzz_events_h5.c). A file is read once in a child
+ * first: a crash or a hang there is one error line, a failure is the reader's message without
+ * its leaks, and only a file the child read completely is read again in the caller's process.
+ * The child shares nothing but a pipe (a status byte and the message), and leaves with _exit. */
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -16,12 +17,21 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "scene/import_internal.h"
+#include "io/child_job.h"
 
-static void child(evr_import_job fn, void *ctx, int fd)
+/* Set by a sanitizer runtime (the fuzz builds); absent otherwise. */
+extern void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
+static void child(evr_child_job fn, void *ctx, int fd)
 {
+    static const int deadly[] = {SIGSEGV, SIGBUS,  SIGFPE, SIGILL,
+                                 SIGABRT, SIGALRM, SIGINT, SIGTERM};
     char msg[512];
-    int null = open("/dev/null", O_WRONLY);
+    int null = open("/dev/null", O_WRONLY), k;
+    /* The child dies of its crash as it is: no handler of the caller's (a fuzzer's would save
+     * the input as a crash of its own, which the parent has contained) */
+    for (k = 0; k < (int)(sizeof deadly / sizeof *deadly); k++) signal(deadly[k], SIG_DFL);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(NULL);
     /* Assimp's own assertion messages: the parent says what happened, in one line */
     if (null >= 0) {
         dup2(null, 1);
@@ -43,7 +53,8 @@ static long long now_ms(void)
     return (long long)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
 }
 
-int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, size_t cap)
+int evr_child_job_run(evr_child_job fn, void *ctx, const char *reader, int timeout_s, char *msg,
+                      size_t cap)
 {
     int fds[2], status = 0, got_status = 0;
     char buf[512];
@@ -82,7 +93,8 @@ int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, 
     if (now_ms() >= end && waitpid(pid, &status, WNOHANG) == 0) {
         kill(pid, SIGKILL);
         waitpid(pid, &status, 0);
-        snprintf(msg, cap, "reading it took longer than %d s (a malformed file?)", timeout_s);
+        snprintf(msg, cap, "%s took longer than %d s reading it (a malformed file?)", reader,
+                 timeout_s);
         return -1;
     }
     while (!got_status) {
@@ -90,12 +102,12 @@ int evr_import_isolated(evr_import_job fn, void *ctx, int timeout_s, char *msg, 
         else if (errno != EINTR) break;
     }
     if (got_status && WIFSIGNALED(status)) {
-        snprintf(msg, cap, "Assimp crashed reading it (signal %d: %s): the file is malformed",
+        snprintf(msg, cap, "%s crashed reading it (signal %d: %s): the file is malformed", reader,
                  WTERMSIG(status), strsignal(WTERMSIG(status)));
         return -1;
     }
     if (have < 1) {
-        snprintf(msg, cap, "Assimp stopped reading it without a word: the file is malformed");
+        snprintf(msg, cap, "%s stopped reading it without a word: the file is malformed", reader);
         return -1;
     }
     snprintf(msg, cap, "%s", buf + 1);
