@@ -81,8 +81,8 @@ EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs,
 
 enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_BOUNCE = 1, EVR_PHOTON_ABSORB = 2 };
 
-/* The most a photon keeps going with at a hit (Russian roulette's odds): a little is always
- * left to stay, and a white surface does not keep a photon forever. */
+/* The most a photon keeps going with at a hit where it may stay (Russian roulette's odds): a
+ * little is always left to stay, and a white surface does not keep a photon forever. */
 #define EVR_PHOTON_KEEP_MAX 0.95f
 
 /* The path meets surface s (material mat) and the BSDF decides (core/bsdf_sample.h). Where the
