@@ -3,7 +3,7 @@ dielectric floor): the path tracer and the photon pass, both over the metallic-r
 agree where the photon estimate applies (the diffuse walls, lit through the glossy surfaces
 too), and the indirect light each adds is light, never darkness. At 48x48 with 1024 paths per
 pixel, the path tracer's own noise is about a quarter of the walls' mean; the photon image at
-the defaults (8 photons per pixel) measured 0.40 relative RMSE against it over the walls and
+the defaults (8 photons per pixel) measured 0.37 relative RMSE against it over the walls and
 its indirect mean 9% below the path tracer's (the walls' own specular lobe reflects indirect
 light the photon gather leaves out, core/photon.h)."""
 import os

@@ -81,19 +81,24 @@ EVR_HD static inline int evr_photon_path_start(const evr_render_scene *rs,
 
 enum { EVR_PHOTON_STAY = 0, EVR_PHOTON_BOUNCE = 1, EVR_PHOTON_ABSORB = 2 };
 
-/* The most a photon keeps going with at a hit (Russian roulette's odds): a little is always
- * left to stay, and a white surface does not keep a photon forever. */
+/* The most a photon keeps going with at a hit where it may stay (Russian roulette's odds): a
+ * little is always left to stay, and a white surface does not keep a photon forever. */
 #define EVR_PHOTON_KEEP_MAX 0.95f
 
-/* The path meets surface s (material mat) and the BSDF decides (core/bsdf_sample.h). With A the
- * largest channel of s's albedo (all lobes, as seen from the photon's side) and q = A clamped
- * to [0.05, 0.95] (at most 0.95 where it may not stay), one number xi decides:
+/* The path meets surface s (material mat) and the BSDF decides (core/bsdf_sample.h). Where the
+ * photon may stay (a surface with a diffuse part, the photon not `direct`), with A the largest
+ * channel of s's albedo (all lobes, as seen from the photon's side) and q = A clamped to
+ * [0.05, 0.95], one number xi decides:
  *   - xi < 1 - q: the photon stays, stored[] = its flux / (1 - q): the stored photons estimate
  *     the incident flux without bias (the gather turns it into radiance with the diffuse
- *     weight). Only on a surface with a diffuse part, and not while the photon is `direct`;
- *     otherwise that share of xi absorbs it (Russian roulette);
+ *     weight), and the path ends;
  *   - else a lobe by its weight (the rest of xi spread over the lobes, evr_bsdf_pick), a
- *     direction from it, and the flux times f cos / pdf over the odds of the choice.
+ *     direction from it, and the flux times f cos / pdf over q and the odds of the choice: the
+ *     flux goes on at about its size (Russian roulette by the albedo).
+ * Where it may not stay, it bounces (q = 1; all of xi picks the lobe) with its flux times the
+ * lobe's weight over the odds, as a light's photon at its first hit did before the BSDF: no
+ * photon is lost there (absorbing a share of them at a light's first hit, with the others' flux
+ * raised to match, made the Cornell box's walls 15% noisier at one photon per pixel).
  * Returns EVR_PHOTON_STAY (stored[] and *key, its canonical order, set), EVR_PHOTON_BOUNCE (the
  * path's ray is the next one to trace while bounce < max_hits; past that the path is capped) or
  * EVR_PHOTON_ABSORB (the path ends). absorbed[] gets the flux the hit absorbs in expectation,
@@ -118,8 +123,8 @@ EVR_HD static inline int evr_photon_path_hit(evr_photon_path *p, const evr_photo
     const int can_stay = !p->direct && !s->unlit &&
                          (w[EVR_LOBE_DIFFUSE][0] > 0.0f || w[EVR_LOBE_DIFFUSE][1] > 0.0f ||
                           w[EVR_LOBE_DIFFUSE][2] > 0.0f);
-    float q = fminf(amax, EVR_PHOTON_KEEP_MAX);
-    if (can_stay) q = fmaxf(q, 1.0f - EVR_PHOTON_KEEP_MAX);
+    const float q = can_stay ? fminf(fmaxf(amax, 1.0f - EVR_PHOTON_KEEP_MAX), EVR_PHOTON_KEEP_MAX)
+                             : (amax > 0.0f ? 1.0f : 0.0f);
     const float xi = evr_photon_rand(pp->seed, p->ei, p->j, 5 + 3 * p->bounce);
     if (xi < 1.0f - q) {
         if (!can_stay) return EVR_PHOTON_ABSORB;
