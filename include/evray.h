@@ -31,11 +31,15 @@ typedef struct {
     char msg[512];
 } evr_error;
 
-/* One DVS event. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in microseconds. */
+/* One DVS event. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in microseconds. id
+ * (with evr_config.event_ids): 1 + the scene instance whose surface the pixel centre's primary ray
+ * hit at the pixel's sample after the crossing (labels.h5's ids), 0 when it hit nothing (or ids
+ * are off). */
 typedef struct {
     int64_t t;
     uint16_t x, y;
     int8_t p;
+    uint32_t id;
 } evr_event;
 
 /* ---- scenes ---- */
@@ -226,6 +230,10 @@ typedef struct {
     int label_normals;
     int trajectories;
     int eye_labels;
+    /* event_ids: every event gets evr_event.id (its instance), written by the file formats that
+     * have a place for it (events.h5 events/id and an instances table, events.npy's id field,
+     * events.txt's fifth column) */
+    int event_ids;
     /* scene loading: 1 lets a scene read files outside its folder (evr_load_options
      * .allow_external); the evray program loads the scene with it */
     int allow_external_files;

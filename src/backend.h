@@ -29,6 +29,7 @@ typedef struct {
     int gather_max, gather_window, photon_layers, gi_bounces;
     int adaptive;           /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
     evr_adapt_params adapt; /* its parameters (max_dt resolved: > 0) */
+    int event_ids;          /* every event's id: 1 + the instance its sample's primary ray hit */
     /* non-zero (read with __atomic_load_n) once the run is to stop at once (evr_sim_cancel): a
      * backend may then give up the segment it renders, its submit() returning
      * EVR_ERR_INTERRUPTED; NULL: never */

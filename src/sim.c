@@ -201,6 +201,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.gpu_bvh = c->gpu_bvh;
     sim->setup.gpu_event_capacity = c->gpu_event_capacity;
     sim->setup.adaptive = c->sampling == EVR_SAMPLING_ADAPTIVE;
+    sim->setup.event_ids = c->event_ids;
     sim->setup.adapt.frac = c->adapt_frac;
     sim->setup.adapt.min_dt = (float)c->min_dt;
     sim->setup.adapt.max_dt = (float)(c->max_dt > 0.0 ? c->max_dt : 1.0 / sim->fps);

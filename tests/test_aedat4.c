@@ -117,7 +117,7 @@ static unsigned char *write_events(const char *path, const evr_event *ev, size_t
                                    size_t batch, int flush, size_t copy_at, const char *partial,
                                    size_t *len)
 {
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     char tmp[600];
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
@@ -183,7 +183,7 @@ static void test_round_trip(const char *dir)
 static void test_empty(const char *dir)
 {
     char path[512];
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_event *got = NULL;
     size_t ngot = 1;
@@ -204,7 +204,7 @@ static void test_empty(const char *dir)
 static void test_refused(const char *dir)
 {
     char path[512];
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_event e[2];
     evr_error err;

@@ -5,11 +5,15 @@
 int main(void)
 {
     /* reference: pixel (1,0) ON at 100, 200, 300; pixel (0,1) OFF at 1000 */
-    evr_event ref[4] = {{100, 1, 0, 1}, {200, 1, 0, 1}, {300, 1, 0, 1}, {1000, 0, 1, 0}};
+    evr_event ref[4] = {
+        {100, 1, 0, 1, 0}, {200, 1, 0, 1, 0}, {300, 1, 0, 1, 0}, {1000, 0, 1, 0, 0}};
     /* test: 150 matches 100 or 200 (greedy in time order: 100), 260 matches 200 (dt 60),
      * 900 (OFF, same pixel) within 100 of 1000, an ON at (0,1) matches nothing, 301 matches 300 */
-    evr_event test[5] = {
-        {150, 1, 0, 1}, {260, 1, 0, 1}, {301, 1, 0, 1}, {900, 0, 1, 0}, {950, 0, 1, 1}};
+    evr_event test[5] = {{150, 1, 0, 1, 0},
+                         {260, 1, 0, 1, 0},
+                         {301, 1, 0, 1, 0},
+                         {900, 0, 1, 0, 0},
+                         {950, 0, 1, 1, 0}};
     evr_compare_result r;
     evr_error err;
     CHECK(evr_compare_events(ref, 4, test, 5, 100, &r, &err) == EVR_OK);

@@ -22,7 +22,7 @@ int main(void)
     int64_t base = 5000000000LL; /* large absolute times */
     for (i = 0; i < n; i++) {
         uint64_t h = evr_hash4(7, i, 0, 0);
-        evr_event e;
+        evr_event e = {0};
         e.t = base + (int64_t)(h % 70000);
         e.x = (uint16_t)((h >> 20) % 1280);
         e.y = (uint16_t)((h >> 40) % 720);
@@ -62,7 +62,7 @@ int main(void)
         v.n = 0;
         for (k = 0; k < m; k++) {
             uint64_t h = evr_hash4(9, k, 0, 0), g = evr_hash4(9, k, 1, 0);
-            evr_event e;
+            evr_event e = {0};
             e.t = (int64_t)(h >> 2) - (INT64_C(1) << 61) + (int64_t)(k % 5);
             if (k % 7 == 0) e.t = INT64_C(-4000000000000000000) + (int64_t)(k % 3); /* ties */
             e.x = (uint16_t)g;
@@ -86,7 +86,7 @@ int main(void)
     /* stability: equal keys keep input order */
     v.n = 0;
     for (i = 0; i < 1000; i++) {
-        evr_event e = {base + (int64_t)(i % 3), 5, 5, (int8_t)(i % 2)};
+        evr_event e = {base + (int64_t)(i % 3), 5, 5, (int8_t)(i % 2), 0};
         evr_event_vec_push(&v, e);
     }
     CHECK(evr_events_sort(&v, &scratch));
@@ -110,7 +110,7 @@ int main(void)
                 for (int r = 0; r < 2; r++)
                     for (size_t k = 0; k < lens[c][r];
                          k++) { /* run r: sorted keys, t from a small range */
-                        evr_event e;
+                        evr_event e = {0};
                         e.t = base + (int64_t)(k / 3) + (r ? shifts[sh] : 0);
                         e.y = (uint16_t)(k % 3 == 2 ? 1 : 0);
                         e.x = (uint16_t)(k % 3 == 1 ? 7 : 3);

@@ -17,6 +17,7 @@ typedef struct {
 
 struct evr_event_sink {
     ev_t ev[512];
+    unsigned id, ids[512]; /* the sample's id (a backend's event id), and each event's */
     int n, pushes;
 };
 
@@ -30,6 +31,7 @@ static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long lo
         k->ev[k->n].x = x;
         k->ev[k->n].y = y;
         k->ev[k->n].p = polarity;
+        k->ids[k->n] = k->id;
     }
     k->n++;
     return 1;
@@ -154,15 +156,19 @@ static void test_adapt_machine(void)
     t = evr_adapt_start(&rs, &ap, &plan, &st, ray0, 0.0f, 0.5f, seg);
     CHECK_NEAR(t, 0.5e-3, 1e-9); /* a pixel's very first sample: its phase times min_dt */
     while (t < seg && traced < 1000) {
+        /* id: what the sample saw (1 before the step, 2 after), carried with held samples */
         float in = t < 0.3f ? 1.0f : 2.0f, hit = INFINITY, step = 0.0f;
+        unsigned id = t < 0.3f ? 1u : 2u;
         int moving = 0;
         traced++;
-        while (evr_adapt_candidate(&rs, &ap, &plan, &st, &p, ray0, &sk, t, in, hit, &t, &step,
+        while (evr_adapt_candidate(&rs, &ap, &plan, &st, &p, ray0, &sk, t, in, hit, id, &t, &step,
                                    &moving)) {
             if (t < last) ok_order = 0;
             last = t;
+            k.id = id;
+            CHECK(id == (t < 0.3f ? 1u : 2u));
             evr_pixel_sample_events(&st, &p, evr_pixel_ideal_of(&p), 0, 1, t, in, 0.0, 0, 0, &k);
-            if (!evr_adapt_taken(&ap, &sk, step, moving, seg, &t, &in, &hit, &t)) break;
+            if (!evr_adapt_taken(&ap, &sk, step, moving, seg, &t, &in, &hit, &id, &t)) break;
         }
     }
     CHECK(ok_order);
@@ -172,6 +178,7 @@ static void test_adapt_machine(void)
     for (int i = 0; i < k.n && i < 3; i++) {
         CHECK(k.ev[i].p == 1);
         CHECK(fabs((double)k.ev[i].t * 1e-6 - 0.3) < 2.0 * ap.min_dt);
+        CHECK(k.ids[i] == 2u); /* the sample after the crossing saw the new surface */
     }
 }
 

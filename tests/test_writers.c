@@ -161,7 +161,7 @@ static void test_format(const char *dir, size_t f, const evr_event *ev, size_t n
                         int64_t duration_us, const char *config)
 {
     char path[512], tmp[600], partial[600];
-    evr_writer_meta meta;
+    evr_writer_meta meta = {0};
     evr_event_writer *w = NULL;
     evr_error err;
     evr_status st;
@@ -278,7 +278,10 @@ static void test_h5_large(const char *root)
     } steps[] = {
         {1, 1}, {65535, 1}, {0, 1}, {0, 1}, {3, 0}, {300000, 1}, {7, 0}, {20000, 1}, {14454, 1},
     };
-    evr_writer_meta meta = {W, H, "{}", 0}; /* no bound on the timestamps: t is int64 */
+    evr_writer_meta meta = {.width = W,
+                            .height = H,
+                            .config_json = "{}",
+                            .max_t_us = 0}; /* no bound on the timestamps: t is int64 */
     evr_event_writer *w = NULL;
     evr_event *ev, *got = NULL;
     int64_t last_t;
@@ -340,10 +343,11 @@ static void test_h5_large(const char *root)
 static void test_h5_t_range(const char *root)
 {
     char path[600];
-    evr_event ev[3] = {{1000, 1, 2, 1}, {2000, 3, 4, 0}, {(int64_t)UINT32_MAX + 5, 5, 6, 1}};
+    evr_event ev[3] = {
+        {1000, 1, 2, 1, 0}, {2000, 3, 4, 0, 0}, {(int64_t)UINT32_MAX + 5, 5, 6, 1, 0}};
     evr_error err;
     evr_event_writer *w = NULL;
-    evr_writer_meta meta = {W, H, "{}", 3000};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = "{}", .max_t_us = 3000};
     snprintf(path, sizeof path, "%s/t32.h5", root);
     CHECK_OK(evr_h5_writer_open(path, &meta, &w, &err));
     if (w) {
@@ -381,7 +385,7 @@ static void test_npy_large(const char *root)
     const size_t n = 400000;
     int64_t last_t;
     evr_event *ev = make_events(n, &last_t), *got = NULL;
-    evr_writer_meta meta = {W, H, "{}", 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = "{}", .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_error err;
     size_t at = 0, ngot = 0;
@@ -445,7 +449,8 @@ static void test_h5_refused_in_bulk(const char *root)
     for (int kind = 0; kind < 2; kind++) {
         int64_t last_t;
         evr_event *ev = make_events(n, &last_t), *got = NULL;
-        evr_writer_meta meta = {W, H, "{}", kind == 0 ? 0 : last_t + 10};
+        evr_writer_meta meta = {
+            .width = W, .height = H, .config_json = "{}", .max_t_us = kind == 0 ? 0 : last_t + 10};
         evr_event_writer *w = NULL;
         evr_error err;
         size_t ngot = 0, k = bad_at[kind];
@@ -809,7 +814,7 @@ static void test_camera_format(const char *dir, const char *file, open_fn open, 
                                size_t n)
 {
     char path[512], tmp[600], partial[600];
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_error err;
     size_t at = 0;
@@ -867,7 +872,7 @@ static void check_refused(const char *dir, const char *file, open_fn open, evr_e
                           const char *what)
 {
     char path[512];
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_error err;
     snprintf(path, sizeof path, "%s/%s", dir, file);
@@ -886,7 +891,7 @@ static void check_refused(const char *dir, const char *file, open_fn open, evr_e
 static unsigned char *write_in_batches(const char *path, open_fn open, const evr_event *ev,
                                        size_t n, size_t first, size_t batch, size_t *len)
 {
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_error err;
     unsigned char *data = NULL;
@@ -939,9 +944,9 @@ static void test_camera_parts(const char *root)
         open_fn open;
         evr_event bad; /* put in the middle of a large write */
         const char *why;
-    } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1}, "(2048, 5)"},
-             {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1}, "(5, 2048)"},
-             {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0}, "4294967296 us"}};
+    } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1, 0}, "(2048, 5)"},
+             {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1, 0}, "(5, 2048)"},
+             {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0, 0}, "4294967296 us"}};
     const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
     evr_event *ev = calloc(n, sizeof *ev);
     uint64_t s = 4242;
@@ -967,7 +972,7 @@ static void test_camera_parts(const char *root)
     for (size_t k = 0; k < sizeof f / sizeof f[0]; k++) {
         size_t len_serial, len_parts;
         unsigned char *serial, *parts;
-        evr_writer_meta meta = {W, H, NULL, 0};
+        evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
         evr_event_writer *w = NULL;
         evr_error err;
         evr_event *bad;
@@ -1012,7 +1017,7 @@ static void test_camera_formats(const char *root)
     const size_t n = 6000;
     evr_event *ev = make_camera_events(n);
     char dir[512], path[600];
-    evr_event e;
+    evr_event e = {0};
     CHECK(ev != NULL);
     if (!ev) return;
     CHECK(ev[n - 1].t > (INT64_C(1) << 24)); /* spans an EVT 3.0 wrap */
@@ -1074,7 +1079,7 @@ static void test_rosbag(const char *root)
 {
     const size_t n = 6000;
     evr_event *ev = make_camera_events(n), *got = NULL, e;
-    evr_writer_meta meta = {W, H, NULL, 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
     evr_event_writer *w = NULL;
     char dir[512], path[600], tmp[700], partial[700];
     size_t at = 0, ngot = 0;
@@ -1186,7 +1191,7 @@ static void test_writers(const char *root, int *python_ok)
     snprintf(dir, sizeof dir, "%s/aborted", root);
     CHECK(mkdir(dir, 0700) == 0);
     for (size_t f = 0; f < NFORMATS; f++) {
-        evr_writer_meta meta = {W, H, config, 0};
+        evr_writer_meta meta = {.width = W, .height = H, .config_json = config, .max_t_us = 0};
         evr_event_writer *w = NULL;
         snprintf(path, sizeof path, "%s/events.%s", dir, formats[f].ext);
         CHECK_OK(formats[f].open(path, &meta, &w, &e_));
@@ -1200,7 +1205,7 @@ static void test_writers(const char *root, int *python_ok)
 
     /* a folder that does not exist: a clear error, no crash */
     for (size_t f = 0; f < NFORMATS; f++) {
-        evr_writer_meta meta = {W, H, config, 0};
+        evr_writer_meta meta = {.width = W, .height = H, .config_json = config, .max_t_us = 0};
         evr_event_writer *w = NULL;
         evr_error err;
         err.msg[0] = 0;
@@ -1590,7 +1595,7 @@ static void bench_writer(const char *root, const char *name, open_fn open, const
 #endif
     const size_t seg = 333333;
     const char *env = getenv("EVR_H5_BENCH_EVENTS");
-    evr_writer_meta meta = {W, H, "{}", 0};
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = "{}", .max_t_us = 0};
     evr_event_writer *w = NULL;
     evr_event *ev;
     int64_t last_t;

@@ -1037,6 +1037,17 @@ static const evr_config_option table[] = {
              "README \"Ground truth\")",
      .json = "eye_labels",
      .json_rank = 58},
+    {.name = "event_ids",
+     .type = EVR_OPT_FLAG,
+     .offset = F(event_ids),
+     .flag = "--event-ids",
+     .label = "--event-ids",
+     .help = "label every event with the instance its pixel saw (1 + the\n"
+             "instance hit at the sample after the crossing, 0 none):\n"
+             "events.h5 events/id and /instances, events.npy's id field,\n"
+             "events.txt's fifth column (README \"Ground truth\")",
+     .json = "event_ids",
+     .json_rank = 62},
 
     /* ---- scene loading ---- */
     {.name = "strict",

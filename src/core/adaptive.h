@@ -190,6 +190,7 @@ EVR_HD static inline float evr_adapt_next_time(const evr_adapt_params *ap, float
 
 typedef struct {
     float t[EVR_ADAPT_DEPTH], intensity[EVR_ADAPT_DEPTH], hit[EVR_ADAPT_DEPTH];
+    unsigned id[EVR_ADAPT_DEPTH]; /* the event id of each (evr_event.id) */
     int n;
 } evr_adapt_stack;
 
@@ -206,7 +207,7 @@ EVR_HD static inline float evr_adapt_start(const evr_render_scene *rs, const evr
     return evr_adapt_first(ap, pl, st->started, next_t, st->t_prev, phase, speed, jump, seg);
 }
 
-/* The candidate sample (t, intensity, primary hit distance hit): 0 when it is held back (pushed;
+/* The candidate sample (t, intensity, primary hit distance hit, event id): 0 when it is held back (pushed;
  * *t_trace: the time to trace first), 1 when it is taken: *step and *moving are set for
  * evr_adapt_taken and the pixel's cache of change-driven sampling keeps its hit. Call before the
  * sample goes through the pixel model (st is the state before it). */
@@ -214,13 +215,15 @@ EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const e
                                              const evr_adapt_plan *pl, evr_pixel_state *st,
                                              const evr_pixel_params *p, evr_ray ray0,
                                              evr_adapt_stack *sk, float t, float intensity,
-                                             float hit, float *t_trace, float *step, int *moving)
+                                             float hit, unsigned id, float *t_trace, float *step,
+                                             int *moving)
 {
     float mid;
     if (sk->n < EVR_ADAPT_DEPTH && evr_adapt_refine(ap, st, p, t, intensity, &mid)) {
         sk->t[sk->n] = t;
         sk->intensity[sk->n] = intensity;
         sk->hit[sk->n] = hit;
+        sk->id[sk->n] = id;
         sk->n++;
         *t_trace = mid; /* trace halfway first */
         return 0;
@@ -231,17 +234,18 @@ EVR_HD static inline int evr_adapt_candidate(const evr_render_scene *rs, const e
 }
 
 /* After a taken sample at *t went through the pixel model: 1 with the next candidate in (*t,
- * *intensity, *hit), the latest held back; else 0 with *t_trace the next time to trace (at or
+ * *intensity, *hit, *id), the latest held back; else 0 with *t_trace the next time to trace (at or
  * past seg: none in this segment). */
 EVR_HD static inline int evr_adapt_taken(const evr_adapt_params *ap, evr_adapt_stack *sk,
                                          float step, int moving, float seg, float *t,
-                                         float *intensity, float *hit, float *t_trace)
+                                         float *intensity, float *hit, unsigned *id, float *t_trace)
 {
     if (sk->n > 0) {
         sk->n--;
         *t = sk->t[sk->n];
         *intensity = sk->intensity[sk->n];
         *hit = sk->hit[sk->n];
+        *id = sk->id[sk->n];
         return 1;
     }
     *t_trace = evr_adapt_next_time(ap, *t, step, seg, moving);

@@ -47,8 +47,9 @@ typedef struct {
     int gi;        /* global illumination on */
     evr_cpu_gi gi_state;
     evr_pixel_state *pixels;
-    float *phase;  /* per-pixel sample-time offset in [0, 1) */
-    float *next_t; /* adaptive sampling: each pixel's next sample, segment-relative */
+    float *phase;      /* per-pixel sample-time offset in [0, 1) */
+    float *next_t;     /* adaptive sampling: each pixel's next sample, segment-relative */
+    unsigned *last_id; /* event ids (setup.event_ids): each pixel's last traced sample's */
     int tiles_x, tiles_y;
     evr_event_vec *tile_events;
     /* results of submitted segments not yet collected (a ring of two) */
@@ -181,10 +182,12 @@ static void primary_packet8(const cpu_backend *b, const evr_m34 *pose_static, co
  * Embree's packet traversal for the primary rays and for each light's shadow rays, then the
  * shared shading of src/core lane by lane. Counts the rays it traces; t_hit gets each primary
  * ray's hit distance (INFINITY: none); NULL for a frame's samples, which are not the pixel
- * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. */
+ * model's (they leave its GI memo alone). direct (may be NULL): the direct light alone. ids (may
+ * be NULL): each sample's event id (evr_event.id: 1 + the instance hit, 0 none). */
 static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_static, const int *xs,
                                    const int *ys, const float *fs, const int *valid, float *out,
-                                   float *t_hit, float *direct, int *deep, unsigned long long *rays)
+                                   float *t_hit, float *direct, int *deep, unsigned *ids,
+                                   unsigned long long *rays)
 {
     const evr_render_scene *rs = &b->host.rs;
     struct RTCIntersectContext ctx;
@@ -204,10 +207,12 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         acc[i][0] = acc[i][1] = acc[i][2] = 0.0f;
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
+        if (ids) ids[i] = 0;
         if (!hit[i]) continue;
         int inst =
             b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
         inst_of[i] = inst;
+        if (ids) ids[i] = (unsigned)inst + 1u;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[inst].track), fs[i]);
         evr_surface_at(rs, inst, rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i], &xf, fs[i], ray[i],
                        rh.ray.tfar[i], evr_camera_cone(&rs->camera, rh.ray.tfar[i]), &s[i]);
@@ -280,7 +285,7 @@ static void sample_intensity8(const cpu_backend *b, const evr_m34 *pose_static, 
 {
     int ys[PACKET], i;
     for (i = 0; i < PACKET; i++) ys[i] = y;
-    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, NULL, NULL, rays);
+    sample_intensity8_rows(b, pose_static, xs, ys, fs, valid, out, t_hit, NULL, NULL, NULL, rays);
 }
 
 static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
@@ -289,6 +294,7 @@ static void render_frames(cpu_backend *b, int x0, int y0, int x1, int y1);
 struct evr_event_sink {
     evr_event_vec *out;
     atomic_int *failed;
+    unsigned id; /* the sample's event id */
 };
 
 static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us, int x,
@@ -300,21 +306,23 @@ static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long lo
     e.x = (uint16_t)x;
     e.y = (uint16_t)y;
     e.p = (int8_t)polarity;
+    e.id = k->id;
     if (!evr_event_vec_push(k->out, e)) atomic_store(k->failed, 1);
     return 1;
 }
 
-/* One sample of pixel (x, y) (intensity at t seconds from the segment's start) through its pixel
- * model; its events go to out. Kept out of line with the loop inlined in it: inlined into its
+/* One sample of pixel (x, y) (intensity at t seconds from the segment's start, id its event id)
+ * through its pixel model; its events go to out. Kept out of line with the loop inlined in it: inlined into its
  * callers instead, GCC kept the loop as a call of many arguments (about 1% slower). */
 __attribute__((noinline)) static void pixel_sample(cpu_backend *b, evr_pixel_state *st,
                                                    const evr_pixel_params *pp, int ideal, float t,
-                                                   float intensity, int x, int y,
+                                                   float intensity, unsigned id, int x, int y,
                                                    evr_event_vec *out)
 {
     struct evr_event_sink k;
     k.out = out;
     k.failed = &b->failed;
+    k.id = id;
     evr_pixel_sample_events(st, pp, evr_pixel_ideal_of(pp), !ideal, 1, t, intensity, b->seg->t0, x,
                             y, &k);
 }
@@ -328,6 +336,7 @@ typedef struct {
     int deep;                 /* its last traced sample's path went past the primary hit */
     float direct;             /* GI: its last traced sample's direct light */
     int last_span;            /* the still span (evr_skip_still_span) of its last traced sample */
+    unsigned id;              /* its last traced sample's event id */
     int x, y;
 } tile_pixel;
 
@@ -359,7 +368,8 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
     if (gi_lit(b, q) && !evr_cpu_gi_flat(&b->gi_state, q->x, q->y)) {
         for (k = k0; k < n; k++) {
             const float f = ((float)k + q->phi) / (float)n;
-            pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y, out);
+            pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->id, q->x,
+                         q->y, out);
         }
         return;
     }
@@ -369,8 +379,8 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
         return;
     }
     for (k = k0; k < n; k++)
-        pixel_sample(b, q->st, &q->pp, ideal, (((float)k + q->phi) / (float)n) * dt, in, q->x, q->y,
-                     out);
+        pixel_sample(b, q->st, &q->pp, ideal, (((float)k + q->phi) / (float)n) * dt, in, q->id,
+                     q->x, q->y, out);
 }
 
 /* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
@@ -404,8 +414,8 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             const int span = evr_skip_still_span(seg->skip, f);
             if (evr_skip_held(seg->skip, span, q->last_span)) {
                 bucket[j] = -1;
-                pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->x, q->y,
-                             out);
+                pixel_sample(b, q->st, &q->pp, ideal, f * dt, kept_intensity(b, q, f), q->id, q->x,
+                             q->y, out);
                 continue;
             }
             q->last_span = span;
@@ -421,6 +431,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
             int xs[PACKET], ys[PACKET], valid[PACKET];
             float fs[PACKET], intensity[PACKET], t_hit[PACKET], direct[PACKET];
             int deep[PACKET];
+            unsigned ids[PACKET];
             tile_pixel *q[PACKET];
             for (i = 0; i < PACKET; i++) {
                 valid[i] = c + i < ntr;
@@ -431,15 +442,16 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
                 fs[i] = fk[j];
             }
             sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid,
-                                   intensity, t_hit, direct, deep, rays);
+                                   intensity, t_hit, direct, deep, b->last_id ? ids : NULL, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 (*traced)++;
                 q[i]->t_hit = t_hit[i];
                 q[i]->deep = deep[i];
                 q[i]->direct = direct[i];
-                pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], xs[i], ys[i],
-                             out);
+                if (b->last_id) q[i]->id = ids[i];
+                pixel_sample(b, q[i]->st, &q[i]->pp, ideal, fs[i] * dt, intensity[i], q[i]->id,
+                             xs[i], ys[i], out);
             }
         }
     }
@@ -495,6 +507,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
                     q->t_hit = INFINITY;
                     q->deep = 0;
                     q->last_span = -1;
+                    q->id = b->last_id ? b->last_id[(size_t)y * (size_t)w + (size_t)x] : 0u;
                     if (ideal) q->pp = b->setup.pixel;
                     else evr_pixel_params_at(&b->setup.pixel, x, y, &q->pp);
                     /* global illumination: whether the pixel's indirect light may differ from its last sample's */
@@ -522,6 +535,7 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
         if (q->t_hit >= 0.0f)
             q->st->cache_dist = evr_skip_cache_after_trace(rs, plan, q->ray, q->t_hit, q->deep);
         evr_pixel_end_segment(q->st, dt);
+        if (b->last_id) b->last_id[(size_t)q->y * (size_t)w + (size_t)q->x] = q->id;
     }
     render_frames(b, x0, y0, x1, y1);
     *samples +=
@@ -640,6 +654,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
         for (base = 0; base < nact; base += PACKET) {
             int xs[PACKET], ys[PACKET], valid[PACKET], js[PACKET], i;
             float fs[PACKET], intensity[PACKET], t_hit[PACKET];
+            unsigned ids[PACKET];
             for (i = 0; i < PACKET; i++) {
                 valid[i] = base + i < nact;
                 js[i] = act[valid[i] ? base + i : base];
@@ -648,7 +663,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 fs[i] = tnext[js[i]] / dt;
             }
             sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid,
-                                   intensity, t_hit, NULL, NULL, rays);
+                                   intensity, t_hit, NULL, NULL, ids, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 const int jj = js[i];
@@ -657,13 +672,15 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                                                    (float)ys[i] + 0.5f);
                 evr_adapt_stack *sk = &stack[jj];
                 float t = tnext[jj], in = intensity[i], hit = t_hit[i], step;
+                unsigned id = ids[i];
                 int moving;
                 (*samples)++;
-                /* the pixel's candidate sample (t, in, hit): held back, or through the pixel model */
-                while (evr_adapt_candidate(rs, ap, plan, st, &pp[jj], ray, sk, t, in, hit,
+                /* the pixel's candidate sample (t, in, hit, id): held back, or through the pixel
+                 * model */
+                while (evr_adapt_candidate(rs, ap, plan, st, &pp[jj], ray, sk, t, in, hit, id,
                                            &tnext[jj], &step, &moving)) {
-                    pixel_sample(b, st, &pp[jj], ideal, t, in, xs[i], ys[i], out);
-                    if (!evr_adapt_taken(ap, sk, step, moving, dt, &t, &in, &hit, &tnext[jj]))
+                    pixel_sample(b, st, &pp[jj], ideal, t, in, id, xs[i], ys[i], out);
+                    if (!evr_adapt_taken(ap, sk, step, moving, dt, &t, &in, &hit, &id, &tnext[jj]))
                         break;
                 }
                 if (tnext[jj] < dt) act[kept++] = jj; /* kept <= base + i: in place */
@@ -956,6 +973,7 @@ static void cpu_release(evr_backend *base)
     free(b->pixels);
     free(b->phase);
     free(b->next_t);
+    free(b->last_id);
     free(b->frame_f);
     free(b->label_f);
     free(b);
@@ -1110,11 +1128,12 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
     b->pixels = malloc(npix * sizeof *b->pixels);
     b->phase = malloc(npix * sizeof *b->phase);
     b->next_t = calloc(npix, sizeof *b->next_t);
+    if (b->setup.event_ids) b->last_id = calloc(npix, sizeof *b->last_id);
     b->tile_events = calloc((size_t)b->tiles_x * (size_t)b->tiles_y, sizeof *b->tile_events);
     b->done_intensity[0] = malloc(npix * sizeof(float));
     b->done_intensity[1] = malloc(npix * sizeof(float));
     if (!b->pixels || !b->phase || !b->next_t || !b->tile_events || !b->done_intensity[0] ||
-        !b->done_intensity[1])
+        !b->done_intensity[1] || (b->setup.event_ids && !b->last_id))
         goto nomem;
     for (i = 0; i < npix; i++) evr_pixel_reset(&b->pixels[i]);
     for (y = 0; y < setup->height; y++)

@@ -132,6 +132,11 @@ struct kernel_args {
     /* per pixel, its camera ray's hit in the static group while the camera holds still (NULL:
      * not this segment): primary rays search the other groups only */
     const gpu_static_hit *static_hits;
+    /* event ids (evr_event.id; NULL when off): ids[k] is keys[k]'s; id_in / id_out each pixel's
+     * last traced sample's, a ring as the states */
+    unsigned *ids;
+    const unsigned *id_in;
+    unsigned *id_out;
 };
 
 /* Adaptive sampling's own arguments: a second kernel parameter, so that kernel_args (and the
@@ -175,6 +180,7 @@ struct gi_request {
  * order on the render stream). Per-sample arrays are [sample][thread]. */
 struct gi_deferred {
     float *direct; /* a traced sample's direct light */
+    unsigned *ids; /* its event id (NULL: ids off) */
     unsigned *req; /* its gather request, GI_NO_REQUEST for a miss (no light) */
     int *
         traced; /* per thread: samples with an entry (traced or held); later samples keep the last */

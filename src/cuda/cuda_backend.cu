@@ -176,6 +176,9 @@ static void cuda_release(evr_backend *base)
         sl->d_dtris.release();
         sl->d_keys_ev.release();
         sl->d_keys_sorted.release();
+        sl->d_ids_ev.release();
+        sl->d_ids_sorted.release();
+        sl->h_ids.release();
         sl->d_sort_temp.release();
         sl->d_count.release();
         sl->d_counters.release();
@@ -234,6 +237,7 @@ static void cuda_release(evr_backend *base)
     for (int i = 0; i < NRING; i++) {
         b->d_state[i].release();
         b->d_next[i].release();
+        b->d_id[i].release();
         b->gi_ring[i].slots.release();
         b->gi_ring[i].count.release();
         b->gi_ring[i].gbuf.release();
@@ -288,6 +292,12 @@ static evr_status init(cuda_backend *b, evr_error *err)
             CK(cudaMemset(b->d_next[i].p, 0, npix * sizeof(float)));
         }
     }
+    if (b->setup.event_ids) {
+        for (int i = 0; i < NRING; i++) {
+            CK(b->d_id[i].reserve(npix));
+            CK(cudaMemset(b->d_id[i].p, 0, npix * sizeof(unsigned)));
+        }
+    }
     CK(b->d_phase.reserve(npix));
     CK(b->d_sensor.reserve(1));
     CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params),
@@ -337,9 +347,15 @@ static evr_status init(cuda_backend *b, evr_error *err)
          * and pinned allocations stalled the GPU for 0.2 s of the eye's first second */
         CK(sl->d_keys_sorted.reserve(b->capacity));
         CK(sl->h_sorted.reserve(b->capacity));
+        if (b->setup.event_ids) {
+            CK(sl->d_ids_ev.reserve(b->capacity));
+            CK(sl->d_ids_sorted.reserve(b->capacity));
+            CK(sl->h_ids.reserve(b->capacity));
+        }
         size_t temp = 0;
-        CK(event_sort_temp_bytes(sl->d_keys_ev.p, sl->d_keys_sorted.p, (int)sl->d_keys_sorted.cap,
-                                 &temp));
+        CK(event_sort_temp_bytes(
+            sl->d_keys_ev.p, sl->d_keys_sorted.p, b->setup.event_ids ? sl->d_ids_ev.p : nullptr,
+            b->setup.event_ids ? sl->d_ids_sorted.p : nullptr, (int)sl->d_keys_sorted.cap, &temp));
         CK(sl->d_sort_temp.reserve(temp));
         CK(sl->d_count.reserve(COUNT_N));
         CK(sl->d_counters.reserve(CTR_COUNT));

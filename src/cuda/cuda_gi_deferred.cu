@@ -45,9 +45,9 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
     const evr_ray ray0 =
         evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
-    float direct = 0.0f; /* the last traced sample's, and its request */
+    float direct = 0.0f; /* the last traced sample's, and its request and event id */
     int deep = 0;        /* the last traced sample's path went past its primary hit */
-    unsigned r = GI_NO_REQUEST;
+    unsigned r = GI_NO_REQUEST, id = 0;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
         const int span = evr_skip_still_span(a.plan, f);
@@ -58,6 +58,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
         if (now) {
             r = GI_NO_REQUEST;
             direct = 0.0f;
+            id = 0;
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             evr_surface s;
             int inst = 0;
@@ -65,6 +66,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
             if (gpu_sample_direct<LAYOUT>(a, &pose, x, y, f, &rays, &t_hit,
                                           a.coherence ? t_hit : INFINITY, &direct, &s, &inst, &org,
                                           &deep)) {
+                id = (unsigned)inst + 1u;
                 gpu_gather_point(&a.rs, inst, &s, org, &g);
                 if (gi_memo_take(&memo, inst, &g)) r = memo.req;
                 else want = true;
@@ -89,6 +91,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
         if (tracing) {
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
             d.direct[at] = direct;
+            if (d.ids) d.ids[at] = id;
             d.req[at] = r;
             entries = k + 1;
         }
@@ -238,7 +241,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     const int traced = active ? d.traced[i] : 0;
     float direct = 0.0f;
-    unsigned r = GI_NO_REQUEST;
+    unsigned r = GI_NO_REQUEST, id = active && a.id_in ? a.id_in[pix] : 0u;
     for (int k = 0; k < a.samples; k++) {
         const float f = ((float)k + phi) / (float)a.samples;
         float intensity = st.intensity; /* kept when settled on nothing */
@@ -246,6 +249,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
             const size_t at = (size_t)k * (size_t)d.stride + (size_t)i;
             direct = d.direct[at];
             r = d.req[at];
+            if (d.ids) id = d.ids[at];
         }
         if (k < traced ||
             r !=
@@ -256,12 +260,13 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
                 intensity += evr_gi_lerp(l.x, l.y, f);
             }
         }
-        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
+        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane, id);
     }
     if (active) {
         st.cache_dist = d.cache_dist[i];
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
+        if (a.id_out) a.id_out[pix] = id;
         if (a.gi->ends_out) { /* its last gather, for the next segment's start */
             gi_end e{};
             e.g.dist = -1.0f;
@@ -280,6 +285,7 @@ gi_deferred deferred_args(const cuda_backend *b)
 {
     gi_deferred d;
     d.direct = b->d_gd_direct.p;
+    d.ids = b->setup.event_ids ? b->d_gd_ids.p : nullptr;
     d.req = b->d_gd_req.p;
     d.traced = b->d_gd_traced.p;
     d.cache_dist = b->d_gd_cache.p;
@@ -296,6 +302,7 @@ gi_deferred deferred_args(const cuda_backend *b)
 void gi_deferred_release(cuda_backend *b)
 {
     b->d_gd_direct.release();
+    b->d_gd_ids.release();
     b->d_gd_req.release();
     b->d_gd_lum.release();
     b->d_gd_requests.release();
@@ -332,6 +339,7 @@ void gi_deferred_alloc(cuda_backend *b, const cudaDeviceProp *prop)
     const size_t npix = (size_t)b->setup.width * b->setup.height,
                  n = npix * (size_t)b->setup.samples_per_frame;
     if (b->d_gd_direct.reserve(n, true) == cudaSuccess &&
+        (!b->setup.event_ids || b->d_gd_ids.reserve(n, true) == cudaSuccess) &&
         b->d_gd_req.reserve(n, true) == cudaSuccess &&
         b->d_gd_lum.reserve(n, true) == cudaSuccess &&
         b->d_gd_requests.reserve(n, true) == cudaSuccess &&

@@ -88,11 +88,13 @@ __global__ void carry_keys(const unsigned long long *from, size_t n, unsigned lo
         to[i] = from[i] - delta;
 }
 
-/* Grows d to hold n keys, keeping its first keep (the buffer is reallocated rarely: doubling). */
-static cudaError_t grow_keeping(dbuf<unsigned long long> &d, size_t n, size_t keep, cudaStream_t s)
+/* Grows d to hold n keys (or ids), keeping its first keep (the buffer is reallocated rarely:
+ * doubling). */
+template <typename T>
+static cudaError_t grow_keeping(dbuf<T> &d, size_t n, size_t keep, cudaStream_t s)
 {
     if (n <= d.cap) return cudaSuccess;
-    dbuf<unsigned long long> g;
+    dbuf<T> g;
     cudaError_t e = g.reserve(n);
     if (e == cudaSuccess && keep)
         e = cudaMemcpyAsync(g.p, d.p, keep * sizeof(unsigned long long), cudaMemcpyDeviceToDevice,
@@ -110,10 +112,21 @@ static cudaError_t grow_keeping(dbuf<unsigned long long> &d, size_t n, size_t ke
     return cudaSuccess;
 }
 
-cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n,
-                                  size_t *temp)
+/* The sort of n event keys on the copy stream, their ids (when not NULL) moved with them. */
+static cudaError_t sort_events(void *temp, size_t &temp_bytes, unsigned long long *keys,
+                               unsigned long long *sorted, unsigned *ids, unsigned *ids_sorted,
+                               int n, int end_bit, cudaStream_t s)
 {
-    return cub::DeviceRadixSort::SortKeys(nullptr, *temp, keys, sorted, n, 0, 64);
+    if (ids)
+        return cub::DeviceRadixSort::SortPairs(temp, temp_bytes, keys, sorted, ids, ids_sorted, n,
+                                               0, end_bit, s);
+    return cub::DeviceRadixSort::SortKeys(temp, temp_bytes, keys, sorted, n, 0, end_bit, s);
+}
+
+cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted,
+                                  unsigned *ids, unsigned *ids_sorted, int n, size_t *temp)
+{
+    return sort_events(nullptr, *temp, keys, sorted, ids, ids_sorted, n, 64, 0);
 }
 
 /* Queues the sort and copy to the host of a rendered segment's n events, with the keys the
@@ -141,21 +154,36 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
                                                        b->carry_at,
                                                    carried, delta, sl->d_keys_ev.p + n);
         CK(cudaGetLastError());
+        if (b->setup.event_ids) {
+            CK(grow_keeping(sl->d_ids_ev, n + carried, n, sl->copy));
+            CK(cudaMemcpyAsync(sl->d_ids_ev.p + n,
+                               b->slots[b->carry_slot].d_ids_sorted.p + b->carry_at,
+                               carried * sizeof(unsigned), cudaMemcpyDeviceToDevice, sl->copy));
+        }
     }
     n += carried;
     sl->total = n;
     if (n) {
         size_t temp = 0;
+        const bool ids = b->setup.event_ids != 0;
         CK(sl->d_keys_sorted.reserve(n));
-        CK(cub::DeviceRadixSort::SortKeys(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p,
-                                          (int)n, 0, sl->end_bit, sl->copy));
+        if (ids) CK(sl->d_ids_sorted.reserve(n));
+        unsigned *ids_in = ids ? sl->d_ids_ev.p : nullptr,
+                 *ids_out = ids ? sl->d_ids_sorted.p : nullptr;
+        CK(sort_events(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, ids_in, ids_out, (int)n,
+                       sl->end_bit, sl->copy));
         CK(sl->d_sort_temp.reserve(temp));
-        CK(cub::DeviceRadixSort::SortKeys(sl->d_sort_temp.p, temp, sl->d_keys_ev.p,
-                                          sl->d_keys_sorted.p, (int)n, 0, sl->end_bit, sl->copy));
+        CK(sort_events(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, ids_in,
+                       ids_out, (int)n, sl->end_bit, sl->copy));
         CK(sl->h_sorted.reserve(n));
         CK(cudaEventRecord(sl->sorted, sl->copy));
         CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long),
                            cudaMemcpyDeviceToHost, sl->copy));
+        if (ids) {
+            CK(sl->h_ids.reserve(n));
+            CK(cudaMemcpyAsync(sl->h_ids.p, sl->d_ids_sorted.p, n * sizeof(unsigned),
+                               cudaMemcpyDeviceToHost, sl->copy));
+        }
     }
     if (sl->want_intensity) {
         size_t npix = (size_t)b->setup.width * b->setup.height;
@@ -279,6 +307,7 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     slot *sl = &b->slots[(b->head + b->queued) % NSLOT];
     /* the slot's previous segment was collected, so its copy stream is idle */
     CK(sl->d_keys_ev.reserve(b->capacity));
+    if (b->setup.event_ids) CK(sl->d_ids_ev.reserve(sl->d_keys_ev.cap));
     sl->index = seg->index;
     sl->t0 = seg->t0;
     sl->t1 = seg->t1;
@@ -420,6 +449,7 @@ static inline evr_event decode_key(unsigned long long k, long long base_us, int 
     e.y = (uint16_t)((k >> (1 + xb)) & ((1u << yb) - 1u));
     e.x = (uint16_t)((k >> 1) & ((1u << xb) - 1u));
     e.p = (int8_t)(k & 1u);
+    e.id = 0;
     return e;
 }
 
@@ -428,6 +458,7 @@ static inline evr_event decode_key(unsigned long long k, long long base_us, int 
  * threads started per segment cost about as much as the work. */
 struct decode_job {
     const unsigned long long *keys;
+    const unsigned *ids; /* NULL: ids off */
     size_t n, parts;
     long long base_us;
     int xb, yb;
@@ -439,15 +470,17 @@ static void decode_part(void *ctx, int k, int)
     size_t i0, i1;
     evr_par_share(j->n, (int)j->parts, k, &i0, &i1);
     for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
+    if (j->ids)
+        for (size_t i = i0; i < i1; i++) j->dst[i].id = j->ids[i];
 }
-static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, size_t n,
-                        long long base_us, int xb, int yb, evr_event *dst)
+static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, const unsigned *ids,
+                        size_t n, long long base_us, int xb, int yb, evr_event *dst)
 {
     const size_t chunk = (size_t)1 << 17;
     size_t parts = (n + chunk - 1) / chunk, most = (size_t)evr_par_pool_threads(pool);
     if (parts > most) parts = most;
     if (parts < 1) parts = 1;
-    decode_job j = {keys, n, parts, base_us, xb, yb, dst};
+    decode_job j = {keys, ids, n, parts, base_us, xb, yb, dst};
     evr_par_pool_run(pool, (int)parts, decode_part, &j);
 }
 
@@ -472,6 +505,7 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
          * next segment, if rendering, reads states this re-run rewrites identically: wait) */
         CK(cudaDeviceSynchronize());
         CK(sl->d_keys_ev.reserve(n + n / 4));
+        if (b->setup.event_ids) CK(sl->d_ids_ev.reserve(sl->d_keys_ev.cap));
         if (sl->d_keys_ev.cap > b->capacity)
             b->capacity = sl->d_keys_ev.cap; /* the other slots grow at their next submit */
         if ((st = launch(b, sl, err)) != EVR_OK) return st;
@@ -562,7 +596,8 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
         snprintf(err->msg, sizeof err->msg, "out of memory for events");
         return EVR_ERR_NOMEM;
     }
-    decode_keys(b->par, sl->h_sorted.p, split, sl->base_us, xb, yb, out->data + held);
+    decode_keys(b->par, sl->h_sorted.p, b->setup.event_ids ? sl->h_ids.p : nullptr, split,
+                sl->base_us, xb, yb, out->data + held);
     out->n += split;
     if (!evr_events_merge_runs(out, held, &b->scratch)) {
         snprintf(err->msg, sizeof err->msg, "out of memory for events");

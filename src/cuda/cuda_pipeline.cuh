@@ -11,8 +11,9 @@ extern "C" {
 evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err);
 evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us,
                         const float **intensity, const float **frames, evr_error *err);
-/* Bytes of temporary storage the sort of n event keys takes (for the buffers made up front). */
-cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted, int n,
-                                  size_t *temp);
+/* Bytes of temporary storage the sort of n event keys takes (for the buffers made up front);
+ * with ids (not NULL), the sort that moves them with the keys. */
+cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted,
+                                  unsigned *ids, unsigned *ids_sorted, int n, size_t *temp);
 
 #endif

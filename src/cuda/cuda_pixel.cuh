@@ -121,12 +121,13 @@ __device__ static bool gpu_sample_direct(const kernel_args &a, const evr_m34 *po
 }
 
 /* Intensity of one sample; GI: plus the indirect light gathered from the segment's photons (memo:
- * the pixel's last gather). direct (may be NULL): the direct light alone. */
+ * the pixel's last gather). direct (may be NULL): the direct light alone; id (may be NULL): the
+ * sample's event id (evr_event.id: 1 + the instance hit, 0 none). */
 template <int LAYOUT, int GI>
 __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, int x, int y, float f,
                                    unsigned *rays, float *t_hit, gi_memo *memo,
                                    float hint = INFINITY, float *direct = nullptr,
-                                   int *deep = nullptr)
+                                   int *deep = nullptr, unsigned *id = nullptr)
 {
     evr_surface s;
     int inst = 0;
@@ -134,8 +135,10 @@ __device__ static float gpu_sample(const kernel_args &a, const evr_m34 *pose, in
     float out;
     int dp = 0;
     if (deep) *deep = 0;
+    if (id) *id = 0;
     if (!gpu_sample_direct<LAYOUT>(a, pose, x, y, f, rays, t_hit, hint, &out, &s, &inst, &org, &dp))
         return 0.0f;
+    if (id) *id = (unsigned)inst + 1u;
     if (deep) *deep = dp;
     if (direct) *direct = out;
     if (GI) out += gi_indirect(a.gi, &a.rs, inst, &s, org, x, y, f, memo);
@@ -211,6 +214,7 @@ __device__ __forceinline__ float pixel_begin(const kernel_args &a, bool active, 
 struct evr_event_sink {
     const kernel_args *a;
     unsigned lane;
+    unsigned id; /* the sample's event id */
 };
 
 EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long long t_us,
@@ -227,8 +231,10 @@ EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, 
         unsigned idx = base + (unsigned)__popc(mask & ((1u << k->lane) - 1u));
         if (t_us < a.base_us || t_us - a.base_us >= a.span_us)
             atomicAdd(&a.counters[CTR_KEY_RANGE], 1ull); /* collect fails */
-        else if (idx < a.capacity)
-            a.keys[idx] = pack_event(a, t_us, x, y, polarity); /* else: re-run */
+        else if (idx < a.capacity) {                     /* else: re-run */
+            a.keys[idx] = pack_event(a, t_us, x, y, polarity);
+            if (a.ids) a.ids[idx] = k->id;
+        }
     }
     return 1;
 #else
@@ -237,13 +243,13 @@ EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, 
 #endif
 }
 
-/* One sample (intensity at t seconds from the segment's start) through the pixel model
- * (core/pixel_flow.h); its events are appended with warp-aggregated atomics. Every lane of the
- * warp calls it together; live: this lane has a sample. */
+/* One sample (intensity at t seconds from the segment's start; event_id: its id) through the
+ * pixel model (core/pixel_flow.h); its events are appended with warp-aggregated atomics. Every
+ * lane of the warp calls it together; live: this lane has a sample. */
 template <int SENSOR>
-__device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_state &st,
-                                                const evr_pixel_params &own, bool live, float t,
-                                                float intensity, int x, int y, unsigned lane)
+__device__ __forceinline__ void
+pixel_sample_at(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own, bool live,
+                float t, float intensity, int x, int y, unsigned lane, unsigned event_id)
 {
     evr_pixel_ideal id; /* the ideal kernel's parameters, from the launch's arguments */
     id.log_floor = a.log_floor;
@@ -253,16 +259,17 @@ __device__ __forceinline__ void pixel_sample_at(const kernel_args &a, evr_pixel_
     struct evr_event_sink k;
     k.a = &a;
     k.lane = lane;
+    k.id = event_id;
     evr_pixel_sample_events(&st, &own, id, SENSOR, live, t, intensity, a.t0, x, y, &k);
 }
 
 /* The same at normalized segment time f (uniform sampling). */
 template <int SENSOR>
-__device__ __forceinline__ void pixel_sample(const kernel_args &a, evr_pixel_state &st,
-                                             const evr_pixel_params &own, bool live, float f,
-                                             float intensity, int x, int y, unsigned lane)
+__device__ __forceinline__ void
+pixel_sample(const kernel_args &a, evr_pixel_state &st, const evr_pixel_params &own, bool live,
+             float f, float intensity, int x, int y, unsigned lane, unsigned id)
 {
-    pixel_sample_at<SENSOR>(a, st, own, live, f * a.dt, intensity, x, y, lane);
+    pixel_sample_at<SENSOR>(a, st, own, live, f * a.dt, intensity, x, y, lane, id);
 }
 
 /* Adds the warp's rays and traced samples to the segment's counters. */

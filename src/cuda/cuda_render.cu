@@ -79,6 +79,7 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
         d.requests[r].pix = pix;
         d.requests[r].ls = e->le;
         d.direct[at] = e->direct; /* sample 0's entry */
+        if (d.ids) d.ids[at] = a.id_in[pix];
         d.req[at] = r;
         d.traced[at] = 1;
         d.cache_dist[at] = cache;
@@ -87,12 +88,14 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
     if (!skipped) return; /* the whole warp */
     if (lane == 0) atomicAdd(&a.counters[CTR_SKIPPED], (unsigned long long)__popc(skipped));
     const float kept = st.intensity;
+    const unsigned id = skip && a.id_in ? a.id_in[pix] : 0u; /* its last traced sample's */
     for (int k = 0; k < a.samples; k++)
         pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y,
-                             lane);
+                             lane, id);
     if (skip) {
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
+        if (a.id_out) a.id_out[pix] = id;
         if (a.gi && a.gi->ends_out)
             a.gi->ends_out[pix] = a.gi->ends_in[pix]; /* its last gather holds */
     }
@@ -125,6 +128,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
     const evr_ray ray0 =
         evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
     int last_span = -1; /* the still span of the last traced sample */
+    unsigned id = active && a.id_in ? a.id_in[pix] : 0u; /* the last traced sample's event id */
     for (int k = 0; k < a.samples; k++) {
         float f = ((float)k + phi) / (float)a.samples,
               intensity = st.intensity; /* kept when settled or held */
@@ -132,7 +136,8 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
         if (tracing && !evr_skip_held(a.plan, span, last_span)) {
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
             intensity = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &t_hit, &memo,
-                                               a.coherence ? t_hit : INFINITY, &direct, &deep);
+                                               a.coherence ? t_hit : INFINITY, &direct, &deep,
+                                               a.ids ? &id : nullptr);
             traced++;
             last_span = span;
         } else if (
@@ -141,7 +146,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
                 INFINITY) { /* settled or held on a surface: its direct light, its gathers at f */
             intensity = direct + evr_gi_lerp(memo.ls, memo.le, f);
         }
-        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane);
+        pixel_sample<SENSOR>(a, st, own, active, f, intensity, x, y, lane, id);
         if (k == 0 && tracing) {
             /* settle: the first sample's rays meet nothing that moves in the segment, so every
              * sample sees the same triangles: keep its intensity (GI: its direct light) */
@@ -156,6 +161,7 @@ __global__ void __launch_bounds__(BLOCK, GI ? MIN_BLOCKS_GI : MIN_BLOCKS)
         if (tracing) st.cache_dist = evr_skip_cache_after_trace(&a.rs, a.plan, ray0, t_hit, deep);
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
+        if (a.id_out) a.id_out[pix] = id;
     }
     add_counts(a, lane, rays, traced);
 }
@@ -189,7 +195,8 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
     evr_adapt_stack sk;
     sk.n = 0;
     float ct = 0.0f, ci = 0.0f,
-          ch = INFINITY; /* the candidate sample: time, intensity, hit distance */
+          ch = INFINITY; /* the candidate sample: time, intensity, hit distance, event id */
+    unsigned cid = 0;
     bool cand = false;
     unsigned rays = 0, taken = 0;
     gi_memo memo;
@@ -198,7 +205,8 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         if (need) {
             const float f = t / a.dt;
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
-            ci = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &ch, &memo);
+            ci = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &ch, &memo, INFINITY, nullptr,
+                                        nullptr, a.ids ? &cid : nullptr);
             ct = t;
             cand = true;
             need = false;
@@ -208,15 +216,15 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         float step = 0.0f;
         int moving = 0;
         if (cand) { /* held back (trace t first) or taken */
-            consume = evr_adapt_candidate(&a.rs, &d.p, d.plan, &st, &own, ray0, &sk, ct, ci, ch, &t,
-                                          &step, &moving);
+            consume = evr_adapt_candidate(&a.rs, &d.p, d.plan, &st, &own, ray0, &sk, ct, ci, ch,
+                                          cid, &t, &step, &moving);
             if (!consume) {
                 need = true;
                 cand = false;
             }
         }
-        pixel_sample_at<SENSOR>(a, st, own, consume, ct, ci, x, y, lane);
-        if (consume && !evr_adapt_taken(&d.p, &sk, step, moving, a.dt, &ct, &ci, &ch, &t)) {
+        pixel_sample_at<SENSOR>(a, st, own, consume, ct, ci, x, y, lane, cid);
+        if (consume && !evr_adapt_taken(&d.p, &sk, step, moving, a.dt, &ct, &ci, &ch, &cid, &t)) {
             cand = false; /* none held back: t is the next to trace */
             need = t < a.dt;
         }

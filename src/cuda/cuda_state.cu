@@ -92,6 +92,9 @@ kernel_args make_args(cuda_backend *b, slot *sl)
     /* a re-render at overflow after the camera moved on renders without them */
     a.static_hits =
         sl->static_gen >= 0 && sl->static_gen == b->static_gen ? b->d_static.p : nullptr;
+    a.ids = b->setup.event_ids ? sl->d_ids_ev.p : nullptr;
+    a.id_in = b->setup.event_ids ? b->d_id[sl->index % NRING].p : nullptr;
+    a.id_out = b->setup.event_ids ? b->d_id[(sl->index + 1) % NRING].p : nullptr;
     return a;
 }
 
@@ -112,17 +115,18 @@ uint64_t device_bytes(const cuda_backend *b)
                  bytes(b->d_texels) + bytes(b->d_instances) + bytes(b->d_lights) +
                  bytes(b->d_nodes4) + bytes(b->d_nodes8) + bytes(b->d_tris) + bytes(b->d_phase) +
                  bytes(b->d_sensor);
-    for (int i = 0; i < NRING; i++) n += bytes(b->d_state[i]) + bytes(b->d_next[i]);
+    for (int i = 0; i < NRING; i++)
+        n += bytes(b->d_state[i]) + bytes(b->d_next[i]) + bytes(b->d_id[i]);
     for (int i = 0; i < NSLOT; i++) {
         const slot *sl = &b->slots[i];
         n += bytes(sl->d_keys) + bytes(sl->d_tracks) + bytes(sl->d_top4) + bytes(sl->d_top8) +
              bytes(sl->d_insts) + bytes(sl->d_keys_ev) + bytes(sl->d_keys_sorted) +
-             bytes(sl->d_sort_temp) + bytes(sl->d_count) + bytes(sl->d_counters) +
-             bytes(sl->d_plan) + bytes(sl->d_list) + bytes(sl->d_intensity) + bytes(sl->d_frame_f) +
-             bytes(sl->d_frames) + bytes(sl->d_sat) + bytes(sl->d_ch_before) +
-             bytes(sl->d_ch_base) + bytes(sl->d_ch_x) + bytes(sl->d_em) + bytes(sl->d_cdf) +
-             bytes(sl->d_dverts) + bytes(sl->d_dviews) + bytes(sl->d_dnodes4) +
-             bytes(sl->d_dnodes8) + bytes(sl->d_dtris);
+             bytes(sl->d_ids_ev) + bytes(sl->d_ids_sorted) + bytes(sl->d_sort_temp) +
+             bytes(sl->d_count) + bytes(sl->d_counters) + bytes(sl->d_plan) + bytes(sl->d_list) +
+             bytes(sl->d_intensity) + bytes(sl->d_frame_f) + bytes(sl->d_frames) +
+             bytes(sl->d_sat) + bytes(sl->d_ch_before) + bytes(sl->d_ch_base) + bytes(sl->d_ch_x) +
+             bytes(sl->d_em) + bytes(sl->d_cdf) + bytes(sl->d_dverts) + bytes(sl->d_dviews) +
+             bytes(sl->d_dnodes4) + bytes(sl->d_dnodes8) + bytes(sl->d_dtris);
     }
     for (int i = 0; i < NRING; i++)
         n += bytes(b->gi_ring[i].slots) + bytes(b->gi_ring[i].count) + bytes(b->gi_ring[i].gbuf);
@@ -130,8 +134,8 @@ uint64_t device_bytes(const cuda_backend *b)
     for (int i = 0; i < NRING; i++) n += bytes(b->d_gi_ends[i]);
     n += bytes(b->d_pending) + bytes(b->d_pkeys) + bytes(b->d_pkeys_sorted) + bytes(b->d_pvals) +
          bytes(b->d_pvals_sorted) + bytes(b->d_pcount) + bytes(b->d_ptemp) + bytes(b->d_trails) +
-         bytes(b->d_trail_rays) + bytes(b->d_todo) + bytes(b->d_gd_direct) + bytes(b->d_gd_cache) +
-         bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) + bytes(b->d_gd_requests) +
-         bytes(b->d_gd_newpix) + bytes(b->d_gd_delta);
+         bytes(b->d_trail_rays) + bytes(b->d_todo) + bytes(b->d_gd_direct) + bytes(b->d_gd_ids) +
+         bytes(b->d_gd_cache) + bytes(b->d_gd_lum) + bytes(b->d_gd_req) + bytes(b->d_gd_traced) +
+         bytes(b->d_gd_requests) + bytes(b->d_gd_newpix) + bytes(b->d_gd_delta);
     return n;
 }

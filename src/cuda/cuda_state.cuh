@@ -56,6 +56,7 @@ struct slot {
     dbuf<evr_gpu_node8> d_dnodes8;
     dbuf<evr_gpu_dtri> d_dtris;
     dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
+    dbuf<unsigned> d_ids_ev, d_ids_sorted; /* event ids (setup.event_ids), beside the keys */
     dbuf<unsigned char> d_sort_temp;
     dbuf<unsigned int> d_count;          /* indexed by launch_count */
     dbuf<unsigned long long> d_counters; /* indexed by segment_counter */
@@ -69,6 +70,7 @@ struct slot {
     hbuf<unsigned int> h_count;
     hbuf<unsigned long long> h_counters;
     hbuf<unsigned long long> h_sorted;
+    hbuf<unsigned> h_ids;
     hbuf<float> h_intensity;
     hbuf<float> h_frame_f; /* normalized times of the frames */
     dbuf<float> d_frame_f;
@@ -140,7 +142,8 @@ struct cuda_backend {
     dbuf<evr_gpu_node8> d_nodes8;
     dbuf<evr_gpu_tri> d_tris;
     dbuf<evr_pixel_state> d_state[NRING];
-    dbuf<float> d_next[NRING]; /* adaptive sampling: next sample times, a ring as d_state */
+    dbuf<float> d_next[NRING];  /* adaptive sampling: next sample times, a ring as d_state */
+    dbuf<unsigned> d_id[NRING]; /* event ids: each pixel's last traced sample's, as d_state */
     dbuf<float> d_phase;
     dbuf<evr_pixel_params> d_sensor; /* the run's pixel parameters, for the sensor kernel */
     cudaStream_t render = nullptr;
@@ -181,6 +184,7 @@ struct cuda_backend {
     int gi_deferred;
     unsigned gather_grid;
     dbuf<float> d_gd_direct, d_gd_cache;
+    dbuf<unsigned> d_gd_ids;
     dbuf<float2> d_gd_lum;
     dbuf<unsigned> d_gd_req, d_gd_count;
     dbuf<int> d_gd_traced, d_gd_newpix;

@@ -331,6 +331,7 @@ static evr_status event_packet(reader *r, span b, size_t at)
         e->x = (uint16_t)x;
         e->y = (uint16_t)y;
         e->p = (int8_t)(p[12] ? 1 : 0);
+        e->id = 0;
     }
     return EVR_OK;
 }

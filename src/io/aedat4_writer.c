@@ -564,4 +564,5 @@ const evr_event_format evr_format_aedat4 = {
     "events.aedat4",
     evr_aedat4_writer_open,
     "iniVation AEDAT 4.0, LZ4 packets with a data table (DV, dv-processing, aedat)",
-    ".aedat4"};
+    ".aedat4",
+    0};

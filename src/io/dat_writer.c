@@ -73,5 +73,5 @@ evr_status evr_dat_writer_open(const char *path, const evr_writer_meta *meta,
 }
 
 const evr_event_format evr_format_dat = {
-    "dat", NULL, "events_td.dat", evr_dat_writer_open, "Prophesee DAT of CD events (expelliarmus)",
-    ".dat"};
+    "dat",  NULL, "events_td.dat", evr_dat_writer_open, "Prophesee DAT of CD events (expelliarmus)",
+    ".dat", 0};

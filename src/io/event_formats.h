@@ -16,6 +16,7 @@ typedef struct {
                        evr_error *err);
     const char *help;     /* what the file is, in a few words */
     const char *suffixes; /* file name endings that ask for it (evray convert), space-separated */
+    int holds_ids;        /* it writes evr_event.id (evr_writer_meta.event_ids) */
 } evr_event_format;
 
 /* The formats, in bit order; *count is set to their number. */

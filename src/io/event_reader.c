@@ -172,6 +172,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         out[count].x = (uint16_t)x;
         out[count].y = (uint16_t)y;
         out[count].p = p > 0 ? 1 : 0;
+        out[count].id = 0;
         count++;
         s = next;
     }
@@ -413,6 +414,7 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         out[i].x = (uint16_t)x;
         out[i].y = (uint16_t)y;
         out[i].p = npy_get(rec, &fields[3]) > 0 ? 1 : 0;
+        out[i].id = 0;
     }
 done:
     free(header);
@@ -567,6 +569,7 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
                 e->x = bx[i];
                 e->y = by[i];
                 e->p = bp[i] > 0 ? 1 : 0;
+                e->id = 0;
             }
         }
         if (st != EVR_OK && st != EVR_ERR_NOMEM) h5r_fail(err, what, path, st);

@@ -35,11 +35,16 @@ struct evr_event_writer {
 
 /* Metadata every writer may store: image size and the full configuration as JSON text; and
  * what a writer may size its fields by: max_t_us, no event's timestamp is larger (0: unknown;
- * timestamps are never negative). */
+ * timestamps are never negative). event_ids: the events carry evr_event.id, which the formats
+ * with a place for it write, with the instances' names (id i + 1 is inst_node[i], inst_mesh[i]:
+ * io/h5_instances.h) where the format can hold them. */
 typedef struct {
     int width, height;
     const char *config_json;
     int64_t max_t_us;
+    int event_ids;
+    const char *const *inst_node, *const *inst_mesh;
+    int num_instances;
 } evr_writer_meta;
 
 /* path is the final name; writers write to path + ".tmp" until finish(). */

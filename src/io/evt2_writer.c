@@ -96,4 +96,5 @@ const evr_event_format evr_format_evt2 = {"evt2",
                                           "events_evt2.raw",
                                           evr_evt2_writer_open,
                                           "Prophesee EVT 2.0 RAW (Metavision, expelliarmus, evlib)",
-                                          "evt2.raw"};
+                                          "evt2.raw",
+                                          0};

@@ -225,4 +225,5 @@ const evr_event_format evr_format_evt3 = {"evt3",
                                           "events_evt3.raw",
                                           evr_evt3_writer_open,
                                           "Prophesee EVT 3.0 RAW (Metavision, evlib, evt3)",
-                                          ".raw"};
+                                          ".raw",
+                                          0};

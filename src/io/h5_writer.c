@@ -2,6 +2,8 @@
  *
  *   /events/x  uint16   /events/y  uint16   /events/t  uint32 (us)   /events/p  int8 (1 ON, 0 OFF)
  *   /ms_to_idx uint64   index of the first event with t >= i ms, i = 0 .. ceil(duration/1 ms)
+ *   with event ids (evr_writer_meta.event_ids): /events/id uint32 (evr_event.id) and
+ *   /instances naming each id (io/h5_instances.h)
  *   /t_offset  int64    0 (our timestamps start at the simulation start)
  *   attributes on /: width, height (int32), config (JSON text), complete (int8, 1 once finished)
  *
@@ -26,6 +28,7 @@
 #include "io/event_formats.h"
 #include "io/chunk_compress.h"
 #include "io/file_commit.h"
+#include "io/h5_instances.h"
 #include "par_pool.h"
 
 #include <errno.h>
@@ -42,7 +45,7 @@
     1 /* libdeflate's level 1: smaller than zlib's level 3 and 2-3x faster (chunk_compress.c) */
 #define H5W_MAX_THREADS 16 /* compression threads, the caller included */
 #define H5W_MIN_BATCH 4    /* chunks staged before they are stored, at least */
-#define H5W_COLUMNS 4      /* t, x, y, p: the largest elements first */
+#define H5W_COLUMNS 5      /* t, x, y, p, id (with event ids): the largest first but id */
 /* Staging (checking and copying arriving events, finding the millisecond index) on this many
  * threads, the writer's included: alone it was most of the writer thread's time and bound by
  * one core's memory bandwidth (the eye's 218.7 M events: 0.8 of 1.15 s busy, H100 machine) */
@@ -61,7 +64,8 @@ typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     hid_t file, group;
-    hid_t ds_x, ds_y, ds_t, ds_p, ds_ms;
+    hid_t ds_x, ds_y, ds_t, ds_p, ds_id, ds_ms;
+    int ncols; /* columns written: H5W_COLUMNS with event ids, else one fewer */
     /* staged events, from dataset index written on (p already 0 or 1), in set[fill].stage */
     size_t nstage, cap_stage; /* cap_stage: a whole number of chunks */
     uint64_t written;         /* events in full chunks stored (a multiple of H5W_CHUNK) */
@@ -213,7 +217,7 @@ static herr_t write_scalar_dataset(hid_t loc, const char *name, hid_t ftype, hid
 
 static void close_all(h5_writer *w)
 {
-    hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms};
+    hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_id, &w->ds_ms};
     H5E_BEGIN_TRY
     {
         for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++)
@@ -275,20 +279,21 @@ static int push_ms(h5_writer *w, uint64_t value)
 static size_t column_size(const h5_writer *w, int c)
 {
     static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t),
-                                             sizeof(int8_t)};
+                                             sizeof(int8_t), sizeof(uint32_t)};
     return c == 0 && w->t32 ? sizeof(uint32_t) : size[c];
 }
 
 static size_t column_offset(int c)
 {
     static const size_t off[H5W_COLUMNS] = {offsetof(evr_event, t), offsetof(evr_event, x),
-                                            offsetof(evr_event, y), offsetof(evr_event, p)};
+                                            offsetof(evr_event, y), offsetof(evr_event, p),
+                                            offsetof(evr_event, id)};
     return off[c];
 }
 
 static hid_t column_dataset(const h5_writer *w, int c)
 {
-    return c == 0 ? w->ds_t : c == 1 ? w->ds_x : c == 2 ? w->ds_y : w->ds_p;
+    return c == 0 ? w->ds_t : c == 1 ? w->ds_x : c == 2 ? w->ds_y : c == 3 ? w->ds_p : w->ds_id;
 }
 
 /* Bytes of zbuf that the compressed chunks of one column take in a full batch. */
@@ -305,7 +310,7 @@ static size_t make_jobs(const h5_writer *w, h5_set *set, size_t nchunks, size_t 
     evr_chunk_job *jobs = set->jobs;
     unsigned char *room = set->zbuf;
     size_t njobs = 0;
-    for (int c = 0; c < H5W_COLUMNS; c++) {
+    for (int c = 0; c < w->ncols; c++) {
         size_t bound = evr_chunk_bound(H5W_CHUNK * column_size(w, c));
         for (size_t k = 0; k < nchunks; k++) {
             evr_chunk_job *j = &jobs[njobs++];
@@ -332,10 +337,10 @@ static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nch
     H5E_BEGIN_TRY
     {
         hsize_t size[1] = {(hsize_t)extent};
-        for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
+        for (int c = 0; c < w->ncols && r >= 0; c++)
             if (extent != w->extent && H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
         for (size_t k = 0; k < nchunks && r >= 0; k++)
-            for (int c = 0; c < H5W_COLUMNS && r >= 0; c++) {
+            for (int c = 0; c < w->ncols && r >= 0; c++) {
                 const evr_chunk_job *j = &jobs[(size_t)c * nchunks + k];
                 hsize_t offset[1] = {(hsize_t)(at + k * H5W_CHUNK)};
                 r = H5Dwrite_chunk(column_dataset(w, c), H5P_DEFAULT, 0, offset, j->dst_size,
@@ -464,6 +469,7 @@ static void stage_event(evr_event *d, const evr_event *e)
     d->x = e->x;
     d->y = e->y;
     d->p = e->p ? 1 : 0;
+    d->id = e->id;
 }
 
 /* Parallel staging of m events (m >= 2) after a first one staged alone: part k checks and copies
@@ -653,9 +659,9 @@ static evr_status close_publish(h5_writer *w, evr_error *err)
     H5E_BEGIN_TRY
     {
         /* closing the datasets first lets H5Fclose really close the file */
-        hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_ms, &w->group};
+        hid_t *ids[] = {&w->ds_x, &w->ds_y, &w->ds_t, &w->ds_p, &w->ds_id, &w->ds_ms, &w->group};
         for (size_t i = 0; i < sizeof ids / sizeof ids[0]; i++) {
-            if (*ids[i] >= 0 && (i == 5 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
+            if (*ids[i] >= 0 && (i == 6 ? H5Gclose(*ids[i]) : H5Dclose(*ids[i])) < 0) r = -1;
             *ids[i] = -1;
         }
         if (H5Fclose(w->file) < 0) r = -1;
@@ -745,7 +751,7 @@ static evr_status h5_salvage(evr_event_writer *base, uint64_t events, int64_t du
     {
         hsize_t size[1] = {(hsize_t)events};
         int8_t complete = 0;
-        for (int c = 0; c < H5W_COLUMNS && r >= 0; c++)
+        for (int c = 0; c < w->ncols && r >= 0; c++)
             if (H5Dset_extent(column_dataset(w, c), size) < 0) r = -1;
         if (r >= 0 && keep_ms &&
             append(w->ds_ms, H5T_NATIVE_UINT64, w->ms, w->ms_written, keep_ms) < 0)
@@ -789,11 +795,12 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         /* a batch gives every thread a chunk of each column; about 40 MB with 16 threads */
         int threads = evr_par_threads(H5W_MAX_THREADS);
         size_t room = 0;
-        w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_ms = -1;
+        w->file = w->group = w->ds_x = w->ds_y = w->ds_t = w->ds_p = w->ds_id = w->ds_ms = -1;
+        w->ncols = meta->event_ids ? H5W_COLUMNS : H5W_COLUMNS - 1;
         w->t32 = meta->max_t_us > 0 && meta->max_t_us <= (int64_t)UINT32_MAX;
         w->batch = threads < H5W_MIN_BATCH ? H5W_MIN_BATCH : (size_t)threads;
         w->cap_stage = w->batch * H5W_CHUNK;
-        for (int c = 0; c < H5W_COLUMNS; c++) room += column_room(w, c);
+        for (int c = 0; c < w->ncols; c++) room += column_room(w, c);
         w->path = strdup(path);
         w->tmp = evr_file_tmp_name(path);
         for (int i = 0; i < 2; i++) {
@@ -830,8 +837,12 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
             w->ds_t =
                 make_extendible(w->group, "t", w->t32 ? H5T_STD_U32LE : H5T_STD_I64LE, H5W_CHUNK);
         if (w->ds_t >= 0) w->ds_p = make_extendible(w->group, "p", H5T_STD_I8LE, H5W_CHUNK);
-        if (w->ds_p >= 0)
-            w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
+        int ids_ok = w->ds_p >= 0 && !meta->event_ids;
+        if (w->ds_p >= 0 && meta->event_ids &&
+            (w->ds_id = make_extendible(w->group, "id", H5T_STD_U32LE, H5W_CHUNK)) >= 0)
+            ids_ok = evr_h5_write_instances(w->file, meta->inst_node, meta->inst_mesh,
+                                            meta->num_instances) >= 0;
+        if (ids_ok) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
         if (w->ds_ms >= 0 &&
             write_scalar_dataset(w->file, "t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &zero) >=
                 0 &&
@@ -861,5 +872,5 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
 }
 
 const evr_event_format evr_format_h5 = {
-    "h5",       "hdf5", "events.h5", evr_h5_writer_open, "HDF5: events/x, y, t, p and ms_to_idx",
-    ".h5 .hdf5"};
+    "h5",        "hdf5", "events.h5", evr_h5_writer_open, "HDF5: events/x, y, t, p and ms_to_idx",
+    ".h5 .hdf5", 1};

@@ -3,6 +3,7 @@
  * keeps up). HDF5's error printing is off around every call (H5E_BEGIN_TRY). */
 #include "io/labels_h5.h"
 #include "io/file_commit.h"
+#include "io/h5_instances.h"
 
 #include <hdf5.h>
 #include <stddef.h>
@@ -12,8 +13,6 @@
 
 #define LABELS_DEFLATE 4
 #define LABELS_SETS 6 /* t, depth, instance, flow, displacement, normal */
-#define NODE_CHARS 256
-#define MESH_CHARS 64
 
 struct evr_labels_h5 {
     char *path, *tmp;
@@ -81,43 +80,6 @@ static herr_t string_attr(hid_t loc, const char *name, const char *text)
     return r;
 }
 
-typedef struct {
-    uint32_t id;
-    char node[NODE_CHARS];
-    char mesh[MESH_CHARS];
-} instance_row;
-
-static herr_t write_instances(hid_t file, const evr_labels_h5_meta *m)
-{
-    hsize_t n = (hsize_t)m->num_instances;
-    instance_row *rows = calloc(n ? n : 1, sizeof *rows);
-    hid_t sn = H5Tcopy(H5T_C_S1), sm = H5Tcopy(H5T_C_S1),
-          type = H5Tcreate(H5T_COMPOUND, sizeof(instance_row)), space = -1, ds = -1;
-    herr_t r = -1;
-    if (rows && sn >= 0 && sm >= 0 && type >= 0 && H5Tset_size(sn, NODE_CHARS) >= 0 &&
-        H5Tset_size(sm, MESH_CHARS) >= 0 &&
-        H5Tinsert(type, "id", offsetof(instance_row, id), H5T_STD_U32LE) >= 0 &&
-        H5Tinsert(type, "node", offsetof(instance_row, node), sn) >= 0 &&
-        H5Tinsert(type, "mesh", offsetof(instance_row, mesh), sm) >= 0 &&
-        (space = H5Screate_simple(1, &n, NULL)) >= 0 &&
-        (ds = H5Dcreate2(file, "instances", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) >=
-            0) {
-        for (hsize_t i = 0; i < n; i++) {
-            rows[i].id = (uint32_t)i + 1;
-            snprintf(rows[i].node, NODE_CHARS, "%s", m->instances[i].node);
-            snprintf(rows[i].mesh, MESH_CHARS, "%s", m->instances[i].mesh);
-        }
-        r = n ? H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, rows) : 0;
-    }
-    if (ds >= 0) H5Dclose(ds);
-    if (space >= 0) H5Sclose(space);
-    if (type >= 0) H5Tclose(type);
-    if (sn >= 0) H5Tclose(sn);
-    if (sm >= 0) H5Tclose(sm);
-    free(rows);
-    return r;
-}
-
 static void close_all(evr_labels_h5 *w)
 {
     int i;
@@ -172,7 +134,7 @@ evr_status evr_labels_h5_open(const char *path, const evr_labels_h5_meta *m, evr
                                     2)) >= 0 &&
             (!m->normals || (w->ds[5] = make_frames(w->file, "normal", H5T_IEEE_F32LE, m->height,
                                                     m->width, 3)) >= 0) &&
-            write_instances(w->file, m) >= 0 &&
+            evr_h5_write_instances(w->file, m->inst_node, m->inst_mesh, m->num_instances) >= 0 &&
             scalar_attr(w->file, "width", H5T_STD_I32LE, H5T_NATIVE_INT32, &width) >= 0 &&
             scalar_attr(w->file, "height", H5T_STD_I32LE, H5T_NATIVE_INT32, &height) >= 0 &&
             scalar_attr(w->file, "fps", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &m->fps) >= 0 &&

@@ -22,15 +22,11 @@
 typedef struct evr_labels_h5 evr_labels_h5;
 
 typedef struct {
-    const char *node; /* node path */
-    const char *mesh;
-} evr_label_instance;
-
-typedef struct {
     int width, height, normals;
     double fps, flow_dt;
     const char *config_json;
-    const evr_label_instance *instances; /* id i + 1 is instances[i] */
+    /* id i + 1 is instance i: its node's path and its mesh's name (io/h5_instances.h) */
+    const char *const *inst_node, *const *inst_mesh;
     int num_instances;
 } evr_labels_h5_meta;
 

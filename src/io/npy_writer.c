@@ -1,5 +1,6 @@
 /* NumPy .npy (format 1.0) event files: one 1-D structured array of packed 13-byte records,
- * dtype [('t','<i8'), ('x','<u2'), ('y','<u2'), ('p','|i1')], which numpy.load reads as is.
+ * dtype [('t','<i8'), ('x','<u2'), ('y','<u2'), ('p','|i1')], which numpy.load reads as is;
+ * with event ids (evr_writer_meta.event_ids) 17-byte records with a last field ('id','<u4').
  *
  * The count is known only at the end, so the header is written with room for a 20-digit shape
  * (padded with spaces, total header a multiple of 64 bytes) and rewritten in place at every
@@ -16,14 +17,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NPY_RECORD 13
+#define NPY_RECORD_MAX 17
 #define NPY_BUFFER_RECORDS (1u << 16)
 #define NPY_DESCR "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1')]"
+#define NPY_DESCR_IDS "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1'), ('id', '<u4')]"
 
 typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     FILE *f;
+    size_t record; /* bytes a record: 13, or 17 with ids */
+    int ids;
     unsigned char *buf;
     size_t nbuf;       /* records in buf */
     uint64_t count;    /* records in the file */
@@ -39,12 +43,12 @@ typedef struct {
 
 /* Builds the whole header (magic, version, length, dict, padding, newline) for count records.
  * total 0: the smallest multiple of 64 with room for any 64-bit count; else exactly total bytes. */
-static size_t build_header(char *out, size_t cap, uint64_t count, size_t total)
+static size_t build_header(char *out, size_t cap, int ids, uint64_t count, size_t total)
 {
     char dict[256];
     int n = snprintf(dict, sizeof dict,
-                     "{'descr': %s, 'fortran_order': False, 'shape': (%" PRIu64 ",), }", NPY_DESCR,
-                     count);
+                     "{'descr': %s, 'fortran_order': False, 'shape': (%" PRIu64 ",), }",
+                     ids ? NPY_DESCR_IDS : NPY_DESCR, count);
     size_t digits = (size_t)snprintf(NULL, 0, "%" PRIu64, count);
     if (total == 0) total = ((10 + (size_t)n - digits + 20 + 1) + 63) / 64 * 64;
     if (total > cap || 10 + (size_t)n + 1 > total) return 0;
@@ -60,7 +64,7 @@ static size_t build_header(char *out, size_t cap, uint64_t count, size_t total)
 static evr_status write_header(npy_writer *w, evr_error *err)
 {
     char h[256];
-    size_t n = build_header(h, sizeof h, w->count, w->header_len);
+    size_t n = build_header(h, sizeof h, w->ids, w->count, w->header_len);
     if (n != w->header_len || fseek(w->f, 0, SEEK_SET) != 0 || fwrite(h, 1, n, w->f) != n ||
         fseek(w->f, 0, SEEK_END) != 0) {
         snprintf(err->msg, sizeof err->msg, "npy writer: cannot write the header of %s: %s", w->tmp,
@@ -79,8 +83,7 @@ static evr_status cannot_write(const npy_writer *w, evr_error *err)
 
 static evr_status drain(npy_writer *w, evr_error *err)
 {
-    if (w->nbuf && fwrite(w->buf, NPY_RECORD, w->nbuf, w->f) != w->nbuf)
-        return cannot_write(w, err);
+    if (w->nbuf && fwrite(w->buf, w->record, w->nbuf, w->f) != w->nbuf) return cannot_write(w, err);
     w->count += w->nbuf;
     w->nbuf = 0;
     return EVR_OK;
@@ -96,32 +99,32 @@ static void free_writer(npy_writer *w)
 }
 
 /* One record, little-endian whatever the host. */
-static void pack(unsigned char *r, const evr_event *e)
+static void pack(unsigned char *r, const evr_event *e, int ids)
 {
     evr_put_le64(r, (uint64_t)e->t);
     evr_put_le16(r + 8, e->x);
     evr_put_le16(r + 10, e->y);
     r[12] = e->p ? 1 : 0;
+    if (ids) evr_put_le32(r + 13, e->id);
 }
 
-/* A part of a large write (io/par_pack.h): 13 bytes an event. */
+/* A part of a large write (io/par_pack.h; ctx the writer): a record an event. */
 static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
-    (void)ctx;
     (void)ev;
-    return (b - a) * NPY_RECORD;
+    return (b - a) * ((const npy_writer *)ctx)->record;
 }
 
 static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
                         unsigned char *out, size_t room)
 {
-    (void)ctx;
+    const npy_writer *w = (const npy_writer *)ctx;
     (void)room;
-    for (size_t i = a; i < b; i++, out += NPY_RECORD) {
+    for (size_t i = a; i < b; i++, out += w->record) {
         if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
-        pack(out, &ev[i]);
+        pack(out, &ev[i], w->ids);
     }
-    return (b - a) * NPY_RECORD;
+    return (b - a) * w->record;
 }
 
 /* Writes ev[0 .. n) (n >= EVR_PAR_PACK_MIN, ev[0] not before the last event written) in parts
@@ -130,7 +133,7 @@ static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b
 static int write_parallel(npy_writer *w, const evr_event *ev, size_t n, evr_error *err,
                           evr_status *st)
 {
-    const evr_par_packer parts = {bound_part, pack_part, NULL, NULL};
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
     size_t bytes;
     evr_par_pack_result r;
     if ((*st = drain(w, err)) != EVR_OK) return 1;
@@ -169,8 +172,8 @@ static evr_status npy_write(evr_event_writer *base, const evr_event *ev, size_t 
             evr_status st = drain(w, err);
             if (st != EVR_OK) return st;
         }
-        r = w->buf + w->nbuf * NPY_RECORD;
-        pack(r, e);
+        r = w->buf + w->nbuf * w->record;
+        pack(r, e, w->ids);
         w->nbuf++;
     }
     return EVR_OK;
@@ -213,14 +216,14 @@ static evr_status npy_salvage(evr_event_writer *base, uint64_t events, int64_t d
     evr_status st;
     (void)duration_us;
     if ((events != given && events != w->prev_given) ||
-        build_header(h, sizeof h, events, w->header_len) != w->header_len) {
+        build_header(h, sizeof h, w->ids, events, w->header_len) != w->header_len) {
         snprintf(err->msg, sizeof err->msg, "npy writer: cannot keep %llu events of %s",
                  (unsigned long long)events, w->path);
         evr_file_discard(w->f, w->tmp);
         st = EVR_ERR_IO;
     } else {
-        st = evr_file_salvage(w->f, w->tmp, w->path, w->header_len + events * NPY_RECORD,
-                              w->header_len + given * NPY_RECORD, w->buf, w->nbuf * NPY_RECORD, h,
+        st = evr_file_salvage(w->f, w->tmp, w->path, w->header_len + events * w->record,
+                              w->header_len + given * w->record, w->buf, w->nbuf * w->record, h,
                               w->header_len, "npy writer", err);
     }
     w->f = NULL;
@@ -233,9 +236,8 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
 {
     npy_writer *w;
     char h[256];
-    (void)meta;
     *out = NULL;
-    if (!path || !*path) {
+    if (!path || !*path || !meta) {
         snprintf(err->msg, sizeof err->msg, "npy writer: no path given");
         return EVR_ERR_ARG;
     }
@@ -243,14 +245,16 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
     if (w) {
         w->path = strdup(path);
         w->tmp = evr_file_tmp_name(path);
-        w->buf = malloc((size_t)NPY_BUFFER_RECORDS * NPY_RECORD);
+        w->ids = meta->event_ids != 0;
+        w->record = w->ids ? NPY_RECORD_MAX : NPY_RECORD_MAX - 4;
+        w->buf = malloc((size_t)NPY_BUFFER_RECORDS * w->record);
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);
         snprintf(err->msg, sizeof err->msg, "npy writer: out of memory");
         return EVR_ERR_NOMEM;
     }
-    w->header_len = build_header(h, sizeof h, 0, 0);
+    w->header_len = build_header(h, sizeof h, w->ids, 0, 0);
     w->f = evr_file_create(w->tmp, "npy writer", err);
     if (!w->f) {
         free_writer(w);
@@ -272,4 +276,5 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
 }
 
 const evr_event_format evr_format_npy = {
-    "npy", NULL, "events.npy", evr_npy_writer_open, "NumPy structured array (t, x, y, p)", ".npy"};
+    "npy",  NULL, "events.npy", evr_npy_writer_open, "NumPy structured array (t, x, y, p)",
+    ".npy", 1};

@@ -28,6 +28,7 @@ static int push(event_list *l, int64_t t, unsigned x, unsigned y, int p)
     e->x = (uint16_t)x;
     e->y = (uint16_t)y;
     e->p = (int8_t)(p ? 1 : 0);
+    e->id = 0;
     return 1;
 }
 

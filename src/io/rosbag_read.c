@@ -91,6 +91,7 @@ static int message(bag_reader *r, span m)
             e->y = (uint16_t)evr_get_le16(p + 2);
             e->t = (int64_t)evr_get_le32(p + 4) * 1000000 + evr_get_le32(p + 8) / 1000;
             e->p = (int8_t)(p[12] ? 1 : 0);
+            e->id = 0;
         }
     else r->n += evr_get_le32(count.p);
     return 1;

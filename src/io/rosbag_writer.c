@@ -460,4 +460,5 @@ const evr_event_format evr_format_rosbag = {
     "events.bag",
     evr_rosbag_writer_open,
     "ROS1 bag of dvs_msgs/EventArray at 30 Hz (rosbags, ROS)",
-    ".bag"};
+    ".bag",
+    0};

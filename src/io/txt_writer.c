@@ -1,6 +1,7 @@
 /* Text event files: one event per line, "t x y p", t in seconds with exactly six decimals (printed
  * from the integer microseconds, so no rounding), p 1 (ON) or 0 (OFF). No header line, so that
- * numpy.loadtxt and the usual event-camera tools read the file as is. */
+ * numpy.loadtxt and the usual event-camera tools read the file as is. With event ids
+ * (evr_writer_meta.event_ids) a fifth column: evr_event.id. */
 #include "io/event_formats.h"
 #include "io/file_commit.h"
 
@@ -11,7 +12,7 @@
 #include <string.h>
 
 #define TXT_BUFFER (1u << 20)
-#define TXT_LINE_MAX 64 /* "-9223372036854.775808 65535 65535 1\n" fits easily */
+#define TXT_LINE_MAX 64 /* "-9223372036854.775808 65535 65535 1 4294967295\n" fits */
 
 typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
@@ -19,6 +20,7 @@ typedef struct {
     FILE *f;
     char *buf;
     size_t len;
+    int ids; /* a fifth column */
     int64_t last_t;
     int have_last;
     /* events and text bytes given so far (written and buffered), and as the last write() began
@@ -38,7 +40,7 @@ static char *put_uint(char *o, uint64_t v)
     return o;
 }
 
-static char *format_event(char *o, const evr_event *e)
+static char *format_event(char *o, const evr_event *e, int ids)
 {
     uint64_t u = (uint64_t)e->t, frac;
     if (e->t < 0) {
@@ -55,6 +57,10 @@ static char *format_event(char *o, const evr_event *e)
     o = put_uint(o, e->y);
     *o++ = ' ';
     *o++ = e->p ? '1' : '0';
+    if (ids) {
+        *o++ = ' ';
+        o = put_uint(o, e->id);
+    }
     *o++ = '\n';
     return o;
 }
@@ -96,7 +102,7 @@ static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t 
             evr_status st = drain(w, err);
             if (st != EVR_OK) return st;
         }
-        size_t len = (size_t)(format_event(w->buf + w->len, &ev[i]) - w->buf);
+        size_t len = (size_t)(format_event(w->buf + w->len, &ev[i], w->ids) - w->buf);
         w->bytes += len - w->len;
         w->len = len;
         w->count++;
@@ -159,9 +165,8 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
                                evr_event_writer **out, evr_error *err)
 {
     txt_writer *w;
-    (void)meta;
     *out = NULL;
-    if (!path || !*path) {
+    if (!path || !*path || !meta) {
         snprintf(err->msg, sizeof err->msg, "text writer: no path given");
         return EVR_ERR_ARG;
     }
@@ -170,6 +175,7 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
         w->path = strdup(path);
         w->tmp = evr_file_tmp_name(path);
         w->buf = malloc(TXT_BUFFER);
+        w->ids = meta->event_ids != 0;
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);
@@ -191,4 +197,4 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
 }
 
 const evr_event_format evr_format_txt = {
-    "txt", NULL, "events.txt", evr_txt_writer_open, "text, one event a line (t x y p)", ".txt"};
+    "txt", NULL, "events.txt", evr_txt_writer_open, "text, one event a line (t x y p)", ".txt", 1};

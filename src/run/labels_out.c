@@ -7,6 +7,7 @@
 #include "io/file_commit.h"
 #include "io/labels_h5.h"
 #include "run/eye_labels.h"
+#include "run/instance_table.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -35,7 +36,7 @@ struct evr_labels_out {
     double *times;
     int *seg_first;
     evr_labels_h5 *h5;
-    char **node_paths;
+    evr_instance_table names;
     inst_cache *cache;
     float *depth, *flow, *disp, *normal;
     uint32_t *ids;
@@ -59,25 +60,6 @@ static evr_status nomem(evr_error *err)
 static evr_m34 camera_pose(const evr_sim *sim, double t)
 {
     return evr_camera_rig_pose(&sim->rig, t); /* the camera as rendered: overrides and path */
-}
-
-/* "root/child/node": the node's path of names. */
-static char *node_path(const evr_scene *s, int node)
-{
-    size_t n = 1;
-    int k;
-    for (k = node; k >= 0; k = s->nodes[k].parent) n += strlen(s->nodes[k].name) + 1;
-    char *p = malloc(n);
-    if (!p) return NULL;
-    size_t at = n - 1;
-    p[at] = 0;
-    for (k = node; k >= 0; k = s->nodes[k].parent) {
-        size_t l = strlen(s->nodes[k].name);
-        at -= l;
-        memcpy(p + at, s->nodes[k].name, l);
-        if (at > 0) p[--at] = '/';
-    }
-    return p;
 }
 
 evr_status evr_labels_plan(evr_sim *sim, evr_error *err)
@@ -148,28 +130,15 @@ static evr_status open_dense(evr_sim *sim, evr_error *err)
     struct evr_labels_out *L = sim->labels;
     const evr_scene *s = sim->scene;
     const size_t npix = (size_t)sim->cfg.width * (size_t)sim->cfg.height;
-    int i;
-    L->node_paths = calloc((size_t)s->num_instances + 1, sizeof *L->node_paths);
     L->cache = calloc((size_t)s->num_instances + 1, sizeof *L->cache);
-    evr_label_instance *inst = calloc((size_t)s->num_instances + 1, sizeof *inst);
     L->depth = malloc(npix * sizeof(float));
     L->ids = malloc(npix * sizeof(uint32_t));
     L->flow = malloc(2 * npix * sizeof(float));
     L->disp = malloc(2 * npix * sizeof(float));
     L->normal = malloc(3 * npix * sizeof(float));
-    if (!L->node_paths || !L->cache || !inst || !L->depth || !L->ids || !L->flow || !L->disp ||
-        !L->normal) {
-        free(inst);
+    if (!L->cache || !L->depth || !L->ids || !L->flow || !L->disp || !L->normal ||
+        !evr_instance_table_make(s, &L->names))
         return nomem(err);
-    }
-    for (i = 0; i < s->num_instances; i++) {
-        if (!(L->node_paths[i] = node_path(s, s->instances[i].node))) {
-            free(inst);
-            return nomem(err);
-        }
-        inst[i].node = L->node_paths[i];
-        inst[i].mesh = s->meshes[s->instances[i].mesh].name;
-    }
     char path[4200];
     snprintf(path, sizeof path, "%s/labels.h5", sim->out_dir);
     evr_labels_h5_meta m;
@@ -179,11 +148,10 @@ static evr_status open_dense(evr_sim *sim, evr_error *err)
     m.fps = sim->cfg.labels_fps;
     m.flow_dt = sim->cfg.flow_dt;
     m.config_json = sim->config_json;
-    m.instances = inst;
-    m.num_instances = s->num_instances;
-    evr_status st = evr_labels_h5_open(path, &m, &L->h5, err);
-    free(inst);
-    return st;
+    m.inst_node = (const char *const *)L->names.node;
+    m.inst_mesh = L->names.mesh;
+    m.num_instances = L->names.n;
+    return evr_labels_h5_open(path, &m, &L->h5, err);
 }
 
 evr_status evr_labels_open(evr_sim *sim, evr_error *err)
@@ -211,7 +179,7 @@ evr_status evr_labels_open(evr_sim *sim, evr_error *err)
                           "from the node's frame to the world as a unit quaternion)\n");
         for (i = 0; i < s->num_nodes; i++) {
             if (!evr_node_chain_animated(s, i)) continue;
-            char *p = node_path(s, i);
+            char *p = evr_node_path(s, i);
             if (!p) return nomem(err);
             fprintf(L->poses, "# node %d %s\n", i, p);
             free(p);
@@ -456,9 +424,7 @@ void evr_labels_free(evr_sim *sim)
             free(L->cache[i].nrm);
         }
     }
-    if (L->node_paths)
-        for (i = 0; i < sim->scene->num_instances; i++) free(L->node_paths[i]);
-    free(L->node_paths);
+    evr_instance_table_free(&L->names);
     free(L->cache);
     free(L->times);
     free(L->seg_first);

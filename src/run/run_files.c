@@ -2,6 +2,7 @@
 #include "run/frames_out.h"
 #include "run/camera_poses.h"
 #include "run/labels_out.h"
+#include "run/instance_table.h"
 #include "io/mkdir_p.h"
 #include "io/file_commit.h"
 #include "io/event_formats.h"
@@ -184,16 +185,33 @@ evr_status evr_run_writers_open(evr_sim *sim, evr_error *err)
     /* timestamps end with the run, moved by jitter and rounding to the resolution */
     meta.max_t_us =
         (int64_t)ceil((sim->cfg.start + sim->duration) * 1e6) + sim->timestamp_slack_us + 1;
-    for (i = 0; i < count && i < EVR_MAX_WRITERS; i++) {
+    /* the instances' names, for the formats that list them (written as the files open) */
+    evr_instance_table names = {0};
+    meta.event_ids = sim->cfg.event_ids;
+    if (meta.event_ids && !evr_instance_table_make(sim->scene, &names)) {
+        snprintf(err->msg, sizeof err->msg, "out of memory for the instances' names");
+        return EVR_ERR_NOMEM;
+    }
+    meta.inst_node = (const char *const *)names.node;
+    meta.inst_mesh = names.mesh;
+    meta.num_instances = names.n;
+    st = EVR_OK;
+    for (i = 0; i < count && i < EVR_MAX_WRITERS && st == EVR_OK; i++) {
         if (!(sim->cfg.formats & (1 << i))) continue;
-        if ((st = path_join(p, sizeof p, sim->out_dir, formats[i]->file, err)) != EVR_OK) return st;
+        if ((st = path_join(p, sizeof p, sim->out_dir, formats[i]->file, err)) != EVR_OK) break;
         evr_event_writer *w = NULL;
-        if ((st = formats[i]->open(p, &meta, &w, err)) != EVR_OK) return st;
+        if ((st = formats[i]->open(p, &meta, &w, err)) != EVR_OK) break;
         sim->writers[sim->num_writers] = w;
         sim->writer_names[sim->num_writers] = formats[i]->file;
         sim->num_writers++;
+        if (meta.event_ids && !formats[i]->holds_ids) { /* said, not silently dropped */
+            size_t len = strlen(sim->st.notice);
+            snprintf(sim->st.notice + len, sizeof sim->st.notice - len,
+                     "%s%s has no place for event ids", len ? "; " : "", formats[i]->file);
+        }
     }
-    return EVR_OK;
+    evr_instance_table_free(&names);
+    return st;
 }
 
 evr_status evr_run_preview_events(evr_sim *sim, const evr_event *ev, size_t n, int64_t limit_us,
