@@ -55,6 +55,29 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
                             evr_error *err);
 
+/* ---- labels.h5 (src/io/labels_read.c; README "Ground truth" has the layout) ---- */
+typedef struct {
+    int width, height;   /* of each frame */
+    size_t frames;       /* >= 1 */
+    double *t;           /* each frame's time, seconds, increasing (malloc'ed) */
+    double fps, flow_dt; /* the file's attributes (NaN when missing) */
+    int complete;        /* the run finished the file */
+} evr_labels_info;
+
+/* Reads a labels.h5's frame times and sizes (checked in a child process first: HDF5 crashes on
+ * some corrupt files). A file without the t, depth, instance and flow datasets, of inconsistent
+ * shapes or without frames is refused (EVR_ERR_FORMAT). Free with evr_labels_info_free. */
+evr_status evr_labels_read_info(const char *path, evr_labels_info *info, evr_error *err);
+void evr_labels_info_free(evr_labels_info *info);
+/* Reads frame k (< info->frames) of the file info was read from: width * height values of depth
+ * and instance, twice that of flow; a NULL buffer is not read. */
+evr_status evr_labels_read_frame(const char *path, const evr_labels_info *info, size_t k,
+                                 float *depth, uint32_t *instance, float *flow, evr_error *err);
+/* The frame nearest time t (seconds); EVR_ERR_ARG, naming the frames' range, when t is more
+ * than half a frame interval (1 / fps) before the first or after the last. */
+evr_status evr_labels_nearest_frame(const evr_labels_info *info, double t, size_t *k,
+                                    evr_error *err);
+
 /* ---- accuracy of an event stream against a reference (src/compare.c) ---- */
 /* One-to-one matching of events at the same pixel with the same polarity within a time
  * tolerance, in time order. */
