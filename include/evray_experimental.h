@@ -120,6 +120,24 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec,
  * receive the image size. */
 evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h,
                                 const char *title, int *out_w, int *out_h, evr_error *err);
+/* Draws an optical flow field (w x h, 2 floats per pixel: px/s, x right, y down; a pixel that is
+ * not finite has no surface) with the optical-flow colour wheel of Baker et al. (Middlebury):
+ * hue the direction (+x red, +y yellow, -x cyan-blue), saturation the magnitude over *max_px_s
+ * (white: no motion; beyond the maximum full colour at 3/4 brightness), no surface black; with a
+ * title and the wheel as a legend. *max_px_s <= 0: the 99th percentile of the finite magnitudes, returned
+ * there. Each flow pixel is scale x scale image pixels (the largest whole factor keeping the
+ * field within 640x640), the field's top-left corner at (EVR_PLOT_LABEL_X, EVR_PLOT_LABEL_Y);
+ * *scale (may be NULL) receives it. Writes an RGB8 PNG. */
+#define EVR_PLOT_LABEL_X 10
+#define EVR_PLOT_LABEL_Y 40
+evr_status evr_plot_flow_png(const char *path, const float *flow, int w, int h, const char *title,
+                             double *max_px_s, int *scale, evr_error *err);
+/* Draws a depth map (w x h; not finite: no surface) in the heat map's colours over the finite
+ * range, near white and bright, far black; no surface teal (0, 128, 128); with a title and a
+ * colour bar. Layout and *scale as evr_plot_flow_png; *near and *far (may be NULL) receive the
+ * range (NaN when no pixel has a surface). Writes an RGB8 PNG. */
+evr_status evr_plot_depth_png(const char *path, const float *depth, int w, int h, const char *title,
+                              double *near, double *far, int *scale, evr_error *err);
 /* channels: 1 (gray), 3 (RGB) or 4 (RGBA); bit_depth 8 or 16 (16-bit samples in native order).
  * Rows are top to bottom. Writes under path + ".tmp" and renames when complete. */
 evr_status evr_png_write(const char *path, const void *pixels, int width, int height, int channels,
