@@ -1,4 +1,5 @@
-/* evray plot: the event rate over time (ON and OFF per bin) and an events-per-pixel heat map. */
+/* evray plot: the event rate over time (ON and OFF per bin), an events-per-pixel heat map, and a
+ * run's labels.h5 at one label frame: the optical flow in the colour wheel and the depth. */
 #include "commands.h"
 #include "evray.h"
 #include "evray_experimental.h"
@@ -12,25 +13,130 @@
 static int plot_usage(void)
 {
     puts(
-        "usage: evray plot EVENTS [-o rate.png] [--bin-ms MS] [--heatmap heat.png] [--size WxH]\n\n"
+        "usage: evray plot EVENTS [-o rate.png] [--bin-ms MS] [--heatmap heat.png] [--size WxH]\n"
+        "                  [--flow flow.png] [--depth depth.png] [--time S] [--labels FILE]\n"
+        "                  [--flow-max PX_S]\n"
+        "       evray plot --labels labels.h5 [--flow flow.png] [--depth depth.png] [--time S]\n\n"
         "Reads an event file evray writes (.h5, .txt, .npy, Prophesee .raw and .dat) and draws:\n"
         "  -o FILE         the number of ON and OFF events per time bin, two lines against time\n"
         "                  (default rate.png); an asynchronous simulator gives a continuous curve,\n"
         "                  a frame-based one spikes at every frame\n"
         "  --bin-ms MS     the bin width in milliseconds (default 1)\n"
         "  --heatmap FILE  also the events per pixel, log colour map with a colour bar\n"
-        "  --size WxH      the rate plot's size in pixels (default 1000x420)");
+        "  --size WxH      the rate plot's size in pixels (default 1000x420)\n"
+        "and from a run's ground truth (labels.h5, --labels-fps) at the label frame nearest --time:\n"
+        "  --flow FILE     the optical flow in the standard colour wheel (hue: direction, +x red;\n"
+        "                  saturation: speed, white still; black: no surface), the wheel beside it\n"
+        "  --depth FILE    the depth, near white, far black (heat map colours over the frame's\n"
+        "                  range); teal: no surface\n"
+        "  --time S        scene time in seconds (default: the middle frame)\n"
+        "  --labels FILE   the labels file (default: labels.h5 beside EVENTS)\n"
+        "  --flow-max PX_S the speed at the wheel's edge (default: the frame's 99th percentile)");
     return 0;
+}
+
+/* Reads labels.h5's frame nearest t (NaN: the middle one) and draws its flow and depth. */
+static int plot_labels(const char *labels, double t, double flow_max, const char *flow_png,
+                       const char *depth_png)
+{
+    evr_labels_info info;
+    evr_error err = {{0}};
+    size_t k, n, i, none = 0;
+    float *depth = NULL, *flow = NULL;
+    uint32_t *inst = NULL;
+    int rc = 1, scale = 0;
+    char title[160], at[160];
+    if (evr_labels_read_info(labels, &info, &err) != EVR_OK) {
+        cli_error("%s", err.msg);
+        return 1;
+    }
+    if (isnan(t)) k = (info.frames - 1) / 2;
+    else if (evr_labels_nearest_frame(&info, t, &k, &err) != EVR_OK) {
+        cli_error("%s: %s", labels, err.msg);
+        goto done;
+    }
+    n = (size_t)info.width * (size_t)info.height;
+    depth = malloc(n * sizeof *depth);
+    flow = malloc(2 * n * sizeof *flow);
+    inst = malloc(n * sizeof *inst);
+    if (!depth || !flow || !inst) {
+        cli_error("out of memory for %dx%d label frames", info.width, info.height);
+        goto done;
+    }
+    if (evr_labels_read_frame(labels, &info, k, depth, inst, flow, &err) != EVR_OK) {
+        cli_error("%s", err.msg);
+        goto done;
+    }
+    if (!info.complete)
+        fprintf(stderr, "evray: note: %s is not marked complete (an interrupted run?)\n", labels);
+    /* instance 0 is the file's mark of a pixel without a surface, whatever the values there */
+    for (i = 0; i < n; i++)
+        if (inst[i] == 0) {
+            depth[i] = flow[2 * i] = flow[2 * i + 1] = NAN;
+            none++;
+        }
+    if (isnan(t)) snprintf(at, sizeof at, "t = %g s, the middle frame", info.t[k]);
+    else snprintf(at, sizeof at, "t = %g s, the nearest to %g s", info.t[k], t);
+    if (flow_png) {
+        double max = flow_max;
+        snprintf(title, sizeof title, "optical flow at t = %g s", info.t[k]);
+        if (evr_plot_flow_png(flow_png, flow, info.width, info.height, title, &max, &scale, &err) !=
+            EVR_OK) {
+            cli_error("%s", err.msg);
+            goto done;
+        }
+        printf("%s: label frame %zu of %zu (%s), %dx%d drawn at %dx; wheel edge %g px/s (%s); "
+               "%zu pixels without a surface\n",
+               flow_png, k, info.frames, at, info.width, info.height, scale, max,
+               flow_max > 0.0 ? "--flow-max" : "99th percentile", none);
+    }
+    if (depth_png) {
+        double lo, hi;
+        snprintf(title, sizeof title, "depth at t = %g s", info.t[k]);
+        if (evr_plot_depth_png(depth_png, depth, info.width, info.height, title, &lo, &hi, &scale,
+                               &err) != EVR_OK) {
+            cli_error("%s", err.msg);
+            goto done;
+        }
+        printf("%s: label frame %zu of %zu (%s), %dx%d drawn at %dx; depth %g (near, white) to "
+               "%g (far, black); %zu pixels without a surface\n",
+               depth_png, k, info.frames, at, info.width, info.height, scale, lo, hi, none);
+    }
+    rc = 0;
+done:
+    free(depth);
+    free(flow);
+    free(inst);
+    evr_labels_info_free(&info);
+    return rc;
+}
+
+/* labels.h5 in the folder of the event file at path. NULL when out of memory. */
+static char *labels_beside(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dir = slash ? (size_t)(slash - path + 1) : 0;
+    char *out = malloc(dir + sizeof "labels.h5");
+    if (out) {
+        memcpy(out, path, dir);
+        memcpy(out + dir, "labels.h5", sizeof "labels.h5");
+    }
+    return out;
 }
 
 int cmd_plot(int argc, char **argv)
 {
-    const char *in = NULL, *out = "rate.png", *heat = NULL, *v;
-    double bin_ms = 1.0;
-    int pw = 1000, ph = 420, i, width = -1, height = -1, rc = 1;
+    const char *in = NULL, *out = "rate.png", *heat = NULL, *v, *labels = NULL, *flow_png = NULL,
+               *depth_png = NULL, *event_opt = NULL;
+    char *labels_alloc = NULL;
+    double bin_ms = 1.0, t = NAN, flow_max = 0.0;
+    int pw = 1000, ph = 420, i, width = -1, height = -1, rc = 1, timed = 0;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) return plot_usage();
+        if (!strcmp(a, "-o") || opt_is(a, "--out") || opt_is(a, "--heatmap") ||
+            opt_is(a, "--bin-ms") || opt_is(a, "--size"))
+            event_opt = a;
         if (!strcmp(a, "-o")) {
             if (!(out = opt_value(argc, argv, &i, "-o"))) return 2;
         } else if (opt_is(a, "--out")) {
@@ -51,6 +157,28 @@ int cmd_plot(int argc, char **argv)
                 cli_error("--size must be between 200x150 and 8000x8000 (got %s)", v);
                 return 2;
             }
+        } else if (opt_is(a, "--labels")) {
+            if (!(labels = opt_value(argc, argv, &i, "--labels"))) return 2;
+        } else if (opt_is(a, "--flow")) {
+            if (!(flow_png = opt_value(argc, argv, &i, "--flow"))) return 2;
+        } else if (opt_is(a, "--depth")) {
+            if (!(depth_png = opt_value(argc, argv, &i, "--depth"))) return 2;
+        } else if (opt_is(a, "--time")) {
+            if (!(v = opt_value(argc, argv, &i, "--time")) || !opt_double("--time", v, &t))
+                return 2;
+            if (!isfinite(t)) {
+                cli_error("--time must be a finite number of seconds (got %s)", v);
+                return 2;
+            }
+            timed = 1;
+        } else if (opt_is(a, "--flow-max")) {
+            if (!(v = opt_value(argc, argv, &i, "--flow-max")) ||
+                !opt_double("--flow-max", v, &flow_max))
+                return 2;
+            if (!(flow_max > 0.0 && flow_max < 1e30)) {
+                cli_error("--flow-max must be a speed above 0 px/s (got %s)", v);
+                return 2;
+            }
         } else if (a[0] == '-' && a[1]) {
             cli_error("plot: unknown option '%s'", a);
             return 2;
@@ -60,10 +188,29 @@ int cmd_plot(int argc, char **argv)
             return 2;
         }
     }
-    if (!in) {
-        cli_error("plot: no event file given (evray plot EVENTS [-o rate.png])");
+    if (!in && !labels) {
+        cli_error("plot: no event file given (evray plot EVENTS [-o rate.png], or --labels "
+                  "labels.h5 --flow flow.png)");
         return 2;
     }
+    if (!in && event_opt) {
+        cli_error("plot: %.*s draws events: give an event file", (int)strcspn(event_opt, "="),
+                  event_opt);
+        return 2;
+    }
+    if (labels && !flow_png && !depth_png) {
+        cli_error("plot: --labels needs --flow FILE or --depth FILE (what to draw)");
+        return 2;
+    }
+    if ((timed || flow_max > 0.0) && !flow_png && !depth_png) {
+        cli_error("plot: %s applies to --flow and --depth", timed ? "--time" : "--flow-max");
+        return 2;
+    }
+    if (flow_max > 0.0 && !flow_png) {
+        cli_error("plot: --flow-max applies to --flow");
+        return 2;
+    }
+    if (!in) return plot_labels(labels, timed ? t : NAN, flow_max, flow_png, depth_png);
 
     evr_error err = {{0}};
     evr_event *ev = NULL;
@@ -160,11 +307,16 @@ int cmd_plot(int argc, char **argv)
         printf("%s: %dx%d pixels, heat map %dx%d\n", heat, width, height, hw, hh);
     }
     rc = 0;
+    if ((flow_png || depth_png) && !labels && !(labels = labels_alloc = labels_beside(in)))
+        cli_error("out of memory");
+    else if (flow_png || depth_png)
+        rc = plot_labels(labels, timed ? t : NAN, flow_max, flow_png, depth_png);
 done:
     free(counts);
     free(x);
     free(on);
     free(off);
     free(ev);
+    free(labels_alloc);
     return rc;
 }

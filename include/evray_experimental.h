@@ -55,6 +55,29 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
                             evr_error *err);
 
+/* ---- labels.h5 (src/io/labels_read.c; README "Ground truth" has the layout) ---- */
+typedef struct {
+    int width, height;   /* of each frame */
+    size_t frames;       /* >= 1 */
+    double *t;           /* each frame's time, seconds, increasing (malloc'ed) */
+    double fps, flow_dt; /* the file's attributes (NaN when missing) */
+    int complete;        /* the run finished the file */
+} evr_labels_info;
+
+/* Reads a labels.h5's frame times and sizes (checked in a child process first: HDF5 crashes on
+ * some corrupt files). A file without the t, depth, instance and flow datasets, of inconsistent
+ * shapes or without frames is refused (EVR_ERR_FORMAT). Free with evr_labels_info_free. */
+evr_status evr_labels_read_info(const char *path, evr_labels_info *info, evr_error *err);
+void evr_labels_info_free(evr_labels_info *info);
+/* Reads frame k (< info->frames) of the file info was read from: width * height values of depth
+ * and instance, twice that of flow; a NULL buffer is not read. */
+evr_status evr_labels_read_frame(const char *path, const evr_labels_info *info, size_t k,
+                                 float *depth, uint32_t *instance, float *flow, evr_error *err);
+/* The frame nearest time t (seconds); EVR_ERR_ARG, naming the frames' range, when t is more
+ * than half a frame interval (1 / fps) before the first or after the last. */
+evr_status evr_labels_nearest_frame(const evr_labels_info *info, double t, size_t *k,
+                                    evr_error *err);
+
 /* ---- accuracy of an event stream against a reference (src/compare.c) ---- */
 /* One-to-one matching of events at the same pixel with the same polarity within a time
  * tolerance, in time order. */
@@ -97,6 +120,24 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec,
  * receive the image size. */
 evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w, int h,
                                 const char *title, int *out_w, int *out_h, evr_error *err);
+/* Draws an optical flow field (w x h, 2 floats per pixel: px/s, x right, y down; a pixel that is
+ * not finite has no surface) with the optical-flow colour wheel of Baker et al. (Middlebury):
+ * hue the direction (+x red, +y yellow, -x cyan-blue), saturation the magnitude over *max_px_s
+ * (white: no motion; beyond the maximum full colour at 3/4 brightness), no surface black; with a
+ * title and the wheel as a legend. *max_px_s <= 0: the 99th percentile of the finite magnitudes, returned
+ * there. Each flow pixel is scale x scale image pixels (the largest whole factor keeping the
+ * field within 640x640), the field's top-left corner at (EVR_PLOT_LABEL_X, EVR_PLOT_LABEL_Y);
+ * *scale (may be NULL) receives it. Writes an RGB8 PNG. */
+#define EVR_PLOT_LABEL_X 10
+#define EVR_PLOT_LABEL_Y 40
+evr_status evr_plot_flow_png(const char *path, const float *flow, int w, int h, const char *title,
+                             double *max_px_s, int *scale, evr_error *err);
+/* Draws a depth map (w x h; not finite: no surface) in the heat map's colours over the finite
+ * range, near white and bright, far black; no surface teal (0, 128, 128); with a title and a
+ * colour bar. Layout and *scale as evr_plot_flow_png; *near and *far (may be NULL) receive the
+ * range (NaN when no pixel has a surface). Writes an RGB8 PNG. */
+evr_status evr_plot_depth_png(const char *path, const float *depth, int w, int h, const char *title,
+                              double *near, double *far, int *scale, evr_error *err);
 /* channels: 1 (gray), 3 (RGB) or 4 (RGBA); bit_depth 8 or 16 (16-bit samples in native order).
  * Rows are top to bottom. Writes under path + ".tmp" and renames when complete. */
 evr_status evr_png_write(const char *path, const void *pixels, int width, int height, int channels,

@@ -44,6 +44,7 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" render /tmp/evray-am/a
     --duration 1.0 -o "$OUT/cs-am" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck all_materials exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x48 --duration 0.3 \
     --camera-path orbit+shake --labels-fps 30 -o "$OUT/cs-path" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck path+labels exit $?" >> "$OUT/sanitizer.log"
+# CPU and CUDA labels.h5 compared by gpu-carry/labels_compare (beside $E; no h5py here)
 python3 tests/test_cuda_labels.py "$E" > "$OUT/test_cuda_labels.log" 2>&1; echo "test_cuda_labels exit $?" >> "$OUT/test_cuda_labels.log"
 # issue 7's figure: the eye at 1280x720, 10 samples per frame, 30 fps, the whole 30 s, ideal
 # sensor, change-driven sampling against brute force in the same run, with the identity check

@@ -13,9 +13,10 @@ EVRAY = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("EVRAY", "build/evr
 failures = []
 
 
-def oracle_python(modules):
+def oracle_python(modules, optional=False):
     """The Python of the oracle environment (build/venv, made by scripts/test-venv.sh) that can
-    import modules; exits 77 (CTest: skipped) with a clear line when there is none."""
+    import modules; exits 77 (CTest: skipped) with a clear line when there is none, or with
+    optional returns None."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     # the environment beside the program, else the release build's (for build-asan)
     candidates = [os.environ.get("EVR_VENV_PYTHON"),
@@ -26,10 +27,31 @@ def oracle_python(modules):
                            text=True) if os.path.exists(python) else None
     if probe is None or probe.returncode != 0:
         why = "missing" if probe is None else "unusable: " + probe.stderr.strip().splitlines()[-1]
+        if optional:
+            print(f"note: the oracle environment {python} is {why}")
+            return None
         print(f"SKIP: the oracle environment {python} is {why} (run scripts/test-venv.sh; it "
               "needs the package registry)")
         sys.exit(77)
     return python
+
+
+def labels_compare_program():
+    """labels_compare (tests/labels_compare.c), built beside the evray under test (and carried
+    beside it to the GPU machine); None when it is not there."""
+    p = os.path.join(os.path.dirname(os.path.abspath(EVRAY)), "labels_compare")
+    return p if os.access(p, os.X_OK) else None
+
+
+def compare_labels(a, b):
+    """labels_compare's figures for two labels.h5 (a dict: same, depth, flow, seen, ...)."""
+    prog = labels_compare_program()
+    if prog is None:
+        raise SystemExit("labels_compare is not built beside " + EVRAY)
+    p = subprocess.run([prog, a, b], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise SystemExit(f"labels_compare {a} {b}: exit {p.returncode}: {p.stderr.strip()}")
+    return json.loads(p.stdout)
 
 
 def check(cond, what):

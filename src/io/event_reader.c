@@ -3,12 +3,11 @@
 #include "io/prophesee_read.h"
 #include "io/rosbag_read.h"
 #include "io/byte_order.h"
-#include "io/child_job.h"
 #include "io/file_read.h"
+#include "io/h5_read.h"
 
 #include <ctype.h>
 #include <errno.h>
-#include <hdf5.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
@@ -430,60 +429,6 @@ done:
 
 /* ---- HDF5 ---- */
 
-typedef struct {
-    char desc[200];
-    int got;
-} h5r_walk_data;
-
-static herr_t h5r_walk(unsigned i, const H5E_error2_t *e, void *data)
-{
-    h5r_walk_data *d = (h5r_walk_data *)data;
-    (void)i;
-    if (!d->got && e->desc && e->desc[0]) { /* keep the most specific one */
-        snprintf(d->desc, sizeof d->desc, "%s", e->desc);
-        d->got = 1;
-    }
-    return 0;
-}
-
-static evr_status h5r_fail(evr_error *err, const char *what, const char *path, evr_status st)
-{
-    h5r_walk_data d;
-    d.desc[0] = 0;
-    d.got = 0;
-    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, h5r_walk, &d);
-    H5Eclear2(H5E_DEFAULT);
-    if (d.got) snprintf(err->msg, sizeof err->msg, "%s: %s (%s)", path, what, d.desc);
-    else snprintf(err->msg, sizeof err->msg, "%s: %s", path, what);
-    return st;
-}
-
-static int h5r_int_attr(hid_t file, const char *name)
-{
-    int v = -1;
-    if (H5Aexists(file, name) > 0) {
-        hid_t a = H5Aopen(file, name, H5P_DEFAULT);
-        if (a >= 0) {
-            hid_t space = H5Aget_space(a);
-            if (space >= 0 && H5Sget_simple_extent_npoints(space) == 1 &&
-                H5Aread(a, H5T_NATIVE_INT, &v) < 0)
-                v = -1;
-            if (space >= 0) H5Sclose(space);
-            H5Aclose(a);
-        }
-    }
-    return v;
-}
-
-/* HDF5 would open a FIFO and block, or read a device: a regular file only. */
-static evr_status h5r_regular(const char *path, evr_error *err)
-{
-    const char *why = NULL;
-    if (evr_is_regular_file(path, &why)) return EVR_OK;
-    snprintf(err->msg, sizeof err->msg, "cannot open %s: %s", path, why);
-    return EVR_ERR_IO;
-}
-
 static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *width, int *height,
                           evr_error *err)
 {
@@ -498,7 +443,7 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
     const char *what = NULL;
     int w = -1, h = -1;
 
-    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
+    if ((st = evr_h5_regular(path, err)) != EVR_OK) return st;
     H5E_BEGIN_TRY
     {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -528,8 +473,8 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
             if (space >= 0) H5Sclose(space);
         }
         if (st == EVR_OK) {
-            w = h5r_int_attr(file, "width");
-            h = h5r_int_attr(file, "height");
+            w = evr_h5_int_attr(file, "width");
+            h = evr_h5_int_attr(file, "height");
             H5Eclear2(H5E_DEFAULT);
             if (count) {
                 size_t block = count < READ_BLOCK ? (size_t)count : READ_BLOCK;
@@ -572,7 +517,7 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
                 e->id = 0;
             }
         }
-        if (st != EVR_OK && st != EVR_ERR_NOMEM) h5r_fail(err, what, path, st);
+        if (st != EVR_OK && st != EVR_ERR_NOMEM) evr_h5_fail(err, what, path, st);
         for (int k = 0; k < 4; k++)
             if (ds[k] >= 0) H5Dclose(ds[k]);
         if (file >= 0) H5Fclose(file);
@@ -605,7 +550,7 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     const char *what = NULL;
     *idx = NULL;
     *n = 0;
-    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
+    if ((st = evr_h5_regular(path, err)) != EVR_OK) return st;
     H5E_BEGIN_TRY
     {
         file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -633,7 +578,7 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
                 st = EVR_ERR_FORMAT;
             }
         }
-        if (st != EVR_OK && st != EVR_ERR_NOMEM) h5r_fail(err, what, path, st);
+        if (st != EVR_OK && st != EVR_ERR_NOMEM) evr_h5_fail(err, what, path, st);
         if (space >= 0) H5Sclose(space);
         if (ds >= 0) H5Dclose(ds);
         if (file >= 0) H5Fclose(file);
@@ -651,8 +596,7 @@ evr_status evr_h5_read_ms_to_idx(const char *path, uint64_t **idx, size_t *n, ev
     return EVR_OK;
 }
 
-/* HDF5 1.10 crashes on some corrupt files (a division by zero, reads past its buffers: found by
- * tests/fuzz/fuzz_events_h5.c), so a file is read in a child process first (io/child_job.c). */
+/* An HDF5 event file is read in a child process first (io/h5_read.h says why). */
 typedef struct {
     const char *path;
     evr_error err;
@@ -674,28 +618,15 @@ static const void *h5_probe_run(void *ctx, char *msg, size_t cap)
     return p;
 }
 
-/* The longest the child may read: 600 s, or EVR_IMPORT_SECONDS (a test's switch). */
-static int h5_probe_seconds(void)
-{
-    const char *e = getenv("EVR_IMPORT_SECONDS");
-    int v = e ? atoi(e) : 0;
-    return v > 0 ? v : 600;
-}
-
 static evr_status read_h5_isolated(const char *path, evr_event **ev, size_t *n, int *width,
                                    int *height, evr_error *err)
 {
     h5_probe p;
-    char msg[sizeof err->msg];
     evr_status st;
-    int r;
-    if ((st = h5r_regular(path, err)) != EVR_OK) return st;
+    if ((st = evr_h5_regular(path, err)) != EVR_OK) return st;
     p.path = path;
     p.err.msg[0] = 0;
-    r = evr_child_job_run(h5_probe_run, &p, "HDF5", h5_probe_seconds(), msg, sizeof msg);
-    if (r == -1) snprintf(err->msg, sizeof err->msg, "%s: %s", path, msg);
-    else if (r == 0) snprintf(err->msg, sizeof err->msg, "%s", msg);
-    if (r == -1 || r == 0) return EVR_ERR_FORMAT;
+    if ((st = evr_h5_isolated(h5_probe_run, &p, path, err)) != EVR_OK) return st;
     return read_h5(path, ev, n, width, height, err);
 }
 

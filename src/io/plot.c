@@ -221,13 +221,13 @@ evr_status evr_plot_lines_png(const char *path, const evr_plot_spec *spec,
 }
 
 /* A perceptual-ish dark-to-bright map (black, purple, red, orange, yellow, white), v in [0, 1]. */
-static void colormap(double v, uint8_t out[3])
+void evr_plot_colormap(double v, uint8_t out[3])
 {
     static const double stops[6][3] = {{0, 0, 4},     {87, 16, 110},   {188, 55, 84},
                                        {249, 142, 9}, {252, 255, 164}, {255, 255, 255}};
-    double t = (v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v) * 4.0;
+    double t = (v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v) * 5.0;
     int i = (int)t, ch;
-    if (i > 3) i = 3;
+    if (i > 4) i = 4;
     t -= i;
     for (ch = 0; ch < 3; ch++)
         out[ch] = (uint8_t)lround(stops[i][ch] + (stops[i + 1][ch] - stops[i][ch]) * t);
@@ -258,7 +258,7 @@ evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w,
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
             uint8_t col[3];
-            colormap(log1p((double)counts[(size_t)y * (size_t)w + (size_t)x]) / lm, col);
+            evr_plot_colormap(log1p((double)counts[(size_t)y * (size_t)w + (size_t)x]) / lm, col);
             evr_canvas_rect(&c, x * s, top + y * s, (x + 1) * s, top + (y + 1) * s, col);
         }
     if (title) evr_canvas_text(&c, 4, 8, 2, title, BLACK);
@@ -267,7 +267,7 @@ evr_status evr_plot_heatmap_png(const char *path, const uint32_t *counts, int w,
     bar_h = H - top - 20;
     for (y = 0; y < bar_h; y++) {
         uint8_t col[3];
-        colormap(1.0 - (double)y / (bar_h - 1), col);
+        evr_plot_colormap(1.0 - (double)y / (bar_h - 1), col);
         evr_canvas_rect(&c, bar_x, top + y, bar_x + 16, top + y + 1, col);
     }
     {

@@ -27,6 +27,9 @@ void evr_canvas_line(evr_canvas *c, double x0, double y0, double x1, double y1, 
 void evr_canvas_text(evr_canvas *c, int x, int y, int scale, const char *text,
                      const uint8_t col[3]);
 int evr_text_width(const char *text, int scale);
+/* The heat map's dark-to-bright colours (black, purple, red, orange, yellow, white), v in [0, 1]
+ * (clamped). */
+void evr_plot_colormap(double v, uint8_t out[3]);
 
 /* The line plots and heat maps (evr_plot_series, evr_plot_spec, evr_plot_lines_png,
  * evr_plot_heatmap_png) are declared in evray_experimental.h. */

@@ -3,7 +3,7 @@ every target in tests/fuzz (fuzz_TARGET.c), from the scenes the tests already wr
 built-in scenes exported as GLB, tests/data/import, tests/import_assets.py, deform_assets.py,
 material_assets.py; .gltf files whose data is external are made self-contained), small files of
 the other formats Assimp reads, and the event files of one short run in every format evray
-writes. The seeds are small (a few KB each): libFuzzer mutates them from there.
+writes, and its labels.h5. The seeds are small (a few KB each): libFuzzer mutates them from there.
 
 Standard library only; EVRAY is the built program (it exports the demos and writes the event
 files)."""
@@ -137,6 +137,21 @@ def event_seeds(evray, work, outs):
     return made
 
 
+def labels_seeds(evray, work, out):
+    """labels.h5 of a short run of the square demo, with and without normals."""
+    n = 0
+    for extra in ([], ["--label-normals"]):
+        run = os.path.join(work, "labels%d" % n)
+        subprocess.run([evray, "demo", "--scene", "square", "-o", run, "--res", "32x24",
+                        "--duration", "0.2", "--labels-fps", "10", "--no-preview", "--quiet",
+                        *extra], check=True)
+        with open(os.path.join(run, "labels.h5"), "rb") as f, \
+                open(os.path.join(out, "%03d_labels.h5" % n), "wb") as g:
+            g.write(f.read())
+        n += 1
+    return n
+
+
 def main():
     evray, outdir = sys.argv[1], sys.argv[2]
     targets = [os.path.basename(p)[5:-2] for p in sorted(glob.glob(os.path.join(HERE, "fuzz_*.c")))]
@@ -147,6 +162,7 @@ def main():
     try:
         counts = {"scene": scene_seeds(evray, work, outs["scene"]),
                   "scene_assimp": assimp_seeds(outs["scene_assimp"])}
+        counts["labels_h5"] = labels_seeds(evray, work, outs["labels_h5"])
         counts.update(event_seeds(evray, work, {k: outs[k] for k in
                                                 ("events_h5", "events_text", "events_camera")}))
     finally:
