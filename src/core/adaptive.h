@@ -53,7 +53,11 @@ typedef struct {
 /* The fastest image speed (pixels per second) of the moving things that a sample's rays meet:
  * the primary ray up to its hit at t_hit (1e29 or more: nothing hit, the whole ray) and the
  * segments from the hit to every light that sends light there (as evr_skip_rays_meet). *jump is
- * set when one of them moved between the segments. 0 when they meet nothing that moves. */
+ * set when one of them moved between the segments. 0 when they meet nothing that moves.
+ * t_hit EVR_SKIP_DEEP: the sample's path went on past its primary hit (a reflection, refraction
+ * or blended layer: evr_adapt_hit), whose rays are not followed here: every moving thing counts
+ * (the fastest speed; seen through a curved mirror or lens its image may move faster still, so
+ * there the bound is an estimate). */
 EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
                                                 const evr_adapt_plan *pl, evr_ray ray, float t_hit,
                                                 int *jump)
@@ -62,10 +66,12 @@ EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
     uint64_t met = 0;
     *jump = 0;
     if (pl->num_boxes == 0) return 0.0f;
-    const int hit = t_hit < 1e29f;
+    if (t_hit == EVR_SKIP_DEEP) met = ~0ull;
+    const int hit = t_hit < 1e29f && t_hit != EVR_SKIP_DEEP;
     const float tmax = hit ? t_hit * 1.0001f + pl->pad : INFINITY;
     for (int b = 0; b < pl->num_boxes; b++)
-        if (evr_skip_segment_meets(ray.org, ray.dir, tmax, pl->lo[b], pl->hi[b], pl->pad))
+        if (!(met >> b & 1u) &&
+            evr_skip_segment_meets(ray.org, ray.dir, tmax, pl->lo[b], pl->hi[b], pl->pad))
             met |= 1ull << b;
     if (hit) {
         const evr_v3 p = evr_v3_add(ray.org, evr_v3_scale(ray.dir, t_hit));
@@ -85,6 +91,13 @@ EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
         if (pl->jump[b]) *jump = 1;
     }
     return v;
+}
+
+/* The hit distance a backend hands adaptive sampling for a sample (t_hit, its path's
+ * EVR_DEEP_* bits): EVR_SKIP_DEEP when the path went past the primary hit. */
+EVR_HD static inline float evr_adapt_hit(float t_hit, int deep)
+{
+    return deep ? EVR_SKIP_DEEP : t_hit;
 }
 
 /* Time between samples allowed by an image speed (pixels per second; 0: nothing moves). */

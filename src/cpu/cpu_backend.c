@@ -208,6 +208,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (t_hit) t_hit[i] = hit[i] ? rh.ray.tfar[i] : INFINITY;
         if (ids) ids[i] = 0;
+        if (deep) deep[i] = 0;
         if (!hit[i]) continue;
         int inst =
             b->groups.members[b->groups.group_first[rh.hit.instID[0][i]] + (int)rh.hit.geomID[i]];
@@ -655,6 +656,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
             int xs[PACKET], ys[PACKET], valid[PACKET], js[PACKET], i;
             float fs[PACKET], intensity[PACKET], t_hit[PACKET];
             unsigned ids[PACKET];
+            int deep[PACKET];
             for (i = 0; i < PACKET; i++) {
                 valid[i] = base + i < nact;
                 js[i] = act[valid[i] ? base + i : base];
@@ -663,7 +665,7 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 fs[i] = tnext[js[i]] / dt;
             }
             sample_intensity8_rows(b, seg->camera_static ? &pose_static : NULL, xs, ys, fs, valid,
-                                   intensity, t_hit, NULL, NULL, ids, rays);
+                                   intensity, t_hit, NULL, deep, ids, rays);
             for (i = 0; i < PACKET; i++) {
                 if (!valid[i]) continue;
                 const int jj = js[i];
@@ -671,7 +673,8 @@ static void render_tile_adaptive(cpu_backend *b, int tile, unsigned long long *s
                 const evr_ray ray = evr_camera_ray(&rs->camera, &pose_static, (float)xs[i] + 0.5f,
                                                    (float)ys[i] + 0.5f);
                 evr_adapt_stack *sk = &stack[jj];
-                float t = tnext[jj], in = intensity[i], hit = t_hit[i], step;
+                float t = tnext[jj], in = intensity[i], hit = evr_adapt_hit(t_hit[i], deep[i]),
+                      step;
                 unsigned id = ids[i];
                 int moving;
                 (*samples)++;

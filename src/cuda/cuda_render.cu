@@ -205,8 +205,10 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
         if (need) {
             const float f = t / a.dt;
             evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
+            int deep = 0;
             ci = gpu_sample<LAYOUT, GI>(a, &pose, x, y, f, &rays, &ch, &memo, INFINITY, nullptr,
-                                        nullptr, a.ids ? &cid : nullptr);
+                                        &deep, a.ids ? &cid : nullptr);
+            ch = evr_adapt_hit(ch, deep);
             ct = t;
             cand = true;
             need = false;
