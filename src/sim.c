@@ -261,12 +261,6 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
-    if (sim->labels && sim->rig.ortho) { /* core/labels.h projects through a perspective camera */
-        snprintf(err->msg, sizeof err->msg,
-                 "--labels-fps: label frames through an orthographic camera are not supported");
-        evr_sim_release(sim);
-        return EVR_ERR_ARG;
-    }
     if (sim->labels && evr_labels_times(sim) && !sim->backend->label_hits) {
         snprintf(err->msg, sizeof err->msg, "the %s backend cannot make label frames",
                  sim->backend->name);

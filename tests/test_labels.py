@@ -77,6 +77,48 @@ def flow_on_square():
     print(f"square: {n_sq} pixels on the square, worst relative error {worst:.2e}")
 
 
+def flow_orthographic():
+    """Through an orthographic camera (xmag = ymag = 2: the view spans 4 m): a square sliding at
+    1 m/s along +X flows at W / 4 px/s whatever its depth; depth is the distance to the
+    camera's plane."""
+    d = T.tmpdir()
+    path = os.path.join(d, "ortho.gltf")
+    g = gltf_build.Gltf()
+    g.cameras.append({"type": "orthographic",
+                      "orthographic": {"xmag": 2.0, "ymag": 2.0, "znear": 0.01, "zfar": 100.0}})
+    g.node("cam", camera=len(g.cameras) - 1, translation=[0, 0, 3])
+    g.light("lamp", "directional", 2.0)
+    grey = g.material({"pbrMetallicRoughness": {"baseColorFactor": [0.4, 0.4, 0.4, 1]}})
+    white = g.material({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.9, 1]}})
+    g.mesh_node("background", *gltf_build.rect(-4, 4, -4, 4, 0), grey)
+    sq = g.mesh_node("square", *gltf_build.rect(-0.5, 0.5, -0.5, 0.5, 0), white,
+                     translation=[-1, 0, 1])
+    g.animation([(sq, "translation", [0.0, 2.0], [[-1, 0, 1], [1, 0, 1]])])
+    g.write(path)
+    W = 32
+    out = os.path.join(d, "run")
+    T.run("render", path, "--res", f"{W}x{W}", "--duration", "1", "--labels-fps", "4", "-o", out,
+          "-q")
+    L = read_labels(os.path.join(out, "labels.h5"))
+    names = {i: node for i, node, _ in L["instances"]}
+    sq_id = [i for i, n in names.items() if n.endswith("square")][0]
+    v = W / 4.0
+    worst, n_sq = 0.0, 0
+    for k in range(len(L["t"])):
+        for y in range(W):
+            for x in range(W):
+                fx, fy = L["flow"][k][y][x]
+                z = L["depth"][k][y][x]
+                if L["instance"][k][y][x] == sq_id:
+                    n_sq += 1
+                    worst = max(worst, abs(fx - v) / v, abs(fy) / v, abs(z - 2.0) / 2.0)
+                else:
+                    worst = max(worst, abs(fx) / v, abs(fy) / v, abs(z - 3.0) / 3.0)
+    T.check(n_sq > 100, f"orthographic: pixels on the square {n_sq}")
+    T.check(worst < 0.005, f"orthographic flow and depth within 0.5% (worst {worst:.2e})")
+    print(f"orthographic: {n_sq} pixels on the square, worst relative error {worst:.2e}")
+
+
 def depth_on_tilted_plane():
     d = T.tmpdir()
     path = os.path.join(d, "tilted.gltf")
@@ -195,6 +237,7 @@ def pupil_centre():
 
 
 flow_on_square()
+flow_orthographic()
 depth_on_tilted_plane()
 imu_of_turning_camera()
 pupil_centre()

@@ -83,11 +83,17 @@ EVR_HD static inline evr_label_d3 evr_label_camera_point(const evr_label_pose *p
 }
 
 /* Image position of a camera-space point (core/camera.h's projection, in double); 0 when it is
- * behind the camera. */
+ * behind the camera (behind its plane z = 0, for an orthographic one). */
 EVR_HD static inline int evr_label_project(const evr_camera_intr *c, evr_label_d3 q, double *px,
                                            double *py)
 {
     if (!(q.z < 0.0)) return 0;
+    if (c->ortho) {
+        const double hy = (double)c->half_h, hx = hy * (double)c->aspect;
+        *px = (q.x / hx + 1.0) * 0.5 * (double)c->width;
+        *py = (1.0 - q.y / hy) * 0.5 * (double)c->height;
+        return 1;
+    }
     const double ty = (double)c->tan_half_y, tx = ty * (double)c->aspect;
     *px = (q.x / -q.z / tx + 1.0) * 0.5 * (double)c->width;
     *py = (1.0 - q.y / -q.z / ty) * 0.5 * (double)c->height;
