@@ -1130,7 +1130,9 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
         return EVR_ERR_BACKEND;
     }
     rtcSetDeviceErrorFunction(b->device, embree_error, b);
+    const double t_bvh = evr_host_seconds();
     if (!build_groups(b, s) || b->embree_error[0]) goto embree_fail;
+    b->base.bvh_seconds = evr_host_seconds() - t_bvh;
     b->top = rtcNewScene(b->device);
     if (!b->top) goto embree_fail;
     /* rebuilt every segment, but over a handful of instances (thousands when static instances are

@@ -454,6 +454,9 @@ static char *run_json(const evr_sim *sim)
 static void backend_times(evr_sim *sim)
 {
     sim->st.time_setup = sim->time_setup;
+    sim->st.time_setup_host = sim->time_setup_host;
+    sim->st.time_setup_bvh = sim->backend->bvh_seconds;
+    sim->st.time_first_plan = sim->time_first_plan;
     sim->st.time_render = sim->time_render;
     sim->st.time_device = sim->backend->device_seconds;
     sim->st.time_sort = sim->backend->sort_seconds;
