@@ -311,6 +311,7 @@ static const struct aiScene *sort_and_join(const struct aiScene *ai, char *dropp
     if (!(ai = aiApplyPostProcessing(ai, aiProcess_SortByPType))) return NULL;
     for (i = 0; i < ai->mNumMeshes; i++)
         if (ai->mMeshes[i]->mNumBones || ai->mMeshes[i]->mNumAnimMeshes) return ai;
+    if (evr_import_join_is_noop(ai)) return ai; /* the same scene, without the step's time */
     return aiApplyPostProcessing(ai, aiProcess_JoinIdenticalVertices);
 }
 
