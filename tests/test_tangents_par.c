@@ -1,7 +1,9 @@
-/* Generated tangents (src/scene/tangents.c) on several threads are the same bits as on one: a
- * bumpy grid with uv seams (vertices repeated with other uvs, welded by position, normal and
- * uv), mirrored triangles, triangles without a uv gradient, signed zeros and repeated vertices,
- * more than one chunk of triangles, sorted and summed on 1, 2, 3 and 4 threads. */
+/* Generated tangents (src/scene/tangents.c) are the same bits on any number of threads and
+ * whether the vertices are welded by the sort or by the hash: a bumpy grid with uv seams
+ * (vertices repeated with other uvs, welded by position, normal and uv), mirrored triangles,
+ * triangles without a uv gradient and repeated vertices, more than one chunk of triangles; once
+ * with signed zeros (-0 is equal to 0 as a float but not in bits: the sort decides) and once
+ * without (the hash may), on 1 to 4 threads, against the sort on one thread. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +14,7 @@
 #define NU 181
 #define NV 211
 
-static void make_mesh(evr_mesh *m)
+static void make_mesh(evr_mesh *m, int signed_zeros)
 {
     const uint32_t nv = 2 * NU * NV, nt = 4 * (NU - 1) * (NV - 1);
     memset(m, 0, sizeof *m);
@@ -37,10 +39,18 @@ static void make_mesh(evr_mesh *m)
                 const float l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
                 m->positions[3 * v] = x - 0.5f;
                 m->positions[3 * v + 1] = y - 0.5f;
-                m->positions[3 * v + 2] = i % 7 == 0 ? -0.0f : h; /* signed zeros */
+                m->positions[3 * v + 2] = signed_zeros && i % 7 == 0 ? -0.0f : h;
                 for (int k = 0; k < 3; k++) m->normals[3 * v + k] = n[k] / l;
                 m->uvs[2 * v] = copy && j > NV / 2 ? 1.0f - 2.0f * x : 2.0f * x;
                 m->uvs[2 * v + 1] = j % 11 == 0 ? 0.0f : 3.0f * y; /* flat rows: no gradient */
+                if (!signed_zeros) { /* x + 0 turns -0 (sin(0) times a negative) into +0 */
+                    for (int k = 0; k < 3; k++) {
+                        m->positions[3 * v + k] += 0.0f;
+                        m->normals[3 * v + k] += 0.0f;
+                    }
+                    m->uvs[2 * v] += 0.0f;
+                    m->uvs[2 * v + 1] += 0.0f;
+                }
             }
     uint32_t t = 0;
     for (uint32_t copy = 0; copy < 2; copy++)
@@ -54,19 +64,20 @@ static void make_mesh(evr_mesh *m)
             }
 }
 
-int main(void)
+static void same_tangents(int signed_zeros)
 {
     evr_mesh m;
-    make_mesh(&m);
+    make_mesh(&m, signed_zeros);
     CHECK(m.num_triangles > 65536); /* more than one chunk */
-    CHECK(evr_mesh_tangents_threads(&m, 1));
+    CHECK(evr_mesh_tangents_threads(&m, 1, 1));
     float *one = m.tangents;
-    for (int threads = 2; threads <= 4 && one; threads++) {
-        m.tangents = NULL;
-        CHECK(evr_mesh_tangents_threads(&m, threads));
-        CHECK(m.tangents && !memcmp(one, m.tangents, 4 * sizeof(float) * m.num_vertices));
-        free(m.tangents);
-    }
+    for (int threads = 1; threads <= 4 && one; threads++)
+        for (int by_sort = 0; by_sort < 2; by_sort++) {
+            m.tangents = NULL;
+            CHECK(evr_mesh_tangents_threads(&m, threads, by_sort));
+            CHECK(m.tangents && !memcmp(one, m.tangents, 4 * sizeof(float) * m.num_vertices));
+            free(m.tangents);
+        }
     /* and what the import calls, however many processors this machine has */
     m.tangents = NULL;
     CHECK(evr_mesh_generate_tangents(&m));
@@ -83,5 +94,11 @@ int main(void)
     free(m.normals);
     free(m.uvs);
     free(m.indices);
+}
+
+int main(void)
+{
+    same_tangents(1);
+    same_tangents(0);
     return check_report("test_tangents_par");
 }

@@ -259,10 +259,11 @@ evr_status evr_gltf_materials_read(importer *im, int *count);
 /* Tangents of mesh m (tangents.c): MikkTSpace's definition from its uvs (glTF's v, pointing down
  * the image) and normals; m->tangents allocated. 0 when out of memory. */
 int evr_mesh_generate_tangents(evr_mesh *m);
-/* The same on `threads` threads (1: on the caller alone); the tangents are the same bits for
- * any number (tests/test_tangents_par.c). evr_mesh_generate_tangents uses the processors for a
- * big mesh. */
-int evr_mesh_tangents_threads(evr_mesh *m, int threads);
+/* The same on `threads` threads (1: on the caller alone), the vertices welded by a sort
+ * (by_sort) or by a hash where that gives the same groups; the tangents are the same bits either
+ * way (tests/test_tangents_par.c). evr_mesh_generate_tangents uses the processors for a big
+ * mesh, and the hash. */
+int evr_mesh_tangents_threads(evr_mesh *m, int threads, int by_sort);
 /* Flattens the node tree depth-first (parents before children) and makes the instances. */
 evr_status evr_import_nodes(importer *im);
 /* The first node (in depth-first order) with Assimp name `name`, or -1. */

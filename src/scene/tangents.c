@@ -179,17 +179,66 @@ static int sort_records(tan_job *j, evr_par_pool *pool)
     return 1;
 }
 
+/* A vertex's weld key: the bits of its position, normal and uv. */
+static void weld_key(const evr_mesh *m, uint32_t v, uint32_t k[8])
+{
+    memcpy(k, m->positions + 3 * (size_t)v, 3 * sizeof(float));
+    memcpy(k + 3, m->normals + 3 * (size_t)v, 3 * sizeof(float));
+    memcpy(k + 6, m->uvs + 2 * (size_t)v, 2 * sizeof(float));
+}
+
+/* The groups the sort gives, by hashing: each vertex to the first vertex of the same key bits.
+ * With no -0 and no NaN in any key, keys equal as floats are equal bits, so the sort's runs are
+ * these sets and a run's first vertex (ties go by vertex) is the set's first. 1 when done; 0
+ * when a key holds -0 or NaN or memory ran out (then the sort decides). */
+static int weld_by_hash(const evr_mesh *m, uint32_t *group)
+{
+    const uint32_t nv = m->num_vertices;
+    size_t cap = 16, mask;
+    while (cap < 2 * (size_t)nv) cap *= 2;
+    mask = cap - 1;
+    uint32_t *slot = malloc(cap * sizeof *slot);
+    if (!slot) return 0;
+    memset(slot, 0xff, cap * sizeof *slot); /* empty */
+    for (uint32_t v = 0; v < nv; v++) {
+        uint32_t k[8], u[8];
+        uint64_t h = 0x9e3779b97f4a7c15ull;
+        weld_key(m, v, k);
+        for (int i = 0; i < 8; i++) {
+            if (k[i] == 0x80000000u || (k[i] & 0x7fffffffu) > 0x7f800000u) {
+                free(slot); /* -0 or NaN */
+                return 0;
+            }
+            h = (h ^ k[i]) * 0x100000001b3ull;
+            h ^= h >> 29;
+        }
+        size_t at = (size_t)h & mask;
+        group[v] = v;
+        for (; slot[at] != 0xffffffffu; at = (at + 1) & mask) {
+            weld_key(m, slot[at], u);
+            if (!memcmp(u, k, sizeof k)) {
+                group[v] = slot[at];
+                break;
+            }
+        }
+        if (group[v] == v) slot[at] = v;
+    }
+    free(slot);
+    return 1;
+}
+
 int evr_mesh_generate_tangents(evr_mesh *m)
 {
     const int big = m->num_vertices >= PAR_MIN || m->num_triangles >= PAR_MIN;
-    return evr_mesh_tangents_threads(m, big ? evr_par_threads(8) : 1);
+    return evr_mesh_tangents_threads(m, big ? evr_par_threads(8) : 1, 0);
 }
 
-int evr_mesh_tangents_threads(evr_mesh *m, int threads)
+int evr_mesh_tangents_threads(evr_mesh *m, int threads, int by_sort)
 {
     uint32_t nv = m->num_vertices, v, f;
-    weld_rec *rec = malloc((size_t)nv * sizeof *rec + 1);
     uint32_t *group = malloc((size_t)nv * sizeof *group + 1);
+    const int hashed = group && !by_sort && weld_by_hash(m, group);
+    weld_rec *rec = hashed ? NULL : malloc((size_t)nv * sizeof *rec + 1);
     /* per group and orientation (0 mirrored, 1 preserving): summed tangent and angle */
     float *acc = calloc((size_t)nv * 8 + 1, sizeof *acc);
     evr_par_pool *pool = threads > 1 ? evr_par_pool_new(threads) : NULL;
@@ -203,15 +252,16 @@ int evr_mesh_tangents_threads(evr_mesh *m, int threads)
     j.corners =
         malloc(sizeof *j.corners * (m->num_triangles < CHUNK ? m->num_triangles : CHUNK) + 1);
     m->tangents = malloc((size_t)nv * 4 * sizeof(float) + 1);
-    int ok = rec && group && acc && j.corners && m->tangents;
-    for (v = 0; ok && v < nv; v++) {
+    int ok = (hashed || rec) && group && acc && j.corners && m->tangents;
+    for (v = 0; ok && !hashed && v < nv; v++) {
         memcpy(rec[v].k, m->positions + 3 * v, 3 * sizeof(float));
         memcpy(rec[v].k + 3, m->normals + 3 * v, 3 * sizeof(float));
         memcpy(rec[v].k + 6, m->uvs + 2 * v, 2 * sizeof(float));
         rec[v].v = v;
     }
-    if (ok) ok = sort_records(&j, pool);
-    for (v = 0; ok && v < nv; v++) /* each vertex to the first of its run of equal keys */
+    if (ok && !hashed) ok = sort_records(&j, pool);
+    for (v = 0; ok && !hashed && v < nv;
+         v++) /* each vertex to the first of its run of equal keys */
         group[rec[v].v] = (v > 0 && !memcmp(rec[v].k, rec[v - 1].k, sizeof rec[v].k))
                               ? group[rec[v - 1].v]
                               : rec[v].v;
