@@ -260,8 +260,8 @@ int evr_mesh_tangents_threads(evr_mesh *m, int threads, int by_sort)
         rec[v].v = v;
     }
     if (ok && !hashed) ok = sort_records(&j, pool);
-    for (v = 0; ok && !hashed && v < nv;
-         v++) /* each vertex to the first of its run of equal keys */
+    /* by the sort: each vertex to the first of its run of equal keys */
+    for (v = 0; ok && !hashed && v < nv; v++)
         group[rec[v].v] = (v > 0 && !memcmp(rec[v].k, rec[v - 1].k, sizeof rec[v].k))
                               ? group[rec[v - 1].v]
                               : rec[v].v;
