@@ -34,8 +34,9 @@ typedef struct {
     double temporal_us; /* mean time between a pixel's samples */
     double render_s;    /* device kernels on the GPU, else the render wait */
     double peak_mb;
-    int skip;     /* change-driven sampling was on */
-    int adaptive; /* adaptive sampling (samples: those taken) */
+    int skip;            /* change-driven sampling was on */
+    int adaptive;        /* adaptive sampling (samples: those taken) */
+    evr_load_times load; /* the scene's load */
 } bench_figures;
 
 /* Samples taken per pixel per simulated second. */
@@ -97,6 +98,7 @@ static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, in
         const evr_stats *s = evr_sim_stats(sim);
         getrusage(RUSAGE_SELF, &ru);
         f->s = *s;
+        f->load = *evr_scene_load_times(scene);
         f->width = cfg.width;
         f->height = cfg.height;
         f->samples_per_frame = cfg.samples_per_frame;
@@ -124,6 +126,19 @@ static int bench_run(const evr_scene *scene, const evr_config *cfg_in, int keep,
     return bench_run_events(scene, cfg_in, keep, f, NULL, NULL);
 }
 
+/* Where the set-up went, from the file to the first segment's plan (none of it in wall_s). */
+static void print_setup(const bench_figures *f)
+{
+    const evr_load_times *l = &f->load;
+    const evr_stats *s = &f->s;
+    printf("set-up %.3f s: load %.3f (glTF checks %.3f, Assimp %.3f, materials and textures %.3f, "
+           "meshes %.3f with tangents %.3f, the rest %.3f), before the backend %.3f, backend "
+           "%.3f (BVH %.3f), first plan %.3f\n",
+           l->total + s->time_setup_host + s->time_setup + s->time_first_plan, l->total,
+           l->gltf_checks, l->assimp, l->materials, l->meshes, l->tangents, l->rest,
+           s->time_setup_host, s->time_setup, s->time_setup_bvh, s->time_first_plan);
+}
+
 static void print_row(const char *name, const bench_figures *f, int json)
 {
     const evr_stats *s = &f->s;
@@ -140,7 +155,7 @@ static void print_row(const char *name, const bench_figures *f, int json)
             "\"equivalent_samples_per_second\": %.6g, \"rays\": %llu, \"pixels_skipped\": %llu, "
             "\"pixels_skipped_per_segment\": %.1f, \"sampling\": \"%s\", \"samples_per_pixel_per_second\": %.6g, "
             "\"photon_seconds\": %.4f, \"photons_stored\": %llu, \"photon_collisions\": %llu, \"photon_cells_changed\": %llu, "
-            "\"photons_traced\": %llu, \"photons_reused\": %llu, \"device_seconds\": %.4f}\n",
+            "\"photons_traced\": %llu, \"photons_reused\": %llu, \"device_seconds\": %.4f, ",
             name, s->backend, s->device, f->width, f->height, f->samples_per_frame, s->sim_time,
             (unsigned long long)(s->events_on + s->events_off), s->wall_time, s->realtime_factor,
             (double)s->samples / w, (double)s->rays / w, f->temporal_us,
@@ -155,6 +170,14 @@ static void print_row(const char *name, const bench_figures *f, int json)
             (unsigned long long)s->photons_stored, (unsigned long long)s->photon_collisions,
             (unsigned long long)s->photon_cells_changed, (unsigned long long)s->photons_traced,
             (unsigned long long)s->photons_reused, s->time_device);
+        printf("\"load_seconds\": %.4f, \"load_gltf_checks_seconds\": %.4f, "
+               "\"load_assimp_seconds\": %.4f, \"load_materials_seconds\": %.4f, "
+               "\"load_meshes_seconds\": %.4f, \"load_tangents_seconds\": %.4f, "
+               "\"setup_host_seconds\": %.4f, \"setup_bvh_seconds\": %.4f, "
+               "\"first_plan_seconds\": %.4f}\n",
+               f->load.total, f->load.gltf_checks, f->load.assimp, f->load.materials,
+               f->load.meshes, f->load.tangents, s->time_setup_host, s->time_setup_bvh,
+               s->time_first_plan);
     } else {
         char res[32], spf[16];
         /* adaptive sampling has no samples per frame: each pixel picks its own times */
@@ -173,6 +196,7 @@ static void print_row(const char *name, const bench_figures *f, int json)
             s->time_copy / w, s->time_write / w);
         printf("(%s; %.3f s simulated; setup %.2f s not in wall_s)\n", s->device, s->sim_time,
                s->time_setup);
+        print_setup(f);
         if (f->adaptive) {
             printf(
                 "adaptive sampling: %.4g samples taken (all traced), %.1f per pixel per simulated second "

@@ -99,6 +99,18 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
 /* One line the loader has for the user (e.g. the animation clips that do not play by the
  * default rule), or NULL when it has nothing to say. Valid while the scene lives. */
 const char *evr_scene_notice(const evr_scene *s);
+/* Where a load's time went: seconds of wall time, each step's own (total: the whole load). */
+typedef struct {
+    double total;
+    double gltf_checks; /* glTF: the JSON and buffers checked (and patched) before Assimp reads */
+    double assimp;      /* Assimp's read and post-processing (identical vertices joined) */
+    double materials;   /* materials, their textures decoded and mip-mapped */
+    double meshes;      /* meshes taken from Assimp's, tangents included */
+    double tangents;    /* of meshes: tangents generated from uvs */
+    double rest;        /* nodes, animation, deformation, cameras, lights, number checks */
+} evr_load_times;
+/* The load's timings (zeros for NULL). Valid while the scene lives. */
+const evr_load_times *evr_scene_load_times(const evr_scene *s);
 /* Names of the built-in scenes, NULL-terminated. */
 const char *const *evr_demo_names(void);
 /* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
@@ -292,6 +304,12 @@ typedef struct {
      * holding every event before complete_until and a run.json saying the run failed, 0 when
      * the run left nothing. */
     int outputs_kept;
+    /* set-up, before the first segment renders (seconds; the scene's load is evr_load_times) */
+    double time_setup_host; /* before the backend: the renderer's view of the scene, the camera,
+                                trackers, tables */
+    double time_setup_bvh;  /* of time_setup: the ray tracer's acceleration structures built */
+    double time_first_plan; /* the run's start to the first segment's plan (motion keys, skip
+                                plan, deformation keys) taken */
 } evr_stats;
 
 typedef struct evr_sim evr_sim;

@@ -105,6 +105,7 @@ struct evr_backend {
     double wait_seconds; /* the calling thread blocked on the device in submit and collect (GPU) */
     double sort_seconds, copy_seconds;
     uint64_t device_bytes; /* memory held on the device */
+    double bvh_seconds;    /* set-up: the acceleration structures' builds (0: not measured) */
 };
 
 /* Host arrays behind an evr_render_scene (everything but the per-segment keys). */

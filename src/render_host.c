@@ -1,10 +1,20 @@
 #include "backend.h"
+#include "par_pool.h"
 #include "core/hit_filter.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A part of the BSDF table's rows (70 ms on one core of machine A, every run's set-up). */
+static void bsdf_rows_part(void *ctx, int k, int thread)
+{
+    size_t j0, j1;
+    (void)thread;
+    evr_par_share(EVR_BSDF_ROUGH, 4, k, &j0, &j1);
+    evr_bsdf_table_fill_rows(ctx, 1024, (int)j0, (int)j1);
+}
 
 int evr_render_mesh_filter(const evr_scene *s, const evr_mesh *m)
 {
@@ -45,7 +55,11 @@ evr_status evr_render_host_init(evr_render_host *h, const evr_scene *s, int came
         h->materials[i] = *p;
         if (p->transmission > 0.0f || p->alpha_mode == EVR_ALPHA_BLEND) h->rs.translucent = 1;
     }
-    evr_bsdf_table_fill(h->bsdf_table, 1024);
+    {
+        evr_par_pool *pool = evr_par_pool_new(evr_par_threads(4)); /* NULL: all here */
+        evr_par_pool_run(pool, 4, bsdf_rows_part, h->bsdf_table);
+        evr_par_pool_free(pool);
+    }
     for (i = 0; i < s->num_textures; i++) {
         h->textures[i].width = s->textures[i].width;
         h->textures[i].height = s->textures[i].height;

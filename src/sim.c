@@ -114,6 +114,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     int i;
     *out = NULL;
     evr_config cur;
+    const double t_new = evr_host_seconds();
     if ((st = evr_config_validate(c, s, err)) != EVR_OK ||
         (st = evr_config_current(c, &cur, err)) != EVR_OK)
         return st;
@@ -240,6 +241,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     if (!sim->rig.has_path) mark_used(sim, sim->rig.node);
 
     double t_setup = evr_host_seconds();
+    sim->time_setup_host = t_setup - t_new;
     st = make_backend(sim, err);
     sim->time_setup = evr_host_seconds() - t_setup;
     if (st != EVR_OK) {
@@ -438,6 +440,7 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     const double tw = evr_host_seconds();
     const evr_planned_segment *pl = evr_planner_take(sim->planner, i);
     sim->time_plan_wait += evr_host_seconds() - tw;
+    if (i == 0) sim->time_first_plan = evr_host_seconds() - sim->wall0; /* the planner started */
     if (pl->failed) {
         evr_planner_release(sim->planner, i);
         return nomem(err);

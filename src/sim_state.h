@@ -107,6 +107,7 @@ struct evr_sim {
     double wall0;          /* the run's start: its wall time ends when every output is complete */
     double time_motion;    /* motion keys and the skip plan, per segment on the planner's thread */
     double time_plan_wait; /* the segment loop waiting for the planner */
+    double time_setup_host, time_first_plan; /* set-up before the backend; the first plan */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
 };
 

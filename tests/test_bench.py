@@ -51,6 +51,20 @@ T.check(len(gi_line) == 1 and f"{js['photons_traced']} photon paths traced, {js[
 p = T.run("bench", "--scene", "cornell", "--backend", "cpu", "--res", "48x36", "--duration", "0.1")
 T.check("global illumination:" not in p.stdout, "bench without GI: no photon line")
 
+# the set-up's phases: one line, the JSON's keys; the phases add up to no more than the whole
+setup = [l for l in p.stdout.splitlines() if l.startswith("set-up ")]
+T.check(len(setup) == 1 and "load" in setup[0] and "BVH" in setup[0] and "first plan" in setup[0],
+        f"bench: one set-up line ({setup})")
+keys = ("load_seconds", "load_gltf_checks_seconds", "load_assimp_seconds", "load_materials_seconds",
+        "load_meshes_seconds", "load_tangents_seconds", "setup_host_seconds", "setup_bvh_seconds",
+        "first_plan_seconds")
+T.check(all(k in js and js[k] >= 0 for k in keys), "bench --json: the set-up's phases")
+T.check(js["load_seconds"] > 0 and js["load_assimp_seconds"] + js["load_gltf_checks_seconds"] +
+        js["load_materials_seconds"] + js["load_meshes_seconds"] <= js["load_seconds"] + 1e-3
+        and js["load_tangents_seconds"] <= js["load_meshes_seconds"] + 1e-6
+        and 0 < js["setup_bvh_seconds"] <= js["setup_seconds"] + 1e-6,
+        f"bench --json: the phases inside the whole ({ {k: js[k] for k in keys} })")
+
 # --sweep res, tiny: 80x60 and 160x120 over 0.05 s
 out = os.path.join(tmp, "sweep")
 os.makedirs(out)

@@ -126,8 +126,27 @@ static void test_reciprocity_and_spread(void)
     CHECK(fabs(e0 - e1) <= 0.02 * e0);
 }
 
+/* The table filled by rows in parts, in any order (the set-up fills it on a pool), is the whole
+ * table's bits. */
+static void test_table_by_rows(void)
+{
+    const size_t n = 2 * EVR_BSDF_MU * EVR_BSDF_ROUGH;
+    float *whole = malloc(n * sizeof *whole), *parts = malloc(n * sizeof *parts);
+    CHECK(whole && parts);
+    if (!whole || !parts) return;
+    evr_bsdf_table_fill(whole, 256);
+    memset(parts, 0xff, n * sizeof *parts);
+    evr_bsdf_table_fill_rows(parts, 256, EVR_BSDF_ROUGH / 2, EVR_BSDF_ROUGH);
+    evr_bsdf_table_fill_rows(parts, 256, 3, EVR_BSDF_ROUGH / 2);
+    evr_bsdf_table_fill_rows(parts, 256, 0, 3);
+    CHECK(!memcmp(whole, parts, n * sizeof *parts));
+    free(whole);
+    free(parts);
+}
+
 int main(void)
 {
+    test_table_by_rows();
     test_white_furnace();
     test_table_matches_integral();
     test_fresnel_limits();

@@ -95,11 +95,13 @@ EVR_HD static inline void evr_bsdf_table_ab(const float *table, float mu, float 
     *b = (p00[1] * (1 - fx) + p10[1] * fx) * (1 - fy) + (p01[1] * (1 - fx) + p11[1] * fx) * fy;
 }
 
-/* Fills the table (2 * EVR_BSDF_MU * EVR_BSDF_ROUGH floats) by integrating the lobe over
- * GGX-distributed half vectors on a Hammersley set of n points per entry. Host code. */
-static inline void evr_bsdf_table_fill(float *table, int n)
+/* Fills the table's roughness rows [j0, j1) (of EVR_BSDF_ROUGH; each row EVR_BSDF_MU entries of
+ * 2 floats) by integrating the lobe over GGX-distributed half vectors on a Hammersley set of n
+ * points per entry; rows are independent, so parts of the table can be filled at once. Host
+ * code. */
+static inline void evr_bsdf_table_fill_rows(float *table, int n, int j0, int j1)
 {
-    for (int j = 0; j < EVR_BSDF_ROUGH; j++) {
+    for (int j = j0; j < j1; j++) {
         const float r = (float)j / (float)(EVR_BSDF_ROUGH - 1);
         float alpha = r * r;
         if (alpha < EVR_GGX_ALPHA_MIN) alpha = EVR_GGX_ALPHA_MIN;
@@ -140,6 +142,12 @@ static inline void evr_bsdf_table_fill(float *table, int n)
             table[2 * (j * EVR_BSDF_MU + i) + 1] = (float)(sb / n);
         }
     }
+}
+
+/* The whole table (2 * EVR_BSDF_MU * EVR_BSDF_ROUGH floats). */
+static inline void evr_bsdf_table_fill(float *table, int n)
+{
+    evr_bsdf_table_fill_rows(table, n, 0, EVR_BSDF_ROUGH);
 }
 
 #endif

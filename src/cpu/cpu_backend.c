@@ -985,12 +985,13 @@ static void cpu_release(evr_backend *base)
 /* Adds a mesh to an Embree scene as geometry geom_id, its vertices transformed by xf (NULL:
  * object space), with the hit filters of its material (filter: evr_mesh_view.filter). */
 static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, const evr_m34 *xf,
-                             unsigned geom_id, const evr_cpu_filter_map *map, int filter)
+                             unsigned geom_id, const evr_cpu_filter_map *map, int filter,
+                             enum RTCBuildQuality quality)
 {
     uint32_t v;
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return 0;
-    rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_HIGH);
+    rtcSetGeometryBuildQuality(g, quality);
     float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                         3 * sizeof(float), m->num_vertices);
     unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
@@ -1015,6 +1016,32 @@ static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, cons
     return 1;
 }
 
+/* The quality of the trees that are built once (every group's but a deforming one's): HIGH (spatial splits) while
+ * they hold at most this many triangles in all, MEDIUM (binned SAH, 4-6x faster to build) past
+ * it. On a 1 M-triangle model HIGH took 0.73 s of set-up, MEDIUM 0.19 s, and the renders and
+ * events were the same (docs/benchmarks.md, "Set-up"). */
+#define EVR_HIGH_QUALITY_TRIANGLES 262144u
+
+static enum RTCBuildQuality static_quality(const evr_scene *s, const evr_instance_groups *gr)
+{
+    uint64_t tris = 0;
+    uint8_t *seen = calloc((size_t)s->num_meshes + 1, 1);
+    for (int g = 0; g < gr->num_groups; g++) {
+        const int kind = gr->group_kind[g];
+        for (int j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
+            const int mesh = s->instances[gr->members[j]].mesh;
+            if (kind == EVR_GROUP_BAKED || kind == EVR_GROUP_MOVING)
+                tris += s->meshes[mesh].num_triangles;
+            else if (kind == EVR_GROUP_STATIC && seen && !seen[mesh]) {
+                seen[mesh] = 1; /* one tree per mesh, however many instances */
+                tris += s->meshes[mesh].num_triangles;
+            }
+        }
+    }
+    free(seen);
+    return tris > EVR_HIGH_QUALITY_TRIANGLES ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH;
+}
+
 /* Groups the instances (see cpu_backend) and builds one Embree scene per group (per mesh for
  * static groups). */
 static int build_groups(cpu_backend *b, const evr_scene *s)
@@ -1026,6 +1053,7 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
         free(mesh_scenes);
         return 0;
     }
+    const enum RTCBuildQuality quality = static_quality(s, gr);
     b->filter_map.rs = &b->host.rs;
     b->filter_map.members = gr->members;
     b->filter_map.group_first = gr->group_first;
@@ -1045,9 +1073,9 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
                     break;
                 }
                 mesh_scenes[mesh] = sc;
-                rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+                rtcSetSceneBuildQuality(sc, quality);
                 if (!add_mesh_geometry(b->device, sc, &s->meshes[mesh], NULL, 0, &b->filter_map,
-                                       b->host.meshes[mesh].filter)) {
+                                       b->host.meshes[mesh].filter, quality)) {
                     ok = 0;
                     break;
                 }
@@ -1088,14 +1116,14 @@ static int build_groups(cpu_backend *b, const evr_scene *s)
             rtcCommitScene(sc);
             continue;
         }
-        rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_HIGH);
+        rtcSetSceneBuildQuality(sc, quality); /* baked or moving: built once */
         for (j = gr->group_first[g]; j < gr->group_first[g + 1]; j++) {
             const evr_instance *in = &s->instances[gr->members[j]];
             evr_m34 world = evr_node_world_at(s, in->node, s->anim_start);
             if (!add_mesh_geometry(b->device, sc, &s->meshes[in->mesh],
                                    gr->group_kind[g] == EVR_GROUP_BAKED ? &world : NULL,
                                    (unsigned)(j - gr->group_first[g]), &b->filter_map,
-                                   b->host.meshes[in->mesh].filter)) {
+                                   b->host.meshes[in->mesh].filter, quality)) {
                 ok = 0;
                 break;
             }
@@ -1152,7 +1180,9 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
         return EVR_ERR_BACKEND;
     }
     rtcSetDeviceErrorFunction(b->device, embree_error, b);
+    const double t_bvh = evr_host_seconds();
     if (!build_groups(b, s) || b->embree_error[0]) goto embree_fail;
+    b->base.bvh_seconds = evr_host_seconds() - t_bvh;
     b->top = rtcNewScene(b->device);
     if (!b->top) goto embree_fail;
     /* rebuilt every segment, but over a handful of instances (thousands when static instances are

@@ -408,8 +408,16 @@ static char *run_json(const evr_sim *sim)
         evr_json_number(&j, sim->setup.adaptive ? (spps > 0.0 ? 1.0 / spps : 0.0)
                                                 : 1.0 / (sim->fps * sim->cfg.samples_per_frame));
     }
+    evr_json_key(&j, "time_load_seconds"); /* the scene's (evr_scene_load_times) */
+    evr_json_number(&j, evr_scene_load_times(sim->scene)->total);
+    evr_json_key(&j, "time_setup_host_seconds");
+    evr_json_number(&j, sim->time_setup_host);
     evr_json_key(&j, "time_setup_seconds");
     evr_json_number(&j, sim->time_setup);
+    evr_json_key(&j, "time_setup_bvh_seconds");
+    evr_json_number(&j, sim->backend->bvh_seconds);
+    evr_json_key(&j, "time_first_plan_seconds");
+    evr_json_number(&j, sim->time_first_plan);
     evr_json_key(&j, "time_render_seconds");
     evr_json_number(&j, sim->time_render);
     evr_json_key(&j, "time_motion_seconds");
@@ -472,6 +480,9 @@ static char *run_json(const evr_sim *sim)
 static void backend_times(evr_sim *sim)
 {
     sim->st.time_setup = sim->time_setup;
+    sim->st.time_setup_host = sim->time_setup_host;
+    sim->st.time_setup_bvh = sim->backend->bvh_seconds;
+    sim->st.time_first_plan = sim->time_first_plan;
     sim->st.time_render = sim->time_render;
     sim->st.time_device = sim->backend->device_seconds;
     sim->st.time_sort = sim->backend->sort_seconds;

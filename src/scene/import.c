@@ -109,6 +109,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/config.h>
 
+#include "host_clock.h"
 #include "io/byte_order.h"
 #include "io/child_job.h"
 #include "io/file_read.h"
@@ -310,6 +311,7 @@ static const struct aiScene *sort_and_join(const struct aiScene *ai, char *dropp
     if (!(ai = aiApplyPostProcessing(ai, aiProcess_SortByPType))) return NULL;
     for (i = 0; i < ai->mNumMeshes; i++)
         if (ai->mMeshes[i]->mNumBones || ai->mMeshes[i]->mNumAnimMeshes) return ai;
+    if (evr_import_join_is_noop(ai)) return ai; /* the same scene, without the step's time */
     return aiApplyPostProcessing(ai, aiProcess_JoinIdenticalVertices);
 }
 
@@ -333,13 +335,14 @@ static void importer_free(importer *im)
 static evr_status convert(const struct aiScene *ai, const char *source, const char *path,
                           const char *dir, const char *ext, const unsigned char *bytes,
                           size_t nbytes, const evr_load_options *opts, const char *dropped,
-                          evr_scene **out, evr_error *err)
+                          const evr_load_times *before, evr_scene **out, evr_error *err)
 {
     importer im;
     evr_scene *s;
     evr_status st;
     uint64_t tris = 0;
     int i;
+    double t = evr_host_seconds(), t1;
 
     evr_error local;
     memset(&im, 0, sizeof im);
@@ -348,6 +351,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
     if (!s) return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     im.ai = ai;
     im.s = s;
+    s->times = *before;
     im.strict = opts->strict;
     im.allow_external = opts->allow_external;
     im.in_memory = path == NULL;
@@ -371,7 +375,11 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
 
     if (dropped[0]) evr_import_warn(&im, "%s", dropped);
     if ((st = evr_import_materials(&im)) != EVR_OK) goto fail;
+    t1 = evr_host_seconds();
+    s->times.materials = t1 - t;
     if ((st = evr_import_meshes(&im, &tris)) != EVR_OK) goto fail;
+    t = evr_host_seconds();
+    s->times.meshes = t - t1;
     if (tris == 0) {
         st = evr_import_fail(err, EVR_ERR_FORMAT,
                              "'%s' has no triangles (points and lines are not rendered)", source);
@@ -400,6 +408,7 @@ static evr_status convert(const struct aiScene *ai, const char *source, const ch
         goto fail;
     }
     importer_free(&im);
+    s->times.rest = evr_host_seconds() - t;
     *out = s;
     return EVR_OK;
 fail:
@@ -504,6 +513,12 @@ void evr_load_options_init(evr_load_options *o, size_t size)
     o->size = size;
 }
 
+const evr_load_times *evr_scene_load_times(const evr_scene *s)
+{
+    static const evr_load_times none;
+    return s ? &s->times : &none;
+}
+
 const char *evr_scene_notice(const evr_scene *s) { return s && s->notice[0] ? s->notice : NULL; }
 
 /* 1 when the bytes may be glTF 2.0: a GLB, or JSON text (after any byte order mark). */
@@ -586,6 +601,8 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
     char dir[512], dropped[256];
     const char *ext, *slash;
     evr_status st;
+    evr_load_times times = {0};
+    double t0 = evr_host_seconds(), t;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load: no output pointer");
@@ -631,6 +648,7 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
             return st;
         }
     }
+    times.gltf_checks = evr_host_seconds() - t0; /* with the file's first read */
     /* every file Assimp opens goes through this (import_memfile.c) */
     if (!(io = evr_memfile_io_new(path, patched, npatched, dir, o.allow_external))) {
         free(bytes);
@@ -645,10 +663,12 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         evr_memfile_io_free(io);
         return evr_import_fail(err, EVR_ERR_NOMEM, "out of memory");
     }
+    t = evr_host_seconds();
     {
         assimp_read r = {path, io, props, dropped, sizeof dropped};
         st = assimp_load(&r, bytes != NULL, path, &ai, err);
     }
+    times.assimp = evr_host_seconds() - t;
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
@@ -656,9 +676,10 @@ evr_status evr_scene_load_with(const char *path, const evr_load_options *opts, e
         free(bytes);
         return st;
     }
-    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, dropped, out, err);
+    st = convert(ai, path, path, dir, ext, bytes, nbytes, &o, dropped, &times, out, err);
     free(bytes);
     aiReleaseImport(ai);
+    if (st == EVR_OK) (*out)->times.total = evr_host_seconds() - t0;
     return st;
 }
 
@@ -680,6 +701,8 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
     char source[64], dropped[256], name[64];
     evr_status st;
     int gltf;
+    evr_load_times times = {0};
+    double t0 = evr_host_seconds(), t;
 
     if (err) err->msg[0] = 0;
     if (!out) return evr_import_fail(err, EVR_ERR_ARG, "evr_scene_load_memory: no output pointer");
@@ -699,6 +722,8 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         src.allow_external = o.allow_external;
         if ((st = gltf_before_assimp(&src, &patched, &npatched, err)) != EVR_OK) return st;
     }
+    t = evr_host_seconds();
+    times.gltf_checks = t - t0;
     /* Assimp reads the bytes as a file of this name through import_memfile.c, which opens no
      * other file unless external files are allowed (then relative to the current folder) */
     snprintf(name, sizeof name, "evray-memory.%.32s", hint);
@@ -716,13 +741,15 @@ evr_status evr_scene_load_memory_with(const void *data, size_t size, const char 
         assimp_read r = {name, io, props, dropped, sizeof dropped};
         st = assimp_load(&r, gltf, source, &ai, err);
     }
+    times.assimp = evr_host_seconds() - t;
     aiReleasePropertyStore(props);
     evr_memfile_io_free(io);
     free(patched);
     if (st != EVR_OK) return st;
-    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, dropped, out,
-                 err);
+    st = convert(ai, source, NULL, "", hint, (const unsigned char *)data, size, &o, dropped, &times,
+                 out, err);
     aiReleaseImport(ai);
+    if (st == EVR_OK) (*out)->times.total = evr_host_seconds() - t0;
     return st;
 }
 

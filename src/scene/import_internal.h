@@ -259,6 +259,11 @@ evr_status evr_gltf_materials_read(importer *im, int *count);
 /* Tangents of mesh m (tangents.c): MikkTSpace's definition from its uvs (glTF's v, pointing down
  * the image) and normals; m->tangents allocated. 0 when out of memory. */
 int evr_mesh_generate_tangents(evr_mesh *m);
+/* The same on `threads` threads (1: on the caller alone), the vertices welded by a sort
+ * (by_sort) or by a hash where that gives the same groups; the tangents are the same bits either
+ * way (tests/test_tangents_par.c). evr_mesh_generate_tangents uses the processors for a big
+ * mesh, and the hash. */
+int evr_mesh_tangents_threads(evr_mesh *m, int threads, int by_sort);
 /* Flattens the node tree depth-first (parents before children) and makes the instances. */
 evr_status evr_import_nodes(importer *im);
 /* The first node (in depth-first order) with Assimp name `name`, or -1. */
@@ -291,5 +296,8 @@ evr_status evr_import_lights(importer *im);
  * quaternions not zero, cameras with a field of view in (0, pi) and znear > 0, lights not
  * negative: one error line naming the element (import_check.c). */
 evr_status evr_import_check_numbers(importer *im);
+/* 1 when Assimp's JoinIdenticalVertices would change no mesh of ai (every vertex used, no two
+ * it could merge), found without it (import_join.c); 0 when it may change one. */
+int evr_import_join_is_noop(const struct aiScene *ai);
 
 #endif

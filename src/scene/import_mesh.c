@@ -9,6 +9,7 @@
 #include <assimp/scene.h>
 #include <assimp/material.h>
 
+#include "host_clock.h"
 #include "scene/import_internal.h"
 
 /* Tangents for a mesh whose material has a normal texture: the file's (Assimp's mTangents and
@@ -50,8 +51,10 @@ static evr_status mesh_tangents(importer *im, const struct aiMesh *am, evr_mesh 
         free(m->tangents);
         m->tangents = NULL;
     }
-    if (!evr_mesh_generate_tangents(m))
-        return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory generating tangents");
+    const double t = evr_host_seconds();
+    const int made = evr_mesh_generate_tangents(m);
+    im->s->times.tangents += evr_host_seconds() - t;
+    if (!made) return evr_import_fail(im->err, EVR_ERR_NOMEM, "out of memory generating tangents");
     return EVR_OK;
 }
 

@@ -154,6 +154,7 @@ struct evr_scene {
     evr_v3 bounds_min, bounds_max; /* world bounds at rest pose */
     char *warnings;   /* what evray does not render of the file: lines ending in '\n', or NULL */
     int num_warnings; /* how many there were (the text keeps the first EVR_MAX_WARNINGS) */
+    evr_load_times times; /* where the load's time went (evr_scene_load_times) */
 };
 
 #define EVR_MAX_WARNINGS 16
