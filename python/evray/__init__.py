@@ -116,13 +116,28 @@ class Simulator:
             config = Config(**{**config.kwargs, **kwargs})
         self.scene = scene
         self.config = config
-        self.stats = None
+        self._stats = None
+        self._run = None
         _evray.validate(scene, config._c)  # against the scene too (ValueError)
 
+    @property
+    def stats(self):
+        """The run's statistics (a dict of evr_stats' fields): while it goes, as of its last
+        finished segment; then the last run's final ones (None before any)."""
+        return self._run.stats() if self._run is not None else self._stats
+
+    def _start(self, cfg):
+        if self._run is not None:
+            raise RuntimeError("this Simulator is running already")
+        self._run = _evray.new_run(self.scene, cfg)
+        return self._run
+
     def _finish(self, run):
-        interrupted = run.finish()
-        self.stats = run.stats()
-        return interrupted
+        try:
+            run.finish()
+        finally:
+            self._stats = run.stats()
+            self._run = None
 
     def stream(self, out_dir=None):
         """Yields the run's events as arrays of EVENT_DTYPE (x, y, t, p), in time order, as the
@@ -139,8 +154,7 @@ class Simulator:
         else:
             extra = [("--out", os.fspath(out_dir))]
         try:
-            cfg = self.config._with(extra, no_event_files=tmp is not None)
-            run = _evray.new_run(self.scene, cfg)
+            run = self._start(self.config._with(extra, no_event_files=tmp is not None))
             try:
                 run.start_stream()
                 while True:
@@ -159,7 +173,7 @@ class Simulator:
         the evray command does; returns the statistics (also self.stats). Ctrl-C stops the run
         and completes its files before KeyboardInterrupt goes on."""
         extra = [("--out", os.fspath(out_dir))] if out_dir is not None else []
-        run = _evray.new_run(self.scene, self.config._with(extra))
+        run = self._start(self.config._with(extra))
         try:
             run.start_files()
             run.wait()
