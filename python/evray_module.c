@@ -9,6 +9,9 @@
  * consumer has copied the batch into a bytearray, so a slow consumer holds the run back through
  * the library's own bounded queue (evr_sim_set_sink). */
 #define PY_SSIZE_T_CLEAN
+/* the stable ABI of Python 3.9 and later: one build of the module loads in any of them (the GPU
+ * machine's Python is not this one's) */
+#define Py_LIMITED_API 0x03090000
 #include <Python.h>
 
 #include <errno.h>
@@ -21,6 +24,18 @@
 #include "evray_experimental.h"
 
 #define WAIT_SLICE_NS 50000000L /* 50 ms: how long Ctrl-C may wait to be seen */
+
+/* The types, made at import from their specs (the stable ABI has no static types). */
+static PyTypeObject *SceneType, *ConfigType, *RunType;
+
+/* A heap type's instance freed, and its reference to the type dropped. */
+static void free_object(PyObject *self)
+{
+    PyTypeObject *t = Py_TYPE(self);
+    freefunc f = (freefunc)PyType_GetSlot(t, Py_tp_free);
+    f(self);
+    Py_DECREF(t);
+}
 
 /* ---- errors ---- */
 static PyObject *raise_status(evr_status st, const evr_error *err)
@@ -41,7 +56,7 @@ typedef struct {
 static void scene_dealloc(SceneObject *self)
 {
     evr_scene_release(self->scene);
-    Py_TYPE(self)->tp_free((PyObject *)self);
+    free_object((PyObject *)self);
 }
 
 static PyObject *scene_describe(SceneObject *self, PyObject *unused)
@@ -73,18 +88,16 @@ static PyMethodDef scene_methods[] = {
     {"notice", (PyCFunction)scene_notice, METH_NOARGS, "The loader's note, or None."},
     {NULL, NULL, 0, NULL}};
 
-static PyTypeObject SceneType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "evray._evray.Scene",
-    .tp_basicsize = sizeof(SceneObject),
-    .tp_dealloc = (destructor)scene_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A loaded scene (evray.load, evray.demo).",
-    .tp_methods = scene_methods,
-};
+static PyType_Slot scene_slots[] = {{Py_tp_dealloc, (void *)scene_dealloc},
+                                    {Py_tp_doc, (void *)"A loaded scene (evray.load, evray.demo)."},
+                                    {Py_tp_methods, scene_methods},
+                                    {0, NULL}};
+static PyType_Spec scene_spec = {"evray._evray.Scene", sizeof(SceneObject), 0, Py_TPFLAGS_DEFAULT,
+                                 scene_slots};
 
 static PyObject *wrap_scene(evr_scene *s)
 {
-    SceneObject *o = PyObject_New(SceneObject, &SceneType);
+    SceneObject *o = PyObject_New(SceneObject, SceneType);
     if (!o) {
         evr_scene_release(s);
         return NULL;
@@ -150,16 +163,15 @@ static void config_dealloc(ConfigObject *self)
 {
     for (int i = 0; i < self->num_strings; i++) free(self->strings[i]);
     free(self->strings);
-    Py_TYPE(self)->tp_free((PyObject *)self);
+    free_object((PyObject *)self);
 }
 
-static PyTypeObject ConfigType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "evray._evray.Config",
-    .tp_basicsize = sizeof(ConfigObject),
-    .tp_dealloc = (destructor)config_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A checked evr_config (made by evray.Config).",
-};
+static PyType_Slot config_slots[] = {
+    {Py_tp_dealloc, (void *)config_dealloc},
+    {Py_tp_doc, (void *)"A checked evr_config (made by evray.Config)."},
+    {0, NULL}};
+static PyType_Spec config_spec = {"evray._evray.Config", sizeof(ConfigObject), 0,
+                                  Py_TPFLAGS_DEFAULT, config_slots};
 
 /* Applies the options (names[i], values[i], NULL: none) to c in order, as the evray program
  * does; *sensor is set to a --sensor's name. 0, or 1 with err set. */
@@ -193,8 +205,8 @@ static PyObject *mod_make_config(PyObject *mod, PyObject *args)
     PyObject *items;
     int no_files = 0;
     if (!PyArg_ParseTuple(args, "O!|p", &PyList_Type, &items, &no_files)) return NULL;
-    Py_ssize_t n = PyList_GET_SIZE(items);
-    ConfigObject *o = PyObject_New(ConfigObject, &ConfigType);
+    Py_ssize_t n = PyList_Size(items);
+    ConfigObject *o = PyObject_New(ConfigObject, ConfigType);
     if (!o) return NULL;
     o->strings = calloc((size_t)n + 1, sizeof *o->strings);
     o->num_strings = o->strings ? (int)n : 0;
@@ -205,7 +217,7 @@ static PyObject *mod_make_config(PyObject *mod, PyObject *args)
         return PyErr_NoMemory();
     }
     for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *it = PyList_GET_ITEM(items, i);
+        PyObject *it = PyList_GetItem(items, i);
         const char *value = NULL;
         if (!PyArg_ParseTuple(it, "sz", &names[i], &value)) {
             free(names);
@@ -246,7 +258,7 @@ static PyObject *mod_validate(PyObject *mod, PyObject *args)
 {
     SceneObject *s;
     ConfigObject *c;
-    if (!PyArg_ParseTuple(args, "O!O!", &SceneType, &s, &ConfigType, &c)) return NULL;
+    if (!PyArg_ParseTuple(args, "O!O!", SceneType, &s, ConfigType, &c)) return NULL;
     evr_error err = {{0}};
     evr_status st = evr_config_validate(&c->cfg, s->scene, &err);
     if (st != EVR_OK) return raise_status(st, &err);
@@ -345,7 +357,7 @@ static void run_dealloc(RunObject *self)
     pthread_cond_destroy(&self->cv);
     Py_XDECREF(self->scene_obj);
     Py_XDECREF(self->config_obj);
-    Py_TYPE(self)->tp_free((PyObject *)self);
+    free_object((PyObject *)self);
 }
 
 /* Waits (GIL released, in slices) until pred holds or a signal handler raised; 0 or -1. */
@@ -403,7 +415,7 @@ static PyObject *run_next_batch(RunObject *r, PyObject *unused)
     if (!full) Py_RETURN_NONE; /* done */
     /* the sink waits while full: ev stays valid until the hand-back below */
     PyObject *b = PyByteArray_FromStringAndSize(NULL, (Py_ssize_t)(n * sizeof *ev));
-    if (b) memcpy(PyByteArray_AS_STRING(b), ev, n * sizeof *ev);
+    if (b) memcpy(PyByteArray_AsString(b), ev, n * sizeof *ev);
     pthread_mutex_lock(&r->mu);
     r->full = 0;
     pthread_cond_broadcast(&r->cv);
@@ -462,27 +474,26 @@ static PyMethodDef run_methods[] = {
     {"stats", (PyCFunction)run_stats, METH_NOARGS, NULL},
     {NULL, NULL, 0, NULL}};
 
-static PyTypeObject RunType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "evray._evray.Run",
-    .tp_basicsize = sizeof(RunObject),
-    .tp_dealloc = (destructor)run_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "One run of a simulation (evr_sim), driven by evray.Simulator.",
-    .tp_methods = run_methods,
-};
+static PyType_Slot run_slots[] = {
+    {Py_tp_dealloc, (void *)run_dealloc},
+    {Py_tp_doc, (void *)"One run of a simulation (evr_sim), driven by evray.Simulator."},
+    {Py_tp_methods, run_methods},
+    {0, NULL}};
+static PyType_Spec run_spec = {"evray._evray.Run", sizeof(RunObject), 0, Py_TPFLAGS_DEFAULT,
+                               run_slots};
 
 /* new_run(scene, config): evr_sim_new (the run folder prepared), GIL released. */
 static PyObject *mod_new_run(PyObject *mod, PyObject *args)
 {
     SceneObject *s;
     ConfigObject *c;
-    if (!PyArg_ParseTuple(args, "O!O!", &SceneType, &s, &ConfigType, &c)) return NULL;
+    if (!PyArg_ParseTuple(args, "O!O!", SceneType, &s, ConfigType, &c)) return NULL;
     evr_sim *sim = NULL;
     evr_error err = {{0}};
     evr_status st;
     Py_BEGIN_ALLOW_THREADS st = evr_sim_new(s->scene, &c->cfg, &sim, &err);
     Py_END_ALLOW_THREADS if (st != EVR_OK) return raise_status(st, &err);
-    RunObject *r = PyObject_New(RunObject, &RunType);
+    RunObject *r = PyObject_New(RunObject, RunType);
     if (!r) {
         evr_sim_release(sim);
         return NULL;
@@ -542,13 +553,15 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_evray",
 PyMODINIT_FUNC PyInit__evray(void); /* the one symbol Python looks for */
 PyMODINIT_FUNC PyInit__evray(void)
 {
-    if (PyType_Ready(&SceneType) < 0 || PyType_Ready(&ConfigType) < 0 || PyType_Ready(&RunType) < 0)
+    if (!(SceneType = (PyTypeObject *)PyType_FromSpec(&scene_spec)) ||
+        !(ConfigType = (PyTypeObject *)PyType_FromSpec(&config_spec)) ||
+        !(RunType = (PyTypeObject *)PyType_FromSpec(&run_spec)))
         return NULL;
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
-    Py_INCREF(&SceneType);
-    if (PyModule_AddObject(m, "Scene", (PyObject *)&SceneType) < 0) {
-        Py_DECREF(&SceneType);
+    Py_INCREF(SceneType);
+    if (PyModule_AddObject(m, "Scene", (PyObject *)SceneType) < 0) {
+        Py_DECREF(SceneType);
         Py_DECREF(m);
         return NULL;
     }
