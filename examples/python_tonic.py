@@ -24,7 +24,6 @@ class EvrayFrames(IterableDataset):
 
     def __init__(self, scene, config):
         self.scene, self.config = scene, config
-        self.to_frame = T.ToFrame(sensor_size=(W, H, 2), n_time_bins=1)
 
     def windows(self):
         pending = np.empty(0, evray.EVENT_DTYPE)
@@ -47,17 +46,25 @@ class EvrayFrames(IterableDataset):
             if len(events) == 0:  # a window nothing happened in
                 yield torch.zeros((2, H, W))
             else:
-                yield torch.from_numpy(self.to_frame(events)[0].astype(np.float32))  # [2, H, W]
+                # one frame of all the window's events (n_time_bins=1 would leave out those at its
+                # last timestamp); channel 0 OFF, 1 ON
+                frame = T.ToFrame(sensor_size=(W, H, 2), event_count=len(events))(events)[0]
+                yield torch.from_numpy(frame.astype(np.float32))  # [2, H, W]
 
 
 def main():
     seconds = float(sys.argv[1]) if len(sys.argv) > 1 else 0.2
     scene = evray.demo("eye")
     config = evray.Config(res=(W, H), duration=seconds, sensor="davis346", no_preview=True)
-    loader = DataLoader(EvrayFrames(scene, config), batch_size=8)
+    dataset = EvrayFrames(scene, config)
+    loader = DataLoader(dataset, batch_size=8)
+    on = off = 0
     for i, frames in enumerate(loader):
         print(f"batch {i}: {tuple(frames.shape)}, {int(frames[:, 1].sum())} ON and "
               f"{int(frames[:, 0].sum())} OFF events")
+        on += int(frames[:, 1].sum())
+        off += int(frames[:, 0].sum())
+    print(f"{on} ON and {off} OFF events in the frames")
 
 
 if __name__ == "__main__":
