@@ -2,7 +2,8 @@
  *
  * The public C interface. A scene (evr_scene) is loaded from a file or generated; a simulation
  * (evr_sim) renders it over time, every pixel sampling at its own times, and turns the sampled
- * log intensity into a time-sorted stream of ON/OFF events written to the run folder.
+ * log intensity into a time-sorted stream of ON/OFF events written to the run folder and/or
+ * handed to the caller as the run goes (evr_sim_set_sink).
  *
  * Conventions: every function that can fail returns an evr_status and fills an evr_error with
  * one line saying why; no function prints or exits; every handle made by a *_new/_load has a
