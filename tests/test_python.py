@@ -1,8 +1,8 @@
 """The Python package (pyproject.toml, python/): scripts/python-venv.sh makes a fresh virtual
-environment beside the program and installs evray into it from the source tree (pip install .,
-without CUDA), then tests/python's pytest tests run in it. Skips when the environment cannot be
-made (no network for the pinned packages), and in the sanitizer build (the package is built and
-tested once, in the release build)."""
+environment beside the program and installs evray into it from the source tree (pip wheel ., the
+wheel installed; without CUDA), then tests/python's pytest tests run in it. Skips when the
+environment cannot be made (no network for the pinned packages), and in the sanitizer build (the
+package is built and tested once, in the release build)."""
 import os
 import subprocess
 import sys
