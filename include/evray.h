@@ -2,7 +2,8 @@
  *
  * The public C interface. A scene (evr_scene) is loaded from a file or generated; a simulation
  * (evr_sim) renders it over time, every pixel sampling at its own times, and turns the sampled
- * log intensity into a time-sorted stream of ON/OFF events written to the run folder.
+ * log intensity into a time-sorted stream of ON/OFF events written to the run folder and/or
+ * handed to the caller as the run goes (evr_sim_set_sink).
  *
  * Conventions: every function that can fail returns an evr_status and fills an evr_error with
  * one line saying why; no function prints or exits; every handle made by a *_new/_load has a
@@ -190,7 +191,8 @@ typedef struct {
     double min_dt, max_dt; /* seconds; max_dt <= 0: one segment (1 / fps) */
     /* output */
     const char *out_dir;
-    int formats;           /* evr_format bits */
+    int formats;           /* evr_format bits; 0: no event file (a sink takes the events:
+                              evr_sim_set_sink) */
     double preview_window; /* seconds per preview frame; <= 0: no previews (see preview) */
     int force;             /* overwrite an existing run folder (and frames in frames_out) */
     /* intensity frames for frame-based tools (v2e and the like): frame k is every pixel's
@@ -331,6 +333,24 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
 void evr_sim_cancel(evr_sim *sim);
 const evr_stats *evr_sim_stats(const evr_sim *sim);
 void evr_sim_release(evr_sim *sim);
+
+/* ---- streaming ---- */
+/* A sink takes the run's events as it goes: the same batches, in the same order, that the event
+ * files get (every event once; within a batch sorted by t, and no batch earlier than the one
+ * before), each segment's events as soon as no later segment can precede them. It is called on
+ * the library's writer thread, one call at a time, never after evr_sim_run returns; ev is valid
+ * only during the call (copy what you keep). The sink may block: the run goes on rendering
+ * until eight batches wait for it, then waits too, so memory stays bounded however slow it is.
+ * Return 0 to go on; non-zero stops the run as evr_sim_cancel does (evr_sim_run returns
+ * EVR_ERR_INTERRUPTED, the files complete) and the sink is not called again. The files may hold
+ * a few batches more than the sink took then (those queued behind it). A run that fails (a full
+ * disk...) stops calling it at the failure. */
+typedef int (*evr_event_sink_fn)(void *user, const evr_event *ev, size_t n);
+/* Gives the run its sink (one at most: a second call fails with EVR_ERR_ARG), between evr_sim_new
+ * and evr_sim_run (EVR_ERR_ARG once the run started). With evr_config.formats 0 the sink alone
+ * takes the events (no event file; run.json and what else the configuration asks for are
+ * written as usual). */
+evr_status evr_sim_set_sink(evr_sim *sim, evr_event_sink_fn sink, void *user, evr_error *err);
 
 const char *evr_version(void);
 

@@ -225,6 +225,10 @@ int evr_config_option_takes_value(const evr_config_option *o);
  * given, not copied. EVR_ERR_ARG with a one-line message when value is not valid for it. */
 evr_status evr_config_option_set(evr_config *c, const evr_config_option *o, const char *value,
                                  evr_error *err);
+/* The i-th option (0, 1, ... in --help order; NULL past the last): its name ("--res"), whether
+ * it takes a value, and its help text (lines separated by '\n'; "" for one written by a
+ * function of its own). For bindings that mirror the options (the Python package). */
+const char *evr_config_option_name(int i, int *takes_value, const char **help);
 /* The options' help, by section, as `evray render --help` shows it (malloc'ed; NULL: no memory). */
 char *evr_config_options_help(void);
 

@@ -4,8 +4,14 @@
 # libraries a bare CUDA machine lacks into gpu-carry/ (git-ignored), for running on the GPU
 # machine:
 #   scripts/gpu-unpack.sh && LD_LIBRARY_PATH=gpu-carry/lib gpu-carry/evray ...
+# With --python, also the Python package (gpu-carry/python/evray: its module on the stable ABI, so
+# the GPU machine's python3 loads it; numpy is there), built in build-gpu-py (position-independent
+# code, kept apart from build-gpu's program):
+#   LD_LIBRARY_PATH=gpu-carry/lib PYTHONPATH=gpu-carry/python python3 -c 'import evray'
 set -eu
 cd "$(dirname "$0")/.."
+python=0
+[ "${1:-}" = "--python" ] && python=1
 cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 >/dev/null
 cmake --build build-gpu -j"$(nproc)"
 rm -rf gpu-carry
@@ -23,7 +29,17 @@ ldd build-gpu/evray build-gpu/labels_compare | awk '/=> \// {print $3}' | sort -
     while read -r lib; do cp -L "$lib" gpu-carry/lib/; done
 # packed: the carry limit is 64 MiB and the libraries alone come close (unpacked there by
 # scripts/gpu-unpack.sh, which scripts/gpu-check.sh runs)
-(cd gpu-carry && tar -czf ../gpu-carry.tar.gz evray labels_compare lib)
+carried="evray labels_compare lib"
+if [ "$python" = 1 ]; then
+    cmake -S . -B build-gpu-py -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES=90 -DEVR_PYTHON_MODULE=ON >/dev/null
+    cmake --build build-gpu-py -j"$(nproc)" --target _evray
+    mkdir -p gpu-carry/python/evray
+    cp python/evray/__init__.py build-gpu-py/_evray.abi3.so gpu-carry/python/evray/
+    strip --strip-unneeded gpu-carry/python/evray/_evray.abi3.so
+    carried="$carried python"
+fi
+# shellcheck disable=SC2086
+(cd gpu-carry && tar -czf ../gpu-carry.tar.gz $carried)
 rm -rf gpu-carry
 mkdir gpu-carry
 mv gpu-carry.tar.gz gpu-carry/

@@ -11,6 +11,7 @@
 #include "run/frames_out.h"
 #include "run/camera_poses.h"
 #include "run/labels_out.h"
+#include "run/event_sink.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -605,6 +606,26 @@ void evr_sim_cancel(evr_sim *sim)
     if (sim) __atomic_store_n(&sim->cancel, 1, __ATOMIC_RELAXED);
 }
 
+evr_status evr_sim_set_sink(evr_sim *sim, evr_event_sink_fn sink, void *user, evr_error *err)
+{
+    if (!sink) return EVR_OK;
+    if (sim->sink || sim->batches || sim->st.segments_done || !sim->wq) {
+        snprintf(err->msg, sizeof err->msg,
+                 sim->sink ? "the run has a sink already"
+                           : "a sink can only be set before the run starts");
+        return EVR_ERR_ARG;
+    }
+    evr_event_writer *w = evr_event_sink_new(sink, user, &sim->cancel);
+    if (!w) return nomem(err);
+    evr_status st = evr_write_queue_add(sim->wq, w, err);
+    if (st != EVR_OK) {
+        evr_event_sink_free(w);
+        return st;
+    }
+    sim->sink = w;
+    return EVR_OK;
+}
+
 const evr_stats *evr_sim_stats(const evr_sim *sim) { return &sim->st; }
 
 void evr_sim_release(evr_sim *sim)
@@ -612,6 +633,7 @@ void evr_sim_release(evr_sim *sim)
     int w;
     if (!sim) return;
     evr_write_queue_stop(sim->wq);
+    evr_event_sink_free(sim->sink); /* the queue has stopped calling it */
     for (w = 0; w < sim->num_writers; w++)
         if (sim->writers[w]) sim->writers[w]->abort(sim->writers[w]);
     if (sim->backend) sim->backend->release(sim->backend);

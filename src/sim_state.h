@@ -63,6 +63,7 @@ struct evr_sim {
     int num_writers;
     int writer_lost[EVR_MAX_WRITERS]; /* a failed run could not keep its file */
     evr_write_queue *wq;              /* writes on its own thread */
+    evr_event_writer *sink;           /* the caller's sink (run/event_sink.h), or NULL */
     char *config_json;
     /* per-segment motion and plans (segment_planner.h: the tracker is the planner thread's) */
     evr_planner *planner;

@@ -11,7 +11,7 @@ if not tool:
     print("SKIP: clang-format is not installed (scripts/deps.sh installs it)")
     sys.exit(77)
 files = []
-for top in ("src", "cli", "include", "tests"):
+for top in ("src", "cli", "include", "tests", "python"):
     for d, _, names in os.walk(os.path.join(ROOT, top)):
         files += [os.path.join(d, n) for n in sorted(names) if n.endswith((".c", ".h", ".cu", ".cuh"))]
 p = subprocess.run([tool, "--dry-run", "--Werror", *files], capture_output=True, text=True, cwd=ROOT)

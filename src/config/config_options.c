@@ -79,6 +79,21 @@ int evr_config_option_takes_value(const evr_config_option *o)
     return o->type != EVR_OPT_FLAG && !o->no_value;
 }
 
+const char *evr_config_option_name(int i, int *takes_value, const char **help)
+{
+    int k, n;
+    const evr_config_option *t = evr_config_table(&n);
+    for (k = 0; k < n; k++) {
+        /* not an option, or the program's own (-q) */
+        if (!t[k].flag || (t[k].type == EVR_OPT_NONE && !t[k].parse)) continue;
+        if (i-- > 0) continue;
+        *takes_value = evr_config_option_takes_value(&t[k]);
+        *help = t[k].help ? t[k].help : "";
+        return t[k].flag;
+    }
+    return NULL;
+}
+
 const evr_config_option *evr_config_option_find(const char *arg, const char **name)
 {
     int i, n;

@@ -11,9 +11,11 @@
 /* batches that may wait: eight rode out the eye's bursts of saccade segments (main thread waiting
  * for the writer 0.6-0.75 -> 0.01 s of a 4.4-4.9 s run on the H100, against two) */
 #define QUEUE_SLOTS 8
+/* every format's writer (sim_state.h, EVR_MAX_WRITERS) and a caller's sink (run/event_sink.h) */
+#define QUEUE_WRITERS 17
 
 struct evr_write_queue {
-    evr_event_writer *writers[8];
+    evr_event_writer *writers[QUEUE_WRITERS];
     int num_writers;
     double flush_seconds;
     pthread_t thread;
@@ -138,7 +140,7 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     evr_write_queue *q = calloc(1, sizeof *q);
     pthread_condattr_t ca;
     int i, ok;
-    if (!q || num_writers > 8) {
+    if (!q || num_writers > QUEUE_WRITERS) {
         free(q);
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;
@@ -166,6 +168,22 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
         return EVR_ERR_IO;
     }
     *out = q;
+    return EVR_OK;
+}
+
+evr_status evr_write_queue_add(evr_write_queue *q, evr_event_writer *w, evr_error *err)
+{
+    pthread_mutex_lock(&q->mu);
+    /* before the first push: the thread touches the writers only for a batch or after one */
+    int ok = q->num_writers < QUEUE_WRITERS && !q->accepted_batches && !q->count && !q->busy &&
+             !q->dirty;
+    if (ok) q->writers[q->num_writers++] = w;
+    pthread_mutex_unlock(&q->mu);
+    if (!ok) {
+        snprintf(err->msg, sizeof err->msg,
+                 "a writer can only be added to the write queue before the run starts");
+        return EVR_ERR_ARG;
+    }
     return EVR_OK;
 }
 

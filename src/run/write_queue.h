@@ -21,6 +21,9 @@ typedef struct evr_write_queue evr_write_queue;
 
 evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_writers,
                                  double flush_seconds, evr_write_queue **out, evr_error *err);
+/* Adds writer w (not owned: the caller frees it after evr_write_queue_stop) before the first
+ * push; EVR_ERR_ARG after it. The queue calls only its write() and flush(). */
+evr_status evr_write_queue_add(evr_write_queue *q, evr_event_writer *w, evr_error *err);
 /* Queues the first n events of v for writing and returns (waits only while eight batches are
  * pending) without copying them: the queue takes v's buffer and gives v one of its own holding
  * the rest of v (v->data[n .. v->n)), which is usually short. Fails with the writer thread's
