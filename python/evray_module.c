@@ -569,7 +569,8 @@ PyMODINIT_FUNC PyInit__evray(void)
         PyModule_AddIntConstant(m, "OFFSET_T", (long)offsetof(evr_event, t)) < 0 ||
         PyModule_AddIntConstant(m, "OFFSET_X", (long)offsetof(evr_event, x)) < 0 ||
         PyModule_AddIntConstant(m, "OFFSET_Y", (long)offsetof(evr_event, y)) < 0 ||
-        PyModule_AddIntConstant(m, "OFFSET_P", (long)offsetof(evr_event, p)) < 0) {
+        PyModule_AddIntConstant(m, "OFFSET_P", (long)offsetof(evr_event, p)) < 0 ||
+        PyModule_AddIntConstant(m, "OFFSET_ID", (long)offsetof(evr_event, id)) < 0) {
         Py_DECREF(m);
         return NULL;
     }

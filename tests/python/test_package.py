@@ -39,7 +39,7 @@ def test_installed():
     assert p.returncode == 0 and evray.__version__ in p.stdout
     assert "square" in evray.demo_names() and "eye" in evray.demo_names()
     assert "square_camera" in evray.demo("square").describe()
-    assert set(evray.EVENT_DTYPE.names) == {"x", "y", "t", "p"}
+    assert set(evray.EVENT_DTYPE.names) == {"x", "y", "t", "p", "id"}
     assert evray.EVENT_DTYPE["t"] == np.int64 and evray.EVENT_DTYPE["x"] == np.uint16
 
 
@@ -57,6 +57,17 @@ def test_square_against_analytic_crossings(square):
     assert not sim.stats["interrupted"]
 
 
+def test_event_ids(square):
+    """Config(event_ids=True): every streamed event names an instance of the scene (the square
+    or its background; README "Ground truth"), and without it every id is 0."""
+    ev = streamed(evray.Simulator(square, evray.Config(**SQUARE, event_ids=True)))
+    assert len(ev) > 500
+    assert set(np.unique(ev["id"]).tolist()) <= {1, 2} and bool(np.all(ev["id"] > 0))
+    plain = streamed(evray.Simulator(square, evray.Config(**SQUARE)))
+    assert bool(np.all(plain["id"] == 0))
+    assert np.array_equal(plain[["x", "y", "t", "p"]], ev[["x", "y", "t", "p"]])
+
+
 def test_stream_equals_files(square, tmp_path):
     """One run streamed and written: the stream is events.h5 exactly, and every format read back
     by evray.read is the same events; the evray command's run of the same scene and seed too."""
@@ -65,7 +76,7 @@ def test_stream_equals_files(square, tmp_path):
     h5 = evray.read(tmp_path / "run" / "events.h5")
     assert h5.dtype == evray.EVENT_DTYPE
     assert len(ev) > 1000 and np.array_equal(ev, h5)
-    packed = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "i1")])
+    packed = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "i1"), ("id", "<u4")])
     assert h5.astype(packed).tobytes() == ev.astype(packed).tobytes()  # byte for byte
     files = [f for f in os.listdir(tmp_path / "run") if f.startswith("events.")]
     assert len(files) >= 5, files
