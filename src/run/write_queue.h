@@ -1,5 +1,8 @@
 /* Writes event batches on a thread of its own, so that the host writes segment i while the
- * backend renders segment i + 1. Batches are written in the order pushed. Every writer is
+ * backend renders segment i + 1. Batches are written in the order pushed; each batch goes to
+ * the first writer, then to all the others at once on threads of their own (a writer is only
+ * ever called by one thread at a time; the first, HDF5 when asked for, always by this one).
+ * Every writer is
  * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
  * flush, and otherwise once the thread has been idle until then: a killed run's files lag at
  * most about flush_seconds (plus the batch being written, and the HDF5 writer's last partial
