@@ -14,7 +14,7 @@
 #define QUEUE_SLOTS 8
 
 struct evr_write_queue {
-    evr_event_writer *writers[8];
+    evr_event_writer *writers[EVR_WRITE_QUEUE_MAX_WRITERS];
     int num_writers;
     evr_par_pool *pool; /* threads for writers 1, 2, ... (NULL: two writers or fewer) */
     double flush_seconds;
@@ -45,8 +45,8 @@ struct evr_write_queue {
 typedef struct {
     evr_write_queue *q;
     const evr_event_vec *v; /* NULL: flush */
-    evr_status st[8];
-    evr_error err[8];
+    evr_status st[EVR_WRITE_QUEUE_MAX_WRITERS];
+    evr_error err[EVR_WRITE_QUEUE_MAX_WRITERS];
 } writers_job;
 
 static void run_writer(writers_job *j, int w)
@@ -190,7 +190,7 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     evr_write_queue *q = calloc(1, sizeof *q);
     pthread_condattr_t ca;
     int i, ok;
-    if (!q || num_writers > 8) {
+    if (!q || num_writers > EVR_WRITE_QUEUE_MAX_WRITERS) {
         free(q);
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return EVR_ERR_NOMEM;

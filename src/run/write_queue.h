@@ -17,6 +17,9 @@
 #include "events.h"
 #include "io/event_writer.h"
 
+/* Writers a queue takes at most (a run's formats: sim_state.h's EVR_MAX_WRITERS). */
+#define EVR_WRITE_QUEUE_MAX_WRITERS 16
+
 /* The simulation's flush interval: a second of work at most is lost when a run is killed. */
 #define EVR_WRITE_FLUSH_SECONDS 1.0
 
