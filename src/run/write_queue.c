@@ -67,8 +67,10 @@ static void pool_writer(void *ctx, int k, int thread)
  * about the first's time and the slowest other's, not their sum (the 30 s eye's `--format all`
  * on the H100 took 17 s with the writers in turn). The first goes alone because the HDF5 writer
  * does not survive every failed write: when the file system fills up midway through its chunks,
- * a chunk of one column can read as zeros after salvage (seen on main's writers in turn too,
- * tests/test_run_files.py's full file system); alone, it meets the file system as before. The
+ * a chunk of one column can be missing from that column's chunk index after salvage, though
+ * salvage's second H5Dwrite_chunk of it succeeded, and reads as zeros (seen on main's writers in
+ * turn too, tests/test_run_files.py's full file system); alone, it meets the file system as
+ * before. The
  * first failure, in writer order, is the result. */
 static evr_status each_writer(evr_write_queue *q, const evr_event_vec *v, evr_error *err)
 {
