@@ -36,12 +36,12 @@
 #define EVENT_BYTES 13 /* uint16 x, uint16 y, time ts, bool polarity */
 #define ROSBAG_MAX_T ((INT64_C(1) << 32) * 1000000 - 1)
 
-/* The fixed-size record heads, up to their data (header_len, header fields, data_len): */
-#define CHUNK_HEAD (4 + 41 + 4) /* op, compression=none, size */
-#define INDEX_HEAD (4 + 47 + 4) /* op, ver, conn, count */
-#define MSG_HEAD \
-    (4 + 38 + 4 + 28)                /* op, conn, time; then the message's header, height, width,
-                                       and the events[] length */
+/* The fixed-size record heads, up to their data (header_len, header fields, data_len): a chunk's
+ * (op, compression=none, size), an index data record's (op, ver, conn, count) and a message's
+ * (op, conn, time; then in its data the message's header, height, width and events[] length) */
+#define CHUNK_HEAD (4 + 41 + 4)
+#define INDEX_HEAD (4 + 47 + 4)
+#define MSG_HEAD (4 + 38 + 4 + 28)
 #define BAG_THREADS 8                /* threads packing and writing a large write */
 #define BAG_PARTS 32                 /* the parts a large write's events are packed in */
 #define WRITE_PART ((size_t)4 << 20) /* bytes of a part of the file written by one thread */
