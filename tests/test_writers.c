@@ -919,7 +919,7 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     CHECK(data != NULL);
     if (!data) return NULL;
     data[size] = 0;
-    if (data[0] != '%') { /* a bag or text: no header with a date */
+    if (data[0] != '%') { /* a bag: no header with a date */
         *len = size;
         return data;
     }
@@ -935,7 +935,7 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     return data;
 }
 
-/* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag's own): the bytes must be
+/* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way): the bytes must be
  * those of the serial path (batches too small for parts), the file must read back, and a bad
  * event deep in a large write is refused as the serial path refuses it. */
 static void test_camera_parts(const char *root)
@@ -945,14 +945,15 @@ static void test_camera_parts(const char *root)
         open_fn open;
         evr_event bad; /* put in the middle of a large write */
         const char *why;
-    } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1}, "(2048, 5)"},
-             {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1}, "(5, 2048)"},
-             {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0}, "4294967296 us"},
-             {"parts.bag",
-              evr_rosbag_writer_open,
-              {(INT64_C(1) << 32) * 1000000, 5, 6, 0},
-              "4294967296000000 us"},
-             {"parts.txt", evr_txt_writer_open, {0, 5, 6, 0}, "(0 us after"}};
+    } f[] = {
+        {"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1}, "(2048, 5)"},
+        {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1}, "(5, 2048)"},
+        {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0}, "4294967296 us"},
+        {"parts.bag",
+         evr_rosbag_writer_open,
+         {(INT64_C(1) << 32) * 1000000, 5, 6, 0},
+         "4294967296000000 us"},
+    };
     const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
     evr_event *ev = calloc(n, sizeof *ev);
     uint64_t s = 4242;

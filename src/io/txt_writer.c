@@ -3,7 +3,6 @@
  * numpy.loadtxt and the usual event-camera tools read the file as is. */
 #include "io/event_formats.h"
 #include "io/file_commit.h"
-#include "io/par_pack.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -13,8 +12,6 @@
 
 #define TXT_BUFFER (1u << 20)
 #define TXT_LINE_MAX 64 /* "-9223372036854.775808 65535 65535 1\n" fits easily */
-/* threads formatting a large write: a line costs several times a binary event's packing */
-#define TXT_THREADS 8
 
 typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
@@ -27,7 +24,6 @@ typedef struct {
     /* events and text bytes given so far (written and buffered), and as the last write() began
      * (salvage) */
     uint64_t count, bytes, prev_count, prev_bytes;
-    evr_par_packing parts; /* large writes, formatted in parts */
 } txt_writer;
 
 static char *put_uint(char *o, uint64_t v)
@@ -79,62 +75,14 @@ static void free_writer(txt_writer *w)
     free(w->path);
     free(w->tmp);
     free(w->buf);
-    evr_par_packing_free(&w->parts);
     free(w);
-}
-
-/* A large write's parts (io/par_pack.h): each line within TXT_LINE_MAX bytes. */
-static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
-{
-    (void)ctx;
-    (void)ev;
-    return (b - a) * TXT_LINE_MAX;
-}
-
-static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
-                        unsigned char *out, size_t room)
-{
-    char *o = (char *)out;
-    (void)ctx;
-    (void)room;
-    for (size_t i = a; i < b; i++) {
-        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX; /* the serial path says which */
-        o = format_event(o, &ev[i]);
-    }
-    return (size_t)(o - (char *)out);
-}
-
-/* Writes a large write in parallel parts; 0 when it goes serially (small, or out of order). */
-static int write_parts(txt_writer *w, const evr_event *ev, size_t n, evr_status *st, evr_error *err)
-{
-    static const evr_par_packer packer = {bound_part, pack_part, NULL, NULL};
-    size_t bytes;
-    evr_par_pack_result r;
-    *st = EVR_OK;
-    if (n < EVR_PAR_PACK_MIN || (w->have_last && ev[0].t < w->last_t)) return 0;
-    if ((*st = drain(w, err)) != EVR_OK) return 1;
-    r = evr_par_pack_write(&w->parts, &packer, ev, n, w->f, &bytes);
-    if (r == EVR_PAR_PACK_SERIAL) return 0;
-    if (r == EVR_PAR_PACK_FAILED) {
-        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s: %s", w->tmp,
-                 strerror(errno));
-        *st = EVR_ERR_IO;
-        return 1;
-    }
-    w->bytes += bytes;
-    w->count += n;
-    w->last_t = ev[n - 1].t;
-    w->have_last = 1;
-    return 1;
 }
 
 static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     txt_writer *w = (txt_writer *)base;
-    evr_status parts_st;
     w->prev_count = w->count;
     w->prev_bytes = w->bytes;
-    if (write_parts(w, ev, n, &parts_st, err)) return parts_st;
     for (size_t i = 0; i < n; i++) {
         if (w->have_last && ev[i].t < w->last_t) {
             snprintf(err->msg, sizeof err->msg,
@@ -228,7 +176,6 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
         snprintf(err->msg, sizeof err->msg, "text writer: out of memory");
         return EVR_ERR_NOMEM;
     }
-    w->parts.threads = TXT_THREADS;
     w->f = evr_file_create(w->tmp, "text writer", err);
     if (!w->f) {
         free_writer(w);
