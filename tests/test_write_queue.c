@@ -212,6 +212,15 @@ int main(void)
         CHECK(push(q, &t, 10, &err) == EVR_ERR_IO && strstr(err.msg, "cannot flush") != NULL);
         evr_write_queue_stop(q);
     }
+    /* no writer at all: batches and flushes go nowhere */
+    {
+        evr_write_queue *q = NULL;
+        t = 0;
+        CHECK_OK(evr_write_queue_start(NULL, 0, 0.0, &q, &err));
+        CHECK_OK(push(q, &t, 10, &err));
+        CHECK_OK(evr_write_queue_flush(q, &err));
+        evr_write_queue_stop(q);
+    }
     /* several writers: the first alone, then the others at the same time; a failure of one of
      * them is the queue's error, and its batch is not accepted */
     {
