@@ -19,11 +19,12 @@ int cmd_convert(int argc, char **argv)
                 "Reads every event of IN and writes them, in the same order, to OUT; each file's format\n"
                 "comes from its name: .h5/.hdf5 (DSEC layout), .txt, .npy, .dat (Prophesee DAT),\n"
                 ".raw (Prophesee EVT 3.0, or EVT 2.0 for a name ending in evt2.raw; reading, the\n"
-                "header says which), .bag (ROS1, dvs_msgs/EventArray), .aedat4 (iniVation AEDAT\n"
-                "4.0; reading, .aedat too: the first event stream of a camera's recording). Width\n"
-                "and height come from IN when it stores them, else from the largest x and y. What\n"
-                "OUT's format cannot hold (a pixel or a time past its fields) is refused and OUT is\n"
-                "not written.");
+                "header says which), .bag (ROS1, dvs_msgs/EventArray; reading, chunks may be bz2\n"
+                "or lz4), .aedat4 (iniVation AEDAT 4.0, LZ4, or ZSTD for a name ending in\n"
+                "zstd.aedat4; reading, .aedat too: the first event stream of a camera's recording).\n"
+                "Width and height come from IN when it stores them, else from the largest x and y.\n"
+                "What OUT's format cannot hold (a pixel or a time past its fields) is refused and\n"
+                "OUT is not written.");
             return 0;
         }
         if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) quiet = 1;

@@ -37,8 +37,8 @@ double evr_seconds(void);
  *   .raw         Prophesee EVT 2.0 or EVT 3.0 (named by the "% evt" / "% format" header line);
  *                width and height from the header.
  *   .dat         Prophesee DAT of CD events; width and height from the header.
- *   .bag         ROS1 bag: the dvs_msgs/EventArray messages of the first such connection; width
- *                and height from the first message.
+ *   .bag         ROS1 bag: the dvs_msgs/EventArray messages of the first such connection (chunks
+ *                uncompressed, bz2 or lz4); width and height from the first message.
  *   .aedat4      iniVation AEDAT 4.0 (.aedat too): the first event stream (EVTS), packets
  *                uncompressed or LZ4 or ZSTD; width and height from its sizeX and sizeY.
  * Polarity is returned as 1 (p > 0) or 0 (p <= 0, so -1/1 files read too). Events keep the file's
@@ -49,7 +49,8 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
 
 /* Writes n events (sorted by time) to path in the format its name says: .h5/.hdf5, .txt, .npy,
  * .dat (Prophesee DAT), a name ending in "evt2.raw" (Prophesee EVT 2.0) or any other .raw (EVT
- * 3.0), .bag (ROS1 bag), .aedat4 (AEDAT 4.0). width/height <= 0: taken from the largest x/y.
+ * 3.0), .bag (ROS1 bag), a name ending in "zstd.aedat4" (AEDAT 4.0, ZSTD packets) or any other
+ * .aedat4 (AEDAT 4.0, LZ4). width/height <= 0: taken from the largest x/y.
  * Under a temporary name until complete, as the simulation's writers; what the format cannot
  * hold is refused (EVR_ERR_ARG). */
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,

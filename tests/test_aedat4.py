@@ -5,8 +5,9 @@ of 40000 events, Unix-time microseconds, the largest int16 addresses); each pack
 millisecond's events, at most 32768; dv-processing's time-range reads (through the data table)
 give the same events as slicing; the stream is "events" at the run's size. Files dv-processing
 writes (every compression: NONE, LZ4, LZ4_HIGH, ZSTD, ZSTD_HIGH) read back identical through
-`evray convert`, and h5 -> aedat4 -> h5 gives identical events. Skips (77) when the environment is
-missing or unusable."""
+`evray convert`, and h5 -> aedat4 -> h5 gives identical events. The same for ZSTD packets
+(--format aedat4-zstd, files named *zstd.aedat4), which are smaller. Skips (77) when the
+environment is missing or unusable."""
 import json
 import os
 import subprocess
@@ -114,11 +115,17 @@ d = T.tmpdir()
 run = os.path.join(d, "run")
 W, H = 64, 48
 T.run("demo", "--scene", "eye", "-o", run, "--res", f"{W}x{H}", "--duration", "2",
-      "--format", "npy,h5,aedat4", "--no-preview", "--quiet")
+      "--format", "npy,h5,aedat4,aedat4-zstd", "--no-preview", "--quiet")
 npy = os.path.join(run, "events.npy")
 ref = np.load(npy)
 T.check(len(ref) > 100000, f"a run of many events ({len(ref)})")
 aedat4 = os.path.join(run, "events.aedat4")
+zaedat4 = os.path.join(run, "events_zstd.aedat4")
+# the IOHeader's compression (after the version line, at 28 in its FlatBuffer): LZ4 1, ZSTD 3
+T.check(open(aedat4, "rb").read()[42] == 1 and open(zaedat4, "rb").read()[42] == 3,
+        "the IOHeaders say LZ4 and ZSTD")
+T.check(os.path.getsize(zaedat4) < os.path.getsize(aedat4),
+        f"ZSTD packets are smaller than LZ4's ({os.path.getsize(zaedat4)} against {os.path.getsize(aedat4)} bytes)")
 
 # made up: a millisecond of 40000 events (two packets), Unix-time microseconds as a camera
 # stamps them, the largest addresses int16 holds
@@ -138,6 +145,8 @@ snpy = os.path.join(d, "syn.npy")
 np.save(snpy, syn)
 saedat4 = os.path.join(d, "syn.aedat4")
 T.run("convert", snpy, saedat4, "--quiet")
+szaedat4 = os.path.join(d, "syn.zstd.aedat4")
+T.run("convert", snpy, szaedat4, "--quiet")
 ssize = [32768, int(syn["y"].max()) + 1]
 
 # the run's h5 converted: the same bytes as the run wrote (packets depend only on the events)
@@ -147,13 +156,22 @@ T.check(open(conv, "rb").read() == open(aedat4, "rb").read(),
         "h5 -> aedat4 by evray convert is byte-identical to the run's events.aedat4")
 back = os.path.join(d, "back.h5")
 T.run("convert", conv, back, "--quiet")
+zconv = os.path.join(d, "conv.zstd.aedat4")
+T.run("convert", os.path.join(run, "events.h5"), zconv, "--quiet")
+T.check(open(zconv, "rb").read() == open(zaedat4, "rb").read(),
+        "h5 -> zstd.aedat4 by evray convert is byte-identical to the run's events_zstd.aedat4")
+zback = os.path.join(d, "zback.h5")
+T.run("convert", zconv, zback, "--quiet")
 
 dvsmall = os.path.join(d, "small.npy")
 np.save(dvsmall, ref[:20000])
 dvfiles = os.path.join(d, "dv_%s.aedat4")
 jobs = [("dv_processing", aedat4, npy, [W, H]), ("aedat", aedat4, npy, [W, H]),
         ("dv_processing", saedat4, snpy, ssize), ("aedat", saedat4, snpy, ssize),
-        ("h5py", back, npy, [W, H]), ("dv_write", dvfiles, dvsmall, [W, H])]
+        ("dv_processing", zaedat4, npy, [W, H]), ("aedat", zaedat4, npy, [W, H]),
+        ("dv_processing", szaedat4, snpy, ssize), ("aedat", szaedat4, snpy, ssize),
+        ("h5py", back, npy, [W, H]), ("h5py", zback, npy, [W, H]),
+        ("dv_write", dvfiles, dvsmall, [W, H])]
 p = subprocess.run([venv_python, "-c", ORACLES, json.dumps(jobs)], capture_output=True, text=True)
 if p.returncode != 0:
     print(p.stderr, file=sys.stderr)

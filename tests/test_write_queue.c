@@ -42,6 +42,13 @@ static evr_status fake_flush(evr_event_writer *base, evr_error *err)
     return EVR_OK;
 }
 
+static evr_status fake_flush_none(evr_event_writer *base, evr_error *err)
+{
+    (void)base;
+    (void)err;
+    return EVR_OK;
+}
+
 static void fake_init(fake_writer *w)
 {
     memset(w, 0, sizeof *w);
@@ -49,6 +56,53 @@ static void fake_init(fake_writer *w)
     w->base.write = fake_write;
     w->base.flush = fake_flush;
     w->in_order = 1;
+}
+
+/* Writers that meet: the first of a queue checks that none of the others has begun the batch,
+ * each other one counts itself in and waits (up to 10 s) until all the others have come, which
+ * they can only while they run at the same time; fail_at makes that write fail. */
+static void sleep_s(double s);
+
+typedef struct {
+    _Atomic int arrived; /* the others' writes so far */
+    int others;
+} meeting;
+
+typedef struct {
+    evr_event_writer base;
+    meeting *m;
+    int first, writes, met, fail_at;
+} meet_writer;
+
+static evr_status meet_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
+{
+    meet_writer *w = (meet_writer *)base;
+    (void)ev;
+    (void)n;
+    w->writes++;
+    if (w->first) {
+        if (atomic_load(&w->m->arrived) == (w->writes - 1) * w->m->others) w->met++;
+        return EVR_OK;
+    }
+    const int want = w->writes * w->m->others;
+    atomic_fetch_add(&w->m->arrived, 1);
+    double t0 = evr_host_seconds();
+    while (atomic_load(&w->m->arrived) < want && evr_host_seconds() - t0 < 10.0) sleep_s(0.001);
+    if (atomic_load(&w->m->arrived) >= want) w->met++;
+    if (w->writes == w->fail_at) {
+        snprintf(err->msg, sizeof err->msg, "meet writer: cannot write");
+        return EVR_ERR_IO;
+    }
+    return EVR_OK;
+}
+
+static void meet_init(meet_writer *w, meeting *m, int first)
+{
+    memset(w, 0, sizeof *w);
+    w->base.write = meet_write;
+    w->base.flush = fake_flush_none;
+    w->m = m;
+    w->first = first;
 }
 
 /* Pushes batches of n events continuing the time line at *t. */
@@ -156,6 +210,43 @@ int main(void)
         CHECK(st == EVR_ERR_IO && strstr(err.msg, "cannot flush") != NULL);
         err.msg[0] = 0;
         CHECK(push(q, &t, 10, &err) == EVR_ERR_IO && strstr(err.msg, "cannot flush") != NULL);
+        evr_write_queue_stop(q);
+    }
+    /* no writer at all: batches and flushes go nowhere */
+    {
+        evr_write_queue *q = NULL;
+        t = 0;
+        CHECK_OK(evr_write_queue_start(NULL, 0, 0.0, &q, &err));
+        CHECK_OK(push(q, &t, 10, &err));
+        CHECK_OK(evr_write_queue_flush(q, &err));
+        evr_write_queue_stop(q);
+    }
+    /* several writers: the first alone, then the others at the same time; a failure of one of
+     * them is the queue's error, and its batch is not accepted */
+    {
+        meeting m;
+        meet_writer w[4];
+        evr_event_writer *ws[4];
+        evr_write_queue *q = NULL;
+        evr_status st = EVR_OK;
+        uint64_t events = 0, batches = 0;
+        atomic_init(&m.arrived, 0);
+        m.others = 3;
+        for (i = 0; i < 4; i++) {
+            meet_init(&w[i], &m, i == 0);
+            ws[i] = &w[i].base;
+        }
+        w[2].fail_at = 4;
+        t = 0;
+        CHECK_OK(evr_write_queue_start(ws, 4, 1000.0, &q, &err));
+        for (i = 0; i < 3; i++) CHECK_OK(push(q, &t, 100, &err));
+        CHECK_OK(evr_write_queue_drain(q, &err));
+        for (i = 0; i < 4; i++) CHECK(w[i].writes == 3 && w[i].met == 3);
+        CHECK_OK(push(q, &t, 100, &err));
+        st = evr_write_queue_drain(q, &err);
+        CHECK(st == EVR_ERR_IO && strstr(err.msg, "meet writer: cannot write") != NULL);
+        evr_write_queue_accepted(q, &events, &batches);
+        CHECK(events == 300 && batches == 3);
         evr_write_queue_stop(q);
     }
     return check_report("test_write_queue");

@@ -11,6 +11,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <bzlib.h>
+#include <lz4frame.h>
 #include <stb/stb_image.h>
 #include <zlib.h>
 
@@ -922,6 +924,10 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     CHECK(data != NULL);
     if (!data) return NULL;
     data[size] = 0;
+    if (data[0] != '%') { /* a bag: no header with a date */
+        *len = size;
+        return data;
+    }
     end = strstr((const char *)data, "% end\n"); /* the header holds the date: skip it */
     CHECK(end != NULL);
     if (!end) {
@@ -934,9 +940,9 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     return data;
 }
 
-/* Large writes are packed in parallel parts (io/par_pack.h): the bytes must be those of the serial
- * path (batches too small for parts), and a bad event deep in a large write is refused as the
- * serial path refuses it. */
+/* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way): the bytes must be
+ * those of the serial path (batches too small for parts), the file must read back, and a bad
+ * event deep in a large write is refused as the serial path refuses it. */
 static void test_camera_parts(const char *root)
 {
     static const struct {
@@ -944,9 +950,15 @@ static void test_camera_parts(const char *root)
         open_fn open;
         evr_event bad; /* put in the middle of a large write */
         const char *why;
-    } f[] = {{"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1, 0}, "(2048, 5)"},
-             {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1, 0}, "(5, 2048)"},
-             {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0, 0}, "4294967296 us"}};
+    } f[] = {
+        {"parts_evt2.raw", evr_evt2_writer_open, {7, 2048, 5, 1, 0}, "(2048, 5)"},
+        {"parts_evt3.raw", evr_evt3_writer_open, {7, 5, 2048, 1, 0}, "(5, 2048)"},
+        {"parts.dat", evr_dat_writer_open, {INT64_C(1) << 32, 5, 6, 0, 0}, "4294967296 us"},
+        {"parts.bag",
+         evr_rosbag_writer_open,
+         {(INT64_C(1) << 32) * 1000000, 5, 6, 0, 0},
+         "4294967296000000 us"},
+    };
     const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
     evr_event *ev = calloc(n, sizeof *ev);
     uint64_t s = 4242;
@@ -987,6 +999,14 @@ static void test_camera_parts(const char *root)
             CHECK(memcmp(serial, parts, len_serial) == 0);
         free(serial);
         free(parts);
+        {
+            evr_event *got = NULL;
+            size_t ngot = 0;
+            CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &e_));
+            CHECK(ngot == n);
+            if (ngot == n) CHECK(same_events(got, ev, n));
+            free(got);
+        }
         remove(path);
 
         /* the first bad event is refused, the later ones (out of order, past the range) not seen */
@@ -1075,6 +1095,71 @@ static void test_camera_formats(const char *root)
 /* Round trip through the bag writer and reader, flushing after every segment; a copy of the
  * temporary file after a flush is a complete bag holding every finished message (the 30 Hz
  * windows before the last event's). Then what the reader refuses. */
+static uint32_t get_le32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static void put_le32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+/* The bag data[0 .. len) with each chunk's data compressed as rosbag does it, by bz2 (lz4 0) or
+ * as an LZ4 frame (lz4 1), to *out_len bytes; compression_name replaces the header's "bz2" or
+ * "lz4" (a name no reader knows). The chunk infos' offsets go stale: evray's reader reads the
+ * records in turn. NULL when out of memory or a compressor failed. */
+static unsigned char *compress_bag(const unsigned char *data, size_t len, int lz4,
+                                   const char *compression_name, size_t *out_len)
+{
+    const size_t cap = 2 * len + 65536, magic = 13;
+    unsigned char *out = malloc(cap);
+    size_t at = magic, o = magic;
+    if (!out) return NULL;
+    memcpy(out, data, magic);
+    while (at + 8 <= len) {
+        const uint32_t hl = get_le32(data + at), dl = get_le32(data + at + 4 + hl);
+        const unsigned char *h = data + at + 4, *d = data + at + 8 + hl;
+        if (hl >= 8 && !memcmp(h + 4, "op=\x05", 4)) {
+            const size_t name = strlen(compression_name), head = 8 + 4 + 12 + name + 4 + 9;
+            unsigned char *c = out + o + 4 + head + 4;
+            size_t room = cap - (o + 4 + head + 4), clen;
+            if (lz4) {
+                clen = LZ4F_compressFrame(c, room, d, dl, NULL);
+                if (LZ4F_isError(clen)) break;
+            } else {
+                unsigned int n = (unsigned int)room;
+                if (BZ2_bzBuffToBuffCompress((char *)c, &n, (char *)(uintptr_t)d, dl, 9, 0, 0) !=
+                    BZ_OK)
+                    break;
+                clen = n;
+            }
+            unsigned char *p = out + o;
+            put_le32(p, (uint32_t)head);
+            put_le32(p + 4, 4);
+            memcpy(p + 8, "op=\x05", 4);
+            put_le32(p + 12, (uint32_t)(12 + name));
+            memcpy(p + 16, "compression=", 12);
+            memcpy(p + 28, compression_name, name);
+            put_le32(p + 28 + name, 9);
+            memcpy(p + 32 + name, "size=", 5);
+            put_le32(p + 37 + name, dl);
+            put_le32(p + 41 + name, (uint32_t)clen);
+            o += 4 + head + 4 + clen;
+        } else {
+            memcpy(out + o, data + at, 8 + (size_t)hl + dl);
+            o += 8 + (size_t)hl + dl;
+        }
+        at += 8 + (size_t)hl + dl;
+    }
+    if (at != len) {
+        free(out);
+        return NULL;
+    }
+    *out_len = o;
+    return out;
+}
+
 static void test_rosbag(const char *root)
 {
     const size_t n = 6000;
@@ -1118,15 +1203,56 @@ static void test_rosbag(const char *root)
     if (ngot == n) CHECK(same_events(got, ev, n));
     CHECK(width == W && height == H);
     free(got);
-    free(ev);
+    got = NULL;
 
-    /* a truncated file, and one that is no bag: one clear line, no events */
+    /* a truncated file, and one that is no bag: one clear line, no events; its chunks compressed
+     * by bz2 and lz4: the same events, and a chunk whose compressed data is cut or unknown: one
+     * line */
     {
         FILE *fp = fopen(path, "rb");
         char *data = malloc(1 << 22);
         size_t len = fp && data ? fread(data, 1, 1 << 22, fp) : 0;
         if (fp) fclose(fp);
         CHECK(len > 5000);
+        for (int lz4 = 0; lz4 < 2 && len > 5000; lz4++) {
+            const char *name = lz4 ? "lz4" : "bz2";
+            size_t clen = 0;
+            unsigned char *c = compress_bag((const unsigned char *)data, len, lz4, name, &clen);
+            CHECK(c != NULL && clen < len);
+            if (!c) continue;
+            write_file(partial, (const char *)c, clen);
+            CHECK_OK(evr_events_read(partial, &got, &ngot, NULL, NULL, &e_));
+            CHECK(ngot == n);
+            if (ngot == n) CHECK(same_events(got, ev, n));
+            free(got);
+            got = NULL;
+            free(c);
+            c = compress_bag((const unsigned char *)data, len, lz4, "zip", &clen);
+            if (c) {
+                write_file(partial, (const char *)c, clen);
+                check_bad(partial, "compression is none of none, bz2, lz4");
+                free(c);
+            }
+            /* the first chunk's compressed data cut short by one byte, its record kept whole */
+            c = compress_bag((const unsigned char *)data, len, lz4, name, &clen);
+            if (c) {
+                const size_t chunk = 4109; /* the first record after the bag header */
+                const uint32_t hl = get_le32(c + chunk), dl = get_le32(c + chunk + 4 + hl);
+                unsigned char *cut = malloc(clen);
+                CHECK(cut != NULL);
+                if (cut) {
+                    const size_t end = chunk + 8 + hl + dl - 1;
+                    memcpy(cut, c, end);
+                    put_le32(cut + chunk + 4 + hl, dl - 1);
+                    memcpy(cut + end, c + end + 1, clen - end - 1);
+                    write_file(partial, (const char *)cut, clen - 1);
+                    check_bad(partial,
+                              lz4 ? "corrupt lz4 ROS bag chunk" : "corrupt bz2 ROS bag chunk");
+                    free(cut);
+                }
+                free(c);
+            }
+        }
         if (len > 5000) {
             write_file(partial, data, len - 1);
             check_bad(partial, "truncated");
@@ -1141,6 +1267,7 @@ static void test_rosbag(const char *root)
         check_bad(partial, "no dvs_msgs/EventArray connection");
         remove(partial);
     }
+    free(ev);
 
     /* ROS time holds whole seconds below 2^32 */
     memset(&e, 0, sizeof e);

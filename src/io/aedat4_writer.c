@@ -1,6 +1,7 @@
 /* AEDAT 4.0 files (io/aedat4.h) the way dv-processing's MonoCameraWriter writes an event-only
  * recording: one stream, id 0, named "events", of type EVTS, compressed by LZ4 (DV's default and
- * the fastest; every AEDAT 4.0 reader decodes it). Timestamps are the run's microseconds.
+ * the fastest; every AEDAT 4.0 reader decodes it), or by ZSTD at its default level (--format
+ * aedat4-zstd: a smaller file, more CPU). Timestamps are the run's microseconds.
  *
  * Packets hold the events of one millisecond (t / PACKET_US), at most PACKET_MAX_EVENTS of them (a
  * denser millisecond takes several): where packets end depends only on the events, so the file's
@@ -24,6 +25,7 @@
 #include "io/raw_stream.h"
 
 #include <lz4frame.h>
+#include <zstd.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -38,6 +40,8 @@
  * 2-core machine; at even a third of that, the 30 s eye's 218 M events would keep the 4 threads
  * that pack the other formats busy as long as the H100 takes to render them (1.2 s) */
 #define COMPRESS_THREADS 8
+/* ZSTD's level for --format aedat4-zstd: its default, as DV's ZSTD (not ZSTD_HIGH) uses */
+#define ZSTD_LEVEL ZSTD_CLEVEL_DEFAULT
 
 typedef struct {
     int64_t offset; /* the packet's compressed bytes */
@@ -50,6 +54,7 @@ typedef struct {
     /* the stream's own finish and abort, which these wrap */
     evr_status (*raw_finish)(evr_event_writer *w, int64_t duration_us, evr_error *err);
     void (*raw_abort)(evr_event_writer *w);
+    int compression; /* EVR_AEDAT4_LZ4 or EVR_AEDAT4_ZSTD */
     LZ4F_preferences_t lz4;
     int64_t end;     /* file offset after the last closed packet */
     int tail;        /* a flush wrote the open packet and the table after end */
@@ -169,7 +174,7 @@ static size_t data_table(unsigned char *out, const table_entry *e, size_t n)
  *   12 vtable: 10, 20, then compression 4, dataTablePosition 8, infoNode 16  22 padding
  *   24 the table: 12 (to its vtable), 28 compression, 32 dataTablePosition (8-aligned),
  *   40: 4 (to the string at 44)  44 the string's length, its bytes, a 0, padding */
-static unsigned char *io_header(int width, int height, size_t *len)
+static unsigned char *io_header(int width, int height, int compression, size_t *len)
 {
     char xml[1024];
     int n = snprintf(
@@ -177,7 +182,7 @@ static unsigned char *io_header(int width, int height, size_t *len)
         "<dv version=\"2.0\">\n"
         "    <node name=\"outInfo\" path=\"/outInfo/\">\n"
         "        <node name=\"0\" path=\"/outInfo/0/\">\n"
-        "            <attr key=\"compression\" type=\"string\">LZ4</attr>\n"
+        "            <attr key=\"compression\" type=\"string\">%s</attr>\n"
         "            <attr key=\"originalModuleName\" type=\"string\">evray</attr>\n"
         "            <attr key=\"originalOutputName\" type=\"string\">events</attr>\n"
         "            <attr key=\"typeDescription\" type=\"string\">Array of events (polarity ON/OFF).</attr>\n"
@@ -190,7 +195,7 @@ static unsigned char *io_header(int width, int height, size_t *len)
         "        </node>\n"
         "    </node>\n"
         "</dv>\n",
-        width, height);
+        compression == EVR_AEDAT4_ZSTD ? "ZSTD" : "LZ4", width, height);
     const size_t at = EVR_AEDAT4_VERSION_LEN, body = (48 + (size_t)n + 1 + 7) / 8 * 8;
     unsigned char *out = n > 0 && (size_t)n < sizeof xml ? calloc(1, at + body) : NULL;
     if (!out) return NULL;
@@ -205,7 +210,7 @@ static unsigned char *io_header(int width, int height, size_t *len)
     evr_put_le16(b + 18, 8);
     evr_put_le16(b + 20, 16);
     evr_put_le32(b + 24, 12);
-    evr_put_le32(b + 28, EVR_AEDAT4_LZ4);
+    evr_put_le32(b + 28, (uint32_t)compression);
     evr_put_le64(b + 32, UINT64_MAX); /* -1: no data table yet */
     evr_put_le32(b + 40, 4);
     evr_put_le32(b + 44, (uint32_t)n);
@@ -216,22 +221,42 @@ static unsigned char *io_header(int width, int height, size_t *len)
 
 /* ---- packets ---- */
 
+/* ---- compression: one LZ4 or ZSTD frame a packet, and one for the data table ---- */
+
+/* Bytes the frame of len bytes takes at most. */
+static size_t frame_bound(const aedat_writer *w, size_t len)
+{
+    return w->compression == EVR_AEDAT4_ZSTD ? ZSTD_compressBound(len)
+                                             : LZ4F_compressFrameBound(len, &w->lz4);
+}
+
+/* The frame of src[0 .. len) at dst (room bytes); its bytes, 0 when the compressor failed. */
+static size_t frame(const aedat_writer *w, unsigned char *dst, size_t room,
+                    const unsigned char *src, size_t len)
+{
+    size_t c;
+    if (w->compression == EVR_AEDAT4_ZSTD) {
+        c = ZSTD_compress(dst, room, src, len, ZSTD_LEVEL);
+        return ZSTD_isError(c) ? 0 : c;
+    }
+    c = LZ4F_compressFrame(dst, room, src, len, &w->lz4);
+    return LZ4F_isError(c) ? 0 : c;
+}
+
 /* Bytes a packet of n events takes at most in the file. */
 static size_t packet_bound(const aedat_writer *w, size_t n)
 {
-    return PACKET_HEADER +
-           LZ4F_compressFrameBound(EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * n, &w->lz4);
+    return PACKET_HEADER + frame_bound(w, EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * n);
 }
 
 /* Compresses the EventPacket of ev[0 .. n) (built in raw) to a PacketHeader and a frame at out;
- * returns the frame's bytes, 0 when LZ4 failed. */
+ * returns the frame's bytes, 0 when the compressor failed. */
 static size_t pack_packet(const aedat_writer *w, unsigned char *raw, const evr_event *ev, size_t n,
                           unsigned char *out, size_t room)
 {
     const size_t len = event_packet(raw, ev, n);
-    const size_t c =
-        LZ4F_compressFrame(out + PACKET_HEADER, room - PACKET_HEADER, raw, len, &w->lz4);
-    if (LZ4F_isError(c) || c > INT32_MAX) return 0;
+    const size_t c = frame(w, out + PACKET_HEADER, room - PACKET_HEADER, raw, len);
+    if (c == 0 || c > INT32_MAX) return 0;
     evr_put_le32(out, 0);
     evr_put_le32(out + 4, (uint32_t)c);
     return c;
@@ -415,7 +440,7 @@ static evr_status write_tail(aedat_writer *w, int keep_open, evr_error *err)
     if (st == EVR_OK) st = evr_raw_stream_room(&w->s, w->s.cap, err); /* drained */
     if (st != EVR_OK) return st;
     const size_t len = table_head(w->n_table) + TABLE_ENTRY_BYTES * w->n_table;
-    const size_t bound = LZ4F_compressFrameBound(len, &w->lz4);
+    const size_t bound = frame_bound(w, len);
     if (len + bound > w->cap_buf) {
         unsigned char *b = realloc(w->buf, len + bound);
         if (!b) return no_memory(w, err);
@@ -423,8 +448,8 @@ static evr_status write_tail(aedat_writer *w, int keep_open, evr_error *err)
         w->cap_buf = len + bound;
     }
     data_table(w->buf, w->table, w->n_table);
-    const size_t c = LZ4F_compressFrame(w->buf + len, bound, w->buf, len, &w->lz4);
-    if (LZ4F_isError(c)) return no_memory(w, err);
+    const size_t c = frame(w, w->buf + len, bound, w->buf, len);
+    if (c == 0) return no_memory(w, err);
     if (fwrite(w->buf + len, 1, c, w->s.f) != c) return cannot_write(w, err);
     st = set_table_position(w, w->end, err);
     if (st != EVR_OK) return st;
@@ -523,11 +548,11 @@ static void aedat_abort(evr_event_writer *base)
     w->raw_abort(base);
 }
 
-evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
-                                  evr_event_writer **out, evr_error *err)
+static evr_status aedat_open(const char *path, const evr_writer_meta *meta, int compression,
+                             evr_event_writer **out, evr_error *err)
 {
     size_t len = 0;
-    unsigned char *head = io_header(meta->width, meta->height, &len);
+    unsigned char *head = io_header(meta->width, meta->height, compression, &len);
     evr_status st;
     *out = NULL;
     if (!head) {
@@ -544,6 +569,7 @@ evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
     w->s.base.flush = aedat_flush;
     w->s.base.finish = aedat_finish;
     w->s.base.abort = aedat_abort;
+    w->compression = compression;
     memset(&w->lz4, 0, sizeof w->lz4); /* LZ4's defaults: fast, 64 KB linked blocks */
     w->s.parts.threads = COMPRESS_THREADS;
     w->end = (int64_t)len;
@@ -558,6 +584,18 @@ evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
     return EVR_OK;
 }
 
+evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
+                                  evr_event_writer **out, evr_error *err)
+{
+    return aedat_open(path, meta, EVR_AEDAT4_LZ4, out, err);
+}
+
+evr_status evr_aedat4_zstd_writer_open(const char *path, const evr_writer_meta *meta,
+                                       evr_event_writer **out, evr_error *err)
+{
+    return aedat_open(path, meta, EVR_AEDAT4_ZSTD, out, err);
+}
+
 const evr_event_format evr_format_aedat4 = {
     "aedat4",
     NULL,
@@ -565,4 +603,13 @@ const evr_event_format evr_format_aedat4 = {
     evr_aedat4_writer_open,
     "iniVation AEDAT 4.0, LZ4 packets with a data table (DV, dv-processing, aedat)",
     ".aedat4",
+    0};
+
+const evr_event_format evr_format_aedat4_zstd = {
+    "aedat4-zstd",
+    NULL,
+    "events_zstd.aedat4",
+    evr_aedat4_zstd_writer_open,
+    "iniVation AEDAT 4.0, ZSTD packets (smaller, slower to write)",
+    "zstd.aedat4",
     0};

@@ -8,18 +8,19 @@
 
 /* Defined beside each writer. */
 extern const evr_event_format evr_format_h5, evr_format_txt, evr_format_npy, evr_format_evt2,
-    evr_format_evt3, evr_format_dat, evr_format_rosbag, evr_format_aedat4;
+    evr_format_evt3, evr_format_dat, evr_format_rosbag, evr_format_aedat4, evr_format_aedat4_zstd;
 
 /* Format i is configuration bit 1 << i: new formats go at the end. */
 static const evr_event_format *const formats[] = {
-    &evr_format_h5,     /* h5_writer.c */
-    &evr_format_txt,    /* txt_writer.c */
-    &evr_format_npy,    /* npy_writer.c */
-    &evr_format_evt2,   /* evt2_writer.c */
-    &evr_format_evt3,   /* evt3_writer.c */
-    &evr_format_dat,    /* dat_writer.c */
-    &evr_format_rosbag, /* rosbag_writer.c */
-    &evr_format_aedat4, /* aedat4_writer.c */
+    &evr_format_h5,          /* h5_writer.c */
+    &evr_format_txt,         /* txt_writer.c */
+    &evr_format_npy,         /* npy_writer.c */
+    &evr_format_evt2,        /* evt2_writer.c */
+    &evr_format_evt3,        /* evt3_writer.c */
+    &evr_format_dat,         /* dat_writer.c */
+    &evr_format_rosbag,      /* rosbag_writer.c */
+    &evr_format_aedat4,      /* aedat4_writer.c */
+    &evr_format_aedat4_zstd, /* aedat4_writer.c */
 };
 
 #define NUM_FORMATS ((int)(sizeof formats / sizeof formats[0]))

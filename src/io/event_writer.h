@@ -64,5 +64,8 @@ evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
                                   evr_event_writer **out, evr_error *err);
 evr_status evr_aedat4_writer_open(const char *path, const evr_writer_meta *meta,
                                   evr_event_writer **out, evr_error *err);
+/* AEDAT 4.0 with ZSTD packets instead of LZ4. */
+evr_status evr_aedat4_zstd_writer_open(const char *path, const evr_writer_meta *meta,
+                                       evr_event_writer **out, evr_error *err);
 
 #endif

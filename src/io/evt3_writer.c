@@ -17,6 +17,10 @@
 #define EVT3_HIGH_STEP \
     1 /* time-high units between TIME_HIGH words: readers count wraps only on single steps */
 
+/* threads packing a large write: its runs cost about twice a DAT event's packing, and four kept
+ * it level with HDF5 only just on the H100 run (docs/benchmarks.md, "Writers") */
+#define EVT3_THREADS 8
+
 enum {
     EVT3_ADDR_Y = 0x0,
     EVT3_ADDR_X = 0x2,
@@ -214,6 +218,7 @@ evr_status evr_evt3_writer_open(const char *path, const evr_writer_meta *meta,
                                         header, len, evt3_write, out, err);
     if (st == EVR_OK) {
         evt3_writer *w = (evt3_writer *)*out;
+        w->s.parts.threads = EVT3_THREADS;
         w->st.time_high = -1;
         w->st.low = w->st.y = w->st.base_x = w->st.pol = -1;
     }

@@ -1,6 +1,8 @@
 #include "io/rosbag_read.h"
 #include "io/byte_order.h"
 
+#include <bzlib.h>
+#include <lz4frame.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +10,9 @@
 
 #define BAG_MAGIC "#ROSBAG V2.0\n"
 #define EVENT_BYTES 13 /* uint16 x, uint16 y, time ts, bool polarity */
+/* A compressed chunk's data, uncompressed, at most (rosbag's chunks are about 768 KB; this
+ * bounds what a corrupt size field makes the reader allocate) */
+#define CHUNK_MAX ((size_t)1 << 30)
 
 typedef struct {
     const unsigned char *p;
@@ -97,6 +102,71 @@ static int message(bag_reader *r, span m)
     return 1;
 }
 
+static int records(bag_reader *r, span s, int in_chunk);
+
+/* LZ4 chunks are LZ4 frames (roslz4, rosbags); out holds exactly size bytes. */
+static int lz4_chunk(span in, unsigned char *out, size_t size)
+{
+    LZ4F_dctx *dctx = NULL;
+    size_t at = 0, used = 0, ret = 1;
+    if (LZ4F_isError(LZ4F_createDecompressionContext(&dctx, LZ4F_VERSION))) return 0;
+    while (ret != 0 && used < in.n) {
+        size_t src = in.n - used, dst = size - at;
+        ret = LZ4F_decompress(dctx, out + at, &dst, in.p + used, &src, NULL);
+        if (LZ4F_isError(ret) || (src == 0 && dst == 0)) break;
+        used += src;
+        at += dst;
+    }
+    LZ4F_freeDecompressionContext(dctx);
+    return ret == 0 && at == size && used == in.n;
+}
+
+/* bz2 chunks are one bzip2 stream. */
+static int bz2_chunk(span in, unsigned char *out, size_t size)
+{
+    unsigned int len = (unsigned int)size;
+    if (in.n > UINT32_MAX) return 0;
+    return BZ2_bzBuffToBuffDecompress((char *)out, &len, (char *)(uintptr_t)in.p,
+                                      (unsigned int)in.n, 0, 0) == BZ_OK &&
+           len == size;
+}
+
+/* A chunk's records: as they are, or uncompressed first (bz2, lz4) into a buffer of its size
+ * field's bytes. */
+static int chunk(bag_reader *r, span hdr, span data)
+{
+    span comp;
+    uint32_t size;
+    int lz4;
+    if (!field(hdr, "compression", &comp)) {
+        r->why = "corrupt ROS bag chunk header (no compression field)";
+        return 0;
+    }
+    if (comp.n == 4 && !memcmp(comp.p, "none", 4)) return records(r, data, 1);
+    lz4 = comp.n == 3 && !memcmp(comp.p, "lz4", 3);
+    if (!lz4 && !(comp.n == 3 && !memcmp(comp.p, "bz2", 3))) {
+        r->why = "ROS bag chunk compression is none of none, bz2, lz4";
+        return 0;
+    }
+    if (!field_u32(hdr, "size", &size) || size > CHUNK_MAX) {
+        r->why = "corrupt ROS bag chunk header (no size field, or past 1 GB)";
+        return 0;
+    }
+    unsigned char *buf = malloc(size ? size : 1);
+    if (!buf) {
+        r->why = "out of memory uncompressing a ROS bag chunk";
+        return 0;
+    }
+    int ok = lz4 ? lz4_chunk(data, buf, size) : bz2_chunk(data, buf, size);
+    if (!ok) r->why = lz4 ? "corrupt lz4 ROS bag chunk" : "corrupt bz2 ROS bag chunk";
+    else {
+        span plain = {buf, size};
+        ok = records(r, plain, 1);
+    }
+    free(buf);
+    return ok;
+}
+
 /* The records of s (the file after its magic line, or a chunk's data). */
 static int records(bag_reader *r, span s, int in_chunk)
 {
@@ -112,11 +182,7 @@ static int records(bag_reader *r, span s, int in_chunk)
             return 0;
         }
         if (op.p[0] == 0x05 && !in_chunk) {
-            if (!field_is(hdr, "compression", "none")) {
-                r->why = "compressed ROS bag chunks are not read (run rosbag decompress first)";
-                return 0;
-            }
-            if (!records(r, data, 1)) return 0;
+            if (!chunk(r, hdr, data)) return 0;
         } else if (op.p[0] == 0x07 && r->conn < 0) {
             if (!field_u32(hdr, "conn", &conn)) {
                 r->why = "corrupt ROS bag connection record (no conn field)";

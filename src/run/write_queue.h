@@ -1,5 +1,8 @@
 /* Writes event batches on a thread of its own, so that the host writes segment i while the
- * backend renders segment i + 1. Batches are written in the order pushed. Every writer is
+ * backend renders segment i + 1. Batches are written in the order pushed; each batch goes to
+ * the first writer, then to all the others at once on threads of their own (a writer is only
+ * ever called by one thread at a time; the first, HDF5 when asked for, always by this one).
+ * Every writer is
  * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
  * flush, and otherwise once the thread has been idle until then: a killed run's files lag at
  * most about flush_seconds (plus the batch being written, and the HDF5 writer's last partial
@@ -13,6 +16,10 @@
 #include <stdint.h>
 #include "events.h"
 #include "io/event_writer.h"
+
+/* Writers a queue takes at most: a run's formats (sim_state.h's EVR_MAX_WRITERS) and a caller's
+ * sink (run/event_sink.h). */
+#define EVR_WRITE_QUEUE_MAX_WRITERS 17
 
 /* The simulation's flush interval: a second of work at most is lost when a run is killed. */
 #define EVR_WRITE_FLUSH_SECONDS 1.0

@@ -3,11 +3,12 @@ every target in tests/fuzz (fuzz_TARGET.c), from the scenes the tests already wr
 built-in scenes exported as GLB, tests/data/import, tests/import_assets.py, deform_assets.py,
 material_assets.py; .gltf files whose data is external are made self-contained), small files of
 the other formats Assimp reads, and the event files of one short run in every format evray
-writes, and its labels.h5. The seeds are small (a few KB each): libFuzzer mutates them from there.
+writes (and its bag again with bz2 chunks), and its labels.h5. The seeds are small (a few KB each): libFuzzer mutates them from there.
 
 Standard library only; EVRAY is the built program (it exports the demos and writes the event
 files)."""
 import base64
+import bz2
 import glob
 import json
 import os
@@ -104,6 +105,25 @@ def assimp_seeds(out):
     return len(seeds)
 
 
+def bz2_bag(data):
+    """The bag with each chunk's data compressed by bz2, as rosbag writes it (the chunk infos'
+    offsets go stale; the reader goes record by record)."""
+    out, at = [data[:13]], 13
+    while at + 8 <= len(data):
+        hl = struct.unpack_from("<I", data, at)[0]
+        dl = struct.unpack_from("<I", data, at + 4 + hl)[0]
+        head, body = data[at + 4:at + 4 + hl], data[at + 8 + hl:at + 8 + hl + dl]
+        at += 8 + hl + dl
+        if head[4:8] != b"op=\x05":
+            out.append(data[at - 8 - hl - dl:at])
+            continue
+        c = bz2.compress(body)
+        fields = [b"op=\x05", b"compression=bz2", b"size=" + struct.pack("<I", len(body))]
+        head = b"".join(struct.pack("<I", len(f)) + f for f in fields)
+        out.append(struct.pack("<I", len(head)) + head + struct.pack("<I", len(c)) + c)
+    return b"".join(out)
+
+
 def event_seeds(evray, work, outs):
     """One short run of the square demo written in every format; the files cut to MAX_SEED
     events' worth where large (a reader must cope with any length anyway)."""
@@ -134,6 +154,7 @@ def event_seeds(evray, work, outs):
             put("events_camera", name, b"\1" + data[:MAX_SEED])
         elif name.endswith(".bag"):
             put("events_camera", name, b"\2" + data[:MAX_SEED])
+            put("events_camera", "bz2_" + name, b"\2" + bz2_bag(data)[:MAX_SEED])
     return made
 
 
