@@ -51,7 +51,13 @@ int cmd_convert(int argc, char **argv)
         free(ev);
         return 1;
     }
+    size_t with_id = 0;
+    for (size_t i = 0; i < n; i++) with_id += ev[i].id != 0;
     free(ev);
+    if (with_id && evr_events_format_holds_ids(paths[1]) == 0 && !quiet)
+        fprintf(stderr,
+                "evray: note: %s has no place for event ids: the ids of %zu events are left out\n",
+                paths[1], with_id);
     if (!quiet) printf("%zu events: %s -> %s\n", n, paths[0], paths[1]);
     return 0;
 }

@@ -41,6 +41,8 @@ double evr_seconds(void);
  *                uncompressed, bz2 or lz4); width and height from the first message.
  *   .aedat4      iniVation AEDAT 4.0 (.aedat too): the first event stream (EVTS), packets
  *                uncompressed or LZ4 or ZSTD; width and height from its sizeX and sizeY.
+ * Event ids (evr_event.id) come from events/id (.h5), an id field (.npy) and a fifth column
+ * (.txt) where the file has them, else 0.
  * Polarity is returned as 1 (p > 0) or 0 (p <= 0, so -1/1 files read too). Events keep the file's
  * order. *ev is malloc'ed (free() it; NULL when *n is 0). width/height are set to -1 when the
  * format does not store them; either pointer may be NULL. */
@@ -52,9 +54,13 @@ evr_status evr_events_read(const char *path, evr_event **ev, size_t *n, int *wid
  * 3.0), .bag (ROS1 bag), a name ending in "zstd.aedat4" (AEDAT 4.0, ZSTD packets) or any other
  * .aedat4 (AEDAT 4.0, LZ4). width/height <= 0: taken from the largest x/y.
  * Under a temporary name until complete, as the simulation's writers; what the format cannot
- * hold is refused (EVR_ERR_ARG). */
+ * hold is refused (EVR_ERR_ARG), but event ids (evr_event.id), which .h5, .npy and .txt keep
+ * when any is non-zero and the other formats leave out (evr_events_format_holds_ids). */
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
                             evr_error *err);
+/* 1 when the format path's name asks for keeps event ids, 0 when it has none, -1 when the name
+ * asks for no format evray writes. */
+int evr_events_format_holds_ids(const char *path);
 
 /* ---- labels.h5 (src/io/labels_read.c; README "Ground truth" has the layout) ---- */
 typedef struct {

@@ -136,6 +136,22 @@ def check_backend(backend):
             f"{backend}: OFF events (the square leaving) with another id: "
             f"{sum(e[4] != plane for e in off)} of {len(off)}")
     print(f"{backend}: {len(on)} ON events all on the square, {len(off)} OFF all on the plane")
+    if backend == "cpu":
+        convert_keeps_ids(d, ev)
+
+
+def convert_keeps_ids(d, ev):
+    """evray convert reads the ids back (events/id, the npy field, the fifth column) and writes
+    them where the format holds them; a format without a place for them says so."""
+    ids = [e[4] for e in ev]
+    chain = [("events.h5", "c1.npy"), ("c1.npy", "c2.txt"), ("c2.txt", "c3.h5"), ("c3.h5", "c4.txt")]
+    for src, dst in chain:
+        p = T.run("convert", os.path.join(d, src), os.path.join(d, dst))
+        T.check("note" not in p.stderr, f"convert {src} -> {dst}: no note ({p.stderr.strip()})")
+    T.check([e[4] for e in read_txt(os.path.join(d, "c4.txt"))] == ids,
+            "ids through h5 -> npy -> txt -> h5 -> txt")
+    p = T.run("convert", os.path.join(d, "c3.h5"), os.path.join(d, "c5.raw"))
+    T.check("no place for event ids" in p.stderr, f"EVT 3.0 says it leaves the ids out: {p.stderr!r}")
 
 
 # the h5 part needs the oracle environment; the rest runs without it

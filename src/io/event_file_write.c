@@ -43,6 +43,12 @@ static const evr_event_format *format_of(const char *path)
     return best;
 }
 
+int evr_events_format_holds_ids(const char *path)
+{
+    const evr_event_format *f = path ? format_of(path) : NULL;
+    return f ? f->holds_ids : -1;
+}
+
 evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int width, int height,
                             evr_error *err)
 {
@@ -68,6 +74,7 @@ evr_status evr_events_write(const char *path, const evr_event *ev, size_t n, int
     meta.width = width;
     meta.height = height;
     for (size_t i = 0; i < n; i++) {
+        if (ev[i].id && f->holds_ids) meta.event_ids = 1; /* kept where the format holds them */
         if (ev[i].t > meta.max_t_us) meta.max_t_us = ev[i].t;
         if (width <= 0 && ev[i].x >= meta.width) meta.width = ev[i].x + 1;
         if (height <= 0 && ev[i].y >= meta.height) meta.height = ev[i].y + 1;

@@ -139,7 +139,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         const char *eol = strchr(s, '\n');
         const char *next = eol ? eol + 1 : s + strlen(s);
         int64_t t;
-        long x, y, p;
+        long x, y, p, id = 0;
         line++;
         s = skip_blanks(s);
         if (*s == '\n' || *s == 0 || *s == '#') {
@@ -149,9 +149,11 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         if (!parse_seconds(&s, &t) || (s = skip_blanks(s), !parse_long(&s, &x)) ||
             (s = skip_blanks(s), !parse_long(&s, &y)) ||
             (s = skip_blanks(s), !parse_long(&s, &p)) ||
+            (s = skip_blanks(s), *s != '\n' && *s != 0 && *s != '\r' && !parse_long(&s, &id)) ||
             (s = skip_blanks(s), *s != '\n' && *s != 0) || x < 0 || x > 65535 || y < 0 ||
-            y > 65535) {
-            snprintf(err->msg, sizeof err->msg, "%s:%zu: expected \"t x y p\"", path, line);
+            y > 65535 || id < 0 || id > (long)UINT32_MAX) {
+            snprintf(err->msg, sizeof err->msg, "%s:%zu: expected \"t x y p\" (and an event id)",
+                     path, line);
             st = EVR_ERR_FORMAT;
             goto done;
         }
@@ -171,7 +173,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         out[count].x = (uint16_t)x;
         out[count].y = (uint16_t)y;
         out[count].p = p > 0 ? 1 : 0;
-        out[count].id = 0;
+        out[count].id = (uint32_t)id;
         count++;
         s = next;
     }
@@ -254,8 +256,8 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
 {
     char *data, *header = NULL;
     size_t size, hlen, start, itemsize = 0;
-    npy_field fields[4]; /* t, x, y, p */
-    static const char names[4] = {'t', 'x', 'y', 'p'};
+    npy_field fields[5]; /* t, x, y, p and (optional) id */
+    static const char *const names[5] = {"t", "x", "y", "p", "id"};
     evr_event *out = NULL;
     uint64_t count = 0;
     evr_status st = evr_file_slurp(path, &data, &size, err);
@@ -342,10 +344,10 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
             }
             f.size = sz;
         }
-        for (int k = 0; k < 4; k++) {
-            if (name[0] == names[k] && name[1] == 0) {
+        for (int k = 0; k < 5; k++) {
+            if (strcmp(name, names[k]) == 0) {
                 if (!is_int) {
-                    st = npy_bad(err, path, "a field t, x, y or p is not an integer");
+                    st = npy_bad(err, path, "a field t, x, y, p or id is not an integer");
                     goto done;
                 }
                 fields[k] = f;
@@ -413,7 +415,12 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         out[i].x = (uint16_t)x;
         out[i].y = (uint16_t)y;
         out[i].p = npy_get(rec, &fields[3]) > 0 ? 1 : 0;
-        out[i].id = 0;
+        const int64_t id = fields[4].found ? npy_get(rec, &fields[4]) : 0;
+        if (id < 0 || id > (int64_t)UINT32_MAX) {
+            st = npy_bad(err, path, "event id out of range");
+            goto done;
+        }
+        out[i].id = (uint32_t)id;
     }
 done:
     free(header);
@@ -432,13 +439,17 @@ done:
 static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *width, int *height,
                           evr_error *err)
 {
-    static const char *const names[4] = {"events/x", "events/y", "events/t", "events/p"};
-    hid_t file = -1, ds[4] = {-1, -1, -1, -1};
+    /* events/id (the run's --event-ids) is read where the file has it */
+    static const char *const names[5] = {"events/x", "events/y", "events/t", "events/p",
+                                         "events/id"};
+    hid_t file = -1, ds[5] = {-1, -1, -1, -1, -1};
     hsize_t count = 0;
     evr_event *out = NULL;
     uint16_t *bx = NULL, *by = NULL;
     int64_t *bt = NULL;
     int8_t *bp = NULL;
+    uint32_t *bi = NULL;
+    int nds = 4;
     evr_status st = EVR_OK;
     const char *what = NULL;
     int w = -1, h = -1;
@@ -451,7 +462,11 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
             what = "cannot open as HDF5";
             st = EVR_ERR_IO;
         }
-        for (int k = 0; k < 4 && st == EVR_OK; k++) {
+        if (st == EVR_OK && H5Lexists(file, "events", H5P_DEFAULT) > 0 &&
+            H5Lexists(file, "events/id", H5P_DEFAULT) > 0)
+            nds = 5;
+        H5Eclear2(H5E_DEFAULT);
+        for (int k = 0; k < nds && st == EVR_OK; k++) {
             hid_t space;
             hsize_t dims[1];
             ds[k] = H5Dopen2(file, names[k], H5P_DEFAULT);
@@ -484,7 +499,8 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
                 by = malloc(block * sizeof *by);
                 bt = malloc(block * sizeof *bt);
                 bp = malloc(block * sizeof *bp);
-                if (!out || !bx || !by || !bt || !bp) {
+                bi = malloc(block * sizeof *bi);
+                if (!out || !bx || !by || !bt || !bp || !bi) {
                     st = EVR_ERR_NOMEM;
                     what = "out of memory";
                 }
@@ -492,11 +508,11 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
         }
         for (hsize_t at = 0; st == EVR_OK && at < count; at += READ_BLOCK) {
             hsize_t start[1] = {at}, cnt[1] = {count - at < READ_BLOCK ? count - at : READ_BLOCK};
-            hid_t types[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64,
-                              H5T_NATIVE_INT8};
-            void *bufs[4] = {bx, by, bt, bp};
+            hid_t types[5] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64,
+                              H5T_NATIVE_INT8, H5T_NATIVE_UINT32};
+            void *bufs[5] = {bx, by, bt, bp, bi};
             hid_t mspace = H5Screate_simple(1, cnt, NULL);
-            for (int k = 0; k < 4 && st == EVR_OK; k++) {
+            for (int k = 0; k < nds && st == EVR_OK; k++) {
                 hid_t fspace = H5Dget_space(ds[k]);
                 if (mspace < 0 || fspace < 0 ||
                     H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
@@ -514,11 +530,11 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
                 e->x = bx[i];
                 e->y = by[i];
                 e->p = bp[i] > 0 ? 1 : 0;
-                e->id = 0;
+                e->id = nds == 5 ? bi[i] : 0;
             }
         }
         if (st != EVR_OK && st != EVR_ERR_NOMEM) evr_h5_fail(err, what, path, st);
-        for (int k = 0; k < 4; k++)
+        for (int k = 0; k < 5; k++)
             if (ds[k] >= 0) H5Dclose(ds[k]);
         if (file >= 0) H5Fclose(file);
         H5Eclear2(H5E_DEFAULT);
@@ -528,6 +544,7 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
     free(by);
     free(bt);
     free(bp);
+    free(bi);
     if (st != EVR_OK) {
         if (st == EVR_ERR_NOMEM)
             snprintf(err->msg, sizeof err->msg, "out of memory reading %s", path);
