@@ -9,6 +9,7 @@ primary ray hit at the sample after the crossing.
   and events.h5's /instances names them (h5py, in the oracle environment; that part skips
   without it).
 On the CPU, and on the CUDA backend where this build has one and a GPU is present."""
+import json
 import os
 import struct
 import subprocess
@@ -83,19 +84,20 @@ def run(scene_path, backend, d):
     return ev
 
 
-def names_of(d, ev, backend):
-    """id -> node path from events.h5's /instances (None without the oracle environment)."""
-    python = T.oracle_python(["h5py"]) if T_ORACLE else None
-    if python is None:
-        return None
-    import json
-    p = subprocess.run([python, "-c", READ_H5, os.path.join(d, "events.h5")], capture_output=True,
+def check_h5(d, ev, backend, names):
+    """events.h5's events/id are events.txt's, and its /instances names id i by a node path
+    ending in names[i] (skipped without the oracle environment)."""
+    if ORACLE is None:
+        return
+    p = subprocess.run([ORACLE, "-c", READ_H5, os.path.join(d, "events.h5")], capture_output=True,
                        text=True)
     if p.returncode != 0:
         raise SystemExit(p.stderr)
     h = json.loads(p.stdout)
     T.check(h["id"] == [e[4] for e in ev], f"{backend}: events.h5's events/id are events.txt's")
-    return {int(k): v for k, v in h["instances"].items()}
+    got = {int(k): v for k, v in h["instances"].items()}
+    T.check(all(got.get(i, "").endswith(n) for i, n in names.items()),
+            f"{backend}: /instances {got}, expected nodes ending in {names}")
 
 
 def check_backend(backend):
@@ -106,12 +108,9 @@ def check_backend(backend):
 
     d = os.path.join(tmp, f"quads-{backend}")
     ev = run(quads, backend, d)
-    names = names_of(d, ev, backend)
     # instance order is the scene's: left then right (ids 1, 2)
     left, right = 1, 2
-    if names is not None:
-        T.check(names[left].endswith("left") and names[right].endswith("right"),
-                f"{backend}: /instances {names}")
+    check_h5(d, ev, backend, {left: "left", right: "right"})
     # the quads' gap, x in (-0.1, 0.1) at 3 m: columns W/2 -+ 0.8 (and one either side)
     bad = [e for e in ev if (e[1] < W // 2 - 2 and e[4] != left) or
            (e[1] >= W // 2 + 2 and e[4] != right) or e[4] not in (left, right)]
@@ -121,11 +120,8 @@ def check_backend(backend):
 
     d = os.path.join(tmp, f"square-{backend}")
     ev = run(square, backend, d)
-    names = names_of(d, ev, backend)
     plane, sq = 1, 2
-    if names is not None:
-        T.check(names[plane].endswith("plane") and names[sq].endswith("square"),
-                f"{backend}: /instances {names}")
+    check_h5(d, ev, backend, {plane: "plane", sq: "square"})
     on = [e for e in ev if e[3] == 1]
     off = [e for e in ev if e[3] == 0]
     T.check(len(on) > 20 and len(off) > 20, f"{backend}: ON {len(on)}, OFF {len(off)}")
@@ -154,12 +150,11 @@ def convert_keeps_ids(d, ev):
     T.check("no place for event ids" in p.stderr, f"EVT 3.0 says it leaves the ids out: {p.stderr!r}")
 
 
-# the h5 part needs the oracle environment; the rest runs without it
-T_ORACLE = True
+# the h5 part needs the oracle environment (its Python, probed once); the rest runs without it
 try:
-    T.oracle_python(["h5py"])
+    ORACLE = T.oracle_python(["h5py"])
 except SystemExit:
-    T_ORACLE = False
+    ORACLE = None
     print("events.h5 part skipped: no oracle environment with h5py")
 
 check_backend("cpu")
