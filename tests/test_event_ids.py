@@ -148,6 +148,11 @@ def convert_keeps_ids(d, ev):
             "ids through h5 -> npy -> txt -> h5 -> txt")
     p = T.run("convert", os.path.join(d, "c3.h5"), os.path.join(d, "c5.raw"))
     T.check("no place for event ids" in p.stderr, f"EVT 3.0 says it leaves the ids out: {p.stderr!r}")
+    # a run asked for ids that writes a format without a place for them says so
+    p = T.run("demo", "--scene", "square", "--res", "16x16", "--duration", "0.2", "--event-ids",
+              "--format", "h5,evt3", "-o", os.path.join(d, "run-evt3"), "--no-preview")
+    T.check("events_evt3.raw has no place for event ids" in p.stderr and "events.h5" not in p.stderr,
+            f"the run's note names the EVT 3.0 file only: {p.stderr!r}")
 
 
 # the h5 part needs the oracle environment (its Python, probed once); the rest runs without it

@@ -837,12 +837,13 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
             w->ds_t =
                 make_extendible(w->group, "t", w->t32 ? H5T_STD_U32LE : H5T_STD_I64LE, H5W_CHUNK);
         if (w->ds_t >= 0) w->ds_p = make_extendible(w->group, "p", H5T_STD_I8LE, H5W_CHUNK);
-        int ids_ok = w->ds_p >= 0 && !meta->event_ids;
-        if (w->ds_p >= 0 && meta->event_ids &&
-            (w->ds_id = make_extendible(w->group, "id", H5T_STD_U32LE, H5W_CHUNK)) >= 0)
-            ids_ok = evr_h5_write_instances(w->file, meta->inst_node, meta->inst_mesh,
-                                            meta->num_instances) >= 0;
-        if (ids_ok) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
+        int laid_out = w->ds_p >= 0;
+        if (laid_out && meta->event_ids) /* events/id and the /instances that name them */
+            laid_out =
+                (w->ds_id = make_extendible(w->group, "id", H5T_STD_U32LE, H5W_CHUNK)) >= 0 &&
+                evr_h5_write_instances(w->file, meta->inst_node, meta->inst_mesh,
+                                       meta->num_instances) >= 0;
+        if (laid_out) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);
         if (w->ds_ms >= 0 &&
             write_scalar_dataset(w->file, "t_offset", H5T_STD_I64LE, H5T_NATIVE_INT64, &zero) >=
                 0 &&
