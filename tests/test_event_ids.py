@@ -148,6 +148,15 @@ def convert_keeps_ids(d, ev):
             "ids through h5 -> npy -> txt -> h5 -> txt")
     p = T.run("convert", os.path.join(d, "c3.h5"), os.path.join(d, "c5.raw"))
     T.check("no place for event ids" in p.stderr, f"EVT 3.0 says it leaves the ids out: {p.stderr!r}")
+    # an id out of range in a text file: one line naming the line, nothing written
+    for bad in ("0.000001 1 2 1 -3\n", "0.000001 1 2 1 4294967296\n", "0.000001 1 2 1 7 9\n"):
+        src, dst = os.path.join(d, "bad.txt"), os.path.join(d, "bad.h5")
+        with open(src, "w") as f:
+            f.write(bad)
+        p = T.run("convert", src, dst, expect=None)
+        lines = p.stderr.strip().splitlines()
+        T.check(p.returncode == 1 and len(lines) == 1 and "bad.txt:1" in lines[0] and
+                not os.path.exists(dst), f"convert of {bad!r}: {p.returncode} {p.stderr!r}")
     # a run asked for ids that writes a format without a place for them says so
     p = T.run("demo", "--scene", "square", "--res", "16x16", "--duration", "0.2", "--event-ids",
               "--format", "h5,evt3", "-o", os.path.join(d, "run-evt3"), "--no-preview")
