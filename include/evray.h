@@ -32,16 +32,18 @@ typedef struct {
     char msg[512];
 } evr_error;
 
-/* One DVS event. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in microseconds. id
- * (with evr_config.event_ids): 1 + the scene instance whose surface the pixel centre's primary ray
- * hit at the pixel's sample after the crossing (labels.h5's ids), 0 when it hit nothing (or ids
- * are off). */
+/* One DVS event, 16 bytes. Polarity p: 1 ON (brighter), 0 OFF (darker). Timestamp in
+ * microseconds. id (with evr_config.event_ids): 1 + the scene instance whose surface the pixel
+ * centre's primary ray hit at the pixel's sample after the crossing (labels.h5's ids), 0 when it
+ * hit nothing (or ids are off); 16 bits, in the padding the other fields leave, so that ids cost
+ * no memory: event ids take scenes of at most EVR_MAX_EVENT_ID instances. */
 typedef struct {
     int64_t t;
     uint16_t x, y;
     int8_t p;
-    uint32_t id;
+    uint16_t id;
 } evr_event;
+#define EVR_MAX_EVENT_ID 65535
 
 /* ---- scenes ---- */
 typedef struct evr_scene evr_scene;
@@ -246,7 +248,7 @@ typedef struct {
     int eye_labels;
     /* event_ids: every event gets evr_event.id (its instance), written by the file formats that
      * have a place for it (events.h5 events/id and an instances table, events.npy's id field,
-     * events.txt's fifth column) */
+     * events.txt's fifth column); a scene of more than EVR_MAX_EVENT_ID instances is refused */
     int event_ids;
     /* scene loading: 1 lets a scene read files outside its folder (evr_load_options
      * .allow_external); the evray program loads the scene with it */

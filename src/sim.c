@@ -237,6 +237,13 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
+    if (c->event_ids && s->num_instances > EVR_MAX_EVENT_ID) {
+        snprintf(err->msg, sizeof err->msg,
+                 "event ids name at most %d instances (16 bits an event); this scene has %d",
+                 EVR_MAX_EVENT_ID, s->num_instances);
+        evr_sim_release(sim);
+        return EVR_ERR_ARG;
+    }
     for (i = 0; i < s->num_instances; i++) mark_used(sim, s->instances[i].node);
     for (i = 0; i < s->num_lights; i++) mark_used(sim, s->lights[i].node);
     if (!sim->rig.has_path) mark_used(sim, sim->rig.node);

@@ -3,8 +3,10 @@
  * 1/30 s through the writer thread (run/write_queue.h, flushing once a second), then finished.
  * Not a test: docs/benchmarks.md ("Writers") quotes it.
  *
- *   build/tests/bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR]
+ *   build/tests/bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids]
  *
+ * With "ids", the events carry event ids as the eye's do (evr_writer_meta.event_ids): a few
+ * instances, each covering a band of the image.
  * Prints the wall time from the first push to the last finish, the writer thread's busy time and
  * the process CPU time (every thread) per event. DIR (default /tmp) takes the files, which go
  * at the end; a tmpfs (/dev/shm) leaves the disk out of it. */
@@ -41,6 +43,7 @@ int main(int argc, char **argv)
 {
     const size_t n = argc > 2 ? (size_t)strtoull(argv[2], NULL, 10) : 20000000;
     const char *dir = argc > 3 ? argv[3] : "/tmp";
+    const int ids = argc > 4 && strcmp(argv[4], "ids") == 0;
     const size_t seg = RATE * 1000000 / 30;
     evr_event_writer *ws[EVR_WRITE_QUEUE_MAX_WRITERS];
     char paths[EVR_WRITE_QUEUE_MAX_WRITERS][512];
@@ -51,7 +54,7 @@ int main(int argc, char **argv)
     uint64_t s = 7;
     evr_event *ev;
     if (argc < 2 || n == 0) {
-        fprintf(stderr, "usage: bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR]\n");
+        fprintf(stderr, "usage: bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids]\n");
         return 2;
     }
     if (evr_event_formats_parse("bench_writers", argv[1], &formats, &err) != EVR_OK)
@@ -63,9 +66,10 @@ int main(int argc, char **argv)
         ev[i].x = (uint16_t)(next(&s) % 1280);
         ev[i].y = (uint16_t)(next(&s) % 720);
         ev[i].p = (int8_t)(next(&s) & 1);
+        ev[i].id = ids ? 1u + ev[i].x / 160u : 0u;
     }
     evr_writer_meta meta = {
-        .width = 1280, .height = 720, .config_json = "{}", .max_t_us = ev[n - 1].t};
+        .width = 1280, .height = 720, .config_json = "{}", .max_t_us = ev[n - 1].t, .event_ids = ids};
     for (int i = 0; i < count && nw < EVR_WRITE_QUEUE_MAX_WRITERS; i++) {
         if (!(formats & 1 << i)) continue;
         snprintf(paths[nw], sizeof paths[nw], "%s/bench_%s", dir, all[i]->file);

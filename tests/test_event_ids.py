@@ -47,6 +47,46 @@ def sliding_square(path):
     g.write(path)
 
 
+def many_instances(path, n):
+    """n instances of one small triangle (EXT_mesh_gpu_instancing), in a row in front of the
+    camera."""
+    tri = struct.pack("<9f", 0, 0, 0, 0.001, 0, 0, 0, 0.001, 0)
+    offs = b"".join(struct.pack("<3f", (i % 256) * 0.01 - 1.28, (i // 256) * 0.01 - 1.28, 0)
+                    for i in range(n))
+    data = tri + offs
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+           "scenes": [{"nodes": [0, 1]}],
+           "nodes": [{"name": "cam", "camera": 0, "translation": [0, 0, 3]},
+                     {"name": "many", "mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {
+                         "attributes": {"TRANSLATION": 1}}}}],
+           "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.01}}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [0.001, 0.001, 0]},
+                         {"bufferView": 1, "componentType": 5126, "count": n, "type": "VEC3"}],
+           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(tri)},
+                           {"buffer": 0, "byteOffset": len(tri), "byteLength": len(offs)}],
+           "buffers": [{"byteLength": len(data), "uri": "many.bin"}]}
+    with open(os.path.join(os.path.dirname(path), "many.bin"), "wb") as f:
+        f.write(data)
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def too_many_instances():
+    """An event carries a 16-bit id: a scene of more instances than that asked for ids is one
+    line and no run folder."""
+    d = T.tmpdir()
+    scene = os.path.join(d, "many.gltf")
+    many_instances(scene, 65536)
+    out = os.path.join(d, "run-many")
+    p = T.run("render", scene, "--event-ids", "--duration", "0.1", "--res", "16x16", "-o", out,
+              "--no-preview", expect=None)
+    lines = p.stderr.strip().splitlines()
+    T.check(p.returncode != 0 and lines and "65535" in lines[-1] and "65536" in lines[-1] and
+            not os.path.exists(out), f"65536 instances with ids: {p.returncode} {p.stderr!r}")
+
+
 def read_txt(path):
     rows = []
     with open(path) as f:
@@ -61,9 +101,9 @@ def read_npy_ids(path):
         data = f.read()
     hlen = struct.unpack_from("<H", data, 8)[0]
     header = data[10:10 + hlen].decode()
-    T.check("('id', '<u4')" in header, f"events.npy has an id field: {header.strip()}")
+    T.check("('id', '<u2')" in header, f"events.npy has an id field: {header.strip()}")
     body = data[10 + hlen:]
-    return [struct.unpack_from("<I", body, k + 13)[0] for k in range(0, len(body), 17)]
+    return [struct.unpack_from("<H", body, k + 13)[0] for k in range(0, len(body), 15)]
 
 
 READ_H5 = r"""
@@ -149,7 +189,7 @@ def convert_keeps_ids(d, ev):
     p = T.run("convert", os.path.join(d, "c3.h5"), os.path.join(d, "c5.raw"))
     T.check("no place for event ids" in p.stderr, f"EVT 3.0 says it leaves the ids out: {p.stderr!r}")
     # an id out of range in a text file: one line naming the line, nothing written
-    for bad in ("0.000001 1 2 1 -3\n", "0.000001 1 2 1 4294967296\n", "0.000001 1 2 1 7 9\n"):
+    for bad in ("0.000001 1 2 1 -3\n", "0.000001 1 2 1 65536\n", "0.000001 1 2 1 7 9\n"):
         src, dst = os.path.join(d, "bad.txt"), os.path.join(d, "bad.h5")
         with open(src, "w") as f:
             f.write(bad)
@@ -172,6 +212,7 @@ except SystemExit:
     print("events.h5 part skipped: no oracle environment with h5py")
 
 check_backend("cpu")
+too_many_instances()
 probe = T.run("demo", "--scene", "square", "-o", os.path.join(T.tmpdir(), "probe"), "--res",
               "16x16", "--duration", "0.1", "--backend", "cuda", "--quiet", "--no-preview",
               expect=None)

@@ -23,10 +23,10 @@ __version__ = _evray.version()
 
 # The library's evr_event, field for field (include/evray.h): arrays are its records as they
 # come, not converted. Fields by name, as tonic's transforms take them: x, y (uint16), t
-# (int64 microseconds), p (int8, 1 ON, 0 OFF); and id (uint32: with Config(event_ids=True) 1 +
+# (int64 microseconds), p (int8, 1 ON, 0 OFF); and id (uint16: with Config(event_ids=True) 1 +
 # the instance whose surface caused the event, 0 none; README "Ground truth").
 EVENT_DTYPE = np.dtype({"names": ["x", "y", "t", "p", "id"],
-                        "formats": ["<u2", "<u2", "<i8", "i1", "<u4"],
+                        "formats": ["<u2", "<u2", "<i8", "i1", "<u2"],
                         "offsets": [_evray.OFFSET_X, _evray.OFFSET_Y, _evray.OFFSET_T, _evray.OFFSET_P,
                                     _evray.OFFSET_ID],
                         "itemsize": _evray.EVENT_SIZE})

@@ -307,7 +307,7 @@ static inline int evr_event_sink_push(struct evr_event_sink *k, int has, long lo
     e.x = (uint16_t)x;
     e.y = (uint16_t)y;
     e.p = (int8_t)polarity;
-    e.id = k->id;
+    e.id = (uint16_t)k->id;
     if (!evr_event_vec_push(k->out, e)) atomic_store(k->failed, 1);
     return 1;
 }

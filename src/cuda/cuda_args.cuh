@@ -134,7 +134,7 @@ struct kernel_args {
     const gpu_static_hit *static_hits;
     /* event ids (evr_event.id; NULL when off): ids[k] is keys[k]'s; id_in / id_out each pixel's
      * last traced sample's, a ring as the states */
-    unsigned *ids;
+    uint16_t *ids;
     const unsigned *id_in;
     unsigned *id_out;
 };

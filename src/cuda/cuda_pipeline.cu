@@ -114,7 +114,7 @@ static cudaError_t grow_keeping(dbuf<T> &d, size_t n, size_t keep, cudaStream_t 
 
 /* The sort of n event keys on the copy stream, their ids (when not NULL) moved with them. */
 static cudaError_t sort_events(void *temp, size_t &temp_bytes, unsigned long long *keys,
-                               unsigned long long *sorted, unsigned *ids, unsigned *ids_sorted,
+                               unsigned long long *sorted, uint16_t *ids, uint16_t *ids_sorted,
                                int n, int end_bit, cudaStream_t s)
 {
     if (ids)
@@ -124,7 +124,7 @@ static cudaError_t sort_events(void *temp, size_t &temp_bytes, unsigned long lon
 }
 
 cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted,
-                                  unsigned *ids, unsigned *ids_sorted, int n, size_t *temp)
+                                  uint16_t *ids, uint16_t *ids_sorted, int n, size_t *temp)
 {
     return sort_events(nullptr, *temp, keys, sorted, ids, ids_sorted, n, 64, 0);
 }
@@ -158,7 +158,7 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
             CK(grow_keeping(sl->d_ids_ev, n + carried, n, sl->copy));
             CK(cudaMemcpyAsync(sl->d_ids_ev.p + n,
                                b->slots[b->carry_slot].d_ids_sorted.p + b->carry_at,
-                               carried * sizeof(unsigned), cudaMemcpyDeviceToDevice, sl->copy));
+                               carried * sizeof(uint16_t), cudaMemcpyDeviceToDevice, sl->copy));
         }
     }
     n += carried;
@@ -168,7 +168,7 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
         const bool ids = b->setup.event_ids != 0;
         CK(sl->d_keys_sorted.reserve(n));
         if (ids) CK(sl->d_ids_sorted.reserve(n));
-        unsigned *ids_in = ids ? sl->d_ids_ev.p : nullptr,
+        uint16_t *ids_in = ids ? sl->d_ids_ev.p : nullptr,
                  *ids_out = ids ? sl->d_ids_sorted.p : nullptr;
         CK(sort_events(nullptr, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, ids_in, ids_out, (int)n,
                        sl->end_bit, sl->copy));
@@ -181,7 +181,7 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
                            cudaMemcpyDeviceToHost, sl->copy));
         if (ids) {
             CK(sl->h_ids.reserve(n));
-            CK(cudaMemcpyAsync(sl->h_ids.p, sl->d_ids_sorted.p, n * sizeof(unsigned),
+            CK(cudaMemcpyAsync(sl->h_ids.p, sl->d_ids_sorted.p, n * sizeof(uint16_t),
                                cudaMemcpyDeviceToHost, sl->copy));
         }
     }
@@ -458,7 +458,7 @@ static inline evr_event decode_key(unsigned long long k, long long base_us, int 
  * threads started per segment cost about as much as the work. */
 struct decode_job {
     const unsigned long long *keys;
-    const unsigned *ids; /* NULL: ids off */
+    const uint16_t *ids; /* NULL: ids off */
     size_t n, parts;
     long long base_us;
     int xb, yb;
@@ -469,11 +469,17 @@ static void decode_part(void *ctx, int k, int)
     const decode_job *j = (const decode_job *)ctx;
     size_t i0, i1;
     evr_par_share(j->n, (int)j->parts, k, &i0, &i1);
-    for (size_t i = i0; i < i1; i++) j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
     if (j->ids)
-        for (size_t i = i0; i < i1; i++) j->dst[i].id = j->ids[i];
+        for (size_t i = i0; i < i1; i++) {
+            evr_event e = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
+            e.id = j->ids[i];
+            j->dst[i] = e;
+        }
+    else
+        for (size_t i = i0; i < i1; i++)
+            j->dst[i] = decode_key(j->keys[i], j->base_us, j->xb, j->yb);
 }
-static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, const unsigned *ids,
+static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, const uint16_t *ids,
                         size_t n, long long base_us, int xb, int yb, evr_event *dst)
 {
     const size_t chunk = (size_t)1 << 17;

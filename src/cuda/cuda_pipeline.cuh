@@ -14,6 +14,6 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
 /* Bytes of temporary storage the sort of n event keys takes (for the buffers made up front);
  * with ids (not NULL), the sort that moves them with the keys. */
 cudaError_t event_sort_temp_bytes(unsigned long long *keys, unsigned long long *sorted,
-                                  unsigned *ids, unsigned *ids_sorted, int n, size_t *temp);
+                                  uint16_t *ids, uint16_t *ids_sorted, int n, size_t *temp);
 
 #endif

@@ -233,7 +233,7 @@ EVR_HD static inline int evr_event_sink_push(struct evr_event_sink *k, int has, 
             atomicAdd(&a.counters[CTR_KEY_RANGE], 1ull); /* collect fails */
         else if (idx < a.capacity) {                     /* else: re-run */
             a.keys[idx] = pack_event(a, t_us, x, y, polarity);
-            if (a.ids) a.ids[idx] = k->id;
+            if (a.ids) a.ids[idx] = (uint16_t)k->id;
         }
     }
     return 1;

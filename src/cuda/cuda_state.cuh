@@ -56,7 +56,7 @@ struct slot {
     dbuf<evr_gpu_node8> d_dnodes8;
     dbuf<evr_gpu_dtri> d_dtris;
     dbuf<unsigned long long> d_keys_ev, d_keys_sorted;
-    dbuf<unsigned> d_ids_ev, d_ids_sorted; /* event ids (setup.event_ids), beside the keys */
+    dbuf<uint16_t> d_ids_ev, d_ids_sorted; /* event ids (setup.event_ids), beside the keys */
     dbuf<unsigned char> d_sort_temp;
     dbuf<unsigned int> d_count;          /* indexed by launch_count */
     dbuf<unsigned long long> d_counters; /* indexed by segment_counter */
@@ -70,7 +70,7 @@ struct slot {
     hbuf<unsigned int> h_count;
     hbuf<unsigned long long> h_counters;
     hbuf<unsigned long long> h_sorted;
-    hbuf<unsigned> h_ids;
+    hbuf<uint16_t> h_ids;
     hbuf<float> h_intensity;
     hbuf<float> h_frame_f; /* normalized times of the frames */
     dbuf<float> d_frame_f;

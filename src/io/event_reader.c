@@ -151,7 +151,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
             (s = skip_blanks(s), !parse_long(&s, &p)) ||
             (s = skip_blanks(s), *s != '\n' && *s != 0 && *s != '\r' && !parse_long(&s, &id)) ||
             (s = skip_blanks(s), *s != '\n' && *s != 0) || x < 0 || x > 65535 || y < 0 ||
-            y > 65535 || id < 0 || id > (long)UINT32_MAX) {
+            y > 65535 || id < 0 || id > EVR_MAX_EVENT_ID) {
             snprintf(err->msg, sizeof err->msg, "%s:%zu: expected \"t x y p\" (and an event id)",
                      path, line);
             st = EVR_ERR_FORMAT;
@@ -173,7 +173,7 @@ static evr_status read_txt(const char *path, evr_event **ev, size_t *n, evr_erro
         out[count].x = (uint16_t)x;
         out[count].y = (uint16_t)y;
         out[count].p = p > 0 ? 1 : 0;
-        out[count].id = (uint32_t)id;
+        out[count].id = (uint16_t)id;
         count++;
         s = next;
     }
@@ -416,11 +416,11 @@ static evr_status read_npy(const char *path, evr_event **ev, size_t *n, evr_erro
         out[i].y = (uint16_t)y;
         out[i].p = npy_get(rec, &fields[3]) > 0 ? 1 : 0;
         const int64_t id = fields[4].found ? npy_get(rec, &fields[4]) : 0;
-        if (id < 0 || id > (int64_t)UINT32_MAX) {
+        if (id < 0 || id > EVR_MAX_EVENT_ID) {
             st = npy_bad(err, path, "event id out of range");
             goto done;
         }
-        out[i].id = (uint32_t)id;
+        out[i].id = (uint16_t)id;
     }
 done:
     free(header);
@@ -525,12 +525,17 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
             if (mspace >= 0) H5Sclose(mspace);
             for (size_t i = 0; st == EVR_OK && i < (size_t)cnt[0]; i++) {
                 evr_event *e = &out[(size_t)at + i];
+                if (nds == 5 && bi[i] > EVR_MAX_EVENT_ID) {
+                    what = "events/id holds an id past 65535";
+                    st = EVR_ERR_FORMAT;
+                    break;
+                }
                 memset(e, 0, sizeof *e);
                 e->t = bt[i];
                 e->x = bx[i];
                 e->y = by[i];
                 e->p = bp[i] > 0 ? 1 : 0;
-                e->id = nds == 5 ? bi[i] : 0;
+                e->id = nds == 5 ? (uint16_t)bi[i] : 0;
             }
         }
         if (st != EVR_OK && st != EVR_ERR_NOMEM) evr_h5_fail(err, what, path, st);

@@ -2,7 +2,7 @@
  *
  *   /events/x  uint16   /events/y  uint16   /events/t  uint32 (us)   /events/p  int8 (1 ON, 0 OFF)
  *   /ms_to_idx uint64   index of the first event with t >= i ms, i = 0 .. ceil(duration/1 ms)
- *   with event ids (evr_writer_meta.event_ids): /events/id uint32 (evr_event.id) and
+ *   with event ids (evr_writer_meta.event_ids): /events/id uint16 (evr_event.id) and
  *   /instances naming each id (io/h5_instances.h)
  *   /t_offset  int64    0 (our timestamps start at the simulation start)
  *   attributes on /: width, height (int32), config (JSON text), complete (int8, 1 once finished)
@@ -279,7 +279,7 @@ static int push_ms(h5_writer *w, uint64_t value)
 static size_t column_size(const h5_writer *w, int c)
 {
     static const size_t size[H5W_COLUMNS] = {sizeof(int64_t), sizeof(uint16_t), sizeof(uint16_t),
-                                             sizeof(int8_t), sizeof(uint32_t)};
+                                             sizeof(int8_t), sizeof(uint16_t)};
     return c == 0 && w->t32 ? sizeof(uint32_t) : size[c];
 }
 
@@ -840,7 +840,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         int laid_out = w->ds_p >= 0;
         if (laid_out && meta->event_ids) /* events/id and the /instances that name them */
             laid_out =
-                (w->ds_id = make_extendible(w->group, "id", H5T_STD_U32LE, H5W_CHUNK)) >= 0 &&
+                (w->ds_id = make_extendible(w->group, "id", H5T_STD_U16LE, H5W_CHUNK)) >= 0 &&
                 evr_h5_write_instances(w->file, meta->inst_node, meta->inst_mesh,
                                        meta->num_instances) >= 0;
         if (laid_out) w->ds_ms = make_extendible(w->file, "ms_to_idx", H5T_STD_U64LE, H5W_MS_CHUNK);

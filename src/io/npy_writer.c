@@ -1,6 +1,6 @@
 /* NumPy .npy (format 1.0) event files: one 1-D structured array of packed 13-byte records,
  * dtype [('t','<i8'), ('x','<u2'), ('y','<u2'), ('p','|i1')], which numpy.load reads as is;
- * with event ids (evr_writer_meta.event_ids) 17-byte records with a last field ('id','<u4').
+ * with event ids (evr_writer_meta.event_ids) 15-byte records with a last field ('id','<u2').
  *
  * The count is known only at the end, so the header is written with room for a 20-digit shape
  * (padded with spaces, total header a multiple of 64 bytes) and rewritten in place at every
@@ -17,16 +17,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NPY_RECORD_MAX 17
+#define NPY_RECORD_MAX 15
 #define NPY_BUFFER_RECORDS (1u << 16)
 #define NPY_DESCR "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1')]"
-#define NPY_DESCR_IDS "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1'), ('id', '<u4')]"
+#define NPY_DESCR_IDS "[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|i1'), ('id', '<u2')]"
 
 typedef struct {
     evr_event_writer base; /* first: the interface pointer is the writer pointer */
     char *path, *tmp;
     FILE *f;
-    size_t record; /* bytes a record: 13, or 17 with ids */
+    size_t record; /* bytes a record: 13, or 15 with ids */
     int ids;
     unsigned char *buf;
     size_t nbuf;       /* records in buf */
@@ -105,7 +105,7 @@ static void pack(unsigned char *r, const evr_event *e, int ids)
     evr_put_le16(r + 8, e->x);
     evr_put_le16(r + 10, e->y);
     r[12] = e->p ? 1 : 0;
-    if (ids) evr_put_le32(r + 13, e->id);
+    if (ids) evr_put_le16(r + 13, e->id);
 }
 
 /* A part of a large write (io/par_pack.h; ctx the writer): a record an event. */
@@ -246,7 +246,7 @@ evr_status evr_npy_writer_open(const char *path, const evr_writer_meta *meta,
         w->path = strdup(path);
         w->tmp = evr_file_tmp_name(path);
         w->ids = meta->event_ids != 0;
-        w->record = w->ids ? NPY_RECORD_MAX : NPY_RECORD_MAX - 4;
+        w->record = w->ids ? NPY_RECORD_MAX : NPY_RECORD_MAX - 2;
         w->buf = malloc((size_t)NPY_BUFFER_RECORDS * w->record);
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
