@@ -28,6 +28,7 @@
 #include "io/event_formats.h"
 #include "io/chunk_compress.h"
 #include "io/file_commit.h"
+#include "io/file_room.h"
 #include "io/h5_instances.h"
 #include "par_pool.h"
 
@@ -38,6 +39,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define H5W_CHUNK (1u << 16) /* elements per chunk */
 #define H5W_MS_CHUNK 4096u
@@ -52,6 +54,8 @@
 #define H5W_STAGE_THREADS 4
 #define H5W_STAGE_PARTS 16
 #define H5W_STAGE_MIN (1u << 15) /* events: fewer are staged by the writer's thread alone */
+/* file room claimed beyond the data for HDF5's own metadata (claim_room) */
+#define H5W_METADATA_ROOM ((uint64_t)1 << 20)
 
 /* A stage of events with the compression jobs of its chunks and their output room. */
 typedef struct {
@@ -327,12 +331,47 @@ static size_t make_jobs(const h5_writer *w, h5_set *set, size_t nchunks, size_t 
     return njobs;
 }
 
+/* Claims room for `bytes` more of the file, with H5W_METADATA_ROOM for what HDF5 adds to place
+ * them (chunk index nodes, the metadata a flush writes), before HDF5 writes (io/file_room.h): HDF5
+ * does not survive every failed write (after a chunk write that met a full disk, a later write
+ * of that chunk succeeds yet leaves it out of its dataset's chunk index), so a full disk is met
+ * here, with nothing written. */
+static evr_status claim_room(h5_writer *w, uint64_t bytes, evr_error *err)
+{
+    void *handle = NULL;
+    haddr_t eoa = 0;
+    struct stat sb;
+    herr_t r;
+    H5E_BEGIN_TRY
+    {
+        r = H5Fget_vfd_handle(w->file, H5P_DEFAULT, &handle);
+        if (r >= 0) r = H5Fget_eoa(w->file, &eoa);
+    }
+    H5E_END_TRY;
+    if (r < 0 || !handle) return EVR_OK; /* not a plain file: nothing to claim ahead */
+    const int fd = *(const int *)handle;
+    if (fstat(fd, &sb) != 0) return EVR_OK;
+    /* HDF5 writes below its end of allocation and allocates past it */
+    const uint64_t size = (uint64_t)sb.st_size, from = size < eoa ? size : (uint64_t)eoa,
+                   end = (size > eoa ? size : (uint64_t)eoa) + bytes + H5W_METADATA_ROOM;
+    if (evr_file_claim(fd, from, end - from) != 0) {
+        snprintf(err->msg, sizeof err->msg, "hdf5 writer: cannot write %s: %s", w->tmp,
+                 strerror(errno));
+        return EVR_ERR_IO;
+    }
+    return EVR_OK;
+}
+
 /* Stores the compressed chunks of jobs (nchunks per column) from dataset index at on, the
  * datasets first extended to `extent` events when shorter. */
 static evr_status put_chunks(h5_writer *w, const evr_chunk_job *jobs, size_t nchunks, uint64_t at,
                              uint64_t extent, evr_error *err)
 {
     herr_t r = 0;
+    uint64_t bytes = 0;
+    for (size_t k = 0; k < nchunks * (size_t)w->ncols; k++) bytes += jobs[k].dst_size;
+    evr_status st = claim_room(w, bytes, err);
+    if (st != EVR_OK) return st;
     if (extent < w->extent) extent = w->extent;
     H5E_BEGIN_TRY
     {
@@ -439,6 +478,7 @@ static evr_status drain(h5_writer *w, evr_error *err)
 {
     herr_t r = 0;
     evr_status st = store(w, 1, err);
+    if (st == EVR_OK) st = claim_room(w, w->nms * sizeof *w->ms, err);
     if (st != EVR_OK) return st;
     H5E_BEGIN_TRY
     {
@@ -635,6 +675,7 @@ static evr_status h5_flush(evr_event_writer *base, evr_error *err)
     h5_writer *w = (h5_writer *)base;
     herr_t r;
     evr_status st = store(w, 0, err);
+    if (st == EVR_OK) st = claim_room(w, 0, err);
     if (st != EVR_OK) return st;
     H5E_BEGIN_TRY { r = H5Fflush(w->file, H5F_SCOPE_GLOBAL); }
     H5E_END_TRY;
@@ -743,6 +784,7 @@ static evr_status h5_salvage(evr_event_writer *base, uint64_t events, int64_t du
         st = put_chunks(w, w->set[w->unstored_set].jobs, w->batch, w->unstored_at,
                         w->unstored_at + w->batch * H5W_CHUNK, err);
     if (st == EVR_OK) st = store(w, 1, err);
+    if (st == EVR_OK) st = claim_room(w, w->nms * sizeof *w->ms, err);
     if (st != EVR_OK) goto fail;
     /* ms_to_idx[i] is the first event at or after i ms: right for the first `events` events too
      * while it is at most `events` (entries only grow) */

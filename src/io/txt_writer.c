@@ -4,6 +4,7 @@
  * (evr_writer_meta.event_ids) a fifth column: evr_event.id. */
 #include "io/event_formats.h"
 #include "io/file_commit.h"
+#include "io/par_pack.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -26,6 +27,7 @@ typedef struct {
     /* events and text bytes given so far (written and buffered), and as the last write() began
      * (salvage) */
     uint64_t count, bytes, prev_count, prev_bytes;
+    evr_par_packing parts; /* large writes, formatted on threads */
 } txt_writer;
 
 static char *put_uint(char *o, uint64_t v)
@@ -78,10 +80,57 @@ static evr_status drain(txt_writer *w, evr_error *err)
 
 static void free_writer(txt_writer *w)
 {
+    evr_par_packing_free(&w->parts);
     free(w->path);
     free(w->tmp);
     free(w->buf);
     free(w);
+}
+
+/* A part of a large write (io/par_pack.h; ctx the writer): a line an event. */
+static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * TXT_LINE_MAX;
+}
+
+static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b,
+                        unsigned char *out, size_t room)
+{
+    const txt_writer *w = (const txt_writer *)ctx;
+    char *o = (char *)out;
+    (void)room;
+    for (size_t i = a; i < b; i++) {
+        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
+        o = format_event(o, &ev[i], w->ids);
+    }
+    return (size_t)(o - (char *)out);
+}
+
+/* Writes ev[0 .. n) (n >= EVR_PAR_PACK_MIN, ev[0] not before the last event written) in parts
+ * after the buffered text (*st: how it went); returns 0, nothing written, when an event is out of
+ * order or there is no room to format them: the serial path then writes them or reports it. */
+static int write_parallel(txt_writer *w, const evr_event *ev, size_t n, evr_error *err,
+                          evr_status *st)
+{
+    const evr_par_packer parts = {bound_part, pack_part, NULL, w};
+    size_t bytes;
+    evr_par_pack_result r;
+    if ((*st = drain(w, err)) != EVR_OK) return 1;
+    r = evr_par_pack_write(&w->parts, &parts, ev, n, w->f, &bytes);
+    if (r == EVR_PAR_PACK_SERIAL) return 0;
+    if (r == EVR_PAR_PACK_FAILED) {
+        snprintf(err->msg, sizeof err->msg, "text writer: cannot write %s: %s", w->tmp,
+                 strerror(errno));
+        *st = EVR_ERR_IO;
+        return 1;
+    }
+    w->count += n;
+    w->bytes += bytes;
+    w->last_t = ev[n - 1].t;
+    w->have_last = 1;
+    return 1;
 }
 
 static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
@@ -89,6 +138,10 @@ static evr_status txt_write(evr_event_writer *base, const evr_event *ev, size_t 
     txt_writer *w = (txt_writer *)base;
     w->prev_count = w->count;
     w->prev_bytes = w->bytes;
+    if (n >= EVR_PAR_PACK_MIN && !(w->have_last && ev[0].t < w->last_t)) {
+        evr_status st;
+        if (write_parallel(w, ev, n, err, &st)) return st;
+    }
     for (size_t i = 0; i < n; i++) {
         if (w->have_last && ev[i].t < w->last_t) {
             snprintf(err->msg, sizeof err->msg,
@@ -176,6 +229,7 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
         w->tmp = evr_file_tmp_name(path);
         w->buf = malloc(TXT_BUFFER);
         w->ids = meta->event_ids != 0;
+        w->parts.threads = 8; /* formatting text costs several times npy's packing */
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);

@@ -16,7 +16,7 @@
 struct evr_write_queue {
     evr_event_writer *writers[EVR_WRITE_QUEUE_MAX_WRITERS];
     int num_writers;
-    evr_par_pool *pool; /* threads for writers 1, 2, ... (NULL: two writers or fewer) */
+    evr_par_pool *pool; /* threads for the writers at once (NULL: one writer) */
     double flush_seconds;
     pthread_t thread;
     pthread_mutex_t mu;
@@ -59,18 +59,13 @@ static void run_writer(writers_job *j, int w)
 static void pool_writer(void *ctx, int k, int thread)
 {
     (void)thread;
-    run_writer(ctx, k + 1);
+    run_writer(ctx, k);
 }
 
-/* Hands batch v (NULL: a flush) to every writer: the first (HDF5 when asked for) alone, then
- * the others at the same time on the pool's threads and this one, so that several formats take
- * about the first's time and the slowest other's, not their sum (the 30 s eye's `--format all`
- * on the H100 took 17 s with the writers in turn). The first goes alone because the HDF5 writer
- * does not survive every failed write: when the file system fills up midway through its chunks,
- * a chunk of one column can be missing from that column's chunk index after salvage, though
- * salvage's second H5Dwrite_chunk of it succeeded, and reads as zeros (seen on main's writers in
- * turn too, tests/test_run_files.py's full file system); alone, it meets the file system as
- * before. The first failure, in writer order, is the result. */
+/* Hands batch v (NULL: a flush) to every writer at the same time, on the pool's threads and this
+ * one, so that several formats take about the slowest one's time, not their sum (the 30 s eye's
+ * `--format all` on the H100 took 17 s with the writers in turn). The first failure, in writer
+ * order, is the result. */
 static evr_status each_writer(evr_write_queue *q, const evr_event_vec *v, evr_error *err)
 {
     writers_job j;
@@ -78,17 +73,12 @@ static evr_status each_writer(evr_write_queue *q, const evr_event_vec *v, evr_er
     j.q = q;
     j.v = v;
     if (q->num_writers == 0) return EVR_OK;
-    run_writer(&j, 0);
-    if (j.st[0] != EVR_OK) {
-        *err = j.err[0];
-        return j.st[0];
-    }
-    if (q->num_writers > 2 && q->pool) {
-        evr_par_pool_run(q->pool, q->num_writers - 1, pool_writer, &j);
+    if (q->num_writers > 1 && q->pool) {
+        evr_par_pool_run(q->pool, q->num_writers, pool_writer, &j);
     } else {
-        for (w = 1; w < q->num_writers; w++) run_writer(&j, w);
+        for (w = 0; w < q->num_writers; w++) run_writer(&j, w);
     }
-    for (w = 1; w < q->num_writers; w++)
+    for (w = 0; w < q->num_writers; w++)
         if (j.st[w] != EVR_OK) {
             *err = j.err[w];
             return j.st[w];
@@ -199,8 +189,8 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     }
     for (i = 0; i < num_writers; i++) q->writers[i] = writers[i];
     q->num_writers = num_writers;
-    /* writers 1, 2, ... at once (no pool, when it cannot be made: in turn) */
-    if (num_writers > 2) q->pool = evr_par_pool_new(num_writers - 1);
+    /* the writers at once (no pool, when it cannot be made: in turn) */
+    if (num_writers > 1) q->pool = evr_par_pool_new(num_writers);
     q->flush_seconds = flush_seconds;
     q->last_flush = evr_host_seconds(); /* the writers' files are valid when opened */
     q->status = EVR_OK;
