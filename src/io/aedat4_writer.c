@@ -36,10 +36,9 @@
 #define EVENT_PACKET_HEAD 32                          /* an EventPacket before its events */
 #define IOHEADER_DTP_AT (EVR_AEDAT4_VERSION_LEN + 32) /* dataTablePosition's file offset */
 #define TABLE_ENTRY_BYTES 48                          /* a FileDataDefinition and padding */
-/* Compression threads for large writes: LZ4 took 60 ns an event (16 bytes) on one core of a busy
- * 2-core machine; at even a third of that, the 30 s eye's 218 M events would keep the 4 threads
- * that pack the other formats busy as long as the H100 takes to render them (1.2 s) */
-#define COMPRESS_THREADS 8
+/* Compression threads for large writes (as many as the machine has, up to this): LZ4 takes tens
+ * of ns an event, and the eye's events come at about 100 M a second from the H100 */
+#define COMPRESS_THREADS 16
 /* ZSTD's level for --format aedat4-zstd: its default, as DV's ZSTD (not ZSTD_HIGH) uses */
 #define ZSTD_LEVEL ZSTD_CLEVEL_DEFAULT
 

@@ -229,7 +229,7 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
         w->tmp = evr_file_tmp_name(path);
         w->buf = malloc(TXT_BUFFER);
         w->ids = meta->event_ids != 0;
-        w->parts.threads = 8; /* formatting text costs several times npy's packing */
+        w->parts.threads = 16; /* formatting text costs several times npy's packing */
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);
