@@ -68,8 +68,11 @@ int main(int argc, char **argv)
         ev[i].p = (int8_t)(next(&s) & 1);
         ev[i].id = ids ? 1u + ev[i].x / 160u : 0u;
     }
-    evr_writer_meta meta = {
-        .width = 1280, .height = 720, .config_json = "{}", .max_t_us = ev[n - 1].t, .event_ids = ids};
+    evr_writer_meta meta = {.width = 1280,
+                            .height = 720,
+                            .config_json = "{}",
+                            .max_t_us = ev[n - 1].t,
+                            .event_ids = ids};
     for (int i = 0; i < count && nw < EVR_WRITE_QUEUE_MAX_WRITERS; i++) {
         if (!(formats & 1 << i)) continue;
         snprintf(paths[nw], sizeof paths[nw], "%s/bench_%s", dir, all[i]->file);

@@ -1,6 +1,7 @@
 #include "io/par_pack.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
@@ -8,6 +9,11 @@
 
 #define PAR_PACK_THREADS 4
 #define PAR_PACK_PARTS 16
+/* Pipelined (pack_and_write) with a pool of this many threads or more: one of them then only
+ * writes, which a pool of two or three misses more than the overlap gains. Then more parts than
+ * threads, so that the first parts are written while later ones are packed. */
+#define PIPELINE_MIN_THREADS 4
+#define PIPELINE_PARTS 64
 
 typedef struct {
     const evr_par_packer *p;
@@ -16,12 +22,17 @@ typedef struct {
     int fd;
     off_t at;                         /* file offset of ev[0]'s bytes */
     int pass;                         /* 0: pack, 1: write */
-    size_t first[PAR_PACK_PARTS + 1]; /* part k: events [first[k], first[k + 1]) */
-    size_t room[PAR_PACK_PARTS];      /* its bound */
-    size_t boff[PAR_PACK_PARTS];      /* where its room starts in big */
-    size_t size[PAR_PACK_PARTS];      /* its bytes packed */
-    size_t off[PAR_PACK_PARTS];       /* their place after at */
-    int bad[PAR_PACK_PARTS];          /* a failed write */
+    int parts;                        /* PAR_PACK_PARTS, or PIPELINE_PARTS pipelined */
+    size_t first[PIPELINE_PARTS + 1]; /* part k: events [first[k], first[k + 1]) */
+    size_t room[PIPELINE_PARTS];      /* its bound */
+    size_t boff[PIPELINE_PARTS];      /* where its room starts in big */
+    size_t size[PIPELINE_PARTS];      /* its bytes packed */
+    size_t off[PIPELINE_PARTS];       /* their place after at */
+    int bad[PIPELINE_PARTS];          /* a failed write */
+    /* pipelined (pack_and_write): parts packed, under mu; cv signalled at each */
+    int packed[PIPELINE_PARTS];
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
 } pack_job;
 
 /* Writes len bytes at the file offset at. */
@@ -45,11 +56,54 @@ static void pack_part(void *ctx, int k, int thread)
     pack_job *j = ctx;
     const size_t a = j->first[k], b = j->first[k + 1];
     (void)thread;
-    if (a >= b) return;
-    if (j->pass == 0)
-        j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
-    else if (!write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)j->off[k]))
+    if (j->pass == 0) {
+        if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
+        if (j->fd >= 0) { /* pipelined: the writing thread waits for it */
+            pthread_mutex_lock(&j->mu);
+            j->packed[k] = 1;
+            pthread_cond_signal(&j->cv);
+            pthread_mutex_unlock(&j->mu);
+        }
+    } else if (a < b &&
+               !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)j->off[k])) {
         j->bad[k] = 1;
+    }
+}
+
+/* Packs the parts on the pool's threads while this one writes them in order, each as soon as it
+ * is packed: writes to one file go one at a time in the kernel (its inode lock), so the text
+ * writer's 15 GB took the packing's time plus the writing's when one followed the other. Returns
+ * as evr_par_pack_write; on EVR_PAR_PACK_SERIAL the file is cut back to where it was. */
+static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_t *bytes)
+{
+    size_t total = 0;
+    int serial = 0, failed = 0;
+    if (pthread_mutex_init(&j->mu, NULL) != 0) return EVR_PAR_PACK_SERIAL;
+    if (pthread_cond_init(&j->cv, NULL) != 0) {
+        pthread_mutex_destroy(&j->mu);
+        return EVR_PAR_PACK_SERIAL;
+    }
+    evr_par_pool_start(pool, j->parts, pack_part, j);
+    for (int k = 0; k < j->parts; k++) {
+        /* the pool's threads take every part, in order: part k comes */
+        pthread_mutex_lock(&j->mu);
+        while (!j->packed[k]) pthread_cond_wait(&j->cv, &j->mu);
+        pthread_mutex_unlock(&j->mu);
+        if (serial || failed) continue;
+        if (j->size[k] == SIZE_MAX) serial = 1;
+        else if (j->size[k] &&
+                 !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)total))
+            failed = 1;
+        else total += j->size[k];
+    }
+    evr_par_pool_wait(pool);
+    pthread_cond_destroy(&j->cv);
+    pthread_mutex_destroy(&j->mu);
+    if (failed) return EVR_PAR_PACK_FAILED;
+    if (serial)
+        return total && ftruncate(j->fd, j->at) != 0 ? EVR_PAR_PACK_FAILED : EVR_PAR_PACK_SERIAL;
+    *bytes = total;
+    return EVR_PAR_PACK_DONE;
 }
 
 evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer *p,
@@ -63,16 +117,19 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
             evr_par_pool_new(evr_par_threads(pk->threads > 0 ? pk->threads : PAR_PACK_THREADS));
     if (!pk->pool) return EVR_PAR_PACK_SERIAL; /* the serial path needs no threads */
     memset(&j, 0, sizeof j);
+    j.fd = -1;
+    const int pipelined = evr_par_pool_threads(pk->pool) >= PIPELINE_MIN_THREADS;
+    j.parts = pipelined ? PIPELINE_PARTS : PAR_PACK_PARTS;
     j.p = p;
     j.ev = ev;
     /* the parts and their room, on the caller: cuts and bounds are quick */
-    for (int k = 1; k < PAR_PACK_PARTS; k++) {
+    for (int k = 1; k < j.parts; k++) {
         size_t a, b;
-        evr_par_share(n, PAR_PACK_PARTS, k, &a, &b);
+        evr_par_share(n, j.parts, k, &a, &b);
         j.first[k] = p->cut ? p->cut(p->ctx, ev, n, a) : a; /* cuts keep the order */
     }
-    j.first[PAR_PACK_PARTS] = n;
-    for (int k = 0; k < PAR_PACK_PARTS; k++) {
+    j.first[j.parts] = n;
+    for (int k = 0; k < j.parts; k++) {
         j.boff[k] = room;
         if (j.first[k] < j.first[k + 1])
             j.room[k] = p->bound(p->ctx, ev, j.first[k], j.first[k + 1]);
@@ -86,8 +143,17 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
         pk->cap = room;
     }
     j.big = pk->big;
-    evr_par_pool_run(pk->pool, PAR_PACK_PARTS, pack_part, &j);
-    for (int k = 0; k < PAR_PACK_PARTS; k++) {
+    if (pipelined) {
+        if (fflush(f) != 0) return EVR_PAR_PACK_FAILED;
+        j.fd = fileno(f);
+        j.at = ftello(f);
+        if (j.at < 0) return EVR_PAR_PACK_FAILED;
+        const evr_par_pack_result r = pack_and_write(pk->pool, &j, bytes);
+        if (r == EVR_PAR_PACK_DONE && fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
+        return r;
+    }
+    evr_par_pool_run(pk->pool, j.parts, pack_part, &j);
+    for (int k = 0; k < j.parts; k++) {
         if (j.size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
         j.off[k] = total;
         total += j.size[k];
@@ -97,8 +163,8 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     j.at = ftello(f);
     if (j.at < 0) return EVR_PAR_PACK_FAILED;
     j.pass = 1;
-    evr_par_pool_run(pk->pool, PAR_PACK_PARTS, pack_part, &j);
-    for (int k = 0; k < PAR_PACK_PARTS; k++)
+    evr_par_pool_run(pk->pool, j.parts, pack_part, &j);
+    for (int k = 0; k < j.parts; k++)
         if (j.bad[k]) return EVR_PAR_PACK_FAILED;
     /* the stream goes on after the bytes written past it */
     if (fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
