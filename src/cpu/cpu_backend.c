@@ -1016,12 +1016,8 @@ static int add_mesh_geometry(RTCDevice dev, RTCScene sc, const evr_mesh *m, cons
     return 1;
 }
 
-/* The quality of the trees that are built once (every group's but a deforming one's): HIGH (spatial splits) while
- * they hold at most this many triangles in all, MEDIUM (binned SAH, 4-6x faster to build) past
- * it. On a 1 M-triangle model HIGH took 0.73 s of set-up, MEDIUM 0.19 s, and the renders and
- * events were the same (docs/benchmarks.md, "Set-up"). */
-#define EVR_HIGH_QUALITY_TRIANGLES 262144u
-
+/* The quality of the trees that are built once, by the triangles they hold in all
+ * (evr_tree_high_quality). */
 static enum RTCBuildQuality static_quality(const evr_scene *s, const evr_instance_groups *gr)
 {
     uint64_t tris = 0;
@@ -1039,7 +1035,7 @@ static enum RTCBuildQuality static_quality(const evr_scene *s, const evr_instanc
         }
     }
     free(seen);
-    return tris > EVR_HIGH_QUALITY_TRIANGLES ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH;
+    return evr_tree_high_quality(tris) ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
 }
 
 /* Groups the instances (see cpu_backend) and builds one Embree scene per group (per mesh for

@@ -6,7 +6,8 @@
  * space with one tree per mesh; the instances of each moving node in that node's object space;
  * each deforming instance on its own).
  *   bottom  one BVH per group, built once per run by Embree's rtcBuildBVH (SAH with spatial
- *           splits, RTC_BUILD_QUALITY_HIGH) and flattened into wide nodes; every group's nodes
+ *           splits, RTC_BUILD_QUALITY_HIGH; a binned SAH, MEDIUM, past evr_tree_high_quality's
+ *           size) and flattened into wide nodes; every group's nodes
  *           and triangles live in one node array and one triangle array. Moving groups whose
  *           members are consecutive scene instances with the same sequence of meshes (many
  *           instances of one mesh, each on its own node) share one BVH.

@@ -303,8 +303,12 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         c.tri_inst = gt.inst;
         c.tri_filter = gt.filter;
         split.tri = gt.tri;
-        st = evr_gpu_tree_build(dev, &c, gt.prims, cnt, 2 * cnt, RTC_BUILD_QUALITY_HIGH,
-                                layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4, &split, box, &root, err);
+        /* spatial splits (HIGH) for trees up to evr_tree_high_quality's size, as on the CPU */
+        const int high = evr_tree_high_quality(cnt);
+        st = evr_gpu_tree_build(dev, &c, gt.prims, cnt, high ? 2 * cnt : cnt,
+                                high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM,
+                                layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4, high ? &split : NULL, box,
+                                &root, err);
         if (st != EVR_OK) break;
         out->num_trees++;
         need = evr_gpu_tree_stack_need(&c, first, c.num_nodes);

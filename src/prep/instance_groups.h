@@ -48,4 +48,13 @@ void evr_instance_groups_free(evr_instance_groups *g);
  * EVR_STATIC_BAKE_LIMIT (a triangle count; 0: always instance, for tests and comparisons). */
 unsigned long long evr_static_bake_limit(void);
 
+/* Whether both backends build a tree made once (every group's but a deforming one's) over this
+ * many triangles with spatial splits (Embree's HIGH quality): up to 262,144, and past that as a
+ * binned SAH (MEDIUM), several times faster to build at a few per cent of tracing speed
+ * (docs/benchmarks.md, "Set-up of a big static model"). */
+static inline int evr_tree_high_quality(unsigned long long triangles)
+{
+    return triangles <= 262144u;
+}
+
 #endif
