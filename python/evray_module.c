@@ -5,7 +5,7 @@
  * waits for it in slices of WAIT_SLICE_NS, taking the GIL between them to let Python's signal
  * handlers run, so Ctrl-C raises KeyboardInterrupt at once and the run is cancelled
  * (evr_sim_cancel) and joined before the exception goes on. A stream's batches reach Python
- * through a hand-off of one batch: the library's sink (on its writer thread) waits until the
+ * through a hand-off of one batch: the library's sink (on a writer thread) waits until the
  * consumer has copied the batch into a bytearray, so a slow consumer holds the run back through
  * the library's own bounded queue (evr_sim_set_sink). */
 #define PY_SSIZE_T_CLEAN
