@@ -164,6 +164,34 @@ else:
         T.check(False, f"a full file system keeps the run folder ({os.listdir(out)})")
 
 
+# --- evray convert onto a file system that fills: one line, exit 1, nothing left there, no
+# crash (HDF5 used to be able to crash at exit after a failed close when it had read first)
+def convert_in_tmpfs(size_kb, src, name):
+    script = ('mount -t tmpfs -o size=%dk tmpfs "$1" || exit 99; "$2" convert "$3" "$1/%s"; '
+              'rc=$?; ls -A "$1"; exit $rc') % (size_kb, name)
+    mnt = os.path.join(root, "mnt-convert")
+    os.makedirs(mnt, exist_ok=True)
+    for unshare in (["unshare", "-m"], ["unshare", "-rm"]):
+        p = subprocess.run([*unshare, "sh", "-c", script, "sh", mnt, T.EVRAY, src],
+                           capture_output=True, text=True)
+        if p.returncode != 99 and "unshare failed" not in p.stderr:
+            return p
+    return None
+
+
+if tiny is not None:
+    src = os.path.join(a, "events.h5")
+    half = max(16, os.path.getsize(src) // 2048)
+    for name in ("out.h5", "out.npy", "out.txt"):
+        for kb in (16, half):
+            p = convert_in_tmpfs(kb, src, name)
+            lines = p.stderr.strip().splitlines()
+            T.check(p.returncode == 1 and len(lines) == 1 and "No space left on device" in lines[0]
+                    and p.stdout.strip() == "",
+                    f"convert to {name} on a {kb} KB file system: one line, exit 1, nothing left "
+                    f"({p.returncode}: {p.stderr.strip()!r}, left {p.stdout.split()})")
+
+
 # --- Ctrl-C: the files hold exactly every event before the time the message gives
 def signalled(d, sigs, *args, started=0.5):
     """Runs evray, sends sigs [(delay, signal)] once its HDF5 temporary file is there; returns

@@ -28,7 +28,7 @@ typedef struct {
     size_t boff[PIPELINE_PARTS];      /* where its room starts in big */
     size_t size[PIPELINE_PARTS];      /* its bytes packed */
     size_t off[PIPELINE_PARTS];       /* their place after at */
-    int bad[PIPELINE_PARTS];          /* a failed write */
+    int bad[PIPELINE_PARTS];          /* a failed write: its errno (a pool thread's own) */
     /* pipelined (pack_and_write): parts packed, under mu; cv signalled at each */
     int packed[PIPELINE_PARTS];
     pthread_mutex_t mu;
@@ -66,7 +66,7 @@ static void pack_part(void *ctx, int k, int thread)
         }
     } else if (a < b &&
                !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)j->off[k])) {
-        j->bad[k] = 1;
+        j->bad[k] = errno ? errno : EIO;
     }
 }
 
@@ -93,13 +93,16 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
         if (j->size[k] == SIZE_MAX) serial = 1;
         else if (j->size[k] &&
                  !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)total))
-            failed = 1;
+            failed = errno ? errno : EIO;
         else total += j->size[k];
     }
     evr_par_pool_wait(pool);
     pthread_cond_destroy(&j->cv);
     pthread_mutex_destroy(&j->mu);
-    if (failed) return EVR_PAR_PACK_FAILED;
+    if (failed) {
+        errno = failed; /* the caller's message says why */
+        return EVR_PAR_PACK_FAILED;
+    }
     if (serial)
         return total && ftruncate(j->fd, j->at) != 0 ? EVR_PAR_PACK_FAILED : EVR_PAR_PACK_SERIAL;
     *bytes = total;
@@ -165,7 +168,10 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     j.pass = 1;
     evr_par_pool_run(pk->pool, j.parts, pack_part, &j);
     for (int k = 0; k < j.parts; k++)
-        if (j.bad[k]) return EVR_PAR_PACK_FAILED;
+        if (j.bad[k]) {
+            errno = j.bad[k]; /* the caller's message says why */
+            return EVR_PAR_PACK_FAILED;
+        }
     /* the stream goes on after the bytes written past it */
     if (fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
     *bytes = total;

@@ -43,7 +43,7 @@ typedef struct {
 typedef enum {
     EVR_PAR_PACK_SERIAL, /* nothing written: an event cannot be written, or no memory */
     EVR_PAR_PACK_DONE,   /* every event written at the end of the file */
-    EVR_PAR_PACK_FAILED  /* a write to the file failed */
+    EVR_PAR_PACK_FAILED  /* a write to the file failed (errno says why) */
 } evr_par_pack_result;
 
 /* Packs ev[0 .. n) with p and writes them at the end of f (flushed first; the stream goes on
