@@ -340,8 +340,8 @@ void evr_sim_release(evr_sim *sim);
 /* A sink takes the run's events as it goes: the same batches, in the same order, that the event
  * files get (every event once; within a batch sorted by t, and no batch earlier than the one
  * before), each segment's events as soon as no later segment can precede them. It is called on
- * one of the library's writer threads, one call at a time, never after evr_sim_run returns; ev is valid
- * only during the call (copy what you keep). The sink may block: the run goes on rendering
+ * one of the library's writer threads, one call at a time, never after evr_sim_run returns; ev is
+ * valid only during the call (copy what you keep). The sink may block: the run goes on rendering
  * until eight batches wait for it, then waits too, so memory stays bounded however slow it is.
  * Return 0 to go on; non-zero stops the run as evr_sim_cancel does (evr_sim_run returns
  * EVR_ERR_INTERRUPTED, the files complete) and the sink is not called again. The files may hold

@@ -7,10 +7,10 @@
  * each deforming instance on its own).
  *   bottom  one BVH per group, built once per run by Embree's rtcBuildBVH (SAH with spatial
  *           splits, RTC_BUILD_QUALITY_HIGH; a binned SAH, MEDIUM, past evr_tree_high_quality's
- *           size) and flattened into wide nodes; every group's nodes
- *           and triangles live in one node array and one triangle array. Moving groups whose
- *           members are consecutive scene instances with the same sequence of meshes (many
- *           instances of one mesh, each on its own node) share one BVH.
+ *           size) and flattened into wide nodes; every group's nodes and triangles live in one
+ *           node array and one triangle array. Moving groups whose members are consecutive
+ *           scene instances with the same sequence of meshes (many instances of one mesh, each
+ *           on its own node) share one BVH.
  *   deforming  a deforming group's vertices change from segment to segment (evr_deform_view:
  *           vertex keys over the segment): its BVH is made for a segment (evr_gpu_deform: built
  *           once, then refitted, built again when refits have made it much worse), over boxes

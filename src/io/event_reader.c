@@ -499,8 +499,8 @@ static evr_status read_h5(const char *path, evr_event **ev, size_t *n, int *widt
                 by = malloc(block * sizeof *by);
                 bt = malloc(block * sizeof *bt);
                 bp = malloc(block * sizeof *bp);
-                bi = malloc(block * sizeof *bi);
-                if (!out || !bx || !by || !bt || !bp || !bi) {
+                if (nds == 5) bi = malloc(block * sizeof *bi);
+                if (!out || !bx || !by || !bt || !bp || (nds == 5 && !bi)) {
                     st = EVR_ERR_NOMEM;
                     what = "out of memory";
                 }

@@ -10,7 +10,8 @@
 /* Claims the blocks of bytes [from, from + len) of the open file fd without changing its size
  * (Linux fallocate, FALLOC_FL_KEEP_SIZE), so that writes within them cannot fail for want of
  * space. 0 when claimed, or when the file system or system cannot claim room ahead (nothing is
- * guaranteed then, nothing is lost); -1 with errno set (ENOSPC, EFBIG, EIO) when there is no room. */
+ * guaranteed then, nothing is lost); -1 with errno set (ENOSPC, EFBIG, EIO, EDQUOT) when there is
+ * no room. */
 int evr_file_claim(int fd, uint64_t from, uint64_t len);
 
 #endif

@@ -21,7 +21,8 @@ typedef struct {
     unsigned char *big;
     int fd;
     off_t at;                         /* file offset of ev[0]'s bytes */
-    int pass;                         /* 0: pack, 1: write */
+    int pass;                         /* 0: pack, 1: write (pack_then_write) */
+    int pipelined;                    /* pack_and_write: parts are written as they are packed */
     int parts;                        /* PAR_PACK_PARTS, or PIPELINE_PARTS pipelined */
     size_t first[PIPELINE_PARTS + 1]; /* part k: events [first[k], first[k + 1]) */
     size_t room[PIPELINE_PARTS];      /* its bound */
@@ -58,7 +59,7 @@ static void pack_part(void *ctx, int k, int thread)
     (void)thread;
     if (j->pass == 0) {
         if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
-        if (j->fd >= 0) { /* pipelined: the writing thread waits for it */
+        if (j->pipelined) { /* the writing thread waits for it */
             pthread_mutex_lock(&j->mu);
             j->packed[k] = 1;
             pthread_cond_signal(&j->cv);
@@ -109,20 +110,42 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
     return EVR_PAR_PACK_DONE;
 }
 
+/* Packs every part on the pool, then writes them all at their places, each part on a thread.
+ * Returns as evr_par_pack_write; nothing is written when a part cannot be packed. */
+static evr_par_pack_result pack_then_write(evr_par_pool *pool, pack_job *j, size_t *bytes)
+{
+    size_t total = 0;
+    evr_par_pool_run(pool, j->parts, pack_part, j);
+    for (int k = 0; k < j->parts; k++) {
+        if (j->size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
+        j->off[k] = total;
+        total += j->size[k];
+    }
+    j->pass = 1;
+    evr_par_pool_run(pool, j->parts, pack_part, j);
+    for (int k = 0; k < j->parts; k++)
+        if (j->bad[k]) {
+            errno = j->bad[k]; /* a pool thread's: the caller's message says why */
+            return EVR_PAR_PACK_FAILED;
+        }
+    *bytes = total;
+    return EVR_PAR_PACK_DONE;
+}
+
 evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer *p,
                                        const evr_event *ev, size_t n, FILE *f, size_t *bytes)
 {
     pack_job j;
-    size_t room = 0, total = 0;
+    size_t room = 0;
+    evr_par_pack_result r;
     *bytes = 0;
     if (!pk->pool)
         pk->pool =
             evr_par_pool_new(evr_par_threads(pk->threads > 0 ? pk->threads : PAR_PACK_THREADS));
     if (!pk->pool) return EVR_PAR_PACK_SERIAL; /* the serial path needs no threads */
     memset(&j, 0, sizeof j);
-    j.fd = -1;
-    const int pipelined = evr_par_pool_threads(pk->pool) >= PIPELINE_MIN_THREADS;
-    j.parts = pipelined ? PIPELINE_PARTS : PAR_PACK_PARTS;
+    j.pipelined = evr_par_pool_threads(pk->pool) >= PIPELINE_MIN_THREADS;
+    j.parts = j.pipelined ? PIPELINE_PARTS : PAR_PACK_PARTS;
     j.p = p;
     j.ev = ev;
     /* the parts and their room, on the caller: cuts and bounds are quick */
@@ -146,36 +169,14 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
         pk->cap = room;
     }
     j.big = pk->big;
-    if (pipelined) {
-        if (fflush(f) != 0) return EVR_PAR_PACK_FAILED;
-        j.fd = fileno(f);
-        j.at = ftello(f);
-        if (j.at < 0) return EVR_PAR_PACK_FAILED;
-        const evr_par_pack_result r = pack_and_write(pk->pool, &j, bytes);
-        if (r == EVR_PAR_PACK_DONE && fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
-        return r;
-    }
-    evr_par_pool_run(pk->pool, j.parts, pack_part, &j);
-    for (int k = 0; k < j.parts; k++) {
-        if (j.size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
-        j.off[k] = total;
-        total += j.size[k];
-    }
     if (fflush(f) != 0) return EVR_PAR_PACK_FAILED;
     j.fd = fileno(f);
     j.at = ftello(f);
     if (j.at < 0) return EVR_PAR_PACK_FAILED;
-    j.pass = 1;
-    evr_par_pool_run(pk->pool, j.parts, pack_part, &j);
-    for (int k = 0; k < j.parts; k++)
-        if (j.bad[k]) {
-            errno = j.bad[k]; /* the caller's message says why */
-            return EVR_PAR_PACK_FAILED;
-        }
+    r = j.pipelined ? pack_and_write(pk->pool, &j, bytes) : pack_then_write(pk->pool, &j, bytes);
     /* the stream goes on after the bytes written past it */
-    if (fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
-    *bytes = total;
-    return EVR_PAR_PACK_DONE;
+    if (r == EVR_PAR_PACK_DONE && fseeko(f, 0, SEEK_END) != 0) return EVR_PAR_PACK_FAILED;
+    return r;
 }
 
 void evr_par_packing_free(evr_par_packing *pk)

@@ -1,9 +1,10 @@
 /* A large write of events packed in parts on a pool of threads and written at its place in the
  * file (pwrite): one thread packing and copying gigabytes into the page cache kept the GPU run
  * waiting on its writer. With four threads or more, the calling thread writes the parts in order
- * while the others pack the later ones (writes to one file go one at a time in the kernel). The format gives two functions over a part's events:
- * measure (checks them and counts their bytes) and pack; a prefix sum of the measures places each
- * part, so formats whose records vary in size (EVT 2.0's time-high words) are packed in parts too. */
+ * while the others pack the later ones (writes to one file go one at a time in the kernel). The
+ * format gives two functions over a part's events: measure (checks them and counts their bytes)
+ * and pack; a prefix sum of the measures places each part, so formats whose records vary in size
+ * (EVT 2.0's time-high words) are packed in parts too. */
 #ifndef EVR_IO_PAR_PACK_H
 #define EVR_IO_PAR_PACK_H
 
