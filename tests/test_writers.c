@@ -1032,6 +1032,95 @@ static void test_camera_parts(const char *root)
     free(ev);
 }
 
+/* io/par_pack.c's two ways, whatever this machine's cores: packing then writing (a pool of two
+ * threads) and writing each part as it is packed (four). A packer of 8 bytes an event; the
+ * bytes land between what the stream held before and after, and an event out of order in a late
+ * part leaves the file as it was (the pipelined way has written the parts before it: cut back). */
+static size_t pp_bound(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * 8;
+}
+
+static void pp_put(unsigned char *o, const evr_event *e)
+{
+    const uint32_t t = (uint32_t)e->t;
+    for (int i = 0; i < 4; i++) o[i] = (unsigned char)(t >> (8 * i));
+    o[4] = (unsigned char)e->x;
+    o[5] = (unsigned char)(e->x >> 8);
+    o[6] = (unsigned char)e->y;
+    o[7] = (unsigned char)(e->y >> 8);
+}
+
+static size_t pp_pack(const void *ctx, const evr_event *ev, size_t a, size_t b, unsigned char *out,
+                      size_t room)
+{
+    (void)ctx;
+    (void)room;
+    for (size_t i = a; i < b; i++, out += 8) {
+        if (i > 0 && ev[i].t < ev[i - 1].t) return SIZE_MAX;
+        pp_put(out, &ev[i]);
+    }
+    return (b - a) * 8;
+}
+
+static void test_par_pack_ways(const char *root)
+{
+    const size_t n = 200000;
+    const evr_par_packer packer = {pp_bound, pp_pack, NULL, NULL};
+    evr_event *ev = calloc(n, sizeof *ev);
+    unsigned char *want = malloc(n * 8 + 8);
+    char path[600];
+    uint64_t s = 99;
+    CHECK(ev && want);
+    if (!ev || !want) {
+        free(ev);
+        free(want);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        ev[i].t = (int64_t)(i / 3);
+        ev[i].x = (uint16_t)(rng_next(&s) % W);
+        ev[i].y = (uint16_t)(rng_next(&s) % H);
+    }
+    memcpy(want, "head", 4);
+    for (size_t i = 0; i < n; i++) pp_put(want + 4 + 8 * i, &ev[i]);
+    memcpy(want + 4 + 8 * n, "tail", 4);
+    snprintf(path, sizeof path, "%s/par_pack.bin", root);
+    for (int threads = 2; threads <= 4; threads += 2) {
+        for (int bad = 0; bad <= 1; bad++) {
+            evr_par_packing pk;
+            size_t bytes = 0, len = 0;
+            FILE *f = fopen(path, "w+b");
+            CHECK(f != NULL);
+            if (!f) continue;
+            memset(&pk, 0, sizeof pk);
+            pk.pool = evr_par_pool_new(threads); /* else the machine's cores decide */
+            CHECK(evr_par_pool_threads(pk.pool) == threads);
+            if (bad) ev[n * 7 / 8].t = 0;
+            fputs("head", f); /* buffered: the large write flushes it first */
+            const evr_par_pack_result r = evr_par_pack_write(&pk, &packer, ev, n, f, &bytes);
+            if (bad) ev[n * 7 / 8].t = (int64_t)(n * 7 / 8 / 3);
+            CHECK(r == (bad ? EVR_PAR_PACK_SERIAL : EVR_PAR_PACK_DONE));
+            CHECK(bytes == (bad ? 0 : n * 8));
+            if (!bad) fputs("tail", f);
+            CHECK(fclose(f) == 0);
+            char *got = NULL;
+            CHECK_OK(evr_file_slurp(path, &got, &len, &e_));
+            if (bad) CHECK(got && len == 4 && memcmp(got, "head", 4) == 0);
+            else CHECK(got && len == n * 8 + 8 && memcmp(got, want, len) == 0);
+            if (check_failures)
+                fprintf(stderr, "par_pack: %d threads, bad %d: %zu bytes\n", threads, bad, len);
+            free(got);
+            evr_par_packing_free(&pk);
+        }
+    }
+    remove(path);
+    free(ev);
+    free(want);
+}
+
 static void test_camera_formats(const char *root)
 {
     const size_t n = 6000;
@@ -1780,6 +1869,7 @@ int main(void)
     test_writers(root, &python_ok);
     test_camera_formats(root);
     test_camera_parts(root);
+    test_par_pack_ways(root);
     test_rosbag(root);
     test_event_frames(root);
     bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");
