@@ -940,9 +940,10 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     return data;
 }
 
-/* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way): the bytes must be
- * those of the serial path (batches too small for parts), the file must read back, and a bad
- * event deep in a large write is refused as the serial path refuses it. */
+/* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way; text and
+ * NPY too): the bytes must be those of the serial path (batches too small for parts), the file
+ * must read back, and a bad event deep in a large write is refused as the serial path refuses
+ * it. */
 static void test_camera_parts(const char *root)
 {
     static const struct {
@@ -958,6 +959,8 @@ static void test_camera_parts(const char *root)
          evr_rosbag_writer_open,
          {(INT64_C(1) << 32) * 1000000, 5, 6, 0, 0},
          "4294967296000000 us"},
+        {"parts.txt", evr_txt_writer_open, {1, 5, 6, 0, 0}, "out of time order (1 us after"},
+        {"parts.npy", evr_npy_writer_open, {1, 5, 6, 0, 0}, "out of time order (1 us after"},
     };
     const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
     evr_event *ev = calloc(n, sizeof *ev);
