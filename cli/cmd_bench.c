@@ -101,7 +101,7 @@ static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, in
         f->load = *evr_scene_load_times(scene);
         f->width = cfg.width;
         f->height = cfg.height;
-        f->samples_per_frame = cfg.samples_per_frame;
+        f->samples_per_frame = evr_config_samples_per_frame(&cfg);
         f->skip = !cfg.no_skip && cfg.sampling != EVR_SAMPLING_ADAPTIVE;
         f->adaptive = cfg.sampling == EVR_SAMPLING_ADAPTIVE;
         /* the set frame rate; else the scene's, as segments per simulated second (the last segment
@@ -109,7 +109,7 @@ static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, in
         f->fps = cfg.fps > 0                                ? cfg.fps
                  : s->segments_total > 0 && s->sim_time > 0 ? s->segments_total / s->sim_time
                                                             : 0.0;
-        f->temporal_us = f->fps > 0 ? 1e6 / (f->fps * cfg.samples_per_frame) : 0.0;
+        f->temporal_us = f->fps > 0 ? 1e6 / (f->fps * f->samples_per_frame) : 0.0;
         if (f->adaptive)
             f->temporal_us = samples_per_pixel_s(f) > 0.0 ? 1e6 / samples_per_pixel_s(f) : 0.0;
         f->render_s = s->time_device > 0 ? s->time_device : s->time_render;

@@ -137,7 +137,12 @@ const char *evr_scene_warnings(const evr_scene *s);
 typedef enum { EVR_FORMAT_H5 = 1, EVR_FORMAT_TXT = 2, EVR_FORMAT_NPY = 4 } evr_format;
 
 /* auto: CUDA when this build has it and a usable GPU is present, else the CPU (with a notice). */
-typedef enum { EVR_SAMPLING_UNIFORM = 0, EVR_SAMPLING_ADAPTIVE = 1 } evr_sampling;
+typedef enum {
+    EVR_SAMPLING_UNIFORM = 0,
+    EVR_SAMPLING_ADAPTIVE = 1,
+    EVR_SAMPLING_REFINE = 2,
+    EVR_SAMPLING_AUTO = 3 /* evr_config_sampling decides */
+} evr_sampling;
 
 typedef enum { EVR_BACKEND_AUTO = 0, EVR_BACKEND_CPU = 1, EVR_BACKEND_CUDA = 2 } evr_backend_kind;
 
@@ -153,7 +158,7 @@ typedef struct {
     double duration;       /* seconds; <= 0: the scene's animation length */
     double start;          /* seconds into the animation */
     double fps;            /* segments per second; <= 0: the scene's frame rate, else 30 */
-    int samples_per_frame; /* samples per pixel per segment */
+    int samples_per_frame; /* samples per pixel per segment; 0: 10 (evr_config_samples_per_frame) */
     const char *camera;    /* camera name, NULL for the first */
     /* pixel model */
     float pos_thres, neg_thres; /* contrast thresholds in log intensity */
@@ -183,8 +188,11 @@ typedef struct {
                                      and the segment is rendered again when it overflows */
     int no_skip;            /* 1: trace every sample (brute force) instead of reusing the
                                      intensity of pixels nothing moving can reach (identical events) */
-    /* sampling: EVR_SAMPLING_UNIFORM, samples_per_frame per pixel per segment at the pixel's own
-     * phase; EVR_SAMPLING_ADAPTIVE, each pixel picks its next sample time from how fast its log
+    /* sampling: EVR_SAMPLING_AUTO (the default: evr_config_sampling); EVR_SAMPLING_REFINE,
+     * samples_per_frame per pixel per segment where something moving reaches the pixel, each
+     * interval in which its model fires bisected until its events' timing error is within
+     * time_tol (docs/architecture.md, "Refined sampling"); EVR_SAMPLING_UNIFORM, samples_per_frame
+     * per pixel per segment at the pixel's own phase; EVR_SAMPLING_ADAPTIVE, each pixel picks its next sample time from how fast its log
      * intensity changes (adapt_frac of a threshold between samples) and from a bound on how fast
      * what its rays meet moves in the image (2 adapt_frac pixels between samples), within
      * [min_dt, max_dt] (docs/architecture.md, "Adaptive sampling") */
@@ -259,6 +267,8 @@ typedef struct {
      * duration x the leak, shot and hot-pixel rates). */
     double max_samples;
     double max_noise_events;
+    double time_tol;  /* refined sampling: the timing error its refinement aims at, seconds */
+    double refine_px; /* refined sampling: image motion between grid samples, pixels, at most */
 } evr_config;
 
 enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };
@@ -267,6 +277,12 @@ enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };
  * The macro passes the size of the caller's evr_config. */
 void evr_config_init(evr_config *c, size_t size);
 #define evr_config_defaults(c) evr_config_init((c), sizeof(evr_config))
+/* The sampling a configuration runs with: its own, or for EVR_SAMPLING_AUTO, refined sampling
+ * unless samples_per_frame is set (today's uniform sampling at that count) or global
+ * illumination is on (uniform). */
+evr_sampling evr_config_sampling(const evr_config *c);
+/* The samples per pixel per segment it runs with (refined sampling: its grid). */
+int evr_config_samples_per_frame(const evr_config *c);
 /* Names of the sensor presets, NULL-terminated: ideal, davis346, dvxplorer, prophesee-gen4. */
 const char *const *evr_sensor_names(void);
 /* Applies a sensor preset: thresholds, mismatch, refractory period, bandwidth, noise, timestamp

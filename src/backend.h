@@ -11,6 +11,7 @@
 #include "core/pixel.h"
 #include "core/skip.h"
 #include "core/adaptive.h"
+#include "core/refine.h"
 #include "scene/scene.h"
 
 /* Everything fixed for a whole run. */
@@ -29,7 +30,9 @@ typedef struct {
     int gather_max, gather_window, photon_layers, gi_bounces;
     int adaptive;           /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
     evr_adapt_params adapt; /* its parameters (max_dt resolved: > 0) */
-    int event_ids;          /* every event's id: 1 + the instance its sample's primary ray hit */
+    int refine;             /* refined sampling (core/refine.h): every pixel's phase is 1 */
+    evr_refine_params refine_params; /* n: samples_per_frame */
+    int event_ids; /* every event's id: 1 + the instance its sample's primary ray hit */
     /* non-zero (read with __atomic_load_n) once the run is to stop at once (evr_sim_cancel): a
      * backend may then give up the segment it renders, its submit() returning
      * EVR_ERR_INTERRUPTED; NULL: never */

@@ -182,7 +182,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->host.rs.max_bounces = c->max_bounces;
     sim->setup.width = c->width;
     sim->setup.height = c->height;
-    sim->setup.samples_per_frame = c->samples_per_frame;
+    sim->setup.samples_per_frame = evr_config_samples_per_frame(c);
     sim->setup.seed = c->seed;
     sim->setup.pixel.pos_thres = c->pos_thres;
     sim->setup.pixel.neg_thres = c->neg_thres;
@@ -203,6 +203,10 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.gpu_bvh = c->gpu_bvh;
     sim->setup.gpu_event_capacity = c->gpu_event_capacity;
     sim->setup.adaptive = c->sampling == EVR_SAMPLING_ADAPTIVE;
+    sim->setup.refine = evr_config_sampling(c) == EVR_SAMPLING_REFINE;
+    sim->setup.refine_params.tol = (float)c->time_tol;
+    sim->setup.refine_params.n = sim->setup.samples_per_frame;
+    sim->setup.refine_params.px = (float)c->refine_px;
     sim->setup.event_ids = c->event_ids;
     sim->setup.adapt.frac = c->adapt_frac;
     sim->setup.adapt.min_dt = (float)c->min_dt;
@@ -347,7 +351,7 @@ static void plan_segment(void *user, int i, evr_planned_segment *out)
     const evr_deform_keys *dk = out->failed ? NULL : &out->deform;
     evr_skip_plan_build(&sim->skip, s, &rs, dk, !sim->cfg.no_skip && !sim->setup.adaptive,
                         &out->plan);
-    if (sim->setup.adaptive)
+    if (sim->setup.adaptive || sim->setup.refine)
         evr_adapt_plan_build(&sim->skip, s, &rs, dk, &sim->setup.adapt, t1 - t0, &out->adapt);
 }
 
@@ -463,7 +467,7 @@ static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
     seg.num_keys = pl->num_keys;
     seg.camera_static = pl->track_count[sim->host.rs.camera_track] == 1;
     seg.skip = &pl->plan;
-    seg.adapt = sim->setup.adaptive ? &pl->adapt : NULL;
+    seg.adapt = sim->setup.adaptive || sim->setup.refine ? &pl->adapt : NULL;
     seg.want_intensity = evr_run_preview_due(sim, seg.t1, i + 1 == sim->num_segments);
     { /* the camera's poses as the backend renders them */
         evr_render_scene rs = sim->host.rs;
@@ -497,7 +501,7 @@ static int cancelled(const evr_sim *sim) { return __atomic_load_n(&sim->cancel, 
 static evr_status finish_segment(evr_sim *sim, int i, int last, evr_error *err)
 {
     const int final = last;
-    const int n = sim->cfg.samples_per_frame;
+    const int n = sim->setup.samples_per_frame;
     const float *intensity = NULL, *frames = NULL;
     double t0 = segment_start(sim, i), t1 = segment_end(sim, i);
     evr_status st;

@@ -19,7 +19,7 @@ static void test_documented_defaults(void)
     evr_config_defaults(&c);
     CHECK(c.width == 346 && c.height == 260);
     CHECK(c.duration == 0.0 && c.start == 0.0 && c.fps == 0.0);
-    CHECK(c.samples_per_frame == 10 && c.camera == NULL);
+    CHECK(c.samples_per_frame == 0 && evr_config_samples_per_frame(&c) == 10 && c.camera == NULL);
     CHECK(c.pos_thres == 0.2f && c.neg_thres == 0.2f && c.refractory == 0.0f &&
           c.log_floor == 0.02f);
     CHECK(c.sensor == NULL && c.sigma_thres == 0.0f && c.cutoff_hz == 0.0f &&
@@ -29,8 +29,18 @@ static void test_documented_defaults(void)
           c.time_jitter == 0.0);
     CHECK(c.ambient == 0.02f && c.seed == 1 && c.threads == 0 && c.backend == EVR_BACKEND_AUTO);
     CHECK(c.gpu_bvh == 0 && c.gpu_event_capacity == 0 && c.no_skip == 0);
-    CHECK(c.sampling == EVR_SAMPLING_UNIFORM && c.adapt_frac == 0.25f && c.min_dt == 20e-6 &&
-          c.max_dt == 0.0);
+    /* refined sampling unless samples per frame are given or GI is on */
+    CHECK(c.sampling == EVR_SAMPLING_AUTO && evr_config_sampling(&c) == EVR_SAMPLING_REFINE &&
+          c.time_tol == 50e-6 && c.refine_px == 0.5);
+    c.samples_per_frame = 10;
+    CHECK(evr_config_sampling(&c) == EVR_SAMPLING_UNIFORM);
+    c.samples_per_frame = 0;
+    c.gi = 1;
+    CHECK(evr_config_sampling(&c) == EVR_SAMPLING_UNIFORM);
+    c.sampling = EVR_SAMPLING_REFINE;
+    CHECK(evr_config_sampling(&c) == EVR_SAMPLING_REFINE);
+    evr_config_defaults(&c);
+    CHECK(c.adapt_frac == 0.25f && c.min_dt == 20e-6 && c.max_dt == 0.0);
     CHECK(c.out_dir && !strcmp(c.out_dir, "evray-out") && c.formats == EVR_FORMAT_H5);
     CHECK(c.preview_window == 0.05 && c.force == 0);
     CHECK(c.frames_out == NULL && c.frames_fps == 0.0 && c.frames_exposure == 1.0f &&
@@ -171,6 +181,7 @@ static void test_options_set_their_field(void)
         if (!strcmp(t[i].name, "formats")) text = "txt";
         if (!strcmp(t[i].name, "time_res")) text = "2e-6";
         if (!strcmp(t[i].name, "min_dt")) text = "1e-4";
+        if (!strcmp(t[i].name, "refine_px")) text = "0.25";
         if (t[i].type == EVR_OPT_CHOICE) /* a name other than the default's */
             for (ch = t[i].choices; ch->name || ch->json; ch++)
                 if (ch->name && !ch->refuse && ch->value != (int)t[i].def) {
@@ -224,7 +235,7 @@ static void test_special_options(void)
           EVR_ERR_ARG);
     /* the library's checks come from the same rows */
     evr_config_defaults(&c);
-    c.samples_per_frame = 0;
+    c.samples_per_frame = -1;
     CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
           strstr(err.msg, "samples per frame") != NULL);
     evr_config_defaults(&c);

@@ -1,10 +1,12 @@
 /* The per-pixel flow of src/core that every backend runs: the event loop with its sink
- * (core/pixel_flow.h), adaptive sampling's state machine (core/adaptive.h) and the shading of a
+ * (core/pixel_flow.h), adaptive and refined sampling's state machines (core/adaptive.h,
+ * core/refine.h) and the shading of a
  * hit with its shadow-ray query (core/shade_hit.h), each driven here by a sink and an occlusion
  * query of the test's own. */
 #include "check.h"
 #include "core/adaptive.h"
 #include "core/pixel_flow.h"
+#include "core/refine.h"
 #include "core/shade_hit.h"
 
 #include <math.h>
@@ -182,6 +184,70 @@ static void test_adapt_machine(void)
     }
 }
 
+/* Refined sampling's flow (core/refine.h) over one pixel and one segment of 1 s, 10 grid samples,
+ * tol 1 ms, with a log intensity of the test's own (shape 0: a step of ln 2 at 0.3137 s; 1: a
+ * ramp rising by 1.2 over the segment); the events and the samples traced. */
+static int refine_pixel(int shape, struct evr_event_sink *k, int *ok_order)
+{
+    evr_render_scene rs;
+    evr_pixel_params p = {.pos_thres = 0.2f, .neg_thres = 0.2f, .log_floor = 1e-3f};
+    evr_pixel_state st;
+    evr_refine_pixel q;
+    const evr_refine_params rp = {.tol = 1e-3f, .n = 10, .px = 0.0f};
+    evr_skip_plan pl;
+    evr_ray ray0;
+    const float seg = 1.0f;
+    float last = -1.0f;
+    int traced = 0;
+    memset(&rs, 0, sizeof rs);
+    memset(&pl, 0, sizeof pl);
+    memset(k, 0, sizeof *k);
+    ray0.org = evr_v3_make(0, 0, 0);
+    ray0.dir = evr_v3_make(0, 0, 1);
+    evr_pixel_reset(&st);
+    *ok_order = 1;
+    evr_refine_begin(&q, &st, evr_refine_step(&rp, INFINITY, seg), seg);
+    CHECK(q.t == 0.0f); /* a pixel's very first sample: the segment's start */
+    while ((q.need || q.cand) && traced < 1000) {
+        if (q.need && !evr_refine_kept(&q, &pl, q.t / seg)) {
+            const float in = shape == 0 ? (q.t < 0.3137f ? 1.0f : 2.0f) : expf(1.2f * q.t);
+            traced++;
+            evr_refine_traced(&q, &rs, &pl, &st, ray0, q.t / seg, in, INFINITY, 0, 0u, 1);
+        }
+        if (q.cand && evr_refine_decide(&q, &rp, &st, &p)) {
+            if (q.ct < last) *ok_order = 0;
+            last = q.ct;
+            evr_pixel_sample_events(&st, &p, evr_pixel_ideal_of(&p), 0, 1, q.ct, q.ci, 0.0, 0, 0,
+                                    k);
+            evr_refine_next(&q, &rp, INFINITY, seg);
+        }
+    }
+    CHECK(q.sk.n == 0 && st.t_prev == seg); /* the last sample at the segment's end */
+    return traced;
+}
+
+static void test_refine_machine(void)
+{
+    struct evr_event_sink k;
+    int ok_order;
+    /* the step: its interval bisected down to tol (100 ms: 7 halvings), its three ON events
+     * within tol of it */
+    int traced = refine_pixel(0, &k, &ok_order);
+    CHECK(ok_order);
+    CHECK(traced >= 11 + 6 && traced <= 11 + 8);
+    CHECK(k.n == 3); /* ln 2 = 0.69: three ON thresholds of 0.2 */
+    for (int i = 0; i < k.n && i < 3; i++)
+        CHECK(k.ev[i].p == 1 && fabs((double)k.ev[i].t * 1e-6 - 0.3137) <= 1e-3);
+    /* the ramp: straight, so each interval that fires takes one midpoint that vouches for it;
+     * its six events where the line crosses each level (linear interpolation is exact) */
+    traced = refine_pixel(1, &k, &ok_order);
+    CHECK(ok_order);
+    CHECK(traced <= 11 + 6);
+    CHECK(k.n == 6);
+    for (int i = 0; i < k.n && i < 6; i++)
+        CHECK(k.ev[i].p == 1 && fabs((double)k.ev[i].t * 1e-6 - 0.2 * (i + 1) / 1.2) <= 2e-6);
+}
+
 /* A surface of material mat at the origin, normal n, seen along wo: its record as
  * evr_material_at leaves it. */
 static void flow_surface(const evr_render_scene *rs, const evr_material_params *mat, evr_v3 n,
@@ -255,6 +321,7 @@ int main(void)
 {
     test_event_loop();
     test_adapt_machine();
+    test_refine_machine();
     test_shade_hit();
     return check_report("test_flow");
 }

@@ -43,8 +43,12 @@ def read(reader, path):
         import evlib
         df = evlib.load_events(path)
         df = df.collect() if hasattr(df, "collect") else df
-        return (df["t"].dt.total_microseconds().to_numpy(), df["x"].to_numpy(), df["y"].to_numpy(),
-                df["polarity"].to_numpy())
+        t, x, y, p = (df["t"].dt.total_microseconds().to_numpy(), df["x"].to_numpy(), df["y"].to_numpy(),
+                      df["polarity"].to_numpy())
+        # evlib decodes in chunks of 202,107 events and may swap events that share a timestamp
+        # across a chunk's end: the file's (t, y, x) order is restored before comparing
+        o = np.lexsort((x, y, t))
+        return t[o], x[o], y[o], p[o]
     if reader == "evt3":
         import evt3
         e = evt3.decode_file(path)

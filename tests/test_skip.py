@@ -4,8 +4,9 @@ and the moving square, ideal sensor and the davis346 noise model, the deforming 
 hits a material rules out (tests/filter_assets.py's "mixed"), the scene with every material
 feature (tests/all_materials.py), camera paths (a moving camera, and a trajectory that holds still
 between moves), on the CPU and
-(where a GPU is usable) on CUDA; and it really skips: run.json accounts for the samples traced
-and the pixels skipped per segment."""
+(where a GPU is usable) on CUDA, with uniform sampling (10 per frame) and with refined sampling
+(the default, where global illumination does not rule it out); and it really skips: run.json
+accounts for the samples traced and the pixels skipped per segment (uniform sampling)."""
 import os
 import sys
 
@@ -55,12 +56,24 @@ cases.append(("square", ["--res", "64x48", "--duration", "0.5", "--camera-path",
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--camera-path", "pan:rate=5"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
-        runs = {}
         source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)
+        if "--gi" not in extra:  # refined sampling: the same events with and without skipping
+            runs = {}
+            for mode in ("skip", "brute"):
+                d = os.path.join(tmp, f"{backend}-{os.path.basename(scene)}-{case}-refine-{mode}")
+                T.run(*source, "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
+                      "--seed", "3", *extra, *(["--no-skip"] if mode == "brute" else []))
+                runs[mode] = (open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d))
+            (ev_s, js), (ev_b, jb) = runs["skip"], runs["brute"]
+            print(f"{backend} {scene} {' '.join(extra)}, refine: {js['stats']['events']} events; traced "
+                  f"{js['stats']['samples_traced']} vs {jb['stats']['samples_traced']} by brute force")
+            T.check(js["config"]["sampling"] == "refine", f"{backend} {scene}: refined sampling by default")
+            T.check(ev_s == ev_b, f"{backend} {scene} case {case}: refine: identical events with and without skipping")
+        runs = {}
         for mode in ("skip", "brute"):
             d = os.path.join(tmp, f"{backend}-{os.path.basename(scene)}-{case}-{mode}")
             T.run(*source, "-o", d, "--backend", backend, "--format", "npy", "--no-preview", "--quiet",
-                  "--seed", "3", *extra, *(["--no-skip"] if mode == "brute" else []))
+                  "--seed", "3", "--samples-per-frame", "10", *extra, *(["--no-skip"] if mode == "brute" else []))
             runs[mode] = (open(os.path.join(d, "events.npy"), "rb").read(), T.load_run_json(d))
         (ev_s, js), (ev_b, jb) = runs["skip"], runs["brute"]
         ss, sb = js["stats"], jb["stats"]

@@ -159,6 +159,17 @@ void evr_config_init(evr_config *c, size_t size)
     }
 }
 
+evr_sampling evr_config_sampling(const evr_config *c)
+{
+    if (c->sampling != EVR_SAMPLING_AUTO) return (evr_sampling)c->sampling;
+    return c->samples_per_frame > 0 || c->gi ? EVR_SAMPLING_UNIFORM : EVR_SAMPLING_REFINE;
+}
+
+int evr_config_samples_per_frame(const evr_config *c)
+{
+    return c->samples_per_frame > 0 ? c->samples_per_frame : 10;
+}
+
 evr_status evr_config_current(const evr_config *c, evr_config *out, evr_error *err)
 {
     if (!c || c->size < EVR_CONFIG_FIRST_SIZE || c->size > sizeof *out) {
@@ -293,8 +304,9 @@ static evr_status check_run_size(const evr_config *c, const evr_scene *s, evr_er
             duration, fps, segments, EVR_MAX_SEGMENTS);
     if (segments < 1.0) segments = 1.0;
     /* adaptive sampling may take a sample every min_dt */
-    per_pixel = c->sampling == EVR_SAMPLING_ADAPTIVE ? ceil(duration / c->min_dt)
-                                                     : (double)c->samples_per_frame * segments;
+    per_pixel = c->sampling == EVR_SAMPLING_ADAPTIVE
+                    ? ceil(duration / c->min_dt)
+                    : (double)evr_config_samples_per_frame(c) * segments;
     if (c->frames_out)
         frames = floor(duration * (c->frames_fps > 0.0 ? c->frames_fps : fps) + 1e-9) + 1.0;
     if (c->preview != EVR_PREVIEW_NONE && c->preview_window > 0.0)

@@ -18,6 +18,7 @@
 
 /* ---- when a setting matters ---- */
 static int is_adaptive(const evr_config *c) { return c->sampling == EVR_SAMPLING_ADAPTIVE; }
+static int is_refine(const evr_config *c) { return evr_config_sampling(c) == EVR_SAMPLING_REFINE; }
 static int has_gi(const evr_config *c) { return c->gi != 0; }
 static int has_frames(const evr_config *c) { return c->frames_out != NULL; }
 static int has_camera_path(const evr_config *c) { return c->camera_path != NULL; }
@@ -50,6 +51,17 @@ static void json_backend(evr_json *j, const evr_config *c, const evr_config_run 
 static void json_max_dt(evr_json *j, const evr_config *c, const evr_config_run *r)
 {
     evr_json_number(j, fmax(c->max_dt > 0.0 ? c->max_dt : 1.0 / r->fps, c->min_dt));
+}
+static void json_sampling(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    const evr_sampling s = evr_config_sampling(c);
+    evr_json_string(j, s == EVR_SAMPLING_REFINE     ? "refine"
+                       : s == EVR_SAMPLING_ADAPTIVE ? "adaptive"
+                                                    : "uniform, per-pixel phase");
+}
+static void json_samples_per_frame(evr_json *j, const evr_config *c, const evr_config_run *r)
+{
+    evr_json_number(j, evr_config_samples_per_frame(c));
 }
 static void json_frames_fps(evr_json *j, const evr_config *c, const evr_config_run *r)
 {
@@ -199,6 +211,12 @@ static evr_status check_max_dt(const evr_config *c, evr_error *err)
              c->min_dt, c->max_dt);
     return EVR_OK;
 }
+static evr_status check_sampling(const evr_config *c, evr_error *err)
+{
+    if (c->sampling == EVR_SAMPLING_REFINE && c->gi)
+        FAIL("--sampling refine does not take --gi yet: use --sampling uniform");
+    return EVR_OK;
+}
 static evr_status check_sensor(const evr_config *c, evr_error *err)
 {
     char list[128];
@@ -249,6 +267,8 @@ static void help_formats(char *buf, size_t n)
 static const evr_opt_choice sampling_choices[] = {
     {"uniform", EVR_SAMPLING_UNIFORM, "uniform, per-pixel phase", NULL},
     {"adaptive", EVR_SAMPLING_ADAPTIVE, "adaptive", NULL},
+    {"refine", EVR_SAMPLING_REFINE, "refine", NULL},
+    {"auto", EVR_SAMPLING_AUTO, "auto", NULL},
     {NULL, -1, NULL, NULL}};
 static const evr_opt_choice backend_choices[] = {{"auto", EVR_BACKEND_AUTO, "auto", NULL},
                                                  {"cpu", EVR_BACKEND_CPU, "cpu", NULL},
@@ -502,15 +522,21 @@ static const evr_config_option table[] = {
     {.name = "samples_per_frame",
      .type = EVR_OPT_INT,
      .offset = F(samples_per_frame),
-     .def = 10,
-     .lo = 1,
+     .def = 0,
+     .lo = 0,
      .hi = 1000000,
-     .what = "samples per frame must be between 1 and 1000000",
+     .what = "samples per frame must be between 1 and 1000000 (0: the default)",
      .flag = "--samples-per-frame",
+     .cli_lo = 1,
+     .cli_hi = 1000000,
+     .cli_what = "%s must be between 1 and 1000000 (got %s)",
      .label = "--samples-per-frame N",
-     .help = "samples per pixel per segment (default 10)",
+     .help = "samples per pixel per segment, 10 unless given; given alone, it\n"
+             "chooses uniform sampling at that count (the speed runs'\n"
+             "and comparisons' mode)",
      .json = "samples_per_frame",
-     .json_rank = 8},
+     .json_rank = 8,
+     .json_value = json_samples_per_frame},
     {.name = "threads",
      .type = EVR_OPT_INT,
      .offset = F(threads),
@@ -573,14 +599,20 @@ static const evr_config_option table[] = {
     {.name = "sampling",
      .type = EVR_OPT_CHOICE,
      .offset = F(sampling),
-     .def = EVR_SAMPLING_UNIFORM,
+     .def = EVR_SAMPLING_AUTO,
      .choices = sampling_choices,
      .noun = "sampling",
      .what = "unknown sampling",
+     .check = check_sampling,
      .flag = "--sampling",
      .label = "--sampling S",
-     .help = "uniform (default: --samples-per-frame samples per pixel per\n"
-             "segment) or adaptive: each pixel picks its next sample time so\n"
+     .help = "refine (the default; uniform when --samples-per-frame is given\n"
+             "or with --gi): where something moving reaches a pixel, 10\n"
+             "samples per segment, and every interval in which the pixel\n"
+             "fires bisected until its events' timing error is within\n"
+             "--time-tol; pixels nothing moving reaches take no samples.\n"
+             "uniform: --samples-per-frame samples per pixel per segment.\n"
+             "adaptive: each pixel picks its next sample time so\n"
              "that its log intensity moves by at most --adapt-frac of a\n"
              "threshold and anything its rays meet moves by at most\n"
              "2 * --adapt-frac pixels; a pixel nothing moving reaches samples\n"
@@ -588,7 +620,44 @@ static const evr_config_option table[] = {
              "held back while the interval before it is bisected down to\n"
              "--min-dt (ignores --samples-per-frame and --no-skip)",
      .json = "sampling",
-     .json_rank = 9},
+     .json_rank = 9,
+     .json_value = json_sampling},
+    {.name = "time_tol",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(time_tol),
+     .def = 50e-6,
+     .lo = 1e-6,
+     .hi = 1,
+     .what = "time tolerance must be between 1e-6 and 1 s",
+     .flag = "--time-tol",
+     .cli_lo = 1e-6,
+     .cli_hi = 1,
+     .cli_what = "%s must be between 1e-6 and 1 seconds (got %s)",
+     .label = "--time-tol S",
+     .help = "refine: the timing error of events the refinement aims at,\n"
+             "seconds (default 50e-6)",
+     .json = "time_tol",
+     .json_rank = 63,
+     .json_if = is_refine},
+    {.name = "refine_px",
+     .type = EVR_OPT_DOUBLE,
+     .offset = F(refine_px),
+     .def = 0.5,
+     .lo = 0,
+     .hi = 1000,
+     .what = "refine pixels must be between 0 and 1000",
+     .flag = "--refine-px",
+     .cli_lo = 0,
+     .cli_hi = 1000,
+     .cli_what = "%s must be between 0 and 1000 pixels (got %s)",
+     .label = "--refine-px P",
+     .help = "refine: what moves in a pixel's rays moves by at most P pixels\n"
+             "between its grid samples, so thin things (lashes, their\n"
+             "shadows, glints) are seen crossing it (default 0.5; 0: the\n"
+             "grid alone)",
+     .json = "refine_px",
+     .json_rank = 64,
+     .json_if = is_refine},
     {.name = "adapt_frac",
      .type = EVR_OPT_FLOAT,
      .offset = F(adapt_frac),

@@ -58,15 +58,31 @@ typedef struct {
  * or blended layer: evr_adapt_hit), whose rays are not followed here: every moving thing counts
  * (the fastest speed; seen through a curved mirror or lens its image may move faster still, so
  * there the bound is an estimate). */
+EVR_HD static inline uint64_t
+evr_adapt_rays_met(const evr_render_scene *rs, const evr_adapt_plan *pl, evr_ray ray, float t_hit);
+
 EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
                                                 const evr_adapt_plan *pl, evr_ray ray, float t_hit,
                                                 int *jump)
 {
     float v = 0.0f;
-    uint64_t met = 0;
     *jump = 0;
     if (pl->num_boxes == 0) return 0.0f;
-    if (t_hit == EVR_SKIP_DEEP) met = ~0ull;
+    const uint64_t met = evr_adapt_rays_met(rs, pl, ray, t_hit);
+    for (int b = 0; b < pl->num_boxes; b++) {
+        if (!(met >> b & 1u)) continue;
+        v = fmaxf(v, pl->speed[b]);
+        if (pl->jump[b]) *jump = 1;
+    }
+    return v;
+}
+
+/* The boxes of what moves (bit b: box b) that a sample's rays meet, as evr_adapt_rays_speed. */
+EVR_HD static inline uint64_t evr_adapt_rays_met(const evr_render_scene *rs,
+                                                 const evr_adapt_plan *pl, evr_ray ray, float t_hit)
+{
+    uint64_t met = 0;
+    if (t_hit == EVR_SKIP_DEEP) return pl->num_boxes >= 64 ? ~0ull : (1ull << pl->num_boxes) - 1u;
     const int hit = t_hit < 1e29f && t_hit != EVR_SKIP_DEEP;
     const float tmax = hit ? t_hit * 1.0001f + pl->pad : INFINITY;
     for (int b = 0; b < pl->num_boxes; b++)
@@ -85,12 +101,7 @@ EVR_HD static inline float evr_adapt_rays_speed(const evr_render_scene *rs,
                     met |= 1ull << b;
         }
     }
-    for (int b = 0; b < pl->num_boxes; b++) {
-        if (!(met >> b & 1u)) continue;
-        v = fmaxf(v, pl->speed[b]);
-        if (pl->jump[b]) *jump = 1;
-    }
-    return v;
+    return met;
 }
 
 /* The hit distance a backend hands adaptive sampling for a sample (t_hit, its path's

@@ -4,6 +4,7 @@
 #include "host_clock.h"
 #include "core/rng.h"
 #include "core/adaptive.h"
+#include "core/refine.h"
 #include "core/pixel_flow.h"
 #include "core/shade_hit.h"
 #include "core/skip.h"
@@ -337,6 +338,7 @@ typedef struct {
     int deep;                 /* its last traced sample's path went past the primary hit */
     float direct;             /* GI: its last traced sample's direct light */
     int last_span;            /* the still span (evr_skip_still_span) of its last traced sample */
+    int keep;                 /* refined sampling: it keeps its intensity (evr_refine_keep) */
     unsigned id;              /* its last traced sample's event id */
     int x, y;
 } tile_pixel;
@@ -470,6 +472,93 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
     }
 }
 
+/* Runs a pixel's refined sampling (core/refine.h) until it needs a sample traced (1) or is done
+ * with the segment (0): samples it can take without rays, and every candidate the refinement
+ * lets through, go through its pixel model here. */
+static int refine_advance(cpu_backend *b, evr_refine_pixel *r, tile_pixel *q, int ideal, float dt,
+                          evr_event_vec *out)
+{
+    for (;;) {
+        if (r->need && !evr_refine_kept(r, b->seg->skip, r->t / dt)) return 1;
+        if (!r->cand) return 0;
+        if (!evr_refine_decide(r, &b->setup.refine_params, q->st, &q->pp)) continue;
+        pixel_sample(b, q->st, &q->pp, ideal, r->ct, r->ci, r->cid, q->x, q->y, out);
+        const float motion_dt =
+            r->sk.n ? INFINITY
+                    : evr_refine_motion_dt(&b->host.rs, b->seg->adapt, &b->setup.refine_params,
+                                           q->ray, r->ch, r->cdeep);
+        evr_refine_next(r, &b->setup.refine_params, motion_dt, dt);
+    }
+}
+
+/* Refined sampling of the listed pixels (those that trace in the segment, and with a sensor model
+ * those that keep their intensity: tile_pixel.keep): each round, every
+ * pixel that needs a sample traced traces it, eight at a time in packets grouped by the interval
+ * between the segment's motion keys their times fall in (as trace_samples), then runs on until
+ * it needs the next. Each pixel's samples reach its pixel model in time order. */
+static void refine_samples(cpu_backend *b, tile_pixel *px, const int *list, int count,
+                           const evr_m34 *pose_static, int ideal, float dt, evr_event_vec *out,
+                           unsigned long long *rays, unsigned long long *traced)
+{
+    const evr_render_scene *rs = &b->host.rs;
+    const evr_segment *seg = b->seg;
+    const int grid = b->time_grid, may_settle = !b->gi;
+    evr_refine_pixel rq[TILE * TILE];
+    int act[TILE * TILE], order[TILE * TILE], bucket[TILE * TILE], first[EVR_MAX_KEYS + 1];
+    int nact = 0, j, g, c;
+    for (j = 0; j < count; j++) {
+        const tile_pixel *q = &px[list[j]];
+        const float motion_dt =
+            evr_refine_motion_dt_first(rs, seg->adapt, &b->setup.refine_params, q->ray);
+        evr_refine_begin(&rq[j], q->st, evr_refine_step(&b->setup.refine_params, motion_dt, dt),
+                         dt);
+        if (q->keep) evr_refine_keep(&rq[j], q->st, q->id);
+        if (refine_advance(b, &rq[j], &px[list[j]], ideal, dt, out)) act[nact++] = j;
+    }
+    while (nact > 0 && !cancelled(b)) {
+        int kept = 0, a;
+        for (g = 0; g <= grid; g++) first[g] = 0;
+        for (a = 0; a < nact; a++) {
+            const float f = rq[act[a]].t / dt;
+            bucket[a] = grid > 1 ? (int)fminf(f * (float)grid, (float)(grid - 1)) : 0;
+            first[bucket[a] + 1]++;
+        }
+        for (g = 0; g < grid; g++) first[g + 1] += first[g];
+        for (a = 0; a < nact; a++) order[first[bucket[a]]++] = act[a];
+        for (c = 0; c < nact; c += PACKET) {
+            int xs[PACKET], ys[PACKET], valid[PACKET], deep[PACKET], i;
+            float fs[PACKET], intensity[PACKET], t_hit[PACKET];
+            unsigned ids[PACKET];
+            for (i = 0; i < PACKET; i++) {
+                valid[i] = c + i < nact;
+                j = order[valid[i] ? c + i : c];
+                xs[i] = px[list[j]].x;
+                ys[i] = px[list[j]].y;
+                fs[i] = rq[j].t / dt;
+                ids[i] = 0;
+            }
+            sample_intensity8_rows(b, seg->camera_static ? pose_static : NULL, xs, ys, fs, valid,
+                                   intensity, t_hit, NULL, deep, b->last_id ? ids : NULL, rays);
+            for (i = 0; i < PACKET; i++) {
+                if (!valid[i]) continue;
+                j = order[c + i];
+                tile_pixel *q = &px[list[j]];
+                (*traced)++;
+                evr_refine_traced(&rq[j], rs, seg->skip, q->st, q->ray, fs[i], intensity[i],
+                                  t_hit[i], deep[i], ids[i], may_settle);
+                if (refine_advance(b, &rq[j], q, ideal, dt, out)) act[kept++] = j;
+            }
+        }
+        nact = kept;
+    }
+    for (j = 0; j < count; j++) {
+        tile_pixel *q = &px[list[j]];
+        evr_refine_end(&rq[j], rs, seg->skip, q->st, q->ray);
+        q->t_hit = -1.0f; /* its cache is set */
+        if (rq[j].traced_any) q->id = rq[j].last_id;
+    }
+}
+
 /* A tile's pixels through the segment. A pixel that nothing moving can reach keeps its intensity
  * (change-driven sampling) and runs its samples without rays; the others trace, compacted into
  * full packets: first every such pixel's first sample, then the samples of those that did not
@@ -520,17 +609,27 @@ static void render_tile(cpu_backend *b, int tile, unsigned long long *samples,
                     if (evr_skip_pixel(rs, plan, q->st->started, q->st->cache_dist, q->ray) &&
                         !gi_changed) {
                         (*skipped)++;
+                        q->keep = b->setup.refine && !ideal; /* evr_refine_keep */
+                        if (q->keep) {
+                            list[count++] = np;
+                            continue;
+                        }
                         keep_samples(b, q, ideal, 0, n, dt, out);
                         evr_pixel_end_segment(q->st, dt);
                     } else {
+                        q->keep = 0;
                         list[count++] = np;
                     }
                 }
             }
-    trace_samples(b, px, list, count, 0, n < 1 ? n : 1, 1, more, &num_more, &pose_static, ideal, dt,
-                  out, rays, traced);
-    trace_samples(b, px, more, num_more, 1, n, 0, NULL, NULL, &pose_static, ideal, dt, out, rays,
-                  traced);
+    if (b->setup.refine) {
+        refine_samples(b, px, list, count, &pose_static, ideal, dt, out, rays, traced);
+    } else {
+        trace_samples(b, px, list, count, 0, n < 1 ? n : 1, 1, more, &num_more, &pose_static, ideal,
+                      dt, out, rays, traced);
+        trace_samples(b, px, more, num_more, 1, n, 0, NULL, NULL, &pose_static, ideal, dt, out,
+                      rays, traced);
+    }
     for (i = 0; i < count; i++) {
         tile_pixel *q = &px[list[i]];
         if (q->t_hit >= 0.0f)
@@ -1166,7 +1265,7 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
     for (y = 0; y < setup->height; y++)
         for (x = 0; x < setup->width; x++)
             b->phase[(size_t)y * (size_t)setup->width + (size_t)x] =
-                evr_pixel_phase(setup->seed, x, y);
+                setup->refine ? 1.0f : evr_pixel_phase(setup->seed, x, y);
 
     b->device = rtcNewDevice(NULL);
     if (!b->device) {

@@ -13,6 +13,7 @@ extern "C" {
 #include "cuda/gpu_bvh.h"
 }
 #include "core/adaptive.h"
+#include "core/refine.h"
 #include "core/photon.h"
 #include "core/skip.h"
 
@@ -147,6 +148,12 @@ struct adapt_args {
     float *next_out;
     const evr_adapt_plan *plan; /* the segment's motion bounds (device memory) */
     evr_adapt_params p;
+};
+
+/* Refined sampling's own arguments (a second kernel parameter, as adapt_args). */
+struct refine_args {
+    const evr_adapt_plan *plan; /* the segment's motion bounds (device memory) */
+    evr_refine_params p;
 };
 
 /* A listed pixel whose direct light stays while its indirect light changes (deferred gathers):

@@ -303,7 +303,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaMemcpy(b->d_sensor.p, &b->setup.pixel, sizeof(evr_pixel_params),
                   cudaMemcpyHostToDevice));
     cuda_launch_init_pixels(b->d_state[0].p, b->d_phase.p, b->setup.width, b->setup.height,
-                            (unsigned long long)b->setup.seed);
+                            (unsigned long long)b->setup.seed, b->setup.refine);
     CK(cudaGetLastError());
     CK(cudaStreamCreateWithFlags(&b->render, cudaStreamNonBlocking));
     /* four events a pixel per segment: the eye's busiest segments at 1280x720 take 3.3 (a segment
@@ -361,7 +361,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(sl->d_counters.reserve(CTR_COUNT));
         CK(sl->d_plan.reserve(1));
         CK(sl->h_plan.reserve(1));
-        if (b->setup.adaptive) {
+        if (b->setup.adaptive || b->setup.refine) {
             CK(sl->d_adapt.reserve(1));
             CK(sl->h_adapt.reserve(1));
         }

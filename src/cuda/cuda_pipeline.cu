@@ -45,12 +45,19 @@ static evr_status launch(cuda_backend *b, slot *sl, evr_error *err)
             d = deferred_args(b);
             CK(cudaMemsetAsync(d.count, 0, REQ_COUNTS * sizeof(unsigned), rs));
         }
+        refine_args r{};
+        if (b->setup.refine) {
+            r.plan = sl->d_adapt.p;
+            r.p = b->setup.refine_params;
+        }
         if (sl->reuse) {
-            cuda_launch_skip(a, d, ideal, grid, rs);
+            cuda_launch_skip(a, d, r, ideal, grid, rs);
             CK(cudaGetLastError());
         }
         evr_status st;
-        if (b->gi_deferred) {
+        if (b->setup.refine) {
+            cuda_launch_refine(a, r, v, grid, rs);
+        } else if (b->gi_deferred) {
             if ((st = gi_deferred_render(b, a, d, grid, err)) != EVR_OK) return st;
         } else {
             cuda_launch_render(a, v, grid, rs);
@@ -317,7 +324,7 @@ evr_status cuda_submit(evr_backend *base, const evr_segment *seg, evr_error *err
     *sl->h_plan.p = *seg->skip;
     CK(cudaMemcpyAsync(sl->d_plan.p, sl->h_plan.p, sizeof(evr_skip_plan), cudaMemcpyHostToDevice,
                        b->render));
-    if (b->setup.adaptive) {
+    if (b->setup.adaptive || b->setup.refine) {
         *sl->h_adapt.p = *seg->adapt;
         CK(cudaMemcpyAsync(sl->d_adapt.p, sl->h_adapt.p, sizeof(evr_adapt_plan),
                            cudaMemcpyHostToDevice, b->render));

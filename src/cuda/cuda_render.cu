@@ -38,9 +38,11 @@ __global__ void __launch_bounds__(BLOCK) static_hits_kernel(kernel_args a, gpu_s
  * window saw photons change gets here what gi_trace_kernel would make of it, without its rays:
  * its first sample settles on its last traced sample's direct light and surface point (the
  * same rays meet the same still surfaces: the same bits), and a gather request with the start
- * known; it is listed for the gather and pixel kernels only. */
+ * known; it is listed for the gather and pixel kernels only. With refined sampling (rf.plan set)
+ * a sensor model's kept samples come at the times brute force would trace them
+ * (evr_refine_keep). */
 template <int SENSOR>
-__global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred d)
+__global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred d, refine_args rf)
 {
     int pix, x, y;
     const bool active =
@@ -51,9 +53,9 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
     const float phi = pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
     bool skip = false, indirect_only = false;
     float cache = -1.0f;
+    const evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
     if (active) {
-        evr_m34 pose = evr_rs_camera_pose(&a.rs, 0.0f);
-        evr_ray ray = evr_camera_ray(&a.rs.camera, &pose, (float)x + 0.5f, (float)y + 0.5f);
         skip = evr_skip_pixel(&a.rs, a.plan, st.started, st.cache_dist, ray);
         /* global illumination: a pixel whose gather window saw photons change over this segment
          * or the last traces (its indirect light moves, or moved after its last sample) */
@@ -89,9 +91,28 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
     if (lane == 0) atomicAdd(&a.counters[CTR_SKIPPED], (unsigned long long)__popc(skipped));
     const float kept = st.intensity;
     const unsigned id = skip && a.id_in ? a.id_in[pix] : 0u; /* its last traced sample's */
-    for (int k = 0; k < a.samples; k++)
-        pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y,
-                             lane, id);
+    if (SENSOR && rf.plan) { /* refined sampling: at brute force's times (evr_refine_keep) */
+        evr_refine_pixel q;
+        const float m0 = skip ? evr_refine_motion_dt_first(&a.rs, rf.plan, &rf.p, ray) : INFINITY;
+        evr_refine_begin(&q, &st, evr_refine_step(&rf.p, m0, a.dt), a.dt);
+        q.need = skip;
+        evr_refine_keep(&q, &st, id);
+        while (__any_sync(0xffffffffu, q.need || q.cand)) {
+            if (q.need) evr_refine_kept(&q, a.plan, q.t / a.dt); /* settled: always kept */
+            const bool consume = q.cand && evr_refine_decide(&q, &rf.p, &st, &own);
+            pixel_sample_at<SENSOR>(a, st, own, consume, q.ct, q.ci, x, y, lane, q.cid);
+            if (consume) {
+                const float m =
+                    q.sk.n ? INFINITY
+                           : evr_refine_motion_dt(&a.rs, rf.plan, &rf.p, ray, q.ch, q.cdeep);
+                evr_refine_next(&q, &rf.p, m, a.dt);
+            }
+        }
+    } else {
+        for (int k = 0; k < a.samples; k++)
+            pixel_sample<SENSOR>(a, st, own, skip, ((float)k + phi) / (float)a.samples, kept, x, y,
+                                 lane, id);
+    }
     if (skip) {
         evr_pixel_end_segment(&st, a.dt);
         store_state<SENSOR>(a, pix, st);
@@ -239,6 +260,67 @@ __global__ void __launch_bounds__(BLOCK) adapt_kernel(kernel_args a, adapt_args 
     add_counts(a, lane, rays, taken);
 }
 
+/* Refined sampling (core/refine.h), one thread per pixel that traces (the skip kernel's list, or
+ * every pixel), the same steps as the CPU backend's refine_samples: the pixel traces its grid
+ * samples and the bisections of intervals in which it fires; every sample goes through the pixel
+ * model in time order. Lanes run their own schedules; the event appends stay warp-synchronous
+ * (every lane calls pixel_sample_at each round). No global illumination (refused by the
+ * configuration). */
+template <int LAYOUT, int SENSOR>
+__global__ void __launch_bounds__(BLOCK) refine_kernel(kernel_args a, refine_args d)
+{
+    launch_pixel lp;
+    if (!launch_pixel_of(a, &lp)) return;
+    const bool active = lp.active;
+    const int pix = lp.pix, x = lp.x, y = lp.y;
+    const unsigned lane = lp.lane;
+    evr_pixel_state st;
+    evr_pixel_params own;
+    (void)pixel_begin<SENSOR>(a, active, pix, x, y, st, own);
+    if (!SENSOR) own = *a.sensor; /* the thresholds the refinement reads */
+    const evr_m34 pose_static = evr_rs_camera_pose(&a.rs, 0.0f);
+    const evr_ray ray0 =
+        evr_camera_ray(&a.rs.camera, &pose_static, (float)x + 0.5f, (float)y + 0.5f);
+    evr_refine_pixel q;
+    const float motion_dt =
+        active ? evr_refine_motion_dt_first(&a.rs, d.plan, &d.p, ray0) : INFINITY;
+    evr_refine_begin(&q, &st, evr_refine_step(&d.p, motion_dt, a.dt), a.dt);
+    q.need = active;
+    unsigned rays = 0, traced = 0;
+    gi_memo memo;
+    memo.valid = false;
+    float hint = INFINITY; /* temporal coherence: the last traced sample's hit */
+    while (__any_sync(0xffffffffu, q.need || q.cand)) {
+        if (q.need && !evr_refine_kept(&q, a.plan, q.t / a.dt)) {
+            const float f = q.t / a.dt;
+            evr_m34 pose = a.camera_static ? pose_static : evr_rs_camera_pose(&a.rs, f);
+            float hit;
+            int deep = 0;
+            unsigned sid = 0;
+            const float in = gpu_sample<LAYOUT, 0>(a, &pose, x, y, f, &rays, &hit, &memo,
+                                                   a.coherence ? hint : INFINITY, nullptr, &deep,
+                                                   a.ids ? &sid : nullptr);
+            hint = hit;
+            traced++;
+            evr_refine_traced(&q, &a.rs, a.plan, &st, ray0, f, in, hit, deep, sid, 1);
+        }
+        const bool consume = q.cand && evr_refine_decide(&q, &d.p, &st, &own);
+        pixel_sample_at<SENSOR>(a, st, own, consume, q.ct, q.ci, x, y, lane, q.cid);
+        if (consume) {
+            const float m =
+                q.sk.n ? INFINITY : evr_refine_motion_dt(&a.rs, d.plan, &d.p, ray0, q.ch, q.cdeep);
+            evr_refine_next(&q, &d.p, m, a.dt);
+        }
+    }
+    if (active) {
+        evr_refine_end(&q, &a.rs, a.plan, &st, ray0);
+        evr_pixel_end_segment(&st, a.dt);
+        store_state<SENSOR>(a, pix, st);
+        if (a.id_out) a.id_out[pix] = q.traced_any ? q.last_id : (a.id_in ? a.id_in[pix] : 0u);
+    }
+    add_counts(a, lane, rays, traced);
+}
+
 /* Intensity frames: frame k is every pixel's intensity at normalized segment time frame_f[k], one
  * sample through the pixel centre (the same gpu_sample as the segment's samples), written to
  * frames[k * npix + pix]. A kernel of its own so that the render kernel and the pixel states are
@@ -297,12 +379,12 @@ __global__ void __launch_bounds__(BLOCK)
 
 /* Every pixel's first state and its sample phase. */
 __global__ void init_pixels(evr_pixel_state *st, float *phase, int width, int height,
-                            unsigned long long seed)
+                            unsigned long long seed, int aligned)
 {
     int pix = blockIdx.x * blockDim.x + threadIdx.x;
     if (pix >= width * height) return;
     evr_pixel_reset(&st[pix]);
-    phase[pix] = evr_pixel_phase(seed, pix % width, pix / width);
+    phase[pix] = aligned ? 1.0f : evr_pixel_phase(seed, pix % width, pix / width);
 }
 
 /* Calls f with the kernel variant v as compile-time constants: f(variant<LAYOUT, SENSOR, GI>{}). */
@@ -332,11 +414,11 @@ void cuda_launch_static_hits(const kernel_args &a, int layout, gpu_static_hit *o
     });
 }
 
-void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, bool ideal, unsigned grid,
-                      cudaStream_t s)
+void cuda_launch_skip(const kernel_args &a, const gi_deferred &d, const refine_args &r, bool ideal,
+                      unsigned grid, cudaStream_t s)
 {
-    if (ideal) skip_kernel<0><<<grid, BLOCK, 0, s>>>(a, d);
-    else skip_kernel<1><<<grid, BLOCK, 0, s>>>(a, d);
+    if (ideal) skip_kernel<0><<<grid, BLOCK, 0, s>>>(a, d, r);
+    else skip_kernel<1><<<grid, BLOCK, 0, s>>>(a, d, r);
 }
 
 void cuda_launch_render(const kernel_args &a, kernel_variant v, unsigned grid, cudaStream_t s)
@@ -353,6 +435,15 @@ void cuda_launch_adapt(const kernel_args &a, const adapt_args &d, kernel_variant
     with_variant(v, [&](auto k) {
         adapt_kernel<decltype(k)::layout, decltype(k)::sensor, decltype(k)::gi>
             <<<grid, BLOCK, 0, s>>>(a, d);
+    });
+}
+
+void cuda_launch_refine(const kernel_args &a, const refine_args &d, kernel_variant v, unsigned grid,
+                        cudaStream_t s)
+{
+    with_layout(v.layout, [&](auto l) {
+        if (v.sensor) refine_kernel<decltype(l)::value, 1><<<grid, BLOCK, 0, s>>>(a, d);
+        else refine_kernel<decltype(l)::value, 0><<<grid, BLOCK, 0, s>>>(a, d);
     });
 }
 
@@ -374,8 +465,8 @@ void cuda_launch_labels(const kernel_args &a, kernel_variant v, const float *lab
 }
 
 void cuda_launch_init_pixels(evr_pixel_state *st, float *phase, int width, int height,
-                             unsigned long long seed)
+                             unsigned long long seed, int aligned)
 {
     const size_t npix = (size_t)width * (size_t)height;
-    init_pixels<<<(unsigned)((npix + 255) / 256), 256>>>(st, phase, width, height, seed);
+    init_pixels<<<(unsigned)((npix + 255) / 256), 256>>>(st, phase, width, height, seed, aligned);
 }

@@ -406,7 +406,7 @@ static char *run_json(const evr_sim *sim)
         evr_json_number(&j, spps);
         evr_json_key(&j, "mean_sample_interval_seconds");
         evr_json_number(&j, sim->setup.adaptive ? (spps > 0.0 ? 1.0 / spps : 0.0)
-                                                : 1.0 / (sim->fps * sim->cfg.samples_per_frame));
+                                                : 1.0 / (sim->fps * sim->setup.samples_per_frame));
     }
     evr_json_key(&j, "time_load_seconds"); /* the scene's (evr_scene_load_times) */
     evr_json_number(&j, evr_scene_load_times(sim->scene)->total);
