@@ -3,7 +3,8 @@
 by the default (refined) sampling, uniform sampling at 10, 100 and 300 samples per frame and
 adaptive sampling, each scored with `evray compare` against uniform sampling at 1000 samples per
 frame (F1 at 100 us and 1 ms), with wall time, events and samples traced; then the event rate of
-the reference, the default and uniform 10 per frame in 0.1 ms bins over 2 ms of the first saccade.
+the reference, the default and uniform 10 per frame in 0.1 ms bins over the busiest 2 ms of the
+first saccade.
 
     scripts/sampling_table.py EVRAY [--res 346x260] [--start 0] [--duration 3] [--backend cpu]
                               [--scene eye] [--skip adaptive,u300] [--write docs/benchmarks.md]
@@ -30,7 +31,7 @@ p.add_argument("--duration", default="3")
 p.add_argument("--backend", default="cpu")
 p.add_argument("--skip", default="", help="comma-separated rows to leave out: u10, u100, u300, adaptive")
 p.add_argument("--zoom", type=float, default=None, help="start of the 2 ms zoom, seconds (default: the "
-               "reference's busiest 2 ms in its first half second of motion)")
+               "reference's busiest 2 ms in the 0.1 s from its first event: the eye's first saccade)")
 p.add_argument("--write", default=None)
 a = p.parse_args()
 tmp = tempfile.mkdtemp(prefix="evray-sampling-")
@@ -87,10 +88,10 @@ t_ref = times("ref")
 start_us = int(round(float(a.start) * 1e6))
 if a.zoom is not None:
     z0 = int(round(a.zoom * 1e6))
-else:  # the busiest 2 ms of the reference in the first half second after its first event
+else:  # the busiest 2 ms of the reference in the 0.1 s after its first event
     first = int(t_ref.min()) if len(t_ref) else start_us
-    early = t_ref[t_ref < first + 500_000]
-    h, edges = np.histogram(early, bins=np.arange(first, first + 500_001, 2000))
+    early = t_ref[t_ref < first + 100_000]
+    h, edges = np.histogram(early, bins=np.arange(first, first + 100_001, 2000))
     z0 = int(edges[int(np.argmax(h))]) if len(early) else first
 bins = np.arange(z0, z0 + 2001, 100)
 zoom_keys = [k for k in ("ref", "default", "u10") if k in done]
