@@ -69,10 +69,11 @@ for backend in backends:
     T.check(js_a["config"]["sampling"] == "adaptive" and js_u["config"]["sampling"].startswith("uniform"),
             f"{backend}: sampling in run.json")
     T.check(near(su_s["samples_per_pixel_per_second"], FPS * N, 1e-6), f"{backend}: uniform samples per pixel per s")
-    # --sampling uniform is the default, unchanged (and equal to brute force: tests/test_skip.py)
+    # --samples-per-frame alone selects uniform sampling, the same as --sampling uniform (and equal
+    # to brute force: tests/test_skip.py)
     ev_x, _, _ = run(*sq, "--samples-per-frame", N, "--backend", backend, "--sampling", "uniform")
     ev_b, _, _ = run(*sq, "--samples-per-frame", N, "--backend", backend, "--sampling", "uniform", "--no-skip")
-    T.check(ev_x.tobytes() == ev_u.tobytes() == ev_b.tobytes(), f"{backend}: --sampling uniform is the default")
+    T.check(ev_x.tobytes() == ev_u.tobytes() == ev_b.tobytes(), f"{backend}: --samples-per-frame alone is --sampling uniform")
     # --no-skip does not change adaptive sampling
     ev_n, _, _ = run(*sq, "--sampling", "adaptive", "--backend", backend, "--no-skip")
     T.check(ev_n.tobytes() == ev_a.tobytes(), f"{backend} adaptive: --no-skip changes nothing")
