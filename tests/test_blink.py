@@ -39,8 +39,8 @@ T.check("morph" in text, "evray info lists the lids' morph targets")
 
 d = os.path.join(T.tmpdir(), "run")
 T.run("demo", "--scene", "blink", "-o", d, "--res", f"{W}x{H}", "--duration", "0.85", "--format", "npy",
-      "--no-preview", "--quiet", "--backend", "cpu")
-# The default 30 fps x 10 samples per frame: a pixel's sample interval. The first blink starts and
+      "--samples-per-frame", "10", "--no-preview", "--quiet", "--backend", "cpu")
+# Uniform sampling at 30 fps x 10 samples per frame: a pixel's sample interval. The first blink starts and
 # ends on segment boundaries (0.40 = 12/30, 0.70 = 21/30 s), so the lids' fitted vertex keys hold
 # the rest pose exactly on both sides of it (a blink inside a segment may start or settle up to
 # a key spacing early or late in the keys, within their tolerance).

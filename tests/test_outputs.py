@@ -36,7 +36,7 @@ T.check(len(ms) >= 600, "ms_to_idx covers the simulated time")
 # a segment of more than 131,072 events is counted on several threads: the counts still match
 d2 = os.path.join(T.tmpdir(), "big")
 T.run("demo", "--scene", "eye", "-o", d2, "--res", "640x360", "--start", "0.9", "--duration", "0.034",
-      "--quiet", "--no-preview")
+      "--samples-per-frame", "10", "--quiet", "--no-preview")
 s2 = T.load_run_json(d2)["stats"]
 ev2, _, _ = T.load_h5(os.path.join(d2, "events.h5"))
 T.check(len(ev2["t"]) > 131072, f"one segment of {len(ev2['t'])} events, enough for several counting threads")

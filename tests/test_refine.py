@@ -67,7 +67,7 @@ for backend in backends:
             f"{backend} refine: a looser --time-tol takes fewer samples, errors within it ({wt * 1e6:.0f} us)")
 
 # ---- exact with respect to skipping, and deterministic ----
-eye = ["--scene", "eye", "--res", "96x72", "--start", "0.55", "--duration", "0.4"]  # a saccade and the blink
+eye = ["--scene", "eye", "--res", "64x48", "--start", "0.55", "--duration", "0.4"]  # a saccade and the blink
 for backend in backends:
     for scene in (eye, sq):
         ev, js, _ = run(*scene, "--backend", backend)
@@ -85,7 +85,9 @@ for backend in backends:
         T.check(run(*base, *threads)[0].tobytes() == ref, f"{backend} refine: identical events {threads or 'again'}")
 
 # ---- against a dense uniform reference ----
-cases = [("eye", ["--res", "96x72", "--start", "0.55", "--duration", "0.4"], 0.95),
+# (at 64x48 the eye's thin things are five times narrower in pixels than at the benchmark's
+# 346x260, where the default scores 0.987 (docs/benchmarks.md); here about 0.95)
+cases = [("eye", ["--res", "64x48", "--start", "0.55", "--duration", "0.4"], 0.93),
          ("disk", ["--res", "64x64", "--duration", "0.5"], 0.98),
          ("cornell", ["--res", "64x48", "--duration", "0.5"], 0.98)]
 for name, opts, need in cases:
