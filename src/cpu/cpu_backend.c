@@ -386,6 +386,14 @@ static void keep_samples(cpu_backend *b, tile_pixel *q, int ideal, int k0, int n
                      q->x, q->y, out);
 }
 
+/* The interval between the segment's motion keys that Embree traces a sample at normalized time f
+ * in (evr_skip_trace_time): packets are grouped by it. */
+static int key_interval(const cpu_backend *b, float f)
+{
+    const int g = (int)(evr_skip_trace_time(b->seg->skip, f) * (float)b->time_grid);
+    return g < 0 ? 0 : g >= b->time_grid ? b->time_grid - 1 : g;
+}
+
 /* Samples k0 .. k1 - 1 of the listed pixels, traced eight at a time in packets (any pixels of the
  * tile: the packets stay full however few pixels trace). Sample by sample, each packet's lanes
  * are pixels whose ray times fall in the same interval between the segment's motion keys: Embree's
@@ -422,8 +430,7 @@ static void trace_samples(cpu_backend *b, tile_pixel *px, const int *list, int c
                 continue;
             }
             q->last_span = span;
-            g = (int)(evr_skip_trace_time(seg->skip, f) * (float)grid);
-            bucket[j] = g < 0 ? 0 : g >= grid ? grid - 1 : g;
+            bucket[j] = key_interval(b, f);
             first[bucket[j] + 1]++;
             ntr++;
         }
@@ -519,8 +526,7 @@ static void refine_samples(cpu_backend *b, tile_pixel *px, const int *list, int 
         int kept = 0, a;
         for (g = 0; g <= grid; g++) first[g] = 0;
         for (a = 0; a < nact; a++) {
-            const float f = rq[act[a]].t / dt;
-            bucket[a] = grid > 1 ? (int)fminf(f * (float)grid, (float)(grid - 1)) : 0;
+            bucket[a] = key_interval(b, rq[act[a]].t / dt);
             first[bucket[a] + 1]++;
         }
         for (g = 0; g < grid; g++) first[g + 1] += first[g];
