@@ -1,6 +1,6 @@
 /* AEDAT 4.0 files (io/aedat4.h) the way dv-processing's MonoCameraWriter writes an event-only
  * recording: one stream, id 0, named "events", of type EVTS, compressed by LZ4 (DV's default and
- * the fastest; every AEDAT 4.0 reader decodes it), or by ZSTD at level 1, its fastest (--format
+ * the fastest; every AEDAT 4.0 reader decodes it), or by ZSTD at a fast level (--format
  * aedat4-zstd: a smaller file, more CPU). Timestamps are the run's microseconds.
  *
  * Packets hold the events of one millisecond (t / PACKET_US), at most PACKET_MAX_EVENTS of them (a
@@ -26,6 +26,7 @@
 
 #include <lz4frame.h>
 #include <zstd.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -39,9 +40,18 @@
 /* Compression threads for large writes (as many as the machine has, up to this): LZ4 takes tens
  * of ns an event, and the eye's events come at about 100 M a second from the H100 */
 #define COMPRESS_THREADS 16
-/* ZSTD's level for --format aedat4-zstd: its fastest, so that the writer keeps up with the GPU
- * (level 3, ZSTD's default and DV's, made the eye's file 2.4% smaller and its run 1.1x slower) */
-#define ZSTD_LEVEL 1
+/* ZSTD's level for --format aedat4-zstd: one of its fast levels, so that the writer keeps up
+ * with the GPU while the file stays well below LZ4's (docs/benchmarks.md, "Writers") */
+#define ZSTD_LEVEL (-3)
+/* ZSTD contexts kept for reuse: one per compressing thread (the pool's and the caller) */
+#define ZSTD_SLOTS (COMPRESS_THREADS + 1)
+
+/* ZSTD contexts, each taken by one thread at a time: a fresh context per packet allocated and
+ * cleared its tables every millisecond of events. */
+typedef struct {
+    atomic_int taken[ZSTD_SLOTS];
+    ZSTD_CCtx *cctx[ZSTD_SLOTS];
+} zstd_contexts;
 
 typedef struct {
     int64_t offset; /* the packet's compressed bytes */
@@ -68,6 +78,7 @@ typedef struct {
     size_t cap_starts;
     unsigned char *buf; /* the data table, built then compressed */
     size_t cap_buf;
+    zstd_contexts *zstd; /* with ZSTD compression */
 } aedat_writer;
 
 /* The packets of a large write, for the parallel parts: packet q is ev[start[q] .. start[q + 1]). */
@@ -230,13 +241,35 @@ static size_t frame_bound(const aedat_writer *w, size_t len)
                                              : LZ4F_compressFrameBound(len, &w->lz4);
 }
 
+/* ZSTD's frame of src[0 .. len) at dst in a free context of z (made at its first use). */
+static size_t zstd_frame(zstd_contexts *z, unsigned char *dst, size_t room,
+                         const unsigned char *src, size_t len)
+{
+    for (int i = 0; i < ZSTD_SLOTS; i++) {
+        if (atomic_exchange(&z->taken[i], 1)) continue;
+        if (!z->cctx[i]) z->cctx[i] = ZSTD_createCCtx();
+        const size_t c = z->cctx[i] ? ZSTD_compressCCtx(z->cctx[i], dst, room, src, len, ZSTD_LEVEL)
+                                    : ZSTD_compress(dst, room, src, len, ZSTD_LEVEL);
+        atomic_store(&z->taken[i], 0);
+        return c;
+    }
+    return ZSTD_compress(dst, room, src, len, ZSTD_LEVEL); /* more threads than slots */
+}
+
+static void zstd_contexts_free(zstd_contexts *z)
+{
+    if (!z) return;
+    for (int i = 0; i < ZSTD_SLOTS; i++) ZSTD_freeCCtx(z->cctx[i]);
+    free(z);
+}
+
 /* The frame of src[0 .. len) at dst (room bytes); its bytes, 0 when the compressor failed. */
 static size_t frame(const aedat_writer *w, unsigned char *dst, size_t room,
                     const unsigned char *src, size_t len)
 {
     size_t c;
     if (w->compression == EVR_AEDAT4_ZSTD) {
-        c = ZSTD_compress(dst, room, src, len, ZSTD_LEVEL);
+        c = zstd_frame(w->zstd, dst, room, src, len);
         return ZSTD_isError(c) ? 0 : c;
     }
     c = LZ4F_compressFrame(dst, room, src, len, &w->lz4);
@@ -526,6 +559,8 @@ static void free_writer(aedat_writer *w)
     free(w->starts);
     free(w->sizes);
     free(w->buf);
+    zstd_contexts_free(w->zstd);
+    w->zstd = NULL;
 }
 
 static evr_status aedat_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
@@ -575,7 +610,8 @@ static evr_status aedat_open(const char *path, const evr_writer_meta *meta, int 
     w->end = (int64_t)len;
     w->open = malloc(PACKET_MAX_EVENTS * sizeof *w->open);
     w->raw = malloc(EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * PACKET_MAX_EVENTS);
-    if (!w->open || !w->raw) {
+    if (compression == EVR_AEDAT4_ZSTD) w->zstd = calloc(1, sizeof *w->zstd);
+    if (!w->open || !w->raw || (compression == EVR_AEDAT4_ZSTD && !w->zstd)) {
         aedat_abort(*out);
         *out = NULL;
         snprintf(err->msg, sizeof err->msg, "aedat4 writer: out of memory");
