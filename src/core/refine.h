@@ -285,6 +285,17 @@ EVR_HD static inline int evr_refine_next(evr_refine_pixel *q, const evr_refine_p
     return 0;
 }
 
+/* evr_refine_next with the candidate's own motion bound (evr_refine_motion_dt; none while
+ * samples are held back: the stack's next comes first). */
+EVR_HD static inline int evr_refine_next_bounded(evr_refine_pixel *q, const evr_render_scene *rs,
+                                                 const evr_adapt_plan *pl,
+                                                 const evr_refine_params *rp, evr_ray ray0,
+                                                 float seg)
+{
+    const float m = q->sk.n ? INFINITY : evr_refine_motion_dt(rs, pl, rp, ray0, q->ch, q->cdeep);
+    return evr_refine_next(q, rp, m, seg);
+}
+
 /* The pixel's cache after the segment (core/skip.h), as uniform sampling leaves it. */
 EVR_HD static inline void evr_refine_end(const evr_refine_pixel *q, const evr_render_scene *rs,
                                          const evr_skip_plan *pl, evr_pixel_state *st, evr_ray ray0)

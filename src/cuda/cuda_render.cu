@@ -101,12 +101,7 @@ __global__ void __launch_bounds__(BLOCK) skip_kernel(kernel_args a, gi_deferred 
             if (q.need) evr_refine_kept(&q, a.plan, q.t / a.dt); /* settled: always kept */
             const bool consume = q.cand && evr_refine_decide(&q, &rf.p, &st, &own);
             pixel_sample_at<SENSOR>(a, st, own, consume, q.ct, q.ci, x, y, lane, q.cid);
-            if (consume) {
-                const float m =
-                    q.sk.n ? INFINITY
-                           : evr_refine_motion_dt(&a.rs, rf.plan, &rf.p, ray, q.ch, q.cdeep);
-                evr_refine_next(&q, &rf.p, m, a.dt);
-            }
+            if (consume) evr_refine_next_bounded(&q, &a.rs, rf.plan, &rf.p, ray, a.dt);
         }
     } else {
         for (int k = 0; k < a.samples; k++)
@@ -306,11 +301,7 @@ __global__ void __launch_bounds__(BLOCK) refine_kernel(kernel_args a, refine_arg
         }
         const bool consume = q.cand && evr_refine_decide(&q, &d.p, &st, &own);
         pixel_sample_at<SENSOR>(a, st, own, consume, q.ct, q.ci, x, y, lane, q.cid);
-        if (consume) {
-            const float m =
-                q.sk.n ? INFINITY : evr_refine_motion_dt(&a.rs, d.plan, &d.p, ray0, q.ch, q.cdeep);
-            evr_refine_next(&q, &d.p, m, a.dt);
-        }
+        if (consume) evr_refine_next_bounded(&q, &a.rs, d.plan, &d.p, ray0, a.dt);
     }
     if (active) {
         evr_refine_end(&q, &a.rs, a.plan, &st, ray0);
