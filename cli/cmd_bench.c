@@ -724,7 +724,7 @@ int cmd_bench(int argc, char **argv)
         return run_city_sweep(&cfg, sweep, dir, max_detail, max_buildings);
     }
     /* the row goes to stdout; the loader's notice (clips left out) to stderr */
-    evr_scene *scene = cli_load_scene(scene_path, demo, animation, 0, 0, 0);
+    evr_scene *scene = cli_load_scene(scene_path, demo, 0, animation, 0, 0, 0);
     if (!scene) return 1;
     int rc;
     if (suite) {

@@ -6,13 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int export_glb(const char *name, const char *path)
+static int export_glb(const char *name, uint64_t seed, const char *path)
 {
     void *glb = NULL;
     size_t n = 0;
     evr_error err = {{0}};
     char tmp[4200];
-    if (evr_demo_glb(name, &glb, &n, &err) != EVR_OK) {
+    if (evr_demo_glb_variant(name, seed, &glb, &n, &err) != EVR_OK) {
         cli_error("%s", err.msg);
         return 1;
     }
@@ -38,6 +38,7 @@ static int export_glb(const char *name, const char *path)
 int cmd_demo(int argc, char **argv)
 {
     const char *scene = "eye", *export_path = NULL;
+    uint64_t seed = 0;
     int i, j;
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -47,6 +48,8 @@ int cmd_demo(int argc, char **argv)
                 "Renders a built-in scene (as `evray render`, same options), or with --export writes it\n"
                 "as a binary glTF file that any glTF reader (and evray render) loads.\n\n"
                 "  --scene NAME    built-in scene (default eye)\n"
+                "  --scene-seed N  a variant of the scene, drawn from N (0, the default: the scene\n"
+                "                  itself); eye and eye-drift: the gaze plan and the iris\n"
                 "  --export FILE   write the scene as glTF 2.0 binary and exit\n"
                 "  --list          list the built-in scenes\n");
             fputs("scenes:", stdout);
@@ -71,6 +74,15 @@ int cmd_demo(int argc, char **argv)
                 free(rest);
                 return 2;
             }
+        } else if (opt_is(argv[i], "--scene-seed")) {
+            const char *v = opt_value(argc, argv, &i, "--scene-seed");
+            char *end = NULL;
+            if (v) seed = strtoull(v, &end, 10);
+            if (!v || !end || *end || !*v || v[0] == '-') {
+                if (v) cli_error("--scene-seed needs a whole number from 0 (got '%s')", v);
+                free(rest);
+                return 2;
+            }
         } else if (opt_is(argv[i], "--export")) {
             if (!(export_path = opt_value(argc, argv, &i, "--export"))) {
                 free(rest);
@@ -87,10 +99,10 @@ int cmd_demo(int argc, char **argv)
             cli_error("demo --export takes no render options (got '%s')", rest[1]);
             rc = 2;
         } else {
-            rc = export_glb(scene, export_path);
+            rc = export_glb(scene, seed, export_path);
         }
     } else {
-        rc = cmd_render(nrest, rest, scene);
+        rc = cmd_render(nrest, rest, scene, seed);
     }
     free(rest);
     return rc;

@@ -47,7 +47,7 @@ int cmd_info(int argc, char **argv)
         return 2;
     }
     /* quiet: the description says which clips play and why the others do not */
-    evr_scene *s = cli_load_scene(path, NULL, animation, strict, external, CLI_LOAD_DESCRIBED);
+    evr_scene *s = cli_load_scene(path, NULL, 0, animation, strict, external, CLI_LOAD_DESCRIBED);
     if (!s) return 1;
     char *text = evr_scene_describe(s);
     if (text) fputs(text, stdout);

@@ -70,7 +70,7 @@ static void help(void)
     free(options);
 }
 
-int cmd_render(int argc, char **argv, const char *default_demo)
+int cmd_render(int argc, char **argv, const char *default_demo, uint64_t demo_seed)
 {
     evr_config cfg;
     render_options ro;
@@ -114,7 +114,7 @@ int cmd_render(int argc, char **argv, const char *default_demo)
         return 2;
     }
 
-    evr_scene *scene = cli_load_scene(scene_path, default_demo, animation, cfg.strict,
+    evr_scene *scene = cli_load_scene(scene_path, default_demo, demo_seed, animation, cfg.strict,
                                       cfg.allow_external_files, quiet);
     if (!scene) return 1;
     evr_error err = {{0}};

@@ -418,7 +418,7 @@ int cmd_still(int argc, char **argv)
         free(cmp);
         return 2;
     }
-    evr_scene *scene = cli_load_scene(scene_path, demo, animation, strict, external, quiet);
+    evr_scene *scene = cli_load_scene(scene_path, demo, 0, animation, strict, external, quiet);
     if (!scene) {
         free(ref);
         free(cmp);

@@ -1,8 +1,9 @@
 #ifndef EVR_CLI_COMMANDS_H
 #define EVR_CLI_COMMANDS_H
 
+#include <stdint.h>
 /* Each returns the process exit code: 0 success, 1 failure, 2 usage error, 130 interrupted. */
-int cmd_render(int argc, char **argv, const char *default_demo);
+int cmd_render(int argc, char **argv, const char *default_demo, uint64_t demo_seed);
 int cmd_info(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_compare(int argc, char **argv);

@@ -30,7 +30,7 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) return cmd_render(argc, argv, "eye");
+    if (argc < 2) return cmd_render(argc, argv, "eye", 0);
     const char *c = argv[1];
     if (!strcmp(c, "--help") || !strcmp(c, "-h") || !strcmp(c, "help")) {
         usage(stdout);
@@ -40,7 +40,7 @@ int main(int argc, char **argv)
         printf("evray %s\n", evr_version());
         return 0;
     }
-    if (!strcmp(c, "render")) return cmd_render(argc - 1, argv + 1, NULL);
+    if (!strcmp(c, "render")) return cmd_render(argc - 1, argv + 1, NULL, 0);
     if (!strcmp(c, "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(c, "demo")) return cmd_demo(argc - 1, argv + 1);
     if (!strcmp(c, "compare")) return cmd_compare(argc - 1, argv + 1);
@@ -48,7 +48,7 @@ int main(int argc, char **argv)
     if (!strcmp(c, "plot")) return cmd_plot(argc - 1, argv + 1);
     if (!strcmp(c, "still")) return cmd_still(argc - 1, argv + 1);
     if (!strcmp(c, "convert")) return cmd_convert(argc - 1, argv + 1);
-    if (c[0] == '-') return cmd_render(argc, argv, "eye"); /* options for the default job */
+    if (c[0] == '-') return cmd_render(argc, argv, "eye", 0); /* options for the default job */
     fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
     return 2;
 }

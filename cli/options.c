@@ -71,8 +71,8 @@ const char *opt_value(int argc, char **argv, int *i, const char *name)
     return argv[*i];
 }
 
-evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
-                          int allow_external, int quiet)
+evr_scene *cli_load_scene(const char *path, const char *demo, uint64_t demo_seed,
+                          const char *animation, int strict, int allow_external, int quiet)
 {
     evr_error err = {{0}};
     evr_scene *scene = NULL;
@@ -87,7 +87,7 @@ evr_scene *cli_load_scene(const char *path, const char *demo, const char *animat
     } else { /* a built-in scene goes through the same importer, from memory */
         void *glb = NULL;
         size_t n = 0;
-        st = evr_demo_glb(demo, &glb, &n, &err);
+        st = evr_demo_glb_variant(demo, demo_seed, &glb, &n, &err);
         if (st == EVR_OK) st = evr_scene_load_memory_with(glb, n, "glb", &opts, &scene, &err);
         free(glb);
     }

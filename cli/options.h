@@ -20,13 +20,14 @@ int opt_is(const char *arg, const char *name);
 
 void cli_error(const char *fmt, ...);
 
-/* The scene file at path, else the built-in scene demo, with --animation's choice (NULL: the
+/* The scene file at path, else the built-in scene demo (its variant demo_seed:
+ * evr_demo_glb_variant), with --animation's choice (NULL: the
  * default rule), --strict's (every import warning an error) and --allow-external-files' (files
  * outside the scene's folder may be read); prints the loader's notice
  * unless quiet, and the scene's warnings (evr_scene_warnings) always, on stderr. NULL (after the
  * error message) when it cannot be loaded, a clip the file does not have included. */
-evr_scene *cli_load_scene(const char *path, const char *demo, const char *animation, int strict,
-                          int allow_external, int quiet);
+evr_scene *cli_load_scene(const char *path, const char *demo, uint64_t demo_seed,
+                          const char *animation, int strict, int allow_external, int quiet);
 /* cli_load_scene's quiet for a caller that prints the notice and the warnings itself */
 #define CLI_LOAD_DESCRIBED (-1)
 /* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when

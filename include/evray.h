@@ -118,6 +118,11 @@ const evr_load_times *evr_scene_load_times(const evr_scene *s);
 const char *const *evr_demo_names(void);
 /* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
 evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err);
+/* The same for a variant of the scene: seed 0 is the scene itself; any other seed draws what the
+ * scene lets vary (eye, eye-drift: the gaze plan, blinks included, and the iris's pattern and
+ * colour), the same for the same seed. Other scenes refuse a seed. */
+evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, size_t *size,
+                                evr_error *err);
 /* Builds a built-in scene and loads it (through the same importer as any file). */
 evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err);
 void evr_scene_release(evr_scene *s);

@@ -11,13 +11,14 @@
 typedef struct {
     const char *name;
     void (*build)(evr_gltf *g);
+    int varies; /* its builder reads evr_gltf_variant */
 } demo_entry;
 
 static const demo_entry demos[] = {
-    {"eye", evr_demo_build_eye},         {"eye-drift", evr_demo_build_eye_drift},
-    {"square", evr_demo_build_square},   {"disk", evr_demo_build_disk},
-    {"cornell", evr_demo_build_cornell}, {"cornell-still", evr_demo_build_cornell_still},
-    {"city", evr_demo_build_city},       {"blink", evr_demo_build_blink},
+    {"eye", evr_demo_build_eye, 1},         {"eye-drift", evr_demo_build_eye_drift, 1},
+    {"square", evr_demo_build_square, 0},   {"disk", evr_demo_build_disk, 0},
+    {"cornell", evr_demo_build_cornell, 0}, {"cornell-still", evr_demo_build_cornell_still, 0},
+    {"city", evr_demo_build_city, 0},       {"blink", evr_demo_build_blink, 0},
 };
 
 static const char *const demo_names[] = {"eye",           "eye-drift", "square", "disk", "cornell",
@@ -26,6 +27,12 @@ static const char *const demo_names[] = {"eye",           "eye-drift", "square",
 const char *const *evr_demo_names(void) { return demo_names; }
 
 evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err)
+{
+    return evr_demo_glb_variant(name, 0, glb, size, err);
+}
+
+evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, size_t *size,
+                                evr_error *err)
 {
     size_t i;
     evr_gltf *g;
@@ -43,11 +50,17 @@ evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *e
             n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demo_names[k]);
         return EVR_ERR_ARG;
     }
+    if (seed && !demos[i].varies) {
+        snprintf(err->msg, sizeof err->msg,
+                 "demo %s has no variants: a scene seed is for eye and eye-drift", demos[i].name);
+        return EVR_ERR_ARG;
+    }
     g = evr_gltf_new(demos[i].name);
     if (!g) {
         snprintf(err->msg, sizeof err->msg, "demo %s: out of memory", demos[i].name);
         return EVR_ERR_NOMEM;
     }
+    evr_gltf_set_variant(g, seed);
     demos[i].build(g);
     st = evr_gltf_glb(g, glb, size, err);
     evr_gltf_free(g);

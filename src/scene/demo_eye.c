@@ -188,10 +188,16 @@ static double key_time(double t) { return (double)(float)t; }
 /* Builds the plan; 0 when it does not fit in MAX_FIX fixations. Every fixation lasts
  * FIX_MIN..FIX_MAX; a blink comes BLINK_GAP_MIN..BLINK_GAP_MAX after the previous one (measured
  * from the first fixation that starts late enough), BLINK_DELAY into a fixation that is made long
- * enough to hold it. */
-static int make_plan(gaze_plan *p, int drift)
+ * enough to hold it. A variant (seed, evr_gltf_variant) draws every fixation after the first,
+ * straight ahead, from its own seed. */
+static int make_plan(gaze_plan *p, int drift, uint64_t seed)
 {
     uint64_t s = EYE_PLAN_SEED;
+    const int num_start = seed ? 1 : NUM_START;
+    if (seed) {
+        uint64_t v = seed;
+        s ^= splitmix64(&v);
+    }
     double t = 0.0, next_blink = 0.0, ny, np;
     int k;
     p->num_fix = 0;
@@ -210,10 +216,10 @@ static int make_plan(gaze_plan *p, int drift)
         f->blink = -1.0;
         p->num_fix = k + 1;
         blink = k == BLINK_FIX || (k > BLINK_FIX && t + BLINK_DELAY >= next_blink);
-        if (k < NUM_START && plan_start[k].duration >= 0.0) dur = plan_start[k].duration;
+        if (k < num_start && plan_start[k].duration >= 0.0) dur = plan_start[k].duration;
         else if (blink) dur = need + plan_uniform(&s, 0.0, FIX_MAX - need);
         else dur = plan_uniform(&s, FIX_MIN, FIX_MAX);
-        if (k >= NUM_START && rest <= FIX_MAX) { /* the last fixation runs to the end */
+        if (k >= num_start && rest <= FIX_MAX) { /* the last fixation runs to the end */
             f->end = ANIM_LENGTH;
             if (blink && rest >= need) {
                 f->blink = key_time(t + BLINK_DELAY);
@@ -221,7 +227,7 @@ static int make_plan(gaze_plan *p, int drift)
             }
             return 1;
         }
-        if (k + 1 < NUM_START) {
+        if (k + 1 < num_start) {
             ny = plan_start[k + 1].yaw;
             np = plan_start[k + 1].pitch;
         } else {
@@ -305,7 +311,8 @@ static void quat_axis(double ax, double ay, double az, double angle_deg, evr_qua
 
 /* Keys: at both ends of every fixation and saccade, every 2 ms in saccades and blinks, and with
  * drift every <= 25 ms in fixations. Without drift the keys of a fixation are bit-identical. */
-static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int drift)
+static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int drift,
+                            uint64_t seed)
 {
     gaze_plan *plan = malloc(sizeof *plan);
     double *t = malloc(sizeof(double) * MAX_KEYS);
@@ -316,7 +323,7 @@ static void build_animation(evr_gltf *g, int eyeball, int upper, int lower, int 
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while building the eye animation");
         goto done;
     }
-    if (!make_plan(plan, drift)) {
+    if (!make_plan(plan, drift, seed)) {
         evr_gltf_fail(g, EVR_ERR_ARG,
                       "eye animation: the gaze plan needs more than MAX_FIX fixations");
         goto done;
@@ -456,7 +463,7 @@ static void build_eye(evr_gltf *g, int drift)
                               (float)(LED_POS_Z * MM));
     evr_gltf_node_light(g, node, evr_gltf_add_light(g, &led));
 
-    build_animation(g, eyeball, upper, lower, drift);
+    build_animation(g, eyeball, upper, lower, drift, evr_gltf_variant(g));
 }
 
 void evr_demo_build_eye(evr_gltf *g) { build_eye(g, 0); }

@@ -121,17 +121,31 @@ int evr_eye_paint_sclera(evr_gltf *g)
     return tex;
 }
 
+/* Iris colours (sRGB 0-255: near the pupil, outer, the pupillary ruff): the scene's own first,
+ * then those a variant (evr_gltf_variant) may draw. */
+static const double iris_palettes[][3][3] = {
+    {{150.0, 108.0, 68.0}, {112.0, 90.0, 74.0}, {62.0, 42.0, 32.0}},  /* hazel-brown */
+    {{96.0, 62.0, 36.0}, {70.0, 46.0, 30.0}, {40.0, 26.0, 18.0}},     /* dark brown */
+    {{142.0, 136.0, 78.0}, {86.0, 104.0, 82.0}, {70.0, 56.0, 34.0}},  /* green */
+    {{150.0, 168.0, 178.0}, {84.0, 112.0, 140.0}, {78.0, 70.0, 58.0}}, /* blue */
+    {{140.0, 142.0, 138.0}, {98.0, 104.0, 108.0}, {66.0, 60.0, 54.0}}, /* grey */
+};
+
 /* The iris, pupil and limbus painted for the cornea: planar over [-7.5, 7.5] mm in x and y,
- * row 0 at y = +7.5. */
+ * row 0 at y = +7.5. A variant draws its colours and its fibres and crypts from its seed. */
 int evr_eye_paint_iris(evr_gltf *g)
 {
     evr_demo_image im;
-    evr_demo_rng r = {777u};
+    const uint64_t seed = evr_gltf_variant(g);
+    const uint32_t v = (uint32_t)(seed ^ (seed >> 32)) * 2654435761u; /* noise seeds' offset */
+    evr_demo_rng r = {777u ^ v};
     int x, y, k, tex;
     double crypt_a[36], crypt_t[36], crypt_s[36];
     const double pupil[3] = {10.0, 9.0, 9.0};
-    const double inner[3] = {150.0, 108.0, 68.0}, outer[3] = {112.0, 90.0, 74.0};
-    const double ruff[3] = {62.0, 42.0, 32.0};
+    const int n_pal = (int)(sizeof iris_palettes / sizeof iris_palettes[0]);
+    const int pal = seed ? (int)(seed % (uint64_t)n_pal) : 0;
+    const double *inner = iris_palettes[pal][0], *outer = iris_palettes[pal][1],
+                 *ruff = iris_palettes[pal][2];
     if (!evr_demo_image_init(&im, 512, 512, 0)) {
         evr_demo_image_free(&im);
         evr_gltf_fail(g, EVR_ERR_NOMEM, "out of memory while painting a demo texture");
@@ -151,16 +165,16 @@ int evr_eye_paint_iris(evr_gltf *g)
             double au = (ang + PI) / (2.0 * PI), c[3], f1, f2, coll, shade, sc[3];
             double tc = 0.34 + 0.035 * sin(11.0 * ang) + 0.02 * sin(23.0 * ang + 1.0);
             /* radial fibres: noise stretched along the radius, periodic in angle */
-            f1 = evr_demo_fbm(au * 90.0 + 0.6 * sin(7.0 * t), t * 3.0, 31u, 3, 90);
-            f2 = evr_demo_vnoise(au * 260.0, t * 9.0, 47u, 260);
+            f1 = evr_demo_fbm(au * 90.0 + 0.6 * sin(7.0 * t), t * 3.0, 31u + v, 3, 90);
+            f2 = evr_demo_vnoise(au * 260.0, t * 9.0, 47u + v, 260);
             evr_demo_mix3(c, inner, outer, evr_demo_smoothstep(tc - 0.05, tc + 0.25, t));
             shade = 0.78 + 0.45 * (f1 - 0.5) * 1.6 + 0.18 * (f2 - 0.5);
             coll = exp(-pow((t - tc) / 0.035, 2.0)); /* the collarette ridge */
             shade += 0.22 * coll;
             shade -= 0.10 * exp(-pow((t - 0.74) / 0.012, 2.0)) *
-                     (evr_demo_vnoise(au * 40.0, 0.0, 5u, 40) > 0.4);
+                     (evr_demo_vnoise(au * 40.0, 0.0, 5u + v, 40) > 0.4);
             shade -= 0.10 * exp(-pow((t - 0.86) / 0.012, 2.0)) *
-                     (evr_demo_vnoise(au * 40.0, 3.0, 6u, 40) > 0.45);
+                     (evr_demo_vnoise(au * 40.0, 3.0, 6u + v, 40) > 0.45);
             for (k = 0; k < 36; k++) { /* crypts */
                 double da = remainder(ang - crypt_a[k], 2.0 * PI) / (0.05 * crypt_s[k]);
                 double dt = (t - crypt_t[k]) / (0.05 * crypt_s[k]);

@@ -88,6 +88,7 @@ struct evr_gltf {
     int *skin_joints;  /* joint count of each skin */
     int cap_mesh_info; /* (meshes.count and skins.count are the counts) */
     int cap_skin_joints;
+    uint64_t variant; /* evr_gltf_set_variant */
     gnode *nodes;
     int num_nodes, cap_nodes;
     ganim *anims;
@@ -1461,3 +1462,7 @@ evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err)
     *size = total;
     return EVR_OK;
 }
+
+void evr_gltf_set_variant(evr_gltf *g, uint64_t seed) { g->variant = seed; }
+
+uint64_t evr_gltf_variant(const evr_gltf *g) { return g->variant; }

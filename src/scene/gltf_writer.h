@@ -205,6 +205,11 @@ void evr_gltf_fail(evr_gltf *g, evr_status status, const char *msg);
 /* The first failure so far (EVR_OK if none), its message copied into err when err is not NULL. */
 evr_status evr_gltf_status(const evr_gltf *g, evr_error *err);
 
+/* A built-in scene's variant (0: the scene as it always is): a seed its builder draws what
+ * varies from (the eye: its gaze plan and its iris). */
+void evr_gltf_set_variant(evr_gltf *g, uint64_t seed);
+uint64_t evr_gltf_variant(const evr_gltf *g);
+
 /* Serializes to GLB: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded), all
  * 4-byte aligned. *glb is malloc'ed; free() it. The builder stays usable afterwards. */
 evr_status evr_gltf_glb(evr_gltf *g, void **glb, size_t *size, evr_error *err);
