@@ -11,6 +11,7 @@ int cmd_bench(int argc, char **argv);
 int cmd_plot(int argc, char **argv);
 int cmd_still(int argc, char **argv);
 int cmd_convert(int argc, char **argv);
+int cmd_dataset(int argc, char **argv);
 
 #include "evray.h"
 

@@ -22,6 +22,7 @@ static void usage(FILE *f)
         "  compare REF TEST         accuracy of an event file against a reference (precision, recall, F1)\n"
         "  still SCENE -o OUT.png   one image at one time, optionally with global illumination (--gi)\n"
         "  convert IN OUT           an event file to another format (h5, txt, npy, EVT 2.0/3.0 raw, dat, bag, aedat4)\n"
+        "  dataset SPEC -o DIR      many runs (clips) from one specification, on every GPU and core or a Dask cluster\n"
         "\n"
         "  evray COMMAND --help     options of a command\n"
         "  evray --version          version of evray and its libraries\n",
@@ -48,6 +49,7 @@ int main(int argc, char **argv)
     if (!strcmp(c, "plot")) return cmd_plot(argc - 1, argv + 1);
     if (!strcmp(c, "still")) return cmd_still(argc - 1, argv + 1);
     if (!strcmp(c, "convert")) return cmd_convert(argc - 1, argv + 1);
+    if (!strcmp(c, "dataset")) return cmd_dataset(argc - 1, argv + 1);
     if (c[0] == '-') return cmd_render(argc, argv, "eye", 0); /* options for the default job */
     fprintf(stderr, "evray: error: unknown command '%s' (try evray --help)\n", c);
     return 2;

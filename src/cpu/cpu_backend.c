@@ -490,8 +490,7 @@ static int refine_advance(cpu_backend *b, evr_refine_pixel *r, tile_pixel *q, in
         if (!r->cand) return 0;
         if (!evr_refine_decide(r, &b->setup.refine_params, q->st, &q->pp)) continue;
         pixel_sample(b, q->st, &q->pp, ideal, r->ct, r->ci, r->cid, q->x, q->y, out);
-        evr_refine_next_bounded(r, &b->host.rs, b->seg->adapt, &b->setup.refine_params, q->ray,
-                                dt);
+        evr_refine_next_bounded(r, &b->host.rs, b->seg->adapt, &b->setup.refine_params, q->ray, dt);
     }
 }
 

@@ -29,6 +29,19 @@ static evr_status fail(evr_error *err, const char *what, const char *path)
     return EVR_ERR_IO;
 }
 
+/* The file, byte for byte the same for the same labels (as events.h5): no time stamps, the
+ * HDF5 1.8 format. */
+static hid_t create_file(const char *path)
+{
+    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS), f = -1;
+    if (fcpl >= 0 && fapl >= 0 && H5Pset_obj_track_times(fcpl, 0) >= 0 &&
+        H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18) >= 0)
+        f = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
+    if (fcpl >= 0) H5Pclose(fcpl);
+    if (fapl >= 0) H5Pclose(fapl);
+    return f;
+}
+
 /* An extendible dataset of frames: [0, H, W(, c)] chunked one frame per chunk (c 0: none). */
 static hid_t make_frames(hid_t file, const char *name, hid_t type, int h, int w, int c)
 {
@@ -38,7 +51,8 @@ static hid_t make_frames(hid_t file, const char *name, hid_t type, int h, int w,
     const int rank = c ? 4 : 3;
     hid_t space = H5Screate_simple(rank, dims, maxd), dcpl = H5Pcreate(H5P_DATASET_CREATE);
     hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, rank, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0 &&
+        H5Pset_chunk(dcpl, rank, ch) >= 0 && H5Pset_shuffle(dcpl) >= 0 &&
         H5Pset_deflate(dcpl, LABELS_DEFLATE) >= 0)
         ds = H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (dcpl >= 0) H5Pclose(dcpl);
@@ -51,7 +65,8 @@ static hid_t make_times(hid_t file)
     hsize_t dims[1] = {0}, maxd[1] = {H5S_UNLIMITED}, ch[1] = {1024};
     hid_t space = H5Screate_simple(1, dims, maxd), dcpl = H5Pcreate(H5P_DATASET_CREATE);
     hid_t ds = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, 1, ch) >= 0)
+    if (space >= 0 && dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0 &&
+        H5Pset_chunk(dcpl, 1, ch) >= 0)
         ds = H5Dcreate2(file, "t", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (dcpl >= 0) H5Pclose(dcpl);
     if (space >= 0) H5Sclose(space);
@@ -122,7 +137,7 @@ evr_status evr_labels_h5_open(const char *path, const evr_labels_h5_meta *m, evr
     {
         const int32_t width = m->width, height = m->height;
         const int8_t incomplete = 0;
-        w->file = H5Fcreate(w->tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+        w->file = create_file(w->tmp);
         if (w->file >= 0 && (w->ds[0] = make_times(w->file)) >= 0 &&
             (w->ds[1] = make_frames(w->file, "depth", H5T_IEEE_F32LE, m->height, m->width, 0)) >=
                 0 &&

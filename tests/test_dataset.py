@@ -1,0 +1,181 @@
+"""evray dataset (python/evray/dataset.py, run by the evray program): a 6-clip specification over
+built-in scenes runs to a complete manifest on this machine's cores; each clip's parameters follow
+from the master seed and its index alone; a run killed halfway and run again finishes only the
+missing clips; a clip remade alone is byte-identical to its run inside the dataset (events.h5,
+labels.h5 and its scene); the loader reads every clip back; a bad specification gets one line.
+The same on a local Dask cluster: tests/test_dataset_dask.py."""
+import importlib.util
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import evrtest as T
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+RUNNER = os.path.join(ROOT, "python", "evray", "dataset.py")
+
+SPEC = {
+    "clips": 6, "seed": 11,
+    "scenes": [{"demo": "eye"}, {"demo": "square"}, {"demo": "disk", "weight": 0.5}],
+    "format": "h5,npy", "labels_fps": 20,
+    "options": {"duration": 0.2, "res": "48x36", "samples-per-frame": 10},
+    "vary": {"thres": [0.15, 0.3], "sensor": {"choice": ["ideal", "davis346"]},
+             "camera_path": {"kinds": ["orbit", "pan", "still"], "shake": 0.5},
+             "light_intensity": [0.5, 2.0], "light_offset": 0.002, "base_color": 0.2,
+             "scene_seed": True},
+}
+
+
+def manifest(d):
+    path = os.path.join(d, "manifest.jsonl")
+    return [json.loads(l) for l in open(path)] if os.path.exists(path) else []
+
+
+def latest(d):
+    rows = {}
+    for r in manifest(d):
+        rows[r["clip"]] = r
+    return rows
+
+
+def dataset(*args, expect=0, env=None):
+    p = subprocess.run([T.EVRAY, "dataset", *args], capture_output=True, text=True, env=env)
+    T.check(p.returncode == expect, f"evray dataset {' '.join(args)}: exit {p.returncode} "
+            f"(expected {expect}); stderr: {p.stderr.strip()[-400:]}")
+    return p
+
+
+def same_files(a, b, names):
+    for n in names:
+        with open(os.path.join(a, n), "rb") as fa, open(os.path.join(b, n), "rb") as fb:
+            if fa.read() != fb.read():
+                return n
+    return None
+
+
+def main():
+    tmp = tempfile.mkdtemp(prefix="evray-dataset-")
+    try:
+        spec = os.path.join(tmp, "spec.json")
+        json.dump(SPEC, open(spec, "w"))
+
+        # parameters: from the master seed and the index alone (more clips leave the first alone)
+        a = dataset(spec, "-o", os.path.join(tmp, "x"), "--list").stdout.splitlines()
+        more = dict(SPEC, clips=9)
+        json.dump(more, open(os.path.join(tmp, "more.json"), "w"))
+        b = dataset(os.path.join(tmp, "more.json"), "-o", os.path.join(tmp, "x"),
+                    "--list").stdout.splitlines()
+        T.check(len(a) == 6 and len(b) == 9 and b[:6] == a, "clip k's parameters depend on k alone")
+        params = [json.loads(l) for l in a]
+        T.check(len({p["seed"] for p in params}) == 6, "each clip has its own seed")
+        eyes = [p for p in params if p["scene"].get("demo") == "eye"]
+        T.check(all(p["scene"].get("seed") for p in eyes),
+                f"the eye's clips draw their own gaze plan and iris (scene seeds: {eyes})")
+
+        # the whole dataset on this machine's cores
+        full = os.path.join(tmp, "full")
+        t0 = time.time()
+        dataset(spec, "-o", full)
+        rows = latest(full)
+        T.check(sorted(rows) == list(range(6)) and all(r["status"] == "done" for r in rows.values()),
+                f"a complete manifest: {[(k, r['status'], r.get('error')) for k, r in rows.items()]}")
+        for k, r in rows.items():
+            folder = os.path.join(full, "clips", f"{k:05d}")
+            T.check(r["events"] > 0 and {"events.h5", "events.npy", "labels.h5", "run.json"}
+                    <= set(r["files"]) and all(os.path.exists(os.path.join(folder, f))
+                                               for f in r["files"]),
+                    f"clip {k}: its files and events ({r.get('files')}, {r.get('events')})")
+            T.check(r["wall_s"] > 0 and r["params"] == params[k],
+                    f"clip {k}: its row holds its parameters and wall time")
+        print(f"test_dataset: 6 clips in {time.time() - t0:.1f} s, "
+              f"{sum(r['events'] for r in rows.values()):,} events")
+        n_rows = len(manifest(full))
+        dataset(spec, "-o", full)
+        T.check(len(manifest(full)) == n_rows, "a second run of a finished dataset runs nothing")
+        # the scenes differ as drawn: two eye clips with different gaze plans
+        glbs = [open(os.path.join(full, "scenes", f"{p['clip']:05d}.glb"), "rb").read()
+                for p in eyes]
+        T.check(len(set(glbs)) == len(glbs), "each eye clip has its own scene")
+
+        # killed halfway: clip 3 hangs (a wrapper around evray), the runner is killed; the rerun
+        # runs clips 3, 4 and 5 only
+        killed = os.path.join(tmp, "killed")
+        wrapper = os.path.join(tmp, "slow-evray")
+        with open(wrapper, "w") as f:
+            f.write("#!/bin/sh\ncase \"$*\" in *clips/00003*) sleep 600;; esac\n"
+                    f"exec {os.path.abspath(T.EVRAY)} \"$@\"\n")
+        os.chmod(wrapper, 0o755)
+        p = subprocess.Popen([sys.executable, RUNNER, spec, "-o", killed, "--jobs", "1",
+                              "--evray", wrapper], stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL, start_new_session=True)
+        deadline = time.time() + 300
+        while time.time() < deadline and len(latest(killed)) < 3:
+            time.sleep(0.05)
+        time.sleep(0.5)  # clip 3 has started and hangs
+        os.killpg(p.pid, signal.SIGKILL)
+        p.wait()
+        before = latest(killed)
+        T.check(sorted(before) == [0, 1, 2] and all(r["status"] == "done" for r in before.values()),
+                f"the killed run finished clips 0-2 ({[(k, r['status']) for k, r in before.items()]})")
+        n_before = len(manifest(killed))
+        dataset(spec, "-o", killed, "--jobs", "1")
+        new = manifest(killed)[n_before:]
+        T.check(sorted(r["clip"] for r in new) == [3, 4, 5] and all(r["status"] == "done"
+                                                                     for r in new),
+                f"the rerun ran only the missing clips: {[(r['clip'], r['status']) for r in new]}")
+        for k in range(6):
+            d = same_files(os.path.join(full, "clips", f"{k:05d}"),
+                           os.path.join(killed, "clips", f"{k:05d}"),
+                           ["events.h5", "events.npy", "labels.h5"])
+            T.check(d is None, f"clip {k} of the resumed dataset: {d} differs from the full run's")
+
+        # a clip remade alone, in a folder of its own
+        alone = os.path.join(tmp, "alone")
+        dataset(spec, "-o", alone, "--only", "4")
+        T.check(sorted(latest(alone)) == [4], "--only 4 runs clip 4 alone")
+        d = same_files(os.path.join(full, "clips", "00004"), os.path.join(alone, "clips", "00004"),
+                       ["events.h5", "events.npy", "labels.h5"])
+        T.check(d is None, f"clip 4 remade alone: {d} differs from its run in the dataset")
+        T.check(same_files(os.path.join(full, "scenes"), os.path.join(alone, "scenes"),
+                           ["00004.glb"]) is None, "clip 4's scene remade alone is the same")
+
+        # the loader (the module from its file: the package's compiled part is not needed)
+        spec_mod = importlib.util.spec_from_file_location("evray_dataset", RUNNER)
+        mod = importlib.util.module_from_spec(spec_mod)
+        spec_mod.loader.exec_module(mod)
+        ds = mod.EventDataset(full, event_file="events.h5")
+        T.check(len(ds) == 6, f"the loader sees 6 clips ({len(ds)})")
+        for i, item in enumerate(ds):
+            T.check(len(item["events"]) == rows[i]["events"] and item["clip"] == i and
+                    item["labels"] and os.path.exists(item["labels"]),
+                    f"clip {i} read back: {len(item['events'])} events, manifest {rows[i]['events']}")
+            t = item["events"]["t"]
+            T.check(bool((t[1:] >= t[:-1]).all()), f"clip {i}: events in time order")
+
+        # bad specifications and arguments: one line each, exit 1
+        for bad, what in [({"clips": 0, "scenes": [{"demo": "eye"}]}, "clips must be"),
+                          (dict(SPEC, colour=1), "unknown key 'colour'"),
+                          (dict(SPEC, vary={"thres": [0.3, 0.1]}), "runs backwards"),
+                          (dict(SPEC, scenes=[{"demo": "eye", "file": "x.glb"}]), "each scene is")]:
+            path = os.path.join(tmp, "bad.json")
+            json.dump(bad, open(path, "w"))
+            e = dataset(path, "-o", os.path.join(tmp, "bad"), expect=1).stderr.strip()
+            T.check(len(e.splitlines()) == 1 and what in e, f"a bad specification: {e!r}")
+        other = os.path.join(tmp, "other.json")
+        json.dump(dict(SPEC, seed=12), open(other, "w"))
+        e = dataset(other, "-o", full, expect=1).stderr.strip()
+        T.check("another specification" in e, f"a folder of another specification is refused: {e!r}")
+        e = dataset(spec, "-o", os.path.join(tmp, "y"), "--only", "6", expect=1).stderr.strip()
+        T.check("not in the dataset" in e, f"--only past the last clip: {e!r}")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    T.finish("test_dataset")
+
+
+if __name__ == "__main__":
+    main()
