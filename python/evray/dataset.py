@@ -594,10 +594,11 @@ def run_local(jobs_list, gpus, jobs, backend, record):
         if gpus > len(found):
             raise DatasetError(f"--gpus {gpus}: this machine has {len(found)}")
         found = found[:gpus]
-    if found:
-        slots = [{"gpu": g, "backend": backend or "cuda"} for g in found]
+    cores = os.cpu_count() or 1
+    if found:  # the host's cores shared out too: each run would take them all
+        threads = max(1, cores // len(found))
+        slots = [{"gpu": g, "backend": backend or "cuda", "threads": threads} for g in found]
     else:
-        cores = os.cpu_count() or 1
         n, threads = default_jobs(cores)
         if jobs:
             n, threads = jobs, max(1, cores // jobs)
