@@ -23,6 +23,7 @@ def main():
     ap.add_argument("--clips", type=int, default=4)
     ap.add_argument("--gpus", help="GPU counts to run with, e.g. 1,2,4")
     ap.add_argument("--jobs", type=int)
+    ap.add_argument("--per-gpu", default="1", help="clips at once per GPU: one run each, e.g. 1,2")
     ap.add_argument("--res", default="346x260")
     ap.add_argument("--duration", type=float, default=3.0)
     ap.add_argument("--out", help="keep the datasets here (default: a temporary folder)")
@@ -34,13 +35,14 @@ def main():
     os.makedirs(root, exist_ok=True)
     path = os.path.join(root, "spec.json")
     json.dump(spec, open(path, "w"))
-    runs = [("gpus", int(g)) for g in a.gpus.split(",")] if a.gpus else [("cpu", a.jobs)]
+    runs = [("gpus", int(g), int(m)) for m in a.per_gpu.split(",") for g in a.gpus.split(",")] \
+        if a.gpus else [("cpu", a.jobs, 1)]
     first = None
-    for kind, n in runs:
-        out = os.path.join(root, f"{kind}{n or ''}")
+    for kind, n, per in runs:
+        out = os.path.join(root, f"{kind}{n or ''}x{per}")
         shutil.rmtree(out, ignore_errors=True)
         cmd = [a.evray, "dataset", path, "-o", out]
-        cmd += ["--gpus", str(n)] if kind == "gpus" else ["--backend", "cpu"] + \
+        cmd += ["--gpus", str(n), "--per-gpu", str(per)] if kind == "gpus" else ["--backend", "cpu"] + \
             (["--jobs", str(n)] if n else [])
         t0 = time.time()
         p = subprocess.run(cmd, capture_output=True, text=True)
@@ -51,7 +53,8 @@ def main():
         rows = [json.loads(l) for l in open(os.path.join(out, "manifest.jsonl"))]
         events = sum(r["events"] for r in rows)
         first = first or wall
-        label = f"{n} GPU{'s' if n != 1 else ''}" if kind == "gpus" else \
+        label = f"{n} GPU{'s' if n != 1 else ''}, {per} clip{'s' if per != 1 else ''} each" \
+            if kind == "gpus" else \
             f"CPU ({n or 'default'} jobs, {os.cpu_count()} cores)"
         print(f"{label}: {a.clips} clips ({a.res}, {a.duration:g} s each, {events:,} events) in "
               f"{wall:.1f} s: {3600 * a.clips / wall:.1f} clips/hour, speedup {first / wall:.2f}x; "

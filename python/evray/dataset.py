@@ -1,7 +1,8 @@
 """Datasets at scale: many evray runs ("clips") from one specification, as jobs on every local GPU
 and core, or on a Dask cluster.
 
-    evray dataset SPEC -o DIR [--scheduler ADDRESS|local:N] [--gpus N] [--jobs N] [--only K,...]
+    evray dataset SPEC -o DIR [--scheduler ADDRESS|local:N] [--gpus N] [--per-gpu N] [--jobs N]
+                  [--only K,...]
     python3 -m evray.dataset SPEC -o DIR ...           # the same (the evray program runs this)
 
     from evray.dataset import run, EventDataset
@@ -527,11 +528,11 @@ def default_jobs(cores):
 
 
 def run(spec, out, scheduler=None, gpus=None, jobs=None, only=None, evray=None, progress=True,
-        backend=None):
+        backend=None, per_gpu=1):
     """Runs the dataset of spec (a path or a dict as load_spec returns) into folder out; returns
     the manifest's rows of this run's clips. scheduler: a Dask scheduler's address, or "local:N"
     for a local Dask cluster of N worker processes (None: this machine's GPUs, else its cores).
-    only: clip indices to run (remade even when done)."""
+    only: clip indices to run (remade even when done). per_gpu: clips at once on each GPU."""
     if isinstance(spec, str):
         spec = load_spec(spec)
     evray = evray or os.environ.get("EVRAY") or shutil.which("evray")
@@ -579,7 +580,7 @@ def run(spec, out, scheduler=None, gpus=None, jobs=None, only=None, evray=None, 
         if scheduler:
             run_dask(jobs_list, scheduler, record)
         else:
-            run_local(jobs_list, gpus, jobs, backend, record)
+            run_local(jobs_list, gpus, jobs, backend, record, per_gpu)
     finally:
         manifest.close()
         if prog:
@@ -587,8 +588,9 @@ def run(spec, out, scheduler=None, gpus=None, jobs=None, only=None, evray=None, 
     return sorted(finished, key=lambda r: r["clip"])
 
 
-def run_local(jobs_list, gpus, jobs, backend, record):
-    """One job per GPU (CUDA_VISIBLE_DEVICES set to it), else CPU jobs sized to the cores."""
+def run_local(jobs_list, gpus, jobs, backend, record, per_gpu=1):
+    """per_gpu jobs on each GPU (CUDA_VISIBLE_DEVICES set to it), else CPU jobs sized to the
+    cores."""
     found = local_gpus() if backend != "cpu" else []
     if gpus is not None:
         if gpus > len(found):
@@ -596,8 +598,9 @@ def run_local(jobs_list, gpus, jobs, backend, record):
         found = found[:gpus]
     cores = os.cpu_count() or 1
     if found:  # the host's cores shared out too: each run would take them all
-        threads = max(1, cores // len(found))
-        slots = [{"gpu": g, "backend": backend or "cuda", "threads": threads} for g in found]
+        threads = max(1, cores // (len(found) * per_gpu))
+        slots = [{"gpu": g, "backend": backend or "cuda", "threads": threads}
+                 for _ in range(per_gpu) for g in found]
     else:
         n, threads = default_jobs(cores)
         if jobs:
@@ -720,6 +723,8 @@ def main(argv=None):
     ap.add_argument("--scheduler", help="a Dask scheduler's address, or local:N (N workers here)")
     ap.add_argument("--gpus", type=int, help="use only the first N GPUs of this machine")
     ap.add_argument("--jobs", type=int, help="CPU jobs at once (default: one per 8 cores)")
+    ap.add_argument("--per-gpu", type=int, default=1,
+                    help="clips at once on each GPU (default 1; a small clip leaves a GPU idle)")
     ap.add_argument("--backend", choices=["cpu", "cuda"], help="the backend of every clip")
     ap.add_argument("--only", help="clip indices to run (remade even when done): K[,K...]")
     ap.add_argument("--evray", help="the evray program (default: $EVRAY, else evray on PATH)")
@@ -730,6 +735,8 @@ def main(argv=None):
             raise DatasetError("--jobs needs a whole number from 1")
         if a.gpus is not None and a.gpus < 1:
             raise DatasetError("--gpus needs a whole number from 1")
+        if a.per_gpu < 1:
+            raise DatasetError("--per-gpu needs a whole number from 1")
         spec = load_spec(a.spec)
         only = None
         if a.only:
@@ -742,7 +749,7 @@ def main(argv=None):
                 print(json.dumps(clip_params(spec, k), sort_keys=True))
             return 0
         rows = run(spec, a.out, scheduler=a.scheduler, gpus=a.gpus, jobs=a.jobs, only=only,
-                   evray=a.evray, backend=a.backend)
+                   evray=a.evray, backend=a.backend, per_gpu=a.per_gpu)
     except DatasetError as e:
         print(f"evray dataset: error: {e}", file=sys.stderr)
         return 1
