@@ -14,6 +14,9 @@ import sys
 import tempfile
 import time
 
+import struct
+import zlib
+
 import evrtest as T
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -29,6 +32,16 @@ SPEC = {
              "light_intensity": [0.5, 2.0], "light_offset": 0.002, "base_color": 0.2,
              "scene_seed": True},
 }
+
+
+def png(path, rgb):
+    """A 4x4 PNG of one colour."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    rows = b"".join(b"\0" + bytes(rgb) * 4 for _ in range(4))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 4, 8, 2, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
 def manifest(d):
@@ -56,6 +69,14 @@ def same_files(a, b, names):
             if fa.read() != fb.read():
                 return n
     return None
+
+
+def load_runner():
+    """The runner as a module from its file (the package's compiled part is not needed)."""
+    spec_mod = importlib.util.spec_from_file_location("evray_dataset", RUNNER)
+    mod = importlib.util.module_from_spec(spec_mod)
+    spec_mod.loader.exec_module(mod)
+    return mod
 
 
 def main():
@@ -102,6 +123,51 @@ def main():
                 for p in eyes]
         T.check(len(set(glbs)) == len(glbs), "each eye clip has its own scene")
 
+        # the edits are in each clip's scene: lights and base colours against the scene exported
+        # as it is, the iris swapped for a file's (a spec of its own)
+        mod = load_runner()
+        for p in params:
+            scene = p["scene"]
+            base = os.path.join(tmp, "base.glb")
+            subprocess.run([T.EVRAY, "demo", "--scene", scene["demo"], "--export", base],
+                           capture_output=True, check=True)
+            d0, _, _ = mod.read_gltf(base)
+            d1, _, _ = mod.read_gltf(os.path.join(full, "scenes", f"{p['clip']:05d}.glb"))
+            f = p["edits"]["light_intensity"]
+            l0 = d0["extensions"]["KHR_lights_punctual"]["lights"]
+            l1 = d1["extensions"]["KHR_lights_punctual"]["lights"]
+            T.check(all(abs(b["intensity"] - a.get("intensity", 1.0) * f) <= 1e-6 * b["intensity"]
+                        for a, b in zip(l0, l1)), f"clip {p['clip']}: light intensity times {f}")
+            c0 = [m.get("pbrMetallicRoughness", {}).get("baseColorFactor", [1, 1, 1, 1])
+                  for m in d0["materials"]]
+            c1 = [m["pbrMetallicRoughness"]["baseColorFactor"] for m in d1["materials"]]
+            T.check(all(min(1.0, a[i] * 0.8) - 1e-6 <= b[i] <= min(1.0, a[i] * 1.2) + 1e-6
+                        and a[3] == b[3] for a, b in zip(c0, c1) for i in range(3)) and c0 != c1,
+                    f"clip {p['clip']}: base colours within 1 +- 0.2 of the scene's")
+            moved = [n for n0, n in zip(d0["nodes"], d1["nodes"])
+                     if "KHR_lights_punctual" in n.get("extensions", {})
+                     and n.get("translation") != n0.get("translation")]
+            T.check(bool(moved) and all(abs(a - b) <= 0.002 + 1e-9 for n0, n in zip(d0["nodes"], d1["nodes"])
+                                        if n in moved for a, b in zip(n0.get("translation", [0] * 3),
+                                                                      n["translation"])),
+                    f"clip {p['clip']}: lights moved by at most 0.002")
+        png(os.path.join(tmp, "blue.png"), (40, 60, 200))
+        swap = dict(SPEC, clips=1, scenes=[{"demo": "eye"}], vary={"textures": {"iris_texture":
+                                                                              ["blue.png"]}})
+        json.dump(swap, open(os.path.join(tmp, "swap.json"), "w"))
+        dataset(os.path.join(tmp, "swap.json"), "-o", os.path.join(tmp, "swap"))
+        d1, _, _ = mod.read_gltf(os.path.join(tmp, "swap", "scenes", "00000.glb"))
+        iris = [im for im in d1["images"] if im.get("name") == "iris_texture"]
+        T.check(len(iris) == 1 and iris[0].get("uri", "").startswith("data:image/png;base64,")
+                and latest(os.path.join(tmp, "swap"))[0]["status"] == "done",
+                "the iris texture swapped for a file's, and the clip rendered")
+        json.dump(dict(swap, vary={"textures": {"no_such_image": ["blue.png"]}}),
+                  open(os.path.join(tmp, "swap2.json"), "w"))
+        dataset(os.path.join(tmp, "swap2.json"), "-o", os.path.join(tmp, "swap2"), expect=1)
+        r = latest(os.path.join(tmp, "swap2"))[0]
+        T.check(r["status"] == "failed" and "no image named 'no_such_image'" in r["error"],
+                f"a swap of an image the scene lacks fails the clip with a reason: {r.get('error')}")
+
         # killed halfway: clip 3 hangs (a wrapper around evray), the runner is killed; the rerun
         # runs clips 3, 4 and 5 only
         killed = os.path.join(tmp, "killed")
@@ -144,10 +210,7 @@ def main():
         T.check(same_files(os.path.join(full, "scenes"), os.path.join(alone, "scenes"),
                            ["00004.glb"]) is None, "clip 4's scene remade alone is the same")
 
-        # the loader (the module from its file: the package's compiled part is not needed)
-        spec_mod = importlib.util.spec_from_file_location("evray_dataset", RUNNER)
-        mod = importlib.util.module_from_spec(spec_mod)
-        spec_mod.loader.exec_module(mod)
+        # the loader
         ds = mod.EventDataset(full, event_file="events.h5")
         T.check(len(ds) == 6, f"the loader sees 6 clips ({len(ds)})")
         for i, item in enumerate(ds):
