@@ -44,6 +44,16 @@ def png(path, rgb):
                 chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
+def slow_evray(tmp, evray):
+    """A program that runs evray, except that clip 3's render hangs (a run to kill halfway)."""
+    wrapper = os.path.join(tmp, "slow-evray")
+    with open(wrapper, "w") as f:
+        f.write("#!/bin/sh\ncase \"$*\" in *clips/00003*) sleep 600;; esac\n"
+                f"exec {os.path.abspath(evray)} \"$@\"\n")
+    os.chmod(wrapper, 0o755)
+    return wrapper
+
+
 def manifest(d):
     path = os.path.join(d, "manifest.jsonl")
     return [json.loads(l) for l in open(path)] if os.path.exists(path) else []
@@ -171,11 +181,7 @@ def main():
         # killed halfway: clip 3 hangs (a wrapper around evray), the runner is killed; the rerun
         # runs clips 3, 4 and 5 only
         killed = os.path.join(tmp, "killed")
-        wrapper = os.path.join(tmp, "slow-evray")
-        with open(wrapper, "w") as f:
-            f.write("#!/bin/sh\ncase \"$*\" in *clips/00003*) sleep 600;; esac\n"
-                    f"exec {os.path.abspath(T.EVRAY)} \"$@\"\n")
-        os.chmod(wrapper, 0o755)
+        wrapper = slow_evray(tmp, T.EVRAY)
         p = subprocess.Popen([sys.executable, RUNNER, spec, "-o", killed, "--jobs", "1",
                               "--evray", wrapper], stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, start_new_session=True)

@@ -12,7 +12,7 @@ import tempfile
 import time
 
 import evrtest as T
-from test_dataset import RUNNER, SPEC, latest, manifest, same_files
+from test_dataset import RUNNER, SPEC, latest, manifest, same_files, slow_evray
 
 FILES = ["events.h5", "events.npy", "labels.h5"]
 
@@ -58,11 +58,7 @@ def main():
 
         # killed while clip 3 hangs (the other worker finishes the rest): the rerun runs clip 3
         killed = os.path.join(tmp, "killed")
-        wrapper = os.path.join(tmp, "slow-evray")
-        with open(wrapper, "w") as f:
-            f.write("#!/bin/sh\ncase \"$*\" in *clips/00003*) sleep 600;; esac\n"
-                    f"exec {evray} \"$@\"\n")
-        os.chmod(wrapper, 0o755)
+        wrapper = slow_evray(tmp, evray)
         p = subprocess.Popen([python, RUNNER, spec, "-o", killed, "--scheduler", "local:2",
                               "--evray", wrapper], stdout=subprocess.DEVNULL,
                              stderr=subprocess.DEVNULL, start_new_session=True)

@@ -22,13 +22,14 @@
  * data, as HDF5 fills it). ms_to_idx is small, goes through H5Dwrite and is written by finish().
  * Storing the partial chunk at each flush and replacing it later would leave holes whose places
  * depend on when the (timed) flushes came: as it is, the same events give the same bytes
- * however the flushes fell, and no object carries a time stamp (create_file).
+ * however the flushes fell, and no object carries a time stamp (evr_h5_create_reproducible).
  * HDF5's automatic error printing is switched off around every call (H5E_BEGIN_TRY) and its
  * error stack is turned into the message instead. */
 #include "io/event_formats.h"
 #include "io/chunk_compress.h"
 #include "io/file_commit.h"
 #include "io/file_room.h"
+#include "io/h5_file.h"
 #include "io/h5_instances.h"
 #include "par_pool.h"
 
@@ -164,20 +165,6 @@ static herr_t append(hid_t ds, hid_t mtype, const void *data, uint64_t old, size
     if (mspace >= 0) H5Sclose(mspace);
     if (fspace >= 0) H5Sclose(fspace);
     return r;
-}
-
-/* Creates (truncates) the file so that the same calls give the same bytes: no modification times
- * on any object (the root group's come from the file creation list), and the file format pinned
- * to HDF5 1.8's (readable by 1.8 and later), whatever library version writes it. */
-static hid_t create_file(const char *path)
-{
-    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS), f = -1;
-    if (fcpl >= 0 && fapl >= 0 && H5Pset_obj_track_times(fcpl, 0) >= 0 &&
-        H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18) >= 0)
-        f = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
-    if (fapl >= 0) H5Pclose(fapl);
-    if (fcpl >= 0) H5Pclose(fcpl);
-    return f;
 }
 
 static herr_t write_scalar_attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype,
@@ -865,7 +852,7 @@ evr_status evr_h5_writer_open(const char *path, const evr_writer_meta *meta, evr
         int32_t width = meta->width, height = meta->height;
         int64_t zero = 0;
         int8_t incomplete = 0;
-        w->file = create_file(w->tmp);
+        w->file = evr_h5_create_reproducible(w->tmp);
         if (w->file >= 0) {
             hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
             what = "cannot lay out";

@@ -3,6 +3,7 @@
  * keeps up). HDF5's error printing is off around every call (H5E_BEGIN_TRY). */
 #include "io/labels_h5.h"
 #include "io/file_commit.h"
+#include "io/h5_file.h"
 #include "io/h5_instances.h"
 
 #include <hdf5.h>
@@ -27,19 +28,6 @@ static evr_status fail(evr_error *err, const char *what, const char *path)
     H5Eclear2(H5E_DEFAULT);
     snprintf(err->msg, sizeof err->msg, "hdf5: %s %s", what, path);
     return EVR_ERR_IO;
-}
-
-/* The file, byte for byte the same for the same labels (as events.h5): no time stamps, the
- * HDF5 1.8 format. */
-static hid_t create_file(const char *path)
-{
-    hid_t fcpl = H5Pcreate(H5P_FILE_CREATE), fapl = H5Pcreate(H5P_FILE_ACCESS), f = -1;
-    if (fcpl >= 0 && fapl >= 0 && H5Pset_obj_track_times(fcpl, 0) >= 0 &&
-        H5Pset_libver_bounds(fapl, H5F_LIBVER_EARLIEST, H5F_LIBVER_V18) >= 0)
-        f = H5Fcreate(path, H5F_ACC_TRUNC, fcpl, fapl);
-    if (fcpl >= 0) H5Pclose(fcpl);
-    if (fapl >= 0) H5Pclose(fapl);
-    return f;
 }
 
 /* An extendible dataset of frames: [0, H, W(, c)] chunked one frame per chunk (c 0: none). */
@@ -137,7 +125,7 @@ evr_status evr_labels_h5_open(const char *path, const evr_labels_h5_meta *m, evr
     {
         const int32_t width = m->width, height = m->height;
         const int8_t incomplete = 0;
-        w->file = create_file(w->tmp);
+        w->file = evr_h5_create_reproducible(w->tmp); /* the same bytes for the same labels */
         if (w->file >= 0 && (w->ds[0] = make_times(w->file)) >= 0 &&
             (w->ds[1] = make_frames(w->file, "depth", H5T_IEEE_F32LE, m->height, m->width, 0)) >=
                 0 &&
