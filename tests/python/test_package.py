@@ -200,3 +200,26 @@ def test_slow_consumer(square):
         got.append(b)
         time.sleep(0.002)
     assert np.array_equal(np.concatenate(got), np.concatenate(fast))
+
+
+def test_dataset(tmp_path):
+    """The installed package's dataset runner: the installed evray program's dataset command
+    (which runs python3 -m evray.dataset here) and run() from Python make the same clips, and
+    EventDataset reads them back through evray.read."""
+    from evray.dataset import EventDataset, run
+    spec = {"clips": 2, "seed": 3, "scenes": [{"demo": "square"}], "format": "npy",
+            "options": {"res": "32x24", "duration": 0.1, "samples-per-frame": 10},
+            "vary": {"thres": [0.2, 0.3]}}
+    path = tmp_path / "spec.json"
+    path.write_text(__import__("json").dumps(spec))
+    p = subprocess.run(["evray", "dataset", str(path), "-o", str(tmp_path / "cli")],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    rows = run(str(path), str(tmp_path / "py"), progress=False, evray=shutil.which("evray"))
+    assert [r["status"] for r in rows] == ["done", "done"]
+    a, b = EventDataset(str(tmp_path / "cli")), EventDataset(str(tmp_path / "py"))
+    assert len(a) == len(b) == 2
+    for i in range(2):
+        assert len(a[i]["events"]) == rows[i]["events"] > 0
+        assert np.array_equal(a[i]["events"], b[i]["events"])
+        assert a[i]["params"] == b[i]["params"]
