@@ -127,11 +127,12 @@ static PyObject *mod_load(PyObject *mod, PyObject *args)
 static PyObject *mod_demo(PyObject *mod, PyObject *args)
 {
     const char *name;
-    if (!PyArg_ParseTuple(args, "s", &name)) return NULL;
+    unsigned long long seed = 0;
+    if (!PyArg_ParseTuple(args, "s|K", &name, &seed)) return NULL;
     evr_scene *s = NULL;
     evr_error err = {{0}};
     evr_status st;
-    Py_BEGIN_ALLOW_THREADS st = evr_demo_load(name, &s, &err);
+    Py_BEGIN_ALLOW_THREADS st = evr_demo_load_variant(name, (uint64_t)seed, &s, &err);
     Py_END_ALLOW_THREADS if (st != EVR_OK) return raise_status(st, &err);
     return wrap_scene(s);
 }
@@ -535,7 +536,7 @@ static PyObject *mod_version(PyObject *mod, PyObject *unused)
 
 static PyMethodDef module_methods[] = {
     {"load", mod_load, METH_VARARGS, "load(path, animation, strict, allow_external) -> Scene"},
-    {"demo", mod_demo, METH_VARARGS, "demo(name) -> Scene"},
+    {"demo", mod_demo, METH_VARARGS, "demo(name, seed=0) -> Scene"},
     {"demo_names", mod_demo_names, METH_NOARGS, "The built-in scenes' names."},
     {"make_config", mod_make_config, METH_VARARGS, "make_config([(option, value), ...])"},
     {"validate", mod_validate, METH_VARARGS, "validate(scene, config)"},

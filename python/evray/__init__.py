@@ -43,9 +43,12 @@ def load(path, animation=None, strict=False, allow_external_files=False):
     return _evray.load(os.fspath(path), animation, bool(strict), bool(allow_external_files))
 
 
-def demo(name="eye"):
-    """A built-in scene (evray.demo_names() lists them)."""
-    return _evray.demo(name)
+def demo(name="eye", seed=0):
+    """A built-in scene (evray.demo_names() lists them); seed > 0: a variant of it (the eye's gaze
+    plan and iris drawn from the seed, as `evray demo --scene-seed`)."""
+    if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**64:
+        raise ValueError(f"seed must be a whole number from 0 to 2^64 - 1 (got {seed!r})")
+    return _evray.demo(name, seed)
 
 
 def demo_names():

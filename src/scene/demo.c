@@ -69,11 +69,16 @@ evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, siz
 
 evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err)
 {
+    return evr_demo_load_variant(name, 0, out, err);
+}
+
+evr_status evr_demo_load_variant(const char *name, uint64_t seed, evr_scene **out, evr_error *err)
+{
     void *glb = NULL;
     size_t size = 0;
     evr_status st;
     *out = NULL;
-    st = evr_demo_glb(name, &glb, &size, err);
+    st = evr_demo_glb_variant(name, seed, &glb, &size, err);
     if (st != EVR_OK) return st;
     st = evr_scene_load_memory(glb, size, "glb", out, err);
     free(glb);

@@ -223,3 +223,15 @@ def test_dataset(tmp_path):
         assert len(a[i]["events"]) == rows[i]["events"] > 0
         assert np.array_equal(a[i]["events"], b[i]["events"])
         assert a[i]["params"] == b[i]["params"]
+
+
+def test_demo_variants():
+    """evray.demo(name, seed): the eye's variants (as evray demo --scene-seed), refused for a scene
+    without any."""
+    cfg = evray.Config(res=(32, 24), duration=0.3, samples_per_frame=10, no_preview=True)
+    counts = [len(streamed(evray.Simulator(evray.demo("eye", seed=s), cfg))) for s in (0, 0, 9)]
+    assert counts[0] == counts[1] > 0 and counts[2] > 0 and counts[2] != counts[0]
+    with pytest.raises(ValueError, match="no variants"):
+        evray.demo("square", seed=1)
+    with pytest.raises(ValueError):
+        evray.demo("eye", seed=-1)
