@@ -126,8 +126,7 @@ evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, siz
 /* Builds a built-in scene and loads it (through the same importer as any file). */
 evr_status evr_demo_load(const char *name, evr_scene **out, evr_error *err);
 /* The same for a variant (evr_demo_glb_variant). */
-evr_status evr_demo_load_variant(const char *name, uint64_t seed, evr_scene **out,
-                                 evr_error *err);
+evr_status evr_demo_load_variant(const char *name, uint64_t seed, evr_scene **out, evr_error *err);
 void evr_scene_release(evr_scene *s);
 
 /* A human-readable description (cameras, lights, animation clips and whether each plays,
