@@ -189,6 +189,8 @@ def main():
         while time.time() < deadline and len(latest(killed)) < 3:
             time.sleep(0.05)
         time.sleep(0.5)  # clip 3 has started and hangs
+        e = dataset(spec, "-o", killed, expect=1).stderr.strip()
+        T.check("another evray dataset is running" in e, f"a second run into a busy folder: {e!r}")
         os.killpg(p.pid, signal.SIGKILL)
         p.wait()
         before = latest(killed)

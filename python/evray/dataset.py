@@ -44,6 +44,7 @@ specification into DIR skips the clips done and runs the rest (failed, killed or
 import argparse
 import base64
 import concurrent.futures
+import fcntl
 import hashlib
 import json
 import os
@@ -57,6 +58,7 @@ import time
 
 MANIFEST = "manifest.jsonl"
 SPEC_COPY = "dataset.json"
+LOCK = ".evray-dataset.lock"
 SPECIAL = ("camera_path", "light_intensity", "light_offset", "base_color", "textures",
            "scene_seed")
 VARIANT_DEMOS = ("eye", "eye-drift")  # built-in scenes with variants (evr_demo_glb_variant)
@@ -540,6 +542,20 @@ def run(spec, out, scheduler=None, gpus=None, jobs=None, only=None, evray=None, 
         raise DatasetError("no evray program found: pass evray=PATH (or --evray), or put it on PATH")
     out = os.path.abspath(out)
     os.makedirs(out, exist_ok=True)
+    lock = open(os.path.join(out, LOCK), "w")  # held until this run ends (closed or exited)
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        lock.close()
+        raise DatasetError(f"another evray dataset is running into {out}")
+    try:
+        return run_locked(spec, out, scheduler, gpus, jobs, only, evray, progress, backend,
+                          per_gpu)
+    finally:
+        lock.close()
+
+
+def run_locked(spec, out, scheduler, gpus, jobs, only, evray, progress, backend, per_gpu):
     public = {k: v for k, v in spec.items() if not k.startswith("_")}
     copy = os.path.join(out, SPEC_COPY)
     if os.path.exists(copy):
