@@ -774,6 +774,11 @@ def main(argv=None):
               file=sys.stderr)
         return 130
     failed = [r for r in rows if r["status"] != "done"]
+    out = os.path.abspath(a.out)
+    done = [r for k, r in read_manifest(out).items() if k < spec["clips"] and clip_done(out, r)]
+    print(f"evray dataset: {len(done)} of {spec['clips']} clips done ({len(rows) - len(failed)} in "
+          f"this run), {sum(r.get('events', 0) for r in done):,} events, in {a.out}",
+          file=sys.stderr)
     if failed:
         print(f"evray dataset: {len(failed)} of {len(rows)} clips failed (manifest.jsonl says why); "
               "run the same command again to retry them", file=sys.stderr)
