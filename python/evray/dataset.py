@@ -244,7 +244,13 @@ def clip_params(spec, k):
 
 def read_gltf(path):
     """(json dict, bin bytes or None, is_glb)."""
-    data = open(path, "rb").read()
+    try:
+        return parse_gltf(path, open(path, "rb").read())
+    except (ValueError, struct.error, UnicodeDecodeError) as e:
+        raise DatasetError(f"{path}: not a glTF file evray dataset can edit ({e})")
+
+
+def parse_gltf(path, data):
     if data[:4] == b"glTF":
         if len(data) < 20:
             raise DatasetError(f"{path}: a truncated GLB")
@@ -431,8 +437,8 @@ def run_clip(job):
         row["events"] = int(info["stats"]["events"])
         row["backend"] = info.get("backend")
         row["status"] = "done"
-    except (DatasetError, OSError, ValueError, KeyError) as e:
-        row["error"] = str(e)
+    except Exception as e:  # a clip that fails (its scene unreadable, ...) fails alone
+        row["error"] = str(e) if isinstance(e, DatasetError) else f"{type(e).__name__}: {e}"
     row["wall_s"] = round(time.time() - t0, 3)
     return row
 
