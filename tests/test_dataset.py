@@ -237,6 +237,15 @@ def main():
             json.dump(bad, open(path, "w"))
             e = dataset(path, "-o", os.path.join(tmp, "bad"), expect=1).stderr.strip()
             T.check(len(e.splitlines()) == 1 and what in e, f"a bad specification: {e!r}")
+        with open(os.path.join(tmp, "bad.glb"), "wb") as f:  # a GLB whose JSON is cut short
+            f.write(b"glTF" + struct.pack("<III", 2, 32, 4) + b"JSON" + b'{"a')
+        json.dump(dict(SPEC, clips=2, scenes=[{"file": "bad.glb"}]),
+                  open(os.path.join(tmp, "badscene.json"), "w"))
+        dataset(os.path.join(tmp, "badscene.json"), "-o", os.path.join(tmp, "badscene"), expect=1)
+        rows = latest(os.path.join(tmp, "badscene"))
+        T.check(sorted(rows) == [0, 1] and all(r["status"] == "failed" and "not a glTF file" in
+                                               r["error"] for r in rows.values()),
+                f"an unreadable scene fails each clip with its reason: {rows}")
         other = os.path.join(tmp, "other.json")
         json.dump(dict(SPEC, seed=12), open(other, "w"))
         e = dataset(other, "-o", full, expect=1).stderr.strip()
