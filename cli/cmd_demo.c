@@ -76,10 +76,7 @@ int cmd_demo(int argc, char **argv)
             }
         } else if (opt_is(argv[i], "--scene-seed")) {
             const char *v = opt_value(argc, argv, &i, "--scene-seed");
-            char *end = NULL;
-            if (v) seed = strtoull(v, &end, 10);
-            if (!v || !end || *end || !*v || v[0] == '-') {
-                if (v) cli_error("--scene-seed needs a whole number from 0 (got '%s')", v);
+            if (!v || !opt_u64("--scene-seed", v, &seed)) {
                 free(rest);
                 return 2;
             }

@@ -246,6 +246,16 @@ def main():
         T.check(sorted(rows) == [0, 1] and all(r["status"] == "failed" and "not a glTF file" in
                                                r["error"] for r in rows.values()),
                 f"an unreadable scene fails each clip with its reason: {rows}")
+        for args, rc, what in [(["--scene", "eye", "--scene-seed", "-3"], 2, "non-negative integer"),
+                               (["--scene", "eye", "--scene-seed", "1" + "0" * 20], 2,
+                                "non-negative integer"),
+                               (["--scene", "square", "--scene-seed", "3"], 1,
+                                "no variants; the scenes with variants are: eye eye-drift")]:
+            p = subprocess.run([T.EVRAY, "demo", *args, "--export", os.path.join(tmp, "v.glb")],
+                               capture_output=True, text=True)
+            T.check(p.returncode == rc and what in p.stderr and len(p.stderr.splitlines()) == 1
+                    and not os.path.exists(os.path.join(tmp, "v.glb")),
+                    f"evray demo {' '.join(args)}: exit {p.returncode}, {p.stderr.strip()!r}")
         other = os.path.join(tmp, "other.json")
         json.dump(dict(SPEC, seed=12), open(other, "w"))
         e = dataset(other, "-o", full, expect=1).stderr.strip()

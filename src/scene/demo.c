@@ -51,8 +51,12 @@ evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, siz
         return EVR_ERR_ARG;
     }
     if (seed && !demos[i].varies) {
-        snprintf(err->msg, sizeof err->msg,
-                 "demo %s has no variants: a scene seed is for eye and eye-drift", demos[i].name);
+        size_t n = (size_t)snprintf(
+            err->msg, sizeof err->msg,
+            "demo %s has no variants; the scenes with variants are:", demos[i].name);
+        for (size_t k = 0; k < sizeof demos / sizeof demos[0] && n < sizeof err->msg; k++)
+            if (demos[k].varies)
+                n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demos[k].name);
         return EVR_ERR_ARG;
     }
     g = evr_gltf_new(demos[i].name);
