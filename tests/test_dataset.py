@@ -15,9 +15,9 @@ import tempfile
 import time
 
 import struct
-import zlib
 
 import evrtest as T
+import gltf_build
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 RUNNER = os.path.join(ROOT, "python", "evray", "dataset.py")
@@ -32,16 +32,6 @@ SPEC = {
              "light_intensity": [0.5, 2.0], "light_offset": 0.002, "base_color": 0.2,
              "scene_seed": True},
 }
-
-
-def png(path, rgb):
-    """A 4x4 PNG of one colour."""
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-    rows = b"".join(b"\0" + bytes(rgb) * 4 for _ in range(4))
-    with open(path, "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 4, 8, 2, 0, 0, 0)) +
-                chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
 def slow_evray(tmp, evray):
@@ -161,7 +151,8 @@ def main():
                                         if n in moved for a, b in zip(n0.get("translation", [0] * 3),
                                                                       n["translation"])),
                     f"clip {p['clip']}: lights moved by at most 0.002")
-        png(os.path.join(tmp, "blue.png"), (40, 60, 200))
+        with open(os.path.join(tmp, "blue.png"), "wb") as f:
+            f.write(gltf_build.png_bytes(4, 4, [(40, 60, 200)] * 16, channels=3))
         swap = dict(SPEC, clips=1, scenes=[{"demo": "eye"}], vary={"textures": {"iris_texture":
                                                                               ["blue.png"]}})
         json.dump(swap, open(os.path.join(tmp, "swap.json"), "w"))
@@ -171,6 +162,35 @@ def main():
         T.check(len(iris) == 1 and iris[0].get("uri", "").startswith("data:image/png;base64,")
                 and latest(os.path.join(tmp, "swap"))[0]["status"] == "done",
                 "the iris texture swapped for a file's, and the clip rendered")
+        # scene files with edits: a GLB and the same scene as .gltf with its buffer beside it (the
+        # edited copy points at that buffer and may read it) give the same events
+        os.makedirs(os.path.join(tmp, "ext"))
+        sq = os.path.join(tmp, "ext", "sq.glb")
+        subprocess.run([T.EVRAY, "demo", "--scene", "square", "--export", sq], capture_output=True,
+                       check=True)
+        doc, binary, _ = mod.read_gltf(sq)
+        open(os.path.join(tmp, "ext", "sq.bin"), "wb").write(binary)
+        doc["buffers"][0]["uri"] = "sq.bin"
+        json.dump(doc, open(os.path.join(tmp, "ext", "sq.gltf"), "w"))
+        events = {}
+        for name in ("sq.glb", "sq.gltf"):
+            d = os.path.join(tmp, "file-" + name)
+            json.dump(dict(SPEC, clips=1, scenes=[{"file": "ext/" + name}],
+                           vary={"base_color": 0.2, "light_intensity": [0.5, 2.0]}),
+                      open(d + ".json", "w"))
+            dataset(d + ".json", "-o", d)
+            r = latest(d)[0]
+            T.check(r["status"] == "done" and r["events"] > 0, f"{name} with edits renders: {r}")
+            events[name] = mod.EventDataset(d, event_file="events.npy")[0]["events"]
+            if name == "sq.gltf":
+                copy = json.load(open(os.path.join(d, "scenes", "00000.gltf")))
+                T.check(os.path.normpath(os.path.join(d, "scenes", copy["buffers"][0]["uri"])) ==
+                        os.path.join(tmp, "ext", "sq.bin") and
+                        "--allow-external-files" in r["command"],
+                        "the edited .gltf points at its buffer where it lies and may read it")
+        T.check(len(events["sq.glb"]) > 0 and
+                (events["sq.glb"].tobytes() == events["sq.gltf"].tobytes()),
+                "the same scene as GLB and as .gltf, edited alike, gives the same events")
         json.dump(dict(swap, vary={"textures": {"no_such_image": ["blue.png"]}}),
                   open(os.path.join(tmp, "swap2.json"), "w"))
         dataset(os.path.join(tmp, "swap2.json"), "-o", os.path.join(tmp, "swap2"), expect=1)

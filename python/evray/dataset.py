@@ -322,14 +322,16 @@ def apply_edits(doc, edits, spec_dir, where):
             im["uri"] = f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
 
 
-def absolute_uris(doc, folder):
-    """A .gltf's relative buffer and image URIs made absolute (its copy lives elsewhere)."""
+def moved_uris(doc, src_folder, dst_folder):
+    """A .gltf's buffer and image URIs, relative to src_folder, made relative to dst_folder, where
+    its edited copy lives (glTF URIs are relative references, not file system paths)."""
+    from urllib.parse import quote, unquote
     for key in ("buffers", "images"):
         for item in doc.get(key, []):
             uri = item.get("uri")
-            if uri and not uri.startswith("data:") and not os.path.isabs(uri):
-                from urllib.parse import unquote
-                item["uri"] = os.path.join(folder, unquote(uri))
+            if uri and not uri.startswith("data:"):
+                target = os.path.join(src_folder, unquote(uri))
+                item["uri"] = quote(os.path.relpath(target, dst_folder))
 
 
 # ---- one clip ----
@@ -351,10 +353,10 @@ def in_dataset(out, path):
 
 
 def prepare_scene(job):
-    """The clip's scene file (exported and edited as its parameters say) and extra options."""
+    """The clip's scene file (a built-in scene exported, then edited as its parameters say) and
+    the extra options it needs."""
     p, out, evray = job["params"], job["out"], job["evray"]
     scene, edits, k = p["scene"], p["edits"], p["clip"]
-    extra = []
     os.makedirs(os.path.join(out, "scenes"), exist_ok=True)
     dst = scene_path(out, k)
     if "demo" in scene:
@@ -364,29 +366,25 @@ def prepare_scene(job):
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             raise DatasetError((r.stderr.strip() or r.stdout.strip()).splitlines()[-1])
-        if not edits:
-            return dst, extra
-        doc, binary, _ = read_gltf(dst)
-        apply_edits(doc, edits, job["spec_dir"], f"clip {k}")
-        write_glb(dst, doc, binary)
-        return dst, extra
-    src = os.path.join(job["spec_dir"], scene["file"])
-    if not os.path.exists(src):
-        raise DatasetError(f"clip {k}: no scene file {src}")
+        src = dst
+    else:
+        src = os.path.join(job["spec_dir"], scene["file"])
+        if not os.path.exists(src):
+            raise DatasetError(f"clip {k}: no scene file {src}")
     if not edits:
-        return src, extra
+        return src, []
     doc, binary, glb = read_gltf(src)
     apply_edits(doc, edits, job["spec_dir"], f"clip {k}")
-    if not glb:  # its buffers and images stay where they are
-        absolute_uris(doc, os.path.dirname(os.path.abspath(src)))
-        dst = dst[:-4] + ".gltf"
-        with open(dst + ".tmp", "w", encoding="utf-8") as f:
-            json.dump(doc, f)
-        os.replace(dst + ".tmp", dst)
-        extra.append("--allow-external-files")
-        return dst, extra
-    write_glb(dst, doc, binary)
-    return dst, extra
+    if glb:
+        write_glb(dst, doc, binary)
+        return dst, []
+    # a .gltf: its buffers and images stay where they are
+    moved_uris(doc, os.path.dirname(os.path.abspath(src)), os.path.dirname(dst))
+    dst = dst[:-4] + ".gltf"
+    with open(dst + ".tmp", "w", encoding="utf-8") as f:
+        json.dump(doc, f)
+    os.replace(dst + ".tmp", dst)
+    return dst, ["--allow-external-files"]
 
 
 def render_command(job, scene_file, extra):
