@@ -101,7 +101,7 @@ def main():
         # the whole dataset on this machine's cores
         full = os.path.join(tmp, "full")
         t0 = time.time()
-        dataset(spec, "-o", full)
+        e = dataset(spec, "-o", full).stderr.strip().splitlines()
         rows = latest(full)
         T.check(sorted(rows) == list(range(6)) and all(r["status"] == "done" for r in rows.values()),
                 f"a complete manifest: {[(k, r['status'], r.get('error')) for k, r in rows.items()]}")
@@ -115,8 +115,13 @@ def main():
                     f"clip {k}: its row holds its parameters and wall time")
         print(f"test_dataset: 6 clips in {time.time() - t0:.1f} s, "
               f"{sum(r['events'] for r in rows.values()):,} events")
+        total = sum(r["events"] for r in rows.values())
+        T.check(e[-1] == f"evray dataset: 6 of 6 clips done (6 in this run), {total:,} events, "
+                f"in {full}", f"the closing line: {e[-1]!r}")
         n_rows = len(manifest(full))
-        dataset(spec, "-o", full)
+        e = dataset(spec, "-o", full).stderr.strip().splitlines()
+        T.check(e[-1].startswith("evray dataset: 6 of 6 clips done (0 in this run)"),
+                f"the closing line of a run with nothing left: {e[-1]!r}")
         T.check(len(manifest(full)) == n_rows, "a second run of a finished dataset runs nothing")
         # the scenes differ as drawn: two eye clips with different gaze plans
         glbs = [open(os.path.join(full, "scenes", f"{p['clip']:05d}.glb"), "rb").read()
