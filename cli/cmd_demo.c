@@ -49,17 +49,23 @@ int cmd_demo(int argc, char **argv)
                 "as a binary glTF file that any glTF reader (and evray render) loads.\n\n"
                 "  --scene NAME    built-in scene (default eye)\n"
                 "  --scene-seed N  a variant of the scene, drawn from N (0, the default: the scene\n"
-                "                  itself); eye and eye-drift: the gaze plan and the iris\n"
+                "                  itself; the eye's variants: its gaze plan and its iris)\n"
                 "  --export FILE   write the scene as glTF 2.0 binary and exit\n"
-                "  --list          list the built-in scenes\n");
+                "  --list          list the built-in scenes\n"
+                "  --list-variants list the scenes that take --scene-seed\n");
             fputs("scenes:", stdout);
             for (j = 0; names[j]; j++) printf(" %s", names[j]);
+            fputs("\nwith variants:", stdout);
+            for (j = 0; names[j]; j++)
+                if (evr_demo_has_variants(names[j])) printf(" %s", names[j]);
             fputs("\n", stdout);
             return 0;
         }
-        if (!strcmp(argv[i], "--list")) {
+        if (!strcmp(argv[i], "--list") || !strcmp(argv[i], "--list-variants")) {
             const char *const *names = evr_demo_names();
-            for (j = 0; names[j]; j++) puts(names[j]);
+            int variants_only = !strcmp(argv[i], "--list-variants");
+            for (j = 0; names[j]; j++)
+                if (!variants_only || evr_demo_has_variants(names[j])) puts(names[j]);
             return 0;
         }
     }

@@ -116,6 +116,8 @@ typedef struct {
 const evr_load_times *evr_scene_load_times(const evr_scene *s);
 /* Names of the built-in scenes, NULL-terminated. */
 const char *const *evr_demo_names(void);
+/* 1 if the built-in scene takes a seed (evr_demo_glb_variant), 0 if not or unknown. */
+int evr_demo_has_variants(const char *name);
 /* Builds a built-in scene as a binary glTF (GLB) in memory; free *glb with free(). */
 evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err);
 /* The same for a variant of the scene: seed 0 is the scene itself; any other seed draws what the

@@ -281,6 +281,17 @@ def main():
             T.check(p.returncode == rc and what in p.stderr and len(p.stderr.splitlines()) == 1
                     and not os.path.exists(os.path.join(tmp, "v.glb")),
                     f"evray demo {' '.join(args)}: exit {p.returncode}, {p.stderr.strip()!r}")
+        p = subprocess.run([T.EVRAY, "demo", "--list-variants"], capture_output=True, text=True)
+        T.check(p.returncode == 0 and p.stdout.split() == ["eye", "eye-drift"],
+                f"evray demo --list-variants: {p.stdout!r}")
+        mixed = os.path.join(tmp, "mixed.json")  # a scene seed reaches only the scenes that vary
+        json.dump({"clips": 12, "seed": 5, "scenes": [{"demo": "eye"}, {"demo": "square"}],
+                   "vary": {"scene_seed": True}}, open(mixed, "w"))
+        p = dataset(mixed, "-o", os.path.join(tmp, "mixed"), "--list")
+        clips = [json.loads(line) for line in p.stdout.splitlines()]
+        kinds = {(c["scene"]["demo"], "seed" in c["scene"]) for c in clips}
+        T.check(len(clips) == 12 and kinds == {("eye", True), ("square", False)},
+                f"scene_seed on eye and square clips: {sorted(kinds)}")
         other = os.path.join(tmp, "other.json")
         json.dump(dict(SPEC, seed=12), open(other, "w"))
         e = dataset(other, "-o", full, expect=1).stderr.strip()

@@ -440,6 +440,9 @@ int main(void)
     CHECK(names != NULL);
     for (k = 0; names && names[k]; k++) count++;
     CHECK(count == (int)(sizeof expected / sizeof expected[0]));
+    CHECK(evr_demo_has_variants("eye") == 1 && evr_demo_has_variants("eye-drift") == 1);
+    CHECK(evr_demo_has_variants("square") == 0 && evr_demo_has_variants("city") == 0);
+    CHECK(evr_demo_has_variants("no-such-scene") == 0 && evr_demo_has_variants(NULL) == 0);
 
     for (i = 0; i < sizeof expected / sizeof expected[0]; i++) {
         const expectation *e = &expected[i];

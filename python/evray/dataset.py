@@ -61,7 +61,6 @@ SPEC_COPY = "dataset.json"
 LOCK = ".evray-dataset.lock"
 SPECIAL = ("camera_path", "light_intensity", "light_offset", "base_color", "textures",
            "scene_seed")
-VARIANT_DEMOS = ("eye", "eye-drift")  # built-in scenes with variants (evr_demo_glb_variant)
 
 
 class DatasetError(Exception):
@@ -195,8 +194,32 @@ def camera_path(rng, v, seed, where):
     return path
 
 
-def clip_params(spec, k):
-    """Everything clip k draws, from the master seed and k alone: a JSON-able dict."""
+def find_evray(evray=None):
+    evray = evray or os.environ.get("EVRAY") or shutil.which("evray")
+    if not evray:
+        raise DatasetError("no evray program found: pass evray=PATH (or --evray), or put it on PATH")
+    return evray
+
+
+def variant_demos(spec, evray):
+    """The spec's built-in scenes that take a scene seed, as the program says (none are asked
+    for when nothing varies scene_seed)."""
+    if not spec.get("vary", {}).get("scene_seed") or \
+            not any("demo" in s for s in spec["scenes"]):
+        return frozenset()
+    try:
+        p = subprocess.run([evray, "demo", "--list-variants"], capture_output=True, text=True)
+    except OSError as e:
+        raise DatasetError(f"cannot run {evray}: {e.strerror}")
+    if p.returncode != 0:
+        raise DatasetError(f"{evray} demo --list-variants: exit {p.returncode}: "
+                           f"{p.stderr.strip()[-300:]}")
+    return frozenset(p.stdout.split())
+
+
+def clip_params(spec, k, variants=frozenset()):
+    """Everything clip k draws, from the master seed and k alone: a JSON-able dict. variants: the
+    built-in scenes that take a scene seed (variant_demos)."""
     seed = clip_seed(spec.get("seed", 0), k)
     rng = random.Random(seed)
     scenes = spec["scenes"]
@@ -231,7 +254,7 @@ def clip_params(spec, k):
             edits["textures"] = {img: draw_value(rng, files, f"{where}.{img}")
                                  for img, files in sorted(v.items())}
         elif name == "scene_seed":
-            if v and scene.get("demo") in VARIANT_DEMOS:
+            if v and scene.get("demo") in variants:
                 scene["seed"] = 1 + seed % (2**63 - 1)
         else:
             options[name.replace("_", "-")] = draw_value(rng, v, where)
@@ -541,9 +564,7 @@ def run(spec, out, scheduler=None, gpus=None, jobs=None, only=None, evray=None, 
     only: clip indices to run (remade even when done). per_gpu: clips at once on each GPU."""
     if isinstance(spec, str):
         spec = load_spec(spec)
-    evray = evray or os.environ.get("EVRAY") or shutil.which("evray")
-    if not evray:
-        raise DatasetError("no evray program found: pass evray=PATH (or --evray), or put it on PATH")
+    evray = find_evray(evray)
     out = os.path.abspath(out)
     os.makedirs(out, exist_ok=True)
     lock = open(os.path.join(out, LOCK), "w")  # held until this run ends (closed or exited)
@@ -585,7 +606,8 @@ def run_locked(spec, out, scheduler, gpus, jobs, only, evray, progress, backend,
     base = {"out": out, "evray": os.path.abspath(evray), "spec_dir": spec["_dir"],
             "format": spec.get("format", "h5"), "labels_fps": spec.get("labels_fps"),
             "options": spec.get("options", {})}
-    jobs_list = [dict(base, params=clip_params(spec, k)) for k in todo]
+    variants = variant_demos(spec, evray)
+    jobs_list = [dict(base, params=clip_params(spec, k, variants)) for k in todo]
     prog = Progress(len(todo) + done_before, done_before, events_before) if progress else None
     manifest = Manifest(out)
     finished = []
@@ -765,8 +787,9 @@ def main(argv=None):
             except ValueError:
                 raise DatasetError(f"--only takes clip indices K[,K...] (got '{a.only}')")
         if a.list:
+            variants = variant_demos(spec, find_evray(a.evray))
             for k in (only if only is not None else range(spec["clips"])):
-                print(json.dumps(clip_params(spec, k), sort_keys=True))
+                print(json.dumps(clip_params(spec, k, variants), sort_keys=True))
             return 0
         rows = run(spec, a.out, scheduler=a.scheduler, gpus=a.gpus, jobs=a.jobs, only=only,
                    evray=a.evray, backend=a.backend, per_gpu=a.per_gpu)

@@ -8,23 +8,37 @@
 #include "core/motion.h"
 #include "scene/demo_scenes.h"
 
+/* name, builder, whether the builder reads evr_gltf_variant (takes a seed) */
+#define EVR_DEMO_TABLE(X)                               \
+    X("eye", evr_demo_build_eye, 1)                     \
+    X("eye-drift", evr_demo_build_eye_drift, 1)         \
+    X("square", evr_demo_build_square, 0)               \
+    X("disk", evr_demo_build_disk, 0)                   \
+    X("cornell", evr_demo_build_cornell, 0)             \
+    X("cornell-still", evr_demo_build_cornell_still, 0) \
+    X("city", evr_demo_build_city, 0)                   \
+    X("blink", evr_demo_build_blink, 0)
+
 typedef struct {
     const char *name;
     void (*build)(evr_gltf *g);
-    int varies; /* its builder reads evr_gltf_variant */
+    int varies;
 } demo_entry;
 
-static const demo_entry demos[] = {
-    {"eye", evr_demo_build_eye, 1},         {"eye-drift", evr_demo_build_eye_drift, 1},
-    {"square", evr_demo_build_square, 0},   {"disk", evr_demo_build_disk, 0},
-    {"cornell", evr_demo_build_cornell, 0}, {"cornell-still", evr_demo_build_cornell_still, 0},
-    {"city", evr_demo_build_city, 0},       {"blink", evr_demo_build_blink, 0},
-};
-
-static const char *const demo_names[] = {"eye",           "eye-drift", "square", "disk", "cornell",
-                                         "cornell-still", "city",      "blink",  NULL};
+#define EVR_DEMO_ENTRY(name, build, varies) {name, build, varies},
+#define EVR_DEMO_NAME(name, build, varies) name,
+static const demo_entry demos[] = {EVR_DEMO_TABLE(EVR_DEMO_ENTRY)};
+static const char *const demo_names[] = {EVR_DEMO_TABLE(EVR_DEMO_NAME) NULL};
+#define NUM_DEMOS (sizeof demos / sizeof demos[0])
 
 const char *const *evr_demo_names(void) { return demo_names; }
+
+int evr_demo_has_variants(const char *name)
+{
+    for (size_t i = 0; name && i < NUM_DEMOS; i++)
+        if (strcmp(name, demos[i].name) == 0) return demos[i].varies;
+    return 0;
+}
 
 evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err)
 {
@@ -39,9 +53,9 @@ evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, siz
     evr_status st;
     *glb = NULL;
     *size = 0;
-    for (i = 0; i < sizeof demos / sizeof demos[0]; i++)
+    for (i = 0; i < NUM_DEMOS; i++)
         if (name && strcmp(name, demos[i].name) == 0) break;
-    if (i == sizeof demos / sizeof demos[0]) {
+    if (i == NUM_DEMOS) {
         size_t n = 0, k;
         n += (size_t)snprintf(
             err->msg, sizeof err->msg,
@@ -54,7 +68,7 @@ evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, siz
         size_t n = (size_t)snprintf(
             err->msg, sizeof err->msg,
             "demo %s has no variants; the scenes with variants are:", demos[i].name);
-        for (size_t k = 0; k < sizeof demos / sizeof demos[0] && n < sizeof err->msg; k++)
+        for (size_t k = 0; k < NUM_DEMOS && n < sizeof err->msg; k++)
             if (demos[k].varies)
                 n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demos[k].name);
         return EVR_ERR_ARG;
