@@ -66,6 +66,10 @@ typedef struct {
     int collected;                        /* the slot collected last, -1: none yet */
     unsigned long long done_counts[2][4]; /* samples, rays, samples traced, pixels skipped */
     int head, queued;
+    /* the packets' context flags: coherent (Embree's frustum traversal, faster for neighbouring
+     * pixels), or incoherent under the hidden EVR_EMBREE_INCOHERENT (scripts/valgrind-eye.sh:
+     * Embree 3.13's coherent traversal branches on values it leaves unset on its own stack) */
+    enum RTCIntersectContextFlags packet_flags;
     char embree_error[256];
     /* per-segment work */
     const evr_segment *seg;
@@ -154,7 +158,7 @@ static void primary_packet8(const cpu_backend *b, const evr_m34 *pose_static, co
     _Alignas(32) int vmask[PACKET]; /* Embree reads the valid mask with aligned vector loads */
     int i;
     rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    ctx.flags = b->packet_flags;
     for (i = 0; i < PACKET; i++) {
         evr_m34 pose = pose_static ? *pose_static : evr_rs_camera_pose(rs, fs[i]);
         ray[i] = evr_camera_ray(&rs->camera, &pose, (float)xs[i] + 0.5f, (float)ys[i] + 0.5f);
@@ -200,7 +204,7 @@ static void sample_intensity8_rows(const cpu_backend *b, const evr_m34 *pose_sta
     _Alignas(32) int vmask[PACKET]; /* Embree reads the valid mask with aligned vector loads */
     int hit[PACKET], inst_of[PACKET], i, l;
     rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    ctx.flags = b->packet_flags;
     primary_packet8(b, pose_static, xs, ys, fs, valid, ray, &rh, rays);
     for (i = 0; i < PACKET; i++) {
         out[i] = 0.0f; /* nothing: black */
@@ -1246,6 +1250,8 @@ evr_status evr_cpu_backend_new(const evr_scene *s, const evr_render_host *h,
     b->base.collect = cpu_collect;
     b->base.release = cpu_release;
     b->base.label_hits = cpu_label_hits;
+    b->packet_flags = getenv("EVR_EMBREE_INCOHERENT") ? RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT
+                                                      : RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     b->collected = -1;
     b->scene = s;
     b->host = *h;
