@@ -3,8 +3,9 @@
  * 1/30 s through the writer thread (run/write_queue.h, flushing once a second), then finished.
  * Not a test: docs/benchmarks.md ("Writers") quotes it.
  *
- *   build/tests/bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids]
+ *   build/tests/bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids|noids] [BATCH]
  *
+ * BATCH: events a push (default a segment's, 233,333; a GPU run pushes pieces of up to 1,048,576).
  * With "ids", the events carry event ids as the eye's do (evr_writer_meta.event_ids): a few
  * instances, each covering a band of the image.
  * Prints the wall time from the first push to the last finish, the writer thread's busy time and
@@ -44,7 +45,7 @@ int main(int argc, char **argv)
     const size_t n = argc > 2 ? (size_t)strtoull(argv[2], NULL, 10) : 20000000;
     const char *dir = argc > 3 ? argv[3] : "/tmp";
     const int ids = argc > 4 && strcmp(argv[4], "ids") == 0;
-    const size_t seg = RATE * 1000000 / 30;
+    const size_t seg = argc > 5 ? (size_t)strtoull(argv[5], NULL, 10) : RATE * 1000000 / 30;
     evr_event_writer *ws[EVR_WRITE_QUEUE_MAX_WRITERS];
     char paths[EVR_WRITE_QUEUE_MAX_WRITERS][512];
     int formats = 0, count, nw = 0;
@@ -53,8 +54,9 @@ int main(int argc, char **argv)
     evr_write_queue *q = NULL;
     uint64_t s = 7;
     evr_event *ev;
-    if (argc < 2 || n == 0) {
-        fprintf(stderr, "usage: bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids]\n");
+    if (argc < 2 || n == 0 || seg == 0) {
+        fprintf(stderr,
+                "usage: bench_writers FORMAT[,FORMAT...]|all [EVENTS] [DIR] [ids|noids] [BATCH]\n");
         return 2;
     }
     if (evr_event_formats_parse("bench_writers", argv[1], &formats, &err) != EVR_OK)

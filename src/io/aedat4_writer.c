@@ -43,15 +43,19 @@
 /* ZSTD's level for --format aedat4-zstd: one of its fast levels, so that the writer keeps up
  * with the GPU while the file stays well below LZ4's (docs/benchmarks.md, "Writers") */
 #define ZSTD_LEVEL (-3)
-/* ZSTD contexts kept for reuse: one per compressing thread (the pool's and the caller) */
-#define ZSTD_SLOTS (COMPRESS_THREADS + 1)
+/* What a compressing thread packs with, kept for reuse: one per thread (the pool's and the caller) */
+#define PACK_SLOTS (COMPRESS_THREADS + 1)
+#define RAW_BYTES (EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * PACKET_MAX_EVENTS)
 
-/* ZSTD contexts, each taken by one thread at a time: a fresh context per packet allocated and
- * cleared its tables every millisecond of events. */
+/* Room for one uncompressed EventPacket and, with ZSTD, a context, each slot taken by one thread
+ * at a time: a fresh room per part of a write (512 KB, allocated and freed) cost page faults at
+ * every write, and a fresh ZSTD context per packet allocated and cleared its tables every
+ * millisecond of events. */
 typedef struct {
-    atomic_int taken[ZSTD_SLOTS];
-    ZSTD_CCtx *cctx[ZSTD_SLOTS];
-} zstd_contexts;
+    atomic_int taken[PACK_SLOTS];
+    ZSTD_CCtx *cctx[PACK_SLOTS];
+    unsigned char *raw[PACK_SLOTS];
+} pack_slots;
 
 typedef struct {
     int64_t offset; /* the packet's compressed bytes */
@@ -78,7 +82,7 @@ typedef struct {
     size_t cap_starts;
     unsigned char *buf; /* the data table, built then compressed */
     size_t cap_buf;
-    zstd_contexts *zstd; /* with ZSTD compression */
+    pack_slots *slots;
 } aedat_writer;
 
 /* The packets of a large write, for the parallel parts: packet q is ev[start[q] .. start[q + 1]). */
@@ -241,35 +245,57 @@ static size_t frame_bound(const aedat_writer *w, size_t len)
                                              : LZ4F_compressFrameBound(len, &w->lz4);
 }
 
-/* ZSTD's frame of src[0 .. len) at dst in a free context of z (made at its first use). */
-static size_t zstd_frame(zstd_contexts *z, unsigned char *dst, size_t room,
-                         const unsigned char *src, size_t len)
+/* A free slot of z (taken until slot_give), or -1 when more threads than slots pack. */
+static int slot_take(pack_slots *z)
 {
-    for (int i = 0; i < ZSTD_SLOTS; i++) {
-        if (atomic_exchange(&z->taken[i], 1)) continue;
-        if (!z->cctx[i]) z->cctx[i] = ZSTD_createCCtx();
-        const size_t c = z->cctx[i] ? ZSTD_compressCCtx(z->cctx[i], dst, room, src, len, ZSTD_LEVEL)
-                                    : ZSTD_compress(dst, room, src, len, ZSTD_LEVEL);
-        atomic_store(&z->taken[i], 0);
-        return c;
-    }
-    return ZSTD_compress(dst, room, src, len, ZSTD_LEVEL); /* more threads than slots */
+    for (int i = 0; i < PACK_SLOTS; i++)
+        if (!atomic_exchange(&z->taken[i], 1)) return i;
+    return -1;
 }
 
-static void zstd_contexts_free(zstd_contexts *z)
+static void slot_give(pack_slots *z, int i)
+{
+    if (i >= 0) atomic_store(&z->taken[i], 0);
+}
+
+/* Slot i's ZSTD context, made at its first use (NULL: no memory). */
+static ZSTD_CCtx *slot_cctx(pack_slots *z, int i)
+{
+    if (i >= 0 && !z->cctx[i]) z->cctx[i] = ZSTD_createCCtx();
+    return i >= 0 ? z->cctx[i] : NULL;
+}
+
+/* ZSTD's frame of src[0 .. len) at dst, in cctx (NULL: a context of its own). */
+static size_t zstd_frame(ZSTD_CCtx *cctx, unsigned char *dst, size_t room, const unsigned char *src,
+                         size_t len)
+{
+    return cctx ? ZSTD_compressCCtx(cctx, dst, room, src, len, ZSTD_LEVEL)
+                : ZSTD_compress(dst, room, src, len, ZSTD_LEVEL);
+}
+
+static void pack_slots_free(pack_slots *z)
 {
     if (!z) return;
-    for (int i = 0; i < ZSTD_SLOTS; i++) ZSTD_freeCCtx(z->cctx[i]);
+    for (int i = 0; i < PACK_SLOTS; i++) {
+        ZSTD_freeCCtx(z->cctx[i]);
+        free(z->raw[i]);
+    }
     free(z);
 }
 
-/* The frame of src[0 .. len) at dst (room bytes); its bytes, 0 when the compressor failed. */
-static size_t frame(const aedat_writer *w, unsigned char *dst, size_t room,
+/* The frame of src[0 .. len) at dst (room bytes), with ZSTD in cctx (NULL: a free slot's, or a
+ * context of its own); its bytes, 0 when the compressor failed. */
+static size_t frame(const aedat_writer *w, ZSTD_CCtx *cctx, unsigned char *dst, size_t room,
                     const unsigned char *src, size_t len)
 {
     size_t c;
     if (w->compression == EVR_AEDAT4_ZSTD) {
-        c = zstd_frame(w->zstd, dst, room, src, len);
+        if (cctx) c = zstd_frame(cctx, dst, room, src, len);
+        else {
+            const int i = slot_take(w->slots);
+            c = zstd_frame(slot_cctx(w->slots, i), dst, room, src, len);
+            slot_give(w->slots, i);
+        }
         return ZSTD_isError(c) ? 0 : c;
     }
     c = LZ4F_compressFrame(dst, room, src, len, &w->lz4);
@@ -284,11 +310,11 @@ static size_t packet_bound(const aedat_writer *w, size_t n)
 
 /* Compresses the EventPacket of ev[0 .. n) (built in raw) to a PacketHeader and a frame at out;
  * returns the frame's bytes, 0 when the compressor failed. */
-static size_t pack_packet(const aedat_writer *w, unsigned char *raw, const evr_event *ev, size_t n,
-                          unsigned char *out, size_t room)
+static size_t pack_packet(const aedat_writer *w, ZSTD_CCtx *cctx, unsigned char *raw,
+                          const evr_event *ev, size_t n, unsigned char *out, size_t room)
 {
     const size_t len = event_packet(raw, ev, n);
-    const size_t c = frame(w, out + PACKET_HEADER, room - PACKET_HEADER, raw, len);
+    const size_t c = frame(w, cctx, out + PACKET_HEADER, room - PACKET_HEADER, raw, len);
     if (c == 0 || c > INT32_MAX) return 0;
     evr_put_le32(out, 0);
     evr_put_le32(out + 4, (uint32_t)c);
@@ -321,7 +347,7 @@ static evr_status put_packet(aedat_writer *w, const evr_event *ev, size_t n, evr
     const size_t need = packet_bound(w, n);
     evr_status st = evr_raw_stream_room(&w->s, need, err);
     if (st != EVR_OK) return st;
-    size_t c = pack_packet(w, w->raw, ev, n, w->s.buf + w->s.len, need);
+    size_t c = pack_packet(w, NULL, w->raw, ev, n, w->s.buf + w->s.len, need);
     if (!c) return no_memory(w, err);
     w->s.len += PACKET_HEADER + c;
     return add_entry(w, (uint32_t)c, ev, n, err);
@@ -402,25 +428,28 @@ static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b
 {
     const packet_list *l = ctx;
     const evr_raw_stream *s = &l->w->s;
-    unsigned char *raw = malloc(EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * PACKET_MAX_EVENTS);
-    size_t bytes = 0;
-    if (!raw) return SIZE_MAX;
+    pack_slots *z = l->w->slots;
     for (size_t k = a; k < b; k++)
-        if (!evr_raw_stream_fits(s, &ev[k]) || (k > 0 && ev[k].t < ev[k - 1].t)) {
-            free(raw);
-            return SIZE_MAX;
-        }
-    for (size_t q = packet_at(l, a); q < l->np && l->start[q] < b; q++) {
+        if (!evr_raw_stream_fits(s, &ev[k]) || (k > 0 && ev[k].t < ev[k - 1].t)) return SIZE_MAX;
+    const int i = slot_take(z);
+    if (i >= 0 && !z->raw[i]) z->raw[i] = malloc(RAW_BYTES);
+    unsigned char *raw = i >= 0 ? z->raw[i] : malloc(RAW_BYTES);
+    ZSTD_CCtx *cctx = l->w->compression == EVR_AEDAT4_ZSTD ? slot_cctx(z, i) : NULL;
+    size_t bytes = 0;
+    for (size_t q = packet_at(l, a); raw && q < l->np && l->start[q] < b; q++) {
         const size_t n = l->start[q + 1] - l->start[q];
-        const size_t c = pack_packet(l->w, raw, ev + l->start[q], n, out + bytes, room - bytes);
+        const size_t c =
+            pack_packet(l->w, cctx, raw, ev + l->start[q], n, out + bytes, room - bytes);
         if (!c) {
-            free(raw);
-            return SIZE_MAX;
+            bytes = SIZE_MAX;
+            break;
         }
         l->size[q] = c;
         bytes += PACKET_HEADER + c;
     }
-    free(raw);
+    if (!raw) bytes = SIZE_MAX;
+    if (i < 0) free(raw);
+    slot_give(z, i);
     return bytes;
 }
 
@@ -481,7 +510,7 @@ static evr_status write_tail(aedat_writer *w, int keep_open, evr_error *err)
         w->cap_buf = len + bound;
     }
     data_table(w->buf, w->table, w->n_table);
-    const size_t c = frame(w, w->buf + len, bound, w->buf, len);
+    const size_t c = frame(w, NULL, w->buf + len, bound, w->buf, len);
     if (c == 0) return no_memory(w, err);
     if (fwrite(w->buf + len, 1, c, w->s.f) != c) return cannot_write(w, err);
     st = set_table_position(w, w->end, err);
@@ -559,8 +588,8 @@ static void free_writer(aedat_writer *w)
     free(w->starts);
     free(w->sizes);
     free(w->buf);
-    zstd_contexts_free(w->zstd);
-    w->zstd = NULL;
+    pack_slots_free(w->slots);
+    w->slots = NULL;
 }
 
 static evr_status aedat_finish(evr_event_writer *base, int64_t duration_us, evr_error *err)
@@ -609,9 +638,9 @@ static evr_status aedat_open(const char *path, const evr_writer_meta *meta, int 
     w->s.parts.threads = COMPRESS_THREADS;
     w->end = (int64_t)len;
     w->open = malloc(PACKET_MAX_EVENTS * sizeof *w->open);
-    w->raw = malloc(EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * PACKET_MAX_EVENTS);
-    if (compression == EVR_AEDAT4_ZSTD) w->zstd = calloc(1, sizeof *w->zstd);
-    if (!w->open || !w->raw || (compression == EVR_AEDAT4_ZSTD && !w->zstd)) {
+    w->raw = malloc(RAW_BYTES);
+    w->slots = calloc(1, sizeof *w->slots);
+    if (!w->open || !w->raw || !w->slots) {
         aedat_abort(*out);
         *out = NULL;
         snprintf(err->msg, sizeof err->msg, "aedat4 writer: out of memory");
