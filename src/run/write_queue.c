@@ -9,9 +9,12 @@
 #include <string.h>
 #include <time.h>
 
-/* batches that may wait: eight rode out the eye's bursts of saccade segments (main thread waiting
- * for the writer 0.6-0.75 -> 0.01 s of a 4.4-4.9 s run on the H100, against two) */
-#define QUEUE_SLOTS 8
+/* Batches that may wait, and their bytes at most (a larger batch waits alone): enough to ride out
+ * the eye's bursts (eight whole segments took the main thread's wait for the writer from 0.6-0.75
+ * to 0.01 s of a 4.4-4.9 s run on the H100, against two; a GPU run's pieces of 4 MB need the
+ * bytes), and a bound on the memory a burst takes however many events it makes. */
+#define QUEUE_SLOTS 32
+#define QUEUE_BYTES ((size_t)96 << 20)
 
 struct evr_write_queue {
     evr_event_writer *writers[EVR_WRITE_QUEUE_MAX_WRITERS];
@@ -29,10 +32,11 @@ struct evr_write_queue {
      * batches wait at once are ever used. */
     evr_event_vec spare[QUEUE_SLOTS];
     int nspare;
-    int head, count;   /* pending batches: slots[head], slots[head + 1], ... */
-    int busy;          /* the thread is writing the batch at head, or flushing */
-    int dirty;         /* batches written since the last flush */
-    double last_flush; /* host seconds */
+    int head, count;     /* pending batches: slots[head], slots[head + 1], ... */
+    size_t queued_bytes; /* their events' */
+    int busy;            /* the thread is writing the batch at head, or flushing */
+    int dirty;           /* batches written since the last flush */
+    double last_flush;   /* host seconds */
     int stop;
     int flush_now;                              /* a flush asked for by evr_write_queue_flush */
     uint64_t accepted_events, accepted_batches; /* taken by every writer's write() */
@@ -164,8 +168,9 @@ static void *writer_main(void *arg)
         evr_event_vec *v = &q->slots[q->head];
         q->dirty = 1;
         run_batch(q, v, evr_host_seconds() >= q->last_flush + q->flush_seconds);
+        q->queued_bytes -= v->n * sizeof(evr_event);
         v->n = 0;
-        q->spare[q->nspare++] = *v; /* at most eight: one per slot */
+        q->spare[q->nspare++] = *v; /* at most one per slot */
         v->data = NULL;
         v->cap = 0;
         q->head = (q->head + 1) % QUEUE_SLOTS;
@@ -236,7 +241,10 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
 {
     double t = evr_host_seconds();
     pthread_mutex_lock(&q->mu);
-    while (q->count == QUEUE_SLOTS && q->status == EVR_OK) pthread_cond_wait(&q->cv, &q->mu);
+    const size_t bytes = n * sizeof(evr_event);
+    while ((q->count == QUEUE_SLOTS || (q->count > 0 && q->queued_bytes + bytes > QUEUE_BYTES)) &&
+           q->status == EVR_OK)
+        pthread_cond_wait(&q->cv, &q->mu);
     q->wait_seconds += evr_host_seconds() - t;
     if (q->status != EVR_OK) {
         *err = q->err;
@@ -261,6 +269,7 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
     *v = rest;
     pthread_mutex_lock(&q->mu);
     q->count++;
+    q->queued_bytes += bytes;
     pthread_cond_broadcast(&q->cv);
     pthread_mutex_unlock(&q->mu);
     return EVR_OK;
