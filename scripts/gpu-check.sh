@@ -25,6 +25,9 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --bac
     --start 0.9 -o "$OUT/cs-eye" --no-preview -q > "$OUT/sanitizer.log" 2>&1; echo "memcheck exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 --duration 0.3 \
     --sensor davis346 --start 0.9 -o "$OUT/cs-eye2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck davis346 exit $?" >> "$OUT/sanitizer.log"
+# a segment's events in many pieces (the hidden EVR_EVENT_PIECE), event ids on
+EVR_EVENT_PIECE=257 compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene eye --backend cuda --res 96x72 \
+    --duration 0.5 --start 0.9 --event-ids -o "$OUT/cs-pieces" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck pieces exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene square --backend cuda --res 64x64 --duration 0.1 \
     -o "$OUT/cs-sq" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck exit $?" >> "$OUT/sanitizer.log"
 # deforming meshes: per-segment vertex keys and trees (morph-target lids, a skinned finger)

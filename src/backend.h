@@ -89,6 +89,12 @@ struct evr_backend {
      * valid until the next collect(). */
     evr_status (*collect)(evr_backend *b, evr_event_vec *out, int64_t emit_before_us,
                           const float **intensity, const float **frames, evr_error *err);
+    /* Set by the caller (may be NULL): collect may hand a large segment's events over in pieces,
+     * calling this after appending each piece but the last to out, with a limit no later event
+     * of the segment precedes; the caller takes out's events before it (and may swap out's
+     * buffer). Host memory then holds a piece, not a segment's burst. */
+    evr_status (*emit_piece)(void *user, int64_t limit_us, evr_error *err);
+    void *emit_user;
     void (*release)(evr_backend *b);
     /* The primary hits of the segment collected last: its num_labels images, one after the
      * other (each row-major, top row first; inst -1: the pixel sees nothing), or NULL when it

@@ -443,6 +443,16 @@ static evr_status emit_events(evr_sim *sim, int64_t limit_us, evr_error *err)
     return EVR_OK;
 }
 
+/* A piece of a segment's events (evr_backend.emit_piece): written as a segment's would be. */
+static evr_status emit_piece(void *user, int64_t limit_us, evr_error *err)
+{
+    evr_sim *sim = user;
+    const double t = evr_host_seconds();
+    evr_status st = emit_events(sim, limit_us, err);
+    sim->time_piece_emit += evr_host_seconds() - t;
+    return st;
+}
+
 static evr_status submit_segment(evr_sim *sim, int i, evr_error *err)
 {
     evr_segment seg;
@@ -516,10 +526,11 @@ static evr_status finish_segment(evr_sim *sim, int i, int last, evr_error *err)
     /* timestamp jitter and rounding to the resolution can move a later event earlier still */
     if (!final) safe -= sim->timestamp_slack_us;
     double t = evr_host_seconds();
+    sim->time_piece_emit = 0.0;
     if ((st = sim->backend->collect(sim->backend, &sim->pending, safe, &intensity, &frames, err)) !=
         EVR_OK)
         return st;
-    sim->time_render += evr_host_seconds() - t;
+    sim->time_render += evr_host_seconds() - t - sim->time_piece_emit;
     if ((st = emit_events(sim, safe, err)) != EVR_OK)
         return st; /* written and flushed on the writer thread */
     if (intensity) {
@@ -570,6 +581,8 @@ evr_status evr_sim_run(evr_sim *sim, evr_progress_fn progress, void *user, evr_e
     evr_status st = EVR_OK;
     int submitted = 0, i, stop = 0;
     sim->wall0 = evr_host_seconds();
+    sim->backend->emit_piece = emit_piece;
+    sim->backend->emit_user = sim;
     /* keep the backend's depth of segments in flight (at least two: one renders while the previous
      * one is taken in and written) */
     const int depth = sim->backend->depth > 2 ? sim->backend->depth : 2;

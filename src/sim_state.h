@@ -110,6 +110,7 @@ struct evr_sim {
     double time_plan_wait; /* the segment loop waiting for the planner */
     double time_setup_host, time_first_plan; /* set-up before the backend; the first plan */
     double time_setup, time_render, time_sort, time_write, time_write_thread, time_preview;
+    double time_piece_emit; /* of the collect in progress: its pieces written (emit_piece) */
 };
 
 #endif

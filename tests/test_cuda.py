@@ -126,6 +126,23 @@ T.check(len(runs["auto"]) > 100000 and runs["auto"] == runs["tiny"],
 T.check(len(runs["adaptive-auto"]) > 100000 and runs["adaptive-auto"] == runs["adaptive-tiny"],
         "adaptive sampling: overflowing event buffers are re-rendered, identical events")
 
+# a segment's events come to the host in pieces (cuda_state.cuh's EVENT_PIECE, 1,048,576 keys):
+# pieces of 997 (the hidden EVR_EVENT_PIECE), hundreds a segment, ending inside runs of equal
+# timestamps, give byte-identical files, event ids included
+pieces = {}
+for label, value in (("default", None), ("small", "997")):
+    d = os.path.join(tmp, f"piece-{label}")
+    if value:
+        os.environ["EVR_EVENT_PIECE"] = value
+    try:
+        T.run("demo", "--scene", "eye", "-o", d, "--backend", "cuda", "--res", "200x150", "--duration", "1.0",
+              "--event-ids", "--format", "npy,h5", "--no-preview", "--quiet")
+    finally:
+        os.environ.pop("EVR_EVENT_PIECE", None)
+    pieces[label] = [open(os.path.join(d, f), "rb").read() for f in ("events.npy", "events.h5")]
+T.check(len(pieces["default"][0]) > 100000 and pieces["default"] == pieces["small"],
+        "events in pieces of 997: identical events.npy and events.h5 (ids included)")
+
 # temporal coherence (a primary ray first bounded by its pixel's last hit, traced again unbounded
 # when that finds nothing) changes no event: EVR_NO_COHERENCE turns it off
 for scene, extra in (("eye", ["--res", "200x150", "--duration", "1.0", "--start", "0.9"]),

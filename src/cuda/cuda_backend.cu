@@ -6,10 +6,11 @@
  * segment (one thread per pixel, its samples in a loop): camera ray, our own BVH traversal with
  * motion transforms (cuda/gpu_traverse.h), shading and the pixel model from src/core, the very
  * functions the CPU backend runs. Events are appended with warp-aggregated atomics as 64-bit
- * keys (time, y, x, polarity), sorted on the GPU with CUB's radix sort and copied to pinned host
- * memory on a second stream while the next segments render: NSLOT segments are in flight, so that
- * the GPU has work queued while the host takes in and writes earlier ones (render times vary
- * widely from segment to segment).
+ * keys (time, y, x, polarity), sorted on the GPU with CUB's radix sort on a second stream while
+ * the next segments render: NSLOT segments are in flight, so that the GPU has work queued while
+ * the host takes in and writes earlier ones (render times vary widely from segment to segment).
+ * The sorted keys come to pinned host memory in pieces of a fixed size, each decoded and handed to
+ * the writers before the next, so that a burst of events does not grow host memory.
  *
  * Pixel states live in a ring of NRING device arrays: segment i reads ring[i % NRING] and writes
  * ring[(i + 1) % NRING], so when segment i's event buffer overflows (found at collect, when the
@@ -178,7 +179,6 @@ static void cuda_release(evr_backend *base)
         sl->d_keys_sorted.release();
         sl->d_ids_ev.release();
         sl->d_ids_sorted.release();
-        sl->h_ids.release();
         sl->d_sort_temp.release();
         sl->d_count.release();
         sl->d_counters.release();
@@ -190,7 +190,6 @@ static void cuda_release(evr_backend *base)
         sl->h_adapt.release();
         sl->h_count.release();
         sl->h_counters.release();
-        sl->h_sorted.release();
         sl->h_intensity.release();
         sl->h_frame_f.release();
         sl->d_frame_f.release();
@@ -217,6 +216,14 @@ static void cuda_release(evr_backend *base)
         if (sl->copied) cudaEventDestroy(sl->copied);
         if (sl->sort_from) cudaEventDestroy(sl->sort_from);
     }
+    for (int k = 0; k < 2; k++) {
+        b->h_piece[k].release();
+        b->h_piece_ids[k].release();
+        if (b->piece_from[k]) cudaEventDestroy(b->piece_from[k]);
+        if (b->piece_copied[k]) cudaEventDestroy(b->piece_copied[k]);
+    }
+    b->d_split.release();
+    b->h_split.release();
     b->d_floats.release();
     b->d_indices.release();
     b->d_meshes.release();
@@ -346,11 +353,9 @@ static evr_status init(cuda_backend *b, evr_error *err)
         /* the sort's buffers too, up front: allocated as segments first need them, the frees
          * and pinned allocations stalled the GPU for 0.2 s of the eye's first second */
         CK(sl->d_keys_sorted.reserve(b->capacity));
-        CK(sl->h_sorted.reserve(b->capacity));
         if (b->setup.event_ids) {
             CK(sl->d_ids_ev.reserve(b->capacity));
             CK(sl->d_ids_sorted.reserve(b->capacity));
-            CK(sl->h_ids.reserve(b->capacity));
         }
         size_t temp = 0;
         CK(event_sort_temp_bytes(
@@ -372,6 +377,19 @@ static evr_status init(cuda_backend *b, evr_error *err)
         CK(cudaMemset(sl->d_counters.p, 0, CTR_COUNT * sizeof(unsigned long long)));
         if (b->gi && (st = gi_alloc(b, sl, gi_window, err)) != EVR_OK) return st;
     }
+    b->piece = EVENT_PIECE;
+    if (const char *v = getenv("EVR_EVENT_PIECE")) {
+        const long long n = atoll(v);
+        if (n > 0 && n < (1ll << 30)) b->piece = (size_t)n;
+    }
+    for (int k = 0; k < 2; k++) {
+        CK(b->h_piece[k].reserve(b->piece + 1, true));
+        if (b->setup.event_ids) CK(b->h_piece_ids[k].reserve(b->piece, true));
+        CK(cudaEventCreate(&b->piece_from[k]));
+        CK(cudaEventCreate(&b->piece_copied[k]));
+    }
+    CK(b->d_split.reserve(SPLIT_N));
+    CK(b->h_split.reserve(SPLIT_N));
     if (b->gi) CK(b->d_pcount.reserve(1));
     gi_deferred_alloc(b, &prop);
     CK(cudaDeviceSynchronize());

@@ -1,10 +1,10 @@
 /* The CUDA backend's segment pipeline: submit queues a segment's upload, photon passes and render
  * on the render stream in the next free slot; when its render is done its events (64-bit keys)
- * are sorted with CUB's radix sort and copied to pinned host memory on the slot's copy stream
- * while later segments render; collect takes the oldest segment's events, renders it again with
- * a larger buffer if its events overflowed (its input pixel states are unchanged: ring of NRING),
- * decodes the sorted keys before emit_before on the thread pool and carries the rest on the
- * device into the next segment's sort. */
+ * are sorted with CUB's radix sort on the slot's copy stream while later segments render;
+ * collect takes the oldest segment's events, renders it again with a larger buffer if its events
+ * overflowed (its input pixel states are unchanged: ring of NRING), brings the sorted keys before
+ * emit_before to the host in pieces, decoded on the thread pool and handed to the writers piece
+ * by piece, and carries the rest on the device into the next segment's sort. */
 #include "cuda/cuda_pipeline.cuh"
 #include "cuda/cuda_gi.cuh"
 #include "cuda/cuda_gi_deferred.cuh"
@@ -182,16 +182,8 @@ static evr_status start_copy(cuda_backend *b, slot *sl, size_t n, evr_error *err
         CK(sl->d_sort_temp.reserve(temp));
         CK(sort_events(sl->d_sort_temp.p, temp, sl->d_keys_ev.p, sl->d_keys_sorted.p, ids_in,
                        ids_out, (int)n, sl->end_bit, sl->copy));
-        CK(sl->h_sorted.reserve(n));
-        CK(cudaEventRecord(sl->sorted, sl->copy));
-        CK(cudaMemcpyAsync(sl->h_sorted.p, sl->d_keys_sorted.p, n * sizeof(unsigned long long),
-                           cudaMemcpyDeviceToHost, sl->copy));
-        if (ids) {
-            CK(sl->h_ids.reserve(n));
-            CK(cudaMemcpyAsync(sl->h_ids.p, sl->d_ids_sorted.p, n * sizeof(uint16_t),
-                               cudaMemcpyDeviceToHost, sl->copy));
-        }
     }
+    CK(cudaEventRecord(sl->sorted, sl->copy));
     if (sl->want_intensity) {
         size_t npix = (size_t)b->setup.width * b->setup.height;
         CK(sl->h_intensity.reserve(npix));
@@ -489,12 +481,47 @@ static void decode_part(void *ctx, int k, int)
 static void decode_keys(evr_par_pool *pool, const unsigned long long *keys, const uint16_t *ids,
                         size_t n, long long base_us, int xb, int yb, evr_event *dst)
 {
-    const size_t chunk = (size_t)1 << 17;
+    const size_t chunk = (size_t)1 << 17; /* eight parts of a piece (EVENT_PIECE) */
     size_t parts = (n + chunk - 1) / chunk, most = (size_t)evr_par_pool_threads(pool);
     if (parts > most) parts = most;
     if (parts < 1) parts = 1;
     decode_job j = {keys, ids, n, parts, base_us, xb, yb, dst};
     evr_par_pool_run(pool, (int)parts, decode_part, &j);
+}
+
+/* Where the sorted keys reach limit (the first at or after it), the key there and the last key:
+ * one thread's binary search, so that the keys need not come to the host to be split. */
+__global__ void split_keys(const unsigned long long *keys, size_t n, unsigned long long limit,
+                           unsigned long long *out)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (keys[mid] < limit) lo = mid + 1;
+        else hi = mid;
+    }
+    out[0] = lo;
+    out[1] = lo < n ? keys[lo] : 0ull;
+    out[2] = n ? keys[n - 1] : 0ull;
+}
+
+/* Queues the copy of piece k of the slot's sorted keys before split (and their ids) into
+ * b->h_piece[k % 2], with the next piece's first key after it, on the slot's copy stream. */
+static cudaError_t copy_piece(cuda_backend *b, slot *sl, size_t k, size_t split)
+{
+    const int buf = (int)(k & 1);
+    const size_t at = k * b->piece, m = split - at < b->piece ? split - at : b->piece;
+    const size_t with_next = at + m < split ? m + 1 : m;
+    cudaError_t e = cudaEventRecord(b->piece_from[buf], sl->copy);
+    if (e == cudaSuccess)
+        e = cudaMemcpyAsync(b->h_piece[buf].p, sl->d_keys_sorted.p + at,
+                            with_next * sizeof(unsigned long long), cudaMemcpyDeviceToHost,
+                            sl->copy);
+    if (e == cudaSuccess && b->setup.event_ids)
+        e = cudaMemcpyAsync(b->h_piece_ids[buf].p, sl->d_ids_sorted.p + at, m * sizeof(uint16_t),
+                            cudaMemcpyDeviceToHost, sl->copy);
+    if (e == cudaSuccess) e = cudaEventRecord(b->piece_copied[buf], sl->copy);
+    return e;
 }
 
 evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_before_us,
@@ -582,39 +609,62 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
     const int shift = key_time_shift(b->setup.width, b->setup.height);
     const size_t total = sl->total; /* its own n and those carried in */
     size_t split = total;
-    if (emit_before_us != INT64_MAX) {
+    unsigned long long key_split = 0, key_last = 0;
+    if (total && emit_before_us != INT64_MAX) {
         const long long rel = (long long)emit_before_us - sl->base_us;
         const unsigned long long limit =
             rel <= 0 ? 0ull : (unsigned long long)rel << shift; /* the first key at or after it */
-        size_t lo = 0, hi = total;
-        if (rel >= slot_span_us(b, sl)) lo = total;
-        while (lo < hi) {
-            const size_t mid = lo + (hi - lo) / 2;
-            if (sl->h_sorted.p[mid] < limit) lo = mid + 1;
-            else hi = mid;
+        if (rel < slot_span_us(b, sl)) {
+            split_keys<<<1, 1, 0, sl->copy>>>(sl->d_keys_sorted.p, total, limit, b->d_split.p);
+            CK(cudaGetLastError());
+            CK(cudaMemcpyAsync(b->h_split.p, b->d_split.p, SPLIT_N * sizeof(unsigned long long),
+                               cudaMemcpyDeviceToHost, sl->copy));
+            CK(cudaStreamSynchronize(sl->copy));
+            split = (size_t)b->h_split.p[0];
+            key_split = b->h_split.p[1];
+            key_last = b->h_split.p[2];
         }
-        split = lo;
     }
     b->carry_slot = split < total ? b->head : -1;
     b->carry_at = split;
     b->carry_n = total - split;
     b->carry_base_us = sl->base_us;
     if (split < total) {
-        b->carry_t_lo = decode_key(sl->h_sorted.p[split], sl->base_us, xb, yb).t;
-        b->carry_t_hi = decode_key(sl->h_sorted.p[total - 1], sl->base_us, xb, yb).t;
+        b->carry_t_lo = decode_key(key_split, sl->base_us, xb, yb).t;
+        b->carry_t_hi = decode_key(key_last, sl->base_us, xb, yb).t;
     }
-    /* decoded straight after any events held back in out, the two runs merged where they overlap */
-    const size_t held = out->n;
-    if (!evr_event_vec_reserve(out, split)) {
-        snprintf(err->msg, sizeof err->msg, "out of memory for events");
-        return EVR_ERR_NOMEM;
-    }
-    decode_keys(b->par, sl->h_sorted.p, b->setup.event_ids ? sl->h_ids.p : nullptr, split,
-                sl->base_us, xb, yb, out->data + held);
-    out->n += split;
-    if (!evr_events_merge_runs(out, held, &b->scratch)) {
-        snprintf(err->msg, sizeof err->msg, "out of memory for events");
-        return EVR_ERR_NOMEM;
+    /* The keys before the split come over piece by piece, the next piece copied while this one
+     * is decoded (straight after any events held back in out, the two runs merged where they
+     * overlap) and handed to the writers: each piece brings the next one's first key, before
+     * which every event of the segment is then on the host. */
+    const size_t pieces = (split + b->piece - 1) / b->piece;
+    if (pieces) CK(copy_piece(b, sl, 0, split));
+    for (size_t k = 0; k < pieces; k++) {
+        const int buf = (int)(k & 1);
+        const size_t m = split - k * b->piece < b->piece ? split - k * b->piece : b->piece;
+        tw = evr_host_seconds();
+        CK(cudaEventSynchronize(b->piece_copied[buf]));
+        base->wait_seconds += evr_host_seconds() - tw;
+        float piece_ms = 0.0f;
+        CK(cudaEventElapsedTime(&piece_ms, b->piece_from[buf], b->piece_copied[buf]));
+        base->copy_seconds += 1e-3 * (double)piece_ms;
+        if (k + 1 < pieces) CK(copy_piece(b, sl, k + 1, split));
+        const size_t held = out->n;
+        if (!evr_event_vec_reserve(out, m)) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for events");
+            return EVR_ERR_NOMEM;
+        }
+        decode_keys(b->par, b->h_piece[buf].p, b->setup.event_ids ? b->h_piece_ids[buf].p : nullptr,
+                    m, sl->base_us, xb, yb, out->data + held);
+        out->n += m;
+        if (!evr_events_merge_runs(out, held, &b->scratch)) {
+            snprintf(err->msg, sizeof err->msg, "out of memory for events");
+            return EVR_ERR_NOMEM;
+        }
+        if (k + 1 < pieces && base->emit_piece) {
+            const long long next_t = decode_key(b->h_piece[buf].p[m], sl->base_us, xb, yb).t;
+            if ((st = base->emit_piece(base->emit_user, next_t, err)) != EVR_OK) return st;
+        }
     }
     *intensity = sl->want_intensity ? sl->h_intensity.p : NULL;
     *frames = sl->num_frames ? sl->h_frames.p : NULL;

@@ -22,6 +22,13 @@ extern "C" {
 #endif
 #define NRING \
     (NSLOT + 1) /* pixel-state arrays: the in-flight segments' inputs and the last output */
+/* Event keys a piece brings to the host (cuda_backend.h_piece), 16 MB decoded: a bound on host
+ * memory whatever a burst makes (with the write queue's bytes), and a batch large enough that
+ * the writers pack it in parallel (AEDAT 4.0 one packet of up to 32,768 events a thread). */
+#ifndef EVENT_PIECE
+#define EVENT_PIECE ((size_t)1 << 20)
+#endif
+#define SPLIT_N 3 /* d_split: the split index, the key there, the last key */
 
 /* One segment in flight. */
 struct slot {
@@ -69,8 +76,6 @@ struct slot {
     dbuf<float> d_intensity;
     hbuf<unsigned int> h_count;
     hbuf<unsigned long long> h_counters;
-    hbuf<unsigned long long> h_sorted;
-    hbuf<uint16_t> h_ids;
     hbuf<float> h_intensity;
     hbuf<float> h_frame_f; /* normalized times of the frames */
     dbuf<float> d_frame_f;
@@ -98,7 +103,7 @@ struct slot {
     cudaEvent_t gi_started = nullptr, gi_done = nullptr;
     int gi_passes;                   /* photon passes run for this segment (0: a still copy) */
     int copying;                     /* the sort and copy of this render's events are queued */
-    size_t total;                    /* keys sorted and copied: its own, then those carried in */
+    size_t total;                    /* keys sorted: its own, then those carried in */
     cudaEvent_t sort_from = nullptr; /* start of the sort (copy stream) */
     int static_gen = -1; /* the static hits it renders with (cuda_backend.static_gen), -1: none */
 };
@@ -157,6 +162,16 @@ struct cuda_backend {
     size_t carry_at, carry_n;
     long long carry_base_us, carry_t_lo, carry_t_hi;
     evr_event_vec scratch;
+    /* The collected segment's keys come to the host in pieces of EVENT_PIECE, through two pinned
+     * buffers (one copied while the other is decoded and written), so that host memory holds a
+     * piece however many events a segment makes. d_split/h_split: where emit_before splits the
+     * sorted keys, the key there and the last key. */
+    size_t piece; /* EVENT_PIECE, or the hidden EVR_EVENT_PIECE's (tests: many pieces) */
+    hbuf<unsigned long long> h_piece[2];
+    hbuf<uint16_t> h_piece_ids[2];
+    cudaEvent_t piece_from[2] = {nullptr, nullptr}, piece_copied[2] = {nullptr, nullptr};
+    dbuf<unsigned long long> d_split;
+    hbuf<unsigned long long> h_split;
     /* global illumination (cuda_gi.cu): the pass's photons and their sort, shared by the slots
      * (one pass at a time on the render stream) */
     int gi, gi_have_prev;
