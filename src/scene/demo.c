@@ -33,11 +33,18 @@ static const char *const demo_names[] = {EVR_DEMO_TABLE(EVR_DEMO_NAME) NULL};
 
 const char *const *evr_demo_names(void) { return demo_names; }
 
-int evr_demo_has_variants(const char *name)
+/* The table's entry of the scene called name, or NULL. */
+static const demo_entry *find_demo(const char *name)
 {
     for (size_t i = 0; name && i < NUM_DEMOS; i++)
-        if (strcmp(name, demos[i].name) == 0) return demos[i].varies;
-    return 0;
+        if (strcmp(name, demos[i].name) == 0) return &demos[i];
+    return NULL;
+}
+
+int evr_demo_has_variants(const char *name)
+{
+    const demo_entry *d = find_demo(name);
+    return d ? d->varies : 0;
 }
 
 evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *err)
@@ -45,41 +52,43 @@ evr_status evr_demo_glb(const char *name, void **glb, size_t *size, evr_error *e
     return evr_demo_glb_variant(name, 0, glb, size, err);
 }
 
+/* err->msg: head, then the table's scenes (those with variants only, or all). */
+static void scenes_message(evr_error *err, const char *head, int variants_only)
+{
+    size_t n = (size_t)snprintf(err->msg, sizeof err->msg, "%s", head);
+    for (size_t k = 0; k < NUM_DEMOS && n < sizeof err->msg; k++)
+        if (!variants_only || demos[k].varies)
+            n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demos[k].name);
+}
+
 evr_status evr_demo_glb_variant(const char *name, uint64_t seed, void **glb, size_t *size,
                                 evr_error *err)
 {
-    size_t i;
+    const demo_entry *d = find_demo(name);
+    char head[sizeof err->msg];
     evr_gltf *g;
     evr_status st;
     *glb = NULL;
     *size = 0;
-    for (i = 0; i < NUM_DEMOS; i++)
-        if (name && strcmp(name, demos[i].name) == 0) break;
-    if (i == NUM_DEMOS) {
-        size_t n = 0, k;
-        n += (size_t)snprintf(
-            err->msg, sizeof err->msg,
-            "unknown demo scene \"%s\"; the built-in scenes are:", name ? name : "(null)");
-        for (k = 0; demo_names[k] && n < sizeof err->msg; k++)
-            n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demo_names[k]);
+    if (!d) {
+        snprintf(head, sizeof head,
+                 "unknown demo scene \"%s\"; the built-in scenes are:", name ? name : "(null)");
+        scenes_message(err, head, 0);
         return EVR_ERR_ARG;
     }
-    if (seed && !demos[i].varies) {
-        size_t n = (size_t)snprintf(
-            err->msg, sizeof err->msg,
-            "demo %s has no variants; the scenes with variants are:", demos[i].name);
-        for (size_t k = 0; k < NUM_DEMOS && n < sizeof err->msg; k++)
-            if (demos[k].varies)
-                n += (size_t)snprintf(err->msg + n, sizeof err->msg - n, " %s", demos[k].name);
+    if (seed && !d->varies) {
+        snprintf(head, sizeof head,
+                 "demo %s has no variants; the scenes with variants are:", d->name);
+        scenes_message(err, head, 1);
         return EVR_ERR_ARG;
     }
-    g = evr_gltf_new(demos[i].name);
+    g = evr_gltf_new(d->name);
     if (!g) {
-        snprintf(err->msg, sizeof err->msg, "demo %s: out of memory", demos[i].name);
+        snprintf(err->msg, sizeof err->msg, "demo %s: out of memory", d->name);
         return EVR_ERR_NOMEM;
     }
     evr_gltf_set_variant(g, seed);
-    demos[i].build(g);
+    d->build(g);
     st = evr_gltf_glb(g, glb, size, err);
     evr_gltf_free(g);
     return st;
