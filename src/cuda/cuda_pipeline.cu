@@ -505,12 +505,19 @@ __global__ void split_keys(const unsigned long long *keys, size_t n, unsigned lo
     out[2] = n ? keys[n - 1] : 0ull;
 }
 
+/* Keys in piece k of the split first keys. */
+static size_t piece_keys(const cuda_backend *b, size_t k, size_t split)
+{
+    const size_t at = k * b->piece;
+    return split - at < b->piece ? split - at : b->piece;
+}
+
 /* Queues the copy of piece k of the slot's sorted keys before split (and their ids) into
  * b->h_piece[k % 2], with the next piece's first key after it, on the slot's copy stream. */
 static cudaError_t copy_piece(cuda_backend *b, slot *sl, size_t k, size_t split)
 {
     const int buf = (int)(k & 1);
-    const size_t at = k * b->piece, m = split - at < b->piece ? split - at : b->piece;
+    const size_t at = k * b->piece, m = piece_keys(b, k, split);
     const size_t with_next = at + m < split ? m + 1 : m;
     cudaError_t e = cudaEventRecord(b->piece_from[buf], sl->copy);
     if (e == cudaSuccess)
@@ -641,7 +648,7 @@ evr_status cuda_collect(evr_backend *base, evr_event_vec *out, int64_t emit_befo
     if (pieces) CK(copy_piece(b, sl, 0, split));
     for (size_t k = 0; k < pieces; k++) {
         const int buf = (int)(k & 1);
-        const size_t m = split - k * b->piece < b->piece ? split - k * b->piece : b->piece;
+        const size_t m = piece_keys(b, k, split);
         tw = evr_host_seconds();
         CK(cudaEventSynchronize(b->piece_copied[buf]));
         base->wait_seconds += evr_host_seconds() - tw;

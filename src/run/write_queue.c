@@ -11,8 +11,8 @@
 
 /* Batches that may wait, and their bytes at most (a larger batch waits alone): enough to ride out
  * the eye's bursts (eight whole segments took the main thread's wait for the writer from 0.6-0.75
- * to 0.01 s of a 4.4-4.9 s run on the H100, against two; a GPU run's pieces of 4 MB need the
- * bytes), and a bound on the memory a burst takes however many events it makes. */
+ * to 0.01 s of a 4.4-4.9 s run on the H100, against two; a GPU run's pieces of up to 16 MB need
+ * the bytes), and a bound on the memory a burst takes however many events it makes. */
 #define QUEUE_SLOTS 32
 #define QUEUE_BYTES ((size_t)96 << 20)
 
