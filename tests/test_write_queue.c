@@ -4,6 +4,7 @@
 #include "run/write_queue.h"
 #include "host_clock.h"
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -118,6 +119,41 @@ static evr_status push(evr_write_queue *q, int64_t *t, size_t n, evr_error *err)
     evr_status st = evr_write_queue_push_take(q, &v, v.n, err);
     evr_event_vec_free(&v);
     return st;
+}
+
+/* A writer that holds each write until the test opens its gate. */
+typedef struct {
+    evr_event_writer base;
+    _Atomic int open;
+} gate_writer;
+
+static evr_status gate_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
+{
+    gate_writer *w = (gate_writer *)base;
+    (void)ev;
+    (void)n;
+    (void)err;
+    double t0 = evr_host_seconds();
+    while (!atomic_load(&w->open) && evr_host_seconds() - t0 < 20.0) sleep_s(0.001);
+    return EVR_OK;
+}
+
+/* A push on a thread of its own, for a push that may wait. */
+typedef struct {
+    evr_write_queue *q;
+    int64_t t;
+    size_t n;
+    evr_status st;
+    _Atomic int done;
+    evr_error err;
+} pusher;
+
+static void *push_main(void *arg)
+{
+    pusher *p = arg;
+    p->st = push(p->q, &p->t, p->n, &p->err);
+    atomic_store(&p->done, 1);
+    return NULL;
 }
 
 static void sleep_s(double s)
@@ -248,6 +284,42 @@ int main(void)
         CHECK(st == EVR_ERR_IO && strstr(err.msg, "meet writer: cannot write") != NULL);
         evr_write_queue_accepted(q, &events, &batches);
         CHECK(events == 300 && batches == 3);
+        evr_write_queue_stop(q);
+    }
+    /* the queue's bound in bytes (96 MB, run/write_queue.c): with a batch of 51.2 MB being
+     * written, a second one waits until the writer is done, though slots are free; a batch
+     * larger than the bound still goes when the queue is empty */
+    {
+        gate_writer g;
+        evr_event_writer *ws[1] = {&g.base};
+        evr_write_queue *q = NULL;
+        pusher p;
+        pthread_t th;
+        memset(&g, 0, sizeof g);
+        atomic_init(&g.open, 0);
+        g.base.write = gate_write;
+        g.base.flush = fake_flush_none;
+        t = 0;
+        CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
+        CHECK_OK(push(q, &t, 3200000, &err)); /* taken by the writer, which waits at the gate */
+        memset(&p, 0, sizeof p);
+        p.q = q;
+        p.t = t;
+        p.n = 3200000;
+        atomic_init(&p.done, 0);
+        CHECK(pthread_create(&th, NULL, push_main, &p) == 0);
+        sleep_s(0.3);
+        CHECK(!atomic_load(&p.done)); /* 102.4 MB would wait: it waits */
+        atomic_store(&g.open, 1);
+        pthread_join(th, NULL);
+        CHECK(atomic_load(&p.done) && p.st == EVR_OK);
+        t = p.t;
+        CHECK_OK(evr_write_queue_drain(q, &err));
+        CHECK_OK(push(q, &t, 7000000, &err)); /* 112 MB alone */
+        CHECK_OK(evr_write_queue_drain(q, &err));
+        uint64_t events = 0, batches = 0;
+        evr_write_queue_accepted(q, &events, &batches);
+        CHECK(events == (uint64_t)t && batches == 3);
         evr_write_queue_stop(q);
     }
     return check_report("test_write_queue");
