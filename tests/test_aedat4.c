@@ -171,6 +171,14 @@ static void test_round_trip(const char *dir)
     CHECK(c && len2 == len && memcmp(a, c, len) == 0);
     free(b);
     free(c);
+    /* a large write that starts a new millisecond: it closes the open packet with none of its
+     * events, in parallel with its own packets */
+    size_t k = EVR_PAR_PACK_MIN + 1;
+    while (k < n && ev[k].t / 1000 == ev[k - 1].t / 1000) k++;
+    CHECK(k < n - EVR_PAR_PACK_MIN);
+    c = write_events(other, ev, n, k, n - k, 0, 0, NULL, &len2);
+    CHECK(c && len2 == len && memcmp(a, c, len) == 0);
+    free(c);
 
     free(a);
     free(ev);

@@ -85,11 +85,14 @@ typedef struct {
     pack_slots *slots;
 } aedat_writer;
 
-/* The packets of a large write, for the parallel parts: packet q is ev[start[q] .. start[q + 1]). */
+/* The packets of a large write, for the parallel parts: packet q is ev[start[q] .. start[q + 1]),
+ * but with first_open packet 0 is the open packet, which ev[0 .. start[1]) close (copied after
+ * its events in w->open, first_open of them in all). */
 typedef struct {
     const aedat_writer *w;
     const size_t *start;
     size_t np;
+    size_t first_open;
     size_t *size; /* packet q's compressed bytes, set by pack */
 } packet_list;
 
@@ -367,23 +370,36 @@ static size_t packet_end(const evr_event *ev, size_t a, size_t n, int64_t ms, si
     return lo;
 }
 
-/* Cuts ev[0 .. n) (n > 0) into packets: w->starts[0 .. np] with starts[np] = n; returns np. */
-static size_t cut_packets(aedat_writer *w, const evr_event *ev, size_t n, evr_error *err)
+/* Room in w->starts and w->sizes for `need` entries. */
+static int reserve_starts(aedat_writer *w, size_t need, evr_error *err)
 {
-    size_t np = 0, a = 0;
+    if (need <= w->cap_starts) return 1;
+    size_t cap = w->cap_starts ? 2 * w->cap_starts : 4096;
+    while (cap < need) cap *= 2;
+    size_t *s = realloc(w->starts, cap * sizeof *s), *z;
+    if (s) w->starts = s;
+    z = s ? realloc(w->sizes, cap * sizeof *z) : NULL;
+    if (!z) {
+        no_memory(w, err);
+        return 0;
+    }
+    w->sizes = z;
+    w->cap_starts = cap;
+    return 1;
+}
+
+/* Cuts ev[0 .. n) (n > 0) into packets: w->starts[0 .. np] with starts[np] = n; returns np (0:
+ * no memory). With open, ev[0 .. a) (perhaps none) is the first packet: they close the open one. */
+static size_t cut_packets(aedat_writer *w, const evr_event *ev, size_t n, size_t a, int open,
+                          evr_error *err)
+{
+    size_t np = 0;
+    if (open) {
+        if (!reserve_starts(w, 2, err)) return 0;
+        w->starts[np++] = 0;
+    }
     while (a < n) {
-        if (np + 2 > w->cap_starts) {
-            size_t cap = w->cap_starts ? 2 * w->cap_starts : 4096;
-            size_t *s = realloc(w->starts, cap * sizeof *s), *z;
-            if (s) w->starts = s;
-            z = s ? realloc(w->sizes, cap * sizeof *z) : NULL;
-            if (!z) {
-                no_memory(w, err);
-                return 0;
-            }
-            w->sizes = z;
-            w->cap_starts = cap;
-        }
+        if (!reserve_starts(w, np + 2, err)) return 0;
         w->starts[np++] = a;
         a = packet_end(ev, a, n, ev[a].t / PACKET_US, PACKET_MAX_EVENTS);
     }
@@ -413,13 +429,26 @@ static size_t cut_part(const void *ctx, const evr_event *ev, size_t n, size_t at
     return q < l->np ? l->start[q] : n;
 }
 
+/* Packet q's events (*n of them): in ev, or the open packet's in w->open. */
+static const evr_event *packet_events(const packet_list *l, const evr_event *ev, size_t q,
+                                      size_t *n)
+{
+    if (q == 0 && l->first_open) {
+        *n = l->first_open;
+        return l->w->open;
+    }
+    *n = l->start[q + 1] - l->start[q];
+    return ev + l->start[q];
+}
+
 static size_t bound_part(const void *ctx, const evr_event *ev, size_t a, size_t b)
 {
     const packet_list *l = ctx;
-    size_t bytes = 0;
-    (void)ev;
-    for (size_t q = packet_at(l, a); q < l->np && l->start[q] < b; q++)
-        bytes += packet_bound(l->w, l->start[q + 1] - l->start[q]);
+    size_t bytes = 0, n;
+    for (size_t q = packet_at(l, a); q < l->np && l->start[q] < b; q++) {
+        packet_events(l, ev, q, &n);
+        bytes += packet_bound(l->w, n);
+    }
     return bytes;
 }
 
@@ -437,9 +466,9 @@ static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b
     ZSTD_CCtx *cctx = l->w->compression == EVR_AEDAT4_ZSTD ? slot_cctx(z, i) : NULL;
     size_t bytes = 0;
     for (size_t q = packet_at(l, a); raw && q < l->np && l->start[q] < b; q++) {
-        const size_t n = l->start[q + 1] - l->start[q];
-        const size_t c =
-            pack_packet(l->w, cctx, raw, ev + l->start[q], n, out + bytes, room - bytes);
+        size_t n;
+        const evr_event *pe = packet_events(l, ev, q, &n);
+        const size_t c = pack_packet(l->w, cctx, raw, pe, n, out + bytes, room - bytes);
         if (!c) {
             bytes = SIZE_MAX;
             break;
@@ -453,17 +482,18 @@ static size_t pack_part(const void *ctx, const evr_event *ev, size_t a, size_t b
     return bytes;
 }
 
-/* Writes the np closed packets of ev[0 .. w->starts[np]) in parallel parts; returns 0 (nothing
- * written) when they go serially. */
-static int write_parallel(aedat_writer *w, const evr_event *ev, size_t np, evr_status *st,
-                          evr_error *err)
+/* Writes the closed packets of list l in parallel parts; returns 0 (nothing written) when they
+ * go serially. */
+static int write_parallel(aedat_writer *w, const packet_list *l, const evr_event *ev,
+                          evr_status *st, evr_error *err)
 {
-    const packet_list l = {w, w->starts, np, w->sizes};
-    const evr_par_packer parts = {bound_part, pack_part, cut_part, &l};
-    if (!evr_raw_stream_write_parts(&w->s, &parts, ev, w->starts[np], st, err)) return 0;
-    for (size_t q = 0; q < np && *st == EVR_OK; q++)
-        *st = add_entry(w, (uint32_t)w->sizes[q], ev + w->starts[q],
-                        w->starts[q + 1] - w->starts[q], err);
+    const evr_par_packer parts = {bound_part, pack_part, cut_part, l};
+    if (!evr_raw_stream_write_parts(&w->s, &parts, ev, l->start[l->np], st, err)) return 0;
+    for (size_t q = 0; q < l->np && *st == EVR_OK; q++) {
+        size_t n;
+        const evr_event *pe = packet_events(l, ev, q, &n);
+        *st = add_entry(w, (uint32_t)w->sizes[q], pe, n, err);
+    }
     return 1;
 }
 
@@ -539,31 +569,35 @@ static evr_status check_all(aedat_writer *w, const evr_event *ev, size_t n, evr_
 static evr_status aedat_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     aedat_writer *w = (aedat_writer *)base;
-    size_t i = 0, np, closed;
+    size_t i = 0, first_open = 0, np, closed;
     evr_status st;
     if (!n) return EVR_OK;
     if ((st = cut_tail(w, err)) != EVR_OK) return st;
     w->dirty = 1;
-    /* the open packet takes the events of its millisecond, as many as it has room for */
+    /* the open packet takes the events of its millisecond, as many as it has room for; when the
+     * write goes on past them, it is closed and packed with the write's other packets */
     if (w->n_open) {
         i = packet_end(ev, 0, n, w->open[0].t / PACKET_US, PACKET_MAX_EVENTS - w->n_open);
-        if ((st = check_all(w, ev, i, err)) != EVR_OK) return st;
+        if (i == n && (st = check_all(w, ev, i, err)) != EVR_OK) return st;
         memcpy(w->open + w->n_open, ev, i * sizeof *ev);
-        w->n_open += i;
-        if (i == n) return EVR_OK;
-        if ((st = put_packet(w, w->open, w->n_open, err)) != EVR_OK) return st;
-        w->n_open = 0;
+        if (i == n) {
+            w->n_open += i;
+            return EVR_OK;
+        }
+        first_open = w->n_open + i;
     }
-    /* the packets of the rest, the last left open */
-    ev += i;
-    n -= i;
-    np = cut_packets(w, ev, n, err);
+    /* the packets, the last left open */
+    np = cut_packets(w, ev, n, i, first_open > 0, err);
     if (!np) return EVR_ERR_NOMEM;
     closed = w->starts[np - 1];
-    if (closed && !write_parallel(w, ev, np - 1, &st, err)) {
+    const packet_list l = {w, w->starts, np - 1, first_open, w->sizes};
+    if (np > 1 && !write_parallel(w, &l, ev, &st, err)) {
         if ((st = check_all(w, ev, closed, err)) != EVR_OK) return st;
-        for (size_t q = 0; q + 1 < np && st == EVR_OK; q++)
-            st = put_packet(w, ev + w->starts[q], w->starts[q + 1] - w->starts[q], err);
+        for (size_t q = 0; q + 1 < np && st == EVR_OK; q++) {
+            size_t m;
+            const evr_event *pe = packet_events(&l, ev, q, &m);
+            st = put_packet(w, pe, m, err);
+        }
     }
     if (st == EVR_OK) st = check_all(w, ev + closed, n - closed, err);
     if (st != EVR_OK) return st;
