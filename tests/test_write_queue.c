@@ -138,6 +138,39 @@ static evr_status gate_write(evr_event_writer *base, const evr_event *ev, size_t
     return EVR_OK;
 }
 
+/* Pushes as the simulation does: one vector whose events beyond those pushed stay in it (in a
+ * buffer the queue gives back); each of `rounds` pushes takes 1,000 of 2,000,000 events, so every
+ * batch's buffer holds 32 MB in memory for its 16 KB of events. */
+typedef struct {
+    evr_write_queue *q;
+    int rounds;
+    _Atomic int pushed;
+    evr_status st;
+    evr_error err;
+} held_pusher;
+
+static void *held_push_main(void *arg)
+{
+    held_pusher *p = arg;
+    evr_event_vec v = {0};
+    int64_t t = 0;
+    p->st = EVR_OK;
+    for (int r = 0; r < p->rounds && p->st == EVR_OK; r++) {
+        while (v.n < 2000000) {
+            evr_event e = {0};
+            e.t = t++;
+            if (!evr_event_vec_push(&v, e)) {
+                p->st = EVR_ERR_NOMEM;
+                break;
+            }
+        }
+        if (p->st == EVR_OK) p->st = evr_write_queue_push_take(p->q, &v, 1000, &p->err);
+        atomic_fetch_add(&p->pushed, 1);
+    }
+    evr_event_vec_free(&v);
+    return NULL;
+}
+
 /* A push on a thread of its own, for a push that may wait. */
 typedef struct {
     evr_write_queue *q;
@@ -320,6 +353,39 @@ int main(void)
         uint64_t events = 0, batches = 0;
         evr_write_queue_accepted(q, &events, &batches);
         CHECK(events == (uint64_t)t && batches == 3);
+        evr_write_queue_stop(q);
+    }
+    /* the bound counts the memory a batch's buffer holds, not its events: with the writer held
+     * at the gate, three batches of 1,000 events in 32 MB buffers fill the 96 MB (counting by
+     * events, all ten would wait, 320 MB of buffers) */
+    {
+        gate_writer g;
+        evr_event_writer *ws[1] = {&g.base};
+        evr_write_queue *q = NULL;
+        held_pusher p;
+        pthread_t th;
+        memset(&g, 0, sizeof g);
+        atomic_init(&g.open, 0);
+        g.base.write = gate_write;
+        g.base.flush = fake_flush_none;
+        CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
+        memset(&p, 0, sizeof p);
+        p.q = q;
+        p.rounds = 10;
+        atomic_init(&p.pushed, 0);
+        CHECK(pthread_create(&th, NULL, held_push_main, &p) == 0);
+        for (double t0 = evr_host_seconds();
+             atomic_load(&p.pushed) < 3 && evr_host_seconds() - t0 < 30.0;)
+            sleep_s(0.01);
+        sleep_s(0.3); /* time for a fourth, if it would not wait */
+        CHECK(atomic_load(&p.pushed) == 3);
+        atomic_store(&g.open, 1);
+        pthread_join(th, NULL);
+        CHECK(atomic_load(&p.pushed) == 10 && p.st == EVR_OK);
+        CHECK_OK(evr_write_queue_drain(q, &err));
+        uint64_t events = 0, batches = 0;
+        evr_write_queue_accepted(q, &events, &batches);
+        CHECK(events == 10000 && batches == 10);
         evr_write_queue_stop(q);
     }
     return check_report("test_write_queue");

@@ -9,10 +9,11 @@
 #include <string.h>
 #include <time.h>
 
-/* Batches that may wait, and their bytes at most (a larger batch waits alone): enough to ride out
- * the eye's bursts (eight whole segments took the main thread's wait for the writer from 0.6-0.75
- * to 0.01 s of a 4.4-4.9 s run on the H100, against two; a GPU run's pieces of up to 16 MB need
- * the bytes), and a bound on the memory a burst takes however many events it makes. */
+/* Batches that may wait, and the bytes of their buffers at most (a larger batch waits alone),
+ * buffers kept for reuse included: enough to ride out the eye's bursts (eight whole segments
+ * took the main thread's wait for the writer from 0.6-0.75 to 0.01 s of a 4.4-4.9 s run on the
+ * H100, against two; a GPU run's pieces of up to 16 MB need the bytes), and a bound on the memory
+ * a burst takes however many events it makes. */
 #define QUEUE_SLOTS 32
 #define QUEUE_BYTES ((size_t)96 << 20)
 
@@ -32,8 +33,14 @@ struct evr_write_queue {
      * batches wait at once are ever used. */
     evr_event_vec spare[QUEUE_SLOTS];
     int nspare;
+    /* A buffer's bytes in memory: the most events it has held (its pages touched; its capacity
+     * may be twice that, untouched), for the slots, the spares and the buffer push gave out
+     * last, which the caller fills and pushes next. The queue's bound counts these. */
+    size_t slot_bytes[QUEUE_SLOTS], spare_held[QUEUE_SLOTS], out_bytes;
+    size_t spare_bytes;  /* the spares' */
     int head, count;     /* pending batches: slots[head], slots[head + 1], ... */
-    size_t queued_bytes; /* their events' */
+    size_t queued_bytes; /* the pending batches' (the one being written too) */
+    size_t max_bytes;    /* QUEUE_BYTES, or the hidden EVR_QUEUE_BYTES (for measuring) */
     int busy;            /* the thread is writing the batch at head, or flushing */
     int dirty;           /* batches written since the last flush */
     double last_flush;   /* host seconds */
@@ -168,14 +175,27 @@ static void *writer_main(void *arg)
         evr_event_vec *v = &q->slots[q->head];
         q->dirty = 1;
         run_batch(q, v, evr_host_seconds() >= q->last_flush + q->flush_seconds);
-        q->queued_bytes -= v->n * sizeof(evr_event);
+        const size_t bytes = q->slot_bytes[q->head];
+        evr_event_vec drop = {0};
+        q->queued_bytes -= bytes;
         v->n = 0;
-        q->spare[q->nspare++] = *v; /* at most one per slot */
+        /* kept for reuse while the spares and the queue stay within the queue's bound: else the
+         * buffers a burst grew all stayed, and a long run's memory crept up with its bursts */
+        if (q->queued_bytes + q->spare_bytes + bytes <= q->max_bytes) {
+            q->spare_held[q->nspare] = bytes;
+            q->spare[q->nspare++] = *v; /* at most one per slot */
+            q->spare_bytes += bytes;
+        } else drop = *v;
         v->data = NULL;
         v->cap = 0;
         q->head = (q->head + 1) % QUEUE_SLOTS;
         q->count--;
         pthread_cond_broadcast(&q->cv);
+        if (drop.data) {
+            pthread_mutex_unlock(&q->mu);
+            evr_event_vec_free(&drop);
+            pthread_mutex_lock(&q->mu);
+        }
     }
     pthread_mutex_unlock(&q->mu);
     return NULL;
@@ -197,6 +217,9 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     /* the writers at once (no pool, when it cannot be made: in turn) */
     if (num_writers > 1) q->pool = evr_par_pool_new(num_writers);
     q->flush_seconds = flush_seconds;
+    q->max_bytes = QUEUE_BYTES;
+    const char *mb = getenv("EVR_QUEUE_BYTES");
+    if (mb && strtoull(mb, NULL, 10) > 0) q->max_bytes = (size_t)strtoull(mb, NULL, 10);
     q->last_flush = evr_host_seconds(); /* the writers' files are valid when opened */
     q->status = EVR_OK;
     pthread_mutex_init(&q->mu, NULL);
@@ -241,8 +264,11 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
 {
     double t = evr_host_seconds();
     pthread_mutex_lock(&q->mu);
-    const size_t bytes = n * sizeof(evr_event);
-    while ((q->count == QUEUE_SLOTS || (q->count > 0 && q->queued_bytes + bytes > QUEUE_BYTES)) &&
+    /* v's buffer is the one given out last (or one of the caller's own): its pages touched */
+    size_t bytes = v->n * sizeof(evr_event);
+    if (bytes < q->out_bytes) bytes = q->out_bytes;
+    if (bytes > v->cap * sizeof(evr_event)) bytes = v->cap * sizeof(evr_event);
+    while ((q->count == QUEUE_SLOTS || (q->count > 0 && q->queued_bytes + bytes > q->max_bytes)) &&
            q->status == EVR_OK)
         pthread_cond_wait(&q->cv, &q->mu);
     q->wait_seconds += evr_host_seconds() - t;
@@ -252,9 +278,15 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
         pthread_mutex_unlock(&q->mu);
         return st;
     }
-    evr_event_vec *slot = &q->slots[(q->head + q->count) % QUEUE_SLOTS];
+    const int at = (q->head + q->count) % QUEUE_SLOTS;
+    evr_event_vec *slot = &q->slots[at];
     evr_event_vec rest = {0};
-    if (q->nspare) rest = q->spare[--q->nspare]; /* the last written: warm, and large enough */
+    size_t rest_bytes = 0;
+    if (q->nspare) { /* the last written: warm, and large enough */
+        rest = q->spare[--q->nspare];
+        rest_bytes = q->spare_held[q->nspare];
+        q->spare_bytes -= rest_bytes;
+    }
     pthread_mutex_unlock(&q->mu);
     /* this slot is not pending, so the thread does not touch it; the spare buffer takes v's rest */
     rest.n = 0;
@@ -267,7 +299,10 @@ evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_
     slot->cap = v->cap;
     slot->n = n;
     *v = rest;
+    if (rest_bytes < rest.n * sizeof(evr_event)) rest_bytes = rest.n * sizeof(evr_event);
     pthread_mutex_lock(&q->mu);
+    q->slot_bytes[at] = bytes;
+    q->out_bytes = rest_bytes;
     q->count++;
     q->queued_bytes += bytes;
     pthread_cond_broadcast(&q->cv);

@@ -6,8 +6,8 @@
  * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
  * flush, and otherwise once the thread has been idle until then: a killed run's files lag at
  * most about flush_seconds (plus the batch being written, and the HDF5 writer's last partial
- * chunk) behind the batches pushed, and a fast run does not flush per segment. At most eight
- * batches wait (write_queue.c). A stopped or failed run completes the files itself
+ * chunk) behind the batches pushed, and a fast run does not flush per segment. At most 32
+ * batches wait, holding at most 96 MB of buffers with the ones kept for reuse (write_queue.c). A stopped or failed run completes the files itself
  * (run/run_files.h), with what every writer took (evr_write_queue_accepted). */
 #ifndef EVR_WRITE_QUEUE_H
 #define EVR_WRITE_QUEUE_H
@@ -31,8 +31,8 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
 /* Adds writer w (not owned: the caller frees it after evr_write_queue_stop) before the first
  * push; EVR_ERR_ARG after it. The queue calls only its write() and flush(). */
 evr_status evr_write_queue_add(evr_write_queue *q, evr_event_writer *w, evr_error *err);
-/* Queues the first n events of v for writing and returns (waits only while eight batches are
- * pending) without copying them: the queue takes v's buffer and gives v one of its own holding
+/* Queues the first n events of v for writing and returns (waits only while the queue is full)
+ * without copying them: the queue takes v's buffer and gives v one of its own holding
  * the rest of v (v->data[n .. v->n)), which is usually short. Fails with the writer thread's
  * first error, if any. */
 evr_status evr_write_queue_push_take(evr_write_queue *q, evr_event_vec *v, size_t n,
