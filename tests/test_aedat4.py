@@ -2,7 +2,7 @@
 installed by scripts/test-venv.sh into build/venv (never the system Python). Every event must come
 back identical (t, x, y, p) to events.npy, on a run of the eye and on made-up events (a millisecond
 of 40000 events, Unix-time microseconds, the largest int16 addresses); each packet holds one
-millisecond's events, at most 32768; dv-processing's time-range reads (through the data table)
+millisecond's events, at most 8192; dv-processing's time-range reads (through the data table)
 give the same events as slicing; the stream is "events" at the run's size. Files dv-processing
 writes (every compression: NONE, LZ4, LZ4_HIGH, ZSTD, ZSTD_HIGH) read back identical through
 `evray convert`, and h5 -> aedat4 -> h5 gives identical events. The same for ZSTD packets
@@ -38,9 +38,9 @@ def same(ref, t, x, y, p):
     return ""
 
 def packets_ok(ts):
-    """each packet one millisecond's events, at most 32768"""
+    """each packet one millisecond's events, at most 8192"""
     for k, t in enumerate(ts):
-        if len(t) == 0 or len(t) > 32768 or t[0] // 1000 != t[-1] // 1000:
+        if len(t) == 0 or len(t) > 8192 or t[0] // 1000 != t[-1] // 1000:
             return f"packet {k}: {len(t)} events from {t[0] if len(t) else '-'} to {t[-1] if len(t) else '-'} us"
     return ""
 

@@ -32,7 +32,10 @@
 #include <unistd.h>
 
 #define PACKET_US 1000
-#define PACKET_MAX_EVENTS ((size_t)1 << 15)
+/* At most this many events a packet: a piece of 2^20 events (what a GPU run hands over at once)
+ * then makes 128 packets or more for the compressing threads; 32,768 left threads idle in the
+ * eye's bursts, one packet being one thread's work (docs/benchmarks.md) */
+#define PACKET_MAX_EVENTS ((size_t)1 << 13)
 #define PACKET_HEADER 8                               /* int32 stream id, int32 size */
 #define EVENT_PACKET_HEAD 32                          /* an EventPacket before its events */
 #define IOHEADER_DTP_AT (EVR_AEDAT4_VERSION_LEN + 32) /* dataTablePosition's file offset */
