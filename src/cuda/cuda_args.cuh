@@ -19,7 +19,9 @@ extern "C" {
 
 #define BLOCK 128 /* threads a block (the summed-area columns kernel excepted) */
 #ifndef MIN_BLOCKS
-#define MIN_BLOCKS 6 /* 80 registers: measured faster than 128 (occupancy) on the H100 */
+/* 64 registers: more warps in flight to hide the traversal's latency; faster than 80 and than
+ * 48 (docs/benchmarks.md, "Render kernels' registers") */
+#define MIN_BLOCKS 8
 #endif
 #ifndef MIN_BLOCKS_GI
 #define MIN_BLOCKS_GI 4 /* with global illumination: 128 registers (the gather's state) */
