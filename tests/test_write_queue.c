@@ -138,6 +138,15 @@ static evr_status gate_write(evr_event_writer *base, const evr_event *ev, size_t
     return EVR_OK;
 }
 
+/* A gate writer, closed. */
+static void gate_init(gate_writer *g)
+{
+    memset(g, 0, sizeof *g);
+    atomic_init(&g->open, 0);
+    g->base.write = gate_write;
+    g->base.flush = fake_flush_none;
+}
+
 /* Pushes as the simulation does: one vector whose events beyond those pushed stay in it (in a
  * buffer the queue gives back); each of `rounds` pushes takes 1,000 of 2,000,000 events, so every
  * batch's buffer holds 32 MB in memory for its 16 KB of events. */
@@ -328,10 +337,7 @@ int main(void)
         evr_write_queue *q = NULL;
         pusher p;
         pthread_t th;
-        memset(&g, 0, sizeof g);
-        atomic_init(&g.open, 0);
-        g.base.write = gate_write;
-        g.base.flush = fake_flush_none;
+        gate_init(&g);
         t = 0;
         CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
         CHECK_OK(push(q, &t, 3200000, &err)); /* taken by the writer, which waits at the gate */
@@ -364,10 +370,7 @@ int main(void)
         evr_write_queue *q = NULL;
         held_pusher p;
         pthread_t th;
-        memset(&g, 0, sizeof g);
-        atomic_init(&g.open, 0);
-        g.base.write = gate_write;
-        g.base.flush = fake_flush_none;
+        gate_init(&g);
         CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
         memset(&p, 0, sizeof p);
         p.q = q;
