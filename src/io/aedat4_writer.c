@@ -581,12 +581,14 @@ static evr_status aedat_write(evr_event_writer *base, const evr_event *ev, size_
      * write goes on past them, it is closed and packed with the write's other packets */
     if (w->n_open) {
         i = packet_end(ev, 0, n, w->open[0].t / PACKET_US, PACKET_MAX_EVENTS - w->n_open);
-        if (i == n && (st = check_all(w, ev, i, err)) != EVR_OK) return st;
-        memcpy(w->open + w->n_open, ev, i * sizeof *ev);
         if (i == n) {
-            w->n_open += i;
+            if ((st = check_all(w, ev, n, err)) != EVR_OK) return st;
+            memcpy(w->open + w->n_open, ev, n * sizeof *ev);
+            w->n_open += n;
             return EVR_OK;
         }
+        /* ev[0 .. i) close it: copied after its events, checked with the write's packets */
+        memcpy(w->open + w->n_open, ev, i * sizeof *ev);
         first_open = w->n_open + i;
     }
     /* the packets, the last left open */
