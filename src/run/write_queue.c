@@ -219,7 +219,8 @@ evr_status evr_write_queue_start(evr_event_writer *const *writers, int num_write
     q->flush_seconds = flush_seconds;
     q->max_bytes = QUEUE_BYTES;
     const char *mb = getenv("EVR_QUEUE_BYTES");
-    if (mb && strtoull(mb, NULL, 10) > 0) q->max_bytes = (size_t)strtoull(mb, NULL, 10);
+    const unsigned long long want = mb ? strtoull(mb, NULL, 10) : 0;
+    if (want > 0) q->max_bytes = (size_t)want;
     q->last_flush = evr_host_seconds(); /* the writers' files are valid when opened */
     q->status = EVR_OK;
     pthread_mutex_init(&q->mu, NULL);

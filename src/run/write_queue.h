@@ -2,13 +2,13 @@
  * backend renders segment i + 1. Batches are written in the order pushed; each batch goes to
  * the first writer, then to all the others at once on threads of their own (a writer is only
  * ever called by one thread at a time; the first, HDF5 when asked for, always by this one).
- * Every writer is
- * flushed (a valid file up to there) after a batch when flush_seconds have passed since the last
- * flush, and otherwise once the thread has been idle until then: a killed run's files lag at
- * most about flush_seconds (plus the batch being written, and the HDF5 writer's last partial
- * chunk) behind the batches pushed, and a fast run does not flush per segment. At most 32
- * batches wait, holding at most 96 MB of buffers with the ones kept for reuse (write_queue.c). A stopped or failed run completes the files itself
- * (run/run_files.h), with what every writer took (evr_write_queue_accepted). */
+ * Every writer is flushed (a valid file up to there) after a batch when flush_seconds have
+ * passed since the last flush, and otherwise once the thread has been idle until then: a killed
+ * run's files lag at most about flush_seconds (plus the batch being written, and the HDF5
+ * writer's last partial chunk) behind the batches pushed, and a fast run does not flush per
+ * segment. At most 32 batches wait, holding at most 96 MB of buffers with the ones kept for
+ * reuse (write_queue.c). A stopped or failed run completes the files itself (run/run_files.h),
+ * with what every writer took (evr_write_queue_accepted). */
 #ifndef EVR_WRITE_QUEUE_H
 #define EVR_WRITE_QUEUE_H
 
