@@ -138,13 +138,15 @@ static evr_status gate_write(evr_event_writer *base, const evr_event *ev, size_t
     return EVR_OK;
 }
 
-/* A gate writer, closed. */
-static void gate_init(gate_writer *g)
+/* A queue whose one writer is g, its gate closed. */
+static evr_status gated_queue(gate_writer *g, evr_write_queue **q, evr_error *err)
 {
+    evr_event_writer *ws[1] = {&g->base};
     memset(g, 0, sizeof *g);
     atomic_init(&g->open, 0);
     g->base.write = gate_write;
     g->base.flush = fake_flush_none;
+    return evr_write_queue_start(ws, 1, 1000.0, q, err);
 }
 
 /* Pushes as the simulation does: one vector whose events beyond those pushed stay in it (in a
@@ -333,13 +335,11 @@ int main(void)
      * larger than the bound still goes when the queue is empty */
     {
         gate_writer g;
-        evr_event_writer *ws[1] = {&g.base};
         evr_write_queue *q = NULL;
         pusher p;
         pthread_t th;
-        gate_init(&g);
         t = 0;
-        CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
+        CHECK_OK(gated_queue(&g, &q, &err));
         CHECK_OK(push(q, &t, 3200000, &err)); /* taken by the writer, which waits at the gate */
         memset(&p, 0, sizeof p);
         p.q = q;
@@ -366,12 +366,10 @@ int main(void)
      * events, all ten would wait, 320 MB of buffers) */
     {
         gate_writer g;
-        evr_event_writer *ws[1] = {&g.base};
         evr_write_queue *q = NULL;
         held_pusher p;
         pthread_t th;
-        gate_init(&g);
-        CHECK_OK(evr_write_queue_start(ws, 1, 1000.0, &q, &err));
+        CHECK_OK(gated_queue(&g, &q, &err));
         memset(&p, 0, sizeof p);
         p.q = q;
         p.rounds = 10;
