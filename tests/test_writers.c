@@ -23,6 +23,8 @@
 #include "par_pool.h"
 #include "io/event_reader.h"
 #include "io/event_writer.h"
+#include "io/file_commit.h"
+#include "io/file_room.h"
 #include "io/json.h"
 #include "io/json_read.h"
 #include "io/par_pack.h"
@@ -1124,6 +1126,64 @@ static void test_par_pack_ways(const char *root)
     free(want);
 }
 
+/* A large write with claim_room claims the room its parts may take (their bound) while they are
+ * packed, and publishing the file frees what was claimed past its end: a packer bounded at 16
+ * bytes an event that packs 8. Where the file system claims no room ahead, only the release is
+ * checked. */
+static size_t pp_bound_loose(const void *ctx, const evr_event *ev, size_t a, size_t b)
+{
+    (void)ctx;
+    (void)ev;
+    return (b - a) * 16;
+}
+
+static void test_par_pack_claims(const char *root)
+{
+    const size_t n = 200000;
+    const evr_par_packer packer = {pp_bound_loose, pp_pack, NULL, NULL};
+    evr_event *ev = calloc(n, sizeof *ev);
+    char path[600], tmp[620];
+    struct stat sb;
+    CHECK(ev != NULL);
+    if (!ev) return;
+    for (size_t i = 0; i < n; i++) ev[i].t = (int64_t)(i / 3);
+    snprintf(path, sizeof path, "%s/claims.bin", root);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    /* does this file system claim room ahead? */
+    FILE *f = fopen(tmp, "wb");
+    CHECK(f != NULL);
+    if (!f) {
+        free(ev);
+        return;
+    }
+    const int claims = evr_file_claim(fileno(f), 0, (uint64_t)1 << 20) == 0 &&
+                       fstat(fileno(f), &sb) == 0 && (uint64_t)sb.st_blocks * 512 >= (1u << 20);
+    CHECK(ftruncate(fileno(f), 0) == 0);
+    for (int threads = 2; threads <= 4; threads += 2) {
+        evr_par_packing pk;
+        size_t bytes = 0;
+        memset(&pk, 0, sizeof pk);
+        pk.pool = evr_par_pool_new(threads);
+        pk.claim_room = 1;
+        CHECK(evr_par_pack_write(&pk, &packer, ev, n, f, &bytes) == EVR_PAR_PACK_DONE);
+        CHECK(bytes == n * 8);
+        CHECK(fflush(f) == 0 && fstat(fileno(f), &sb) == 0);
+        /* claimed: from where the write began (after the first's n * 8 bytes), its bound */
+        if (claims)
+            CHECK((uint64_t)sb.st_blocks * 512 >= (uint64_t)(threads / 2 - 1) * n * 8 + n * 16);
+        evr_par_packing_free(&pk);
+    }
+    CHECK(fclose(f) == 0);
+    CHECK(evr_file_publish(tmp, path) == 0);
+    CHECK(stat(path, &sb) == 0 && sb.st_size == (off_t)(2 * n * 8));
+    CHECK((uint64_t)sb.st_blocks * 512 <= 2 * n * 8 + 65536);
+    if (check_failures)
+        fprintf(stderr, "claims: %d; %lld bytes in %lld blocks\n", claims, (long long)sb.st_size,
+                (long long)sb.st_blocks);
+    remove(path);
+    free(ev);
+}
+
 static void test_camera_formats(const char *root)
 {
     const size_t n = 6000;
@@ -1873,6 +1933,7 @@ int main(void)
     test_camera_formats(root);
     test_camera_parts(root);
     test_par_pack_ways(root);
+    test_par_pack_claims(root);
     test_rosbag(root);
     test_event_frames(root);
     bench_writer(root, "hdf5", evr_h5_writer_open, "bench.h5");

@@ -131,11 +131,16 @@ static size_t event_packet(unsigned char *out, const evr_event *ev, size_t n)
     evr_put_le32(out + 20, 6);
     evr_put_le32(out + 24, 4);
     evr_put_le32(out + 28, (uint32_t)n);
+    /* each Event built in a local, then copied: stores through p could alias ev, which kept the
+     * compiler from merging the byte stores */
     for (size_t i = 0; i < n; i++, p += EVR_AEDAT4_EVENT_BYTES) {
-        evr_put_le64(p, (uint64_t)ev[i].t);
-        evr_put_le16(p + 8, ev[i].x);
-        evr_put_le16(p + 10, ev[i].y);
-        evr_put_le32(p + 12, ev[i].p > 0);
+        const evr_event e = ev[i];
+        unsigned char rec[EVR_AEDAT4_EVENT_BYTES];
+        evr_put_le64(rec, (uint64_t)e.t);
+        evr_put_le16(rec + 8, e.x);
+        evr_put_le16(rec + 10, e.y);
+        evr_put_le32(rec + 12, e.p > 0);
+        memcpy(p, rec, sizeof rec);
     }
     return EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * n;
 }
@@ -520,6 +525,7 @@ static evr_status cut_tail(aedat_writer *w, evr_error *err)
     if ((st = set_table_position(w, -1, err)) != EVR_OK) return st;
     if (ftruncate(fileno(w->s.f), (off_t)w->end) != 0 || fseeko(w->s.f, 0, SEEK_END) != 0)
         return cannot_write(w, err);
+    w->s.parts.claimed = 0; /* the cut freed what was claimed past it */
     w->tail = 0;
     return EVR_OK;
 }
@@ -675,6 +681,7 @@ static evr_status aedat_open(const char *path, const evr_writer_meta *meta, int 
     w->compression = compression;
     memset(&w->lz4, 0, sizeof w->lz4); /* LZ4's defaults: fast, 64 KB linked blocks */
     w->s.parts.threads = COMPRESS_THREADS;
+    w->s.parts.claim_room = 1;
     w->end = (int64_t)len;
     w->open = malloc(PACKET_MAX_EVENTS * sizeof *w->open);
     w->raw = malloc(RAW_BYTES);

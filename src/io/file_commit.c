@@ -1,4 +1,5 @@
 #include "io/file_commit.h"
+#include "io/file_room.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -32,11 +33,13 @@ void evr_file_discard(FILE *f, const char *tmp)
     remove(tmp);
 }
 
-/* fsync of an open file or folder by path; 0, or -1 with errno. */
+/* fsync of a file (opened for writing: room claimed past its end is freed first, io/file_room.h)
+ * or folder by path; 0, or -1 with errno. */
 static int sync_path(const char *path, int flags)
 {
     int fd = open(path, flags | O_CLOEXEC), r, e;
     if (fd < 0) return -1;
+    if ((flags & O_ACCMODE) == O_WRONLY) evr_file_unclaim_tail(fd);
     r = fsync(fd);
     e = errno;
     close(fd);
@@ -64,7 +67,7 @@ int evr_folder_sync(const char *path)
 
 int evr_file_publish(const char *tmp, const char *path)
 {
-    if (sync_path(tmp, O_RDONLY) != 0 || evr_folder_sync(tmp) != 0 || rename(tmp, path) != 0)
+    if (sync_path(tmp, O_WRONLY) != 0 || evr_folder_sync(tmp) != 0 || rename(tmp, path) != 0)
         return -1;
     return evr_folder_sync(path);
 }

@@ -17,9 +17,10 @@ FILE *evr_file_create(const char *tmp, const char *who, evr_error *err);
 /* Gives up a file: closes and removes it. */
 void evr_file_discard(FILE *f, const char *tmp);
 
-/* Makes the file tmp durable under the name path: tmp's data is synced to the disk, then its
- * folder, then tmp is renamed to path and the folder synced again, so that after a power loss
- * path is either absent (or its earlier self) or complete. 0, or -1 with errno set. */
+/* Makes the file tmp durable under the name path: room claimed past its end is freed
+ * (io/file_room.h), tmp's data is synced to the disk, then its folder, then tmp is renamed to
+ * path and the folder synced again, so that after a power loss path is either absent (or its
+ * earlier self) or complete. 0, or -1 with errno set. */
 int evr_file_publish(const char *tmp, const char *path);
 
 /* Syncs the folder that holds path (after creating, renaming or removing a file in it). 0, or -1

@@ -14,4 +14,9 @@
  * no room. */
 int evr_file_claim(int fd, uint64_t from, uint64_t len);
 
+/* Frees what was claimed past the end of the open file fd (opened for writing): a truncation to
+ * its own size, which file systems take as the way to drop blocks kept past the end. Failing
+ * changes nothing but the space the file holds, so it is not reported. */
+void evr_file_unclaim_tail(int fd);
+
 #endif

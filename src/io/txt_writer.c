@@ -230,6 +230,7 @@ evr_status evr_txt_writer_open(const char *path, const evr_writer_meta *meta,
         w->buf = malloc(TXT_BUFFER);
         w->ids = meta->event_ids != 0;
         w->parts.threads = 16; /* formatting text costs several times npy's packing */
+        w->parts.claim_room = 1;
     }
     if (!w || !w->path || !w->tmp || !w->buf) {
         if (w) free_writer(w);
