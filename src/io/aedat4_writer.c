@@ -45,7 +45,7 @@
 #define COMPRESS_THREADS 16
 /* ZSTD's level for --format aedat4-zstd: one of its fast levels, so that the writer keeps up
  * with the GPU while the file stays well below LZ4's (docs/benchmarks.md, "Writers") */
-#define ZSTD_LEVEL (-3)
+#define ZSTD_LEVEL (-4)
 /* What a compressing thread packs with, kept for reuse: one per thread (the pool's and the caller) */
 #define PACK_SLOTS (COMPRESS_THREADS + 1)
 #define RAW_BYTES (EVENT_PACKET_HEAD + EVR_AEDAT4_EVENT_BYTES * PACKET_MAX_EVENTS)
