@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Whether each event writer keeps up with the render (docs/benchmarks.md, "Writers"): the built-in
+eye run once per format and program, the formats and programs alternating, round after round, and
+each run set against events.h5's run of the same program in the same round.
+
+    scripts/writer_bench.py EVRAY [BASE_EVRAY] [--formats h5,aedat4,rosbag] [--rounds 2]
+                            [--dir /dev/shm] [--res 1280x720] [--duration 30] [--backend cuda]
+
+Each run is `evray demo --scene eye --backend B --res R --samples-per-frame 10 --duration D -o
+DIR/writer-bench --no-preview -q --format F`; the figures come from its run.json. Prints one
+Markdown row per run: format, program, wall seconds, the render's wait for the writer, the writer
+thread's busy time, the wall against events.h5's in that round, the files' bytes and the first
+16 hex digits of their sha256 (files of equal digits are byte-identical). A run folder on tmpfs
+(the default) leaves the disk out of it."""
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+
+def find(obj, key):
+    """The first value of key anywhere in run.json's objects."""
+    if isinstance(obj, dict):
+        if key in obj:
+            return obj[key]
+        for v in obj.values():
+            r = find(v, key)
+            if r is not None:
+                return r
+    return None
+
+
+def digest(paths):
+    h = hashlib.sha256()
+    for p in paths:
+        with open(p, "rb") as f:
+            while True:
+                b = f.read(1 << 24)
+                if not b:
+                    break
+                h.update(b)
+    return h.hexdigest()[:16]
+
+
+def run(evray, fmt, a, out):
+    shutil.rmtree(out, ignore_errors=True)
+    cmd = [evray, "demo", "--scene", "eye", "--backend", a.backend, "--res", a.res,
+           "--samples-per-frame", "10", "--duration", str(a.duration), "-o", out, "--no-preview",
+           "-q", "--format", fmt]
+    p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        sys.exit("writer_bench: %s failed: %s" % (" ".join(cmd), p.stderr.strip()[-300:]))
+    with open(os.path.join(out, "run.json")) as f:
+        rj = json.load(f)
+    files = sorted(os.path.join(out, n) for n in os.listdir(out) if n.startswith("events"))
+    return {"wall": find(rj, "wall_seconds"), "wait": find(rj, "time_write_wait_seconds"),
+            "busy": find(rj, "time_write_thread_seconds"),
+            "bytes": sum(os.path.getsize(p) for p in files), "sha": digest(files)}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("evray")
+    ap.add_argument("base", nargs="?", help="a second program, run beside the first")
+    ap.add_argument("--formats", default="h5,aedat4,aedat4-zstd,evt2,evt3,dat,rosbag,npy")
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--dir", default="/dev/shm")
+    ap.add_argument("--res", default="1280x720")
+    ap.add_argument("--duration", type=float, default=30.0)
+    ap.add_argument("--backend", default="cuda")
+    a = ap.parse_args()
+    programs = [("base", a.base)] if a.base else []
+    programs.append(("new" if a.base else "evray", a.evray))
+    formats = a.formats.split(",")
+    if "h5" in formats:
+        formats.remove("h5")
+    out = os.path.join(a.dir, "writer-bench")
+    print("| round | `--format` | program | wall s | wait s | writer busy s | / h5 | bytes | sha256 |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    h5_wall = {}  # each program's events.h5 run of this round
+    for r in range(1, a.rounds + 1):
+        for fmt in ["h5"] + formats:
+            for name, evray in programs:
+                m = run(evray, fmt, a, out)
+                if fmt == "h5":
+                    h5_wall[name], ratio = m["wall"], ""
+                else:
+                    ratio = "%.3fx" % (m["wall"] / h5_wall[name])
+                print("| %d | %s | %s | %.3f | %.2f | %.2f | %s | %d | %s |" % (
+                    r, fmt, name, m["wall"], m["wait"], m["busy"], ratio, m["bytes"], m["sha"]),
+                    flush=True)
+    shutil.rmtree(out, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
