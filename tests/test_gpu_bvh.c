@@ -651,6 +651,58 @@ static void timing(const char *what, const evr_gpu_scene_view *v, const evr_rend
            1e-6 * n / (t1 - t0), 1e-6 * n / (t2 - t1), h1, h2);
 }
 
+#ifdef EVR_TRAVERSE_STATS
+evr_traverse_stats evr_tstats;
+
+static void stats_line(const char *what, long rays)
+{
+    const double n = rays > 0 ? (double)rays : 1.0;
+    printf("    %-28s top nodes %6.1f, groups entered %5.1f, nodes %6.1f, triangles %6.1f a ray\n",
+           what, evr_tstats.top_nodes / n, evr_tstats.groups / n, evr_tstats.nodes / n,
+           evr_tstats.tris / n);
+    memset(&evr_tstats, 0, sizeof evr_tstats);
+}
+
+/* The searches' work per ray (gpu_traverse.h's counters, kept by the CW8 searches): the camera
+ * rays, then from each hit a shadow ray to the scene's first light. */
+static void traverse_stats(const evr_gpu_scene_view *v, const evr_render_scene *rs,
+                           const test_ray *rays, int n, float eps)
+{
+    long shadows = 0;
+    evr_gpu_hit h;
+    memset(&evr_tstats, 0, sizeof evr_tstats);
+    for (int i = 0; i < n; i++) evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
+    stats_line("camera rays:", n);
+    if (rs->num_lights == 0) return;
+    const evr_light_view *l = &rs->lights[0];
+    evr_traverse_stats sum;
+    memset(&sum, 0, sizeof sum);
+    for (int i = 0; i < n; i++) {
+        if (!evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h)) continue;
+        const evr_v3 p = evr_v3_add(rays[i].ray.org, evr_v3_scale(rays[i].ray.dir, h.t));
+        evr_v3 lpos = l->pos, ldir = l->dir;
+        if (l->track >= 0) { /* the light's node at the ray's time */
+            const evr_m34 m = evr_motion_eval(evr_rs_track(rs, l->track), rays[i].f);
+            lpos = evr_m34_point(&m, lpos);
+            ldir = evr_m34_vector(&m, ldir);
+        }
+        evr_v3 d =
+            l->type == EVR_LIGHT_DIRECTIONAL ? evr_v3_scale(ldir, -1.0f) : evr_v3_sub(lpos, p);
+        const float len = l->type == EVR_LIGHT_DIRECTIONAL ? INFINITY : evr_v3_len(d);
+        const evr_ray sr = {p, evr_v3_norm(d)};
+        memset(&evr_tstats, 0, sizeof evr_tstats); /* the closest hit's counts */
+        evr_trace_any(v, rs, sr, eps, len, rays[i].f);
+        sum.top_nodes += evr_tstats.top_nodes;
+        sum.groups += evr_tstats.groups;
+        sum.nodes += evr_tstats.nodes;
+        sum.tris += evr_tstats.tris;
+        shadows++;
+    }
+    evr_tstats = sum;
+    stats_line("shadow rays to light 0:", shadows);
+}
+#endif
+
 /* ---- conservative motion bounds ---- */
 
 static int inside(evr_v3 p, const float *lo, const float *hi)
@@ -1512,6 +1564,10 @@ static void test_scene(const char *name, const evr_scene *s, const scene_expect 
             tot->well_mismatches += well_bad;
             snprintf(what, sizeof what, "camera rays, %s", layout_name(layouts[li]));
             timing(what, &view, &host.rs, &ref, rays, n_cam);
+#ifdef EVR_TRAVERSE_STATS
+            if (layouts[li] == EVR_GPU_LAYOUT_CW8) /* the counters are CW8's */
+                traverse_stats(&view, &host.rs, rays, n_cam, 1e-4f * host.scene_size);
+#endif
         }
         free(kind);
         free(rays);
@@ -1803,6 +1859,12 @@ int main(void)
         test_demo("eye", &eye, eye_t0, 2, 60000 / RAY_SCALE, 45000 / RAY_SCALE, 15000 / RAY_SCALE,
                   &tot);
         printf("(%.1f s)\n", now() - t);
+#ifdef EVR_TRAVERSE_STATS
+        {
+            static const double city_t0[1] = {1.0}; /* the camera flying down the street */
+            test_demo("city", NULL, city_t0, 1, 20000, 2000, 2000, &tot);
+        }
+#endif
         test_demo("square", NULL, square_t0, 1, 20000 / RAY_SCALE, 10000 / RAY_SCALE,
                   10000 / RAY_SCALE, &tot);
         printf("(%.1f s)\n", now() - t);

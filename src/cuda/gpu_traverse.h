@@ -84,6 +84,18 @@ typedef struct {
 #define EVR__ALWAYS_INLINE inline __attribute__((always_inline))
 #endif
 
+/* The searches' work counted, on the host only and only where EVR_TRAVERSE_STATS is defined
+ * (tests/test_gpu_bvh.c's stats build: docs/benchmarks.md); otherwise no code at all */
+#if defined(EVR_TRAVERSE_STATS) && !defined(__CUDACC__)
+typedef struct {
+    long top_nodes, groups, nodes, tris;
+} evr_traverse_stats;
+extern evr_traverse_stats evr_tstats;
+#define EVR__STAT(field) (evr_tstats.field++)
+#else
+#define EVR__STAT(field) ((void)0)
+#endif
+
 /* 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps), eps = 2^-24 */
 #define EVR__BOX_WIDEN 1.00000036f
 
@@ -563,6 +575,7 @@ evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const 
         if (ng_hits > 0x00ffffffu) {
             const evr_gpu_node8 *n = &nodes[evr__group_next(&ng_base, &ng_hits, r, stack, &sp)];
             uint32_t h = evr__node8(n, r, tnear, *tfar);
+            EVR__STAT(nodes);
             ng_base = n->child_base;
             ng_hits = (h & 0xff000000u) | n->imask;
             tg_base = n->item_base;
@@ -573,6 +586,7 @@ evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const 
             const uint32_t item = tg_base + (uint32_t)bit;
             float t, u, v;
             tg_hits &= ~(1u << bit);
+            EVR__STAT(tris);
             if (evr__leaf_tri(tris, ds, item, r, tnear, *tfar, &t, &u, &v) && t < *tfar &&
                 !evr__leaf_filtered(tris, ds, fs, item, u, v)) {
                 *tfar = t;
@@ -743,6 +757,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
         if (ng_hits > 0x00ffffffu) {
             const evr_gpu_node8 *n = &v->top8[evr__group_next(&ng_base, &ng_hits, &r, stack, &sp)];
             uint32_t h = evr__node8(n, &r, tnear, tfar);
+            EVR__STAT(top_nodes);
             ng_base = n->child_base;
             ng_hits = (h & 0xff000000u) | n->imask;
             tg_base = n->item_base;
@@ -752,6 +767,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
             int bit = evr__msb(tg_hits);
             tg_hits &= ~(1u << bit);
             if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
+            EVR__STAT(groups);
             if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear,
                               &tfar, any, stack, sp, hit, general)) {
                 found = 1;
