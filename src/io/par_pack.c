@@ -17,8 +17,8 @@
 #define PIPELINE_MIN_THREADS 4
 #define PIPELINE_PARTS 64
 /* Pause instructions the writing thread spins for a part before it sleeps on the condition
- * variable (about 0.1 ms on the GPU machine's Xeon): where packing is the bottleneck, a sleep
- * and a wake-up per part cost the AEDAT 4.0 writer a tenth of its busy time (docs/benchmarks.md) */
+ * variable (about 0.1 ms on the GPU machine's Xeon): where packing is the bottleneck, a sleep and
+ * a wake-up per part held the writer back (docs/benchmarks.md, "Writers") */
 #define PIPELINE_SPINS 2000
 
 typedef struct {

@@ -6,9 +6,9 @@
  * and pack; a prefix sum of the measures places each part, so formats whose records vary in size
  * (EVT 2.0's time-high words) are packed in parts too. A format whose packing outlasts its
  * writes (compression, text) has one of the pool's threads claim the parts' room in the file
- * while the others pack (io/file_room.h): the writes then only copy into claimed pages, which on
- * tmpfs halved their time; where the writes are the bottleneck (NPY), the claim only held the
- * file's lock longer. */
+ * while the others pack (io/file_room.h): the writes then only copy into claimed pages, not
+ * allocate them (on tmpfs, where the page cache is the file, the larger part of a write); where the
+ * writes are the bottleneck (NPY), the claim only held the file's lock longer. */
 #ifndef EVR_IO_PAR_PACK_H
 #define EVR_IO_PAR_PACK_H
 
