@@ -186,8 +186,17 @@ def test_slow_consumer(square):
     sim = evray.Simulator(square, long_config())
     it = sim.stream()
     got = [next(it).copy()]
-    time.sleep(1.0)  # the whole run takes about that on 2 cores; held back, it is far from done
-    st1 = sim.stats
+    # held back, the run stops once the hand-off and the queue are full; on a loaded machine it
+    # takes longer to get there than the second the whole run takes on 2 idle cores: wait until
+    # two looks half a second apart see the same segments done (30 s at most)
+    st1, deadline = sim.stats, time.monotonic() + 30.0
+    while True:
+        time.sleep(0.5)
+        st2 = sim.stats
+        if st2["segments_done"] == st1["segments_done"] or time.monotonic() > deadline:
+            break
+        st1 = st2
+    st1 = st2
     rss1 = rss_bytes()
     time.sleep(0.5)
     st2 = sim.stats
