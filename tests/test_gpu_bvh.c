@@ -664,21 +664,30 @@ static void stats_line(const char *what, long rays)
 }
 
 /* The searches' work per ray (gpu_traverse.h's counters, kept by the CW8 searches): the camera
- * rays, then from each hit a shadow ray to the scene's first light. */
+ * rays, and from each hit a shadow ray to the scene's first light. */
+static void stats_add(evr_traverse_stats *sum)
+{
+    sum->top_nodes += evr_tstats.top_nodes;
+    sum->groups += evr_tstats.groups;
+    sum->nodes += evr_tstats.nodes;
+    sum->tris += evr_tstats.tris;
+    memset(&evr_tstats, 0, sizeof evr_tstats);
+}
+
 static void traverse_stats(const evr_gpu_scene_view *v, const evr_render_scene *rs,
                            const test_ray *rays, int n, float eps)
 {
+    const evr_light_view *l = rs->num_lights > 0 ? &rs->lights[0] : NULL;
+    evr_traverse_stats cam, shadow;
     long shadows = 0;
-    evr_gpu_hit h;
+    memset(&cam, 0, sizeof cam);
+    memset(&shadow, 0, sizeof shadow);
     memset(&evr_tstats, 0, sizeof evr_tstats);
-    for (int i = 0; i < n; i++) evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
-    stats_line("camera rays:", n);
-    if (rs->num_lights == 0) return;
-    const evr_light_view *l = &rs->lights[0];
-    evr_traverse_stats sum;
-    memset(&sum, 0, sizeof sum);
     for (int i = 0; i < n; i++) {
-        if (!evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h)) continue;
+        evr_gpu_hit h;
+        const int hit = evr_trace_closest(v, rs, rays[i].ray, rays[i].tfar, rays[i].f, &h);
+        stats_add(&cam);
+        if (!hit || !l) continue;
         const evr_v3 p = evr_v3_add(rays[i].ray.org, evr_v3_scale(rays[i].ray.dir, h.t));
         evr_v3 lpos = l->pos, ldir = l->dir;
         if (l->track >= 0) { /* the light's node at the ray's time */
@@ -690,15 +699,14 @@ static void traverse_stats(const evr_gpu_scene_view *v, const evr_render_scene *
             l->type == EVR_LIGHT_DIRECTIONAL ? evr_v3_scale(ldir, -1.0f) : evr_v3_sub(lpos, p);
         const float len = l->type == EVR_LIGHT_DIRECTIONAL ? INFINITY : evr_v3_len(d);
         const evr_ray sr = {p, evr_v3_norm(d)};
-        memset(&evr_tstats, 0, sizeof evr_tstats); /* the closest hit's counts */
         evr_trace_any(v, rs, sr, eps, len, rays[i].f);
-        sum.top_nodes += evr_tstats.top_nodes;
-        sum.groups += evr_tstats.groups;
-        sum.nodes += evr_tstats.nodes;
-        sum.tris += evr_tstats.tris;
+        stats_add(&shadow);
         shadows++;
     }
-    evr_tstats = sum;
+    evr_tstats = cam;
+    stats_line("camera rays:", n);
+    if (!l) return;
+    evr_tstats = shadow;
     stats_line("shadow rays to light 0:", shadows);
 }
 #endif

@@ -30,8 +30,7 @@ typedef struct {
     int pass;                         /* 0: pack, 1: write (pack_then_write) */
     int pipelined;                    /* pack_and_write: parts are written as they are packed */
     int parts;                        /* PAR_PACK_PARTS, or PIPELINE_PARTS pipelined */
-    int claim;                        /* task 0 claims the parts' room, the others pack */
-    uint64_t claim_from, claim_to;    /* the file's bytes it claims */
+    evr_par_claim claim;              /* task 0 claims the parts' room when there is one */
     size_t first[PIPELINE_PARTS + 1]; /* part k: events [first[k], first[k + 1]) */
     size_t room[PIPELINE_PARTS];      /* its bound */
     size_t boff[PIPELINE_PARTS];      /* where its room starts in big */
@@ -73,14 +72,7 @@ static void pack_part(void *ctx, int k, int thread)
 {
     pack_job *j = ctx;
     (void)thread;
-    if (j->claim && j->pass == 0) {
-        if (k == 0) {
-            /* no room is no error here: the writes then fail and say why */
-            evr_file_claim(j->fd, j->claim_from, j->claim_to - j->claim_from);
-            return;
-        }
-        k--; /* task k packs part k - 1 */
-    }
+    if (j->pass == 0 && evr_par_claim_task(&j->claim, &k)) return;
     const size_t a = j->first[k], b = j->first[k + 1];
     if (j->pass == 0) {
         if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
@@ -109,7 +101,7 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
         pthread_mutex_destroy(&j->mu);
         return EVR_PAR_PACK_SERIAL;
     }
-    evr_par_pool_start(pool, j->parts + j->claim, pack_part, j);
+    evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_part, j);
     for (int k = 0; k < j->parts; k++) {
         /* the pool's threads take every part, in order: part k comes */
         for (int n = 0;
@@ -143,7 +135,7 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
 static evr_par_pack_result pack_then_write(evr_par_pool *pool, pack_job *j, size_t *bytes)
 {
     size_t total = 0;
-    evr_par_pool_run(pool, j->parts + j->claim, pack_part, j);
+    evr_par_pool_run(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_part, j);
     for (int k = 0; k < j->parts; k++) {
         if (j->size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
         j->off[k] = total;
@@ -158,6 +150,25 @@ static evr_par_pack_result pack_then_write(evr_par_pool *pool, pack_job *j, size
         }
     *bytes = total;
     return EVR_PAR_PACK_DONE;
+}
+
+evr_par_claim evr_par_claim_plan(evr_par_packing *pk, int fd, uint64_t at, uint64_t end)
+{
+    evr_par_claim c = {fd, at > pk->claimed ? at : pk->claimed, 0};
+    c.to = pk->claim_room && end > c.from ? end : c.from;
+    if (c.to > c.from) pk->claimed = c.to;
+    return c;
+}
+
+int evr_par_claim_task(const evr_par_claim *c, int *k)
+{
+    if (!evr_par_claim_tasks(c)) return 0;
+    if (*k == 0) {
+        evr_file_claim(c->fd, c->from, c->to - c->from);
+        return 1;
+    }
+    --*k; /* task k packs part k - 1 */
+    return 0;
 }
 
 evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer *p,
@@ -201,11 +212,7 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     j.fd = fileno(f);
     j.at = ftello(f);
     if (j.at < 0) return EVR_PAR_PACK_FAILED;
-    /* the room the parts may take, past what earlier writes claimed */
-    j.claim_from = (uint64_t)j.at > pk->claimed ? (uint64_t)j.at : pk->claimed;
-    j.claim_to = (uint64_t)j.at + room;
-    j.claim = pk->claim_room && j.claim_to > j.claim_from;
-    if (j.claim) pk->claimed = j.claim_to;
+    j.claim = evr_par_claim_plan(pk, j.fd, (uint64_t)j.at, (uint64_t)j.at + room);
     r = j.pipelined ? pack_and_write(pk->pool, &j, bytes) : pack_then_write(pk->pool, &j, bytes);
     if (r == EVR_PAR_PACK_SERIAL) pk->claimed = 0; /* the file may have been cut back */
     /* the stream goes on after the bytes written past it */

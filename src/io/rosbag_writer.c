@@ -19,7 +19,6 @@
  * and copying its 2.8 GB. Where messages and chunks end depends only on the events and the
  * flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
-#include "io/file_room.h"
 #include "io/raw_stream.h"
 #include "par_pool.h"
 
@@ -400,8 +399,8 @@ typedef struct {
     const evr_event *ev;
     size_t n;
     int parts;
-    int bad[BAG_PARTS]; /* check: an event the bag cannot hold; write: a failed write (errno) */
-    uint64_t claim_from, claim_to; /* pack: the file's bytes task 0 claims (none: equal) */
+    int bad[BAG_PARTS];  /* check: an event the bag cannot hold; write: a failed write (errno) */
+    evr_par_claim claim; /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
 } bag_job;
 
 /* Part k of a check: its events fit and keep time order (the first against the event before). */
@@ -453,21 +452,11 @@ static void pack_part(void *ctx, int k, int thread)
     }
 }
 
-/* Task k of packing: with room to claim, task 0 claims it (io/file_room.h; a bag is as large as
- * NPY, but its writes follow its packing, so the claim overlaps the packing rather than the
- * writes) and task k packs part k - 1; else part k. */
+/* Task k of packing: the claim's task, or a part (a bag is as large as NPY, but its writes follow
+ * its packing, so the claim overlaps the packing rather than the writes). */
 static void pack_task(void *ctx, int k, int thread)
 {
-    bag_job *j = ctx;
-    if (j->claim_to > j->claim_from) {
-        if (k == 0) {
-            /* no room is no error here: the writes then fail and say why */
-            evr_file_claim(fileno(j->w->s.f), j->claim_from, j->claim_to - j->claim_from);
-            return;
-        }
-        k--;
-    }
-    pack_part(ctx, k, thread);
+    if (!evr_par_claim_task(&((bag_job *)ctx)->claim, &k)) pack_part(ctx, k, thread);
 }
 
 /* Part k of writing the finished chunks: its share of their bytes. */
@@ -670,13 +659,10 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     j.n = n;
     j.parts = n < EVR_PAR_PACK_MIN ? 1 : BAG_PARTS;
     evr_par_pool *pool = pool_for(w, n, EVR_PAR_PACK_MIN);
-    if (pool) { /* the laid-out bytes' room, past what earlier writes claimed */
-        const uint64_t end = w->file_pos + w->pend.len;
-        j.claim_from = w->file_pos > w->s.parts.claimed ? w->file_pos : w->s.parts.claimed;
-        j.claim_to = end > j.claim_from ? end : j.claim_from;
-        w->s.parts.claimed = j.claim_to;
-    }
-    evr_par_pool_run(pool, j.parts + (j.claim_to > j.claim_from), pack_task, &j);
+    if (pool) /* the laid-out bytes' room */
+        j.claim =
+            evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos, w->file_pos + w->pend.len);
+    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
     st = write_ready(w, err);
     if (st != EVR_OK) w->broken = 1;
     return st;
@@ -764,6 +750,7 @@ evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
         w->width = (uint32_t)meta->width;
         w->height = (uint32_t)meta->height;
         w->file_pos = head.len;
+        w->s.parts.claim_room = 1; /* claimed while packing (bag_write) */
         /* the current chunk's head goes first; everything after the header goes by pwrite */
         if (!reserve(&w->pend, CHUNK_HEAD)) st = no_memory(w, err);
         else if (fflush(w->s.f) != 0) st = cannot_write(w, err);
