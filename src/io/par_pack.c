@@ -1,13 +1,12 @@
 #include "io/par_pack.h"
 
 #include <errno.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
 #include <unistd.h>
 #include "io/file_room.h"
+#include "io/par_order.h"
 
 #define PAR_PACK_THREADS 4
 #define PAR_PACK_PARTS 16
@@ -15,11 +14,7 @@
  * writes, which a pool of two or three misses more than the overlap gains. Then more parts than
  * threads, so that the first parts are written while later ones are packed. */
 #define PIPELINE_MIN_THREADS 4
-#define PIPELINE_PARTS 64
-/* Pause instructions the writing thread spins for a part before it sleeps on the condition
- * variable (about 0.1 ms on the GPU machine's Xeon): where packing is the bottleneck, a sleep and
- * a wake-up per part held the writer back (docs/benchmarks.md, "Writers") */
-#define PIPELINE_SPINS 2000
+#define PIPELINE_PARTS EVR_PAR_ORDER_MAX
 
 typedef struct {
     const evr_par_packer *p;
@@ -37,20 +32,8 @@ typedef struct {
     size_t size[PIPELINE_PARTS];      /* its bytes packed */
     size_t off[PIPELINE_PARTS];       /* their place after at */
     int bad[PIPELINE_PARTS];          /* a failed write: its errno (a pool thread's own) */
-    /* pipelined (pack_and_write): parts packed, under mu; cv signalled at each */
-    atomic_int packed[PIPELINE_PARTS];
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
+    evr_par_order packed;             /* pipelined (pack_and_write): the parts packed */
 } pack_job;
-
-static inline void cpu_relax(void)
-{
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#elif defined(__aarch64__)
-    __asm__ __volatile__("yield");
-#endif
-}
 
 /* Writes len bytes at the file offset at. */
 static int write_at(int fd, const unsigned char *src, size_t len, off_t at)
@@ -76,12 +59,7 @@ static void pack_part(void *ctx, int k, int thread)
     const size_t a = j->first[k], b = j->first[k + 1];
     if (j->pass == 0) {
         if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
-        if (j->pipelined) { /* the writing thread waits for it */
-            pthread_mutex_lock(&j->mu);
-            atomic_store_explicit(&j->packed[k], 1, memory_order_release); /* the spin reads it */
-            pthread_cond_signal(&j->cv);
-            pthread_mutex_unlock(&j->mu);
-        }
+        if (j->pipelined) evr_par_order_done(&j->packed, k); /* the writing thread waits */
     } else if (a < b &&
                !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)j->off[k])) {
         j->bad[k] = errno ? errno : EIO;
@@ -96,20 +74,11 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
 {
     size_t total = 0;
     int serial = 0, failed = 0;
-    if (pthread_mutex_init(&j->mu, NULL) != 0) return EVR_PAR_PACK_SERIAL;
-    if (pthread_cond_init(&j->cv, NULL) != 0) {
-        pthread_mutex_destroy(&j->mu);
-        return EVR_PAR_PACK_SERIAL;
-    }
+    if (evr_par_order_init(&j->packed) != 0) return EVR_PAR_PACK_SERIAL;
     evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_part, j);
     for (int k = 0; k < j->parts; k++) {
         /* the pool's threads take every part, in order: part k comes */
-        for (int n = 0;
-             n < PIPELINE_SPINS && !atomic_load_explicit(&j->packed[k], memory_order_acquire); n++)
-            cpu_relax();
-        pthread_mutex_lock(&j->mu);
-        while (!j->packed[k]) pthread_cond_wait(&j->cv, &j->mu);
-        pthread_mutex_unlock(&j->mu);
+        evr_par_order_wait(&j->packed, k);
         if (serial || failed) continue;
         if (j->size[k] == SIZE_MAX) serial = 1;
         else if (j->size[k] &&
@@ -118,8 +87,7 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
         else total += j->size[k];
     }
     evr_par_pool_wait(pool);
-    pthread_cond_destroy(&j->cv);
-    pthread_mutex_destroy(&j->mu);
+    evr_par_order_destroy(&j->packed);
     if (failed) {
         errno = failed; /* the caller's message says why */
         return EVR_PAR_PACK_FAILED;

@@ -19,6 +19,7 @@
  * and copying its 2.8 GB. Where messages and chunks end depends only on the events and the
  * flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
+#include "io/par_order.h"
 #include "io/raw_stream.h"
 #include "par_pool.h"
 
@@ -42,9 +43,11 @@
 #define CHUNK_HEAD (4 + 41 + 4)
 #define INDEX_HEAD (4 + 47 + 4)
 #define MSG_HEAD (4 + 38 + 4 + 28)
-#define BAG_THREADS 8                /* threads packing and writing a large write */
-#define BAG_PARTS 32                 /* the parts a large write's events are packed in */
-#define WRITE_PART ((size_t)4 << 20) /* bytes of a part of the file written by one thread */
+/* threads packing and writing a large write; the parts its events are packed in
+ * (EVR_PAR_ORDER_MAX at most); bytes of a part of the file written by one thread */
+#define BAG_THREADS 8
+#define BAG_PARTS 32
+#define WRITE_PART ((size_t)4 << 20)
 
 #define OP_MSG_DATA 0x02
 #define OP_BAG_HEADER 0x03
@@ -399,8 +402,10 @@ typedef struct {
     const evr_event *ev;
     size_t n;
     int parts;
-    int bad[BAG_PARTS];  /* check: an event the bag cannot hold; write: a failed write (errno) */
-    evr_par_claim claim; /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
+    int bad[BAG_PARTS];    /* check: an event the bag cannot hold; write: a failed write (errno) */
+    evr_par_claim claim;   /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
+    evr_par_order *packed; /* pack, pipelined: the parts packed (else NULL) */
+    size_t from;           /* write: pend's bytes [from, from + n) */
 } bag_job;
 
 /* Part k of a check: its events fit and keep time order (the first against the event before). */
@@ -456,7 +461,10 @@ static void pack_part(void *ctx, int k, int thread)
  * its packing, so the claim overlaps the packing rather than the writes). */
 static void pack_task(void *ctx, int k, int thread)
 {
-    if (!evr_par_claim_task(&((bag_job *)ctx)->claim, &k)) pack_part(ctx, k, thread);
+    bag_job *j = ctx;
+    if (evr_par_claim_task(&j->claim, &k)) return;
+    pack_part(ctx, k, thread);
+    if (j->packed) evr_par_order_done(j->packed, k);
 }
 
 /* Part k of writing the finished chunks: its share of their bytes. */
@@ -466,6 +474,8 @@ static void write_part(void *ctx, int k, int thread)
     size_t a, b;
     (void)thread;
     evr_par_share(j->n, j->parts, k, &a, &b);
+    a += j->from;
+    b += j->from;
     if (!write_at(fileno(j->w->s.f), j->w->pend.p + a, b - a, j->w->file_pos + a))
         j->bad[k] = errno ? errno : EIO;
 }
@@ -567,17 +577,19 @@ static int lay_out(bag_writer *w, const evr_event *ev, size_t n)
     return 1;
 }
 
-/* Writes the finished chunks at their place in the file; pend keeps the current chunk. */
-static evr_status write_ready(bag_writer *w, evr_error *err)
+/* Writes the finished chunks at their place in the file, past the first `done` bytes (written
+ * already); pend keeps the current chunk. */
+static evr_status write_ready_from(bag_writer *w, size_t done, evr_error *err)
 {
     bag_job j;
     if (w->pend.failed || w->index.failed) return no_memory(w, err);
     if (!w->ready) return EVR_OK;
     memset(&j, 0, sizeof j);
     j.w = w;
-    j.n = w->ready;
-    j.parts = w->ready / WRITE_PART < BAG_PARTS ? (int)(w->ready / WRITE_PART) + 1 : BAG_PARTS;
-    evr_par_pool_run(pool_for(w, w->ready, 2 * WRITE_PART), j.parts, write_part, &j);
+    j.n = w->ready - done;
+    j.parts = j.n / WRITE_PART < BAG_PARTS ? (int)(j.n / WRITE_PART) + 1 : BAG_PARTS;
+    j.from = done;
+    evr_par_pool_run(pool_for(w, j.n, 2 * WRITE_PART), j.parts, write_part, &j);
     for (int k = 0; k < j.parts; k++)
         if (j.bad[k]) {
             errno = j.bad[k];
@@ -641,6 +653,44 @@ static evr_status write_tail(bag_writer *w, evr_error *err)
     return EVR_OK;
 }
 
+static evr_status write_ready(bag_writer *w, evr_error *err) { return write_ready_from(w, 0, err); }
+
+/* Where event i of the write (laid out) lies in pend. */
+static size_t event_at(const bag_writer *w, size_t i)
+{
+    size_t lo = 0, hi = w->n_pieces;
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (w->pieces[mid].first <= i) lo = mid;
+        else hi = mid;
+    }
+    return w->pieces[lo].at + (i - w->pieces[lo].first) * EVENT_BYTES;
+}
+
+/* Packs job j's parts on the pool while this thread writes the finished chunks' bytes in order,
+ * those before part k + 1's first event as soon as part k is packed (writes to one file go one at
+ * a time in the kernel: a bag packed and then written took the packing's time plus the writing's);
+ * returns the bytes written (the rest of the finished chunks is the caller's), 0 with *failed
+ * set (errno) when a write failed. */
+static size_t pack_and_write(bag_writer *w, evr_par_pool *pool, bag_job *j, int *failed)
+{
+    size_t written = 0;
+    evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_task, j);
+    for (int k = 0; k < j->parts; k++) {
+        size_t a, b;
+        evr_par_order_wait(j->packed, k);
+        evr_par_share(j->n, j->parts, k, &a, &b);
+        size_t upto = b < j->n ? event_at(w, b) : w->ready;
+        if (upto > w->ready) upto = w->ready;
+        if (*failed || upto <= written) continue;
+        if (!write_at(fileno(w->s.f), w->pend.p + written, upto - written, w->file_pos + written))
+            *failed = errno ? errno : EIO;
+        written = upto;
+    }
+    evr_par_pool_wait(pool);
+    return *failed ? 0 : written;
+}
+
 static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     bag_writer *w = (bag_writer *)base;
@@ -662,8 +712,19 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     if (pool) /* the laid-out bytes' room */
         j.claim =
             evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos, w->file_pos + w->pend.len);
-    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
-    st = write_ready(w, err);
+    evr_par_order packed;
+    /* pipelined with four threads or more, as io/par_pack.c: fewer miss the one that writes */
+    if (pool && evr_par_pool_threads(pool) >= 4 && evr_par_order_init(&packed) == 0) {
+        int failed = 0;
+        j.packed = &packed;
+        const size_t written = pack_and_write(w, pool, &j, &failed);
+        evr_par_order_destroy(&packed);
+        errno = failed;
+        st = failed ? cannot_write(w, err) : write_ready_from(w, written, err);
+    } else {
+        evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
+        st = write_ready(w, err);
+    }
     if (st != EVR_OK) w->broken = 1;
     return st;
 }
