@@ -1002,6 +1002,14 @@ static void test_camera_parts(const char *root)
                     len_serial);
         if (serial && parts && len_serial == len_parts)
             CHECK(memcmp(serial, parts, len_serial) == 0);
+        /* the same with the pools of a many-core machine (their pipelined ways) */
+        size_t len_many = 0;
+        setenv("EVR_PAR_THREADS", "16", 1);
+        unsigned char *many = write_in_batches(path, f[k].open, ev, n, 1000, 140000, &len_many);
+        unsetenv("EVR_PAR_THREADS");
+        CHECK(serial && many && len_many == len_serial);
+        if (serial && many && len_many == len_serial) CHECK(memcmp(serial, many, len_serial) == 0);
+        free(many);
         free(serial);
         free(parts);
         {
