@@ -12,12 +12,13 @@
  *
  * Speed: the bytes not written yet are laid out in one buffer as they will lie in the file
  * (finished chunks, then the current chunk with the gathering message last), the fixed-size
- * record headers filled in when their lengths are known. A write() first checks its events,
- * then finds where its messages begin (a search on the sorted times, not a test per event),
- * then packs the events at their places and writes the finished chunks at their file offsets,
- * both in parts on a pool of threads: the GPU run of the 30 s eye waited on one thread packing
- * and copying its 2.8 GB. Where messages and chunks end depends only on the events and the
- * flush() calls, not on how the events are cut into write() calls. */
+ * record headers filled in when their lengths are known. A write() first checks its events
+ * while one of the pool's threads claims their room in the file (io/file_room.h), then finds
+ * where its messages begin (a search on the sorted times, not a test per event), then packs the
+ * events at their places in parts on the pool while this thread writes the finished chunks'
+ * bytes as soon as the parts before them are packed: the GPU run of the 30 s eye waited on one
+ * thread packing and copying its gigabytes. Where messages and chunks end depends only on the
+ * events and the flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
 #include "io/par_order.h"
 #include "io/raw_stream.h"
@@ -48,6 +49,8 @@
 #define BAG_THREADS 8
 #define BAG_PARTS 32
 #define WRITE_PART ((size_t)4 << 20)
+/* pend's written bytes go when the rest is this fraction of them or less (pend_at) */
+#define PEND_MOVE_FRACTION 4
 
 #define OP_MSG_DATA 0x02
 #define OP_BAG_HEADER 0x03
@@ -108,11 +111,14 @@ typedef struct {
     evr_status (*raw_finish)(evr_event_writer *w, int64_t duration_us, evr_error *err);
     void (*raw_abort)(evr_event_writer *w);
     uint32_t width, height, seq;
-    /* the file's bytes from file_pos on, not written yet: finished chunks (the first `ready`
-     * bytes), then the current chunk, whose record starts at chunk_at */
+    /* the file's bytes from file_pos on, not written yet, are pend's from pend_at on: finished
+     * chunks up to `ready`, then the current chunk, whose record starts at chunk_at (offsets in
+     * pend). The bytes before pend_at were written; the rest moves down once it is a fraction of
+     * them (moving the gathering message's megabytes down at every write was a large part of the
+     * writer's time) */
     bytes pend;
     uint64_t file_pos;
-    size_t ready, chunk_at;
+    size_t pend_at, ready, chunk_at;
     bytes index; /* the current chunk's index entries */
     uint64_t chunk_start, chunk_end;
     uint32_t chunk_n;  /* its finished messages */
@@ -321,7 +327,7 @@ static int close_chunk(bag_writer *w)
     memcpy(p + upto + INDEX_HEAD, w->index.p, w->index.len);
     w->pend.len += gap;
     chunk_info *ci = &w->infos[w->n_infos++];
-    ci->pos = w->file_pos + w->chunk_at;
+    ci->pos = w->file_pos + (w->chunk_at - w->pend_at);
     ci->start = w->chunk_start;
     ci->end = w->chunk_end;
     ci->count = w->chunk_n;
@@ -408,12 +414,14 @@ typedef struct {
     size_t from;           /* write: pend's bytes [from, from + n) */
 } bag_job;
 
-/* Part k of a check: its events fit and keep time order (the first against the event before). */
+/* Task k of a check: the claim's task, or part k's events fit and keep time order (the first
+ * against the event before). */
 static void check_part(void *ctx, int k, int thread)
 {
     bag_job *j = ctx;
     size_t a, b;
     (void)thread;
+    if (evr_par_claim_task(&j->claim, &k)) return;
     evr_par_share(j->n, j->parts, k, &a, &b);
     for (size_t i = a; i < b; i++)
         if (!evr_raw_stream_fits(&j->w->s, &j->ev[i]) || (i > 0 && j->ev[i].t < j->ev[i - 1].t)) {
@@ -457,8 +465,8 @@ static void pack_part(void *ctx, int k, int thread)
     }
 }
 
-/* Task k of packing: the claim's task, or a part (a bag is as large as NPY, but its writes follow
- * its packing, so the claim overlaps the packing rather than the writes). */
+/* Task k of packing: the claim's task, or a part (marked done for the writing thread when it
+ * waits on the parts). */
 static void pack_task(void *ctx, int k, int thread)
 {
     bag_job *j = ctx;
@@ -476,7 +484,7 @@ static void write_part(void *ctx, int k, int thread)
     evr_par_share(j->n, j->parts, k, &a, &b);
     a += j->from;
     b += j->from;
-    if (!write_at(fileno(j->w->s.f), j->w->pend.p + a, b - a, j->w->file_pos + a))
+    if (!write_at(fileno(j->w->s.f), j->w->pend.p + a, b - a, j->w->file_pos + (a - j->w->pend_at)))
         j->bad[k] = errno ? errno : EIO;
 }
 
@@ -488,18 +496,34 @@ static evr_par_pool *pool_for(bag_writer *w, size_t work, size_t large)
     return w->s.parts.pool;
 }
 
+/* A bound on the bytes ev[0 .. n) add to the bag when they can go in it: their records and, for
+ * each message they may end or begin, its head, its index entry and a chunk's heads. */
+static uint64_t bytes_bound(const evr_event *ev, size_t n)
+{
+    const int64_t t0 = ev[0].t < 0 ? 0 : ev[0].t, t1 = ev[n - 1].t < t0 ? t0 : ev[n - 1].t;
+    const uint64_t msgs = (uint64_t)((t1 - t0) / 1000000 * MSG_HZ) + MSG_HZ + n / MSG_MAX_EVENTS;
+    return (uint64_t)n * EVENT_BYTES + (msgs + 2) * (MSG_HEAD + 12 + CHUNK_HEAD + INDEX_HEAD) +
+           BAG_HEADER_BYTES;
+}
+
 /* Refuses the write when an event cannot go in the bag, with the first such event's line;
- * nothing changes then. */
+ * nothing changes then (but room claimed past the file's end). A large write's pool claims its
+ * bytes' room while the others check: the claim allocates tmpfs pages, as long as the writes. */
 static evr_status check_events(bag_writer *w, const evr_event *ev, size_t n, evr_error *err)
 {
     bag_job j;
     int bad = w->s.have_last && ev[0].t < w->s.last_t;
+    evr_par_pool *pool = pool_for(w, n, EVR_PAR_PACK_MIN);
     memset(&j, 0, sizeof j);
     j.w = w;
     j.ev = ev;
     j.n = n;
     j.parts = n < EVR_PAR_PACK_MIN ? 1 : BAG_PARTS;
-    evr_par_pool_run(pool_for(w, n, EVR_PAR_PACK_MIN), j.parts, check_part, &j);
+    if (pool) {
+        const uint64_t end = w->file_pos + (w->pend.len - w->pend_at);
+        j.claim = evr_par_claim_plan(&w->s.parts, fileno(w->s.f), end, end + bytes_bound(ev, n));
+    }
+    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), check_part, &j);
     for (int k = 0; k < j.parts; k++) bad |= j.bad[k];
     if (bad) {
         const int64_t last_t = w->s.last_t;
@@ -577,30 +601,35 @@ static int lay_out(bag_writer *w, const evr_event *ev, size_t n)
     return 1;
 }
 
-/* Writes the finished chunks at their place in the file, past the first `done` bytes (written
+/* Writes the finished chunks at their place in the file, past their first `done` bytes (written
  * already); pend keeps the current chunk. */
 static evr_status write_ready_from(bag_writer *w, size_t done, evr_error *err)
 {
     bag_job j;
     if (w->pend.failed || w->index.failed) return no_memory(w, err);
-    if (!w->ready) return EVR_OK;
+    if (w->ready == w->pend_at) return EVR_OK;
     memset(&j, 0, sizeof j);
     j.w = w;
-    j.n = w->ready - done;
+    j.n = w->ready - w->pend_at - done;
     j.parts = j.n / WRITE_PART < BAG_PARTS ? (int)(j.n / WRITE_PART) + 1 : BAG_PARTS;
-    j.from = done;
+    j.from = w->pend_at + done;
     evr_par_pool_run(pool_for(w, j.n, 2 * WRITE_PART), j.parts, write_part, &j);
     for (int k = 0; k < j.parts; k++)
         if (j.bad[k]) {
             errno = j.bad[k];
             return cannot_write(w, err);
         }
-    memmove(w->pend.p, w->pend.p + w->ready, w->pend.len - w->ready);
-    w->pend.len -= w->ready;
-    w->file_pos += w->ready;
-    w->chunk_at -= w->ready;
-    if (w->msg_open) w->msg_at -= w->ready;
-    w->ready = 0;
+    w->file_pos += w->ready - w->pend_at;
+    w->pend_at = w->ready;
+    if ((w->pend.len - w->pend_at) * PEND_MOVE_FRACTION <= w->pend_at) {
+        const size_t at = w->pend_at;
+        memmove(w->pend.p, w->pend.p + at, w->pend.len - at);
+        w->pend.len -= at;
+        w->ready -= at;
+        w->chunk_at -= at;
+        if (w->msg_open) w->msg_at -= at;
+        w->pend_at = 0;
+    }
     return EVR_OK;
 }
 
@@ -674,7 +703,7 @@ static size_t event_at(const bag_writer *w, size_t i)
  * set (errno) when a write failed. */
 static size_t pack_and_write(bag_writer *w, evr_par_pool *pool, bag_job *j, int *failed)
 {
-    size_t written = 0;
+    size_t written = w->pend_at; /* pend's bytes before it are in the file */
     evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_task, j);
     for (int k = 0; k < j->parts; k++) {
         size_t a, b;
@@ -683,12 +712,13 @@ static size_t pack_and_write(bag_writer *w, evr_par_pool *pool, bag_job *j, int 
         size_t upto = b < j->n ? event_at(w, b) : w->ready;
         if (upto > w->ready) upto = w->ready;
         if (*failed || upto <= written) continue;
-        if (!write_at(fileno(w->s.f), w->pend.p + written, upto - written, w->file_pos + written))
+        if (!write_at(fileno(w->s.f), w->pend.p + written, upto - written,
+                      w->file_pos + (written - w->pend_at)))
             *failed = errno ? errno : EIO;
         written = upto;
     }
     evr_par_pool_wait(pool);
-    return *failed ? 0 : written;
+    return *failed ? 0 : written - w->pend_at;
 }
 
 static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
@@ -709,9 +739,9 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     j.n = n;
     j.parts = n < EVR_PAR_PACK_MIN ? 1 : BAG_PARTS;
     evr_par_pool *pool = pool_for(w, n, EVR_PAR_PACK_MIN);
-    if (pool) /* the laid-out bytes' room */
-        j.claim =
-            evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos, w->file_pos + w->pend.len);
+    if (pool) /* the laid-out bytes' room, where check_events' bound fell short */
+        j.claim = evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos,
+                                     w->file_pos + (w->pend.len - w->pend_at));
     evr_par_order packed;
     /* pipelined with four threads or more, as io/par_pack.c: fewer miss the one that writes */
     if (pool && evr_par_pool_threads(pool) >= 4 && evr_par_order_init(&packed) == 0) {
@@ -811,7 +841,7 @@ evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
         w->width = (uint32_t)meta->width;
         w->height = (uint32_t)meta->height;
         w->file_pos = head.len;
-        w->s.parts.claim_room = 1; /* claimed while packing (bag_write) */
+        w->s.parts.claim_room = 1; /* claimed while checking (check_events) */
         /* the current chunk's head goes first; everything after the header goes by pwrite */
         if (!reserve(&w->pend, CHUNK_HEAD)) st = no_memory(w, err);
         else if (fflush(w->s.f) != 0) st = cannot_write(w, err);
