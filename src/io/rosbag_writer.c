@@ -15,12 +15,13 @@
  * record headers filled in when their lengths are known. A write() first checks its events
  * while one of the pool's threads claims their room in the file (io/file_room.h), then finds
  * where its messages begin (a search on the sorted times, not a test per event), then packs the
- * events at their places in parts on the pool while this thread writes the finished chunks'
- * bytes as soon as the parts before them are packed: the GPU run of the 30 s eye waited on one
- * thread packing and copying its gigabytes. Where messages and chunks end depends only on the
- * events and the flush() calls, not on how the events are cut into write() calls. */
+ * events at their places in parts on the pool; a large write's finished chunks are then written
+ * by a thread of their own while the next write is checked and packed (io/write_behind.h): the
+ * GPU run of the 30 s eye waited on one thread packing and copying its gigabytes, and then on
+ * these phases one after the other. Where messages and chunks end depends only on the events
+ * and the flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
-#include "io/par_order.h"
+#include "io/write_behind.h"
 #include "io/raw_stream.h"
 #include "par_pool.h"
 
@@ -44,8 +45,8 @@
 #define CHUNK_HEAD (4 + 41 + 4)
 #define INDEX_HEAD (4 + 47 + 4)
 #define MSG_HEAD (4 + 38 + 4 + 28)
-/* threads packing and writing a large write; the parts its events are packed in
- * (EVR_PAR_ORDER_MAX at most); bytes of a part of the file written by one thread */
+/* threads packing and writing a large write; the parts its events are packed in; bytes of a
+ * part of the file written by one thread */
 #define BAG_THREADS 8
 #define BAG_PARTS 32
 #define WRITE_PART ((size_t)4 << 20)
@@ -133,6 +134,10 @@ typedef struct {
     piece *pieces; /* the current write's */
     size_t n_pieces, cap_pieces;
     int broken; /* a write or flush failed: chunks may be cut, the tail overwritten */
+    /* a large write's finished chunks, written from pend while the next write is checked, laid
+     * out and packed: pend's bytes stay in place until it is waited for (pend_room, settle) */
+    evr_write_behind behind;
+    int io_err; /* its failed write's errno, met where pend had to grow */
 } bag_writer;
 
 /* Room for n more bytes at b->p + b->len (NULL, and b->failed, when out of memory). */
@@ -151,6 +156,13 @@ static unsigned char *reserve(bytes *b, size_t n)
         b->cap = cap;
     }
     return b->p + b->len;
+}
+
+/* Room for n more bytes in pend; a buffer that must move waits for the write behind first. */
+static unsigned char *pend_room(bag_writer *w, size_t n)
+{
+    if (w->pend.cap - w->pend.len < n && !w->io_err) w->io_err = evr_write_behind_wait(&w->behind);
+    return w->io_err ? NULL : reserve(&w->pend, n);
 }
 
 static void put(bytes *b, const void *data, size_t n)
@@ -312,7 +324,7 @@ static int close_chunk(bag_writer *w)
     const size_t upto = w->msg_open ? w->msg_at : w->pend.len;
     const size_t index_len = INDEX_HEAD + w->index.len, gap = index_len + CHUNK_HEAD;
     const size_t tail = w->pend.len - upto;
-    if (w->index.failed || !reserve(&w->pend, gap)) return 0;
+    if (w->index.failed || !pend_room(w, gap)) return 0;
     if (w->n_infos == w->cap_infos) {
         size_t cap = w->cap_infos ? 2 * w->cap_infos : 64;
         chunk_info *p = realloc(w->infos, cap * sizeof *p);
@@ -344,10 +356,11 @@ static int close_chunk(bag_writer *w)
 static int begin_message(bag_writer *w, int64_t win)
 {
     if (!w->conn_in_chunk) {
+        if (!pend_room(w, 4096)) return 0; /* the record's few hundred bytes */
         connection_record(&w->pend);
         w->conn_in_chunk = 1;
     }
-    if (!reserve(&w->pend, MSG_HEAD)) return 0;
+    if (!pend_room(w, MSG_HEAD)) return 0;
     w->msg_at = w->pend.len;
     w->pend.len += MSG_HEAD;
     w->msg_open = 1;
@@ -408,10 +421,9 @@ typedef struct {
     const evr_event *ev;
     size_t n;
     int parts;
-    int bad[BAG_PARTS];    /* check: an event the bag cannot hold; write: a failed write (errno) */
-    evr_par_claim claim;   /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
-    evr_par_order *packed; /* pack, pipelined: the parts packed (else NULL) */
-    size_t from;           /* write: pend's bytes [from, from + n) */
+    int bad[BAG_PARTS];  /* check: an event the bag cannot hold; write: a failed write (errno) */
+    evr_par_claim claim; /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
+    size_t from;         /* write: pend's bytes [from, from + n) */
 } bag_job;
 
 /* Task k of a check: the claim's task, or part k's events fit and keep time order (the first
@@ -465,14 +477,12 @@ static void pack_part(void *ctx, int k, int thread)
     }
 }
 
-/* Task k of packing: the claim's task, or a part (marked done for the writing thread when it
- * waits on the parts). */
+/* Task k of packing: the claim's task, or a part. */
 static void pack_task(void *ctx, int k, int thread)
 {
     bag_job *j = ctx;
     if (evr_par_claim_task(&j->claim, &k)) return;
     pack_part(ctx, k, thread);
-    if (j->packed) evr_par_order_done(j->packed, k);
 }
 
 /* Part k of writing the finished chunks: its share of their bytes. */
@@ -581,7 +591,7 @@ static int add_piece(bag_writer *w, size_t first, size_t end, size_t at)
 static int lay_out(bag_writer *w, const evr_event *ev, size_t n)
 {
     w->n_pieces = 0;
-    if (!reserve(&w->pend, n * EVENT_BYTES + MSG_HEAD)) return 0;
+    if (!pend_room(w, n * EVENT_BYTES + MSG_HEAD)) return 0;
     for (size_t i = 0; i < n;) {
         const int64_t win = ev[i].t * MSG_HZ / 1000000;
         const int64_t next = ((win + 1) * 1000000 + MSG_HZ - 1) / MSG_HZ; /* the next window */
@@ -591,8 +601,7 @@ static int lay_out(bag_writer *w, const evr_event *ev, size_t n)
         if (!w->msg_open && !begin_message(w, win)) return 0;
         end = first_from(ev, i, n, next);
         if (end - i > MSG_MAX_EVENTS - w->msg_n) end = i + (MSG_MAX_EVENTS - w->msg_n);
-        if (!reserve(&w->pend, (end - i) * EVENT_BYTES) || !add_piece(w, i, end, w->pend.len))
-            return 0;
+        if (!pend_room(w, (end - i) * EVENT_BYTES) || !add_piece(w, i, end, w->pend.len)) return 0;
         w->pend.len += (end - i) * EVENT_BYTES;
         w->msg_n += end - i;
         w->msg_t = ev[end - 1].t;
@@ -601,26 +610,16 @@ static int lay_out(bag_writer *w, const evr_event *ev, size_t n)
     return 1;
 }
 
-/* Writes the finished chunks at their place in the file, past their first `done` bytes (written
- * already); pend keeps the current chunk. */
-static evr_status write_ready_from(bag_writer *w, size_t done, evr_error *err)
+/* Waits for the write behind, then moves pend's unwritten bytes down once they are a fraction of
+ * the written ones. */
+static evr_status settle(bag_writer *w, evr_error *err)
 {
-    bag_job j;
-    if (w->pend.failed || w->index.failed) return no_memory(w, err);
-    if (w->ready == w->pend_at) return EVR_OK;
-    memset(&j, 0, sizeof j);
-    j.w = w;
-    j.n = w->ready - w->pend_at - done;
-    j.parts = j.n / WRITE_PART < BAG_PARTS ? (int)(j.n / WRITE_PART) + 1 : BAG_PARTS;
-    j.from = w->pend_at + done;
-    evr_par_pool_run(pool_for(w, j.n, 2 * WRITE_PART), j.parts, write_part, &j);
-    for (int k = 0; k < j.parts; k++)
-        if (j.bad[k]) {
-            errno = j.bad[k];
-            return cannot_write(w, err);
-        }
-    w->file_pos += w->ready - w->pend_at;
-    w->pend_at = w->ready;
+    const int e = w->io_err ? w->io_err : evr_write_behind_wait(&w->behind);
+    if (e) {
+        w->io_err = e;
+        errno = e;
+        return cannot_write(w, err);
+    }
     if ((w->pend.len - w->pend_at) * PEND_MOVE_FRACTION <= w->pend_at) {
         const size_t at = w->pend_at;
         memmove(w->pend.p, w->pend.p + at, w->pend.len - at);
@@ -630,6 +629,46 @@ static evr_status write_ready_from(bag_writer *w, size_t done, evr_error *err)
         if (w->msg_open) w->msg_at -= at;
         w->pend_at = 0;
     }
+    return EVR_OK;
+}
+
+/* Writes the finished chunks at their place in the file, in parts on the pool; pend keeps the
+ * current chunk. */
+static evr_status write_ready(bag_writer *w, evr_error *err)
+{
+    bag_job j;
+    if (w->pend.failed || w->index.failed) return no_memory(w, err);
+    evr_status st = settle(w, err);
+    if (st != EVR_OK || w->ready == w->pend_at) return st;
+    memset(&j, 0, sizeof j);
+    j.w = w;
+    j.n = w->ready - w->pend_at;
+    j.parts = j.n / WRITE_PART < BAG_PARTS ? (int)(j.n / WRITE_PART) + 1 : BAG_PARTS;
+    j.from = w->pend_at;
+    evr_par_pool_run(pool_for(w, j.n, 2 * WRITE_PART), j.parts, write_part, &j);
+    for (int k = 0; k < j.parts; k++)
+        if (j.bad[k]) {
+            errno = j.bad[k];
+            return cannot_write(w, err);
+        }
+    w->file_pos += w->ready - w->pend_at;
+    w->pend_at = w->ready;
+    return EVR_OK;
+}
+
+/* Starts writing the finished chunks behind (the previous ones waited for), or writes them now
+ * when no thread can. */
+static evr_status write_behind(bag_writer *w, evr_error *err)
+{
+    if (w->pend.failed || w->index.failed) return no_memory(w, err);
+    evr_status st = settle(w, err);
+    if (st != EVR_OK || w->ready == w->pend_at) return st;
+    const size_t len = w->ready - w->pend_at;
+    if (evr_write_behind_start(&w->behind, fileno(w->s.f), w->pend.p + w->pend_at, len,
+                               w->file_pos) != 0)
+        return write_ready(w, err);
+    w->file_pos += len;
+    w->pend_at = w->ready;
     return EVR_OK;
 }
 
@@ -682,45 +721,6 @@ static evr_status write_tail(bag_writer *w, evr_error *err)
     return EVR_OK;
 }
 
-static evr_status write_ready(bag_writer *w, evr_error *err) { return write_ready_from(w, 0, err); }
-
-/* Where event i of the write (laid out) lies in pend. */
-static size_t event_at(const bag_writer *w, size_t i)
-{
-    size_t lo = 0, hi = w->n_pieces;
-    while (hi - lo > 1) {
-        const size_t mid = lo + (hi - lo) / 2;
-        if (w->pieces[mid].first <= i) lo = mid;
-        else hi = mid;
-    }
-    return w->pieces[lo].at + (i - w->pieces[lo].first) * EVENT_BYTES;
-}
-
-/* Packs job j's parts on the pool while this thread writes the finished chunks' bytes in order,
- * those before part k + 1's first event as soon as part k is packed (writes to one file go one at
- * a time in the kernel: a bag packed and then written took the packing's time plus the writing's);
- * returns the bytes written (the rest of the finished chunks is the caller's), 0 with *failed
- * set (errno) when a write failed. */
-static size_t pack_and_write(bag_writer *w, evr_par_pool *pool, bag_job *j, int *failed)
-{
-    size_t written = w->pend_at; /* pend's bytes before it are in the file */
-    evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_task, j);
-    for (int k = 0; k < j->parts; k++) {
-        size_t a, b;
-        evr_par_order_wait(j->packed, k);
-        evr_par_share(j->n, j->parts, k, &a, &b);
-        size_t upto = b < j->n ? event_at(w, b) : w->ready;
-        if (upto > w->ready) upto = w->ready;
-        if (*failed || upto <= written) continue;
-        if (!write_at(fileno(w->s.f), w->pend.p + written, upto - written,
-                      w->file_pos + (written - w->pend_at)))
-            *failed = errno ? errno : EIO;
-        written = upto;
-    }
-    evr_par_pool_wait(pool);
-    return *failed ? 0 : written - w->pend_at;
-}
-
 static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t n, evr_error *err)
 {
     bag_writer *w = (bag_writer *)base;
@@ -731,7 +731,9 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     if (st != EVR_OK) return st; /* refused before anything changed */
     if (!lay_out(w, ev, n)) {
         w->broken = 1;
-        return no_memory(w, err);
+        if (!w->io_err) return no_memory(w, err);
+        errno = w->io_err;
+        return cannot_write(w, err);
     }
     memset(&j, 0, sizeof j);
     j.w = w;
@@ -742,19 +744,8 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     if (pool) /* the laid-out bytes' room, where check_events' bound fell short */
         j.claim = evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos,
                                      w->file_pos + (w->pend.len - w->pend_at));
-    evr_par_order packed;
-    /* pipelined with four threads or more, as io/par_pack.c: fewer miss the one that writes */
-    if (pool && evr_par_pool_threads(pool) >= 4 && evr_par_order_init(&packed) == 0) {
-        int failed = 0;
-        j.packed = &packed;
-        const size_t written = pack_and_write(w, pool, &j, &failed);
-        evr_par_order_destroy(&packed);
-        errno = failed;
-        st = failed ? cannot_write(w, err) : write_ready_from(w, written, err);
-    } else {
-        evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
-        st = write_ready(w, err);
-    }
+    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
+    st = pool ? write_behind(w, err) : write_ready(w, err);
     if (st != EVR_OK) w->broken = 1;
     return st;
 }
@@ -773,6 +764,7 @@ static evr_status bag_flush(evr_event_writer *base, evr_error *err)
 
 static void free_bag(bag_writer *w)
 {
+    evr_write_behind_stop(&w->behind); /* it reads pend */
     free_bytes(&w->pend);
     free_bytes(&w->index);
     free_bytes(&w->out);
