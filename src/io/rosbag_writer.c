@@ -12,13 +12,14 @@
  *
  * Speed: the bytes not written yet are laid out in one buffer as they will lie in the file
  * (finished chunks, then the current chunk with the gathering message last), the fixed-size
- * record headers filled in when their lengths are known. A write() first checks its events
- * while one of the pool's threads claims their room in the file (io/file_room.h), then finds
- * where its messages begin (a search on the sorted times, not a test per event), then packs the
- * events at their places in parts on the pool; a large write's finished chunks are then written
- * by a thread of their own while the next write is checked and packed (io/write_behind.h): the
- * GPU run of the 30 s eye waited on one thread packing and copying its gigabytes, and then on
- * these phases one after the other. Where messages and chunks end depends only on the events
+ * record headers filled in when their lengths are known. A write() first checks its events,
+ * then finds where its messages begin (a search on the sorted times, not a test per event),
+ * then packs the events at their places in parts on the pool; a large write's finished chunks
+ * are then written by a thread of their own while the next write is checked and packed
+ * (io/write_behind.h): the GPU run of the 30 s eye waited on one thread packing and copying its
+ * gigabytes, and then on these phases one after the other. Its room is not claimed ahead (as
+ * the AEDAT 4.0 writer does): with the packing off the file's path, a claim only adds to the
+ * time the file is locked. Where messages and chunks end depends only on the events
  * and the flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
 #include "io/write_behind.h"
@@ -421,19 +422,16 @@ typedef struct {
     const evr_event *ev;
     size_t n;
     int parts;
-    int bad[BAG_PARTS];  /* check: an event the bag cannot hold; write: a failed write (errno) */
-    evr_par_claim claim; /* pack: task 0 claims the laid-out bytes' room (io/par_pack.h) */
-    size_t from;         /* write: pend's bytes [from, from + n) */
+    int bad[BAG_PARTS]; /* check: an event the bag cannot hold; write: a failed write (errno) */
+    size_t from;        /* write: pend's bytes [from, from + n) */
 } bag_job;
 
-/* Task k of a check: the claim's task, or part k's events fit and keep time order (the first
- * against the event before). */
+/* Part k of a check: its events fit and keep time order (the first against the event before). */
 static void check_part(void *ctx, int k, int thread)
 {
     bag_job *j = ctx;
     size_t a, b;
     (void)thread;
-    if (evr_par_claim_task(&j->claim, &k)) return;
     evr_par_share(j->n, j->parts, k, &a, &b);
     for (size_t i = a; i < b; i++)
         if (!evr_raw_stream_fits(&j->w->s, &j->ev[i]) || (i > 0 && j->ev[i].t < j->ev[i - 1].t)) {
@@ -477,14 +475,6 @@ static void pack_part(void *ctx, int k, int thread)
     }
 }
 
-/* Task k of packing: the claim's task, or a part. */
-static void pack_task(void *ctx, int k, int thread)
-{
-    bag_job *j = ctx;
-    if (evr_par_claim_task(&j->claim, &k)) return;
-    pack_part(ctx, k, thread);
-}
-
 /* Part k of writing the finished chunks: its share of their bytes. */
 static void write_part(void *ctx, int k, int thread)
 {
@@ -506,34 +496,18 @@ static evr_par_pool *pool_for(bag_writer *w, size_t work, size_t large)
     return w->s.parts.pool;
 }
 
-/* A bound on the bytes ev[0 .. n) add to the bag when they can go in it: their records and, for
- * each message they may end or begin, its head, its index entry and a chunk's heads. */
-static uint64_t bytes_bound(const evr_event *ev, size_t n)
-{
-    const int64_t t0 = ev[0].t < 0 ? 0 : ev[0].t, t1 = ev[n - 1].t < t0 ? t0 : ev[n - 1].t;
-    const uint64_t msgs = (uint64_t)((t1 - t0) / 1000000 * MSG_HZ) + MSG_HZ + n / MSG_MAX_EVENTS;
-    return (uint64_t)n * EVENT_BYTES + (msgs + 2) * (MSG_HEAD + 12 + CHUNK_HEAD + INDEX_HEAD) +
-           BAG_HEADER_BYTES;
-}
-
 /* Refuses the write when an event cannot go in the bag, with the first such event's line;
- * nothing changes then (but room claimed past the file's end). A large write's pool claims its
- * bytes' room while the others check: the claim allocates tmpfs pages, as long as the writes. */
+ * nothing changes then. */
 static evr_status check_events(bag_writer *w, const evr_event *ev, size_t n, evr_error *err)
 {
     bag_job j;
     int bad = w->s.have_last && ev[0].t < w->s.last_t;
-    evr_par_pool *pool = pool_for(w, n, EVR_PAR_PACK_MIN);
     memset(&j, 0, sizeof j);
     j.w = w;
     j.ev = ev;
     j.n = n;
     j.parts = n < EVR_PAR_PACK_MIN ? 1 : BAG_PARTS;
-    if (pool) {
-        const uint64_t end = w->file_pos + (w->pend.len - w->pend_at);
-        j.claim = evr_par_claim_plan(&w->s.parts, fileno(w->s.f), end, end + bytes_bound(ev, n));
-    }
-    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), check_part, &j);
+    evr_par_pool_run(pool_for(w, n, EVR_PAR_PACK_MIN), j.parts, check_part, &j);
     for (int k = 0; k < j.parts; k++) bad |= j.bad[k];
     if (bad) {
         const int64_t last_t = w->s.last_t;
@@ -741,10 +715,7 @@ static evr_status bag_write(evr_event_writer *base, const evr_event *ev, size_t 
     j.n = n;
     j.parts = n < EVR_PAR_PACK_MIN ? 1 : BAG_PARTS;
     evr_par_pool *pool = pool_for(w, n, EVR_PAR_PACK_MIN);
-    if (pool) /* the laid-out bytes' room, where check_events' bound fell short */
-        j.claim = evr_par_claim_plan(&w->s.parts, fileno(w->s.f), w->file_pos,
-                                     w->file_pos + (w->pend.len - w->pend_at));
-    evr_par_pool_run(pool, j.parts + evr_par_claim_tasks(&j.claim), pack_task, &j);
+    evr_par_pool_run(pool, j.parts, pack_part, &j);
     st = pool ? write_behind(w, err) : write_ready(w, err);
     if (st != EVR_OK) w->broken = 1;
     return st;
@@ -833,7 +804,6 @@ evr_status evr_rosbag_writer_open(const char *path, const evr_writer_meta *meta,
         w->width = (uint32_t)meta->width;
         w->height = (uint32_t)meta->height;
         w->file_pos = head.len;
-        w->s.parts.claim_room = 1; /* claimed while checking (check_events) */
         /* the current chunk's head goes first; everything after the header goes by pwrite */
         if (!reserve(&w->pend, CHUNK_HEAD)) st = no_memory(w, err);
         else if (fflush(w->s.f) != 0) st = cannot_write(w, err);
