@@ -942,6 +942,18 @@ static unsigned char *write_in_batches(const char *path, open_fn open, const evr
     return data;
 }
 
+/* The file at path reads back as ev[0 .. n); then it is removed. */
+static void reads_back_and_goes(const char *path, const evr_event *ev, size_t n)
+{
+    evr_event *got = NULL;
+    size_t ngot = 0;
+    CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &e_));
+    CHECK(ngot == n);
+    if (ngot == n) CHECK(same_events(got, ev, n));
+    free(got);
+    remove(path);
+}
+
 /* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way; text and
  * NPY too): the bytes must be those of the serial path (batches too small for parts), the file
  * must read back, and a bad event deep in a large write is refused as the serial path refuses
@@ -1012,15 +1024,7 @@ static void test_camera_parts(const char *root)
         free(many);
         free(serial);
         free(parts);
-        {
-            evr_event *got = NULL;
-            size_t ngot = 0;
-            CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &e_));
-            CHECK(ngot == n);
-            if (ngot == n) CHECK(same_events(got, ev, n));
-            free(got);
-        }
-        remove(path);
+        reads_back_and_goes(path, ev, n);
 
         /* the first bad event is refused, the later ones (out of order, past the range) not seen */
         bad = malloc(n * sizeof *bad);
@@ -1078,15 +1082,7 @@ static void test_bag_dense_parts(const char *root)
     CHECK(len_parts == len_serial && len_many == len_serial);
     if (serial && parts && len_parts == len_serial) CHECK(memcmp(serial, parts, len_serial) == 0);
     if (serial && many && len_many == len_serial) CHECK(memcmp(serial, many, len_serial) == 0);
-    {
-        evr_event *got = NULL;
-        size_t ngot = 0;
-        CHECK_OK(evr_events_read(path, &got, &ngot, NULL, NULL, &e_));
-        CHECK(ngot == n);
-        if (ngot == n) CHECK(same_events(got, ev, n));
-        free(got);
-    }
-    remove(path);
+    reads_back_and_goes(path, ev, n);
     free(serial);
     free(parts);
     free(many);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include "io/file_room.h"
 #include "io/par_order.h"
+#include "io/write_at.h"
 
 #define PAR_PACK_THREADS 4
 #define PAR_PACK_PARTS 16
@@ -35,22 +36,6 @@ typedef struct {
     evr_par_order packed;             /* pipelined (pack_and_write): the parts packed */
 } pack_job;
 
-/* Writes len bytes at the file offset at. */
-static int write_at(int fd, const unsigned char *src, size_t len, off_t at)
-{
-    while (len > 0) {
-        const ssize_t wrote = pwrite(fd, src, len, at);
-        if (wrote <= 0) {
-            if (wrote < 0 && errno == EINTR) continue;
-            return 0;
-        }
-        src += wrote;
-        len -= (size_t)wrote;
-        at += wrote;
-    }
-    return 1;
-}
-
 static void pack_part(void *ctx, int k, int thread)
 {
     pack_job *j = ctx;
@@ -60,8 +45,8 @@ static void pack_part(void *ctx, int k, int thread)
     if (j->pass == 0) {
         if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
         if (j->pipelined) evr_par_order_done(&j->packed, k); /* the writing thread waits */
-    } else if (a < b &&
-               !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)j->off[k])) {
+    } else if (a < b && !evr_write_at(j->fd, j->big + j->boff[k], j->size[k],
+                                      (uint64_t)(j->at + (off_t)j->off[k]))) {
         j->bad[k] = errno ? errno : EIO;
     }
 }
@@ -81,8 +66,8 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
         evr_par_order_wait(&j->packed, k);
         if (serial || failed) continue;
         if (j->size[k] == SIZE_MAX) serial = 1;
-        else if (j->size[k] &&
-                 !write_at(j->fd, j->big + j->boff[k], j->size[k], j->at + (off_t)total))
+        else if (j->size[k] && !evr_write_at(j->fd, j->big + j->boff[k], j->size[k],
+                                             (uint64_t)(j->at + (off_t)total)))
             failed = errno ? errno : EIO;
         else total += j->size[k];
     }

@@ -22,6 +22,7 @@
  * time the file is locked. Where messages and chunks end depends only on the events
  * and the flush() calls, not on how the events are cut into write() calls. */
 #include "io/event_formats.h"
+#include "io/write_at.h"
 #include "io/write_behind.h"
 #include "io/raw_stream.h"
 #include "par_pool.h"
@@ -399,23 +400,6 @@ static evr_status cannot_write(bag_writer *w, evr_error *err)
     return EVR_ERR_IO;
 }
 
-/* Writes len bytes at the file offset at. */
-static int write_at(int fd, const unsigned char *src, size_t len, uint64_t at)
-{
-    while (len > 0) {
-        const ssize_t wrote = pwrite(fd, src, len, (off_t)at);
-        if (wrote <= 0) {
-            if (wrote < 0 && errno == EINTR) continue;
-            if (wrote == 0) errno = EIO;
-            return 0;
-        }
-        src += wrote;
-        len -= (size_t)wrote;
-        at += (uint64_t)wrote;
-    }
-    return 1;
-}
-
 /* One job on the pool: checking, packing or writing a write()'s parts. */
 typedef struct {
     bag_writer *w;
@@ -484,7 +468,8 @@ static void write_part(void *ctx, int k, int thread)
     evr_par_share(j->n, j->parts, k, &a, &b);
     a += j->from;
     b += j->from;
-    if (!write_at(fileno(j->w->s.f), j->w->pend.p + a, b - a, j->w->file_pos + (a - j->w->pend_at)))
+    if (!evr_write_at(fileno(j->w->s.f), j->w->pend.p + a, b - a,
+                      j->w->file_pos + (a - j->w->pend_at)))
         j->bad[k] = errno ? errno : EIO;
 }
 
@@ -687,11 +672,11 @@ static evr_status write_tail(bag_writer *w, evr_error *err)
     w->out.failed |= hdr.failed;
     free_bytes(&hdr);
     if (w->out.failed) return no_memory(w, err);
-    if (!write_at(fd, w->out.p, w->out.len, w->file_pos)) return cannot_write(w, err);
+    if (!evr_write_at(fd, w->out.p, w->out.len, w->file_pos)) return cannot_write(w, err);
     w->out.len = 0;
     bag_header(&w->out, w->file_pos, 1, (uint32_t)w->n_infos);
     if (w->out.failed) return no_memory(w, err);
-    if (!write_at(fd, w->out.p, w->out.len, strlen(BAG_MAGIC))) return cannot_write(w, err);
+    if (!evr_write_at(fd, w->out.p, w->out.len, strlen(BAG_MAGIC))) return cannot_write(w, err);
     return EVR_OK;
 }
 

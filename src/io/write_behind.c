@@ -1,23 +1,7 @@
 #include "io/write_behind.h"
+#include "io/write_at.h"
 
 #include <errno.h>
-#include <sys/types.h>
-#include <unistd.h>
-
-static int write_all(int fd, const unsigned char *src, size_t len, uint64_t at)
-{
-    while (len > 0) {
-        const ssize_t wrote = pwrite(fd, src, len, (off_t)at);
-        if (wrote <= 0) {
-            if (wrote < 0 && errno == EINTR) continue;
-            return wrote == 0 ? EIO : errno;
-        }
-        src += wrote;
-        len -= (size_t)wrote;
-        at += (uint64_t)wrote;
-    }
-    return 0;
-}
 
 static void *behind_main(void *arg)
 {
@@ -27,7 +11,7 @@ static void *behind_main(void *arg)
         while (!wb->busy && !wb->stop) pthread_cond_wait(&wb->cv, &wb->mu);
         if (!wb->busy) break; /* stopped with nothing in flight */
         pthread_mutex_unlock(&wb->mu);
-        const int err = write_all(wb->fd, wb->src, wb->len, wb->at);
+        const int err = evr_write_at(wb->fd, wb->src, wb->len, wb->at) ? 0 : errno;
         pthread_mutex_lock(&wb->mu);
         if (err && !wb->err) wb->err = err;
         wb->busy = 0;
