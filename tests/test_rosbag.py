@@ -4,7 +4,7 @@ from the bag's own definition. Every event must come back identical (x, y, t in 
 events.npy; each message on /dvs/events of type dvs_msgs/EventArray with the registered type's
 md5sum, the run's width and height, seq counting from 0, header.stamp and the record time its last
 event's time, and its events within one 30 Hz window. evray's reader gives the same events
-(evray convert), and one line for a truncated bag. Bags rosbags writes with compressed chunks
+(evray convert, also h5 -> bag -> h5), and one line for a truncated bag. Bags rosbags writes with compressed chunks
 (bz2, lz4; many chunks) read back identical through evray convert, and a corrupt compressed chunk
 gives one line. Skips (77) when the environment is missing or unusable."""
 import json
@@ -102,7 +102,7 @@ d = T.tmpdir()
 run = os.path.join(d, "run")
 W, H = 64, 48
 T.run("demo", "--scene", "eye", "-o", run, "--res", f"{W}x{H}", "--duration", "1",
-      "--format", "npy,rosbag", "--no-preview", "--quiet")
+      "--format", "h5,npy,rosbag", "--no-preview", "--quiet")
 ref = np.load(os.path.join(run, "events.npy"))
 T.check(len(ref) > 1000, f"a run of many events ({len(ref)})")
 
@@ -140,6 +140,15 @@ T.run("convert", os.path.join(run, "events.bag"), back, "--quiet")
 b = np.load(back)
 T.check(len(b) == len(ref) and all(np.array_equal(b[k], ref[k]) for k in "txyp"),
         "evray convert events.bag -> npy: every event identical")
+
+# evray convert's round trip: h5 -> bag -> h5 (read back as npy)
+conv, back_h5, back = (os.path.join(d, n) for n in ("conv.bag", "back.h5", "back2.npy"))
+T.run("convert", os.path.join(run, "events.h5"), conv, "--quiet")
+T.run("convert", conv, back_h5, "--quiet")
+T.run("convert", back_h5, back, "--quiet")
+b = np.load(back)
+T.check(len(b) == len(ref) and all(np.array_equal(b[k], ref[k]) for k in "txyp"),
+        "evray convert events.h5 -> bag -> h5: every event identical")
 
 # bad input through the program: one line, exit 1, no crash
 bad = os.path.join(d, "bad.bag")
