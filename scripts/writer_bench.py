@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Whether each event writer keeps up with the render (docs/benchmarks.md, "Writers"): the built-in
 eye run once per format and program, the formats and programs alternating, round after round, and
-each run set against events.h5's run of the same program in the same round.
+each run set against events.h5's run of the same program in the same round; the programs' order
+turns from round to round.
 
-    scripts/writer_bench.py EVRAY [BASE_EVRAY] [--formats h5,aedat4,rosbag] [--rounds 2]
+    scripts/writer_bench.py EVRAY [BASE_EVRAY] [--formats h5,aedat4,rosbag] [--rounds 2] [--warm]
                             [--dir /dev/shm] [--res 1280x720] [--duration 30] [--backend cuda]
 
 Each run is `evray demo --scene eye --backend B --res R --samples-per-frame 10 --duration D -o
@@ -71,6 +72,9 @@ def main():
     ap.add_argument("--res", default="1280x720")
     ap.add_argument("--duration", type=float, default=30.0)
     ap.add_argument("--backend", default="cuda")
+    ap.add_argument("--warm", action="store_true",
+                    help="first one unmeasured run of each format (a fresh machine's first "
+                         "gigabytes on tmpfs run slow)")
     a = ap.parse_args()
     programs = [("base", a.base)] if a.base else []
     programs.append(("new" if a.base else "evray", a.evray))
@@ -81,9 +85,14 @@ def main():
     print("| round | `--format` | program | wall s | wait s | writer busy s | / h5 | bytes | sha256 |")
     print("|---|---|---|---|---|---|---|---|---|")
     h5_wall = {}  # each program's events.h5 run of this round
+    if a.warm:
+        for fmt in ["h5"] + formats:
+            run(programs[0][1], fmt, a, out)
     for r in range(1, a.rounds + 1):
         for fmt in ["h5"] + formats:
-            for name, evray in programs:
+            # the programs' order turns round by round: the first run after another format's
+            # can be the slower one
+            for name, evray in programs if r % 2 else programs[::-1]:
                 m = run(evray, fmt, a, out)
                 if fmt == "h5":
                     h5_wall[name], ratio = m["wall"], ""
