@@ -17,6 +17,40 @@
 #define PIPELINE_MIN_THREADS 4
 #define PIPELINE_PARTS EVR_PAR_ORDER_MAX
 
+/* A large write's claim of room in its file (io/file_room.h): the first task of its pool job
+ * claims [from, to) while the others pack; none when from == to. */
+typedef struct {
+    int fd;
+    uint64_t from, to;
+} par_claim;
+
+/* The claim of a write to fd whose bytes end at `end`, from `at` or from where pk's earlier
+ * writes claimed to, whichever is later (none unless pk->claim_room); recorded in pk. */
+static par_claim claim_plan(evr_par_packing *pk, int fd, uint64_t at, uint64_t end)
+{
+    par_claim c = {fd, at > pk->claimed ? at : pk->claimed, 0};
+    c.to = pk->claim_room && end > c.from ? end : c.from;
+    if (c.to > c.from) pk->claimed = c.to;
+    return c;
+}
+
+/* Tasks the claim adds to its job: 0 or 1. */
+static int claim_tasks(const par_claim *c) { return c->to > c->from; }
+
+/* For task *k of a job that starts with claim c's task: claims the room and returns 1 for that
+ * task (no room is no error there: the writes then fail and say why); otherwise returns 0 with
+ * *k the part the task packs. */
+static int claim_task(const par_claim *c, int *k)
+{
+    if (!claim_tasks(c)) return 0;
+    if (*k == 0) {
+        evr_file_claim(c->fd, c->from, c->to - c->from);
+        return 1;
+    }
+    --*k; /* task k packs part k - 1 */
+    return 0;
+}
+
 typedef struct {
     const evr_par_packer *p;
     const evr_event *ev;
@@ -26,7 +60,7 @@ typedef struct {
     int pass;                         /* 0: pack, 1: write (pack_then_write) */
     int pipelined;                    /* pack_and_write: parts are written as they are packed */
     int parts;                        /* PAR_PACK_PARTS, or PIPELINE_PARTS pipelined */
-    evr_par_claim claim;              /* task 0 claims the parts' room when there is one */
+    par_claim claim;                  /* task 0 claims the parts' room when there is one */
     size_t first[PIPELINE_PARTS + 1]; /* part k: events [first[k], first[k + 1]) */
     size_t room[PIPELINE_PARTS];      /* its bound */
     size_t boff[PIPELINE_PARTS];      /* where its room starts in big */
@@ -40,7 +74,7 @@ static void pack_part(void *ctx, int k, int thread)
 {
     pack_job *j = ctx;
     (void)thread;
-    if (j->pass == 0 && evr_par_claim_task(&j->claim, &k)) return;
+    if (j->pass == 0 && claim_task(&j->claim, &k)) return;
     const size_t a = j->first[k], b = j->first[k + 1];
     if (j->pass == 0) {
         if (a < b) j->size[k] = j->p->pack(j->p->ctx, j->ev, a, b, j->big + j->boff[k], j->room[k]);
@@ -60,7 +94,7 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
     size_t total = 0;
     int serial = 0, failed = 0;
     if (evr_par_order_init(&j->packed) != 0) return EVR_PAR_PACK_SERIAL;
-    evr_par_pool_start(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_part, j);
+    evr_par_pool_start(pool, j->parts + claim_tasks(&j->claim), pack_part, j);
     for (int k = 0; k < j->parts; k++) {
         /* the pool's threads take every part, in order: part k comes */
         evr_par_order_wait(&j->packed, k);
@@ -88,7 +122,7 @@ static evr_par_pack_result pack_and_write(evr_par_pool *pool, pack_job *j, size_
 static evr_par_pack_result pack_then_write(evr_par_pool *pool, pack_job *j, size_t *bytes)
 {
     size_t total = 0;
-    evr_par_pool_run(pool, j->parts + evr_par_claim_tasks(&j->claim), pack_part, j);
+    evr_par_pool_run(pool, j->parts + claim_tasks(&j->claim), pack_part, j);
     for (int k = 0; k < j->parts; k++) {
         if (j->size[k] == SIZE_MAX) return EVR_PAR_PACK_SERIAL;
         j->off[k] = total;
@@ -103,25 +137,6 @@ static evr_par_pack_result pack_then_write(evr_par_pool *pool, pack_job *j, size
         }
     *bytes = total;
     return EVR_PAR_PACK_DONE;
-}
-
-evr_par_claim evr_par_claim_plan(evr_par_packing *pk, int fd, uint64_t at, uint64_t end)
-{
-    evr_par_claim c = {fd, at > pk->claimed ? at : pk->claimed, 0};
-    c.to = pk->claim_room && end > c.from ? end : c.from;
-    if (c.to > c.from) pk->claimed = c.to;
-    return c;
-}
-
-int evr_par_claim_task(const evr_par_claim *c, int *k)
-{
-    if (!evr_par_claim_tasks(c)) return 0;
-    if (*k == 0) {
-        evr_file_claim(c->fd, c->from, c->to - c->from);
-        return 1;
-    }
-    --*k; /* task k packs part k - 1 */
-    return 0;
 }
 
 evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer *p,
@@ -165,7 +180,7 @@ evr_par_pack_result evr_par_pack_write(evr_par_packing *pk, const evr_par_packer
     j.fd = fileno(f);
     j.at = ftello(f);
     if (j.at < 0) return EVR_PAR_PACK_FAILED;
-    j.claim = evr_par_claim_plan(pk, j.fd, (uint64_t)j.at, (uint64_t)j.at + room);
+    j.claim = claim_plan(pk, j.fd, (uint64_t)j.at, (uint64_t)j.at + room);
     r = j.pipelined ? pack_and_write(pk->pool, &j, bytes) : pack_then_write(pk->pool, &j, bytes);
     if (r == EVR_PAR_PACK_SERIAL) pk->claimed = 0; /* the file may have been cut back */
     /* the stream goes on after the bytes written past it */

@@ -49,25 +49,6 @@ typedef struct {
     uint64_t claimed;
 } evr_par_packing;
 
-/* A large write's claim of room in its file (io/file_room.h): the first task of its pool job
- * claims [from, to) while the others pack; none when from == to. */
-typedef struct {
-    int fd;
-    uint64_t from, to;
-} evr_par_claim;
-
-/* The claim of a write to fd whose bytes end at `end`, from `at` or from where pk's earlier
- * writes claimed to, whichever is later (none unless pk->claim_room); recorded in pk. */
-evr_par_claim evr_par_claim_plan(evr_par_packing *pk, int fd, uint64_t at, uint64_t end);
-
-/* Tasks the claim adds to its job: 0 or 1. */
-static inline int evr_par_claim_tasks(const evr_par_claim *c) { return c->to > c->from; }
-
-/* For task *k of a job that starts with claim c's task: claims the room and returns 1 for that
- * task (no room is no error there: the writes then fail and say why); otherwise returns 0 with
- * *k the part the task packs. */
-int evr_par_claim_task(const evr_par_claim *c, int *k);
-
 typedef enum {
     EVR_PAR_PACK_SERIAL, /* nothing written: an event cannot be written, or no memory */
     EVR_PAR_PACK_DONE,   /* every event written at the end of the file */
