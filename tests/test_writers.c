@@ -3,10 +3,12 @@
  * preview images.
  * Python (h5py, numpy) reads the files as an independent check when it is installed. */
 #include <dirent.h>
+#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -954,6 +956,31 @@ static void reads_back_and_goes(const char *path, const evr_event *ev, size_t n)
     remove(path);
 }
 
+/* ev[0 .. n) written to path three ways: serially (batches too small for parts), in parts of
+ * 140,000 events, and so through the pools of a 16-core machine (their pipelined ways); the
+ * three files must hold the same bytes and read back as ev. Returns the serial file's bytes. */
+static size_t same_bytes_in_parts(const char *path, open_fn open, const evr_event *ev, size_t n)
+{
+    size_t len_serial = 0, len_parts = 0, len_many = 0;
+    unsigned char *serial =
+        write_in_batches(path, open, ev, n, 1000, EVR_PAR_PACK_MIN / 2, &len_serial);
+    unsigned char *parts = write_in_batches(path, open, ev, n, 1000, 140000, &len_parts);
+    setenv("EVR_PAR_THREADS", "16", 1);
+    unsigned char *many = write_in_batches(path, open, ev, n, 1000, 140000, &len_many);
+    unsetenv("EVR_PAR_THREADS");
+    CHECK(serial && parts && many && len_parts == len_serial && len_many == len_serial);
+    if (len_parts != len_serial || len_many != len_serial)
+        fprintf(stderr, "%s: %zu bytes in parts, %zu on 16 threads, %zu serially\n", path,
+                len_parts, len_many, len_serial);
+    if (serial && parts && len_parts == len_serial) CHECK(memcmp(serial, parts, len_serial) == 0);
+    if (serial && many && len_many == len_serial) CHECK(memcmp(serial, many, len_serial) == 0);
+    free(serial);
+    free(parts);
+    free(many);
+    reads_back_and_goes(path, ev, n);
+    return len_serial;
+}
+
 /* Large writes are packed in parallel parts (io/par_pack.h; the ROS bag its own way; text and
  * NPY too): the bytes must be those of the serial path (batches too small for parts), the file
  * must read back, and a bad event deep in a large write is refused as the serial path refuses
@@ -976,7 +1003,7 @@ static void test_camera_parts(const char *root)
         {"parts.txt", evr_txt_writer_open, {1, 5, 6, 0, 0}, "out of time order (1 us after"},
         {"parts.npy", evr_npy_writer_open, {1, 5, 6, 0, 0}, "out of time order (1 us after"},
     };
-    const size_t n = 300000, small = EVR_PAR_PACK_MIN / 2;
+    const size_t n = 300000;
     evr_event *ev = calloc(n, sizeof *ev);
     uint64_t s = 4242;
     int64_t t = 0;
@@ -999,32 +1026,12 @@ static void test_camera_parts(const char *root)
         ev[i].p = (int8_t)(rng_next(&s) & 1);
     }
     for (size_t k = 0; k < sizeof f / sizeof f[0]; k++) {
-        size_t len_serial, len_parts;
-        unsigned char *serial, *parts;
         evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
         evr_event_writer *w = NULL;
         evr_error err;
         evr_event *bad;
         snprintf(path, sizeof path, "%s/%s", root, f[k].file);
-        serial = write_in_batches(path, f[k].open, ev, n, 1000, small, &len_serial);
-        parts = write_in_batches(path, f[k].open, ev, n, 1000, 140000, &len_parts);
-        CHECK(serial && parts && len_serial == len_parts && len_serial > n);
-        if (len_serial != len_parts)
-            fprintf(stderr, "%s: %zu bytes in parts, %zu serially\n", f[k].file, len_parts,
-                    len_serial);
-        if (serial && parts && len_serial == len_parts)
-            CHECK(memcmp(serial, parts, len_serial) == 0);
-        /* the same with the pools of a many-core machine (their pipelined ways) */
-        size_t len_many = 0;
-        setenv("EVR_PAR_THREADS", "16", 1);
-        unsigned char *many = write_in_batches(path, f[k].open, ev, n, 1000, 140000, &len_many);
-        unsetenv("EVR_PAR_THREADS");
-        CHECK(serial && many && len_many == len_serial);
-        if (serial && many && len_many == len_serial) CHECK(memcmp(serial, many, len_serial) == 0);
-        free(many);
-        free(serial);
-        free(parts);
-        reads_back_and_goes(path, ev, n);
+        CHECK(same_bytes_in_parts(path, f[k].open, ev, n) > n);
 
         /* the first bad event is refused, the later ones (out of order, past the range) not seen */
         bad = malloc(n * sizeof *bad);
@@ -1051,7 +1058,8 @@ static void test_camera_parts(const char *root)
 
 /* A bag whose messages are larger than its writes (a dense burst: 600,000 events in 0.12 s, about
  * 166,000 a 1/30 s message): writes that finish no chunk, and writes that finish one while the
- * next message keeps growing in the writer's buffer, must give the serial path's bytes. */
+ * next message keeps growing in the writer's buffer, must give the serial path's bytes; and its
+ * finished chunks written behind (io/write_behind.h) must report a failed write. */
 static void test_bag_dense_parts(const char *root)
 {
     const size_t n = 600000;
@@ -1069,23 +1077,34 @@ static void test_bag_dense_parts(const char *root)
         ev[i].p = (int8_t)(rng_next(&s) & 1);
     }
     snprintf(path, sizeof path, "%s/dense.bag", root);
-    size_t len_serial = 0, len_parts = 0, len_many = 0;
-    unsigned char *serial = write_in_batches(path, evr_rosbag_writer_open, ev, n, 1000,
-                                             EVR_PAR_PACK_MIN / 2, &len_serial);
-    unsigned char *parts =
-        write_in_batches(path, evr_rosbag_writer_open, ev, n, 1000, 140000, &len_parts);
+    CHECK(same_bytes_in_parts(path, evr_rosbag_writer_open, ev, n) > n * 13);
+
+    /* a write behind that fails (a file size limit of 4 MB: EFBIG, as a full disk's ENOSPC):
+     * a later write says why (no flush writes anything itself here), and the bag is not kept */
+    evr_writer_meta meta = {.width = W, .height = H, .config_json = NULL, .max_t_us = 0};
+    evr_event_writer *w = NULL;
+    evr_error err;
+    evr_status st = EVR_OK;
+    struct rlimit old, lim;
+    void (*old_xfsz)(int) = signal(SIGXFSZ, SIG_IGN);
+    char tmp[700];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
     setenv("EVR_PAR_THREADS", "16", 1);
-    unsigned char *many =
-        write_in_batches(path, evr_rosbag_writer_open, ev, n, 1000, 140000, &len_many);
+    CHECK_OK(evr_rosbag_writer_open(path, &meta, &w, &e_));
+    CHECK(getrlimit(RLIMIT_FSIZE, &old) == 0);
+    lim = old;
+    lim.rlim_cur = 4 << 20;
+    CHECK(setrlimit(RLIMIT_FSIZE, &lim) == 0);
+    err.msg[0] = 0;
+    for (size_t at = 0; w && at < n && st == EVR_OK; at += 140000)
+        st = w->write(w, ev + at, n - at < 140000 ? n - at : 140000, &err);
+    CHECK(st == EVR_ERR_IO && strstr(err.msg, "File too large") != NULL);
+    if (st != EVR_ERR_IO) fprintf(stderr, "a failed write behind: %d %s\n", (int)st, err.msg);
+    if (w) CHECK(w->finish(w, ev[n - 1].t + 1, &err) != EVR_OK);
+    CHECK(setrlimit(RLIMIT_FSIZE, &old) == 0);
+    signal(SIGXFSZ, old_xfsz);
     unsetenv("EVR_PAR_THREADS");
-    CHECK(serial && parts && many && len_serial > n * 13);
-    CHECK(len_parts == len_serial && len_many == len_serial);
-    if (serial && parts && len_parts == len_serial) CHECK(memcmp(serial, parts, len_serial) == 0);
-    if (serial && many && len_many == len_serial) CHECK(memcmp(serial, many, len_serial) == 0);
-    reads_back_and_goes(path, ev, n);
-    free(serial);
-    free(parts);
-    free(many);
+    CHECK(!file_exists(path) && !file_exists(tmp));
     free(ev);
 }
 
