@@ -10,9 +10,9 @@ turns from round to round.
 Each run is `evray demo --scene eye --backend B --res R --samples-per-frame 10 --duration D -o
 DIR/writer-bench --no-preview -q --format F`; the figures come from its run.json. Prints one
 Markdown row per run: format, program, wall seconds, the render's wait for the writer, the writer
-thread's busy time, the wall against events.h5's in that round, the files' bytes and the first
-16 hex digits of their sha256 (files of equal digits are byte-identical). A run folder on tmpfs
-(the default) leaves the disk out of it."""
+thread's busy time, the wall against events.h5's in that round, the run's peak resident set, the
+files' bytes and the first 16 hex digits of their sha256 (files of equal digits are
+byte-identical). A run folder on tmpfs (the default) leaves the disk out of it."""
 import argparse
 import hashlib
 import json
@@ -20,6 +20,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
 
 def find(obj, key):
@@ -51,14 +52,18 @@ def run(evray, fmt, a, out):
     cmd = [evray, "demo", "--scene", "eye", "--backend", a.backend, "--res", a.res,
            "--samples-per-frame", "10", "--duration", str(a.duration), "-o", out, "--no-preview",
            "-q", "--format", fmt]
-    p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    if p.returncode != 0:
-        sys.exit("writer_bench: %s failed: %s" % (" ".join(cmd), p.stderr.strip()[-300:]))
+    with tempfile.TemporaryFile(mode="w+") as err:
+        p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
+        _, status, usage = os.wait4(p.pid, 0)  # this run's own peak memory
+        p.returncode = os.waitstatus_to_exitcode(status)
+        if p.returncode != 0:
+            err.seek(0)
+            sys.exit("writer_bench: %s failed: %s" % (" ".join(cmd), err.read().strip()[-300:]))
     with open(os.path.join(out, "run.json")) as f:
         rj = json.load(f)
     files = sorted(os.path.join(out, n) for n in os.listdir(out) if n.startswith("events"))
     return {"wall": find(rj, "wall_seconds"), "wait": find(rj, "time_write_wait_seconds"),
-            "busy": find(rj, "time_write_thread_seconds"),
+            "busy": find(rj, "time_write_thread_seconds"), "peak_mb": usage.ru_maxrss // 1024,
             "bytes": sum(os.path.getsize(p) for p in files), "sha": digest(files)}
 
 
@@ -82,8 +87,9 @@ def main():
     if "h5" in formats:
         formats.remove("h5")
     out = os.path.join(a.dir, "writer-bench")
-    print("| round | `--format` | program | wall s | wait s | writer busy s | / h5 | bytes | sha256 |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| round | `--format` | program | wall s | wait s | writer busy s | / h5 | peak MB | bytes "
+          "| sha256 |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     h5_wall = {}  # each program's events.h5 run of this round
     if a.warm:
         for fmt in ["h5"] + formats:
@@ -98,9 +104,9 @@ def main():
                     h5_wall[name], ratio = m["wall"], ""
                 else:
                     ratio = "%.3fx" % (m["wall"] / h5_wall[name])
-                print("| %d | %s | %s | %.3f | %.2f | %.2f | %s | %d | %s |" % (
-                    r, fmt, name, m["wall"], m["wait"], m["busy"], ratio, m["bytes"], m["sha"]),
-                    flush=True)
+                print("| %d | %s | %s | %.3f | %.2f | %.2f | %s | %d | %d | %s |" % (
+                    r, fmt, name, m["wall"], m["wait"], m["busy"], ratio, m["peak_mb"],
+                    m["bytes"], m["sha"]), flush=True)
     shutil.rmtree(out, ignore_errors=True)
 
 
