@@ -96,6 +96,7 @@ static int bench_run_events(const evr_scene *scene, const evr_config *cfg_in, in
     } else {
         struct rusage ru;
         const evr_stats *s = evr_sim_stats(sim);
+        cli_warn_photon_drops(s);
         getrusage(RUSAGE_SELF, &ru);
         f->s = *s;
         f->load = *evr_scene_load_times(scene);

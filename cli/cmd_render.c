@@ -153,6 +153,7 @@ int cmd_render(int argc, char **argv, const char *default_demo, uint64_t demo_se
         else fprintf(stderr, "evray: nothing kept in %s\n", cfg.out_dir);
         rc = 1;
     } else {
+        cli_warn_photon_drops(stats);
         if (!quiet) {
             unsigned long long ev = (unsigned long long)(stats->events_on + stats->events_off);
             printf(

@@ -110,3 +110,15 @@ int cli_is_animation_option(int argc, char **argv, int *i, const char **animatio
     *animation = opt_value(argc, argv, i, "--animation");
     return *animation ? 1 : -1;
 }
+
+void cli_warn_photon_drops(const evr_stats *s)
+{
+    const unsigned long long kept = s->photons_stored, dropped = s->photon_collisions;
+    if (dropped == 0 || (double)dropped <= 0.01 * (double)(kept + dropped)) return;
+    fprintf(stderr,
+            "evray: warning: %llu of %llu photons (%.1f%%) found their pixel of the photon buffer "
+            "full (--photon-layers %d) and were left out of the indirect light; more layers (at "
+            "most 256) or fewer --photons keep them\n",
+            dropped, kept + dropped, 100.0 * (double)dropped / (double)(kept + dropped),
+            s->photon_layers);
+}

@@ -33,6 +33,10 @@ evr_scene *cli_load_scene(const char *path, const char *demo, uint64_t demo_seed
 /* --animation NAME|INDEX|all at argv[*i]: 1 (its value in *animation, *i past it), 0 when
  * argv[*i] is another argument, -1 after an error message. */
 int cli_is_animation_option(int argc, char **argv, int *i, const char **animation);
+
+/* A run with global illumination whose photon buffer dropped more than 1% of the photons that
+ * reached it: one warning line saying how many and what keeps them. */
+void cli_warn_photon_drops(const evr_stats *s);
 /* The help line of --animation, for every command that loads a scene. */
 #define CLI_ANIMATION_HELP                                                                     \
     "  --animation CLIP           animation clips that play: a clip's name or 0-based index\n" \

@@ -230,7 +230,7 @@ typedef struct {
     float gather_radius; /* distance filter r, world units (<= 0: 2% of the scene's diagonal) */
     int gather_max;      /* photons per estimate at most */
     int gather_window;   /* the gather window's half size at most, pixels */
-    int photon_layers;   /* photons each pixel of the buffer holds */
+    int photon_layers;   /* photons each pixel of the buffer holds (0: from photons) */
     int gi_bounces;      /* indirect bounces of a photon */
     /* shading: reflections and refractions a camera ray may take (core/path.h) */
     int max_bounces;
@@ -319,6 +319,7 @@ typedef struct {
     double time_write;           /* the writer thread's busy time (overlaps rendering) */
     double time_photons;         /* global illumination: the photon passes (GPU: device time) */
     uint64_t photons_stored, photon_collisions, photon_cells_changed;
+    int photon_layers; /* the photon buffer's layers (config's, or made from its photons) */
     uint64_t photons_traced,
         photons_reused;     /* photon paths traced, and those that reused their trail */
     uint64_t device_memory; /* bytes the backend holds on the GPU (0 on the CPU) */

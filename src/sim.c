@@ -12,6 +12,7 @@
 #include "run/camera_poses.h"
 #include "run/labels_out.h"
 #include "run/event_sink.h"
+#include "prep/gi_params.h"
 #ifdef EVR_HAVE_CUDA
 #include "cuda/cuda_backend.h"
 #endif
@@ -219,7 +220,9 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         c->gather_radius > 0.0f ? c->gather_radius : 0.02f * sim->host.scene_size;
     sim->setup.gather_max = c->gather_max;
     sim->setup.gather_window = c->gather_window;
-    sim->setup.photon_layers = c->photon_layers;
+    sim->setup.photon_layers =
+        evr_gi_photon_layers(c->photon_layers, c->photons, sim->setup.width, sim->setup.height);
+    sim->st.photon_layers = sim->setup.photon_layers;
     sim->setup.gi_bounces = c->gi_bounces;
     sim->timestamp_slack_us = timestamp_slack_us(sim);
     sim->setup.cancel = &sim->cancel;

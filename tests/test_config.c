@@ -46,7 +46,7 @@ static void test_documented_defaults(void)
     CHECK(c.frames_out == NULL && c.frames_fps == 0.0 && c.frames_exposure == 1.0f &&
           c.frames_max == 4.0f);
     CHECK(c.gi == 0 && c.photons == 0 && c.gather_radius == 0.0f && c.gather_max == 0);
-    CHECK(c.gather_window == 8 && c.photon_layers == 8 && c.gi_bounces == 4);
+    CHECK(c.gather_window == 8 && c.photon_layers == 0 && c.gi_bounces == 4);
 }
 
 /* Every row's default is the field's value in evr_config_defaults, and the "(default N)" of its
@@ -240,7 +240,7 @@ static void test_special_options(void)
           strstr(err.msg, "samples per frame") != NULL);
     evr_config_defaults(&c);
     c.gi = 1;
-    c.photon_layers = 0;
+    c.photon_layers = 257;
     CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
           strstr(err.msg, "--photon-layers") != NULL);
     c.gi = 0; /* GI settings are checked only with GI on */

@@ -69,7 +69,36 @@ T.check(st["photons_reused"] + st["photons_traced"] == jt["stats"]["photons_trac
         "GI: every photon is either traced or reused")
 T.check(jb["stats"]["photons_reused"] == 0, "GI brute force (--no-skip): no photon reuses its trail")
 
-bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "0"],
+# the photon buffer holds what the pass sends it: 8 layers a pixel for each photon per pixel
+# (at most 64) unless --photon-layers says otherwise, and a run whose buffer dropped more than 1%
+# of its photons says so in one warning line (run.json counts them)
+def layers_run(name, *extra):
+    d = os.path.join(tmp, name)
+    p = T.run("demo", "--scene", "cornell", "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
+              "--res", "64x48", "--gi", "photon", "--duration", "0.3", *extra)
+    return p, T.load_run_json(d)["stats"]
+
+
+pixels = 64 * 48
+p1, s1 = layers_run("layers-default")
+p4, s4 = layers_run("layers-4", "--photons", str(4 * pixels))
+p16, s16 = layers_run("layers-16", "--photons", str(16 * pixels))
+p16c, s16c = layers_run("layers-16-capped", "--photons", str(16 * pixels), "--photon-layers", "8")
+for what, st in (("default", s1), ("4 a pixel", s4), ("16 a pixel", s16), ("16 a pixel, 8 layers", s16c)):
+    print(f"photon buffer, {what}: {st['photon_layers']} layers, {st['photons_stored']} stored, "
+          f"{st['photon_collisions']} dropped")
+T.check((s1["photon_layers"], s4["photon_layers"], s16["photon_layers"], s16c["photon_layers"]) == (8, 32, 64, 8),
+        "the photon buffer's layers follow the photons per pixel, or --photon-layers")
+for p, st in ((p1, s1), (p4, s4), (p16, s16)):
+    T.check(st["photon_collisions"] <= 0.01 * (st["photons_stored"] + st["photon_collisions"]) and
+            "photon buffer" not in p.stderr, f"{st['photon_layers']} layers keep the photons, no warning ({p.stderr})")
+dropped = s16c["photon_collisions"]
+T.check(dropped > 0.01 * (s16c["photons_stored"] + dropped), "16 photons a pixel in 8 layers: photons dropped")
+warn = [l for l in p16c.stderr.splitlines() if "photon buffer" in l]
+T.check(len(warn) == 1 and warn[0].startswith("evray: warning: ") and f"{dropped} of " in warn[0] and
+        "--photon-layers 8" in warn[0], f"dropped photons: one warning line with the count ({p16c.stderr})")
+
+bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "257"],
        ["--gi", "photon", "--gather-max", "-1"], ["--gi", "photon", "--gather-radius", "-1"],
        ["--gi", "photon", "--photons", "x"]]
 for args in bad:

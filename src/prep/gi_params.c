@@ -2,6 +2,7 @@
 #include "prep/gi_params.h"
 #include "scene/scene.h"
 
+#include <math.h>
 #include <string.h>
 
 void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons,
@@ -25,4 +26,13 @@ void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t 
     pp->bounds.radius = 0.55f * evr_v3_len(evr_v3_sub(hi, lo)) + 1e-6f;
     *margin = setup->gather_window < 16 ? setup->gather_window : 16;
     *window = setup->gather_window + 1;
+}
+
+int evr_gi_photon_layers(int asked, uint32_t photons, int width, int height)
+{
+    const double pixels = (double)width * (double)height;
+    double per_pixel = photons > 0u && pixels > 0.0 ? (double)photons / pixels : 1.0;
+    if (asked > 0) return asked;
+    if (per_pixel < 1.0) per_pixel = 1.0;
+    return per_pixel >= 8.0 ? 64 : (int)ceil(8.0 * per_pixel);
 }

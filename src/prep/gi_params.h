@@ -13,4 +13,9 @@
 void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t *photons,
                        evr_gather_params *gp, evr_photon_params *pp, int *margin, int *window);
 
+/* The photon buffer's layers: `asked` (config's photon_layers) when set, otherwise 8 for each
+ * photon per pixel the pass traces (one per pixel without `photons`), at most 64; a pixel the
+ * light favours receives several times the mean, and a full pixel drops what comes later. */
+int evr_gi_photon_layers(int asked, uint32_t photons, int width, int height);
+
 #endif

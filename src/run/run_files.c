@@ -372,6 +372,8 @@ static char *run_json(const evr_sim *sim)
         evr_json_unsigned(&j, sim->backend->photons_stored);
         evr_json_key(&j, "photon_collisions");
         evr_json_unsigned(&j, sim->backend->photon_collisions);
+        evr_json_key(&j, "photon_layers");
+        evr_json_unsigned(&j, (uint64_t)sim->setup.photon_layers);
         evr_json_key(&j, "photon_cells_changed");
         evr_json_unsigned(&j, sim->backend->photon_cells_changed);
         evr_json_key(&j, "time_photons_seconds");
