@@ -208,6 +208,26 @@ T.check(st_gpu["photons_reused"] > st_gpu["photons_traced"] and st_nr["photons_r
         "cornell GI on CUDA: most photons reuse their trails")
 T.check(abs(st_gpu["photons_reused"] - st_cpu["photons_reused"]) <= 0.02 * st_cpu["photons_reused"],
         "cornell GI: CUDA reuses as many photon trails as the CPU (within 2%)")
+# the photon buffer's layers follow the budget on the GPU as on the CPU (16 photons a pixel: 64
+# layers, as good as none dropped, about the CPU's photons stored); 8 layers drop them, with the
+# warning
+layers_runs = {}
+for label, extra in (("cpu", ["--backend", "cpu"]), ("cuda", ["--backend", "cuda"]),
+                     ("cuda-8", ["--backend", "cuda", "--photon-layers", "8"])):
+    d = os.path.join(tmp, f"gi-layers-{label}")
+    p = T.run("demo", "--scene", "cornell", "-o", d, "--no-preview", "--quiet", *gi, "--photons", str(16 * 96 * 72),
+              *extra)
+    layers_runs[label] = (p.stderr, T.load_run_json(d)["stats"])
+for label, (err, st) in layers_runs.items():
+    print(f"GI, 16 photons a pixel, {label}: {st['photon_layers']} layers, {st['photons_stored']} stored, "
+          f"{st['photon_collisions']} dropped")
+(_, lc), (ec, lg), (e8, l8) = layers_runs["cpu"], layers_runs["cuda"], layers_runs["cuda-8"]
+T.check(lg["photon_layers"] == 64 and lg["photon_collisions"] <= 0.01 * lg["photons_stored"] and "photon buffer" not in ec,
+        "cornell GI on CUDA, 16 photons a pixel: 64 layers keep them")
+T.check(abs(lg["photons_stored"] - lc["photons_stored"]) <= 0.02 * lc["photons_stored"],
+        "cornell GI, 16 photons a pixel: CUDA stores as many photons as the CPU (within 2%)")
+T.check(l8["photon_collisions"] > 0.01 * (l8["photons_stored"] + l8["photon_collisions"]) and
+        sum("photon buffer" in l for l in e8.splitlines()) == 1, "cornell GI on CUDA, 8 layers: photons dropped, one warning")
 d = os.path.join(tmp, "gi-still")
 T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
       "--res", "96x72", "--duration", "1.0")
