@@ -791,8 +791,8 @@ static const evr_config_option table[] = {
      .applies = has_gi,
      .flag = "--photon-layers",
      .label = "--photon-layers N",
-     .help = "photons each pixel of the buffer holds (default 0: 8 for each photon per pixel\n"
-             "of --photons, at most 64)",
+     .help = "photons each pixel of the buffer holds (default 0: 8 for\n"
+             "each photon per pixel of --photons, at most 64)",
      .json = "photon_layers",
      .json_rank = 39,
      .json_if = has_gi},
