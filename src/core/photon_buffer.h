@@ -32,10 +32,10 @@ typedef struct {
     uint32_t *count;
     uint32_t *collisions;
     /* Optional (NULL: none): what the camera sees through each cell's centre, 8 floats per cell:
-     * position (3), normal facing the camera (3), the surface area the cell covers there, 0; a
-     * cell that sees nothing has area 0. evr_photon_gather then normalizes its kernel over the
-     * part of the disk that lies on surfaces like the query's, not the whole disk (no darkening
-     * at creases and silhouettes). */
+     * position (3), normal facing the camera (3), the surface area the cell covers there, the
+     * variance of that footprint (evr_photon_cell_view); a cell that sees nothing has area 0.
+     * evr_photon_gather then normalizes its kernel over the part of the disk that lies on
+     * surfaces like the query's, not the whole disk (no darkening at creases and silhouettes). */
     float *gbuf;
 } evr_photon_buffer;
 
@@ -138,7 +138,11 @@ EVR_HD static inline evr_ray evr_photon_cell_ray(const evr_render_scene *rs, con
 /* A cell's view (gbuf, 8 floats) from the surface s met at distance t along its ray; fwd: the
  * camera's forward axis. The area is the pixel's at unit distance * depth^2 * cos(off-axis
  * angle) / |cos of the incidence| (the cosine at least 0.1); an orthographic camera's pixel has
- * the same area at every depth. */
+ * the same area at every depth. The footprint is a strip w wide and w / cos long (w^2 = area *
+ * cos); its variance (w^2 + (w / cos)^2) / 12 = area (cos + 1 / cos) / 12 lets a gather take the
+ * kernel's integral over the strip rather than its value at the centre (evr_cell_area_weight):
+ * on a surface seen at a grazing angle a strip is as long as the kernel is wide, and centre
+ * values alone swing as a moving point's kernel passes over the strips. */
 EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v3 fwd,
                                                const evr_surface *s, evr_ray ray, float t,
                                                float g[8])
@@ -159,7 +163,28 @@ EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v
     } else {
         g[6] = a * z * z * ca / ct;
     }
-    g[7] = 0.0f;
+    g[7] = g[6] * (ct + 1.0f / ct) * (1.0f / 12.0f);
+}
+
+/* A cell's share of the kernel's integral over the surfaces the camera sees, for a query at
+ * squared distance d2 from the cell's view g with the kernel's variance s2 (sigma^2): the
+ * Gaussian convolved with the footprint taken as a Gaussian of variance g[7] (the integral over
+ * the plane stays the area's), counted while the footprint reaches within r^2 = lim2
+ * (evr_cell_area_reaches). Products unfused (EVR_MUL_RN: the same bits wherever computed). */
+#if defined(__CUDA_ARCH__)
+#define EVR_AREA_MUL_RN(a, b) __fmul_rn((a), (b))
+#else
+#define EVR_AREA_MUL_RN(a, b) ((a) * (b))
+#endif
+EVR_HD static inline int evr_cell_area_reaches(const float *g, float d2, float lim2)
+{
+    return g[6] > 0.0f && d2 <= lim2 + 4.0f * g[7];
+}
+
+EVR_HD static inline float evr_cell_area_weight(const float *g, float d2, float s2)
+{
+    const float se = s2 + g[7];
+    return EVR_AREA_MUL_RN(EVR_AREA_MUL_RN(expf(EVR_AREA_MUL_RN(d2, -0.5f / se)), s2 / se), g[6]);
 }
 
 #endif

@@ -70,10 +70,10 @@ EVR_HD static inline int evr_photon_cell_reaches(const evr_photon_buffer *b, siz
     if (b->gbuf) {
         const float *g = b->gbuf + 8 * i;
         evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
-        if (g[6] > 0.0f &&
-            ((evr_v3_dot(d, d) <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos) ||
-             (evr_dot_rn(d.x, d.y, d.z, d.x, d.y, d.z) <= lim2 &&
-              evr_dot_rn(g[3], g[4], g[5], n.x, n.y, n.z) >= normal_cos)))
+        if ((evr_cell_area_reaches(g, evr_v3_dot(d, d), lim2) &&
+             g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos) ||
+            (evr_cell_area_reaches(g, evr_dot_rn(d.x, d.y, d.z, d.x, d.y, d.z), lim2) &&
+             evr_dot_rn(g[3], g[4], g[5], n.x, n.y, n.z) >= normal_cos))
             return 1;
     }
     for (l = 0; l < nl; l++) {

@@ -68,6 +68,7 @@ typedef struct {
     evr_v3 p, n, c;
     float r2, normal_cos, flux_scale;
     float e, area_scale; /* -1 / (2 sigma^2), 2^32 / sigma^2 */
+    float s2;            /* sigma^2 */
 } evr_sum_query;
 
 /* Adds cell i's terms for query q to s (sub: subtracts them). Returns the photons taken. */
@@ -84,8 +85,8 @@ EVR_HD static inline int evr_photon_cell_sum(const evr_photon_buffer *b, size_t 
         float dx = g[0] - p.x, dy = g[1] - p.y, dz = g[2] - p.z;
         float d2 = evr_dot_rn(dx, dy, dz, dx, dy, dz),
               c = evr_dot_rn(g[3], g[4], g[5], n.x, n.y, n.z);
-        if (g[6] > 0.0f && d2 <= q->r2 && c >= q->normal_cos)
-            aw = evr_fix(EVR_MUL_RN(EVR_MUL_RN(expf(EVR_MUL_RN(d2, e)), g[6]), area_scale));
+        if (evr_cell_area_reaches(g, d2, q->r2) && c >= q->normal_cos)
+            aw = evr_fix(EVR_MUL_RN(evr_cell_area_weight(g, d2, q->s2), area_scale));
     }
     nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
     for (l = 0; l < nl; l++) {

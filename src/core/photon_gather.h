@@ -79,8 +79,9 @@ EVR_HD static inline int evr_photon_gather_cell(const evr_photon_buffer *b, int 
         const float *g = b->gbuf + 8 * i;
         evr_v3 d = evr_v3_make(g[0] - p.x, g[1] - p.y, g[2] - p.z);
         float d2 = evr_v3_dot(d, d);
-        if (g[6] > 0.0f && d2 <= lim2 && g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos)
-            *area_w += expf(-d2 / (2.0f * s2)) * g[6];
+        if (evr_cell_area_reaches(g, d2, lim2) &&
+            g[3] * n.x + g[4] * n.y + g[5] * n.z >= normal_cos)
+            *area_w += evr_cell_area_weight(g, d2, s2);
     }
     nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
     for (l = 0; l < nl; l++) {

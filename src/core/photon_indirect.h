@@ -66,6 +66,7 @@ EVR_HD static inline evr_gather_window evr_gather_point_query(const evr_photon_b
     q->flux_scale = gp->flux_scale;
     q->e = -0.5f / w.s2;
     q->area_scale = 4294967296.0f / w.s2;
+    q->s2 = w.s2;
     return w;
 }
 
