@@ -798,6 +798,48 @@ static void test_gather_moved(void)
     }
 }
 
+/* The cells' view: a cell adds the kernel convolved with its footprint (variance g[7]), whose
+ * integral over a plane of such cells is the kernel's; a changed view whose centre lies just
+ * past r but whose footprint reaches within it moves the gather, one whose footprint does not
+ * leaves it as it was. */
+static void test_cell_view(void)
+{
+    const float s2 = 0.01f, r2 = 4.0f * s2, cell = 0.01f;
+    double sum = 0.0;
+    for (int j = -60; j <= 60; j++)
+        for (int k = -60; k <= 60; k++) {
+            const float g[8] = {0, 0, 0, 0, 0, 1, cell * cell, 0.3f * cell * cell};
+            const float d2 = (float)(j * j + k * k) * cell * cell;
+            if (evr_cell_area_reaches(g, d2, r2)) sum += evr_cell_area_weight(g, d2, s2);
+        }
+    /* the kernel's integral within the disk reached: 2 pi s2 (1 - exp(-(r2 + 4 g7) / (2 s2))) */
+    CHECK_NEAR(sum / (2.0 * EVR_PI * s2 * (1.0 - exp(-(r2 + 1.2 * cell * cell) / (2.0 * s2)))), 1.0,
+               0.01);
+    enum { N = 21 };
+    const evr_camera_intr cam = evr_camera_intr_make(N, N, 0.5f * EVR_PI);
+    evr_gather_params gp = {0.2f, 64, 8, 0.5f, 0.0f};
+    const evr_v3 p = evr_v3_make(0.0f, 0.0f, 0.0f), nrm = evr_v3_make(0.0f, 0.0f, 1.0f);
+    static uint32_t sat[(N + 1) * (N + 1)];
+    evr_error err;
+    for (int reach = 0; reach < 2; reach++) {
+        evr_photon_buffer cur, prev;
+        CHECK_OK(evr_photon_buffer_alloc(&cur, N, N, 1, 0, &err));
+        CHECK_OK(evr_photon_buffer_alloc(&prev, N, N, 1, 0, &err));
+        cur.gbuf = calloc((size_t)N * N * 8, sizeof(float));
+        prev.gbuf = calloc((size_t)N * N * 8, sizeof(float));
+        float *gc = cur.gbuf + 8 * (10 * N + 12), *gpv = prev.gbuf + 8 * (10 * N + 12);
+        gc[0] = gpv[0] = 0.21f; /* just past r = 0.2 */
+        gc[5] = gpv[5] = 1.0f;
+        gc[6] = 0.01f;
+        gpv[6] = 0.02f;                         /* the view changed */
+        gc[7] = gpv[7] = reach ? 0.002f : 0.0f; /* 4 g7 = 0.008 > 0.21^2 - 0.2^2 = 0.0041 */
+        changed_sat(&cur, &prev, sat);
+        CHECK(evr_photon_gather_moved(&cur, &prev, sat, &cam, &gp, 10, 10, p, nrm, 1.0f) == reach);
+        evr_photon_buffer_free(&cur);
+        evr_photon_buffer_free(&prev);
+    }
+}
+
 static uint64_t rng_next(uint64_t *s) { return evr_mix64(++*s); }
 static float rng_uniform(uint64_t *s) { return evr_uniform(rng_next(s)); }
 
@@ -908,5 +950,6 @@ int main(void)
     test_trail();
     test_gather_moved();
     test_gather_delta();
+    test_cell_view();
     return check_report("test_photon");
 }
