@@ -102,7 +102,7 @@ T.check(len(warn) == 1 and warn[0].startswith("evray: warning: ") and f"{dropped
 # over what the camera sees takes each cell's footprint as a strip, not its centre point, so the
 # face's indirect light does not swing within every segment as the box slides (with centre
 # points, 16 photons a pixel made 4.9 times direct light's events there, in ON and OFF bursts at
-# the segment rate; 2.1 times now: docs/benchmarks.md, "... fidelity")
+# the segment rate; 2.2 times now: docs/benchmarks.md, "... fidelity")
 def face_events(name, *extra):
     d = os.path.join(tmp, name)
     T.run("demo", "--scene", "cornell", "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
