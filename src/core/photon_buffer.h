@@ -10,8 +10,12 @@
 
 #if defined(__CUDA_ARCH__) /* nvcc's device pass; its host pass is the host compiler's */
 #define EVR_ATOMIC_INC_U32(p) atomicAdd((unsigned int *)(p), 1u)
+/* a product that is never fused with an addition (nvcc fuses a * b + c into one rounding where
+ * it likes; the C compiler here, ISO C without FMA, never does) */
+#define EVR_MUL_RN(a, b) __fmul_rn((a), (b))
 #else
 #define EVR_ATOMIC_INC_U32(p) __atomic_fetch_add((p), 1u, __ATOMIC_RELAXED)
+#define EVR_MUL_RN(a, b) ((a) * (b))
 #endif
 
 typedef struct {
@@ -171,11 +175,6 @@ EVR_HD static inline void evr_photon_cell_view(const evr_render_scene *rs, evr_v
  * Gaussian convolved with the footprint taken as a Gaussian of variance g[7] (the integral over
  * the plane stays the area's), counted while the footprint reaches within r^2 = lim2
  * (evr_cell_area_reaches). Products unfused (EVR_MUL_RN: the same bits wherever computed). */
-#if defined(__CUDA_ARCH__)
-#define EVR_AREA_MUL_RN(a, b) __fmul_rn((a), (b))
-#else
-#define EVR_AREA_MUL_RN(a, b) ((a) * (b))
-#endif
 EVR_HD static inline int evr_cell_area_reaches(const float *g, float d2, float lim2)
 {
     return g[6] > 0.0f && d2 <= lim2 + 4.0f * g[7];
@@ -184,7 +183,7 @@ EVR_HD static inline int evr_cell_area_reaches(const float *g, float d2, float l
 EVR_HD static inline float evr_cell_area_weight(const float *g, float d2, float s2)
 {
     const float se = s2 + g[7];
-    return EVR_AREA_MUL_RN(EVR_AREA_MUL_RN(expf(EVR_AREA_MUL_RN(d2, -0.5f / se)), s2 / se), g[6]);
+    return EVR_MUL_RN(EVR_MUL_RN(expf(EVR_MUL_RN(d2, -0.5f / se)), s2 / se), g[6]);
 }
 
 #endif

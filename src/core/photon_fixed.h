@@ -20,14 +20,6 @@
 #include <stdint.h>
 #include "core/photon_gather.h"
 
-#if defined(__CUDA_ARCH__) /* nvcc's device pass; its host pass is the host compiler's */
-/* a product that is never fused with an addition (nvcc fuses a * b + c into one rounding where
- * it likes; the C compiler here, ISO C without FMA, never does) */
-#define EVR_MUL_RN(a, b) __fmul_rn((a), (b))
-#else
-#define EVR_MUL_RN(a, b) ((a) * (b))
-#endif
-
 typedef struct {
     uint64_t a; /* weighted luminance flux, in units of 1 / flux_scale */
     uint64_t w; /* the view's weighted area, in units of sigma^2 / 2^32 */
