@@ -121,9 +121,9 @@ def load_h5(path):
     return ev, ms, attrs
 
 
-def npy_event_times(data):
-    """The t column (microseconds) of an events.npy file's bytes, without numpy (the GPU machine
-    has none): the header's dtype gives the record layout."""
+def npy_columns(data, names):
+    """The named columns of an events.npy file's bytes, as tuples per event, without numpy (the GPU
+    machine has none): the header's dtype gives the record layout."""
     import ast
     import struct
     major = data[6]
@@ -131,34 +131,26 @@ def npy_event_times(data):
     start = 10 + hlen if major == 1 else 12 + hlen
     header = ast.literal_eval(data[10 if major == 1 else 12:start].decode("latin1"))
     sizes = {"i8": 8, "u8": 8, "u2": 2, "i2": 2, "i1": 1, "u1": 1, "f8": 8, "i4": 4, "u4": 4, "f4": 4}
-    offset, t_at = 0, None
-    for name, typ in header["descr"]:
-        if name == "t":
-            t_at = offset
-        offset += sizes[typ.lstrip("<>|=")]
-    n = (len(data) - start) // offset
-    return [struct.unpack_from("<q", data, start + i * offset + t_at)[0] for i in range(n)]
-
-
-def npy_event_pixels(data):
-    """The (x, y) of every event of an events.npy file's bytes, without numpy (as npy_event_times)."""
-    import ast
-    import struct
-    major = data[6]
-    hlen = struct.unpack_from("<H" if major == 1 else "<I", data, 8)[0]
-    start = 10 + hlen if major == 1 else 12 + hlen
-    header = ast.literal_eval(data[10 if major == 1 else 12:start].decode("latin1"))
-    sizes = {"i8": 8, "u8": 8, "u2": 2, "i2": 2, "i1": 1, "u1": 1, "f8": 8, "i4": 4, "u4": 4, "f4": 4}
-    codes = {"i8": "q", "u8": "Q", "u2": "H", "i2": "h", "i1": "b", "u1": "B", "i4": "i", "u4": "I"}
+    codes = {"i8": "q", "u8": "Q", "u2": "H", "i2": "h", "i1": "b", "u1": "B", "i4": "i", "u4": "I",
+             "f8": "d", "f4": "f"}
     offset, at = 0, {}
     for name, typ in header["descr"]:
         typ = typ.lstrip("<>|=")
         at[name] = (offset, "<" + codes[typ])
         offset += sizes[typ]
     n = (len(data) - start) // offset
-    (xo, xc), (yo, yc) = at["x"], at["y"]
-    return [(struct.unpack_from(xc, data, start + i * offset + xo)[0],
-             struct.unpack_from(yc, data, start + i * offset + yo)[0]) for i in range(n)]
+    cols = [at[name] for name in names]
+    return [tuple(struct.unpack_from(c, data, start + i * offset + o)[0] for o, c in cols) for i in range(n)]
+
+
+def npy_event_times(data):
+    """The t column (microseconds) of an events.npy file's bytes."""
+    return [t for (t,) in npy_columns(data, ("t",))]
+
+
+def npy_event_pixels(data):
+    """The (x, y) of every event of an events.npy file's bytes."""
+    return npy_columns(data, ("x", "y"))
 
 
 def boundary_share(npy, segments, duration):
