@@ -18,17 +18,20 @@ static int sorted(const evr_event *e, size_t n)
 int cmd_compare(int argc, char **argv)
 {
     const char *paths[2] = {NULL, NULL}, *v;
-    double tol = 100.0;
+    double tol = 100.0, tol_level = 0.0;
     int json = 0, np = 0, i;
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             puts(
-                "usage: evray compare REF TEST [--tol-us 100] [--json]\n\n"
+                "usage: evray compare REF TEST [--tol-us 100] [--tol-level F] [--json]\n\n"
                 "Matches TEST's events one-to-one against REF's (same pixel, same polarity, |dt| <= tolerance,\n"
                 "in time order) and prints event counts and their ratio, precision, recall, F1, the median\n"
                 "and 95th percentile |dt| of matches and the correlation of per-pixel event counts.\n"
-                "Reads any format evray writes (.h5, .txt, .npy, Prophesee .raw EVT 2.0/3.0 and .dat).");
+                "Reads any format evray writes (.h5, .txt, .npy, Prophesee .raw EVT 2.0/3.0 and .dat).\n\n"
+                "  --tol-level F  (0 to 0.5) a REF event also matches within F times the time since the\n"
+                "                 previous REF event of its pixel and polarity: the timing error that a\n"
+                "                 log-intensity error of F thresholds makes where the pixel changes slowly");
             return 0;
         }
         if (!strcmp(a, "--json")) json = 1;
@@ -37,6 +40,14 @@ int cmd_compare(int argc, char **argv)
                 return 2;
             if (tol < 0) {
                 cli_error("--tol-us must be >= 0");
+                return 2;
+            }
+        } else if (opt_is(a, "--tol-level")) {
+            if (!(v = opt_value(argc, argv, &i, "--tol-level")) ||
+                !opt_double("--tol-level", v, &tol_level))
+                return 2;
+            if (!(tol_level >= 0.0 && tol_level <= 0.5)) {
+                cli_error("--tol-level must be between 0 and 0.5");
                 return 2;
             }
         } else if (a[0] == '-' && a[1]) {
@@ -69,7 +80,7 @@ int cmd_compare(int argc, char **argv)
         }
     }
     evr_compare_result r;
-    evr_status st = evr_compare_events(ev[0], n[0], ev[1], n[1], (int64_t)tol, &r, &err);
+    evr_status st = evr_compare_events(ev[0], n[0], ev[1], n[1], (int64_t)tol, tol_level, &r, &err);
     free(ev[0]);
     free(ev[1]);
     if (st != EVR_OK) {
@@ -78,10 +89,10 @@ int cmd_compare(int argc, char **argv)
     }
     if (json) {
         printf(
-            "{\"tol_us\": %.17g, \"ref_on\": %llu, \"ref_off\": %llu, \"test_on\": %llu, \"test_off\": %llu, "
+            "{\"tol_us\": %.17g, \"tol_level\": %.17g, \"ref_on\": %llu, \"ref_off\": %llu, \"test_on\": %llu, \"test_off\": %llu, "
             "\"count_ratio\": %.6f, \"matched\": %llu, \"precision\": %.6f, \"recall\": %.6f, \"f1\": %.6f, "
             "\"median_dt_us\": %.1f, \"p95_dt_us\": %.1f, \"pixel_count_correlation\": %.6f}\n",
-            tol, (unsigned long long)r.ref_on, (unsigned long long)r.ref_off,
+            tol, tol_level, (unsigned long long)r.ref_on, (unsigned long long)r.ref_off,
             (unsigned long long)r.test_on, (unsigned long long)r.test_off, r.count_ratio,
             (unsigned long long)r.matched, r.precision, r.recall, r.f1, r.median_dt_us, r.p95_dt_us,
             r.pixel_count_correlation);
@@ -92,8 +103,13 @@ int cmd_compare(int argc, char **argv)
         printf("test:      %llu events (%llu ON, %llu OFF), ratio %.4f\n",
                (unsigned long long)(r.test_on + r.test_off), (unsigned long long)r.test_on,
                (unsigned long long)r.test_off, r.count_ratio);
-        printf("matched within %.0f us: %llu; precision %.4f, recall %.4f, F1 %.4f\n", tol,
-               (unsigned long long)r.matched, r.precision, r.recall, r.f1);
+        if (tol_level > 0.0)
+            printf("matched within %.0f us or %g of the reference's gap: %llu; precision %.4f, "
+                   "recall %.4f, F1 %.4f\n",
+                   tol, tol_level, (unsigned long long)r.matched, r.precision, r.recall, r.f1);
+        else
+            printf("matched within %.0f us: %llu; precision %.4f, recall %.4f, F1 %.4f\n", tol,
+                   (unsigned long long)r.matched, r.precision, r.recall, r.f1);
         printf("|dt| of matches: median %.0f us, 95th percentile %.0f us\n", r.median_dt_us,
                r.p95_dt_us);
         printf("per-pixel event count correlation: %.4f\n", r.pixel_count_correlation);

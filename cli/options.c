@@ -118,7 +118,7 @@ void cli_warn_photon_drops(const evr_stats *s)
     fprintf(stderr,
             "evray: warning: %llu of %llu photons (%.1f%%) found their pixel of the photon buffer "
             "full (--photon-layers %d) and were left out of the indirect light; more layers (at "
-            "most 256) or fewer --photons keep them\n",
+            "most 4096) or fewer --photons keep them\n",
             dropped, kept + dropped, 100.0 * (double)dropped / (double)(kept + dropped),
             s->photon_layers);
 }

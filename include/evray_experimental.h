@@ -97,10 +97,15 @@ typedef struct {
     double pixel_count_correlation; /* Pearson correlation of per-pixel event counts */
 } evr_compare_result;
 
-/* Both streams sorted by time. tol_us >= 0. */
+/* Both streams sorted by time. tol_us >= 0. tol_level in [0, 0.5]: a reference event also
+ * matches within tol_level times its gap, the time since the previous reference event of its
+ * pixel and polarity (the group's first event: the time to the next one). The log intensity
+ * moves one threshold over a gap, so that is the timing error a level error of tol_level
+ * thresholds makes: an event of a slowly changing pixel is placed by its level to within a
+ * fraction of its gap, not of a fixed time. 0: the fixed tolerance alone. */
 evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test,
-                              size_t ntest, int64_t tol_us, evr_compare_result *out,
-                              evr_error *err);
+                              size_t ntest, int64_t tol_us, double tol_level,
+                              evr_compare_result *out, evr_error *err);
 
 /* ---- charts and images (src/io/plot.c, src/io/png.c) ---- */
 /* One line series: n points (x[i], y[i]) joined in order. */

@@ -32,8 +32,18 @@ static int cmp_i64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Reference event a's tolerance in its group [a0, a1) of times t (evr_compare_events). */
+static int64_t ref_tolerance(const int64_t *t, size_t a0, size_t a1, size_t a, int64_t tol_us,
+                             double tol_level)
+{
+    int64_t gap = a > a0 ? t[a] - t[a - 1] : (a + 1 < a1 ? t[a + 1] - t[a] : 0);
+    int64_t by_level = (int64_t)floor(tol_level * (double)gap);
+    return by_level > tol_us ? by_level : tol_us;
+}
+
 evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event *test,
-                              size_t ntest, int64_t tol_us, evr_compare_result *out, evr_error *err)
+                              size_t ntest, int64_t tol_us, double tol_level,
+                              evr_compare_result *out, evr_error *err)
 {
     size_t i, g;
     int width = 1, height = 1;
@@ -68,7 +78,8 @@ evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event
         size_t a = sa[g], ae = sa[g + 1], b = sb[g], be = sb[g + 1];
         while (a < ae && b < be) {
             int64_t d = tb[b] - ta[a];
-            if (llabs(d) <= tol_us) {
+            if (llabs(d) <=
+                (tol_level > 0.0 ? ref_tolerance(ta, sa[g], ae, a, tol_us, tol_level) : tol_us)) {
                 dts[matched++] = llabs(d);
                 a++;
                 b++;

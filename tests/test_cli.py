@@ -55,6 +55,11 @@ T.check(r["f1"] == 1.0 and r["count_ratio"] == 1.0, f"compare: identical runs ma
 r = json.loads(T.run("compare", os.path.join(out, "events.npy"), os.path.join(static_out, "events.npy"), "--json").stdout)
 T.check(r["recall"] == 0.0, "compare: nothing matches an empty stream")
 expect_error(["compare", os.path.join(out, "events.npy")], "compare with one file")
+r = json.loads(T.run("compare", os.path.join(out, "events.npy"), os.path.join(out2, "events.txt"), "--tol-level", "0.1",
+                     "--json").stdout)
+T.check(r["f1"] == 1.0 and r["tol_level"] == 0.1, f"compare --tol-level: identical runs match fully ({r})")
+expect_error(["compare", os.path.join(out, "events.npy"), os.path.join(out2, "events.txt"), "--tol-level", "0.6"],
+             "compare --tol-level above 0.5")
 
 # bench: one row of figures
 b = json.loads(T.run("bench", "--scene", "square", "--res", "32x32", "--duration", "0.5", "--json").stdout.splitlines()[0])

@@ -16,7 +16,7 @@ int main(void)
                          {950, 0, 1, 1, 0}};
     evr_compare_result r;
     evr_error err;
-    CHECK(evr_compare_events(ref, 4, test, 5, 100, &r, &err) == EVR_OK);
+    CHECK(evr_compare_events(ref, 4, test, 5, 100, 0.0, &r, &err) == EVR_OK);
     CHECK(r.ref_on == 3 && r.ref_off == 1 && r.test_on == 4 && r.test_off == 1);
     CHECK(r.matched == 4);
     CHECK_NEAR(r.precision, 4.0 / 5.0, 1e-12);
@@ -26,14 +26,37 @@ int main(void)
     CHECK_NEAR(r.median_dt_us, 60.0, 1e-12); /* sorted |dt|: 1, 50, 60, 100 */
     CHECK_NEAR(r.p95_dt_us, 60.0, 1e-12);    /* floor(0.95 * 3) = 2 */
     /* a tighter tolerance loses the 100 us pair and the 60 us one */
-    CHECK(evr_compare_events(ref, 4, test, 5, 55, &r, &err) == EVR_OK);
+    CHECK(evr_compare_events(ref, 4, test, 5, 55, 0.0, &r, &err) == EVR_OK);
     CHECK(r.matched == 2);
     /* identical streams: everything matches, correlation 1 */
-    CHECK(evr_compare_events(ref, 4, ref, 4, 0, &r, &err) == EVR_OK);
+    CHECK(evr_compare_events(ref, 4, ref, 4, 0, 0.0, &r, &err) == EVR_OK);
     CHECK(r.matched == 4 && r.f1 == 1.0);
     CHECK_NEAR(r.pixel_count_correlation, 1.0, 1e-12);
+    /* the level tolerance: a slow pixel's events (gaps of 100 ms) placed 8 ms off match at a
+     * tenth of the gap, not at 1 ms; a fast pixel's (gaps of 1 ms) keep the fixed 1 ms, so
+     * 1.2 ms off misses there either way. The first event of a group takes the gap to the next. */
+    {
+        evr_event slow_ref[5] = {{0, 2, 0, 1, 0},
+                                 {100000, 2, 0, 1, 0},
+                                 {200000, 2, 0, 1, 0},
+                                 {200500, 3, 0, 0, 0},
+                                 {201500, 3, 0, 0, 0}};
+        evr_event slow_test[5] = {{8000, 2, 0, 1, 0},
+                                  {108000, 2, 0, 1, 0},
+                                  {189000, 2, 0, 1, 0},
+                                  {202700, 3, 0, 0, 0},
+                                  {203900, 3, 0, 0, 0}};
+        CHECK(evr_compare_events(slow_ref, 5, slow_test, 5, 1000, 0.0, &r, &err) == EVR_OK);
+        CHECK(r.matched == 0);
+        CHECK(evr_compare_events(slow_ref, 5, slow_test, 5, 1000, 0.1, &r, &err) == EVR_OK);
+        /* 8, 8 and 11 ms off the slow pixel's: the first two within 10 ms, the third not; the
+         * fast pixel's, 1.2 ms off, are not within max(1 ms, 0.1 ms) */
+        CHECK(r.matched == 2);
+        CHECK(evr_compare_events(slow_ref, 5, slow_test, 5, 1000, 0.15, &r, &err) == EVR_OK);
+        CHECK(r.matched == 3);
+    }
     /* empty against empty */
-    CHECK(evr_compare_events(ref, 0, test, 0, 10, &r, &err) == EVR_OK);
+    CHECK(evr_compare_events(ref, 0, test, 0, 10, 0.0, &r, &err) == EVR_OK);
     CHECK(r.f1 == 0.0 || r.f1 == 1.0);
     return check_report("test_compare");
 }

@@ -240,7 +240,7 @@ static void test_special_options(void)
           strstr(err.msg, "samples per frame") != NULL);
     evr_config_defaults(&c);
     c.gi = 1;
-    c.photon_layers = 257;
+    c.photon_layers = 4097;
     CHECK(evr_config_validate(&c, NULL, &err) == EVR_ERR_ARG &&
           strstr(err.msg, "--photon-layers") != NULL);
     c.gi = 0; /* GI settings are checked only with GI on */

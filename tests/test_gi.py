@@ -126,7 +126,7 @@ print(f"the short box's grazing face (x 110-119, y 90-109): {face_gi} events wit
 T.check(face_direct > 500 and face_gi < 3 * face_direct,
         "GI on a grazing moving face: under 3x direct light's events (no bursts at the segment rate)")
 
-bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "257"],
+bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "4097"],
        ["--gi", "photon", "--gather-max", "-1"], ["--gi", "photon", "--gather-radius", "-1"],
        ["--gi", "photon", "--photons", "x"]]
 for args in bad:
