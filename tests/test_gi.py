@@ -126,6 +126,38 @@ print(f"the short box's grazing face (x 110-119, y 90-109): {face_gi} events wit
 T.check(face_direct > 500 and face_gi < 3 * face_direct,
         "GI on a grazing moving face: under 3x direct light's events (no bursts at the segment rate)")
 
+
+
+# cornell-bleed: the red short box slides along the white right wall; the wall above the box is
+# redder (red / green) beside the box than 0.4 m from it, with GI only, and the tint follows the box
+def wall_redness(pfm, z):
+    """red / green of the right wall (x = 0.5) at depth z, 0.34-0.46 m up (above the box)"""
+    rows = T.pfm_rows(pfm)
+    h, w = len(rows), len(rows[0])
+    dz, tan_half = 1.9 - z, 0.5 / 1.4  # the camera at (0, 0.5, 1.9), square image
+    red = green = 0.0
+    for y_wall in (0.34, 0.38, 0.42, 0.46):
+        x = int(w / 2 + w / 2 * (0.5 / dz) / tan_half)
+        y = int(h / 2 - h / 2 * ((y_wall - 0.5) / dz) / tan_half)
+        for dx in (-1, 0):
+            red += rows[y][x + dx][0]
+            green += rows[y][x + dx][1]
+    return red / green
+
+
+for t, near, far in (("0", 0.2, -0.2), ("1", -0.2, 0.2)):  # the box at z = 0.2, then at -0.2
+    lit = {}
+    for gi in ("photon", "none"):
+        pfm = os.path.join(tmp, f"bleed-{gi}-{t}.pfm")
+        T.run("still", "--scene", "cornell-bleed", "--gi", gi, "--time", t, "--res", "128x128", "-q", "-o", pfm)
+        lit[gi] = (wall_redness(pfm, near), wall_redness(pfm, far))
+    print(f"cornell-bleed at {t} s, the wall's red / green beside the box and away from it: GI {lit['photon']}, "
+          f"direct {lit['none']}")
+    T.check(abs(lit["none"][0] - lit["none"][1]) < 0.01, "cornell-bleed, direct light: the white wall is as white "
+            "beside the box as away from it")
+    T.check(lit["photon"][0] > lit["photon"][1] + 0.05, f"cornell-bleed at {t} s: GI bleeds the moving box's red onto "
+            "the wall beside it")
+
 bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "4097"],
        ["--gi", "photon", "--gather-max", "-1"], ["--gi", "photon", "--gather-radius", "-1"],
        ["--gi", "photon", "--photons", "x"]]

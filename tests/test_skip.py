@@ -25,6 +25,7 @@ cases.append(("square", ["--sensor", "davis346", "--res", "64x48", "--duration",
 cases.append(("cornell", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
 # global illumination: a pixel whose gather window saw no photon change keeps its intensity
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
+cases.append(("cornell-bleed", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
 # wider windows (a still pixel's sums updated from the cells that changed), and the ring search
 # with a limit on the photons per estimate
 cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))

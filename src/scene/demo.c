@@ -16,6 +16,7 @@
     X("disk", evr_demo_build_disk, 0)                   \
     X("cornell", evr_demo_build_cornell, 0)             \
     X("cornell-still", evr_demo_build_cornell_still, 0) \
+    X("cornell-bleed", evr_demo_build_cornell_bleed, 0) \
     X("city", evr_demo_build_city, 0)                   \
     X("blink", evr_demo_build_blink, 0)
 

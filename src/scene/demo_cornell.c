@@ -1,5 +1,7 @@
 /* The "cornell" scene: a Cornell box with a moving box, for global illumination ("cornell-still":
- * the same with the short box held still by its animation). A 1 m room
+ * the same with the short box held still by its animation; "cornell-bleed": white side walls and
+ * a red short box sliding along the right wall, so that the colour bled onto the wall and floor
+ * comes from what moves). A 1 m room
  * (x in [-0.5, 0.5], y in [0, 1], z in [-0.5, 0.5], open at +z) with a red left wall (0.63, 0.065,
  * 0.05), a green right wall (0.14, 0.45, 0.091), white floor, ceiling and back wall (0.725, 0.71,
  * 0.68: the reflectances of the classic Cornell data); an emissive ceiling panel (0.25 m square,
@@ -72,12 +74,14 @@ static void place(evr_gltf *g, const char *name, int mesh, float x, float y, flo
 }
 
 /* moving 0: the short box's animation holds it where it starts (cornell-still: nothing moves,
- * though the box is animated; with global illumination on it must make no events) */
-static void build_cornell(evr_gltf *g, int moving)
+ * though the box is animated; with global illumination on it must make no events). bleed: the
+ * side walls white, the short box red and unturned, sliding 0.4 m along the right wall 0.1 m
+ * from it and back over 2 s (cornell-bleed). */
+static void build_cornell(evr_gltf *g, int moving, int bleed)
 {
     int white = material(g, "white", 0.725f, 0.71f, 0.68f, 0.0f);
     int red = material(g, "red", 0.63f, 0.065f, 0.05f, 0.0f);
-    int green = material(g, "green", 0.14f, 0.45f, 0.091f, 0.0f);
+    int green = bleed ? white : material(g, "green", 0.14f, 0.45f, 0.091f, 0.0f);
     int light =
         material(g, "light", 0.78f, 0.78f, 0.78f, 1.0f); /* glTF caps emissive factors at 1 */
     static const double floor_c[3] = {0, 0, 0}, floor_n[3] = {0, 1, 0};
@@ -89,7 +93,8 @@ static void build_cornell(evr_gltf *g, int moving)
     place(g, "floor", wall(g, "floor", floor_c, 0, 2, 0.5, 0.5, floor_n, white), 0, 0, 0);
     place(g, "ceiling", wall(g, "ceiling", ceil_c, 0, 2, 0.5, 0.5, ceil_n, white), 0, 0, 0);
     place(g, "back_wall", wall(g, "back_wall", back_c, 0, 1, 0.5, 0.5, back_n, white), 0, 0, 0);
-    place(g, "left_wall", wall(g, "left_wall", left_c, 2, 1, 0.5, 0.5, left_n, red), 0, 0, 0);
+    place(g, "left_wall", wall(g, "left_wall", left_c, 2, 1, 0.5, 0.5, left_n, bleed ? white : red),
+          0, 0, 0);
     place(g, "right_wall", wall(g, "right_wall", right_c, 2, 1, 0.5, 0.5, right_n, green), 0, 0, 0);
     place(g, "light_panel", wall(g, "light_panel", panel_c, 0, 2, 0.125, 0.125, ceil_n, light), 0,
           0, 0);
@@ -100,12 +105,15 @@ static void build_cornell(evr_gltf *g, int moving)
     evr_gltf_node_translation(g, n_tall, -0.17f, 0.3f, -0.15f);
     evr_gltf_node_rotation(g, n_tall, 0.0f, (float)sin(0.5 * 0.29), 0.0f, (float)cos(0.5 * 0.29));
     int n_short = evr_gltf_node(g, "short_box", -1);
-    evr_gltf_node_mesh(g, n_short, box(g, "short_box", short_h, white));
-    evr_gltf_node_rotation(g, n_short, 0.0f, (float)sin(-0.5 * 0.3), 0.0f, (float)cos(-0.5 * 0.3));
+    evr_gltf_node_mesh(g, n_short, box(g, "short_box", short_h, bleed ? red : white));
+    if (!bleed)
+        evr_gltf_node_rotation(g, n_short, 0.0f, (float)sin(-0.5 * 0.3), 0.0f,
+                               (float)cos(-0.5 * 0.3));
     const float times[3] = {0.0f, 1.0f, 2.0f};
     const float pos_moving[9] = {0.18f, 0.15f, 0.12f, -0.17f, 0.15f, 0.2f, 0.18f, 0.15f, 0.12f};
     const float pos_still[9] = {0.18f, 0.15f, 0.12f, 0.18f, 0.15f, 0.12f, 0.18f, 0.15f, 0.12f};
-    const float *pos = moving ? pos_moving : pos_still;
+    const float pos_bleed[9] = {0.25f, 0.15f, 0.2f, 0.25f, 0.15f, -0.2f, 0.25f, 0.15f, 0.2f};
+    const float *pos = bleed ? pos_bleed : moving ? pos_moving : pos_still;
     /* cornell-still: the rest pose differs from the held one, so the importer keeps the curve
      * and the box is an animated node that never moves */
     if (moving) evr_gltf_node_translation(g, n_short, pos[0], pos[1], pos[2]);
@@ -128,5 +136,6 @@ static void build_cornell(evr_gltf *g, int moving)
     evr_gltf_node_camera(g, n_cam, cam);
 }
 
-void evr_demo_build_cornell(evr_gltf *g) { build_cornell(g, 1); }
-void evr_demo_build_cornell_still(evr_gltf *g) { build_cornell(g, 0); }
+void evr_demo_build_cornell(evr_gltf *g) { build_cornell(g, 1, 0); }
+void evr_demo_build_cornell_still(evr_gltf *g) { build_cornell(g, 0, 0); }
+void evr_demo_build_cornell_bleed(evr_gltf *g) { build_cornell(g, 1, 1); }

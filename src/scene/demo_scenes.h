@@ -15,6 +15,7 @@ void evr_demo_build_square(evr_gltf *g);
 void evr_demo_build_disk(evr_gltf *g);
 void evr_demo_build_cornell(evr_gltf *g);
 void evr_demo_build_cornell_still(evr_gltf *g);
+void evr_demo_build_cornell_bleed(evr_gltf *g);
 void evr_demo_build_city(evr_gltf *g);
 void evr_demo_build_blink(evr_gltf *g); /* morph-target lids and a skinned finger */
 
