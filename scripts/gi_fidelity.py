@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The GI fidelity table of docs/benchmarks.md: a scene with `--gi photon` at several photon
-budgets, each scored with `evray compare` against a converged reference, the same scene with many
+budgets, each scored with `evray compare` against a reference, the same scene with many
 times the photons (every photon kept: the buffer's layers raised with the budget). The reference
 is rendered with two seeds; their agreement says how far it is converged. Direct light alone is
 scored too, for scale. Each run is scored twice: within --tol-us, and within the larger of that
