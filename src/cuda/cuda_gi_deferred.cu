@@ -18,6 +18,14 @@
 
 #include <stdlib.h>
 
+/* Where a launch's thread keeps its entries in the arrays of one per pixel (direct, req, traced,
+ * cache_dist; stride the pixels): its place in the skip kernel's list, or without a list its
+ * pixel (a launch over every pixel in tiles has more threads than pixels). */
+__device__ __forceinline__ int entry_slot(const kernel_args &a, const launch_pixel &lp)
+{
+    return a.list ? lp.i : lp.pix;
+}
+
 /* First kernel: render_kernel's rays and settling, without the pixel model. */
 template <int LAYOUT>
 __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args a, gi_deferred d)
@@ -26,7 +34,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_trace_kernel(kernel_args
     if (!launch_pixel_of(a, &lp)) return;
     const bool active =
         lp.active && !lp.indirect_only; /* the skip kernel made the others' entries */
-    const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
+    const int i = entry_slot(a, lp), pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     const float phi = active ? a.phase[pix] : 0.0f;
     unsigned rays = 0, traced = 0;
@@ -234,7 +242,7 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
     launch_pixel lp;
     if (!launch_pixel_of(a, &lp)) return;
     const bool active = lp.active;
-    const int i = lp.i, pix = lp.pix, x = lp.x, y = lp.y;
+    const int i = entry_slot(a, lp), pix = lp.pix, x = lp.x, y = lp.y;
     const unsigned lane = lp.lane;
     evr_pixel_state st;
     evr_pixel_params own;
