@@ -26,6 +26,8 @@ import subprocess
 import sys
 import tempfile
 
+from doc_section import write_section
+
 p = argparse.ArgumentParser()
 p.add_argument("evray")
 p.add_argument("--scene", default="cornell")
@@ -113,14 +115,5 @@ for label, key, opts in rows:
 text = "\n".join(lines) + "\n"
 print(text)
 if a.write:
-    begin, end = f"<!-- gi-fidelity:{a.scene} -->", "<!-- /gi-fidelity -->"
-    doc = open(a.write).read() if os.path.exists(a.write) else ""
-    if begin in doc:
-        i = doc.index(begin)
-        j = doc.index(end, i) + len(end)
-        doc = doc[:i] + begin + "\n" + text + end + doc[j:]
-    else:
-        doc += "\n" + begin + "\n" + text + end + "\n"
-    with open(a.write, "w") as f:
-        f.write(doc)
+    write_section(a.write, f"<!-- gi-fidelity:{a.scene} -->", "<!-- /gi-fidelity -->", text)
 print(f"machine: {platform.node()}, outputs in {tmp}", file=sys.stderr)

@@ -22,6 +22,8 @@ import tempfile
 
 import numpy as np
 
+from doc_section import write_section
+
 p = argparse.ArgumentParser()
 p.add_argument("evray")
 p.add_argument("--scene", default="eye")
@@ -104,14 +106,5 @@ for i in range(len(bins) - 1):
 text = "\n".join(lines) + "\n"
 print(text)
 if a.write:
-    begin, end = f"<!-- sampling-table:{a.scene}:{a.backend} -->", "<!-- /sampling-table -->"
-    doc = open(a.write).read() if os.path.exists(a.write) else ""
-    if begin in doc:
-        i = doc.index(begin)
-        j = doc.index(end, i) + len(end)
-        doc = doc[:i] + begin + "\n" + text + end + doc[j:]
-    else:
-        doc += "\n" + begin + "\n" + text + end + "\n"
-    with open(a.write, "w") as f:
-        f.write(doc)
+    write_section(a.write, f"<!-- sampling-table:{a.scene}:{a.backend} -->", "<!-- /sampling-table -->", text)
 print(f"machine: {platform.node()}, outputs in {tmp}", file=sys.stderr)
