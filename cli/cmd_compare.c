@@ -103,13 +103,10 @@ int cmd_compare(int argc, char **argv)
         printf("test:      %llu events (%llu ON, %llu OFF), ratio %.4f\n",
                (unsigned long long)(r.test_on + r.test_off), (unsigned long long)r.test_on,
                (unsigned long long)r.test_off, r.count_ratio);
-        if (tol_level > 0.0)
-            printf("matched within %.0f us or %g of the reference's gap: %llu; precision %.4f, "
-                   "recall %.4f, F1 %.4f\n",
-                   tol, tol_level, (unsigned long long)r.matched, r.precision, r.recall, r.f1);
-        else
-            printf("matched within %.0f us: %llu; precision %.4f, recall %.4f, F1 %.4f\n", tol,
-                   (unsigned long long)r.matched, r.precision, r.recall, r.f1);
+        printf("matched within %.0f us", tol);
+        if (tol_level > 0.0) printf(" or %g of the reference's gap", tol_level);
+        printf(": %llu; precision %.4f, recall %.4f, F1 %.4f\n", (unsigned long long)r.matched,
+               r.precision, r.recall, r.f1);
         printf("|dt| of matches: median %.0f us, 95th percentile %.0f us\n", r.median_dt_us,
                r.p95_dt_us);
         printf("per-pixel event count correlation: %.4f\n", r.pixel_count_correlation);

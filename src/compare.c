@@ -32,7 +32,8 @@ static int cmp_i64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Reference event a's tolerance in its group [a0, a1) of times t (evr_compare_events). */
+/* Reference event a's tolerance in its group [a0, a1) of times t (evr_compare_events); tol_us
+ * alone where tol_level is 0. */
 static int64_t ref_tolerance(const int64_t *t, size_t a0, size_t a1, size_t a, int64_t tol_us,
                              double tol_level)
 {
@@ -78,8 +79,7 @@ evr_status evr_compare_events(const evr_event *ref, size_t nref, const evr_event
         size_t a = sa[g], ae = sa[g + 1], b = sb[g], be = sb[g + 1];
         while (a < ae && b < be) {
             int64_t d = tb[b] - ta[a];
-            if (llabs(d) <=
-                (tol_level > 0.0 ? ref_tolerance(ta, sa[g], ae, a, tol_us, tol_level) : tol_us)) {
+            if (llabs(d) <= ref_tolerance(ta, sa[g], ae, a, tol_us, tol_level)) {
                 dts[matched++] = llabs(d);
                 a++;
                 b++;

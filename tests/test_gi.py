@@ -127,7 +127,6 @@ T.check(face_direct > 500 and face_gi < 3 * face_direct,
         "GI on a grazing moving face: under 3x direct light's events (no bursts at the segment rate)")
 
 
-
 # cornell-bleed: the red short box slides along the white right wall; the wall above the box is
 # redder (red / green) beside the box than 0.4 m from it, with GI only, and the tint follows the box
 def wall_redness(pfm, z):

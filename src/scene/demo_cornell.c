@@ -81,7 +81,8 @@ static void build_cornell(evr_gltf *g, int moving, int bleed)
 {
     int white = material(g, "white", 0.725f, 0.71f, 0.68f, 0.0f);
     int red = material(g, "red", 0.63f, 0.065f, 0.05f, 0.0f);
-    int green = bleed ? white : material(g, "green", 0.14f, 0.45f, 0.091f, 0.0f);
+    int right = bleed ? white : material(g, "green", 0.14f, 0.45f, 0.091f, 0.0f);
+    int left = bleed ? white : red;
     int light =
         material(g, "light", 0.78f, 0.78f, 0.78f, 1.0f); /* glTF caps emissive factors at 1 */
     static const double floor_c[3] = {0, 0, 0}, floor_n[3] = {0, 1, 0};
@@ -93,9 +94,8 @@ static void build_cornell(evr_gltf *g, int moving, int bleed)
     place(g, "floor", wall(g, "floor", floor_c, 0, 2, 0.5, 0.5, floor_n, white), 0, 0, 0);
     place(g, "ceiling", wall(g, "ceiling", ceil_c, 0, 2, 0.5, 0.5, ceil_n, white), 0, 0, 0);
     place(g, "back_wall", wall(g, "back_wall", back_c, 0, 1, 0.5, 0.5, back_n, white), 0, 0, 0);
-    place(g, "left_wall", wall(g, "left_wall", left_c, 2, 1, 0.5, 0.5, left_n, bleed ? white : red),
-          0, 0, 0);
-    place(g, "right_wall", wall(g, "right_wall", right_c, 2, 1, 0.5, 0.5, right_n, green), 0, 0, 0);
+    place(g, "left_wall", wall(g, "left_wall", left_c, 2, 1, 0.5, 0.5, left_n, left), 0, 0, 0);
+    place(g, "right_wall", wall(g, "right_wall", right_c, 2, 1, 0.5, 0.5, right_n, right), 0, 0, 0);
     place(g, "light_panel", wall(g, "light_panel", panel_c, 0, 2, 0.125, 0.125, ceil_n, light), 0,
           0, 0);
 
