@@ -232,6 +232,9 @@ typedef struct {
     int gather_window;   /* the gather window's half size at most, pixels */
     int photon_layers;   /* photons each pixel of the buffer holds (0: from photons) */
     int gi_bounces;      /* indirect bounces of a photon */
+    float gi_blur;       /* > 0: indirect light from a per-pass estimate blurred over each
+                          * surface, sigma this x gather_radius (core/photon_blur.h; CPU backend);
+                          * 0: a gather at every sample */
     /* shading: reflections and refractions a camera ray may take (core/path.h) */
     int max_bounces;
     /* previews (one per preview_window): EVR_PREVIEW_VIDEO, one animated PNG preview.apng in

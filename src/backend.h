@@ -28,6 +28,7 @@ typedef struct {
     uint32_t photons;
     float gather_radius; /* world units (resolved: > 0) */
     int gather_max, gather_window, photon_layers, gi_bounces;
+    float gi_blur;          /* evr_config.gi_blur */
     int adaptive;           /* adaptive sampling (core/adaptive.h): samples_per_frame unused */
     evr_adapt_params adapt; /* its parameters (max_dt resolved: > 0) */
     int refine;             /* refined sampling (core/refine.h): every pixel's phase is 1 */

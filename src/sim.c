@@ -47,7 +47,15 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
     evr_backend_kind kind = sim->cfg.backend;
     evr_status st;
 #ifdef EVR_HAVE_CUDA
-    if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
+    if (kind == EVR_BACKEND_CUDA && sim->setup.gi && sim->setup.gi_blur > 0.0f) {
+        snprintf(err->msg, sizeof err->msg,
+                 "--gi-blur is not implemented on the CUDA backend; use --backend cpu");
+        return EVR_ERR_ARG;
+    }
+    if (kind == EVR_BACKEND_AUTO && sim->setup.gi && sim->setup.gi_blur > 0.0f) {
+        snprintf(sim->st.notice, sizeof sim->st.notice,
+                 "CUDA backend not used: --gi-blur runs on the CPU only; running on the CPU");
+    } else if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
         evr_error cerr;
         cerr.msg[0] = 0;
         st = evr_cuda_backend_new(s, &sim->host, &sim->setup, &sim->backend, &cerr);
@@ -224,6 +232,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_gi_photon_layers(c->photon_layers, c->photons, sim->setup.width, sim->setup.height);
     sim->st.photon_layers = sim->setup.photon_layers;
     sim->setup.gi_bounces = c->gi_bounces;
+    sim->setup.gi_blur = c->gi_blur;
     sim->timestamp_slack_us = timestamp_slack_us(sim);
     sim->setup.cancel = &sim->cancel;
     sim->emitted_until_us = (int64_t)llround(c->start * 1e6);

@@ -295,4 +295,14 @@ T.check(int(sum(r[col["n"]] for r in rows)) == T.load_run_json(d)["stats"]["even
 T.check(bad.returncode != 0 and "cannot write" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1,
         f"timeline: an unwritable path is a one-line error ({bad.stderr.strip()!r})")
 
+# --gi-blur runs on the CPU only: the CUDA backend refuses it in one line, auto runs on the CPU
+p = T.run("demo", "--scene", "cornell", "--gi", "photon", "--gi-blur", "4", "--backend", "cuda", "--res", "32x24",
+          "--duration", "0.1", "-o", os.path.join(tmp, "blur-cuda"), "--quiet", "--no-preview", expect=None)
+T.check(p.returncode != 0 and "--gi-blur" in p.stderr and len(p.stderr.strip().splitlines()) == 1,
+        f"--gi-blur on CUDA: a one-line error ({p.stderr.strip()!r})")
+d = os.path.join(tmp, "blur-auto")
+T.run("demo", "--scene", "cornell", "--gi", "photon", "--gi-blur", "4", "--res", "32x24", "--duration", "0.1",
+      "-o", d, "--quiet", "--no-preview")
+T.check(T.load_run_json(d)["backend"] == "cpu", "--gi-blur with the automatic backend: the CPU")
+
 T.finish("test_cuda")

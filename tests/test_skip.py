@@ -30,6 +30,12 @@ cases.append(("cornell-bleed", ["--gi", "photon", "--res", "64x48", "--duration"
 # with a limit on the photons per estimate
 cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8"]))
+# the blurred estimate (CPU only): a pixel keeps its light while its cell and the eight around it
+# give the same lookups
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gi-blur", "4"]))
+cases.append(("cornell-bleed", ["--gi", "photon", "--res", "96x72", "--duration", "0.4", "--gi-blur", "4"]))
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--gi-blur", "4",
+                          "--camera-path", "pan:rate=5"]))
 # the deforming meshes (a path: a scene file): a still stretch keeps its vertices and (on CUDA) its
 # tree bit for bit, so pixels that see it skip exactly
 for asset in T.deform_assets(tmp):
@@ -57,6 +63,8 @@ cases.append(("square", ["--res", "64x48", "--duration", "0.5", "--camera-path",
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--camera-path", "pan:rate=5"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
+        if backend == "cuda" and "--gi-blur" in extra:
+            continue
         source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)
         if "--gi" not in extra:  # refined sampling: the same events with and without skipping
             runs = {}

@@ -810,6 +810,22 @@ static const evr_config_option table[] = {
      .json = "gi_bounces",
      .json_rank = 40,
      .json_if = has_gi},
+    {.name = "gi_blur",
+     .type = EVR_OPT_FLOAT,
+     .offset = F(gi_blur),
+     .def = 0.0,
+     .lo = 0,
+     .hi = 16,
+     .what = "--gi-blur must be between 0 (off) and 16",
+     .applies = has_gi,
+     .flag = "--gi-blur",
+     .label = "--gi-blur K",
+     .help = "indirect light estimated once per photon pass where the\n"
+             "camera sees and blurred over each surface, sigma K x the\n"
+             "gather radius (default 0: a gather at every sample; CPU only)",
+     .json = "gi_blur",
+     .json_rank = 65,
+     .json_if = has_gi},
 
     /* ---- sensor ---- */
     {.name = "sensor",

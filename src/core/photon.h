@@ -45,5 +45,6 @@
 #include "core/photon_fixed.h"
 #include "core/photon_change.h"
 #include "core/photon_indirect.h"
+#include "core/photon_blur.h"
 
 #endif

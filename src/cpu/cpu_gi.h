@@ -50,6 +50,16 @@ typedef struct {
     uint32_t *ch_before, *ch_base, *ch_x;
     int image_width;
     int memo_off; /* EVR_GI_NO_MEMO set: no memo (tests) */
+    /* --gi-blur (core/photon_blur.h): sigma in world units (0: off, a gather at every sample);
+     * per buffer (end, start; swapped with them) the instance each cell sees (-1: none) and its
+     * blurred estimate (RGB); then sat counts the cells whose lookups differ, end against start,
+     * and a pixel's window is its cell and the eight around it */
+    float blur_sigma;
+    struct evr_gi_blur {
+        int *inst;
+        float *e;
+    } blur_end, blur_start;
+    float *blur_tmp;
 } evr_cpu_gi;
 
 /* One ray through an Embree scene at normalized time f (the photon pass's evr_tracer calls, the
