@@ -9,7 +9,7 @@ and --tol-level times the gap since the reference's previous event of the same p
 log intensity, so a small error of the estimate moves it by a share of that gap.
 
     scripts/gi_fidelity.py EVRAY [--scene cornell] [--res 173x130] [--duration 1]
-                           [--ref-ppp 1024] [--budgets 16,64] [--tol-us 1000] [--tol-level 0.1]
+                           [--ref-ppp 1024] [--budgets 16,64] [--tol-us 1000] [--tol-level 0.1] [--ref-cache DIR]
                            [--extra "LABEL=OPTS;LABEL=OPTS"]
                            [--write docs/benchmarks.md]
 
@@ -40,6 +40,9 @@ p.add_argument("--tol-us", type=int, default=1000)
 p.add_argument("--tol-level", type=float, default=0.1)
 p.add_argument("--extra", default="", help="more GI rows: 'LABEL=OPTIONS' separated by ';' (options split on spaces)")
 p.add_argument("--write", default=None)
+p.add_argument("--ref-cache", default=None,
+               help="a folder that keeps the references: one already there for the same scene, size, duration, "
+                    "budget and seed is taken instead of rendered again")
 a = p.parse_args()
 w, h = (int(v) for v in a.res.split("x"))
 tmp = tempfile.mkdtemp(prefix="evray-gi-fidelity-")
@@ -88,8 +91,25 @@ for item in (v for v in a.extra.split(";") if v.strip()):
     rows.append((f"GI, {label.strip()} (`{opts.strip()}`)", "x-" + "".join(c for c in label if c.isalnum()),
                  ["--gi", "photon", *opts.split()]))
 ref_opts = ["--gi", "photon", *budget(a.ref_ppp)]
-ref1, ref1_st = render("ref-seed1", 1, ref_opts)
-ref2, ref2_st = render("ref-seed2", 2, ref_opts)
+
+
+def reference(seed):
+    if not a.ref_cache:
+        return render(f"ref-seed{seed}", seed, ref_opts)
+    out = os.path.join(a.ref_cache, f"{a.scene}-{a.res}-{a.duration}s-{a.ref_ppp}ppp-{a.backend}-seed{seed}")
+    if not os.path.exists(os.path.join(out, "run.json")):
+        r = subprocess.run([a.evray, *common, "-o", out, "--seed", str(seed), *ref_opts, "--force"],
+                           capture_output=True, text=True)
+        if r.returncode != 0 or "photon buffer" in r.stderr:
+            sys.exit(f"gi_fidelity: the reference of seed {seed} failed: {r.stderr.strip()}")
+    with open(os.path.join(out, "run.json")) as f:
+        st = json.load(f)["stats"]
+    print(f"reference of seed {seed}: {st['events']:,} events, {st['wall_seconds']:.1f} s ({out})", file=sys.stderr)
+    return out, st
+
+
+ref1, ref1_st = reference(1)
+ref2, ref2_st = reference(2)
 tol = f"{a.tol_us / 1000:g} ms" if a.tol_us >= 1000 else f"{a.tol_us} µs"
 lines = [f"{a.scene}, {a.duration} s, {a.res}, ideal sensor, thresholds 0.2, backend {a.backend}, "
          f"{datetime.date.today().isoformat()}, `scripts/gi_fidelity.py EVRAY --scene {a.scene} --res {a.res} "

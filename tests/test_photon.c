@@ -937,60 +937,82 @@ static void test_gather_delta(void)
 }
 
 /* The blurred estimate (core/photon_blur.h) on a hand-made buffer, 16 x 8 cells 0.1 apart on the
- * plane z = 0: the left half instance 0 with a noisy estimate, one column of it turned to face +x
- * (another surface), the right half instance 1 at 3. The blur smooths the left half around its
- * mean, keeps the turned column and the right half apart, and a lookup takes the cell's estimate,
- * its like neighbours' mean at an outline, or nothing. */
+ * plane z = 0 seen from 1 away: the left half instance 0 with a noisy estimate, one column of it
+ * turned to face +x (another surface), the right half instance 1 at 3. The blur smooths the left
+ * half around its mean, keeps the turned column and the right half apart; a lookup takes the
+ * cell's estimate, its like neighbours' mean at an outline, the mean of what is around, or
+ * nothing; a sample seen at one pass only takes that pass's estimate at both. */
 static void test_blur(void)
 {
     enum { W = 16, H = 8 };
-    evr_photon_buffer b;
+    evr_photon_buffer b, none;
     static float gbuf[W * H * 8], e[W * H * 3], tmp[W * H * 3];
-    static int inst[W * H];
+    static int inst[W * H], inst_none[W * H];
     int x, y, k;
+    /* a camera whose pixel spans 0.1 at distance 1: steps 1, 2, 4 for sigma 0.4 */
+    evr_camera_intr cam = evr_camera_intr_make(W, H, 2.0f * atanf(0.05f * (float)H));
+    const evr_v3 org = evr_v3_make(0.0f, 0.0f, 1.0f);
     memset(&b, 0, sizeof b);
     b.width = W;
     b.height = H;
     b.gbuf = gbuf;
+    b.view_inst = inst;
+    b.blur = e;
     for (y = 0; y < H; y++)
         for (x = 0; x < W; x++) {
             const int i = y * W + x, turned = x == 3;
             float *g = gbuf + 8 * i;
-            g[0] = 0.1f * (float)x;
-            g[1] = 0.1f * (float)y;
             g[3] = turned ? 1.0f : 0.0f;
             g[5] = turned ? 0.0f : 1.0f;
             g[6] = 0.01f;
             inst[i] = x < W / 2 ? 0 : 1;
+            inst_none[i] = -1;
             for (k = 0; k < 3; k++)
                 e[3 * i + k] = turned ? 10.0f : x < W / 2 ? ((x + y) % 2 ? 0.5f : 1.5f) : 3.0f;
         }
+    /* every cell at distance 1 (its position only enters the weights through differences) */
+    for (y = 0; y < H; y++)
+        for (x = 0; x < W; x++) {
+            float *g = gbuf + 8 * (y * W + x);
+            g[0] = 0.1f * (float)x;
+            g[1] = 0.1f * (float)y;
+        }
+    const float pix = evr_camera_pixel_size(&cam, 1.0f);
+    CHECK_NEAR(pix, 0.1f, 1e-4);
     CHECK(evr_blur_steps(0.4f, 0.1f) == 3); /* steps 1, 2, 4: taps up to 8 cells out, 2 sigma */
-    CHECK(evr_blur_steps(0.05f, 0.1f) == 1 && evr_blur_steps(1e6f, 0.1f) == 8);
-    for (k = 0; k < 2; k++) {
-        const float *src = k ? tmp : e;
-        float *dst = k ? e : tmp;
+    CHECK(evr_blur_steps(0.05f, 0.1f) == 1 && evr_blur_steps(1e6f, 0.1f) == EVR_BLUR_MAX_STEPS);
+    for (k = 0; k < 3; k++) {
+        const float *src = k % 2 ? tmp : e;
+        float *dst = k % 2 ? e : tmp;
         for (y = 0; y < H; y++)
-            for (x = 0; x < W; x++) evr_blur_cell(&b, inst, src, dst, x, y, 1 << k, 0.5f / 0.16f);
+            for (x = 0; x < W; x++) evr_blur_cell(&b, &cam, org, 0.4f, src, dst, x, y, k);
     }
+    memcpy(e, tmp, sizeof e);
     for (y = 0; y < H; y++)
         for (x = 0; x < W; x++) {
             const float v = e[3 * (y * W + x)];
             if (x == 3) CHECK_NEAR(v, 10.0f, 1e-4);
-            else if (x < W / 2) CHECK(v > 0.8f && v < 1.2f);
+            else if (x < W / 2) CHECK(v > 0.9f && v < 1.1f);
             else CHECK_NEAR(v, 3.0f, 1e-5);
         }
-    float out[3];
+    float out[3], es[3], ee[3];
     const evr_v3 up = evr_v3_make(0.0f, 0.0f, 1.0f);
-    CHECK(evr_blur_lookup(&b, inst, e, 10, 4, 1, up, out) && out[0] == e[3 * (4 * W + 10)]);
+    CHECK(evr_blur_lookup(&b, 10, 4, 1, up, out) == EVR_BLUR_LIKE && out[0] == e[3 * (4 * W + 10)]);
     /* instance 1 seen through cell (8, 4)'s left neighbour: the mean of its like neighbours */
-    CHECK(evr_blur_lookup(&b, inst, e, 7, 4, 1, up, out));
+    CHECK(evr_blur_lookup(&b, 7, 4, 1, up, out) == EVR_BLUR_LIKE);
     CHECK_NEAR(out[0], 3.0f, 1e-5);
     /* the turned column from a cell of the plane: its own cell only faces +x */
-    CHECK(evr_blur_lookup(&b, inst, e, 3, 4, 0, evr_v3_make(1.0f, 0.0f, 0.0f), out));
+    CHECK(evr_blur_lookup(&b, 3, 4, 0, evr_v3_make(1.0f, 0.0f, 0.0f), out) == EVR_BLUR_LIKE);
     CHECK_NEAR(out[0], 10.0f, 1e-4);
-    CHECK(!evr_blur_lookup(&b, inst, e, 1, 4, 1, up, out)); /* nothing of instance 1 around */
-    CHECK(evr_blur_cell_same(&b, inst, e, &b, inst, e, 5));
+    /* nothing of instance 1 around: the mean of the nine */
+    CHECK(evr_blur_lookup(&b, 1, 4, 1, up, out) == EVR_BLUR_NEAR && out[0] > 0.5f && out[0] < 1.5f);
+    none = b;
+    none.view_inst = inst_none;
+    CHECK(evr_blur_lookup(&none, 1, 4, 0, up, out) == EVR_BLUR_NONE && out[0] == 0.0f);
+    /* seen at the end's pass only: the end's estimate at both */
+    evr_blur_ends(&none, &b, 10, 4, 1, up, es, ee);
+    CHECK(es[0] == ee[0] && ee[0] == e[3 * (4 * W + 10)]);
+    CHECK(evr_blur_cell_same(&b, &b, 5) && !evr_blur_cell_same(&b, &none, 5));
 }
 
 int main(void)

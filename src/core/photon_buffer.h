@@ -41,6 +41,10 @@ typedef struct {
      * evr_photon_gather then normalizes its kernel over the part of the disk that lies on
      * surfaces like the query's, not the whole disk (no darkening at creases and silhouettes). */
     float *gbuf;
+    /* Optional (NULL: none; --gi-blur, core/photon_blur.h): per cell, the scene instance seen
+     * through its centre (-1: none) and the blurred irradiance estimate there (RGB). */
+    int *view_inst;
+    float *blur;
 } evr_photon_buffer;
 
 /* Image pixel of world point p for the camera (world_to_cam = inverse pose), which may lie up

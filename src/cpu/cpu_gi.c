@@ -112,15 +112,16 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
     }
     if (setup->gi_blur > 0.0f) {
         const size_t cells = (size_t)g->end.width * (size_t)g->end.height;
+        evr_photon_buffer *bufs[2] = {&g->end, &g->start};
         g->blur_sigma = setup->gi_blur * g->gp.radius;
         g->window = 1;
-        g->blur_end.inst = malloc(cells * sizeof(int));
-        g->blur_start.inst = malloc(cells * sizeof(int));
-        g->blur_end.e = malloc(3 * cells * sizeof(float));
-        g->blur_start.e = malloc(3 * cells * sizeof(float));
         g->blur_tmp = malloc(3 * cells * sizeof(float));
-        if (!g->blur_end.inst || !g->blur_start.inst || !g->blur_end.e || !g->blur_start.e ||
-            !g->blur_tmp) {
+        for (int k = 0; k < 2; k++) {
+            bufs[k]->view_inst = malloc(cells * sizeof(int));
+            bufs[k]->blur = calloc(3 * cells, sizeof(float));
+        }
+        if (!g->blur_tmp || !g->end.view_inst || !g->end.blur || !g->start.view_inst ||
+            !g->start.blur) {
             snprintf(err->msg, sizeof err->msg, "out of memory for the photon buffer");
             return EVR_ERR_NOMEM;
         }
@@ -134,12 +135,10 @@ typedef struct {
     const evr_cpu_gi *g;
     const evr_render_scene *rs;
     const evr_photon_buffer *b;
-    struct evr_gi_blur *bl;
     evr_v3 cam_org;
     const float *src; /* a step of the blur: from */
-    float *dst;       /* a step of the blur: to; NULL: the cells' gathers */
-    int step;
-    float inv2s2;
+    float *dst;       /* a step of the blur: to; NULL: the cells' gathers into b->blur */
+    int k;
     atomic_int next;
 } blur_ctx;
 
@@ -151,11 +150,13 @@ static void *blur_worker(void *arg)
     while ((y = atomic_fetch_add(&c->next, 1)) < b->height)
         for (int x = 0; x < b->width; x++) {
             const size_t i = (size_t)y * (size_t)b->width + (size_t)x;
-            if (c->bl->inst[i] < 0) continue;
-            if (c->dst) evr_blur_cell(b, c->bl->inst, c->src, c->dst, x, y, c->step, c->inv2s2);
+            if (b->view_inst[i] < 0) continue;
+            if (c->dst)
+                evr_blur_cell(b, &c->rs->camera, c->cam_org, c->g->blur_sigma, c->src, c->dst, x, y,
+                              c->k);
             else
                 evr_blur_cell_gather(b, &c->rs->camera, c->cam_org, &c->g->gp, x, y,
-                                     c->bl->e + 3 * i);
+                                     b->blur + 3 * i);
         }
     return NULL;
 }
@@ -168,50 +169,44 @@ static evr_status blur_run(blur_ctx *c, int threads, evr_error *err)
     return EVR_ERR_NOMEM;
 }
 
-/* After a pass at time f into b (bl->inst holds its cells' instances): the cells' gathers, then
- * the blur's steps (as many as the mean distance of what the cells see asks for) into bl->e. */
+/* After a pass at time f into b: the cells' gathers, then the blur's steps, into b->blur (as
+ * many steps as the nearest cell asks for: a cell past its own keeps its value). */
 static evr_status blur_build(evr_cpu_gi *g, const evr_render_scene *rs, float f,
-                             const evr_photon_buffer *b, struct evr_gi_blur *bl, int threads,
-                             evr_error *err)
+                             evr_photon_buffer *b, int threads, evr_error *err)
 {
     const size_t cells = (size_t)b->width * (size_t)b->height;
     const evr_m34 pose = evr_rs_camera_pose(rs, f);
     evr_status st;
     blur_ctx c;
-    double dist = 0.0;
-    size_t n = 0;
+    int steps = 0;
     memset(&c, 0, sizeof c);
     c.g = g;
     c.rs = rs;
     c.b = b;
-    c.bl = bl;
     c.cam_org = evr_m34_point(&pose, evr_v3_make(0.0f, 0.0f, 0.0f));
-    for (size_t i = 0; i < cells; i++) {
+    for (size_t i = 0; i < cells && steps < EVR_BLUR_MAX_STEPS; i++) {
         const float *v = b->gbuf + 8 * i;
-        if (bl->inst[i] < 0) continue;
-        dist += (double)evr_v3_len(evr_v3_sub(evr_v3_make(v[0], v[1], v[2]), c.cam_org));
-        n++;
+        if (b->view_inst[i] < 0) continue;
+        const float d = evr_v3_len(evr_v3_sub(evr_v3_make(v[0], v[1], v[2]), c.cam_org));
+        const int n = evr_blur_steps(g->blur_sigma, evr_camera_pixel_size(&rs->camera, d));
+        if (n > steps) steps = n;
     }
-    if (!n) return EVR_OK;
     if ((st = blur_run(&c, threads, err)) != EVR_OK) return st;
-    const int steps = evr_blur_steps(g->blur_sigma,
-                                     evr_camera_pixel_size(&rs->camera, (float)(dist / (double)n)));
-    c.inv2s2 = 0.5f / (g->blur_sigma * g->blur_sigma);
     for (int k = 0; k < steps; k++) {
-        c.step = 1 << k;
-        c.src = k % 2 ? g->blur_tmp : bl->e;
-        c.dst = k % 2 ? bl->e : g->blur_tmp;
+        c.k = k;
+        c.src = k % 2 ? g->blur_tmp : b->blur;
+        c.dst = k % 2 ? b->blur : g->blur_tmp;
         if ((st = blur_run(&c, threads, err)) != EVR_OK) return st;
     }
-    if (steps % 2) memcpy(bl->e, g->blur_tmp, 3 * cells * sizeof(float));
+    if (steps % 2) memcpy(b->blur, g->blur_tmp, 3 * cells * sizeof(float));
     return EVR_OK;
 }
 
 /* One photon pass at normalized segment time f into buffer out: the photons are a sample in time
  * (every one traced at f), the view of the cells too. */
 static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_skip_plan *plan,
-                          float f, int threads, evr_photon_buffer *out, struct evr_gi_blur *bl,
-                          evr_backend *stats, evr_error *err)
+                          float f, int threads, evr_photon_buffer *out, evr_backend *stats,
+                          evr_error *err)
 {
     evr_status st;
     evr_photon_stats ps;
@@ -227,11 +222,8 @@ static evr_status gi_pass(evr_cpu_gi *g, const evr_render_scene *rs, const evr_s
     if ((st = evr_photon_pass(rs, &g->tr, &g->pp, &g->em, out, &ps,
                               g->trails_off ? NULL : &g->trails, err)) != EVR_OK)
         return st;
-    if ((st = evr_photon_gbuffer(rs, &g->tr, f, out, g->blur_sigma > 0.0f ? bl->inst : NULL,
-                                 threads, err)) != EVR_OK)
-        return st;
-    if (g->blur_sigma > 0.0f && (st = blur_build(g, rs, f, out, bl, threads, err)) != EVR_OK)
-        return st;
+    if ((st = evr_photon_gbuffer(rs, &g->tr, f, out, threads, err)) != EVR_OK) return st;
+    if (g->blur_sigma > 0.0f && (st = blur_build(g, rs, f, out, threads, err)) != EVR_OK) return st;
     stats->photons_traced += ps.paths;
     stats->photons_reused += ps.reused;
     stats->photons_stored += ps.inserted;
@@ -255,18 +247,13 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
     const double t0 = evr_host_seconds();
     if (g->have_prev) { /* the previous segment's end (the last pass's) is this one's start */
         evr_photon_buffer tmp = g->start;
-        struct evr_gi_blur btmp = g->blur_start;
         g->start = g->end;
         g->end = tmp;
-        g->blur_start = g->blur_end;
-        g->blur_end = btmp;
-    } else if ((st = gi_pass(g, rs, plan, 0.0f, threads, &g->start, &g->blur_start, stats, err)) !=
-               EVR_OK) {
+    } else if ((st = gi_pass(g, rs, plan, 0.0f, threads, &g->start, stats, err)) != EVR_OK) {
         return st;
     }
     g->start_same = 0;
-    if ((st = gi_pass(g, rs, plan, 1.0f, threads, &g->end, &g->blur_end, stats, err)) != EVR_OK)
-        return st;
+    if ((st = gi_pass(g, rs, plan, 1.0f, threads, &g->end, stats, err)) != EVR_OK) return st;
     uint64_t photon_cells = 0;
     for (y = 0; y < h; y++) {
         uint32_t row = 0;
@@ -275,10 +262,7 @@ evr_status evr_cpu_gi_segment(evr_cpu_gi *g, const evr_render_scene *rs, const e
             const int same = evr_photon_cell_same(&g->end, &g->start, i);
             photon_cells += !same;
             /* --gi-blur: what changes a pixel's light is its cells' lookups */
-            row += g->blur_sigma > 0.0f
-                       ? !evr_blur_cell_same(&g->end, g->blur_end.inst, g->blur_end.e, &g->start,
-                                             g->blur_start.inst, g->blur_start.e, i)
-                       : !same;
+            row += g->blur_sigma > 0.0f ? !evr_blur_cell_same(&g->end, &g->start, i) : !same;
             g->sat[(size_t)(y + 1) * (size_t)(w + 1) + (size_t)(x + 1)] =
                 g->sat[(size_t)y * (size_t)(w + 1) + (size_t)(x + 1)] + row;
         }
@@ -346,27 +330,16 @@ static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const e
     *le = changed ? evr_gather_point_lum(&g->end, &rs->camera, &g->gp, &gp, x, y) : *ls;
 }
 
-/* --gi-blur: the luminance from each end's blurred estimate where the pixel's cell (or one
- * around it) saw the sample's surface at that pass, else from the sample's own gather there.
- * Returns whether both ends were looked up. */
-static int blur_ends(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,
-                     const evr_surface *s, evr_v3 cam_org, int x, int y, float *ls, float *le)
+/* --gi-blur: the luminance of a sample's irradiance at its segment's ends (evr_blur_ends). */
+static void blur_ends(const evr_cpu_gi *g, int inst, const evr_surface *s, evr_v3 cam_org, int x,
+                      int y, float *ls, float *le)
 {
-    const struct evr_gi_blur *bl[2] = {g->start_same ? &g->blur_end : &g->blur_start, &g->blur_end};
-    const evr_photon_buffer *b[2] = {start_of(g), &g->end};
     evr_gather_point gp;
-    float *out[2] = {ls, le}, e[3];
-    int looked = 1;
+    float es[3], ee[3];
     evr_gather_point_at(s, cam_org, &gp);
-    for (int k = 0; k < 2; k++) {
-        if (evr_blur_lookup(b[k], bl[k]->inst, bl[k]->e, x, y, inst, s->n, e)) {
-            *out[k] = evr_luminance(gp.k[0] * e[0], gp.k[1] * e[1], gp.k[2] * e[2]);
-        } else {
-            *out[k] = evr_gather_point_lum(b[k], &rs->camera, &g->gp, &gp, x, y);
-            looked = 0;
-        }
-    }
-    return looked;
+    evr_blur_ends(start_of(g), &g->end, x, y, inst, s->n, es, ee);
+    *ls = evr_luminance(gp.k[0] * es[0], gp.k[1] * es[1], gp.k[2] * es[2]);
+    *le = evr_luminance(gp.k[0] * ee[0], gp.k[1] * ee[1], gp.k[2] * ee[2]);
 }
 
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,
@@ -375,15 +348,15 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
     struct evr_gi_memo *m = &g->memo[(size_t)y * (size_t)g->image_width + (size_t)x];
     if (g->blur_sigma > 0.0f) {
         float ls, le;
-        const int looked = blur_ends(g, rs, inst, s, cam_org, x, y, &ls, &le);
+        blur_ends(g, inst, s, cam_org, x, y, &ls, &le);
         if (memo) {
-            /* what a kept sample takes (evr_cpu_gi_last); a lookup holds while the pixel's
-             * cells do not change (evr_cpu_gi_pixel_begin), its own gather does not */
+            /* what a kept sample takes (evr_cpu_gi_last); it holds while the pixel's nine cells
+             * do not change (evr_cpu_gi_pixel_begin) */
             m->missed = 0;
             m->ls = ls;
             m->le = le;
             m->flat = ls == le;
-            m->valid = m->end_valid = looked && !g->memo_off;
+            m->valid = m->end_valid = !g->memo_off;
         }
         return evr_gi_lerp(ls, le, f);
     }
@@ -442,10 +415,6 @@ void evr_cpu_gi_free(evr_cpu_gi *g)
     free(g->ch_base);
     free(g->ch_x);
     free(g->memo);
-    free(g->blur_end.inst);
-    free(g->blur_start.inst);
-    free(g->blur_end.e);
-    free(g->blur_start.e);
     free(g->blur_tmp);
     memset(g, 0, sizeof *g);
 }

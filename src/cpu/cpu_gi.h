@@ -51,14 +51,10 @@ typedef struct {
     int image_width;
     int memo_off; /* EVR_GI_NO_MEMO set: no memo (tests) */
     /* --gi-blur (core/photon_blur.h): sigma in world units (0: off, a gather at every sample);
-     * per buffer (end, start; swapped with them) the instance each cell sees (-1: none) and its
-     * blurred estimate (RGB); then sat counts the cells whose lookups differ, end against start,
-     * and a pixel's window is its cell and the eight around it */
+     * the buffers then hold their cells' instances and blurred estimates, sat counts the cells
+     * whose lookups differ, end against start, and a pixel's window is its cell and the eight
+     * around it; blur_tmp: the blur's other half */
     float blur_sigma;
-    struct evr_gi_blur {
-        int *inst;
-        float *e;
-    } blur_end, blur_start;
     float *blur_tmp;
 } evr_cpu_gi;
 

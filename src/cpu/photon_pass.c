@@ -71,6 +71,8 @@ evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, 
 void evr_photon_buffer_free(evr_photon_buffer *b)
 {
     free(b->gbuf);
+    free(b->view_inst);
+    free(b->blur);
     free(b->slots);
     free(b->count);
     free(b->collisions);
@@ -83,7 +85,6 @@ typedef struct {
     const evr_render_scene *rs;
     const evr_tracer *tr;
     evr_photon_buffer *buf;
-    int *view_inst; /* NULL: not asked for */
     evr_m34 pose;
     evr_v3 fwd;
     float f;
@@ -107,9 +108,9 @@ static void *gbuf_worker(void *arg)
             evr_surface s;
             const size_t i = (size_t)y * (size_t)c->buf->width + (size_t)x;
             memset(g, 0, 8 * sizeof *g);
-            if (c->view_inst) c->view_inst[i] = -1;
+            if (c->buf->view_inst) c->buf->view_inst[i] = -1;
             if (!c->tr->closest(c->tr->user, ray, 0.0f, INFINITY, c->f, &h)) continue;
-            if (c->view_inst) c->view_inst[i] = h.inst;
+            if (c->buf->view_inst) c->buf->view_inst[i] = h.inst;
             evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.inst].track), c->f);
             evr_surface_at(rs, h.inst, h.prim, h.u, h.v, &xf, c->f, ray, h.t,
                            evr_camera_cone(&rs->camera, h.t), &s);
@@ -120,7 +121,7 @@ static void *gbuf_worker(void *arg)
 }
 
 evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f,
-                              evr_photon_buffer *buf, int *view_inst, int threads, evr_error *err)
+                              evr_photon_buffer *buf, int threads, evr_error *err)
 {
     gbuf_ctx c;
     if (!buf->gbuf) {
@@ -134,7 +135,6 @@ evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, 
     c.rs = rs;
     c.tr = tr;
     c.buf = buf;
-    c.view_inst = view_inst;
     c.f = f;
     c.pose = evr_rs_camera_pose(rs, f);
     c.fwd = evr_v3_norm(evr_m34_vector(&c.pose, evr_v3_make(0.0f, 0.0f, -1.0f)));

@@ -38,10 +38,10 @@ evr_changed_cells evr_changed_cells_from_sat(const uint32_t *sat, int w, int h, 
 /* Fills buf->gbuf (allocated here when NULL; freed by evr_photon_buffer_free): the surface the
  * camera (pose at time f) sees through every cell's centre, guard band included, and the area
  * the cell covers there (pixel area at unit distance * depth^2 * cos(off-axis angle) / |cos of
- * the incidence|, the cosine at least 0.1); view_inst (NULL: not asked for), one per cell: the
- * scene instance seen there, -1 for none. */
+ * the incidence|, the cosine at least 0.1); where buf->view_inst is allocated, the scene
+ * instance seen through each cell (-1: none). */
 evr_status evr_photon_gbuffer(const evr_render_scene *rs, const evr_tracer *tr, float f,
-                              evr_photon_buffer *buf, int *view_inst, int threads, evr_error *err);
+                              evr_photon_buffer *buf, int threads, evr_error *err);
 
 /* Energy bookkeeping (RGB flux) and counts of one pass. Absorbed is the estimate
  * sum(every hit: F (1 - albedo)) with the flux F arriving there and the surface's albedo (all

@@ -463,7 +463,7 @@ evr_status evr_still_render(const evr_scene *s, const evr_still_params *p, evr_s
         }
         out->photon_layers = buf.layers;
         if (p->gather_area &&
-            (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, NULL, nthreads, err)) != EVR_OK)
+            (st = evr_photon_gbuffer(&host.rs, &c.tr, 0.0f, &buf, nthreads, err)) != EVR_OK)
             goto done;
         c.buf = &buf;
         c.gp.radius = p->gather_radius > 0.0f ? p->gather_radius : 0.02f * host.scene_size;
