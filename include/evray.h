@@ -233,7 +233,7 @@ typedef struct {
     int photon_layers;   /* photons each pixel of the buffer holds (0: from photons) */
     int gi_bounces;      /* indirect bounces of a photon */
     float gi_blur;       /* > 0: indirect light from a per-pass estimate blurred over each
-                          * surface, sigma this x gather_radius (core/photon_blur.h; CPU backend);
+                          * surface, sigma this x gather_radius (core/photon_blur.h);
                           * 0: a gather at every sample */
     /* shading: reflections and refractions a camera ray may take (core/path.h) */
     int max_bounces;

@@ -47,15 +47,7 @@ static evr_status make_backend(evr_sim *sim, evr_error *err)
     evr_backend_kind kind = sim->cfg.backend;
     evr_status st;
 #ifdef EVR_HAVE_CUDA
-    if (kind == EVR_BACKEND_CUDA && sim->setup.gi && sim->setup.gi_blur > 0.0f) {
-        snprintf(err->msg, sizeof err->msg,
-                 "--gi-blur is not implemented on the CUDA backend; use --backend cpu");
-        return EVR_ERR_ARG;
-    }
-    if (kind == EVR_BACKEND_AUTO && sim->setup.gi && sim->setup.gi_blur > 0.0f) {
-        snprintf(sim->st.notice, sizeof sim->st.notice,
-                 "CUDA backend not used: --gi-blur runs on the CPU only; running on the CPU");
-    } else if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
+    if (kind == EVR_BACKEND_CUDA || kind == EVR_BACKEND_AUTO) {
         evr_error cerr;
         cerr.msg[0] = 0;
         st = evr_cuda_backend_new(s, &sim->host, &sim->setup, &sim->backend, &cerr);

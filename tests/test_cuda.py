@@ -7,7 +7,8 @@ reads them) likewise, uniformly and adaptively, and with global illumination (F1
 on a scene of hits a material rules out (tests/filter_assets.py's "mixed": an alpha-masked card
 and a single-sided card seen from behind) likewise; on the scene with every material feature
 (tests/all_materials.py: glint, glass, MASK, BLEND, emission, normal map, culling) likewise; with
-camera paths and an orthographic camera likewise. Skipped (exit 77)
+camera paths and an orthographic camera likewise; the blurred GI estimate (--gi-blur) likewise.
+Skipped (exit 77)
 where this build has no CUDA backend or no GPU is usable."""
 import json
 import os
@@ -36,7 +37,15 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
          # adaptive sampling with global illumination (the adaptive kernel's GI variant)
          ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"]),
          # the sensor model with global illumination (the sensor kernel's GI variant)
-         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"])]
+         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"]),
+         # the blurred estimate (core/photon_blur.h), and with the second Cornell scene. A ray
+         # through a wall's edge may meet the other wall on the other backend (a few pixels of
+         # either GI run differ so); a lookup reads nine cells and the blur many more, so such a
+         # cell moves the indirect light of the pixels around it by a little, and slowly changing
+         # pixels place their events by their level: at 96x72 the F1 was 0.94 and 0.90 (counts
+         # within 0.1%), at 173x130 0.996, where edges hold fewer of the pixels
+         ("cornell", ["--gi", "photon", "--gi-blur", "4", "--res", "173x130", "--duration", "0.5"]),
+         ("cornell-bleed", ["--gi", "photon", "--gi-blur", "4", "--res", "173x130", "--duration", "0.5"])]
 # the deforming meshes: a scene file (a path) instead of a built-in scene; vertices per ray
 # from the segment's keys (the CPU's Embree user geometry, the GPU's own trees per segment)
 for asset in T.deform_assets(tmp):
@@ -188,7 +197,8 @@ T.check(gi_runs["cuda"][1] == gi_runs["cuda-tiny"][1], "cornell GI on CUDA: over
 # bit: with change-driven sampling, brute force and the full sensor model; and with a limit on the
 # photons per estimate (--gather-max 8: the ring search, not the fixed-point sums)
 for label, extra in (("skip", []), ("brute", ["--no-skip"]), ("davis346", ["--sensor", "davis346"]),
-                     ("720p", ["--res", "1280x720", "--duration", "0.3"]), ("gather-max", ["--gather-max", "8"])):
+                     ("720p", ["--res", "1280x720", "--duration", "0.3"]), ("gather-max", ["--gather-max", "8"]),
+                     ("blur", ["--gi-blur", "4"]), ("blur-brute", ["--gi-blur", "4", "--no-skip"])):
     evs = []
     for env in (None, "EVR_GI_INLINE"):
         d = os.path.join(tmp, f"gi-deferred-{label}-{env}")
@@ -294,15 +304,5 @@ T.check(all(r[col["sub0"]] <= r[col["sub1"]] <= r[col["col1"]] and
 T.check(int(sum(r[col["n"]] for r in rows)) == T.load_run_json(d)["stats"]["events"], "timeline: the segments' events add up")
 T.check(bad.returncode != 0 and "cannot write" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1,
         f"timeline: an unwritable path is a one-line error ({bad.stderr.strip()!r})")
-
-# --gi-blur runs on the CPU only: the CUDA backend refuses it in one line, auto runs on the CPU
-p = T.run("demo", "--scene", "cornell", "--gi", "photon", "--gi-blur", "4", "--backend", "cuda", "--res", "32x24",
-          "--duration", "0.1", "-o", os.path.join(tmp, "blur-cuda"), "--quiet", "--no-preview", expect=None)
-T.check(p.returncode != 0 and "--gi-blur" in p.stderr and len(p.stderr.strip().splitlines()) == 1,
-        f"--gi-blur on CUDA: a one-line error ({p.stderr.strip()!r})")
-d = os.path.join(tmp, "blur-auto")
-T.run("demo", "--scene", "cornell", "--gi", "photon", "--gi-blur", "4", "--res", "32x24", "--duration", "0.1",
-      "-o", d, "--quiet", "--no-preview")
-T.check(T.load_run_json(d)["backend"] == "cpu", "--gi-blur with the automatic backend: the CPU")
 
 T.finish("test_cuda")

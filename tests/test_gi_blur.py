@@ -1,9 +1,10 @@
-"""The blurred estimate (--gi-blur, core/photon_blur.h; CPU backend): a still Cornell box makes no
+"""The blurred estimate (--gi-blur, core/photon_blur.h) on the CPU backend (tests/test_cuda.py
+compares the CUDA backend's): a still Cornell box makes no
 events with it; the moving box's events are identical with and without change-driven sampling and
 the gather memo; the flicker that a gather at every sample turns into events falls: the ceiling,
 lit only by indirect light, makes a tenth of the events (a 1024-photons-a-pixel reference makes
 none there: docs/benchmarks.md), and the whole room less than half; run.json records it; bad
-values give one-line errors (tests/test_cuda.py: the CUDA backend refuses it)."""
+values give one-line errors."""
 import os
 
 import numpy as np

@@ -30,8 +30,8 @@ cases.append(("cornell-bleed", ["--gi", "photon", "--res", "64x48", "--duration"
 # with a limit on the photons per estimate
 cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8"]))
-# the blurred estimate (CPU only): a pixel keeps its light while its cell and the eight around it
-# give the same lookups
+# the blurred estimate: a pixel keeps its light while its cell and the eight around it give the same
+# lookups
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gi-blur", "4"]))
 cases.append(("cornell-bleed", ["--gi", "photon", "--res", "96x72", "--duration", "0.4", "--gi-blur", "4"]))
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--gi-blur", "4",
@@ -63,8 +63,6 @@ cases.append(("square", ["--res", "64x48", "--duration", "0.5", "--camera-path",
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--camera-path", "pan:rate=5"]))
 for backend in backends:
     for case, (scene, extra) in enumerate(cases):
-        if backend == "cuda" and "--gi-blur" in extra:
-            continue
         source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)
         if "--gi" not in extra:  # refined sampling: the same events with and without skipping
             runs = {}

@@ -822,7 +822,7 @@ static const evr_config_option table[] = {
      .label = "--gi-blur K",
      .help = "indirect light estimated once per photon pass where the\n"
              "camera sees and blurred over each surface, sigma K x the\n"
-             "gather radius (default 0: a gather at every sample; CPU only)",
+             "gather radius (default 0: a gather at every sample)",
      .json = "gi_blur",
      .json_rank = 65,
      .json_if = has_gi},

@@ -39,11 +39,13 @@ typedef struct evr_gather_point {
     evr_v3 p, n;
     float dist;
     float k[3];
+    int inst; /* the scene instance (the blurred estimate looks it up) */
 } evr_gather_point;
 
-EVR_HD static inline void evr_gather_point_at(const evr_surface *s, evr_v3 cam_org,
+EVR_HD static inline void evr_gather_point_at(const evr_surface *s, int inst, evr_v3 cam_org,
                                               evr_gather_point *g)
 {
+    g->inst = inst;
     g->p = s->p;
     g->n = s->n;
     g->dist = evr_v3_len(evr_v3_sub(s->p, cam_org));

@@ -114,7 +114,6 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
         const size_t cells = (size_t)g->end.width * (size_t)g->end.height;
         evr_photon_buffer *bufs[2] = {&g->end, &g->start};
         g->blur_sigma = setup->gi_blur * g->gp.radius;
-        g->window = 1;
         g->blur_tmp = malloc(3 * cells * sizeof(float));
         for (int k = 0; k < 2; k++) {
             bufs[k]->view_inst = malloc(cells * sizeof(int));
@@ -306,14 +305,14 @@ int evr_cpu_gi_pixel_begin(evr_cpu_gi *g, const evr_camera_intr *cam, int x, int
  * photons at the segment's start (ls) and end (le); one gather where the window saw no change
  * over the segment (the same cells, the same estimate); end_only: le alone. (Walking the two
  * buffers together, cell by cell, was 4-6% faster here and 4% slower on the GPU: one walk kept.) */
-static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, const evr_surface *s,
-                        evr_v3 cam_org, int x, int y, int end_only, float *ls, float *le,
-                        evr_gather_sum *se)
+static void gather_ends(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,
+                        const evr_surface *s, evr_v3 cam_org, int x, int y, int end_only, float *ls,
+                        float *le, evr_gather_sum *se)
 {
     const int changed = evr_photon_window_changed(g->sat, g->end.width, g->end.height,
                                                   g->end.margin, g->window, x, y);
     evr_gather_point gp;
-    evr_gather_point_at(s, cam_org, &gp);
+    evr_gather_point_at(s, inst, cam_org, &gp);
     if (g->gp.max_photons <=
         0) { /* fixed-point sums: the end's from the start's (se) and the cells that changed */
         if (!end_only) {
@@ -336,7 +335,7 @@ static void blur_ends(const evr_cpu_gi *g, int inst, const evr_surface *s, evr_v
 {
     evr_gather_point gp;
     float es[3], ee[3];
-    evr_gather_point_at(s, cam_org, &gp);
+    evr_gather_point_at(s, inst, cam_org, &gp);
     evr_blur_ends(start_of(g), &g->end, x, y, inst, s->n, es, ee);
     *ls = evr_luminance(gp.k[0] * es[0], gp.k[1] * es[1], gp.k[2] * es[2]);
     *le = evr_luminance(gp.k[0] * ee[0], gp.k[1] * ee[1], gp.k[2] * ee[2]);
@@ -363,7 +362,7 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
     if (!memo) {
         float ls, le;
         evr_gather_sum se;
-        gather_ends(g, rs, s, cam_org, x, y, 0, &ls, &le, &se);
+        gather_ends(g, rs, inst, s, cam_org, x, y, 0, &ls, &le, &se);
         return evr_gi_lerp(ls, le, f);
     }
     float dist = evr_v3_len(evr_v3_sub(s->p, cam_org));
@@ -374,7 +373,7 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
      * moves every point it sees) */
     if (!g->memo_off && m->valid && m->inst == inst && !memcmp(m->key, key, sizeof key)) {
         if (!m->end_valid) {
-            gather_ends(g, rs, s, cam_org, x, y, 1, &m->ls, &m->le, &m->se);
+            gather_ends(g, rs, inst, s, cam_org, x, y, 1, &m->ls, &m->le, &m->se);
             m->end_valid = 1;
             m->flat = m->le == m->ls;
         }
@@ -382,7 +381,7 @@ float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int i
     }
     memcpy(m->key, key, sizeof key);
     m->inst = inst;
-    gather_ends(g, rs, s, cam_org, x, y, 0, &m->ls, &m->le, &m->se);
+    gather_ends(g, rs, inst, s, cam_org, x, y, 0, &m->ls, &m->le, &m->se);
     m->valid = m->end_valid = 1;
     m->flat = m->le == m->ls;
     return evr_gi_lerp(m->ls, m->le, f);

@@ -327,6 +327,7 @@ static evr_status init(cuda_backend *b, evr_error *err)
     b->gi = b->setup.gi;
     if (b->gi)
         evr_gi_run_params(&b->setup, b->scene, &b->photons, &b->gp, &b->pp, &gi_margin, &gi_window);
+    b->blur_sigma = b->gi ? b->setup.gi_blur * b->gp.radius : 0.0f;
     b->trails_off = getenv("EVR_NO_PHOTON_REUSE") !=
                     NULL; /* hidden, for tests and measurement: every photon traced */
     b->static_off = getenv("EVR_NO_STATIC_HITS") != NULL;

@@ -29,7 +29,7 @@ __device__ static __noinline__ void gpu_gather_point(const evr_render_scene *rs,
                                                      evr_gather_point *g)
 {
     (void)rs, (void)inst; /* the surface record holds what the gather needs of its material */
-    evr_gather_point_at(s, cam_org, g);
+    evr_gather_point_at(s, inst, cam_org, g);
 }
 
 /* gp.max_photons 0 (core/photon.h's fixed-point sums): the sums of point g over buffer b, those
@@ -82,6 +82,13 @@ __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_
                                                 const evr_gather_point *g, int x, int y, float *ls,
                                                 float *le, const float *known_ls, evr_gather_sum *s)
 {
+    if (v->end.blur) { /* --gi-blur: the lookups (a known start is made again: it is cheap) */
+        float es[3], ee[3];
+        evr_blur_ends(&v->start, &v->end, x, y, g->inst, g->n, es, ee);
+        *ls = evr_luminance(g->k[0] * es[0], g->k[1] * es[1], g->k[2] * es[2]);
+        *le = evr_luminance(g->k[0] * ee[0], g->k[1] * ee[1], g->k[2] * ee[2]);
+        return;
+    }
     const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height,
                                                    v->end.margin, v->window, x, y);
     if (FIXED) {
@@ -103,7 +110,7 @@ __device__ __forceinline__ bool gather_point_same(const evr_gather_point *a,
                           a->n.z, a->dist, a->k[0], a->k[1], a->k[2]};
     const float fb[10] = {b->p.x, b->p.y,  b->p.z,  b->n.x,  b->n.y,
                           b->n.z, b->dist, b->k[0], b->k[1], b->k[2]};
-    unsigned d = 0;
+    unsigned d = (unsigned)(a->inst ^ b->inst);
     for (int i = 0; i < 10; i++) d |= __float_as_uint(fa[i]) ^ __float_as_uint(fb[i]);
     return d == 0;
 }

@@ -163,7 +163,9 @@ __global__ void __launch_bounds__(BLOCK)
     const evr_ray ray = evr_photon_cell_ray(rs, &pose, &buf, cell % buf.width, cell / buf.width);
     float g[8] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
     evr_gpu_hit h;
+    int seen = -1;
     if (gpu_trace<LAYOUT>(&a.view, rs, ray, 0.0f, 1e30f, f, 0, &h)) {
+        seen = h.instance;
         evr_m34 xf = evr_motion_eval(evr_rs_track(rs, rs->instances[h.instance].track), f);
         evr_surface s;
         evr_surface_at(rs, h.instance, h.prim, h.u, h.v, &xf, f, ray, h.t,
@@ -171,6 +173,22 @@ __global__ void __launch_bounds__(BLOCK)
         evr_photon_cell_view(rs, fwd, &s, ray, h.t, g);
     }
     for (int k = 0; k < 8; k++) buf.gbuf[8 * (size_t)cell + k] = g[k];
+    if (buf.view_inst) buf.view_inst[cell] = seen;
+}
+
+/* --gi-blur (core/photon_blur.h), one thread per cell that sees a surface: its gather into
+ * buf.blur (dst NULL), or step k of the blur from src into dst. */
+__global__ void __launch_bounds__(BLOCK)
+    photon_blur_kernel(kernel_args a, evr_photon_buffer buf, float f, float sigma,
+                       evr_gather_params gp, const float *src, float *dst, int k)
+{
+    const int cell = blockIdx.x * blockDim.x + threadIdx.x;
+    if (cell >= buf.width * buf.height || buf.view_inst[cell] < 0) return;
+    const evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
+    const evr_v3 org = evr_m34_point(&pose, evr_v3_make(0.0f, 0.0f, 0.0f));
+    const int x = cell % buf.width, y = cell / buf.width;
+    if (dst) evr_blur_cell(&buf, &a.rs.camera, org, sigma, src, dst, x, y, k);
+    else evr_blur_cell_gather(&buf, &a.rs.camera, org, &gp, x, y, buf.blur + 3 * (size_t)cell);
 }
 
 /* Changed cells into the summed-area table's interior (row 0 and column 0 stay zero): 1 where
@@ -183,10 +201,12 @@ __global__ void __launch_bounds__(BLOCK)
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= end.width * end.height) return;
     const int x = cell % end.width, y = cell / end.width;
-    const uint8_t now = !evr_photon_cell_same(&end, &start, (size_t)cell);
+    const uint8_t photons = !evr_photon_cell_same(&end, &start, (size_t)cell);
+    /* --gi-blur: what changes a pixel's light is its cells' lookups */
+    const uint8_t now = end.blur ? !evr_blur_cell_same(&end, &start, (size_t)cell) : photons;
     sat[(size_t)(y + 1) * (size_t)(end.width + 1) + (size_t)(x + 1)] = now | last[cell];
     last[cell] = now;
-    if (now)
+    if (photons)
         count_lanes(counters, CTR_GI_CHANGED); /* this segment's changes, as the CPU counts them */
 }
 
@@ -411,6 +431,15 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
         photon_view_kernel<decltype(l)::value><<<cgrid, BLOCK, 0, rs>>>(a, *out, f);
     });
     CK(cudaGetLastError());
+    if (b->blur_sigma > 0.0f) { /* every step: a cell past its own keeps its value */
+        const float sg = b->blur_sigma;
+        photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, f, sg, b->gp, nullptr, nullptr, 0);
+        for (int k = 0; k < EVR_BLUR_MAX_STEPS; k++)
+            photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, f, sg, b->gp,
+                                                        k % 2 ? b->d_blur_tmp.p : out->blur,
+                                                        k % 2 ? out->blur : b->d_blur_tmp.p, k);
+        CK(cudaGetLastError());
+    }
     sl->gi_passes++;
     return EVR_OK;
 }
@@ -438,6 +467,12 @@ evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg,
                            cudaMemcpyDeviceToDevice, rs));
         CK(cudaMemcpyAsync(eb->gbuf, sb->gbuf, cells * 8 * sizeof(float), cudaMemcpyDeviceToDevice,
                            rs));
+        if (eb->blur) {
+            CK(cudaMemcpyAsync(eb->view_inst, sb->view_inst, cells * sizeof(int),
+                               cudaMemcpyDeviceToDevice, rs));
+            CK(cudaMemcpyAsync(eb->blur, sb->blur, cells * 3 * sizeof(float),
+                               cudaMemcpyDeviceToDevice, rs));
+        }
     } else {
         CK(cudaEventRecord(sl->gi_started, rs));
         if (!b->gi_have_prev) {
@@ -452,7 +487,7 @@ evr_status gi_segment(cuda_backend *b, slot *sl, const evr_segment *seg,
         sl->d_sat.p, eb->width, eb->height);
     sat_cols_kernel<<<(unsigned)((eb->width + 31) / 32), 32 * SAT_CHUNKS, 0, rs>>>(
         sl->d_sat.p, eb->width, eb->height);
-    if (b->gp.max_photons <= 0) {
+    if (b->gp.max_photons <= 0 && b->blur_sigma <= 0.0f) {
         const evr_changed_cells ch = sl->h_gi_view.p->ch;
         changed_rows_kernel<<<(unsigned)((32 * (size_t)eb->height + BLOCK - 1) / BLOCK), BLOCK, 0,
                               rs>>>(b->d_gi_last.p, eb->width, eb->height, sl->d_ch_before.p);
@@ -495,11 +530,20 @@ evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
         buf->slots = g->slots.p;
         buf->count = g->count.p;
         buf->gbuf = g->gbuf.p;
+        if (b->blur_sigma > 0.0f) {
+            CK(g->view_inst.reserve(cells));
+            CK(g->blur.reserve(cells * 3));
+            CK(cudaMemset(g->view_inst.p, 0xff, cells * sizeof(int)));
+            CK(cudaMemset(g->blur.p, 0, cells * 3 * sizeof(float)));
+            buf->view_inst = g->view_inst.p;
+            buf->blur = g->blur.p;
+        }
         buf->collisions = nullptr; /* the place kernel counts them (CTR_GI_COLLISIONS) */
     }
     const size_t cells = (size_t)b->gi_ring[0].ph.width * (size_t)b->gi_ring[0].ph.height;
     CK(b->d_gi_last.reserve(cells));
     CK(cudaMemset(b->d_gi_last.p, 0, cells));
+    if (b->blur_sigma > 0.0f) CK(b->d_blur_tmp.reserve(cells * 3));
     return EVR_OK;
 }
 

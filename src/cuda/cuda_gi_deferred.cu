@@ -378,7 +378,7 @@ evr_status gi_deferred_render(const cuda_backend *b, const kernel_args &a, const
     with_layout(run_variant(b).layout,
                 [&](auto l) { gi_trace_kernel<decltype(l)::value><<<grid, BLOCK, 0, rs>>>(a, d); });
     CK(cudaGetLastError());
-    if (b->gp.max_photons <= 0) {
+    if (b->gp.max_photons <= 0 && b->blur_sigma <= 0.0f) {
         if (b->d_gi_ends[0].p) { /* what the changed cells add to the pixels' last gathers */
             CK(cudaMemsetAsync(d.delta, 0,
                                2 * (size_t)b->setup.width * (size_t)b->setup.height *

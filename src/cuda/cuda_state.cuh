@@ -113,6 +113,8 @@ struct gi_buffer {
     dbuf<evr_photon> slots;
     dbuf<uint32_t> count;
     dbuf<float> gbuf;
+    dbuf<int> view_inst; /* --gi-blur: the cells' instances and blurred estimates */
+    dbuf<float> blur;
     evr_photon_buffer ph; /* the shape and the device pointers */
 };
 
@@ -177,6 +179,8 @@ struct cuda_backend {
     int gi, gi_have_prev;
     gi_buffer gi_ring[NRING]; /* segment i ends in gi_ring[i % NRING], starts in the one before */
     dbuf<uint8_t> d_gi_last;  /* per cell: changed over the last segment */
+    float blur_sigma;         /* --gi-blur: its sigma in world units (0: off) */
+    dbuf<float> d_blur_tmp;   /* the blur's other half */
     dbuf<gi_end>
         d_gi_ends[NRING]; /* deferred gathers: each pixel's last gather, a ring as d_state */
     uint32_t photons;

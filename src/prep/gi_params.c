@@ -25,7 +25,8 @@ void evr_gi_run_params(const evr_run_setup *setup, const evr_scene *s, uint32_t 
     pp->bounds.center = evr_v3_scale(evr_v3_add(lo, hi), 0.5f);
     pp->bounds.radius = 0.55f * evr_v3_len(evr_v3_sub(hi, lo)) + 1e-6f;
     *margin = setup->gather_window < 16 ? setup->gather_window : 16;
-    *window = setup->gather_window + 1;
+    /* the blurred estimate reads a pixel's cell and the eight around it (core/photon_blur.h) */
+    *window = setup->gi_blur > 0.0f ? 1 : setup->gather_window + 1;
 }
 
 int evr_gi_photon_layers(int asked, uint32_t photons, int width, int height)
