@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""The GI fidelity table of docs/benchmarks.md: a scene with `--gi photon` at several photon
-budgets, each scored with `evray compare` against a reference, the same scene with many
-times the photons (every photon kept: the buffer's layers raised with the budget). The reference
+"""The GI fidelity table of docs/benchmarks.md: a scene with `--gi photon` at its defaults (the
+blurred estimate), with a gather at every sample at several photon budgets, each scored with
+`evray compare` against a reference: the same scene with many times the photons and a gather at
+every sample (every photon kept: the buffer's layers raised with the budget). The reference
 is rendered with two seeds; their agreement says how far it is converged. Direct light alone is
 scored too, for scale. Each run is scored twice: within --tol-us, and within the larger of that
 and --tol-level times the gap since the reference's previous event of the same pixel and polarity
@@ -83,14 +84,16 @@ def scores(ref, test):
 
 # direct light sampled as `--gi` samples (uniform, 10 a frame, each pixel's phase from the seed)
 rows = [("direct light only (`--samples-per-frame 10`)", "direct", ["--samples-per-frame", "10"])]
-rows.append(("GI, the defaults (one photon a pixel)", "default", ["--gi", "photon"]))
+rows.append(("GI, the defaults (one photon a pixel, blurred: `--gi-blur 4`)", "default", ["--gi", "photon"]))
+rows.append(("GI, a gather at every sample (`--gi-blur 0`)", "gather", ["--gi", "photon", "--gi-blur", "0"]))
 for ppp in (int(v) for v in a.budgets.split(",") if v):
-    rows.append((f"GI, {ppp} photons a pixel", f"p{ppp}", ["--gi", "photon", *budget(ppp)]))
+    rows.append((f"GI, {ppp} photons a pixel, a gather at every sample", f"p{ppp}",
+                 ["--gi", "photon", "--gi-blur", "0", *budget(ppp)]))
 for item in (v for v in a.extra.split(";") if v.strip()):
     label, opts = item.split("=", 1)
     rows.append((f"GI, {label.strip()} (`{opts.strip()}`)", "x-" + "".join(c for c in label if c.isalnum()),
                  ["--gi", "photon", *opts.split()]))
-ref_opts = ["--gi", "photon", *budget(a.ref_ppp)]
+ref_opts = ["--gi", "photon", "--gi-blur", "0", *budget(a.ref_ppp)]
 
 
 def reference(seed):

@@ -22,6 +22,8 @@ probe = T.run("demo", "--scene", "square", "-o", os.path.join(tmp, "probe"), "--
 if probe.returncode != 0:
     T.skip("test_cuda", probe.stderr.strip())
 
+# GI runs name --gi-blur: 0 (a gather at every sample) where the backends' agreement on every
+# feature is checked, 4 (the default, the blurred estimate) on the two Cornell scenes below
 cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0.25"]),
          # two segments: the CUDA backend carries a segment's latest events into the next one's
          # sort; the last segment gives them all up (else about a tenth of a segment's are lost)
@@ -35,9 +37,9 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
          ("eye", ["--res", "160x120", "--start", "0.2", "--duration", "1.0", "--sampling", "adaptive"]),
          ("eye", ["--sensor", "davis346", "--res", "160x120", "--duration", "0.5", "--sampling", "adaptive"]),
          # adaptive sampling with global illumination (the adaptive kernel's GI variant)
-         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"]),
+         ("cornell", ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5", "--sampling", "adaptive"]),
          # the sensor model with global illumination (the sensor kernel's GI variant)
-         ("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"]),
+         ("cornell", ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5", "--sensor", "davis346"]),
          # the blurred estimate (core/photon_blur.h), and with the second Cornell scene. A ray
          # through a wall's edge may meet the other wall on the other backend (a few pixels of
          # either GI run differ so); a lookup reads nine cells and the blur many more, so such a
@@ -51,7 +53,7 @@ cases = [("square", ["--res", "160x160", "--pos-thres", "0.3", "--neg-thres", "0
 for asset in T.deform_assets(tmp):
     cases.append((asset, ["--res", "160x120", "--duration", "1.0"]))
     cases.append((asset, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
-    cases.append((asset, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+    cases.append((asset, ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5"]))
 # hits a material rules out (core/hit_filter.h; on the GPU the general kernels,
 # EVR_GPU_TRACE_GENERAL): an alpha-masked checkerboard card sliding in front of a single-sided card
 # seen from behind (invisible, its shadow cast) and a lit wall (tests/filter_assets.py's "mixed")
@@ -60,7 +62,7 @@ import filter_assets  # noqa: E402
 mixed = filter_assets.write_all(os.path.join(tmp, "filter-assets"))["mixed"]
 cases.append((mixed, ["--res", "160x120", "--duration", "1.0"]))
 cases.append((mixed, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
-cases.append((mixed, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+cases.append((mixed, ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5"]))
 # every material feature at once (tests/all_materials.py: a gold mirror sphere with the glint of a
 # sphere light, a glass slab with volume attenuation over a checker, alpha MASK and BLEND cards,
 # an emissive texture, a normal map, a single-sided quad seen from behind; things move, the lamp
@@ -70,11 +72,11 @@ import all_materials  # noqa: E402
 every = all_materials.write(os.path.join(tmp, "all-materials"))
 cases.append((every, ["--res", "160x120", "--duration", "1.0"]))
 cases.append((every, ["--sensor", "davis346", "--res", "128x96", "--duration", "0.5", "--sampling", "adaptive"]))
-cases.append((every, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+cases.append((every, ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5"]))
 # camera paths (the camera's own motion track, docs/camera.md), with and without GI, and an
 # orthographic camera (core/camera.h's parallel rays, photons seen along them) over a moving quad
 cases.append(("square", ["--res", "160x160", "--duration", "0.3", "--camera-path", "orbit+shake"]))
-cases.append(("cornell", ["--gi", "photon", "--res", "96x72", "--duration", "0.3", "--camera-path", "pan:rate=10"]))
+cases.append(("cornell", ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.3", "--camera-path", "pan:rate=10"]))
 ortho = os.path.join(tmp, "ortho.gltf")
 T.quad_gltf(ortho, animated=True)
 with open(ortho) as f:
@@ -89,7 +91,7 @@ g["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2.0, "ymag": 2
 mixed_ortho = os.path.join(os.path.dirname(mixed), "mixed_ortho.gltf")
 with open(mixed_ortho, "w") as f:
     json.dump(g, f)
-cases.append((mixed_ortho, ["--gi", "photon", "--res", "96x72", "--duration", "0.5"]))
+cases.append((mixed_ortho, ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5"]))
 for case, (scene, extra) in enumerate(cases):
     outs = {}
     source = ("render", scene) if os.path.sep in scene else ("demo", "--scene", scene)
@@ -168,7 +170,7 @@ for scene, extra in (("eye", ["--res", "200x150", "--duration", "1.0", "--start"
 # differences of the traversals; the buffer is filled in photon order (deterministic: two runs give
 # the same events); a segment re-rendered after an overflow finds its own photons; a still Cornell
 # box makes no events
-gi = ["--gi", "photon", "--res", "96x72", "--duration", "0.5", "--format", "npy,h5", "--seed", "5"]
+gi = ["--gi", "photon", "--gi-blur", "0", "--res", "96x72", "--duration", "0.5", "--format", "npy,h5", "--seed", "5"]
 gi_runs = {}
 for label, extra in (("cpu", ["--backend", "cpu"]), ("cuda", ["--backend", "cuda"]), ("cuda2", ["--backend", "cuda"]),
                      ("cuda-tiny", ["--backend", "cuda", "--gpu-event-capacity", "1000"])):
@@ -221,7 +223,7 @@ T.check(abs(st_gpu["photons_reused"] - st_cpu["photons_reused"]) <= 0.02 * st_cp
 # at 173x130 the gather's disk spans more than three pixels, so the normalization over the
 # cells' view (their footprints' strips, core/photon_buffer.h) is on: CPU and CUDA agree, and the
 # deferred gathers give the inline ones' events bit for bit
-gi_big = ["--gi", "photon", "--res", "173x130", "--duration", "0.5", "--format", "npy,h5", "--seed", "5"]
+gi_big = ["--gi", "photon", "--gi-blur", "0", "--res", "173x130", "--duration", "0.5", "--format", "npy,h5", "--seed", "5"]
 big = {}
 # (and brute force: a launch over every pixel in 8x4 tiles has more threads than 173x130 pixels,
 # and the deferred kernels' per-pixel entries once overran their arrays there)
@@ -258,10 +260,11 @@ T.check(abs(lg["photons_stored"] - lc["photons_stored"]) <= 0.02 * lc["photons_s
         "cornell GI, 16 photons a pixel: CUDA stores as many photons as the CPU (within 2%)")
 T.check(l8["photon_collisions"] > 0.01 * (l8["photons_stored"] + l8["photon_collisions"]) and
         sum("photon buffer" in l for l in e8.splitlines()) == 1, "cornell GI on CUDA, 8 layers: photons dropped, one warning")
-d = os.path.join(tmp, "gi-still")
-T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
-      "--res", "96x72", "--duration", "1.0")
-T.check(T.load_run_json(d)["stats"]["events"] == 0, "cornell-still with GI on CUDA: no events over 1 s")
+for blur in ("0", "4"):
+    d = os.path.join(tmp, f"gi-still-{blur}")
+    T.run("demo", "--scene", "cornell-still", "-o", d, "--no-preview", "--quiet", "--backend", "cuda", "--gi", "photon",
+          "--gi-blur", blur, "--res", "96x72", "--duration", "1.0")
+    T.check(T.load_run_json(d)["stats"]["events"] == 0, f"cornell-still with GI (--gi-blur {blur}) on CUDA: no events over 1 s")
 # Ctrl-C: the CUDA backend keeps each segment's latest events on the device for the next one's
 # sort; the last segment the run finishes must give them up. The interrupted file equals, byte for
 # byte, a run of the simulated length that was not interrupted (brute force, to be slow enough).

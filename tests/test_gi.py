@@ -1,5 +1,6 @@
-"""Global illumination in the event pipeline (--gi photon, CPU backend): a still Cornell box makes
-no events with GI on (the same photons every segment), with and without change-driven sampling;
+"""Global illumination in the event pipeline (--gi photon, CPU backend) with a gather at every
+sample (--gi-blur 0; the blurred estimate, the default, is tests/test_gi_blur.py's): a still
+Cornell box makes no events with GI on (the same photons every segment), with and without change-driven sampling;
 the moving box's events are identical with and without skipping; GI changes the intensities;
 run.json accounts for the photon passes; GI's events do not cluster at segment boundaries (the
 indirect light is interpolated in time); the per-pixel gather memo and the reuse of photon trails
@@ -19,7 +20,7 @@ def render(name, scene, *extra, env=None):
 
 
 for mode in ([], ["--no-skip"]):
-    ev, js = render("still" + "".join(mode), "cornell-still", "--gi", "photon", "--duration", "1", *mode)
+    ev, js = render("still" + "".join(mode), "cornell-still", "--gi", "photon", "--gi-blur", "0", "--duration", "1", *mode)
     st = js["stats"]
     T.check(st["events"] == 0, f"still Cornell box, GI on {mode}: no events ({st['events']})")
     T.check(js["config"]["gi"] == "photon" and st["photons_traced"] > 0, "GI in run.json")
@@ -29,8 +30,8 @@ for mode in ([], ["--no-skip"]):
     else:
         T.check(st["photon_passes"] == 2, f"nothing moves: the first segment's two photon passes ({st['photon_passes']})")
 
-ev_s, js = render("moving", "cornell", "--gi", "photon", "--duration", "0.5")
-ev_b, jb = render("moving-brute", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip")
+ev_s, js = render("moving", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5")
+ev_b, jb = render("moving-brute", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5", "--no-skip")
 ev_d, jd = render("direct", "cornell", "--duration", "0.5")
 print(f"cornell 0.5 s: {js['stats']['events']} events with GI, {jd['stats']['events']} without; traced "
       f"{js['stats']['samples_traced']} of {js['stats']['samples']} samples; {js['stats']['photon_passes']} photon passes")
@@ -48,18 +49,18 @@ print(f"events within a tenth of a segment of a boundary: GI {share_gi:.3f}, dir
 T.check(share_gi < 0.3 and share_gi < 1.5 * share_direct, "GI's events do not cluster at segment boundaries")
 # a pixel reuses its last gather while its hit and its window are unchanged: gathering at every
 # sample instead (EVR_GI_NO_MEMO) gives the same events
-ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--no-skip", env="EVR_GI_NO_MEMO")
+ev_m, jm = render("no-memo", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5", "--no-skip", env="EVR_GI_NO_MEMO")
 T.check(ev_m == ev_b, "GI: the same events without the gather memo")
 # the same with adaptive sampling (its tiles must forget a pixel's gather when its window changed)
-ev_a, ja = render("adaptive", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive")
-ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--duration", "0.5", "--sampling", "adaptive",
+ev_a, ja = render("adaptive", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5", "--sampling", "adaptive")
+ev_am, jam = render("adaptive-no-memo", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5", "--sampling", "adaptive",
                     env="EVR_GI_NO_MEMO")
 T.check(ja["stats"]["events"] > 0 and ev_a == ev_am, "GI with adaptive sampling: the same events without the gather memo")
 # a photon whose last path met nothing that moves keeps its outcome instead of being traced again
 # (its trail, core/photon.h): the same events as tracing every photon (EVR_NO_PHOTON_REUSE), most
 # photons of the moving box's passes reused, none under brute force
 st = js["stats"]
-ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--duration", "0.5", env="EVR_NO_PHOTON_REUSE")
+ev_t, jt = render("no-reuse", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "0.5", env="EVR_NO_PHOTON_REUSE")
 print(f"photon trails: {st['photons_reused']} reused, {st['photons_traced']} traced in {st['photon_passes']} passes; "
       f"without reuse {jt['stats']['photons_traced']} traced")
 T.check(ev_t == ev_s, "GI: the same events with and without reusing photon trails")
@@ -75,7 +76,7 @@ T.check(jb["stats"]["photons_reused"] == 0, "GI brute force (--no-skip): no phot
 def layers_run(name, *extra):
     d = os.path.join(tmp, name)
     p = T.run("demo", "--scene", "cornell", "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
-              "--res", "64x48", "--gi", "photon", "--duration", "0.3", *extra)
+              "--res", "64x48", "--gi", "photon", "--gi-blur", "0", "--duration", "0.3", *extra)
     return p, T.load_run_json(d)["stats"]
 
 
@@ -117,11 +118,11 @@ big = []
 for mode in ([], ["--no-skip"]):
     d = os.path.join(tmp, "big" + "".join(mode))
     T.run("demo", "--scene", "cornell", "-o", d, "--backend", "cpu", "--format", "npy", "--no-preview", "--quiet",
-          "--res", "173x130", "--duration", "0.5", "--gi", "photon", *mode)
+          "--res", "173x130", "--duration", "0.5", "--gi", "photon", "--gi-blur", "0", *mode)
     big.append(open(os.path.join(d, "events.npy"), "rb").read())
 T.check(len(big[0]) > 10000 and big[0] == big[1], "GI at 173x130: identical events with and without skipping")
 face_direct = face_events("face-direct", "--samples-per-frame", "10")
-face_gi = face_events("face-gi", "--gi", "photon", "--photons", str(16 * 173 * 130))
+face_gi = face_events("face-gi", "--gi", "photon", "--gi-blur", "0", "--photons", str(16 * 173 * 130))
 print(f"the short box's grazing face (x 110-119, y 90-109): {face_gi} events with GI, {face_direct} without")
 T.check(face_direct > 500 and face_gi < 3 * face_direct,
         "GI on a grazing moving face: under 3x direct light's events (no bursts at the segment rate)")
@@ -157,9 +158,9 @@ for t, near, far in (("0", 0.2, -0.2), ("1", -0.2, 0.2)):  # the box at z = 0.2,
     T.check(lit["photon"][0] > lit["photon"][1] + 0.05, f"cornell-bleed at {t} s: GI bleeds the moving box's red onto "
             "the wall beside it")
 
-bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--photon-layers", "4097"],
-       ["--gi", "photon", "--gather-max", "-1"], ["--gi", "photon", "--gather-radius", "-1"],
-       ["--gi", "photon", "--photons", "x"]]
+bad = [["--gi", "sunlight"], ["--gi", "path"], ["--gi", "photon", "--gi-blur", "0", "--photon-layers", "4097"],
+       ["--gi", "photon", "--gi-blur", "0", "--gather-max", "-1"], ["--gi", "photon", "--gi-blur", "0", "--gather-radius", "-1"],
+       ["--gi", "photon", "--gi-blur", "0", "--photons", "x"]]
 for args in bad:
     p = T.run("demo", "--scene", "cornell", "-o", os.path.join(tmp, "bad"), "--duration", "0.1", "--quiet", *args,
               expect=None)

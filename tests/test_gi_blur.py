@@ -1,4 +1,4 @@
-"""The blurred estimate (--gi-blur, core/photon_blur.h) on the CPU backend (tests/test_cuda.py
+"""The blurred estimate (--gi-blur, K = 4 by default; core/photon_blur.h) on the CPU backend (tests/test_cuda.py
 compares the CUDA backend's): a still Cornell box makes no
 events with it; the moving box's events are identical with and without change-driven sampling and
 the gather memo; the flicker that a gather at every sample turns into events falls: the ceiling,
@@ -27,11 +27,13 @@ for mode in ([], ["--no-skip"]):
     T.check(js["stats"]["events"] == 0, f"still Cornell box, --gi-blur {mode}: no events ({js['stats']['events']})")
     T.check(js["config"]["gi_blur"] == 4, "--gi-blur in run.json")
 
-ev_s, js, d_s = render("blur", "cornell", "--gi", "photon", "--gi-blur", "4", "--duration", "1")
+ev_s, js, d_s = render("blur", "cornell", "--gi", "photon", "--duration", "1")
+ev_4, _, _ = render("blur-4", "cornell", "--gi", "photon", "--gi-blur", "4", "--duration", "1")
+T.check(ev_4 == ev_s, "--gi-blur 4 is the default")
 ev_b, jb, _ = render("blur-brute", "cornell", "--gi", "photon", "--gi-blur", "4", "--duration", "1", "--no-skip")
 ev_m, jm, _ = render("blur-no-memo", "cornell", "--gi", "photon", "--gi-blur", "4", "--duration", "1",
                      env="EVR_GI_NO_MEMO")
-ev_g, jg, d_g = render("gather", "cornell", "--gi", "photon", "--duration", "1")
+ev_g, jg, d_g = render("gather", "cornell", "--gi", "photon", "--gi-blur", "0", "--duration", "1")
 ev_d, jd, d_d = render("direct", "cornell", "--duration", "1")
 T.check(js["stats"]["events"] > 0 and ev_s == ev_b, "--gi-blur: identical events with and without skipping")
 T.check(ev_m == ev_s, "--gi-blur: identical events without the memo of a pixel's lookups")

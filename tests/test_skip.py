@@ -23,18 +23,20 @@ cases = [(n, ["--res", "64x48", "--duration", "0.4"]) for n in names]
 cases.append(("square", ["--res", "96x96", "--duration", "1.0", "--pos-thres", "0.3", "--neg-thres", "0.25"]))
 cases.append(("square", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
 cases.append(("cornell", ["--sensor", "davis346", "--res", "64x48", "--duration", "0.5"]))
-# global illumination: a pixel whose gather window saw no photon change keeps its intensity
+# global illumination (the blurred estimate): a pixel whose nine cells' lookups did not change keeps
+# its intensity
 cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
 cases.append(("cornell-bleed", ["--gi", "photon", "--res", "64x48", "--duration", "0.4"]))
-# wider windows (a still pixel's sums updated from the cells that changed), and the ring search
-# with a limit on the photons per estimate
-cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2"]))
-cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8"]))
-# the blurred estimate: a pixel keeps its light while its cell and the eight around it give the same
-# lookups
-cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gi-blur", "4"]))
-cases.append(("cornell-bleed", ["--gi", "photon", "--res", "96x72", "--duration", "0.4", "--gi-blur", "4"]))
-cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--gi-blur", "4",
+# a gather at every sample: wider windows (a still pixel's sums updated from the cells that
+# changed), and the ring search with a limit on the photons per estimate
+cases.append(("cornell", ["--gi", "photon", "--res", "160x120", "--duration", "0.2", "--gi-blur", "0"]))
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gather-max", "8", "--gi-blur", "0"]))
+# a gather at every sample (--gi-blur 0; the cases above take the blurred estimate, the default,
+# where a pixel keeps its light while its cell and the eight around it give the same lookups): the
+# pixel keeps it while its gather window saw no photon change
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.4", "--gi-blur", "0"]))
+cases.append(("cornell-bleed", ["--gi", "photon", "--res", "96x72", "--duration", "0.4", "--gi-blur", "0"]))
+cases.append(("cornell", ["--gi", "photon", "--res", "64x48", "--duration", "0.2", "--gi-blur", "0",
                           "--camera-path", "pan:rate=5"]))
 # the deforming meshes (a path: a scene file): a still stretch keeps its vertices and (on CUDA) its
 # tree bit for bit, so pixels that see it skip exactly

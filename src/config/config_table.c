@@ -813,7 +813,7 @@ static const evr_config_option table[] = {
     {.name = "gi_blur",
      .type = EVR_OPT_FLOAT,
      .offset = F(gi_blur),
-     .def = 0.0,
+     .def = 4.0,
      .lo = 0,
      .hi = 16,
      .what = "--gi-blur must be between 0 (off) and 16",
@@ -822,7 +822,7 @@ static const evr_config_option table[] = {
      .label = "--gi-blur K",
      .help = "indirect light estimated once per photon pass where the\n"
              "camera sees and blurred over each surface, sigma K x the\n"
-             "gather radius (default 0: a gather at every sample)",
+             "gather radius (default 4; 0: a gather at every sample)",
      .json = "gi_blur",
      .json_rank = 65,
      .json_if = has_gi},
