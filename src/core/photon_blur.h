@@ -12,7 +12,7 @@
 #ifndef EVR_CORE_PHOTON_BLUR_H
 #define EVR_CORE_PHOTON_BLUR_H
 
-#include "core/photon_gather.h"
+#include "core/photon_indirect.h"
 
 /* cells whose normals differ more (cosine below) are not the same surface */
 #define EVR_BLUR_NORMAL_COS 0.9f
@@ -146,6 +146,18 @@ EVR_HD static inline void evr_blur_ends(const evr_photon_buffer *s, const evr_ph
         for (int c = 0; c < 3; c++) ee[c] = es[c];
     else if (ke == EVR_BLUR_LIKE && ks != EVR_BLUR_LIKE)
         for (int c = 0; c < 3; c++) es[c] = ee[c];
+}
+
+/* The luminance of the indirect light leaving gather point g (image pixel (x, y)) at the passes
+ * of its segment's start (s) and end (e), from their blurred estimates (evr_blur_ends). */
+EVR_HD static inline void evr_blur_point_lum(const evr_photon_buffer *s, const evr_photon_buffer *e,
+                                             const evr_gather_point *g, int x, int y, float *ls,
+                                             float *le)
+{
+    float es[3], ee[3];
+    evr_blur_ends(s, e, x, y, g->inst, g->n, es, ee);
+    *ls = evr_luminance(g->k[0] * es[0], g->k[1] * es[1], g->k[2] * es[2]);
+    *le = evr_luminance(g->k[0] * ee[0], g->k[1] * ee[1], g->k[2] * ee[2]);
 }
 
 /* Whether cell i gives every lookup the same in passes a and b: the same instance, and where it

@@ -334,11 +334,8 @@ static void blur_ends(const evr_cpu_gi *g, int inst, const evr_surface *s, evr_v
                       int y, float *ls, float *le)
 {
     evr_gather_point gp;
-    float es[3], ee[3];
     evr_gather_point_at(s, inst, cam_org, &gp);
-    evr_blur_ends(start_of(g), &g->end, x, y, inst, s->n, es, ee);
-    *ls = evr_luminance(gp.k[0] * es[0], gp.k[1] * es[1], gp.k[2] * es[2]);
-    *le = evr_luminance(gp.k[0] * ee[0], gp.k[1] * ee[1], gp.k[2] * ee[2]);
+    evr_blur_point_lum(start_of(g), &g->end, &gp, x, y, ls, le);
 }
 
 float evr_cpu_gi_indirect(const evr_cpu_gi *g, const evr_render_scene *rs, int inst,

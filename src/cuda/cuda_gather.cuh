@@ -83,10 +83,7 @@ __device__ __forceinline__ void gpu_gather_ends(const gpu_gi_view *v, const evr_
                                                 float *le, const float *known_ls, evr_gather_sum *s)
 {
     if (v->end.blur) { /* --gi-blur: the lookups (a known start is made again: it is cheap) */
-        float es[3], ee[3];
-        evr_blur_ends(&v->start, &v->end, x, y, g->inst, g->n, es, ee);
-        *ls = evr_luminance(g->k[0] * es[0], g->k[1] * es[1], g->k[2] * es[2]);
-        *le = evr_luminance(g->k[0] * ee[0], g->k[1] * ee[1], g->k[2] * ee[2]);
+        evr_blur_point_lum(&v->start, &v->end, g, x, y, ls, le);
         return;
     }
     const bool changed = evr_photon_window_changed(v->sat, v->end.width, v->end.height,

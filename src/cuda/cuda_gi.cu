@@ -179,13 +179,11 @@ __global__ void __launch_bounds__(BLOCK)
 /* --gi-blur (core/photon_blur.h), one thread per cell that sees a surface: its gather into
  * buf.blur (dst NULL), or step k of the blur from src into dst. */
 __global__ void __launch_bounds__(BLOCK)
-    photon_blur_kernel(kernel_args a, evr_photon_buffer buf, float f, float sigma,
+    photon_blur_kernel(kernel_args a, evr_photon_buffer buf, evr_v3 org, float sigma,
                        evr_gather_params gp, const float *src, float *dst, int k)
 {
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= buf.width * buf.height || buf.view_inst[cell] < 0) return;
-    const evr_m34 pose = evr_rs_camera_pose(&a.rs, f);
-    const evr_v3 org = evr_m34_point(&pose, evr_v3_make(0.0f, 0.0f, 0.0f));
     const int x = cell % buf.width, y = cell / buf.width;
     if (dst) evr_blur_cell(&buf, &a.rs.camera, org, sigma, src, dst, x, y, k);
     else evr_blur_cell_gather(&buf, &a.rs.camera, org, &gp, x, y, buf.blur + 3 * (size_t)cell);
@@ -433,9 +431,11 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
     CK(cudaGetLastError());
     if (b->blur_sigma > 0.0f) { /* every step: a cell past its own keeps its value */
         const float sg = b->blur_sigma;
-        photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, f, sg, b->gp, nullptr, nullptr, 0);
+        const evr_m34 pose = evr_rs_camera_pose(hrs, f); /* the camera at the pass, on the host */
+        const evr_v3 org = evr_m34_point(&pose, evr_v3_make(0.0f, 0.0f, 0.0f));
+        photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp, nullptr, nullptr, 0);
         for (int k = 0; k < EVR_BLUR_MAX_STEPS; k++)
-            photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, f, sg, b->gp,
+            photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp,
                                                         k % 2 ? b->d_blur_tmp.p : out->blur,
                                                         k % 2 ? out->blur : b->d_blur_tmp.p, k);
         CK(cudaGetLastError());
