@@ -936,58 +936,78 @@ static void test_gather_delta(void)
     evr_photon_buffer_free(&b);
 }
 
-/* The blurred estimate (core/photon_blur.h) on a hand-made buffer, 16 x 8 cells 0.1 apart on the
- * plane z = 0 seen from 1 away: the left half instance 0 with a noisy estimate, one column of it
- * turned to face +x (another surface), the right half instance 1 at 3. The blur smooths the left
- * half around its mean, keeps the turned column and the right half apart; a lookup takes the
- * cell's estimate, its like neighbours' mean at an outline, the mean of what is around, or
- * nothing; a sample seen at one pass only takes that pass's estimate at both. */
+/* The blurred estimate (core/photon_blur.h) on a 16 x 8 buffer whose cells see points 0.1 apart on
+ * the plane z = 0 seen from 1 away: the left half instance 0 with a noisy irradiance, one column
+ * of it turned to face +x (another surface), the right half instance 1 at 3 over cells of two
+ * footprint areas. Each cell holds one photon of its irradiance times its area, plus two it must
+ * not count (off the plane, facing away). The blur smooths the left half around its mean, keeps
+ * the turned column and the right half apart, and gives the right half its density whatever the
+ * areas; a lookup takes the cell's estimate, its like neighbours' mean at an outline, the mean of
+ * what is around, or nothing; a sample seen at one pass only takes that pass's estimate at both. */
 static void test_blur(void)
 {
-    enum { W = 16, H = 8 };
+    enum { W = 16, H = 8, L = 3 };
     evr_photon_buffer b, none;
-    static float gbuf[W * H * 8], e[W * H * 3], tmp[W * H * 3];
+    static float gbuf[W * H * 8], e[W * H * 3], work[2][W * H * EVR_BLUR_CH];
+    static evr_photon slots[L * W * H];
+    static uint32_t count[W * H];
     static int inst[W * H], inst_none[W * H];
     int x, y, k;
     /* a camera whose pixel spans 0.1 at distance 1: steps 1, 2, 4 for sigma 0.4 */
     evr_camera_intr cam = evr_camera_intr_make(W, H, 2.0f * atanf(0.05f * (float)H));
     const evr_v3 org = evr_v3_make(0.0f, 0.0f, 1.0f);
+    evr_gather_params gp;
+    memset(&gp, 0, sizeof gp);
+    gp.radius = 0.1f;
+    gp.normal_cos = 0.7f;
     memset(&b, 0, sizeof b);
     b.width = W;
     b.height = H;
+    b.layers = L;
+    b.slots = slots;
+    b.count = count;
     b.gbuf = gbuf;
     b.view_inst = inst;
     b.blur = e;
     for (y = 0; y < H; y++)
         for (x = 0; x < W; x++) {
             const int i = y * W + x, turned = x == 3;
+            const float irr = turned ? 10.0f : x < W / 2 ? ((x + y) % 2 ? 0.5f : 1.5f) : 3.0f;
             float *g = gbuf + 8 * i;
+            g[0] =
+                0.1f * (float)x; /* every cell at distance 1: positions enter through differences */
+            g[1] = 0.1f * (float)y;
             g[3] = turned ? 1.0f : 0.0f;
             g[5] = turned ? 0.0f : 1.0f;
-            g[6] = 0.01f;
+            g[6] = x >= W / 2 && x % 2 ? 0.03f : 0.01f;
             inst[i] = x < W / 2 ? 0 : 1;
             inst_none[i] = -1;
-            for (k = 0; k < 3; k++)
-                e[3 * i + k] = turned ? 10.0f : x < W / 2 ? ((x + y) % 2 ? 0.5f : 1.5f) : 3.0f;
-        }
-    /* every cell at distance 1 (its position only enters the weights through differences) */
-    for (y = 0; y < H; y++)
-        for (x = 0; x < W; x++) {
-            float *g = gbuf + 8 * (y * W + x);
-            g[0] = 0.1f * (float)x;
-            g[1] = 0.1f * (float)y;
+            count[i] = L;
+            for (int l = 0; l < L; l++) {
+                evr_photon *ph = &slots[l * W * H + i];
+                memset(ph, 0, sizeof *ph);
+                for (int c = 0; c < 3; c++) {
+                    ph->p[c] =
+                        g[c] + (l == 1 ? 0.5f * g[3 + c] : 0.0f); /* layer 1: off the plane */
+                    ph->n[c] = l == 2 ? -g[3 + c] : g[3 + c];     /* layer 2: facing away */
+                    ph->flux[c] = irr * g[6];
+                }
+            }
         }
     const float pix = evr_camera_pixel_size(&cam, 1.0f);
     CHECK_NEAR(pix, 0.1f, 1e-4);
     CHECK(evr_blur_steps(0.4f, 0.1f) == 3); /* steps 1, 2, 4: taps up to 8 cells out, 2 sigma */
     CHECK(evr_blur_steps(0.05f, 0.1f) == 1 && evr_blur_steps(1e6f, 0.1f) == EVR_BLUR_MAX_STEPS);
-    for (k = 0; k < 3; k++) {
-        const float *src = k % 2 ? tmp : e;
-        float *dst = k % 2 ? e : tmp;
-        for (y = 0; y < H; y++)
-            for (x = 0; x < W; x++) evr_blur_cell(&b, &cam, org, 0.4f, src, dst, x, y, k);
+    for (int i = 0; i < W * H; i++) {
+        evr_blur_cell_splat(&b, &gp, (size_t)i, work[0] + EVR_BLUR_CH * i);
+        CHECK(work[0][EVR_BLUR_CH * i + 3] == gbuf[8 * i + 6]);
+        CHECK(work[0][EVR_BLUR_CH * i] == slots[i].flux[0]); /* the first photon alone */
     }
-    memcpy(e, tmp, sizeof e);
+    for (k = 0; k < 3; k++)
+        for (y = 0; y < H; y++)
+            for (x = 0; x < W; x++)
+                evr_blur_cell(&b, &cam, org, 0.4f, work[k % 2], work[(k + 1) % 2], x, y, k);
+    for (int i = 0; i < W * H; i++) evr_blur_cell_finish(&b, work[1], (size_t)i);
     for (y = 0; y < H; y++)
         for (x = 0; x < W; x++) {
             const float v = e[3 * (y * W + x)];

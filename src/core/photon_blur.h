@@ -1,14 +1,15 @@
 /* The blurred estimate (--gi-blur): once per photon pass, the irradiance at every buffer cell's
- * view (what the camera sees through its centre), blurred over that surface alone (the same
- * instance, a like normal, a Gaussian of the distance); a sample takes the estimate of its
+ * view (what the camera sees through its centre): the flux of the photons on the cell's footprint
+ * and the footprint's area, each blurred over that surface alone (the same instance, a like
+ * normal, a Gaussian of the distance), their ratio; a sample takes the estimate of its
  * pixel's cell, blended in time between the passes around it (evr_gi_lerp).
  *
  * A gather at each sample counts the few photons of a small disk, and as soon as anything moves
  * some of those photons are drawn anew every pass: the estimate flickers, and the flicker makes
  * events no camera would see, on the moving object and on every still surface its photons reach.
  * Irradiance varies slowly over a surface, so a wide blur on that surface removes the flicker
- * without the cost of a wide gather at every sample: one gather per cell and pass serves every
- * sample of the segments the pass bounds. */
+ * without the cost of a wide gather at every sample: one pass over the cells serves every sample
+ * of the segments the pass bounds. */
 #ifndef EVR_CORE_PHOTON_BLUR_H
 #define EVR_CORE_PHOTON_BLUR_H
 
@@ -19,19 +20,37 @@
 /* the blur's a-trous steps at most (steps 1, 2, ..., 128 cells) */
 #define EVR_BLUR_MAX_STEPS 8
 
-/* The estimate at buffer cell (cx, cy)'s view (b->gbuf): every photon of the gather's disk,
- * irradiance RGB into e. */
-EVR_HD static inline void evr_blur_cell_gather(const evr_photon_buffer *b,
-                                               const evr_camera_intr *cam, evr_v3 cam_org,
-                                               const evr_gather_params *gp, int cx, int cy,
-                                               float e[3])
+/* A cell's working values while it is blurred: the flux of its photons (RGB) and the area of
+ * surface its view covers; the estimate is their ratio (evr_blur_cell_finish), so a blurred
+ * cell is every tap's flux over every tap's area: a density over the surface, whatever the
+ * cells' footprints. */
+#define EVR_BLUR_CH 4
+
+/* Buffer cell i's flux and area (w, EVR_BLUR_CH floats) from the view b->gbuf: the photons it
+ * holds that lie on the surface the view sees (a like normal, off its plane by at most twice the
+ * footprint's width and at most the gather radius). A photon is stored in the cell the camera
+ * sees it through, so the cell's photons are those on its footprint; the blur then spreads them
+ * over the surface as a gather's disk would, at one cell's cost. */
+EVR_HD static inline void evr_blur_cell_splat(const evr_photon_buffer *b,
+                                              const evr_gather_params *gp, size_t i, float w[4])
 {
-    const float *g = b->gbuf + 8 * ((size_t)cy * (size_t)b->width + (size_t)cx);
-    const evr_v3 p = evr_v3_make(g[0], g[1], g[2]), n = evr_v3_make(g[3], g[4], g[5]);
-    evr_gather_params q = *gp;
-    q.max_photons = 0x7fffffff;
-    evr_photon_gather(b, cam, cx - b->margin, cy - b->margin, p, n,
-                      evr_v3_len(evr_v3_sub(p, cam_org)), &q, e);
+    const size_t npix = (size_t)b->width * (size_t)b->height;
+    const float *g = b->gbuf + 8 * i;
+    const float tol = fminf(gp->radius, 2.0f * sqrtf(g[6]));
+    const int nl = b->count[i] < (uint32_t)b->layers ? (int)b->count[i] : b->layers;
+    w[0] = w[1] = w[2] = 0.0f;
+    w[3] = g[6];
+    for (int l = 0; l < nl; l++) {
+        const evr_photon *ph = &b->slots[(size_t)l * npix + i];
+        const float off =
+            (ph->p[0] - g[0]) * g[3] + (ph->p[1] - g[1]) * g[4] + (ph->p[2] - g[2]) * g[5];
+        if (!(fabsf(off) <= tol) ||
+            ph->n[0] * g[3] + ph->n[1] * g[4] + ph->n[2] * g[5] < gp->normal_cos)
+            continue;
+        w[0] += ph->flux[0];
+        w[1] += ph->flux[1];
+        w[2] += ph->flux[2];
+    }
 }
 
 /* The a-trous steps a blur of sigma (world units) takes where a cell spans pix: steps 1, 2, 4,
@@ -44,8 +63,8 @@ EVR_HD static inline int evr_blur_steps(float sigma, float pix)
 }
 
 /* Step k (0, 1, ...) of the blur at cell (cx, cy) that sees a surface (b->view_inst >= 0), from
- * src into dst: an a-trous B3 spline of 5 x 5 taps 2^k cells apart over src's estimates of the
- * taps on the same instance with a like normal, each weighted by a Gaussian of its distance
+ * src into dst (EVR_BLUR_CH floats a cell): an a-trous B3 spline of 5 x 5 taps 2^k cells apart
+ * over src's values of the taps on the same instance with a like normal, each weighted by a Gaussian of its distance
  * (sigma); a cell whose own steps (evr_blur_steps at its distance from the camera at cam_org)
  * are done keeps its value. */
 EVR_HD static inline void evr_blur_cell(const evr_photon_buffer *b, const evr_camera_intr *cam,
@@ -58,12 +77,12 @@ EVR_HD static inline void evr_blur_cell(const evr_photon_buffer *b, const evr_ca
     const float *gi = b->gbuf + 8 * i;
     const float dist = evr_v3_len(evr_v3_sub(evr_v3_make(gi[0], gi[1], gi[2]), cam_org));
     if (k >= evr_blur_steps(sigma, evr_camera_pixel_size(cam, dist))) {
-        for (int c = 0; c < 3; c++) dst[3 * i + c] = src[3 * i + c];
+        for (int c = 0; c < EVR_BLUR_CH; c++) dst[EVR_BLUR_CH * i + c] = src[EVR_BLUR_CH * i + c];
         return;
     }
     const int step = 1 << k;
     const float inv2s2 = 0.5f / (sigma * sigma);
-    float acc[3] = {0.0f, 0.0f, 0.0f}, wsum = 0.0f;
+    float acc[EVR_BLUR_CH] = {0.0f, 0.0f, 0.0f, 0.0f}, wsum = 0.0f;
     for (int dy = -2; dy <= 2; dy++) {
         const int y = cy + dy * step;
         if (y < 0 || y >= b->height) continue;
@@ -77,13 +96,20 @@ EVR_HD static inline void evr_blur_cell(const evr_photon_buffer *b, const evr_ca
                 continue;
             const float ex = gj[0] - gi[0], ey = gj[1] - gi[1], ez = gj[2] - gi[2];
             const float w = h[dy + 2] * h[dx + 2] * expf(-(ex * ex + ey * ey + ez * ez) * inv2s2);
-            acc[0] += w * src[3 * j];
-            acc[1] += w * src[3 * j + 1];
-            acc[2] += w * src[3 * j + 2];
+            for (int c = 0; c < EVR_BLUR_CH; c++) acc[c] += w * src[EVR_BLUR_CH * j + c];
             wsum += w;
         }
     }
-    for (int c = 0; c < 3; c++) dst[3 * i + c] = acc[c] / wsum; /* the centre itself counts */
+    for (int c = 0; c < EVR_BLUR_CH; c++)
+        dst[EVR_BLUR_CH * i + c] = acc[c] / wsum; /* the centre itself counts */
+}
+
+/* Cell i's blurred estimate (b->blur, RGB irradiance) from its blurred flux and area (src). */
+EVR_HD static inline void evr_blur_cell_finish(const evr_photon_buffer *b, const float *src,
+                                               size_t i)
+{
+    const float *w = src + EVR_BLUR_CH * i;
+    for (int c = 0; c < 3; c++) b->blur[3 * i + c] = w[3] > 0.0f ? w[c] / w[3] : 0.0f;
 }
 
 #define EVR_BLUR_NONE 0 /* no cell around sees a surface */

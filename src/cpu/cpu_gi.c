@@ -114,7 +114,7 @@ evr_status evr_cpu_gi_init(evr_cpu_gi *g, const evr_cpu_trace_ctx *tc, const evr
         const size_t cells = (size_t)g->end.width * (size_t)g->end.height;
         evr_photon_buffer *bufs[2] = {&g->end, &g->start};
         g->blur_sigma = setup->gi_blur * g->gp.radius;
-        g->blur_tmp = malloc(3 * cells * sizeof(float));
+        g->blur_tmp = malloc(2 * EVR_BLUR_CH * cells * sizeof(float));
         for (int k = 0; k < 2; k++) {
             bufs[k]->view_inst = malloc(cells * sizeof(int));
             bufs[k]->blur = calloc(3 * cells, sizeof(float));
@@ -135,9 +135,9 @@ typedef struct {
     const evr_render_scene *rs;
     const evr_photon_buffer *b;
     evr_v3 cam_org;
-    const float *src; /* a step of the blur: from */
-    float *dst;       /* a step of the blur: to; NULL: the cells' gathers into b->blur */
-    int k;
+    const float *src; /* a step of the blur, or the finish: from */
+    float *dst;       /* a step of the blur: to; NULL: the finish, into b->blur */
+    int k;            /* the step; -1: the cells' flux and area into dst */
     atomic_int next;
 } blur_ctx;
 
@@ -150,12 +150,11 @@ static void *blur_worker(void *arg)
         for (int x = 0; x < b->width; x++) {
             const size_t i = (size_t)y * (size_t)b->width + (size_t)x;
             if (b->view_inst[i] < 0) continue;
-            if (c->dst)
+            if (!c->dst) evr_blur_cell_finish(b, c->src, i);
+            else if (c->k < 0) evr_blur_cell_splat(b, &c->g->gp, i, c->dst + EVR_BLUR_CH * i);
+            else
                 evr_blur_cell(b, &c->rs->camera, c->cam_org, c->g->blur_sigma, c->src, c->dst, x, y,
                               c->k);
-            else
-                evr_blur_cell_gather(b, &c->rs->camera, c->cam_org, &c->g->gp, x, y,
-                                     b->blur + 3 * i);
         }
     return NULL;
 }
@@ -168,13 +167,14 @@ static evr_status blur_run(blur_ctx *c, int threads, evr_error *err)
     return EVR_ERR_NOMEM;
 }
 
-/* After a pass at time f into b: the cells' gathers, then the blur's steps, into b->blur (as
- * many steps as the nearest cell asks for: a cell past its own keeps its value). */
+/* After a pass at time f into b: the cells' flux and area, the blur's steps (as many as the
+ * nearest cell asks for: a cell past its own keeps its values), their ratio into b->blur. */
 static evr_status blur_build(evr_cpu_gi *g, const evr_render_scene *rs, float f,
                              evr_photon_buffer *b, int threads, evr_error *err)
 {
     const size_t cells = (size_t)b->width * (size_t)b->height;
     const evr_m34 pose = evr_rs_camera_pose(rs, f);
+    float *work[2] = {g->blur_tmp, g->blur_tmp + EVR_BLUR_CH * cells};
     evr_status st;
     blur_ctx c;
     int steps = 0;
@@ -190,15 +190,15 @@ static evr_status blur_build(evr_cpu_gi *g, const evr_render_scene *rs, float f,
         const int n = evr_blur_steps(g->blur_sigma, evr_camera_pixel_size(&rs->camera, d));
         if (n > steps) steps = n;
     }
-    if ((st = blur_run(&c, threads, err)) != EVR_OK) return st;
-    for (int k = 0; k < steps; k++) {
+    for (int k = -1; k < steps; k++) {
         c.k = k;
-        c.src = k % 2 ? g->blur_tmp : b->blur;
-        c.dst = k % 2 ? b->blur : g->blur_tmp;
+        c.src = work[(k + 2) % 2];
+        c.dst = work[(k + 1) % 2];
         if ((st = blur_run(&c, threads, err)) != EVR_OK) return st;
     }
-    if (steps % 2) memcpy(b->blur, g->blur_tmp, 3 * cells * sizeof(float));
-    return EVR_OK;
+    c.src = work[steps % 2];
+    c.dst = NULL;
+    return blur_run(&c, threads, err);
 }
 
 /* One photon pass at normalized segment time f into buffer out: the photons are a sample in time

@@ -53,7 +53,7 @@ typedef struct {
     /* --gi-blur (core/photon_blur.h): sigma in world units (0: off, a gather at every sample);
      * the buffers then hold their cells' instances and blurred estimates, sat counts the cells
      * whose lookups differ, end against start, and a pixel's window is its cell and the eight
-     * around it; blur_tmp: the blur's other half */
+     * around it; blur_tmp: the blur's two working arrays of flux and area (EVR_BLUR_CH a cell) */
     float blur_sigma;
     float *blur_tmp;
 } evr_cpu_gi;

@@ -176,8 +176,9 @@ __global__ void __launch_bounds__(BLOCK)
     if (buf.view_inst) buf.view_inst[cell] = seen;
 }
 
-/* --gi-blur (core/photon_blur.h), one thread per cell that sees a surface: its gather into
- * buf.blur (dst NULL), or step k of the blur from src into dst. */
+/* --gi-blur (core/photon_blur.h), one thread per cell that sees a surface: its flux and area into
+ * dst (k -1), step k of the blur from src into dst, or the ratio from src into buf.blur (dst
+ * NULL). */
 __global__ void __launch_bounds__(BLOCK)
     photon_blur_kernel(kernel_args a, evr_photon_buffer buf, evr_v3 org, float sigma,
                        evr_gather_params gp, const float *src, float *dst, int k)
@@ -185,8 +186,9 @@ __global__ void __launch_bounds__(BLOCK)
     const int cell = blockIdx.x * blockDim.x + threadIdx.x;
     if (cell >= buf.width * buf.height || buf.view_inst[cell] < 0) return;
     const int x = cell % buf.width, y = cell / buf.width;
-    if (dst) evr_blur_cell(&buf, &a.rs.camera, org, sigma, src, dst, x, y, k);
-    else evr_blur_cell_gather(&buf, &a.rs.camera, org, &gp, x, y, buf.blur + 3 * (size_t)cell);
+    if (!dst) evr_blur_cell_finish(&buf, src, (size_t)cell);
+    else if (k < 0) evr_blur_cell_splat(&buf, &gp, (size_t)cell, dst + EVR_BLUR_CH * (size_t)cell);
+    else evr_blur_cell(&buf, &a.rs.camera, org, sigma, src, dst, x, y, k);
 }
 
 /* Changed cells into the summed-area table's interior (row 0 and column 0 stay zero): 1 where
@@ -433,11 +435,12 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
         const float sg = b->blur_sigma;
         const evr_m34 pose = evr_rs_camera_pose(hrs, f); /* the camera at the pass, on the host */
         const evr_v3 org = evr_m34_point(&pose, evr_v3_make(0.0f, 0.0f, 0.0f));
-        photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp, nullptr, nullptr, 0);
-        for (int k = 0; k < EVR_BLUR_MAX_STEPS; k++)
-            photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp,
-                                                        k % 2 ? b->d_blur_tmp.p : out->blur,
-                                                        k % 2 ? out->blur : b->d_blur_tmp.p, k);
+        float *work[2] = {b->d_blur_tmp.p, b->d_blur_tmp.p + EVR_BLUR_CH * cells};
+        for (int k = -1; k < EVR_BLUR_MAX_STEPS; k++)
+            photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp, work[(k + 2) % 2],
+                                                        work[(k + 1) % 2], k);
+        photon_blur_kernel<<<cgrid, BLOCK, 0, rs>>>(a, *out, org, sg, b->gp,
+                                                    work[EVR_BLUR_MAX_STEPS % 2], nullptr, 0);
         CK(cudaGetLastError());
     }
     sl->gi_passes++;
@@ -543,7 +546,7 @@ evr_status gi_ring_alloc(cuda_backend *b, int margin, evr_error *err)
     const size_t cells = (size_t)b->gi_ring[0].ph.width * (size_t)b->gi_ring[0].ph.height;
     CK(b->d_gi_last.reserve(cells));
     CK(cudaMemset(b->d_gi_last.p, 0, cells));
-    if (b->blur_sigma > 0.0f) CK(b->d_blur_tmp.reserve(cells * 3));
+    if (b->blur_sigma > 0.0f) CK(b->d_blur_tmp.reserve(cells * 2 * EVR_BLUR_CH));
     return EVR_OK;
 }
 

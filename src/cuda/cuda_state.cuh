@@ -180,7 +180,7 @@ struct cuda_backend {
     gi_buffer gi_ring[NRING]; /* segment i ends in gi_ring[i % NRING], starts in the one before */
     dbuf<uint8_t> d_gi_last;  /* per cell: changed over the last segment */
     float blur_sigma;         /* --gi-blur: its sigma in world units (0: off) */
-    dbuf<float> d_blur_tmp;   /* the blur's other half */
+    dbuf<float> d_blur_tmp;   /* the blur's two working arrays (EVR_BLUR_CH a cell) */
     dbuf<gi_end>
         d_gi_ends[NRING]; /* deferred gathers: each pixel's last gather, a ring as d_state */
     uint32_t photons;
