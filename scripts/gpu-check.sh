@@ -45,6 +45,8 @@ compute-sanitizer --tool memcheck --error-exitcode 3 "$E" demo --scene cornell -
     --res 96x72 --duration 0.3 -o "$OUT/cs-blur" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "memcheck blur exit $?" >> "$OUT/sanitizer.log"
 compute-sanitizer --tool racecheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --gi-blur 4 --backend cuda \
     --res 64x48 --duration 0.2 -o "$OUT/cs-blur2" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "racecheck blur exit $?" >> "$OUT/sanitizer.log"
+compute-sanitizer --tool initcheck --error-exitcode 3 "$E" demo --scene cornell --gi photon --backend cuda \
+    --res 64x48 --duration 0.2 -o "$OUT/cs-blur3" --no-preview -q >> "$OUT/sanitizer.log" 2>&1; echo "initcheck gi exit $?" >> "$OUT/sanitizer.log"
 # every material feature (normal maps, glass, MASK/BLEND, a sphere light's glint), a camera path
 # and label frames (the label kernel) under memcheck
 python3 tests/all_materials.py /tmp/evray-am > /dev/null

@@ -402,6 +402,8 @@ static evr_status gi_pass(cuda_backend *b, slot *sl, const evr_render_scene *hrs
         p.pending_count = b->d_pcount.p;
         trail_args(b, n, &p);
         CK(cudaMemsetAsync(b->d_pkeys.p, 0xff, (size_t)n * sizeof(unsigned long long), rs));
+        /* the sort moves every value, the unused ones' too (after every used key) */
+        CK(cudaMemsetAsync(b->d_pvals.p, 0xff, (size_t)n * sizeof(unsigned), rs));
         const unsigned pgrid = (n + BLOCK - 1) / BLOCK;
         if (p.reuse) {
             CK(cudaMemsetAsync(p.todo_count, 0, sizeof(unsigned), rs));

@@ -282,7 +282,8 @@ __global__ void __launch_bounds__(BLOCK, MIN_BLOCKS) gi_pixel_kernel(kernel_args
                 e.g = d.requests[r].g;
                 e.le = d.lum[r].y;
                 e.direct = direct;
-                e.s = d.requests[r].s;
+                /* the sums only where the gather kernels made them (gi_gather_known_kernel) */
+                if (a.gi->gp.max_photons <= 0 && !a.gi->end.blur) e.s = d.requests[r].s;
             }
             a.gi->ends_out[pix] = e;
         }
