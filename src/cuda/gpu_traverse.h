@@ -101,8 +101,6 @@ extern evr_traverse_stats evr_tstats;
 
 /* ---- small helpers ---- */
 
-EVR_HD static inline float evr__minf(float a, float b) { return a < b ? a : b; }
-EVR_HD static inline float evr__maxf(float a, float b) { return a > b ? a : b; }
 EVR_HD static inline float evr__sel3(float x, float y, float z, int k)
 {
     return k == 0 ? x : (k == 1 ? y : z);
@@ -223,9 +221,12 @@ EVR_HD static inline int evr__slab(const evr__tray *r, float nx, float ny, float
 {
     const float tnx = (nx - r->ox) * r->ix, tny = (ny - r->oy) * r->iy, tnz = (nz - r->oz) * r->iz;
     const float tfx = (fx - r->ox) * r->ix, tfy = (fy - r->oy) * r->iy, tfz = (fz - r->oz) * r->iz;
-    float a = evr__maxf(evr__maxf(tnx, tny), evr__maxf(tnz, tnear));
-    float b = evr__minf(evr__minf(tfx * EVR__BOX_WIDEN, tfy * EVR__BOX_WIDEN),
-                        evr__minf(tfz * EVR__BOX_WIDEN, tfar));
+    /* fminf/fmaxf (one instruction each on the device): no NaN can occur here (finite planes,
+     * origin and reciprocals), where they equal a compare and select but for the sign of a zero;
+     * widened after the minimum: a product's rounding is monotone, so the same value as each
+     * widened before it, in one multiplication */
+    float a = fmaxf(fmaxf(tnx, tny), fmaxf(tnz, tnear));
+    float b = fminf(fminf(fminf(tfx, tfy), tfz) * EVR__BOX_WIDEN, tfar);
     *tn = a;
     return a <= b;
 }
@@ -499,17 +500,24 @@ EVR_HD static inline uint64_t evr__node_word(const uint8_t *bytes)
 #endif
 }
 
-/* Byte i of a word as a float: 2^23 + q exactly, less 2^23 (cheaper than a conversion). */
-EVR_HD static inline float evr__byte_float(uint64_t w, int i)
+/* Byte j (0..3) of a word as a float: 2^23 + q exactly, less 2^23 (cheaper than a conversion);
+ * sel = 0x7440 + j: on the device one byte permutation builds 0x4b0000qq. */
+EVR_HD static inline float evr__byte_float(uint32_t w, uint32_t sel, int j)
 {
-    return evr__u2f(0x4b000000u | (uint32_t)((w >> (8 * i)) & 0xffu)) - 8388608.0f;
+#ifdef __CUDA_ARCH__
+    (void)j;
+    return __uint_as_float(__byte_perm(w, 0x4b000000u, sel)) - 8388608.0f;
+#else
+    (void)sel;
+    return evr__u2f(0x4b000000u | ((w >> (8 * j)) & 0xffu)) - 8388608.0f;
+#endif
 }
 
 /* Hit mask of a CW8 node: bits 24 + (slot ^ oct_inv) for inner children, the item bits of leaf
  * children below 24. Each axis's near and far planes are chosen once for the node (by the sign of
- * the ray's direction) and its eight quantized bytes read as one word; a child's box is then
- * p + q 2^e (one rounding: q 2^e is exact), as the build checked it, and the slab test is
- * evr__box's (evr__slab). */
+ * the ray's direction) and its eight quantized bytes read as one word, taken four slots at a
+ * time as 32-bit halves; a child's box is then p + q 2^e (one rounding: q 2^e is exact), as the
+ * build checked it, and the slab test is evr__box's (evr__slab). */
 EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray *r, float tnear,
                                          float tfar)
 {
@@ -525,21 +533,31 @@ EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray
     const uint64_t ny = r->iy >= 0.0f ? ly : hy, fy = r->iy >= 0.0f ? hy : ly;
     const uint64_t nz = r->iz >= 0.0f ? lz : hz, fz = r->iz >= 0.0f ? hz : lz;
     uint32_t hits = 0;
-    int i;
-    EVR__NODE8_UNROLL
-    for (i = 0; i < 8; i++) {
-        const uint32_t m = (uint32_t)(meta >> (8 * i)) & 0xffu;
-        uint32_t idx;
-        if (!m) continue;
-        float tn;
-        if (!evr__slab(r, px + evr__byte_float(nx, i) * sx, py + evr__byte_float(ny, i) * sy,
-                       pz + evr__byte_float(nz, i) * sz, px + evr__byte_float(fx, i) * sx,
-                       py + evr__byte_float(fy, i) * sy, pz + evr__byte_float(fz, i) * sz, tnear,
-                       tfar, &tn))
-            continue;
-        idx = m & 31u;
-        if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
-        hits |= (m >> 5) << idx;
+    int h, j;
+#ifdef __CUDA_ARCH__
+#pragma unroll 1
+#endif
+    for (h = 0; h < 64; h += 32) {
+        const uint32_t m4 = (uint32_t)(meta >> h), nx4 = (uint32_t)(nx >> h),
+                       ny4 = (uint32_t)(ny >> h), nz4 = (uint32_t)(nz >> h),
+                       fx4 = (uint32_t)(fx >> h), fy4 = (uint32_t)(fy >> h),
+                       fz4 = (uint32_t)(fz >> h);
+        EVR__NODE8_UNROLL
+        for (j = 0; j < 4; j++) {
+            const uint32_t m = (m4 >> (8 * j)) & 0xffu, sel = 0x7440u + (uint32_t)j;
+            uint32_t idx;
+            if (!m) continue;
+            float tn;
+            if (!evr__slab(
+                    r, px + evr__byte_float(nx4, sel, j) * sx,
+                    py + evr__byte_float(ny4, sel, j) * sy, pz + evr__byte_float(nz4, sel, j) * sz,
+                    px + evr__byte_float(fx4, sel, j) * sx, py + evr__byte_float(fy4, sel, j) * sy,
+                    pz + evr__byte_float(fz4, sel, j) * sz, tnear, tfar, &tn))
+                continue;
+            idx = m & 31u;
+            if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
+            hits |= (m >> 5) << idx;
+        }
     }
     return hits;
 }
