@@ -72,8 +72,10 @@ typedef struct {
 #define EVR__PRAGMA_UNROLL(n) EVR__PRAGMA(unroll n)
 #ifdef __CUDA_ARCH__
 #define EVR__NODE8_UNROLL EVR__PRAGMA_UNROLL(EVR_NODE8_UNROLL)
+#define EVR__NO_UNROLL EVR__PRAGMA_UNROLL(1)
 #else
 #define EVR__NODE8_UNROLL
+#define EVR__NO_UNROLL
 #endif
 
 /* The searches are inlined into each caller with what says deforming or not a constant (see the
@@ -501,14 +503,12 @@ EVR_HD static inline uint64_t evr__node_word(const uint8_t *bytes)
 }
 
 /* Byte j (0..3) of a word as a float: 2^23 + q exactly, less 2^23 (cheaper than a conversion);
- * sel = 0x7440 + j: on the device one byte permutation builds 0x4b0000qq. */
-EVR_HD static inline float evr__byte_float(uint32_t w, uint32_t sel, int j)
+ * on the device one byte permutation (selector 0x7440 + j) builds 0x4b0000qq. */
+EVR_HD static inline float evr__byte_float(uint32_t w, int j)
 {
 #ifdef __CUDA_ARCH__
-    (void)j;
-    return __uint_as_float(__byte_perm(w, 0x4b000000u, sel)) - 8388608.0f;
+    return __uint_as_float(__byte_perm(w, 0x4b000000u, 0x7440u + (uint32_t)j)) - 8388608.0f;
 #else
-    (void)sel;
     return evr__u2f(0x4b000000u | ((w >> (8 * j)) & 0xffu)) - 8388608.0f;
 #endif
 }
@@ -534,9 +534,7 @@ EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray
     const uint64_t nz = r->iz >= 0.0f ? lz : hz, fz = r->iz >= 0.0f ? hz : lz;
     uint32_t hits = 0;
     int h, j;
-#ifdef __CUDA_ARCH__
-#pragma unroll 1
-#endif
+    EVR__NO_UNROLL
     for (h = 0; h < 64; h += 32) {
         const uint32_t m4 = (uint32_t)(meta >> h), nx4 = (uint32_t)(nx >> h),
                        ny4 = (uint32_t)(ny >> h), nz4 = (uint32_t)(nz >> h),
@@ -544,15 +542,14 @@ EVR_HD static inline uint32_t evr__node8(const evr_gpu_node8 *n, const evr__tray
                        fz4 = (uint32_t)(fz >> h);
         EVR__NODE8_UNROLL
         for (j = 0; j < 4; j++) {
-            const uint32_t m = (m4 >> (8 * j)) & 0xffu, sel = 0x7440u + (uint32_t)j;
+            const uint32_t m = (m4 >> (8 * j)) & 0xffu;
             uint32_t idx;
             if (!m) continue;
             float tn;
-            if (!evr__slab(
-                    r, px + evr__byte_float(nx4, sel, j) * sx,
-                    py + evr__byte_float(ny4, sel, j) * sy, pz + evr__byte_float(nz4, sel, j) * sz,
-                    px + evr__byte_float(fx4, sel, j) * sx, py + evr__byte_float(fy4, sel, j) * sy,
-                    pz + evr__byte_float(fz4, sel, j) * sz, tnear, tfar, &tn))
+            if (!evr__slab(r, px + evr__byte_float(nx4, j) * sx, py + evr__byte_float(ny4, j) * sy,
+                           pz + evr__byte_float(nz4, j) * sz, px + evr__byte_float(fx4, j) * sx,
+                           py + evr__byte_float(fy4, j) * sy, pz + evr__byte_float(fz4, j) * sz,
+                           tnear, tfar, &tn))
                 continue;
             idx = m & 31u;
             if (idx >= 24u) idx = 24u + ((idx - 24u) ^ (uint32_t)r->oct_inv);
