@@ -132,12 +132,16 @@ static void print_setup(const bench_figures *f)
 {
     const evr_load_times *l = &f->load;
     const evr_stats *s = &f->s;
+    char cached[64] = "";
+    if (s->bvh_trees_cached) /* the GPU BVH cache's trees: loaded, not built */
+        snprintf(cached, sizeof cached, ", %d of %d trees from the cache", s->bvh_trees_cached,
+                 s->bvh_trees);
     printf("set-up %.3f s: load %.3f (glTF checks %.3f, Assimp %.3f, materials and textures %.3f, "
            "meshes %.3f with tangents %.3f, the rest %.3f), before the backend %.3f, backend "
-           "%.3f (BVH %.3f), first plan %.3f\n",
+           "%.3f (BVH %.3f%s), first plan %.3f\n",
            l->total + s->time_setup_host + s->time_setup + s->time_first_plan, l->total,
            l->gltf_checks, l->assimp, l->materials, l->meshes, l->tangents, l->rest,
-           s->time_setup_host, s->time_setup, s->time_setup_bvh, s->time_first_plan);
+           s->time_setup_host, s->time_setup, s->time_setup_bvh, cached, s->time_first_plan);
 }
 
 static void print_row(const char *name, const bench_figures *f, int json)
@@ -175,10 +179,10 @@ static void print_row(const char *name, const bench_figures *f, int json)
                "\"load_assimp_seconds\": %.4f, \"load_materials_seconds\": %.4f, "
                "\"load_meshes_seconds\": %.4f, \"load_tangents_seconds\": %.4f, "
                "\"setup_host_seconds\": %.4f, \"setup_bvh_seconds\": %.4f, "
-               "\"first_plan_seconds\": %.4f}\n",
+               "\"bvh_trees\": %d, \"bvh_trees_cached\": %d, \"first_plan_seconds\": %.4f}\n",
                f->load.total, f->load.gltf_checks, f->load.assimp, f->load.materials,
                f->load.meshes, f->load.tangents, s->time_setup_host, s->time_setup_bvh,
-               s->time_first_plan);
+               s->bvh_trees, s->bvh_trees_cached, s->time_first_plan);
     } else {
         char res[32], spf[16];
         /* adaptive sampling has no samples per frame: each pixel picks its own times */

@@ -281,6 +281,9 @@ typedef struct {
     double max_noise_events;
     double time_tol;  /* refined sampling: the timing error its refinement aims at, seconds */
     double refine_px; /* refined sampling: image motion between grid samples, pixels, at most */
+    /* the CUDA backend's trees of big meshes kept across runs (src/cuda/gpu_bvh_cache.h): a
+     * folder, "auto" ($XDG_CACHE_HOME/evray, else $HOME/.cache/evray; the default) or "off" */
+    const char *bvh_cache;
 } evr_config;
 
 enum { EVR_PREVIEW_NONE = 0, EVR_PREVIEW_PNG = 1, EVR_PREVIEW_VIDEO = 2 };
@@ -343,6 +346,8 @@ typedef struct {
     double time_setup_bvh;  /* of time_setup: the ray tracer's acceleration structures built */
     double time_first_plan; /* the run's start to the first segment's plan (motion keys, skip
                                 plan, deformation keys) taken */
+    int bvh_trees;          /* bottom-level trees the backend made at set-up (0: not counted) */
+    int bvh_trees_cached;   /* of them, read from the BVH cache (evr_config.bvh_cache) */
 } evr_stats;
 
 typedef struct evr_sim evr_sim;

@@ -15,6 +15,7 @@ export PATH="$PATH:/usr/local/cuda/bin"
     "$E" --version
 } > "$OUT/env.log" 2>&1
 python3 tests/test_cuda.py "$E" > "$OUT/test_cuda.log" 2>&1; echo "test_cuda exit $?" >> "$OUT/test_cuda.log"
+python3 tests/test_cuda_bvh_cache.py "$E" > "$OUT/test_cuda_bvh_cache.log" 2>&1; echo "test_cuda_bvh_cache exit $?" >> "$OUT/test_cuda_bvh_cache.log"
 python3 tests/test_skip.py "$E" > "$OUT/test_skip.log" 2>&1; echo "test_skip exit $?" >> "$OUT/test_skip.log"
 python3 tests/test_bench.py "$E" > "$OUT/test_bench.log" 2>&1; echo "test_bench exit $?" >> "$OUT/test_bench.log"
 # deforming meshes: analytic edges and the blink scene, on the GPU (--backend auto picks it)

@@ -22,6 +22,7 @@ typedef struct {
     evr_pixel_params pixel;
     int threads;
     int gpu_bvh;                /* GPU node layout (0: default) */
+    const char *bvh_cache;      /* GPU BVH cache folder (cuda/gpu_bvh_cache.h), NULL: none */
     int64_t gpu_event_capacity; /* initial GPU event buffer (0: automatic) */
     /* global illumination (CPU backend): image-space photon mapping, 0 photons: one per pixel */
     int gi;
@@ -116,6 +117,8 @@ struct evr_backend {
     double sort_seconds, copy_seconds;
     uint64_t device_bytes; /* memory held on the device */
     double bvh_seconds;    /* set-up: the acceleration structures' builds (0: not measured) */
+    int bvh_trees, bvh_trees_cached; /* set-up: trees made, and of them read from the BVH cache */
+    char notice[256]; /* something the user should know that did not stop the run ("" none) */
 };
 
 /* Host arrays behind an evr_render_scene (everything but the per-segment keys). */

@@ -40,6 +40,19 @@ static void mark_used(evr_sim *sim, int node)
     if (node >= 0) sim->node_used[node] = 1;
 }
 
+/* The GPU BVH cache's folder for the setting ("auto", "off" or a folder) into buf; NULL: none
+ * (off, or auto without a home to put it in). */
+static const char *bvh_cache_dir(const char *opt, char *buf, size_t n)
+{
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    buf[0] = 0;
+    if (!opt || strcmp(opt, "off") == 0) return NULL;
+    if (strcmp(opt, "auto") != 0) snprintf(buf, n, "%s", opt);
+    else if (xdg && xdg[0] == '/') snprintf(buf, n, "%s/evray", xdg); /* the XDG spec: absolute */
+    else if (home && home[0]) snprintf(buf, n, "%s/.cache/evray", home);
+    return buf[0] ? buf : NULL;
+}
+
 /* The backend the configuration asks for; auto tries CUDA first and says why it did not. */
 static evr_status make_backend(evr_sim *sim, evr_error *err)
 {
@@ -202,6 +215,7 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
     sim->setup.pixel.seed = c->seed;
     sim->setup.threads = c->threads;
     sim->setup.gpu_bvh = c->gpu_bvh;
+    sim->setup.bvh_cache = bvh_cache_dir(c->bvh_cache, sim->bvh_cache, sizeof sim->bvh_cache);
     sim->setup.gpu_event_capacity = c->gpu_event_capacity;
     sim->setup.adaptive = c->sampling == EVR_SAMPLING_ADAPTIVE;
     sim->setup.refine = evr_config_sampling(c) == EVR_SAMPLING_REFINE;
@@ -264,6 +278,8 @@ evr_status evr_sim_new(const evr_scene *s, const evr_config *c, evr_sim **out, e
         evr_sim_release(sim);
         return st;
     }
+    if (sim->backend->notice[0] && !sim->st.notice[0])
+        snprintf(sim->st.notice, sizeof sim->st.notice, "%s", sim->backend->notice);
     sim->config_json = evr_config_to_json(&sim->cfg, sim->duration, sim->fps, s->source,
                                           s->cameras[sim->camera].name, sim->backend->name, 0);
     if (!sim->config_json) {

@@ -48,6 +48,7 @@ struct evr_sim {
     int camera;
     evr_camera_rig rig;     /* the camera as the run renders it (scene/camera_rig.h) */
     char camera_path[4096]; /* the configuration's camera path, kept */
+    char bvh_cache[4096];   /* the GPU BVH cache's folder, resolved ("": none) */
     int num_tracks;         /* motion tracks: the nodes', the world frame, the camera's own */
     FILE *poses;            /* camera_poses.txt being written (run/camera_poses.h), or NULL */
     char *poses_tmp;

@@ -6,7 +6,7 @@ negative lights), files outside the scene's folder (a buffer at ../../etc/passwd
 an absolute path, a link out, /dev/zero) unless --allow-external-files, FIFOs as scene and event
 files, corrupt event files, and options out of bounds (--start 1e308, --duration 1e9,
 --duration 1e6 --fps 1e6, --thres 1e-9, --leak-jitter 1e30, --preview-window 1e300 and 1e-9,
-animations of 1e30 s)."""
+a file or an empty path as --bvh-cache, animations of 1e30 s)."""
 import base64
 import copy
 import json
@@ -254,7 +254,9 @@ for args, want in ((("--start", "1e308"), "start time must be between 0 and 1e6"
                    (("--leak-jitter", "1e30"), "leak jitter must be between 0 and 10"),
                    (("--preview-window", "1e300"), "preview window must be between 0"),
                    (("--preview-window", "1e-9"), "at least 0.001 seconds"),
-                   (("--leak-rate-hz", "1000", "--duration", "100"), "more than --max-noise-events")):
+                   (("--leak-rate-hz", "1000", "--duration", "100"), "more than --max-noise-events"),
+                   (("--bvh-cache", static), "is not a folder"),
+                   (("--bvh-cache", ""), "empty path")):
     refused("render " + " ".join(args), want, "render", static, "-o", out, *args)
 T.check(not os.path.exists(out), "a refused run leaves no run folder")
 for args, want in ((("--time", "1e308"), "--time must be between 0 and 1e6"),

@@ -1005,7 +1005,7 @@ static void test_watertight(int layout, int animated, int n)
     rs.keys = &key;
     rs.track_offset = &off;
     rs.track_count = &cnt;
-    CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+    CHECK_OK(evr_gpu_bvh_build(&sc, layout, NULL, &bvh, &e_));
     CHECK(bvh.num_groups == 1 && bvh.group_node[0] == (animated ? 0 : -1));
     CHECK_OK(evr_gpu_top_build(&bvh, NULL, &rs, &top, &e_));
     evr_gpu_scene_view_host(&bvh, NULL, &top, &view);
@@ -1168,7 +1168,7 @@ static void test_many_instances(int n_inst, int n_rays, totals *tot)
         memset(&top, 0, sizeof top);
         memset(&ty, 0, sizeof ty);
         if (li >= 3) setenv("EVR_STATIC_BAKE_LIMIT", "0", 1); /* past the limit: instance */
-        CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+        CHECK_OK(evr_gpu_bvh_build(&sc, layout, NULL, &bvh, &e_));
         unsetenv("EVR_STATIC_BAKE_LIMIT");
         if (li >= 3) {
             CHECK(bvh.grouped && bvh.static_instanced && bvh.static_group < 0);
@@ -1300,7 +1300,7 @@ static void test_deform_refit(int layout)
     rs.track_count = &cnt;
     memset(&d, 0, sizeof d);
     memset(&top, 0, sizeof top);
-    CHECK_OK(evr_gpu_bvh_build(&sc, layout, &bvh, &e_));
+    CHECK_OK(evr_gpu_bvh_build(&sc, layout, NULL, &bvh, &e_));
     CHECK(bvh.num_deforming == 1 && bvh.num_trees == 0);
     for (seg = 0; seg < 3; seg++) {
         int i;
@@ -1460,7 +1460,7 @@ static void test_scene(const char *name, const evr_scene *s, const scene_expect 
         double tb = now();
         char groups[512];
         memset(&top[li], 0, sizeof top[li]);
-        CHECK_OK(evr_gpu_bvh_build(s, layouts[li], &bvh[li], &err));
+        CHECK_OK(evr_gpu_bvh_build(s, layouts[li], NULL, &bvh[li], &err));
         printf(
             "%s, layout %s: %u nodes of %zu bytes, %u triangle references for %u triangles, stack %d; build %.1f ms\n",
             name, layout_name(layouts[li]), bvh[li].num_nodes,

@@ -223,7 +223,7 @@ static void test_layout(int layout, const char *what)
     host.rs.track_offset = off;
     host.rs.track_count = cnt;
     memset(&top, 0, sizeof top);
-    CHECK_OK(evr_gpu_bvh_build(&f.s, layout, &bvh, &e_));
+    CHECK_OK(evr_gpu_bvh_build(&f.s, layout, NULL, &bvh, &e_));
     CHECK(bvh.filtered == 1);
     CHECK_OK(evr_gpu_top_build(&bvh, NULL, &host.rs, &top, &e_));
     evr_gpu_scene_view_host(&bvh, NULL, &top, &v);

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define F(field) offsetof(evr_config, field)
 #define NO_LIMIT HUGE_VAL
@@ -247,6 +248,17 @@ static evr_status check_formats(const evr_config *c, evr_error *err)
 static evr_status check_frames_out(const evr_config *c, evr_error *err)
 {
     if (c->frames_out && !c->frames_out[0]) FAIL("frames folder is an empty path");
+    return EVR_OK;
+}
+
+static evr_status check_bvh_cache(const evr_config *c, evr_error *err)
+{
+    struct stat sb;
+    if (!c->bvh_cache || strcmp(c->bvh_cache, "auto") == 0 || strcmp(c->bvh_cache, "off") == 0)
+        return EVR_OK;
+    if (!c->bvh_cache[0]) FAIL("--bvh-cache is an empty path");
+    if (stat(c->bvh_cache, &sb) == 0 && !S_ISDIR(sb.st_mode))
+        FAIL("--bvh-cache: '%s' is not a folder", c->bvh_cache);
     return EVR_OK;
 }
 
@@ -586,6 +598,20 @@ static const evr_config_option table[] = {
              "grows and the segment is rendered again whenever it overflows)",
      .json = "gpu_event_capacity",
      .json_rank = 31},
+    {.name = "bvh_cache",
+     .type = EVR_OPT_STRING,
+     .offset = F(bvh_cache),
+     .def_text = "auto",
+     .check = check_bvh_cache,
+     .flag = "--bvh-cache",
+     .label = "--bvh-cache DIR",
+     .help = "CUDA: keep the trees of big meshes (65,536 triangles or more) in\n"
+             "DIR across runs, keyed by their triangles, and load them instead\n"
+             "of building them again; at most 4 GiB, the least recently used\n"
+             "removed first (default auto: $XDG_CACHE_HOME/evray, else\n"
+             "~/.cache/evray; off: none)",
+     .json = "bvh_cache",
+     .json_rank = 66},
     {.name = "no_skip",
      .type = EVR_OPT_FLAG,
      .offset = F(no_skip),

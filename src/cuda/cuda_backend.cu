@@ -34,6 +34,8 @@
 
 extern "C" {
 #include "cuda/cuda_backend.h"
+#include "cuda/gpu_bvh_cache.h"
+#include "host_clock.h"
 #include "prep/gi_params.h"
 }
 
@@ -289,7 +291,15 @@ static evr_status init(cuda_backend *b, evr_error *err)
     CK(cudaGetDeviceProperties(&prop, b->device));
     snprintf(b->device_name, sizeof b->device_name, "%s", prop.name);
     evr_status st;
-    if ((st = evr_gpu_bvh_build(b->scene, b->setup.gpu_bvh, &b->bvh, err)) != EVR_OK) return st;
+    evr_gpu_bvh_cache cache;
+    evr_gpu_bvh_cache_init(&cache, b->setup.bvh_cache);
+    const double t_bvh = evr_host_seconds();
+    st = evr_gpu_bvh_build(b->scene, b->setup.gpu_bvh, &cache, &b->bvh, err);
+    b->base.bvh_seconds = evr_host_seconds() - t_bvh;
+    b->base.bvh_trees = b->bvh.num_trees;
+    b->base.bvh_trees_cached = cache.loaded;
+    snprintf(b->base.notice, sizeof b->base.notice, "%s", cache.note);
+    if (st != EVR_OK) return st;
     if ((st = upload_scene(b, err)) != EVR_OK) return st;
     size_t npix = (size_t)b->setup.width * b->setup.height;
     for (int i = 0; i < NRING; i++) CK(b->d_state[i].reserve(npix));

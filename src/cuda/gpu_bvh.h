@@ -255,8 +255,12 @@ typedef struct {
 /* Groups the instances of s (evr_instance_groups_build) and builds the bottom level of every
  * group with the given layout (0: EVR_GPU_LAYOUT_DEFAULT; EVR_GPU_BVH_UNGROUPED or'ed in: no
  * grouping). Reads the meshes, the instances and the nodes (parent, animated, transforms at
- * anim_start). On failure *out is left empty (safe to free). */
-evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err);
+ * anim_start). cache (NULL: none): trees kept across runs (gpu_bvh_cache.h), loaded where it
+ * has them, written where it has not; its counts and note say what happened. On failure *out
+ * is left empty (safe to free). */
+struct evr_gpu_bvh_cache; /* gpu_bvh_cache.h */
+evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, struct evr_gpu_bvh_cache *cache,
+                             evr_gpu_bvh *out, evr_error *err);
 void evr_gpu_bvh_free(evr_gpu_bvh *b);
 
 /* Makes the deforming groups' trees for the segment whose vertex keys rs->deforms holds (host

@@ -2,6 +2,7 @@
  * (gpu_bvh_tree.c builds and flattens each; the deforming groups' per segment, gpu_bvh_deform.c)
  * and the top level over the groups. */
 #include "cuda/gpu_bvh_internal.h"
+#include "cuda/gpu_bvh_cache.h"
 #include "backend.h"
 #include "prep/instance_groups.h"
 #include "prep/swept_bounds.h"
@@ -184,7 +185,8 @@ static size_t gather_group(const evr_scene *s, const evr_gpu_bvh *b, int g, int3
     return n;
 }
 
-evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, evr_error *err)
+evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh_cache *cache,
+                             evr_gpu_bvh *out, evr_error *err)
 {
     flat_ctx c;
     group_tris gt;
@@ -305,11 +307,23 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
         split.tri = gt.tri;
         /* spatial splits (HIGH) for trees up to evr_tree_high_quality's size, as on the CPU */
         const int high = evr_tree_high_quality(cnt);
-        st = evr_gpu_tree_build(dev, &c, gt.prims, cnt, high ? 2 * cnt : cnt,
-                                high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM,
-                                layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4, high ? &split : NULL, box,
-                                &root, err);
-        if (st != EVR_OK) break;
+        const unsigned max_leaf = layout == EVR_GPU_LAYOUT_CW8 ? 3 : 4;
+        const int keep = cache && cache->dir && cnt >= cache->min_tris;
+        const uint32_t first_item = c.num_items;
+        int loaded = 0;
+        uint8_t key[16];
+        if (keep) {
+            evr_gpu_cache_key(&c, cnt, high, max_leaf, key);
+            loaded = evr_gpu_cache_load(cache, key, &c);
+        }
+        if (loaded) {
+            root = first;
+        } else {
+            st = evr_gpu_tree_build(dev, &c, gt.prims, cnt, high ? 2 * cnt : cnt,
+                                    high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM,
+                                    max_leaf, high ? &split : NULL, box, &root, err);
+            if (st != EVR_OK) break;
+        }
         out->num_trees++;
         need = evr_gpu_tree_stack_need(&c, first, c.num_nodes);
         if (need < 0) {
@@ -321,6 +335,7 @@ evr_status evr_gpu_bvh_build(const evr_scene *s, int layout, evr_gpu_bvh *out, e
                       group_name(s, out, g));
             break;
         }
+        if (keep && !loaded) evr_gpu_cache_store(cache, key, &c, first, first_item);
         out->group_root[g] = (int32_t)root;
         out->group_stack[g] = need;
         if (need > out->max_stack) out->max_stack = need;

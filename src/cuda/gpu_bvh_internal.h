@@ -82,6 +82,20 @@ evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimiti
                               size_t cap, enum RTCBuildQuality quality, unsigned max_leaf,
                               split_source *split, const float root_box[6], uint32_t *root_index,
                               evr_error *err);
+/* Room for `nodes` more nodes and `items` more triangles in c's arrays (its counts unchanged);
+ * 0: out of memory. */
+int evr_gpu_tree_reserve(flat_ctx *c, uint32_t nodes, uint32_t items);
+/* gpu_bvh_cache.c. The key of a group's tree: its build's inputs in c (tri9, tri_prim, tri_inst,
+ * tri_filter of n triangles, the layout) and settings (spatial splits or not, the largest leaf). */
+void evr_gpu_cache_key(const flat_ctx *c, size_t n, int high, unsigned max_leaf, uint8_t key[16]);
+/* Appends the tree stored under key to c's nodes and triangles, its root the first node
+ * appended: 1 when loaded; 0 when there is none, or it fails its checks (a note; c's counts
+ * unchanged). */
+int evr_gpu_cache_load(struct evr_gpu_bvh_cache *cache, const uint8_t key[16], flat_ctx *c);
+/* Stores the tree in c's nodes [first_node, end) (its root first) and triangles [first_item,
+ * end) under key; a failure leaves a note. */
+void evr_gpu_cache_store(struct evr_gpu_bvh_cache *cache, const uint8_t key[16], const flat_ctx *c,
+                         uint32_t first_node, uint32_t first_item);
 /* Worst-case stack entries of the traversal of the tree in nodes [first, end) rooted at first
  * (children always come after their parent); -1 when out of memory. */
 int evr_gpu_tree_stack_need(const flat_ctx *c, uint32_t first, uint32_t end);

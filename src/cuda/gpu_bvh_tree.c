@@ -189,6 +189,17 @@ static int alloc_nodes(flat_ctx *c, uint32_t n, uint32_t *first)
     return 1;
 }
 
+int evr_gpu_tree_reserve(flat_ctx *c, uint32_t nodes, uint32_t items)
+{
+    uint32_t first, cap = c->cap_items;
+    if (!alloc_nodes(c, nodes, &first)) return 0;
+    c->num_nodes = first; /* room only */
+    if (items > UINT32_MAX - c->num_items) return 0;
+    if (!grow((void **)&c->tris, &cap, c->num_items + items, sizeof *c->tris)) return 0;
+    c->cap_items = cap;
+    return 1;
+}
+
 static int push_work(flat_ctx *c, const void *ptr, uint32_t index)
 {
     if (c->num_work == c->cap_work) {

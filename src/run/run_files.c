@@ -418,6 +418,10 @@ static char *run_json(const evr_sim *sim)
     evr_json_number(&j, sim->time_setup);
     evr_json_key(&j, "time_setup_bvh_seconds");
     evr_json_number(&j, sim->backend->bvh_seconds);
+    evr_json_key(&j, "bvh_trees"); /* made at set-up, and of them read from the BVH cache */
+    evr_json_number(&j, sim->backend->bvh_trees);
+    evr_json_key(&j, "bvh_trees_cached");
+    evr_json_number(&j, sim->backend->bvh_trees_cached);
     evr_json_key(&j, "time_first_plan_seconds");
     evr_json_number(&j, sim->time_first_plan);
     evr_json_key(&j, "time_render_seconds");
@@ -484,6 +488,8 @@ static void backend_times(evr_sim *sim)
     sim->st.time_setup = sim->time_setup;
     sim->st.time_setup_host = sim->time_setup_host;
     sim->st.time_setup_bvh = sim->backend->bvh_seconds;
+    sim->st.bvh_trees = sim->backend->bvh_trees;
+    sim->st.bvh_trees_cached = sim->backend->bvh_trees_cached;
     sim->st.time_first_plan = sim->time_first_plan;
     sim->st.time_render = sim->time_render;
     sim->st.time_device = sim->backend->device_seconds;
