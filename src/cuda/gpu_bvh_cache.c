@@ -111,23 +111,6 @@ static int tree_valid(int layout, const void *nodes, uint32_t nn, uint32_t ni)
     return 1;
 }
 
-/* Moves the child and item indices of nodes [0, nn) by dn and di (relocating a tree). */
-static void relocate(int layout, void *nodes, uint32_t nn, int64_t dn, int64_t di)
-{
-    for (uint32_t i = 0; i < nn; i++) {
-        if (layout == EVR_GPU_LAYOUT_CW8) {
-            evr_gpu_node8 *nd = (evr_gpu_node8 *)nodes + i;
-            nd->child_base = (uint32_t)(nd->child_base + dn);
-            nd->item_base = (uint32_t)(nd->item_base + di);
-        } else {
-            evr_gpu_node4 *nd = (evr_gpu_node4 *)nodes + i;
-            for (int j = 0; j < 4; j++)
-                if (nd->child[j] >= 0)
-                    nd->child[j] = (int32_t)(nd->child[j] + (nd->count[j] ? di : dn));
-        }
-    }
-}
-
 int evr_gpu_cache_load(evr_gpu_bvh_cache *cache, const uint8_t key[16], flat_ctx *c)
 {
     char path[4096];
@@ -184,7 +167,7 @@ int evr_gpu_cache_load(evr_gpu_bvh_cache *cache, const uint8_t key[16], flat_ctx
         note(cache, "built again, the file was damaged:", path, bad);
         return 0;
     }
-    relocate(c->layout, nodes, h.num_nodes, c->num_nodes, c->num_items);
+    evr_gpu_tree_relocate(c->layout, nodes, h.num_nodes, c->num_nodes, c->num_items);
     c->num_nodes += h.num_nodes;
     c->num_items += h.num_items;
     utimensat(AT_FDCWD, path, NULL, 0); /* recently used: the last to be removed */
@@ -262,7 +245,7 @@ void evr_gpu_cache_store(evr_gpu_bvh_cache *cache, const uint8_t key[16], const 
            c->layout == EVR_GPU_LAYOUT_CW8 ? (const void *)(c->n8 + first_node)
                                            : (const void *)(c->n4 + first_node),
            node_bytes * nn);
-    relocate(c->layout, nodes, nn, -(int64_t)first_node, -(int64_t)first_item);
+    evr_gpu_tree_relocate(c->layout, nodes, nn, -(int64_t)first_node, -(int64_t)first_item);
     memset(&h, 0, sizeof h);
     memcpy(h.magic, MAGIC, 8);
     h.format = FORMAT;

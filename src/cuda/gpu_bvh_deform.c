@@ -256,8 +256,8 @@ static int grow_to(void **p, uint32_t *cap, uint32_t need, size_t elem)
  * and triangles start there. 0: out of memory or too many. */
 static int pack(evr_gpu_deform *d)
 {
-    uint32_t nn = 0, nt = 0, i;
-    int k, j;
+    uint32_t nn = 0, nt = 0;
+    int k;
     for (k = 0; k < d->num; k++) {
         const evr_gpu_dtree *t = &d->trees[k];
         if (t->num_nodes > 0x7fffffffu - nn || t->num_tris > 0x7fffffffu - nt) return 0;
@@ -274,20 +274,15 @@ static int pack(evr_gpu_deform *d)
     for (k = 0, nn = 0, nt = 0; k < d->num; k++) {
         const evr_gpu_dtree *t = &d->trees[k];
         d->root[k] = t->num_nodes ? (int32_t)nn : -1;
-        if (d->layout == EVR_GPU_LAYOUT_CW8) {
-            for (i = 0; i < t->num_nodes; i++) {
-                evr_gpu_node8 n = t->nodes8[i];
-                n.child_base += nn;
-                n.item_base += nt;
-                d->nodes8[nn + i] = n;
-            }
-        } else {
-            for (i = 0; i < t->num_nodes; i++) {
-                evr_gpu_node4 n = t->nodes4[i];
-                for (j = 0; j < 4; j++)
-                    if (n.child[j] >= 0) n.child[j] += (int32_t)(n.count[j] ? nt : nn);
-                d->nodes4[nn + i] = n;
-            }
+        if (t->num_nodes) {
+            void *to = d->layout == EVR_GPU_LAYOUT_CW8 ? (void *)(d->nodes8 + nn)
+                                                       : (void *)(d->nodes4 + nn);
+            memcpy(to,
+                   d->layout == EVR_GPU_LAYOUT_CW8 ? (const void *)t->nodes8
+                                                   : (const void *)t->nodes4,
+                   (d->layout == EVR_GPU_LAYOUT_CW8 ? sizeof *t->nodes8 : sizeof *t->nodes4) *
+                       t->num_nodes);
+            evr_gpu_tree_relocate(d->layout, to, t->num_nodes, nn, nt);
         }
         if (t->num_tris) memcpy(d->tris + nt, t->tris, sizeof *t->tris * t->num_tris);
         nn += t->num_nodes;

@@ -85,6 +85,9 @@ evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimiti
 /* Room for `nodes` more nodes and `items` more triangles in c's arrays (its counts unchanged);
  * 0: out of memory. */
 int evr_gpu_tree_reserve(flat_ctx *c, uint32_t nodes, uint32_t items);
+/* Moves the child and item indices of a tree's nodes [0, nn) (evr_gpu_node8 or evr_gpu_node4
+ * by layout) by dn and di: where its nodes and items start in the arrays it moves into. */
+void evr_gpu_tree_relocate(int layout, void *nodes, uint32_t nn, int64_t dn, int64_t di);
 /* gpu_bvh_cache.c. The key of a group's tree: its build's inputs in c (tri9, tri_prim, tri_inst,
  * tri_filter of n triangles, the layout) and settings (spatial splits or not, the largest leaf). */
 void evr_gpu_cache_key(const flat_ctx *c, size_t n, int high, unsigned max_leaf, uint8_t key[16]);

@@ -200,6 +200,22 @@ int evr_gpu_tree_reserve(flat_ctx *c, uint32_t nodes, uint32_t items)
     return 1;
 }
 
+void evr_gpu_tree_relocate(int layout, void *nodes, uint32_t nn, int64_t dn, int64_t di)
+{
+    for (uint32_t i = 0; i < nn; i++) {
+        if (layout == EVR_GPU_LAYOUT_CW8) {
+            evr_gpu_node8 *nd = (evr_gpu_node8 *)nodes + i;
+            nd->child_base = (uint32_t)(nd->child_base + dn);
+            nd->item_base = (uint32_t)(nd->item_base + di);
+        } else {
+            evr_gpu_node4 *nd = (evr_gpu_node4 *)nodes + i;
+            for (int j = 0; j < 4; j++)
+                if (nd->child[j] >= 0)
+                    nd->child[j] = (int32_t)(nd->child[j] + (nd->count[j] ? di : dn));
+        }
+    }
+}
+
 static int push_work(flat_ctx *c, const void *ptr, uint32_t index)
 {
     if (c->num_work == c->cap_work) {
