@@ -1,7 +1,8 @@
 /* The GPU BVH cache (src/cuda/gpu_bvh_cache.h), on the host: a tree loaded from the folder is the
  * built tree bit for bit (nodes, triangles, roots, stacks, bounds) for both node layouts; a
  * changed mesh misses and is built; a damaged file (a flipped byte, cut short, an index out of
- * range under a valid checksum) is built again and replaced, with a note; a folder that cannot
+ * range under a valid checksum) is built again and replaced, with a note, and a FIFO in a tree's
+ * place is not read (it would block the build) and is replaced; a folder that cannot
  * be made leaves a note and the build goes on; the folder is held to its bound. Every tree of
  * the demo scenes is kept here (min_tris 0); the CUDA backend keeps only big ones. */
 #include "check.h"
@@ -235,6 +236,21 @@ int main(void)
             c = build(s, 0, sub, 0, &ref);
             CHECK(c.stored == 0 && c.loaded == 0 && strstr(c.note, "cannot make the folder"));
             printf("note: %s\n", c.note);
+            /* a FIFO in a tree's place is not read (it would block), and is replaced */
+            {
+                char largest[4096] = "";
+                long long bytes;
+                clear_dir(dir);
+                build(s, 0, dir, 0, &ref);
+                CHECK(list_trees(dir, &bytes, largest, sizeof largest) >= 1);
+                CHECK(unlink(largest) == 0 && mkfifo(largest, 0600) == 0);
+                c = build(s, 0, dir, 0, &ref);
+                CHECK(strstr(c.note, "cannot read") && strstr(c.note, "FIFO"));
+                CHECK(c.stored == 1 && c.loaded == ref.num_trees - 1);
+                c = build(s, 0, dir, 0, &ref);
+                CHECK(c.loaded == ref.num_trees && !c.note[0]);
+                printf("note: %s\n", c.note[0] ? c.note : "(none on the next run)");
+            }
             evr_gpu_bvh_free(&ref);
             evr_scene_release(s);
         }

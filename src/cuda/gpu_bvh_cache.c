@@ -2,6 +2,7 @@
 #include "cuda/gpu_bvh_cache.h"
 #include "cuda/gpu_bvh_code.h" /* generated: EVR_GPU_BVH_CODE, a hash of the builder's sources */
 #include "cuda/gpu_bvh_internal.h"
+#include "io/file_read.h"
 #include "io/mkdir_p.h"
 
 #include <dirent.h>
@@ -117,15 +118,15 @@ int evr_gpu_cache_load(evr_gpu_bvh_cache *cache, const uint8_t key[16], flat_ctx
     file_header h;
     FILE *f;
     struct stat sb;
-    const size_t node_bytes =
-        c->layout == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4);
+    const size_t node_bytes = evr_gpu_node_size(c->layout);
     void *nodes;
-    const char *bad = NULL;
+    const char *bad = NULL, *why = NULL;
     key_path(cache, key, path, sizeof path);
-    f = fopen(path, "rb");
+    errno = 0;
+    f = evr_fopen_regular(path, &why); /* a FIFO in its place would block the read */
     if (!f) {
         /* none yet, or no folder (which writing it says) */
-        if (errno != ENOENT && errno != ENOTDIR) note(cache, "cannot read", path, strerror(errno));
+        if (errno != ENOENT && errno != ENOTDIR) note(cache, "cannot read", path, why);
         return 0;
     }
     if (fread(&h, sizeof h, 1, f) != 1 || fstat(fileno(f), &sb) != 0) {
@@ -225,8 +226,7 @@ void evr_gpu_cache_store(evr_gpu_bvh_cache *cache, const uint8_t key[16], const 
                          uint32_t first_node, uint32_t first_item)
 {
     char path[4096], tmp[4200];
-    const size_t node_bytes =
-        c->layout == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4);
+    const size_t node_bytes = evr_gpu_node_size(c->layout);
     file_header h;
     const uint32_t nn = c->num_nodes - first_node, ni = c->num_items - first_item;
     const evr_gpu_tri *items = c->tris + first_item;

@@ -280,8 +280,7 @@ static int pack(evr_gpu_deform *d)
             memcpy(to,
                    d->layout == EVR_GPU_LAYOUT_CW8 ? (const void *)t->nodes8
                                                    : (const void *)t->nodes4,
-                   (d->layout == EVR_GPU_LAYOUT_CW8 ? sizeof *t->nodes8 : sizeof *t->nodes4) *
-                       t->num_nodes);
+                   evr_gpu_node_size(d->layout) * t->num_nodes);
             evr_gpu_tree_relocate(d->layout, to, t->num_nodes, nn, nt);
         }
         if (t->num_tris) memcpy(d->tris + nt, t->tris, sizeof *t->tris * t->num_tris);

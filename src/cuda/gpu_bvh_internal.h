@@ -82,6 +82,11 @@ evr_status evr_gpu_tree_build(RTCDevice dev, flat_ctx *c, struct RTCBuildPrimiti
                               size_t cap, enum RTCBuildQuality quality, unsigned max_leaf,
                               split_source *split, const float root_box[6], uint32_t *root_index,
                               evr_error *err);
+/* The size of a node of the layout. */
+static inline size_t evr_gpu_node_size(int layout)
+{
+    return layout == EVR_GPU_LAYOUT_CW8 ? sizeof(evr_gpu_node8) : sizeof(evr_gpu_node4);
+}
 /* Room for `nodes` more nodes and `items` more triangles in c's arrays (its counts unchanged);
  * 0: out of memory. */
 int evr_gpu_tree_reserve(flat_ctx *c, uint32_t nodes, uint32_t items);
