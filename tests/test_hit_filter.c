@@ -235,7 +235,7 @@ static void test_layout(int layout, const char *what)
                 const float x = -1.0f + (2.0f * (float)i + 1.0f) / 192.0f,
                             y = -0.5f + ((float)j + 0.5f) / 96.0f;
                 evr_ray ray;
-                evr_gpu_hit h;
+                evr_gpu_hit h = {0}; /* written on a hit only */
                 int want = expect_camera(x, y, t), got;
                 ray.org = evr_v3_make(0, 0, 0);
                 ray.dir = evr_v3_norm(evr_v3_make(x, y, -1));

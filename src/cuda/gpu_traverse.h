@@ -21,18 +21,18 @@
  * triangle carries its mesh's filter bits) are passed over where they are met, and the search
  * goes on behind them (a shadow ray's too). Whether a scene has deforming groups or such meshes
  * at all is a constant of the search (`general`; on the device a bit of the kernel's LAYOUT,
- * EVR_GPU_TRACE_GENERAL): without them the search is the very code it was before deforming
- * meshes, instruction for instruction (nvdisasm, sm_90). Any trace of them in that code changed
- * the eye's render kernel's registers and spills (a branch per group entered, a call to a
- * search of their own inside or after this one, even passing a triangle's vertices by pointer
- * instead of the record); so the CUDA kernels come in both kinds, and the general kind checks
- * each group it enters and, where the scene has filtered meshes, each hit's filter bits. One
- * general kind for both keeps the number of kernel instantiations (cuda_render.cu's compile
- * time) as it was; a scene with deforming meshes but no filtered ones pays a test of a null
- * pointer per hit. One source serves both, inlined with the constants folded
- * (EVR__ALWAYS_INLINE). Triangles are intersected with the
- * watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge or vertex
- * hits at least one of the triangles. Its edge functions must be evaluated without fused
+ * EVR_GPU_TRACE_GENERAL): without them the search holds no trace of them. Any trace of them
+ * in that code changed the eye's render kernel's registers and spills (a branch per group
+ * entered, a call to a search of their own inside or after this one, even passing a
+ * triangle's vertices by pointer instead of the record); so the CUDA kernels come in both
+ * kinds, and the general kind checks each group it enters and, where the scene has filtered
+ * meshes, each hit's filter bits, and searches a deforming group's tree out of line
+ * (evr__blas_deform). One general kind for both keeps the number of kernel instantiations
+ * (cuda_render.cu's compile time) as it was; a scene with deforming meshes but no filtered
+ * ones pays a test of a null pointer per hit. One source serves both, inlined with the
+ * constants folded (EVR__ALWAYS_INLINE), the node layout among them. Triangles are intersected
+ * with the watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through a shared edge
+ * or vertex hits at least one of the triangles. Its edge functions must be evaluated without fused
  * multiply-adds (exactly antisymmetric): on the device through __fmul_rn/__fsub_rn, on the host
  * by the C compiler's default (ISO C mode, -ffp-contract=off); do not build this with
  * -ffast-math. Box tests widen their far distances by 1 + 2 gamma(3) (Ize 2013, pbrt), which
@@ -340,17 +340,17 @@ typedef struct {
 
 /* core/hit_filter.h's test, out of line on the device: inlined into each of the search's leaf
  * loops it made the general kernels' traversal three times longer (PTX), and the instruction
- * cache is what the traversal stalls on (cuda_trace.cuh). */
+ * cache is what the traversal stalls on (cuda_trace.cuh). fs by address: what it alone reads
+ * stays in memory, not in the search's registers. */
 #ifdef __CUDACC__
 #define EVR__NOINLINE __noinline__
 #else
 #define EVR__NOINLINE __attribute__((noinline))
 #endif
-EVR_HD static EVR__NOINLINE int evr__hit_filtered(const evr_render_scene *rs, int inst,
-                                                  uint32_t prim, float u, float v, evr_v3 dir,
-                                                  float f, int shadow)
+EVR_HD static EVR__NOINLINE int evr__hit_filtered(const evr__filter_src *fs, int inst,
+                                                  uint32_t prim, float u, float v)
 {
-    return evr_hit_filtered(rs, inst, prim, u, v, dir, 0, f, shadow);
+    return evr_hit_filtered(fs->rs, inst, prim, u, v, fs->dir, 0, fs->f, fs->shadow);
 }
 
 /* Whether the hit at (u, v) of leaf item i is ruled out; never without fs (the rigid search,
@@ -373,7 +373,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__leaf_filtered(const evr_gpu_tri *tris,
         inst = fs->instance_base + tris[i].instance;
         prim = tris[i].prim;
     }
-    return evr__hit_filtered(fs->rs, inst, prim, u, v, fs->dir, fs->f, fs->shadow);
+    return evr__hit_filtered(fs, inst, prim, u, v);
 }
 
 /* The triangle and instance fields of a leaf item that was hit (read only then). */
@@ -624,16 +624,42 @@ evr__blas8(const evr_gpu_node8 *nodes, const evr_gpu_tri *tris, int root, const 
 
 /* ---- groups ---- */
 
+/* A deforming group's tree (the general search only), out of line: inlined, its vertices'
+ * interpolation doubled the general search's code and raised its register spills. */
+EVR_HD static EVR__NOINLINE int
+evr__blas_deform(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
+                 const evr__tray *r, float f, float tnear, float *tfar, int any,
+                 evr__stack_entry *stack, int sp, evr__tri_hit *th, const evr__filter_src *fs)
+{
+    evr__deform_src ds;
+    evr__filter_src fsrc;
+    ds.tris = v->dtris;
+    ds.view = rs->deforms[rs->instances[in->instance_base].deform];
+    ds.fr = evr_key_interval(ds.view.num_keys, f, &ds.a);
+    if (fs) {
+        fsrc = *fs;
+        fsrc.dbits = (uint32_t)rs->meshes[rs->instances[in->instance_base].mesh].filter & fsrc.bits;
+        fs = &fsrc;
+    }
+    if (v->layout == EVR_GPU_LAYOUT_CW8)
+        return evr__blas8(v->dnodes8, v->tris, -1 - in->root, r, tnear, tfar, any, stack, sp, th,
+                          &ds, fs);
+    return evr__blas4(v->dnodes4, v->tris, -1 - in->root, r, tnear, tfar, any, stack, sp, th, &ds,
+                      fs);
+}
+
 /* Searches one group with the world ray (o, d) at time f; on a (nearer) hit shrinks *tfar
  * and fills hit (when not NULL). general (a constant where inlined): the general search: the
  * group may be a deforming one (root < 0: its tree in the deforming arrays, its vertices the
  * segment's keys at time f), and where the scene has meshes whose hits a material may rule out
  * (v->filtered), their hits are tested (core/hit_filter.h) and a ruled-out one is passed over:
- * the search goes on behind it, a shadow ray's too. */
+ * the search goes on behind it, a shadow ray's too. layout: the trees' node layout, the top
+ * level's, a constant where inlined (read from the view, it put both layouts' searches in
+ * every top-level search). */
 EVR_HD static EVR__ALWAYS_INLINE int
 evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr_gpu_inst *in,
               evr_v3 o, evr_v3 d, float f, float tnear, float *tfar, int any,
-              evr__stack_entry *stack, int sp, evr_gpu_hit *hit, int general)
+              evr__stack_entry *stack, int sp, evr_gpu_hit *hit, int general, int layout)
 {
     evr_m34 inv;
     evr_v3 oo, od;
@@ -666,20 +692,8 @@ evr__instance(const evr_gpu_scene_view *v, const evr_render_scene *rs, const evr
         fs = &fsrc;
     }
     if (general && in->root < 0) {
-        evr__deform_src ds;
-        ds.tris = v->dtris;
-        ds.view = rs->deforms[rs->instances[in->instance_base].deform];
-        ds.fr = evr_key_interval(ds.view.num_keys, f, &ds.a);
-        if (fs)
-            fsrc.dbits =
-                (uint32_t)rs->meshes[rs->instances[in->instance_base].mesh].filter & fsrc.bits;
-        if (v->layout == EVR_GPU_LAYOUT_CW8)
-            found = evr__blas8(v->dnodes8, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
-                               &th, &ds, fs);
-        else
-            found = evr__blas4(v->dnodes4, v->tris, -1 - in->root, &r, tnear, tfar, any, stack, sp,
-                               &th, &ds, fs);
-    } else if (v->layout == EVR_GPU_LAYOUT_CW8) {
+        found = evr__blas_deform(v, rs, in, &r, f, tnear, tfar, any, stack, sp, &th, fs);
+    } else if (layout == EVR_GPU_LAYOUT_CW8) {
         found = evr__blas8(v->nodes8, v->tris, in->root, &r, tnear, tfar, any, stack, sp, &th,
                            (const evr__deform_src *)0, fs);
     } else {
@@ -728,7 +742,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace4(const evr_gpu_scene_view *v,
             for (k = 0; k < lc[i]; k++) {
                 if (evr__group_skipped(&v->insts[(uint32_t)lf[i] + k], groups)) continue;
                 if (evr__instance(v, rs, &v->insts[(uint32_t)lf[i] + k], ray.org, ray.dir, f, tnear,
-                                  &tfar, any, stack, sp, hit, general)) {
+                                  &tfar, any, stack, sp, hit, general, EVR_GPU_LAYOUT_BVH4)) {
                     found = 1;
                     if (any) return 1;
                 }
@@ -784,7 +798,7 @@ EVR_HD static EVR__ALWAYS_INLINE int evr__trace8(const evr_gpu_scene_view *v,
             if (evr__group_skipped(&v->insts[tg_base + (uint32_t)bit], groups)) continue;
             EVR__STAT(groups);
             if (evr__instance(v, rs, &v->insts[tg_base + (uint32_t)bit], ray.org, ray.dir, f, tnear,
-                              &tfar, any, stack, sp, hit, general)) {
+                              &tfar, any, stack, sp, hit, general, EVR_GPU_LAYOUT_CW8)) {
                 found = 1;
                 if (any) return 1;
             }
