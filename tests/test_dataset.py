@@ -45,8 +45,13 @@ def slow_evray(tmp, evray):
 
 
 def manifest(d):
+    """The manifest's rows; a last line still being written (read while a run appends it, so
+    without its newline yet) is left out, as evray.dataset.read_manifest leaves it out."""
     path = os.path.join(d, "manifest.jsonl")
-    return [json.loads(l) for l in open(path)] if os.path.exists(path) else []
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [json.loads(l) for l in f if l.endswith("\n")]
 
 
 def latest(d):
